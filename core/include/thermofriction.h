@@ -1,0 +1,9 @@
+/* thermofriction C core: everything in one include. */
+#ifndef THERMOFRICTION_H
+#define THERMOFRICTION_H
+#include "thermofriction/waveform.h"
+#include "thermofriction/thermal.h"
+#include "thermofriction/friction.h"
+#include "thermofriction/plant.h"
+#include "thermofriction/integrator.h"
+#endif

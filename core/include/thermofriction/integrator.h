@@ -1,0 +1,66 @@
+/* Adaptive integrators with dense output: Dormand-Prince 5(4) (explicit) and Rodas4
+ * (Rosenbrock, L-stable, for stiff problems), behind one driver that stops at every corner
+ * of the input and writes results on a caller's output grid. */
+#ifndef THERMOFRICTION_INTEGRATOR_H
+#define THERMOFRICTION_INTEGRATOR_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    int n;
+    void *ctx;
+    int (*rhs)(double t, const double *y, double *dy, void *ctx);
+    int (*jac)(double t, const double *y, double *J, void *ctx); /* row-major n x n */
+    double (*next_corner)(double t, void *ctx);                  /* may be NULL */
+} tf_ode;
+
+typedef enum {
+    TF_METHOD_AUTO = 0,   /* Dormand-Prince until it detects stiffness, then Rodas4 */
+    TF_METHOD_DOPRI5 = 1,
+    TF_METHOD_RODAS4 = 2
+} tf_method;
+
+typedef struct {
+    int method;
+    double rtol;
+    const double *atol; /* n values */
+    double h0;          /* first step; <= 0: chosen automatically */
+    double hmax;        /* <= 0: unlimited */
+    long max_steps;
+} tf_solver_options;
+
+typedef enum {
+    TF_OK = 0,
+    TF_ERR_NONFINITE = 1,      /* NaN or infinite state or derivative */
+    TF_ERR_STEP_UNDERFLOW = 2,
+    TF_ERR_MAX_STEPS = 3,
+    TF_ERR_BAD_ARGUMENT = 4,
+    TF_ERR_NO_MEMORY = 5
+} tf_status;
+
+typedef struct {
+    long steps, rejected, rhs_evals, jac_evals, decompositions;
+    int method_used;     /* the method at the end (AUTO may switch) */
+    double switch_time;  /* when AUTO switched to Rodas4; -1 if it did not */
+    int stiff_suspected; /* explicit method saw stiffness */
+    /* on failure: */
+    int status;
+    double t_fail, h_fail;
+} tf_solver_stats;
+
+/* Writes one output sample: index into the grid, its time and the state there. */
+typedef void (*tf_emit_fn)(long i, double t, const double *y, void *ctx);
+
+/* Integrates from (t_out[0], y0) through t_out[n_out-1]; y0 is overwritten by the final
+ * state (or the state at failure). t_out must be non-decreasing. Returns a tf_status. */
+int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
+             double *y0, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *stats);
+
+const char *tf_status_message(int status);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

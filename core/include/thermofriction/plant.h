@@ -1,0 +1,86 @@
+/* Plants (SPEC 3) assembled with a friction model, its thermal extension, an input waveform
+ * and a temperature signal into one ODE system: right-hand side, analytic Jacobian, outputs. */
+#ifndef THERMOFRICTION_PLANT_H
+#define THERMOFRICTION_PLANT_H
+
+#include "friction.h"
+#include "thermal.h"
+#include "waveform.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    TF_PLANT_STICK_SLIP = 0 /* SPEC 3.1: states x_p, v_p, x_e, v_e, then friction states */
+} tf_plant_kind;
+
+/* Output channels, in this order, then the friction states. */
+typedef enum {
+    TF_OUT_TIME = 0,
+    TF_OUT_INPUT,
+    TF_OUT_STAGE_DISPLACEMENT,
+    TF_OUT_STAGE_VELOCITY,
+    TF_OUT_DISPLACEMENT,          /* driven body: end effector */
+    TF_OUT_VELOCITY,
+    TF_OUT_RELATIVE_DISPLACEMENT, /* x_e - x_p */
+    TF_OUT_RELATIVE_VELOCITY,     /* v_r = v_e - v_p */
+    TF_OUT_FRICTION_FORCE,        /* F', the force resisting sliding (after the thermal model) */
+    TF_OUT_TEMPERATURE,
+    TF_OUT_NFIXED
+} tf_output_channel;
+
+typedef struct {
+    int plant;
+    /* stick-slip, physical form: m x_p'' + c x_p' + k x_p = T_em u + F ; m_e x_e'' = -F */
+    double m, c, k, T_em, m_e;
+
+    int friction;               /* tf_friction_kind */
+    double p[TF_NPARAM];        /* parameters (temperature-independent values) */
+
+    int thermal;                /* tf_thermal_kind */
+    tf_law law[TF_NPARAM];      /* Model I: TF_LAW_NONE keeps p[i] */
+    tf_law dF;                  /* Model II thermal-induced friction [N] */
+    int dF_form;                /* tf_df_form */
+
+    tf_waveform input;          /* voltage u(t) [V] */
+
+    /* Temperature [degC]: constant T_const, or sampled (T_n > 1) with linear interpolation. */
+    double T_const;
+    int T_n;
+    const double *T_t, *T_v;
+
+    /* Parameters at the last temperature seen, so a constant temperature costs no law
+     * evaluations per step. Zero-initialise the struct (or call tf_model_prepare). */
+    int cache_valid;
+    double cache_T, cache_p[TF_NPARAM], cache_lambda, cache_dF;
+} tf_model;
+
+/* Invalidate the cached parameters after changing a model's fields. */
+void tf_model_prepare(tf_model *model);
+
+int tf_model_nstate(const tf_model *model);
+int tf_model_noutput(const tf_model *model);
+double tf_model_temperature(const tf_model *model, double t);
+/* Parameters at temperature T (Model I laws applied). */
+void tf_model_params_at(const tf_model *model, double T, double *p);
+/* The thermal factor lambda(T) of Model II's scale form (1 otherwise). */
+double tf_model_lambda(const tf_model *model, double T);
+/* Friction force F' at (t, state). */
+double tf_model_friction(const tf_model *model, double t, const double *y);
+void tf_model_initial_state(const tf_model *model, double *y);
+/* Characteristic magnitude of each state, for default absolute tolerances. */
+void tf_model_state_scale(const tf_model *model, double *scale);
+
+int tf_model_rhs(double t, const double *y, double *dy, void *model);
+/* Jacobian d(rhs)/dy, row-major n x n. */
+int tf_model_jac(double t, const double *y, double *J, void *model);
+/* Earliest time after t where the input or the temperature signal has a corner. */
+double tf_model_next_corner(double t, void *model);
+/* Writes the output channels at (t, y). */
+void tf_model_outputs(const tf_model *model, double t, const double *y, double *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,460 @@
+/* Adaptive integrators with dense output, behind one corner-aware driver.
+ *
+ * DOPRI5: Dormand & Prince 5(4), FSAL, PI step control, Hairer's 4th-order continuous
+ *   extension and stiffness detection (Hairer & Wanner, Solving ODEs I, II.4-II.6).
+ * RODAS4: Hairer & Wanner's 6-stage Rosenbrock method of order 4(3), L-stable and stiffly
+ *   accurate, with its 3rd-order dense output (Solving ODEs II, IV.7), analytic state
+ *   Jacobian, predictive (Gustafsson) step control.
+ * AUTO: DOPRI5 until its stiffness test fires (15 of the last steps near the stability
+ *   boundary), then RODAS4 for the rest of the run. */
+#include "thermofriction/integrator.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- Dormand-Prince 5(4) ---- */
+static const double
+    dp_c2 = 1.0 / 5, dp_c3 = 3.0 / 10, dp_c4 = 4.0 / 5, dp_c5 = 8.0 / 9,
+    dp_a21 = 1.0 / 5,
+    dp_a31 = 3.0 / 40, dp_a32 = 9.0 / 40,
+    dp_a41 = 44.0 / 45, dp_a42 = -56.0 / 15, dp_a43 = 32.0 / 9,
+    dp_a51 = 19372.0 / 6561, dp_a52 = -25360.0 / 2187, dp_a53 = 64448.0 / 6561, dp_a54 = -212.0 / 729,
+    dp_a61 = 9017.0 / 3168, dp_a62 = -355.0 / 33, dp_a63 = 46732.0 / 5247, dp_a64 = 49.0 / 176,
+    dp_a65 = -5103.0 / 18656,
+    dp_a71 = 35.0 / 384, dp_a73 = 500.0 / 1113, dp_a74 = 125.0 / 192, dp_a75 = -2187.0 / 6784,
+    dp_a76 = 11.0 / 84,
+    dp_e1 = 71.0 / 57600, dp_e3 = -71.0 / 16695, dp_e4 = 71.0 / 1920, dp_e5 = -17253.0 / 339200,
+    dp_e6 = 22.0 / 525, dp_e7 = -1.0 / 40,
+    dp_d1 = -12715105075.0 / 11282082432.0, dp_d3 = 87487479700.0 / 32700410799.0,
+    dp_d4 = -10690763975.0 / 1880347072.0, dp_d5 = 701980252875.0 / 199316789632.0,
+    dp_d6 = -1453857185.0 / 822651844.0, dp_d7 = 69997945.0 / 29380423.0;
+
+/* ---- Rodas4 (Hairer & Wanner, METH = 1) ---- */
+static const double
+    ro_gamma = 0.25,
+    ro_c2 = 0.386, ro_c3 = 0.21, ro_c4 = 0.63,
+    ro_g1 = 0.25, ro_g2 = -0.1043, ro_g3 = 0.1035, ro_g4 = -0.3620000000000023e-01,
+    ro_a21 = 0.1544000000000000e+01,
+    ro_a31 = 0.9466785280815826e+00, ro_a32 = 0.2557011698983284e+00,
+    ro_a41 = 0.3314825187068521e+01, ro_a42 = 0.2896124015972201e+01, ro_a43 = 0.9986419139977817e+00,
+    ro_a51 = 0.1221224509226641e+01, ro_a52 = 0.6019134481288629e+01, ro_a53 = 0.1253708332932087e+02,
+    ro_a54 = -0.6878860361058950e+00,
+    ro_c21 = -0.5668800000000000e+01,
+    ro_c31 = -0.2430093356833875e+01, ro_c32 = -0.2063599157091915e+00,
+    ro_c41 = -0.1073529058151375e+00, ro_c42 = -0.9594562251023355e+01, ro_c43 = -0.2047028614809616e+02,
+    ro_c51 = 0.7496443313967647e+01, ro_c52 = -0.1024680431464352e+02, ro_c53 = -0.3399990352819905e+02,
+    ro_c54 = 0.1170890893206160e+02,
+    ro_c61 = 0.8083246795921522e+01, ro_c62 = -0.7981132988064893e+01, ro_c63 = -0.3152159432874371e+02,
+    ro_c64 = 0.1631930543123136e+02, ro_c65 = -0.6058818238834054e+01,
+    ro_d21 = 0.1012623508344586e+02, ro_d22 = -0.7487995877610167e+01, ro_d23 = -0.3480091861555747e+02,
+    ro_d24 = -0.7992771707568823e+01, ro_d25 = 0.1025137723295662e+01,
+    ro_d31 = -0.6762803392801253e+00, ro_d32 = 0.6087714651680015e+01, ro_d33 = 0.1643084320892478e+02,
+    ro_d34 = 0.2476722511418386e+02, ro_d35 = -0.6594389125716872e+01;
+
+typedef struct {
+    const tf_ode *ode;
+    const tf_solver_options *opt;
+    tf_solver_stats *st;
+    int n;
+    double *k[7], *ytmp, *y1, *ysti, *ft, *cont[5], *J, *W;
+    int *piv;
+    double t_clamp; /* stages never look past the corner that ends the segment */
+    double *block; /* one allocation for all of the above */
+} work;
+
+static int rhs(work *w, double t, const double *y, double *dy)
+{
+    w->st->rhs_evals++;
+    /* A stage at the end of a segment sees the waveform's left limit, so that a jump at a
+     * corner (an ideal step) belongs to the next segment only. */
+    if (t > w->t_clamp) t = w->t_clamp;
+    if (w->ode->rhs(t, y, dy, w->ode->ctx)) return 1;
+    for (int i = 0; i < w->n; i++)
+        if (!isfinite(dy[i])) return 1;
+    return 0;
+}
+
+static double wnorm(const work *w, const double *e, const double *ya, const double *yb)
+{
+    double s = 0.0;
+    for (int i = 0; i < w->n; i++) {
+        double sk = w->opt->atol[i] + w->opt->rtol * fmax(fabs(ya[i]), fabs(yb[i]));
+        double r = e[i] / sk;
+        s += r * r;
+    }
+    return sqrt(s / w->n);
+}
+
+static int all_finite(const double *v, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+/* ---- dense LU with partial pivoting, for the small systems of a Rosenbrock stage ---- */
+static int lu_factor(double *A, int n, int *piv)
+{
+    for (int k = 0; k < n; k++) {
+        int p = k;
+        double big = fabs(A[k * n + k]);
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > big) { big = fabs(A[i * n + k]); p = i; }
+        piv[k] = p;
+        if (big == 0.0 || !isfinite(big)) return 1;
+        if (p != k)
+            for (int j = 0; j < n; j++) { double tmp = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = tmp; }
+        double inv = 1.0 / A[k * n + k];
+        for (int i = k + 1; i < n; i++) {
+            double l = A[i * n + k] *= inv;
+            if (l != 0.0)
+                for (int j = k + 1; j < n; j++) A[i * n + j] -= l * A[k * n + j];
+        }
+    }
+    return 0;
+}
+
+static void lu_solve(const double *A, int n, const int *piv, double *b)
+{
+    for (int k = 0; k < n; k++) {
+        if (piv[k] != k) { double tmp = b[k]; b[k] = b[piv[k]]; b[piv[k]] = tmp; }
+        for (int i = k + 1; i < n; i++) b[i] -= A[i * n + k] * b[k];
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double s = b[i];
+        for (int j = i + 1; j < n; j++) s -= A[i * n + j] * b[j];
+        b[i] = s / A[i * n + i];
+    }
+}
+
+/* ---- one attempted step of each method: y1, dense coefficients; returns the error norm,
+ *      or a negative value when the step produced non-finite numbers ---- */
+static double dopri5_step(work *w, double t, double h, const double *y, const double *f0)
+{
+    int n = w->n, i;
+    double **k = w->k, *yt = w->ytmp, *y1 = w->y1;
+    memcpy(k[0], f0, sizeof(double) * n);
+    for (i = 0; i < n; i++) yt[i] = y[i] + h * dp_a21 * k[0][i];
+    if (rhs(w, t + dp_c2 * h, yt, k[1])) return -1;
+    for (i = 0; i < n; i++) yt[i] = y[i] + h * (dp_a31 * k[0][i] + dp_a32 * k[1][i]);
+    if (rhs(w, t + dp_c3 * h, yt, k[2])) return -1;
+    for (i = 0; i < n; i++) yt[i] = y[i] + h * (dp_a41 * k[0][i] + dp_a42 * k[1][i] + dp_a43 * k[2][i]);
+    if (rhs(w, t + dp_c4 * h, yt, k[3])) return -1;
+    for (i = 0; i < n; i++)
+        yt[i] = y[i] + h * (dp_a51 * k[0][i] + dp_a52 * k[1][i] + dp_a53 * k[2][i] + dp_a54 * k[3][i]);
+    if (rhs(w, t + dp_c5 * h, yt, k[4])) return -1;
+    for (i = 0; i < n; i++)
+        w->ysti[i] = y[i] + h * (dp_a61 * k[0][i] + dp_a62 * k[1][i] + dp_a63 * k[2][i] +
+                                 dp_a64 * k[3][i] + dp_a65 * k[4][i]);
+    if (rhs(w, t + h, w->ysti, k[5])) return -1;
+    for (i = 0; i < n; i++)
+        y1[i] = y[i] + h * (dp_a71 * k[0][i] + dp_a73 * k[2][i] + dp_a74 * k[3][i] +
+                            dp_a75 * k[4][i] + dp_a76 * k[5][i]);
+    if (rhs(w, t + h, y1, k[6])) return -1;
+    for (i = 0; i < n; i++)
+        yt[i] = h * (dp_e1 * k[0][i] + dp_e3 * k[2][i] + dp_e4 * k[3][i] + dp_e5 * k[4][i] +
+                     dp_e6 * k[5][i] + dp_e7 * k[6][i]);
+    double err = wnorm(w, yt, y, y1);
+    if (!isfinite(err) || !all_finite(y1, n)) return -1;
+    for (i = 0; i < n; i++) {
+        double dy = y1[i] - y[i], bspl = h * k[0][i] - dy;
+        w->cont[0][i] = y[i];
+        w->cont[1][i] = dy;
+        w->cont[2][i] = bspl;
+        w->cont[3][i] = dy - h * k[6][i] - bspl;
+        w->cont[4][i] = h * (dp_d1 * k[0][i] + dp_d3 * k[2][i] + dp_d4 * k[3][i] + dp_d5 * k[4][i] +
+                             dp_d6 * k[5][i] + dp_d7 * k[6][i]);
+    }
+    return err;
+}
+
+static void dopri5_dense(const work *w, double s, double *y)
+{
+    double s1 = 1.0 - s;
+    for (int i = 0; i < w->n; i++)
+        y[i] = w->cont[0][i] +
+               s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * (w->cont[3][i] + s1 * w->cont[4][i])));
+}
+
+/* Time derivative of f at (t, y), one-sided within [t, t_end] (the segment has no corner). */
+static int time_derivative(work *w, double t, double t_end, const double *y, const double *f0, double *ft)
+{
+    double dt = sqrt(DBL_EPSILON) * fmax(fabs(t), 1e-6);
+    if (t + dt > t_end) dt = -dt;
+    if (rhs(w, t + dt, y, ft)) return 1;
+    for (int i = 0; i < w->n; i++) ft[i] = (ft[i] - f0[i]) / dt;
+    return 0;
+}
+
+/* Returns the error norm; -1 for non-finite numbers, -2 for a singular iteration matrix. */
+static double rodas4_step(work *w, double t, double h, const double *y, const double *f0)
+{
+    int n = w->n, i;
+    double **k = w->k, *yt = w->ytmp, *fs = w->k[6], *ft = w->ft;
+    double *W = w->W;
+    for (i = 0; i < n * n; i++) W[i] = -w->J[i];
+    for (i = 0; i < n; i++) W[i * n + i] += 1.0 / (ro_gamma * h);
+    w->st->decompositions++;
+    if (lu_factor(W, n, w->piv)) return -2;
+
+    for (i = 0; i < n; i++) k[0][i] = f0[i] + h * ro_g1 * ft[i];
+    lu_solve(W, n, w->piv, k[0]);
+
+    for (i = 0; i < n; i++) yt[i] = y[i] + ro_a21 * k[0][i];
+    if (rhs(w, t + ro_c2 * h, yt, fs)) return -1;
+    for (i = 0; i < n; i++) k[1][i] = fs[i] + h * ro_g2 * ft[i] + ro_c21 * k[0][i] / h;
+    lu_solve(W, n, w->piv, k[1]);
+
+    for (i = 0; i < n; i++) yt[i] = y[i] + ro_a31 * k[0][i] + ro_a32 * k[1][i];
+    if (rhs(w, t + ro_c3 * h, yt, fs)) return -1;
+    for (i = 0; i < n; i++) k[2][i] = fs[i] + h * ro_g3 * ft[i] + (ro_c31 * k[0][i] + ro_c32 * k[1][i]) / h;
+    lu_solve(W, n, w->piv, k[2]);
+
+    for (i = 0; i < n; i++) yt[i] = y[i] + ro_a41 * k[0][i] + ro_a42 * k[1][i] + ro_a43 * k[2][i];
+    if (rhs(w, t + ro_c4 * h, yt, fs)) return -1;
+    for (i = 0; i < n; i++)
+        k[3][i] = fs[i] + h * ro_g4 * ft[i] + (ro_c41 * k[0][i] + ro_c42 * k[1][i] + ro_c43 * k[2][i]) / h;
+    lu_solve(W, n, w->piv, k[3]);
+
+    for (i = 0; i < n; i++)
+        yt[i] = y[i] + ro_a51 * k[0][i] + ro_a52 * k[1][i] + ro_a53 * k[2][i] + ro_a54 * k[3][i];
+    if (rhs(w, t + h, yt, fs)) return -1;
+    for (i = 0; i < n; i++)
+        k[4][i] = fs[i] + (ro_c51 * k[0][i] + ro_c52 * k[1][i] + ro_c53 * k[2][i] + ro_c54 * k[3][i]) / h;
+    lu_solve(W, n, w->piv, k[4]);
+
+    for (i = 0; i < n; i++) yt[i] += k[4][i];
+    if (rhs(w, t + h, yt, fs)) return -1;
+    for (i = 0; i < n; i++)
+        k[5][i] = fs[i] + (ro_c61 * k[0][i] + ro_c62 * k[1][i] + ro_c63 * k[2][i] + ro_c64 * k[3][i] +
+                           ro_c65 * k[4][i]) / h;
+    lu_solve(W, n, w->piv, k[5]);
+
+    for (i = 0; i < n; i++) w->y1[i] = yt[i] + k[5][i];
+    double err = wnorm(w, k[5], y, w->y1);
+    if (!isfinite(err) || !all_finite(w->y1, n)) return -1;
+    for (i = 0; i < n; i++) {
+        w->cont[0][i] = y[i];
+        w->cont[1][i] = w->y1[i];
+        w->cont[2][i] = ro_d21 * k[0][i] + ro_d22 * k[1][i] + ro_d23 * k[2][i] + ro_d24 * k[3][i] +
+                        ro_d25 * k[4][i];
+        w->cont[3][i] = ro_d31 * k[0][i] + ro_d32 * k[1][i] + ro_d33 * k[2][i] + ro_d34 * k[3][i] +
+                        ro_d35 * k[4][i];
+    }
+    return err;
+}
+
+static void rodas4_dense(const work *w, double s, double *y)
+{
+    double s1 = 1.0 - s;
+    for (int i = 0; i < w->n; i++)
+        y[i] = w->cont[0][i] * s1 + s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * w->cont[3][i]));
+}
+
+/* Hairer's starting step: an explicit Euler step's change in f sets the scale. */
+static double initial_step(work *w, double t, const double *y, const double *f0, int order, double hmax)
+{
+    int n = w->n;
+    double d0 = wnorm(w, y, y, y), d1 = wnorm(w, f0, y, y);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (hmax > 0) h0 = fmin(h0, hmax);
+    for (int i = 0; i < n; i++) w->ytmp[i] = y[i] + h0 * f0[i];
+    if (rhs(w, t + h0, w->ytmp, w->k[1])) return h0 * 1e-3;
+    for (int i = 0; i < n; i++) w->k[2][i] = w->k[1][i] - f0[i];
+    double d2 = wnorm(w, w->k[2], y, y) / h0;
+    double dm = fmax(d1, d2);
+    double h1 = dm <= 1e-15 ? fmax(1e-6, h0 * 1e-3) : pow(0.01 / dm, 1.0 / (order + 1));
+    return fmin(100.0 * h0, h1);
+}
+
+static int fail(work *w, int status, double t, double h)
+{
+    w->st->status = status;
+    w->st->t_fail = t;
+    w->st->h_fail = h;
+    return status;
+}
+
+const char *tf_status_message(int status)
+{
+    switch (status) {
+    case TF_OK: return "success";
+    case TF_ERR_NONFINITE: return "the state or its derivative became NaN or infinite";
+    case TF_ERR_STEP_UNDERFLOW: return "the step size fell below the resolution of the time variable";
+    case TF_ERR_MAX_STEPS: return "the maximum number of steps was reached";
+    case TF_ERR_BAD_ARGUMENT: return "invalid solver arguments";
+    case TF_ERR_NO_MEMORY: return "out of memory";
+    default: return "unknown error";
+    }
+}
+
+static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_solver_stats *st)
+{
+    int n = ode->n;
+    memset(w, 0, sizeof *w);
+    w->t_clamp = INFINITY;
+    w->ode = ode; w->opt = opt; w->st = st; w->n = n;
+    size_t nvec = 7 + 4 + 5;
+    w->block = (double *)malloc(sizeof(double) * (nvec * n + 2 * (size_t)n * n) + sizeof(int) * n);
+    if (!w->block) return 1;
+    double *p = w->block;
+    for (int i = 0; i < 7; i++, p += n) w->k[i] = p;
+    w->ytmp = p; p += n;
+    w->y1 = p; p += n;
+    w->ysti = p; p += n;
+    w->ft = p; p += n;
+    for (int i = 0; i < 5; i++, p += n) w->cont[i] = p;
+    w->J = p; p += n * n;
+    w->W = p; p += n * n;
+    w->piv = (int *)p;
+    return 0;
+}
+
+int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
+             double *y, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *st)
+{
+    memset(st, 0, sizeof *st);
+    st->switch_time = -1.0;
+    int n = ode->n;
+    if (n <= 0 || n_out < 1 || !(opt->rtol > 0) || !opt->atol || opt->max_steps <= 0)
+        return fail(&(work){.st = st}, TF_ERR_BAD_ARGUMENT, t_out[0], 0.0);
+    for (long i = 1; i < n_out; i++)
+        if (!(t_out[i] >= t_out[i - 1])) return fail(&(work){.st = st}, TF_ERR_BAD_ARGUMENT, t_out[i], 0.0);
+
+    work w;
+    if (setup(&w, ode, opt, st)) { st->status = TF_ERR_NO_MEMORY; return TF_ERR_NO_MEMORY; }
+    int method = opt->method == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : opt->method;
+    double t = t_out[0], t_end = t_out[n_out - 1];
+    double *f0 = (double *)malloc(sizeof(double) * n);
+    double *yd = (double *)malloc(sizeof(double) * n);
+    int status = TF_OK;
+    long next = 0;
+    double h = 0.0, facold = 1e-4, hold = 0.0, errold = 1.0;
+    int first_rodas = 1, reject = 0, iasti = 0, nonsti = 0;
+    if (!f0 || !yd) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
+
+    while (next < n_out && t_out[next] <= t) emit(next, t_out[next], y, emit_ctx), next++;
+    if (!all_finite(y, n)) { status = fail(&w, TF_ERR_NONFINITE, t, 0.0); goto done; }
+
+    while (t < t_end) {
+        double seg_end = ode->next_corner ? fmin(ode->next_corner(t, ode->ctx), t_end) : t_end;
+        if (!(seg_end > t)) seg_end = t_end;
+        /* restart at every corner: the derivative may jump there */
+        w.t_clamp = INFINITY;
+        if (rhs(&w, t, y, f0)) { status = fail(&w, TF_ERR_NONFINITE, t, h); goto done; }
+        if (h <= 0.0) {
+            h = opt->h0 > 0 ? opt->h0 : initial_step(&w, t, y, f0, method == TF_METHOD_DOPRI5 ? 5 : 4, opt->hmax);
+        }
+        w.t_clamp = nextafter(seg_end, -INFINITY);
+        int jac_current = 0;
+        while (t < seg_end) {
+            if (st->steps + st->rejected >= opt->max_steps) { status = fail(&w, TF_ERR_MAX_STEPS, t, h); goto done; }
+            if (opt->hmax > 0) h = fmin(h, opt->hmax);
+            int last = 0;
+            if (t + 1.01 * h >= seg_end) { h = seg_end - t; last = 1; }
+            if (h <= 16.0 * DBL_EPSILON * fmax(fabs(t), 1e-300)) {
+                status = fail(&w, TF_ERR_STEP_UNDERFLOW, t, h);
+                goto done;
+            }
+            double err;
+            if (method == TF_METHOD_RODAS4) {
+                if (!jac_current) {
+                    st->jac_evals++;
+                    ode->jac(t, y, w.J, ode->ctx);
+                    if (!all_finite(w.J, n * n) || time_derivative(&w, t, seg_end, y, f0, w.ft)) {
+                        status = fail(&w, TF_ERR_NONFINITE, t, h);
+                        goto done;
+                    }
+                    jac_current = 1;
+                }
+                err = rodas4_step(&w, t, h, y, f0);
+            } else {
+                err = dopri5_step(&w, t, h, y, f0);
+            }
+            if (err < 0.0) { /* non-finite or singular: retry smaller */
+                st->rejected++;
+                reject = 1;
+                h *= 0.25;
+                if (h <= 16.0 * DBL_EPSILON * fmax(fabs(t), 1e-300)) {
+                    status = fail(&w, TF_ERR_NONFINITE, t, h);
+                    goto done;
+                }
+                continue;
+            }
+            if (err <= 1.0) {
+                double t_new = last ? seg_end : t + h;
+                while (next < n_out && t_out[next] <= t_new) {
+                    double s = (t_out[next] - t) / h;
+                    if (method == TF_METHOD_RODAS4) rodas4_dense(&w, s, yd); else dopri5_dense(&w, s, yd);
+                    emit(next, t_out[next], yd, emit_ctx);
+                    next++;
+                }
+                st->steps++;
+                double hnew;
+                if (method == TF_METHOD_RODAS4) {
+                    double fac = fmax(1.0 / 6.0, fmin(5.0, pow(err, 0.25) / 0.9));
+                    if (!first_rodas) {
+                        double facpred = (hold / h) * pow(err * err / errold, 0.25) / 0.9;
+                        fac = fmax(fac, fmax(1.0 / 6.0, fmin(5.0, facpred)));
+                    }
+                    hnew = h / fac;
+                    first_rodas = 0;
+                    hold = h;
+                    errold = fmax(0.01, err);
+                    if (!last && rhs(&w, t_new, w.y1, f0)) { status = fail(&w, TF_ERR_NONFINITE, t_new, h); goto done; }
+                    jac_current = 0;
+                } else {
+                    /* PI control, Hairer's DOPRI5 constants */
+                    const double beta = 0.04, expo1 = 0.2 - beta * 0.75;
+                    double fac11 = pow(err, expo1);
+                    double fac = fac11 / pow(facold, beta);
+                    fac = fmax(0.1, fmin(5.0, fac / 0.9));
+                    hnew = h / fac;
+                    facold = fmax(err, 1e-4);
+                    /* stiffness test: h * |lambda| from the last two stages */
+                    double num = 0.0, den = 0.0;
+                    for (int i = 0; i < n; i++) {
+                        double sk = opt->atol[i] + opt->rtol * fabs(w.y1[i]);
+                        double a = (w.k[6][i] - w.k[5][i]) / sk, b = (w.y1[i] - w.ysti[i]) / sk;
+                        num += a * a;
+                        den += b * b;
+                    }
+                    if (den > 0.0 && h * sqrt(num / den) > 3.25) {
+                        nonsti = 0;
+                        if (++iasti >= 15) {
+                            st->stiff_suspected = 1;
+                            if (opt->method == TF_METHOD_AUTO) {
+                                method = TF_METHOD_RODAS4;
+                                st->switch_time = t_new;
+                            }
+                        }
+                    } else if (++nonsti >= 6) {
+                        iasti = 0;
+                    }
+                    memcpy(f0, w.k[6], sizeof(double) * n); /* FSAL */
+                }
+                if (reject) hnew = fmin(hnew, h);
+                reject = 0;
+                memcpy(y, w.y1, sizeof(double) * n);
+                t = t_new;
+                h = hnew;
+            } else {
+                st->rejected++;
+                reject = 1;
+                if (method == TF_METHOD_RODAS4)
+                    h /= fmax(1.0 / 6.0, fmin(5.0, pow(err, 0.25) / 0.9));
+                else
+                    h /= fmin(5.0, pow(err, 0.2 - 0.04 * 0.75) / 0.9);
+            }
+        }
+    }
+    while (next < n_out) emit(next, t_out[next], y, emit_ctx), next++;
+done:
+    st->method_used = method;
+    free(f0);
+    free(yd);
+    free(w.block);
+    return status;
+}

@@ -1,0 +1,174 @@
+/* Input waveforms (SPEC 6). */
+#include "thermofriction/waveform.h"
+
+#include <math.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* Corners closer than this to t count as "at t": the integrator lands on a corner by
+ * computing its time, so the next search must not find the same corner again. */
+static double corner_margin(double t) { return 1e-12 * fmax(1.0, fabs(t)); }
+
+/* Index i of the segment [x[i], x[i+1]) that holds t, clamped to [0, n-2]. */
+static int pwl_segment(int n, const double *x, double t)
+{
+    int lo = 0, hi = n - 1;
+    if (t <= x[0]) return 0;
+    if (t >= x[n - 1]) return n - 2;
+    while (hi - lo > 1) {
+        int mid = lo + (hi - lo) / 2;
+        if (x[mid] <= t) lo = mid; else hi = mid;
+    }
+    return lo;
+}
+
+double tf_pwl_value(int n, const double *x, const double *y, double t)
+{
+    if (n <= 0) return 0.0;
+    if (n == 1 || t <= x[0]) return y[0];
+    if (t >= x[n - 1]) return y[n - 1];
+    int i = pwl_segment(n, x, t);
+    double s = (t - x[i]) / (x[i + 1] - x[i]);
+    return y[i] + s * (y[i + 1] - y[i]);
+}
+
+double tf_pwl_slope(int n, const double *x, const double *y, double t)
+{
+    if (n <= 1 || t < x[0] || t >= x[n - 1]) return 0.0;
+    int i = pwl_segment(n, x, t);
+    return (y[i + 1] - y[i]) / (x[i + 1] - x[i]);
+}
+
+double tf_pwl_next_knot(int n, const double *x, double t)
+{
+    double tt = t + corner_margin(t);
+    if (n <= 0 || tt >= x[n - 1]) return INFINITY;
+    if (tt < x[0]) return x[0];
+    int i = pwl_segment(n, x, tt);
+    return x[i + 1];
+}
+
+/* Sawtooth shape in [0, 1] at phase ph in [0, 1). */
+static double sawtooth_shape(double ph, double rise, double direction, double *dshape)
+{
+    if (direction < 0) { /* mirrored in time: fast rise, slow fall */
+        double s = sawtooth_shape(1.0 - ph, rise, 1.0, dshape);
+        if (dshape) *dshape = -*dshape;
+        if (ph == 0.0) { /* right-hand slope at the period start */
+            if (dshape) *dshape = 1.0 / (1.0 - rise);
+            return 0.0;
+        }
+        return s;
+    }
+    if (ph < rise) {
+        if (dshape) *dshape = 1.0 / rise;
+        return ph / rise;
+    }
+    if (dshape) *dshape = -1.0 / (1.0 - rise);
+    return (1.0 - ph) / (1.0 - rise);
+}
+
+/* Square shape in [0, 1] at time tau within the period P. */
+static double square_shape(double tau, double P, double duty, double slew, double *dshape)
+{
+    double t_fall = duty * P;
+    double d = 0.0, s;
+    if (tau < slew) { s = tau / slew; d = 1.0 / slew; }
+    else if (tau < t_fall) s = 1.0;
+    else if (tau < t_fall + slew) { s = 1.0 - (tau - t_fall) / slew; d = -1.0 / slew; }
+    else s = 0.0;
+    if (dshape) *dshape = d;
+    return s;
+}
+
+static double eval(const tf_waveform *w, double t, double *slope)
+{
+    double d = 0.0, v = 0.0;
+    switch (w->kind) {
+    case TF_WAVE_SAWTOOTH: {
+        double x = t * w->frequency;
+        double ph = x - floor(x);
+        v = w->offset + w->amplitude * sawtooth_shape(ph, w->rise, w->direction, &d);
+        d *= w->amplitude * w->frequency;
+        break;
+    }
+    case TF_WAVE_SINE: {
+        double om = 2.0 * M_PI * w->frequency;
+        v = w->offset + w->amplitude * sin(om * t);
+        d = w->amplitude * om * cos(om * t);
+        break;
+    }
+    case TF_WAVE_SQUARE: {
+        double P = 1.0 / w->frequency;
+        double x = t * w->frequency;
+        double tau = (x - floor(x)) * P;
+        v = w->offset + w->amplitude * square_shape(tau, P, w->rise, w->slew, &d);
+        d *= w->amplitude;
+        break;
+    }
+    case TF_WAVE_STEP:
+        if (t < w->t0) v = w->offset;
+        else if (t < w->t0 + w->slew) {
+            v = w->offset + w->amplitude * (t - w->t0) / w->slew;
+            d = w->amplitude / w->slew;
+        } else v = w->offset + w->amplitude;
+        break;
+    case TF_WAVE_SAMPLED:
+        v = tf_pwl_value(w->n, w->t, w->v, t);
+        d = tf_pwl_slope(w->n, w->t, w->v, t);
+        break;
+    default:
+        break;
+    }
+    if (slope) *slope = d;
+    return v;
+}
+
+double tf_waveform_value(const tf_waveform *w, double t) { return eval(w, t, 0); }
+
+double tf_waveform_slope(const tf_waveform *w, double t)
+{
+    double d;
+    eval(w, t, &d);
+    return d;
+}
+
+/* Smallest of the per-period corners (k + c_j)/f over this and the next period, > t. */
+static double periodic_next(double t, double f, const double *c, int nc)
+{
+    double tt = t + corner_margin(t);
+    double k = floor(tt * f);
+    double best = INFINITY;
+    for (int p = 0; p < 2; p++)
+        for (int j = 0; j < nc; j++) {
+            double tc = (k + p + c[j]) / f;
+            if (tc > tt && tc < best) best = tc;
+        }
+    return best;
+}
+
+double tf_waveform_next_corner(const tf_waveform *w, double t)
+{
+    double tt = t + corner_margin(t);
+    switch (w->kind) {
+    case TF_WAVE_SAWTOOTH: {
+        double c[2] = {0.0, w->direction < 0 ? 1.0 - w->rise : w->rise};
+        return periodic_next(t, w->frequency, c, 2);
+    }
+    case TF_WAVE_SQUARE: {
+        double P = 1.0 / w->frequency;
+        double c[4] = {0.0, w->slew / P, w->rise, w->rise + w->slew / P};
+        return periodic_next(t, w->frequency, c, 4);
+    }
+    case TF_WAVE_STEP:
+        if (tt < w->t0) return w->t0;
+        if (w->slew > 0 && tt < w->t0 + w->slew) return w->t0 + w->slew;
+        return INFINITY;
+    case TF_WAVE_SAMPLED:
+        return tf_pwl_next_knot(w->n, w->t, t);
+    default:
+        return INFINITY;
+    }
+}

@@ -1,0 +1,276 @@
+/* The C core's own tests: analytic solutions and finite-difference checks, no Python.
+ * Prints one line per failed check and a closing "N passed, N failed" line. */
+#include "thermofriction.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int passed, failed;
+
+#define CHECK(cond, ...)                                                  \
+    do {                                                                  \
+        if (cond) passed++;                                               \
+        else { failed++; printf("FAIL %s:%d: ", __FILE__, __LINE__);      \
+               printf(__VA_ARGS__); printf("\n"); }                       \
+    } while (0)
+
+/* ---- generic ODE harness: records the emitted grid ---- */
+typedef struct { long n; int dim; double *y; } record;
+static void emit_record(long i, double t, const double *y, void *ctx)
+{
+    record *r = (record *)ctx;
+    (void)t;
+    memcpy(r->y + i * r->dim, y, sizeof(double) * r->dim);
+}
+
+/* harmonic oscillator x'' = -w^2 x */
+static int osc_rhs(double t, const double *y, double *dy, void *ctx)
+{
+    double w = *(double *)ctx;
+    dy[0] = y[1];
+    dy[1] = -w * w * y[0];
+    return 0;
+}
+static int osc_jac(double t, const double *y, double *J, void *ctx)
+{
+    double w = *(double *)ctx;
+    J[0] = 0; J[1] = 1; J[2] = -w * w; J[3] = 0;
+    return 0;
+}
+
+/* Prothero-Robinson: y' = -L (y - sin t) + cos t, exact y = sin t; stiff for large L. */
+static int pr_rhs(double t, const double *y, double *dy, void *ctx)
+{
+    double L = *(double *)ctx;
+    dy[0] = -L * (y[0] - sin(t)) + cos(t);
+    return 0;
+}
+static int pr_jac(double t, const double *y, double *J, void *ctx)
+{
+    J[0] = -*(double *)ctx;
+    return 0;
+}
+
+static void test_oscillator_dense_output(int method)
+{
+    double w = 2.0 * 3.14159265358979;
+    tf_ode ode = {2, &w, osc_rhs, osc_jac, 0};
+    double atol[2] = {1e-10, 1e-10};
+    tf_solver_options opt = {method, 1e-8, atol, 0, 0, 1000000};
+    long n = 1001;
+    double *t = malloc(sizeof(double) * n), *buf = malloc(sizeof(double) * 2 * n);
+    for (long i = 0; i < n; i++) t[i] = 3.0 * i / (n - 1);
+    double y0[2] = {1.0, 0.0};
+    record r = {n, 2, buf};
+    tf_solver_stats st;
+    int status = tf_solve(&ode, &opt, t, n, y0, emit_record, &r, &st);
+    CHECK(status == TF_OK, "oscillator method %d status %d", method, status);
+    double worst = 0;
+    for (long i = 0; i < n; i++) worst = fmax(worst, fabs(buf[2 * i] - cos(w * t[i])));
+    /* dense output between steps must be as good as the steps themselves */
+    CHECK(worst < 1e-6, "oscillator method %d dense output error %g", method, worst);
+    CHECK(st.steps < 2000, "oscillator method %d took %ld steps", method, st.steps);
+    free(t); free(buf);
+}
+
+static void test_stiff_prothero_robinson(void)
+{
+    double L = 1e7;
+    tf_ode ode = {1, &L, pr_rhs, pr_jac, 0};
+    double atol[1] = {1e-9};
+    double t[2] = {0.0, 10.0};
+    double y[1] = {0.0}, out[2];
+    record r = {2, 1, out};
+    tf_solver_stats st;
+    tf_solver_options opt = {TF_METHOD_RODAS4, 1e-6, atol, 0, 0, 100000};
+    int status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st);
+    CHECK(status == TF_OK && fabs(out[1] - sin(10.0)) < 1e-5, "Rodas4 stiff: status %d err %g",
+          status, fabs(out[1] - sin(10.0)));
+    CHECK(st.steps < 500, "Rodas4 stiff took %ld steps (should step over the stiff mode)", st.steps);
+
+    /* AUTO starts explicit, detects stiffness and switches */
+    y[0] = 0.0;
+    opt.method = TF_METHOD_AUTO;
+    status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st);
+    CHECK(status == TF_OK && st.switch_time >= 0 && st.method_used == TF_METHOD_RODAS4,
+          "AUTO did not switch: status %d switch %g", status, st.switch_time);
+    CHECK(fabs(out[1] - sin(10.0)) < 1e-5, "AUTO stiff error %g", fabs(out[1] - sin(10.0)));
+
+    /* explicit alone runs out of steps and says it suspected stiffness */
+    y[0] = 0.0;
+    opt.method = TF_METHOD_DOPRI5;
+    opt.max_steps = 5000;
+    status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st);
+    CHECK(status == TF_ERR_MAX_STEPS && st.stiff_suspected, "DOPRI5 on stiff: status %d suspected %d",
+          status, st.stiff_suspected);
+}
+
+static void test_waveforms(void)
+{
+    tf_waveform saw = {TF_WAVE_SAWTOOTH, 30.0, 5.0, 0.99, 0.0, 1.0, 0, 0, 0, 0, 0};
+    CHECK(fabs(tf_waveform_value(&saw, 0.198) - 30.0) < 1e-9, "sawtooth peak %g", tf_waveform_value(&saw, 0.198));
+    CHECK(fabs(tf_waveform_value(&saw, 0.199) - 15.0) < 1e-9, "sawtooth mid-fall %g", tf_waveform_value(&saw, 0.199));
+    CHECK(fabs(tf_waveform_next_corner(&saw, 0.0) - 0.198) < 1e-15, "first corner %g", tf_waveform_next_corner(&saw, 0.0));
+    CHECK(fabs(tf_waveform_next_corner(&saw, 0.198) - 0.2) < 1e-15, "second corner");
+    CHECK(fabs(tf_waveform_slope(&saw, 0.1) - 30.0 / 0.198) < 1e-9, "rising slope");
+    tf_waveform back = saw;
+    back.direction = -1.0;
+    CHECK(fabs(tf_waveform_value(&back, 0.002) - 30.0) < 1e-9, "mirrored sawtooth peaks at (1-rise)/f");
+    CHECK(fabs(tf_waveform_next_corner(&back, 0.0) - 0.002) < 1e-15, "mirrored corner");
+    double v = 0;
+    for (int i = 0; i < 1000; i++) { /* continuity at every corner */
+        double tc = tf_waveform_next_corner(&saw, v);
+        double jump = fabs(tf_waveform_value(&saw, tc + 1e-12) - tf_waveform_value(&saw, tc - 1e-12));
+        if (jump > 1e-6) { CHECK(0, "sawtooth jumps %g at %g", jump, tc); break; }
+        v = tc;
+    }
+    CHECK(fabs(v - 100.0) < 1e-9, "1000 corners of a 5 Hz sawtooth end at 100 s, got %.15g", v);
+    double ts[3] = {0.0, 1.0, 3.0}, vs[3] = {0.0, 2.0, 0.0};
+    tf_waveform smp = {TF_WAVE_SAMPLED, 0, 0, 0, 0, 0, 0, 0, ts, vs, 3};
+    CHECK(fabs(tf_waveform_value(&smp, 2.0) - 1.0) < 1e-15 && tf_waveform_next_corner(&smp, 0.5) == 1.0,
+          "sampled waveform");
+}
+
+static void test_laws(void)
+{
+    double x[5] = {30, 32, 35, 38.4, 41.5}, y[5] = {1.0, 0.9, 0.85, 0.5, 0.1}, d[5];
+    tf_pchip_slopes(5, x, y, d);
+    tf_law table = {TF_LAW_TABLE, 0, 0, 5, x, y, d};
+    double prev = INFINITY, worst = 0;
+    for (int i = 0; i <= 1150; i++) {
+        double T = 30.0 + i * 0.01, dv;
+        double v = tf_law_eval(&table, T, &dv);
+        if (v > prev + 1e-15) { CHECK(0, "PCHIP not monotone at %g", T); break; }
+        prev = v;
+        double h = 1e-6;
+        double fd = (tf_law_eval(&table, T + h, 0) - tf_law_eval(&table, T - h, 0)) / (2 * h);
+        if (fabs(T - 32) > 2e-6 && fabs(T - 35) > 2e-6 && fabs(T - 38.4) > 2e-6) worst = fmax(worst, fabs(fd - dv));
+    }
+    CHECK(worst < 1e-6, "PCHIP derivative vs finite difference %g", worst);
+    for (int i = 0; i < 5; i++) CHECK(fabs(tf_law_eval(&table, x[i], 0) - y[i]) < 1e-14, "PCHIP interpolates");
+    double c[3] = {1.0, -2.0, 0.5};
+    tf_law poly = {TF_LAW_POLY, 0, 0, 3, 0, c, 0};
+    double dv, v = tf_law_eval(&poly, 3.0, &dv);
+    CHECK(fabs(v - (1 - 6 + 4.5)) < 1e-14 && fabs(dv - (-2 + 3.0)) < 1e-14, "poly value %g slope %g", v, dv);
+    tf_law e = {TF_LAW_EXP, 115072.0, -0.136, 0, 0, 0, 0};
+    CHECK(fabs(tf_law_eval(&e, 35.0, 0) - 115072.0 * exp(-0.136 * 35.0)) < 1e-9, "exp law (Eq. 9)");
+}
+
+static void paper_like(tf_model *m, double T)
+{
+    memset(m, 0, sizeof *m);
+    m->plant = TF_PLANT_STICK_SLIP;
+    m->m = 0.05; m->m_e = 0.02;
+    double wn = 6685.5, xi = 0.2488, K = 0.096e-6;
+    m->k = m->m * wn * wn; m->c = 2 * xi * wn * m->m; m->T_em = K * m->k;
+    m->friction = TF_FRICTION_LUGRE;
+    m->p[TF_P_SIGMA0] = 1.15072e8 * exp(-0.136 * T);
+    m->p[TF_P_SIGMA1] = -0.138 * T + 6.445;
+    m->p[TF_P_FC] = m->p[TF_P_FS] = 106.04 * exp(-0.159 * T);
+    m->p[TF_P_VS] = 1e-3; m->p[TF_P_DELTA] = 2; m->p[TF_P_VSMOOTH] = 1e-6;
+    m->input = (tf_waveform){TF_WAVE_SAWTOOTH, 30.0, 5.0, 0.999, 0.0, 1.0, 0, 0, 0, 0, 0};
+    m->T_const = T;
+}
+
+static void test_lugre_steady_sliding(void)
+{
+    /* analytic: z* = g(v) sgn(v) / sigma0, F = g(v) sgn(v) + sigma2 v */
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5; p[TF_P_SIGMA1] = 316; p[TF_P_SIGMA2] = 0.4;
+    p[TF_P_FC] = 1.0; p[TF_P_FS] = 1.5; p[TF_P_VS] = 1e-3; p[TF_P_DELTA] = 2.0; p[TF_P_VD] = 2e-3;
+    double vs[4] = {-0.01, -1e-3, 5e-4, 0.02};
+    for (int i = 0; i < 4; i++) {
+        double v = vs[i], g = tf_stribeck(p, v, 0);
+        double z = (v > 0 ? g : -g) / p[TF_P_SIGMA0], dz;
+        double F = tf_friction_eval(TF_FRICTION_LUGRE, p, v, &z, &dz, 0);
+        CHECK(fabs(dz) < 1e-12 && fabs(F - ((v > 0 ? g : -g) + 0.4 * v)) < 1e-12, "LuGre steady sliding at v=%g", v);
+    }
+}
+
+static void test_jacobian_vs_finite_differences(void)
+{
+    tf_model m;
+    paper_like(&m, 35.0);
+    m.p[TF_P_FS] = 1.5 * m.p[TF_P_FC];
+    m.p[TF_P_SIGMA2] = 0.3;
+    m.p[TF_P_VD] = 2e-3;
+    for (int form = 0; form < 3; form++) {
+        double dFx[2] = {30.0, 41.5}, dFy[2] = {0.0, -0.2};
+        if (form > 0) {
+            m.thermal = TF_THERMAL_MODEL_II;
+            m.dF = (tf_law){TF_LAW_PWL, 0, 0, 2, dFx, dFy, 0};
+            m.dF_form = form == 1 ? TF_DF_SCALE : TF_DF_OFFSET;
+        }
+        tf_model_prepare(&m);
+        double y[5] = {1e-7, 2e-3, 3e-7, -1e-3, 2e-7}, J[25], f0[5], f1[5], f2[5];
+        tf_model_jac(0.01, y, J, &m);
+        tf_model_rhs(0.01, y, f0, &m);
+        double worst = 0;
+        for (int j = 0; j < 5; j++) {
+            double yp[5], ym[5];
+            memcpy(yp, y, sizeof y); memcpy(ym, y, sizeof y);
+            double h = 1e-7 * fmax(fabs(y[j]), 1e-9);
+            yp[j] += h; ym[j] -= h;
+            tf_model_rhs(0.01, yp, f1, &m);
+            tf_model_rhs(0.01, ym, f2, &m);
+            for (int i = 0; i < 5; i++) {
+                double fd = (f1[i] - f2[i]) / (2 * h);
+                double scale = fabs(fd) + fabs(J[i * 5 + j]) + 1e-300;
+                if (fabs(fd - J[i * 5 + j]) > 1e-5 * scale + 1e-12 * (fabs(f0[i]) / fmax(fabs(y[j]), 1e-12)))
+                    worst = fmax(worst, fabs(fd - J[i * 5 + j]) / scale);
+            }
+        }
+        CHECK(worst == 0, "Jacobian vs finite differences (thermal form %d): worst relative error %g", form, worst);
+    }
+}
+
+static void emit_stage(long i, double t, const double *y, void *ctx) { ((double *)ctx)[i] = y[0]; }
+
+static void test_frictionless_step_response(void)
+{
+    /* friction removed: the stage is an exact damped second-order system under a unit step */
+    tf_model m;
+    paper_like(&m, 35.0);
+    m.p[TF_P_SIGMA0] = m.p[TF_P_SIGMA1] = 0.0;
+    m.p[TF_P_FC] = m.p[TF_P_FS] = 1.0;
+    m.input = (tf_waveform){TF_WAVE_STEP, 10.0, 0, 0, 0, 0, 0.0, 1e-3, 0, 0, 0};
+    tf_model_prepare(&m);
+    int n = tf_model_nstate(&m);
+    double atol[5], y[5];
+    tf_model_state_scale(&m, atol);
+    for (int i = 0; i < n; i++) atol[i] *= 1e-8;
+    tf_model_initial_state(&m, y);
+    tf_ode ode = {n, &m, tf_model_rhs, tf_model_jac, tf_model_next_corner};
+    long N = 201;
+    double t[201], xp[201];
+    for (int i = 0; i < N; i++) t[i] = 5e-3 * i / (N - 1);
+    for (int method = 1; method <= 2; method++) {
+        tf_solver_options opt = {method, 1e-8, atol, 0, 0, 100000};
+        tf_solver_stats st;
+        tf_model_initial_state(&m, y);
+        int status = tf_solve(&ode, &opt, t, N, y, emit_stage, xp, &st);
+        double wn = 6685.5, xi = 0.2488, K = 0.096e-6, wd = wn * sqrt(1 - xi * xi), worst = 0;
+        for (int i = 0; i < N; i++) {
+            double tau = t[i] - 1e-3, exact = 0;
+            if (tau > 0) exact = 10.0 * K * (1 - exp(-xi * wn * tau) * (cos(wd * tau) + xi / sqrt(1 - xi * xi) * sin(wd * tau)));
+            worst = fmax(worst, fabs(xp[i] - exact));
+        }
+        CHECK(status == TF_OK && worst < 1e-6 * 10.0 * K, "step response method %d: status %d error %g m", method, status, worst);
+    }
+}
+
+int main(void)
+{
+    test_oscillator_dense_output(TF_METHOD_DOPRI5);
+    test_oscillator_dense_output(TF_METHOD_RODAS4);
+    test_stiff_prothero_robinson();
+    test_waveforms();
+    test_laws();
+    test_lugre_steady_sliding();
+    test_jacobian_vs_finite_differences();
+    test_frictionless_step_response();
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
