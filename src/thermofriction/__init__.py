@@ -1,0 +1,26 @@
+"""thermofriction: temperature-aware friction models for precision motion systems.
+
+Simulate actuators with LuGre friction and thermal extensions (Li et al., Rev. Sci. Instrum. 80,
+045104, 2009) on a compiled C core::
+
+    import thermofriction as tf
+    model = tf.load_model("li2009-model-i")
+    res = tf.simulate(model, duration=2.0, temperature=35.0)
+    res.time, res.displacement, res.step_sizes
+"""
+
+from .errors import ComputationError, InputError, SolverError, TemperatureRangeWarning, ThermofrictionError
+from .models import (PARAMETERS, PRESETS, PWL, Const, Exp, Law, Linear, LuGre, Model, ModelI, ModelII, Poly,
+                     StickSlipPlant, Table, load_model)
+from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
+from .waveforms import Sampled, Sawtooth, Sine, Square, Step, Waveform, parse_waveform
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ComputationError", "InputError", "SolverError", "TemperatureRangeWarning", "ThermofrictionError",
+    "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "LuGre", "Model", "ModelI", "ModelII", "Poly",
+    "StickSlipPlant", "Table", "load_model",
+    "AutoSwitch", "Dopri5", "Rodas4", "SimulationResult", "StepSizeController", "simulate",
+    "Sampled", "Sawtooth", "Sine", "Square", "Step", "Waveform", "parse_waveform",
+]

@@ -1,0 +1,346 @@
+/* Thin CPython binding of the C core: it unpacks a model description (a dict of numbers
+ * and float64 arrays built by thermofriction.simulate) into a tf_model, and moves whole
+ * arrays in and out. No numerics here. */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <string.h>
+
+#include "thermofriction.h"
+
+static PyObject *SolverError;
+
+#define MAX_VIEWS 64
+typedef struct {
+    Py_buffer views[MAX_VIEWS];
+    int nviews;
+    double *owned[TF_NPARAM + 2];
+    int nowned;
+} arena;
+
+static void arena_free(arena *a)
+{
+    for (int i = 0; i < a->nviews; i++) PyBuffer_Release(&a->views[i]);
+    for (int i = 0; i < a->nowned; i++) PyMem_Free(a->owned[i]);
+    a->nviews = a->nowned = 0;
+}
+
+/* A read-only contiguous float64 array; NULL (no error) for None. */
+static const double *get_array(arena *a, PyObject *obj, Py_ssize_t *len, const char *what)
+{
+    *len = 0;
+    if (obj == NULL || obj == Py_None) return NULL;
+    if (a->nviews >= MAX_VIEWS) { PyErr_SetString(PyExc_ValueError, "too many arrays"); return NULL; }
+    Py_buffer *v = &a->views[a->nviews];
+    if (PyObject_GetBuffer(obj, v, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) return NULL;
+    a->nviews++;
+    if (v->itemsize != 8 || v->format == NULL || strcmp(v->format, "d") != 0) {
+        PyErr_Format(PyExc_TypeError, "%s must be a contiguous float64 array", what);
+        return NULL;
+    }
+    *len = v->len / 8;
+    return (const double *)v->buf;
+}
+
+static int get_double(PyObject *dict, const char *key, double *out)
+{
+    PyObject *o = PyDict_GetItemString(dict, key);
+    if (!o) { PyErr_Format(PyExc_KeyError, "model spec lacks '%s'", key); return -1; }
+    *out = PyFloat_AsDouble(o);
+    return PyErr_Occurred() ? -1 : 0;
+}
+
+static int get_int(PyObject *dict, const char *key, int *out)
+{
+    PyObject *o = PyDict_GetItemString(dict, key);
+    if (!o) { PyErr_Format(PyExc_KeyError, "model spec lacks '%s'", key); return -1; }
+    *out = (int)PyLong_AsLong(o);
+    return PyErr_Occurred() ? -1 : 0;
+}
+
+/* law: None or (kind, a, b, x, y) */
+static int parse_law(arena *a, PyObject *obj, tf_law *law)
+{
+    memset(law, 0, sizeof *law);
+    if (obj == NULL || obj == Py_None) return 0;
+    PyObject *x = NULL, *y = NULL;
+    if (!PyArg_ParseTuple(obj, "iddOO", &law->kind, &law->a, &law->b, &x, &y)) return -1;
+    Py_ssize_t nx, ny;
+    law->x = get_array(a, x, &nx, "law breakpoints");
+    if (PyErr_Occurred()) return -1;
+    law->y = get_array(a, y, &ny, "law values");
+    if (PyErr_Occurred()) return -1;
+    law->n = (int)ny;
+    if (law->kind == TF_LAW_POLY && ny < 1) { PyErr_SetString(PyExc_ValueError, "poly law needs coefficients"); return -1; }
+    if ((law->kind == TF_LAW_PWL || law->kind == TF_LAW_TABLE) && (nx != ny || ny < 1)) {
+        PyErr_SetString(PyExc_ValueError, "pwl/table law needs as many breakpoints as values");
+        return -1;
+    }
+    if (law->kind == TF_LAW_TABLE) {
+        double *d = PyMem_Malloc(sizeof(double) * ny);
+        if (!d) { PyErr_NoMemory(); return -1; }
+        a->owned[a->nowned++] = d;
+        tf_pchip_slopes(law->n, law->x, law->y, d);
+        law->d = d;
+    }
+    return 0;
+}
+
+/* waveform: (kind, amplitude, frequency, rise, offset, direction, slew, t0, t, v) */
+static int parse_waveform(arena *a, PyObject *obj, tf_waveform *w)
+{
+    memset(w, 0, sizeof *w);
+    PyObject *t = NULL, *v = NULL;
+    if (!PyArg_ParseTuple(obj, "idddddddOO", &w->kind, &w->amplitude, &w->frequency, &w->rise, &w->offset,
+                          &w->direction, &w->slew, &w->t0, &t, &v))
+        return -1;
+    Py_ssize_t nt, nv;
+    w->t = get_array(a, t, &nt, "waveform times");
+    if (PyErr_Occurred()) return -1;
+    w->v = get_array(a, v, &nv, "waveform values");
+    if (PyErr_Occurred()) return -1;
+    if (nt != nv) { PyErr_SetString(PyExc_ValueError, "waveform times and values differ in length"); return -1; }
+    w->n = (int)nt;
+    return 0;
+}
+
+static int parse_model(arena *a, PyObject *spec, tf_model *m)
+{
+    memset(m, 0, sizeof *m);
+    if (!PyDict_Check(spec)) { PyErr_SetString(PyExc_TypeError, "model spec must be a dict"); return -1; }
+    if (get_int(spec, "plant", &m->plant) || get_double(spec, "m", &m->m) || get_double(spec, "c", &m->c) ||
+        get_double(spec, "k", &m->k) || get_double(spec, "T_em", &m->T_em) || get_double(spec, "m_e", &m->m_e) ||
+        get_int(spec, "friction", &m->friction) || get_int(spec, "thermal", &m->thermal) ||
+        get_int(spec, "dF_form", &m->dF_form) || get_double(spec, "T_const", &m->T_const))
+        return -1;
+    if (tf_friction_nstate(m->friction) < 0) { PyErr_SetString(PyExc_ValueError, "unknown friction model"); return -1; }
+    Py_ssize_t np;
+    const double *p = get_array(a, PyDict_GetItemString(spec, "params"), &np, "params");
+    if (PyErr_Occurred()) return -1;
+    if (np != TF_NPARAM) { PyErr_Format(PyExc_ValueError, "params must have %d values", TF_NPARAM); return -1; }
+    memcpy(m->p, p, sizeof(double) * TF_NPARAM);
+    PyObject *laws = PyDict_GetItemString(spec, "laws");
+    if (laws && laws != Py_None) {
+        if (!PyList_Check(laws) || PyList_GET_SIZE(laws) != TF_NPARAM) {
+            PyErr_Format(PyExc_ValueError, "laws must be a list of %d entries", TF_NPARAM);
+            return -1;
+        }
+        for (int i = 0; i < TF_NPARAM; i++)
+            if (parse_law(a, PyList_GET_ITEM(laws, i), &m->law[i])) return -1;
+    }
+    if (parse_law(a, PyDict_GetItemString(spec, "dF"), &m->dF)) return -1;
+    PyObject *input = PyDict_GetItemString(spec, "input");
+    if (!input) { PyErr_SetString(PyExc_KeyError, "model spec lacks 'input'"); return -1; }
+    if (parse_waveform(a, input, &m->input)) return -1;
+    Py_ssize_t nt, nv;
+    m->T_t = get_array(a, PyDict_GetItemString(spec, "T_t"), &nt, "temperature times");
+    if (PyErr_Occurred()) return -1;
+    m->T_v = get_array(a, PyDict_GetItemString(spec, "T_v"), &nv, "temperature values");
+    if (PyErr_Occurred()) return -1;
+    if (nt != nv) { PyErr_SetString(PyExc_ValueError, "temperature times and values differ in length"); return -1; }
+    m->T_n = (int)nt;
+    return 0;
+}
+
+typedef struct {
+    const tf_model *model;
+    double *out;
+    int nch;
+} emit_ctx;
+
+static void emit_outputs(long i, double t, const double *y, void *ctx)
+{
+    emit_ctx *e = (emit_ctx *)ctx;
+    tf_model_outputs(e->model, t, y, e->out + (size_t)i * e->nch);
+}
+
+/* simulate(spec, t_out, out, method, rtol, atol|None, h0, hmax, max_steps) -> stats dict */
+static PyObject *py_simulate(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *t_obj, *out_obj, *atol_obj;
+    int method;
+    double rtol, h0, hmax;
+    long max_steps;
+    if (!PyArg_ParseTuple(args, "OOOidOddl", &spec, &t_obj, &out_obj, &method, &rtol, &atol_obj, &h0, &hmax,
+                          &max_steps))
+        return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    Py_buffer outv = {0};
+    int have_out = 0;
+    if (parse_model(&a, spec, &m)) goto done;
+    Py_ssize_t n_out, n_atol;
+    const double *t_out = get_array(&a, t_obj, &n_out, "t_out");
+    if (PyErr_Occurred()) goto done;
+    if (n_out < 1) { PyErr_SetString(PyExc_ValueError, "t_out is empty"); goto done; }
+    int n = tf_model_nstate(&m), nch = tf_model_noutput(&m);
+    if (PyObject_GetBuffer(out_obj, &outv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
+    have_out = 1;
+    if (outv.itemsize != 8 || strcmp(outv.format, "d") != 0 || outv.len != (Py_ssize_t)(8 * n_out * nch)) {
+        PyErr_Format(PyExc_ValueError, "out must be a float64 array of shape (%zd, %d)", n_out, nch);
+        goto done;
+    }
+    double atol[TF_MAX_FRICTION_STATES + 8];
+    const double *atol_in = get_array(&a, atol_obj, &n_atol, "atol");
+    if (PyErr_Occurred()) goto done;
+    if (atol_in) {
+        if (n_atol != n) { PyErr_Format(PyExc_ValueError, "atol must have %d values", n); goto done; }
+        memcpy(atol, atol_in, sizeof(double) * n);
+    } else { /* default: rtol times each state's characteristic magnitude */
+        tf_model_state_scale(&m, atol);
+        for (int i = 0; i < n; i++) atol[i] *= rtol;
+    }
+    double y[TF_MAX_FRICTION_STATES + 8];
+    tf_model_initial_state(&m, y);
+    tf_ode ode = {n, &m, tf_model_rhs, tf_model_jac, tf_model_next_corner};
+    tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps};
+    tf_solver_stats st;
+    emit_ctx ec = {&m, (double *)outv.buf, nch};
+    int status;
+    Py_BEGIN_ALLOW_THREADS
+    status = tf_solve(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st);
+    Py_END_ALLOW_THREADS
+    if (status != TF_OK) {
+        PyObject *state = PyTuple_New(n);
+        for (int i = 0; i < n && state; i++) PyTuple_SET_ITEM(state, i, PyFloat_FromDouble(y[i]));
+        PyObject *exc_args = Py_BuildValue("(siddNi)", tf_status_message(status), status, st.t_fail, st.h_fail,
+                                           state, st.stiff_suspected);
+        if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+        goto done;
+    }
+    result = Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:i,s:d}", "steps", st.steps, "rejected", st.rejected,
+                           "rhs_evals", st.rhs_evals, "jac_evals", st.jac_evals, "decompositions",
+                           st.decompositions, "method", st.method_used, "switch_time", st.switch_time);
+done:
+    if (have_out) PyBuffer_Release(&outv);
+    arena_free(&a);
+    return result;
+}
+
+/* rhs_jac(spec, t, y, dy_out, J_out|None): one evaluation, for differential tests */
+static PyObject *py_rhs_jac(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *y_obj, *dy_obj, *J_obj;
+    double t;
+    if (!PyArg_ParseTuple(args, "OdOOO", &spec, &t, &y_obj, &dy_obj, &J_obj)) return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    Py_buffer dyv = {0}, Jv = {0};
+    int have_dy = 0, have_J = 0;
+    if (parse_model(&a, spec, &m)) goto done;
+    int n = tf_model_nstate(&m);
+    Py_ssize_t ny;
+    const double *y = get_array(&a, y_obj, &ny, "y");
+    if (PyErr_Occurred()) goto done;
+    if (ny != n) { PyErr_Format(PyExc_ValueError, "y must have %d values", n); goto done; }
+    if (PyObject_GetBuffer(dy_obj, &dyv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+    have_dy = 1;
+    if (dyv.len != 8 * n) { PyErr_SetString(PyExc_ValueError, "dy has the wrong size"); goto done; }
+    tf_model_rhs(t, y, (double *)dyv.buf, &m);
+    if (J_obj != Py_None) {
+        if (PyObject_GetBuffer(J_obj, &Jv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+        have_J = 1;
+        if (Jv.len != 8 * n * n) { PyErr_SetString(PyExc_ValueError, "J has the wrong size"); goto done; }
+        tf_model_jac(t, y, (double *)Jv.buf, &m);
+    }
+    result = PyFloat_FromDouble(tf_model_friction(&m, t, y));
+done:
+    if (have_dy) PyBuffer_Release(&dyv);
+    if (have_J) PyBuffer_Release(&Jv);
+    arena_free(&a);
+    return result;
+}
+
+/* law_eval(law, T, value_out, slope_out) */
+static PyObject *py_law_eval(PyObject *self, PyObject *args)
+{
+    PyObject *law_obj, *T_obj, *v_obj, *d_obj;
+    if (!PyArg_ParseTuple(args, "OOOO", &law_obj, &T_obj, &v_obj, &d_obj)) return NULL;
+    arena a = {0};
+    tf_law law;
+    PyObject *result = NULL;
+    Py_buffer vv = {0}, dv = {0};
+    int hv = 0, hd = 0;
+    Py_ssize_t nT;
+    if (parse_law(&a, law_obj, &law)) goto done;
+    const double *T = get_array(&a, T_obj, &nT, "T");
+    if (PyErr_Occurred()) goto done;
+    if (PyObject_GetBuffer(v_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+    hv = 1;
+    if (PyObject_GetBuffer(d_obj, &dv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+    hd = 1;
+    if (vv.len != 8 * nT || dv.len != 8 * nT) { PyErr_SetString(PyExc_ValueError, "output sizes differ from T"); goto done; }
+    for (Py_ssize_t i = 0; i < nT; i++) ((double *)vv.buf)[i] = tf_law_eval(&law, T[i], (double *)dv.buf + i);
+    result = Py_NewRef(Py_None);
+done:
+    if (hv) PyBuffer_Release(&vv);
+    if (hd) PyBuffer_Release(&dv);
+    arena_free(&a);
+    return result;
+}
+
+/* waveform_eval(wave, t, value_out) -> list of corners in [t[0], t[-1]] */
+static PyObject *py_waveform_eval(PyObject *self, PyObject *args)
+{
+    PyObject *w_obj, *t_obj, *v_obj;
+    if (!PyArg_ParseTuple(args, "OOO", &w_obj, &t_obj, &v_obj)) return NULL;
+    arena a = {0};
+    tf_waveform w;
+    PyObject *result = NULL;
+    Py_buffer vv = {0};
+    int hv = 0;
+    Py_ssize_t nt;
+    if (parse_waveform(&a, w_obj, &w)) goto done;
+    const double *t = get_array(&a, t_obj, &nt, "t");
+    if (PyErr_Occurred()) goto done;
+    if (PyObject_GetBuffer(v_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+    hv = 1;
+    if (vv.len != 8 * nt) { PyErr_SetString(PyExc_ValueError, "output size differs from t"); goto done; }
+    for (Py_ssize_t i = 0; i < nt; i++) ((double *)vv.buf)[i] = tf_waveform_value(&w, t[i]);
+    result = PyList_New(0);
+    if (nt > 0 && result) {
+        double c = t[0] - 1e-300;
+        for (int guard = 0; guard < 1000000; guard++) {
+            c = tf_waveform_next_corner(&w, c);
+            if (!(c <= t[nt - 1])) break;
+            PyObject *f = PyFloat_FromDouble(c);
+            PyList_Append(result, f);
+            Py_DECREF(f);
+        }
+    }
+done:
+    if (hv) PyBuffer_Release(&vv);
+    arena_free(&a);
+    return result;
+}
+
+static PyObject *py_nstate(PyObject *self, PyObject *args)
+{
+    int kind;
+    if (!PyArg_ParseTuple(args, "i", &kind)) return NULL;
+    return PyLong_FromLong(tf_friction_nstate(kind));
+}
+
+static PyMethodDef methods[] = {
+    {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
+    {"rhs_jac", py_rhs_jac, METH_VARARGS, "Right-hand side and Jacobian at one state; returns the friction force."},
+    {"law_eval", py_law_eval, METH_VARARGS, "Evaluate a temperature law and its slope on an array of T."},
+    {"waveform_eval", py_waveform_eval, METH_VARARGS, "Evaluate a waveform on an array of t; returns its corners."},
+    {"friction_nstate", py_nstate, METH_VARARGS, "Number of internal states of a friction model."},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_core", "thermofriction C core binding", -1, methods};
+
+PyMODINIT_FUNC PyInit__core(void)
+{
+    PyObject *mod = PyModule_Create(&module);
+    if (!mod) return NULL;
+    SolverError = PyErr_NewException("thermofriction._core.SolverError", NULL, NULL);
+    if (PyModule_AddObject(mod, "SolverError", SolverError) < 0) return NULL;
+    Py_INCREF(SolverError);
+    PyModule_AddIntConstant(mod, "NPARAM", TF_NPARAM);
+    PyModule_AddIntConstant(mod, "NFIXED_OUTPUTS", TF_OUT_NFIXED);
+    return mod;
+}

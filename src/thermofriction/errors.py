@@ -1,0 +1,32 @@
+"""Errors that the command line turns into one clear message and an exit status."""
+
+
+class ThermofrictionError(Exception):
+    """Base class; ``exit_status`` is what the command line exits with."""
+
+    exit_status = 1
+
+
+class InputError(ThermofrictionError, ValueError):
+    """Bad file, key, value or option (exit status 2)."""
+
+    exit_status = 2
+
+
+class ComputationError(ThermofrictionError, RuntimeError):
+    """A computation failed (exit status 1)."""
+
+    exit_status = 1
+
+
+class SolverError(ComputationError):
+    """The integrator stopped: ``time`` and ``state`` say where."""
+
+    def __init__(self, message, time=None, state=None):
+        super().__init__(message)
+        self.time = time
+        self.state = state
+
+
+class TemperatureRangeWarning(UserWarning):
+    """A temperature law was evaluated outside the range it was calibrated on."""

@@ -1,0 +1,637 @@
+"""Models: plants, friction models, temperature laws and thermal extensions (SPEC 3-5, 7).
+
+A :class:`Model` is one actuator: a plant, a friction model, an optional thermal extension
+and an optional input waveform. It loads from and saves to the model file (TOML) of SPEC 7;
+``load_model`` also takes the name of a shipped preset (``li2009-model-i``, ...).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from . import _core
+from ._io import atomic_write
+from .errors import InputError
+from .waveforms import Waveform, waveform_from_dict
+
+# ---------------------------------------------------------------------------------------------
+# Temperature laws
+# ---------------------------------------------------------------------------------------------
+
+_LAW_CODES = {"const": 1, "linear": 2, "exp": 3, "poly": 4, "pwl": 5, "table": 6}
+
+
+def _num(value, where, key):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{where}: '{key}' must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise InputError(f"{where}: '{key}' must be finite, got {value!r}")
+    return value
+
+
+def _num_array(value, where, key, min_len=1):
+    if not isinstance(value, (list, tuple, np.ndarray)) or len(value) < min_len:
+        raise InputError(f"{where}: '{key}' must be an array of at least {min_len} number(s)")
+    return np.array([_num(v, where, f"{key}[{i}]") for i, v in enumerate(value)], dtype=float)
+
+
+@dataclass(frozen=True, eq=False)
+class Law:
+    """A function of temperature T [degC]. ``range`` is the calibrated interval (or None).
+
+    Evaluated by the C core, the same code the simulator runs."""
+
+    kind = ""
+
+    def _core_tuple(self):
+        raise NotImplementedError
+
+    def __call__(self, T):
+        return self.evaluate(T)[0]
+
+    def evaluate(self, T):
+        """(value, dvalue/dT) at T (scalars or arrays)."""
+        T_arr = np.ascontiguousarray(np.atleast_1d(T), dtype=float)
+        v, d = np.empty_like(T_arr), np.empty_like(T_arr)
+        _core.law_eval(self._core_tuple(), T_arr, v, d)
+        if np.ndim(T) == 0:
+            return float(v[0]), float(d[0])
+        return v, d
+
+    def slope(self, T):
+        return self.evaluate(T)[1]
+
+    def in_range(self, T) -> bool:
+        rng = getattr(self, "range", None)
+        if rng is None:
+            return True
+        T = np.atleast_1d(T)
+        return bool(np.all((T >= rng[0] - 1e-9) & (T <= rng[1] + 1e-9)))
+
+    def to_dict(self) -> dict:
+        d = {"law": self.kind}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "range":
+                if v is not None:
+                    d["range"] = [float(v[0]), float(v[1])]
+            elif isinstance(v, np.ndarray):
+                d[f.name] = v.tolist()
+            else:
+                d[f.name] = v
+        return d
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.to_dict() == other.to_dict()
+
+    def __repr__(self):
+        args = ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "law")
+        return f"{type(self).__name__}({args})"
+
+
+def _check_range(rng, where):
+    if rng is None:
+        return None
+    r = _num_array(rng, where, "range", 2)
+    if len(r) != 2 or not r[0] < r[1]:
+        raise InputError(f"{where}: 'range' must be [low, high] with low < high, got {list(rng)!r}")
+    return (float(r[0]), float(r[1]))
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Const(Law):
+    value: float
+    range: tuple | None = None
+    kind = "const"
+
+    def _core_tuple(self):
+        return (1, float(self.value), 0.0, None, None)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Linear(Law):
+    """a T + b"""
+
+    a: float
+    b: float
+    range: tuple | None = None
+    kind = "linear"
+
+    def _core_tuple(self):
+        return (2, float(self.a), float(self.b), None, None)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Exp(Law):
+    """a exp(b T)"""
+
+    a: float
+    b: float
+    range: tuple | None = None
+    kind = "exp"
+
+    def _core_tuple(self):
+        return (3, float(self.a), float(self.b), None, None)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Poly(Law):
+    """sum c[i] T^i"""
+
+    c: np.ndarray
+    range: tuple | None = None
+    kind = "poly"
+
+    def __post_init__(self):
+        object.__setattr__(self, "c", np.ascontiguousarray(self.c, dtype=float))
+
+    def _core_tuple(self):
+        return (4, 0.0, 0.0, None, self.c)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PWL(Law):
+    """Linear through (T[i], values[i]); extrapolated linearly with the end segments."""
+
+    T: np.ndarray
+    values: np.ndarray
+    range: tuple | None = None
+    kind = "pwl"
+
+    def __post_init__(self):
+        object.__setattr__(self, "T", np.ascontiguousarray(self.T, dtype=float))
+        object.__setattr__(self, "values", np.ascontiguousarray(self.values, dtype=float))
+
+    def _core_tuple(self):
+        return (5, 0.0, 0.0, self.T, self.values)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Table(PWL):
+    """Monotone cubic (PCHIP) through (T[i], values[i]); extrapolated linearly with the end slopes."""
+
+    kind = "table"
+
+    def _core_tuple(self):
+        return (6, 0.0, 0.0, self.T, self.values)
+
+
+_LAW_CLASSES = {"const": Const, "linear": Linear, "exp": Exp, "poly": Poly, "pwl": PWL, "table": Table}
+_LAW_KEYS = {"const": ("value",), "linear": ("a", "b"), "exp": ("a", "b"), "poly": ("c",),
+             "pwl": ("T", "values"), "table": ("T", "values")}
+
+
+def law_from_dict(d, where: str) -> Law:
+    """A law from its inline table, e.g. ``{ law = "exp", a = 1.15e8, b = -0.136 }``."""
+    if not isinstance(d, dict):
+        raise InputError(f"{where}: a law must be a table such as {{ law = \"linear\", a = ..., b = ... }}")
+    kind = d.get("law")
+    if kind not in _LAW_CLASSES:
+        raise InputError(f"{where}: 'law' must be one of {', '.join(_LAW_CLASSES)}, got {kind!r}")
+    keys = _LAW_KEYS[kind]
+    unknown = set(d) - set(keys) - {"law", "range"}
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} for law '{kind}' "
+                         f"(allowed: {', '.join(keys)}, range)")
+    missing = [k for k in keys if k not in d]
+    if missing:
+        raise InputError(f"{where}: law '{kind}' needs {', '.join(missing)}")
+    rng = _check_range(d.get("range"), where)
+    if kind in ("const", "linear", "exp"):
+        return _LAW_CLASSES[kind](*(_num(d[k], where, k) for k in keys), range=rng)
+    if kind == "poly":
+        return Poly(_num_array(d["c"], where, "c"), range=rng)
+    T = _num_array(d["T"], where, "T")
+    values = _num_array(d["values"], where, "values")
+    if len(T) != len(values):
+        raise InputError(f"{where}: 'T' and 'values' must have the same length ({len(T)} != {len(values)})")
+    if np.any(np.diff(T) <= 0):
+        raise InputError(f"{where}: 'T' must increase strictly")
+    return _LAW_CLASSES[kind](T, values, range=rng)
+
+
+# ---------------------------------------------------------------------------------------------
+# Plants
+# ---------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class StickSlipPlant:
+    """Piezoelectric stick-slip actuator (SPEC 3.1): a stage (equivalent ``mass``, ``damping``,
+    ``stiffness``, driven through ``transducer_ratio`` T_em by the voltage) carrying, by friction,
+    an end effector of ``end_effector_mass``.
+
+    Give either the modal form (``damping_ratio`` xi, ``natural_frequency`` wn [rad/s], ``gain``
+    K [m/V]) or the physical one (``damping`` c, ``stiffness`` k, ``transducer_ratio`` T_em);
+    the other is derived (k = m wn^2, c = 2 xi wn m, T_em = K k). The form given is the form saved.
+    """
+
+    mass: float
+    end_effector_mass: float
+    damping_ratio: float | None = None
+    natural_frequency: float | None = None
+    gain: float | None = None
+    damping: float | None = None
+    stiffness: float | None = None
+    transducer_ratio: float | None = None
+
+    type = "stick-slip"
+    _MODAL = ("damping_ratio", "natural_frequency", "gain")
+    _PHYSICAL = ("damping", "stiffness", "transducer_ratio")
+    _SYMBOLS = {"mass": "m", "end_effector_mass": "m_e", "damping_ratio": "xi", "natural_frequency": "wn",
+                "gain": "K", "damping": "c", "stiffness": "k", "transducer_ratio": "T_em"}
+
+    def __post_init__(self):
+        where = "[plant]"
+        modal = [getattr(self, n) is not None for n in self._MODAL]
+        phys = [getattr(self, n) is not None for n in self._PHYSICAL]
+        if all(modal) == all(phys) or (any(modal) and any(phys)):
+            raise InputError(f"{where}: give either xi, wn and K (modal form) or c, k and T_em (physical form)")
+        for name in ("mass", "end_effector_mass", *(self._MODAL if all(modal) else self._PHYSICAL)):
+            sym = self._SYMBOLS[name]
+            v = _num(getattr(self, name), where, sym)
+            if name in ("mass", "end_effector_mass", "natural_frequency", "stiffness") and v <= 0:
+                raise InputError(f"{where}: '{sym}' must be positive, got {v!r}")
+            if name in ("damping_ratio", "damping") and v < 0:
+                raise InputError(f"{where}: '{sym}' must not be negative, got {v!r}")
+            object.__setattr__(self, name, v)
+
+    @property
+    def modal(self) -> bool:
+        return self.damping_ratio is not None
+
+    def physical(self):
+        """(c, k, T_em) in SI units."""
+        if self.modal:
+            k = self.mass * self.natural_frequency ** 2
+            return 2 * self.damping_ratio * self.natural_frequency * self.mass, k, self.gain * k
+        return self.damping, self.stiffness, self.transducer_ratio
+
+    def modal_parameters(self):
+        """(xi, wn, K)."""
+        if self.modal:
+            return self.damping_ratio, self.natural_frequency, self.gain
+        c, k, T_em = self.physical()
+        wn = math.sqrt(k / self.mass)
+        return c / (2 * wn * self.mass), wn, T_em / k
+
+    def to_dict(self) -> dict:
+        d = {"type": self.type}
+        for name in ("mass", "end_effector_mass", *(self._MODAL if self.modal else self._PHYSICAL)):
+            d[self._SYMBOLS[name]] = getattr(self, name)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[plant]"):
+        d = dict(d)
+        kind = d.pop("type", None)
+        if kind != "stick-slip":
+            if kind in ("mass", "prescribed"):
+                raise InputError(f"{where}: plant type '{kind}' is not available yet (only 'stick-slip')")
+            raise InputError(f"{where}: 'type' must be \"stick-slip\", got {kind!r}")
+        names = {sym: name for name, sym in cls._SYMBOLS.items()}
+        unknown = set(d) - set(names)
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(allowed: type, {', '.join(names)})")
+        for req in ("m", "m_e"):
+            if req not in d:
+                raise InputError(f"{where}: missing '{req}'")
+        return cls(**{names[k]: v for k, v in d.items()})
+
+
+# ---------------------------------------------------------------------------------------------
+# Friction models
+# ---------------------------------------------------------------------------------------------
+
+#: Parameter order of the C core (friction.h, tf_param).
+PARAMETERS = ("sigma0", "sigma1", "sigma2", "fc", "fs", "vs", "delta", "vd", "v_smooth", "z_ba")
+PARAMETER_UNITS = {"sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m", "fc": "N", "fs": "N", "vs": "m/s",
+                   "delta": "-", "vd": "m/s", "v_smooth": "m/s", "z_ba": "m"}
+
+
+@dataclass(frozen=True)
+class LuGre:
+    """LuGre friction (Canudas de Wit et al. 1995), SPEC 4::
+
+        z' = v - sigma0 |v| z / g(v),   F = sigma0 z + sigma1(v) z' + sigma2 v
+        g(v) = fc + (fs - fc) exp(-|v/vs|^delta),   sigma1(v) = sigma1 exp(-(v/vd)^2) if vd
+
+    A parameter that follows a Model I law is None here (the law lives in the thermal model).
+    ``fs`` defaults to ``fc`` (no Stribeck effect, the paper's case). ``v_smooth`` is the velocity
+    band of the smoothed sign used by Model II's offset form.
+    """
+
+    sigma0: float | None
+    sigma1: float | None
+    fc: float | None
+    sigma2: float | None = 0.0
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    vd: float | None = None
+    v_smooth: float = 1e-6
+
+    model = "lugre"
+    core_code = 0
+    nstate = 1
+    state_names = ("z",)
+    state_units = ("m",)
+    required = ("sigma0", "sigma1", "fc")
+
+    def values(self) -> dict:
+        """Parameters given as numbers (None-valued ones omitted)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+
+    def to_dict(self) -> dict:
+        d = {"model": self.model}
+        d.update(self.values())
+        return d
+
+    def with_values(self, **values) -> "LuGre":
+        return replace(self, **values)
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[friction]"):
+        d = dict(d)
+        d.pop("model", None)
+        allowed = [f.name for f in fields(cls)]
+        unknown = set(d) - set(allowed)
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} for lugre "
+                             f"(allowed: {', '.join(allowed)})")
+        for k, v in d.items():
+            d[k] = _num(v, where, k)
+        kw = {k: d.get(k) for k in cls.required}
+        kw.update({k: v for k, v in d.items() if k not in cls.required})
+        return cls(**kw)
+
+
+FRICTION_MODELS = {"lugre": LuGre}
+_NOT_YET = ("coulomb", "stribeck", "dahl", "elastoplastic", "gms")
+
+
+def check_friction_values(values: dict, where: str):
+    """Physical checks on a full set of parameter values (numbers and laws evaluated)."""
+    def need(name, ok, what):
+        v = values.get(name)
+        if v is not None and not ok(v):
+            raise InputError(f"{where}: '{name}' must be {what}, got {v!r}")
+    need("sigma0", lambda v: v > 0, "positive")
+    need("sigma1", lambda v: v >= 0, "non-negative")
+    need("sigma2", lambda v: v >= 0, "non-negative")
+    need("fc", lambda v: v > 0, "positive")
+    need("delta", lambda v: v > 0, "positive")
+    need("vd", lambda v: v > 0, "positive")
+    need("v_smooth", lambda v: v > 0, "positive")
+    fs, fc = values.get("fs"), values.get("fc")
+    if fs is not None and fc is not None and fs < fc:
+        raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r})")
+    if fs is not None and fc is not None and fs != fc:
+        vs = values.get("vs")
+        if vs is None or not vs > 0:
+            raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}")
+
+
+# ---------------------------------------------------------------------------------------------
+# Thermal extensions
+# ---------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class ModelI:
+    """Model I (SPEC 5.1): parameters of the base model follow laws of temperature."""
+
+    laws: dict = field(default_factory=dict)
+    model = "I"
+
+    def to_dict(self):
+        d = {"model": "I"}
+        d.update({k: law.to_dict() for k, law in self.laws.items()})
+        return d
+
+
+@dataclass(frozen=True)
+class ModelII:
+    """Model II (SPEC 5.2): base model plus thermal-induced friction dF(T) [N].
+
+    ``form="scale"`` (default): F' = (1 + dF(T)/F_ref) F_base, F_ref the base model's steady
+    sliding friction (fc) -- Eq. (12) in steady sliding, smooth and passive through v = 0.
+    ``form="offset"``: F' = F_base + dF(T) s(v), s a sign smoothed over ``v_smooth``."""
+
+    dF: Law
+    form: str = "scale"
+    model = "II"
+
+    def __post_init__(self):
+        if self.form not in ("scale", "offset"):
+            raise InputError(f"[thermal]: 'form' must be \"scale\" or \"offset\", got {self.form!r}")
+
+    def to_dict(self):
+        return {"model": "II", "form": self.form, "dF": self.dF.to_dict()}
+
+
+# ---------------------------------------------------------------------------------------------
+# The model
+# ---------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Model:
+    """One actuator: plant, friction model, thermal extension (or None) and input (or None)."""
+
+    plant: StickSlipPlant
+    friction: LuGre
+    thermal: ModelI | ModelII | None = None
+    input: Waveform | None = None
+    name: str | None = None
+    description: str | None = None
+
+    def __post_init__(self):
+        laws = self.thermal.laws if isinstance(self.thermal, ModelI) else {}
+        given = self.friction.values()
+        for pname, law in laws.items():
+            if pname not in PARAMETERS or pname not in [f.name for f in fields(self.friction)]:
+                raise InputError(f"[thermal]: '{pname}' is not a parameter of {self.friction.model}")
+            if pname in given:
+                raise InputError(f"'{pname}' is given both as a number in [friction] and as a law in "
+                                 f"[thermal]; give it once")
+            if not isinstance(law, Law):
+                raise InputError(f"[thermal]: '{pname}' must be a law")
+        for pname in self.friction.required:
+            if pname not in given and pname not in laws:
+                raise InputError(f"[friction]: missing '{pname}' (a number here, or a law in [thermal])")
+        check_friction_values(self._number_values(), "[friction]")
+        if isinstance(self.thermal, ModelII):
+            if not isinstance(self.thermal.dF, Law):
+                raise InputError("[thermal]: 'dF' must be a law")
+
+    def _number_values(self):
+        v = self.friction.values()
+        if "fs" not in v and "fc" in v:
+            v["fs"] = v["fc"]
+        return v
+
+    # -- parameters at a temperature ------------------------------------------------------
+    @property
+    def laws(self) -> dict:
+        return dict(self.thermal.laws) if isinstance(self.thermal, ModelI) else {}
+
+    def parameters_at(self, T: float) -> dict:
+        """Every friction parameter's value at temperature T (Model I laws applied)."""
+        v = self.friction.values()
+        for pname, law in self.laws.items():
+            v[pname] = law(float(T))
+        if "fs" not in v:
+            v["fs"] = v["fc"]
+        return v
+
+    def reference_force(self) -> float:
+        """F_ref of Model II's scale form: the base model's steady sliding friction level."""
+        return float(self.friction.fc)
+
+    def thermal_factor(self, T):
+        """lambda(T) = 1 + dF(T)/F_ref of Model II's scale form (1 for other models)."""
+        if not isinstance(self.thermal, ModelII) or self.thermal.form != "scale":
+            return np.ones_like(np.asarray(T, float)) if np.ndim(T) else 1.0
+        return 1.0 + self.thermal.dF(T) / self.reference_force()
+
+    @property
+    def depends_on_temperature(self) -> bool:
+        return self.thermal is not None
+
+    def temperature_range(self):
+        """The intersection of the calibrated ranges of the model's laws (None if none)."""
+        laws = list(self.laws.values())
+        if isinstance(self.thermal, ModelII):
+            laws.append(self.thermal.dF)
+        ranges = [law.range for law in laws if law.range is not None]
+        if not ranges:
+            return None
+        return (max(r[0] for r in ranges), min(r[1] for r in ranges))
+
+    # -- files ---------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {}
+        if self.name:
+            d["name"] = self.name
+        if self.description:
+            d["description"] = self.description
+        d["plant"] = self.plant.to_dict()
+        d["friction"] = self.friction.to_dict()
+        d["thermal"] = self.thermal.to_dict() if self.thermal else {"model": "none"}
+        if self.input is not None:
+            d["input"] = self.input.to_dict()
+        return d
+
+    def to_toml(self) -> str:
+        return tomli_w.dumps(self.to_dict())
+
+    def save(self, path):
+        """Writes the model file atomically (temporary file, then rename)."""
+        text = self.to_toml()
+        with atomic_write(path, "w") as fh:
+            fh.write(text)
+
+    def with_friction(self, **values) -> "Model":
+        return replace(self, friction=self.friction.with_values(**values))
+
+
+_TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "input"}
+
+
+def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
+    """Builds a model from a parsed model file; errors name the file and the key."""
+    try:
+        unknown = set(d) - _TOP_KEYS
+        if unknown:
+            raise InputError(f"unknown key(s) or section(s) {', '.join(sorted(unknown))} "
+                             f"(allowed: {', '.join(sorted(_TOP_KEYS))})")
+        for sec in ("plant", "friction"):
+            if not isinstance(d.get(sec), dict):
+                raise InputError(f"missing section [{sec}]")
+        plant = StickSlipPlant.from_dict(d["plant"])
+        fmodel = d["friction"].get("model")
+        if fmodel in _NOT_YET:
+            raise InputError(f"[friction]: model '{fmodel}' is not available yet (only 'lugre')")
+        if fmodel not in FRICTION_MODELS:
+            raise InputError(f"[friction]: 'model' must be one of {', '.join(FRICTION_MODELS)}, got {fmodel!r}")
+        th = d.get("thermal", {"model": "none"})
+        if not isinstance(th, dict):
+            raise InputError("[thermal] must be a section")
+        th = dict(th)
+        tkind = th.pop("model", "none")
+        if tkind == "I":
+            laws = {}
+            for k, v in th.items():
+                if k in d["friction"]:
+                    raise InputError(f"'{k}' is given both as a number in [friction] and as a law in "
+                                     f"[thermal]; give it once")
+                if k not in PARAMETERS:
+                    raise InputError(f"[thermal]: unknown key '{k}' (a Model I law must be named after a "
+                                     f"friction parameter: {', '.join(PARAMETERS)})")
+                laws[k] = law_from_dict(v, f"[thermal] {k}")
+            thermal = ModelI(laws)
+        elif tkind == "II":
+            unknown = set(th) - {"dF", "form"}
+            if unknown:
+                raise InputError(f"[thermal]: unknown key(s) {', '.join(sorted(unknown))} for Model II "
+                                 f"(allowed: dF, form)")
+            if "dF" not in th:
+                raise InputError("[thermal]: Model II needs 'dF', a law of temperature")
+            thermal = ModelII(law_from_dict(th["dF"], "[thermal] dF"), th.get("form", "scale"))
+        elif tkind == "none":
+            if th:
+                raise InputError(f"[thermal]: unknown key(s) {', '.join(sorted(th))} for model \"none\"")
+            thermal = None
+        else:
+            raise InputError(f"[thermal]: 'model' must be \"none\", \"I\" or \"II\", got {tkind!r}")
+        friction = FRICTION_MODELS[fmodel].from_dict(d["friction"])
+        inp = waveform_from_dict(d["input"], "[input]", base_dir) if "input" in d else None
+        for key in ("name", "description"):
+            if key in d and not isinstance(d[key], str):
+                raise InputError(f"'{key}' must be a string")
+        return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"))
+    except InputError as e:
+        raise InputError(f"{source}: {e}") from None
+
+
+PRESETS = ("li2009-model-i", "li2009-model-ii", "li2009-base")
+
+
+def preset_path(name: str):
+    return resources.files("thermofriction").joinpath("presets", f"{name}.toml")
+
+
+def load_model(source) -> Model:
+    """Loads a model file, or a shipped preset by name (see ``PRESETS``)."""
+    source = os.fspath(source)
+    p = Path(source)
+    if not p.exists() and source in PRESETS:
+        ref = preset_path(source)
+        text = ref.read_text()
+        base_dir = None
+    else:
+        if not p.exists():
+            hint = f" (presets: {', '.join(PRESETS)})" if os.sep not in source and not source.endswith(".toml") else ""
+            raise InputError(f"{source}: no such file{hint}")
+        try:
+            text = p.read_text()
+        except (OSError, UnicodeDecodeError) as e:
+            raise InputError(f"{source}: cannot read ({e})") from None
+        base_dir = p.parent
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{source}: TOML syntax error: {e}") from None
+    return model_from_dict(data, source, base_dir)
+
+
+__all__ = ["Law", "Const", "Linear", "Exp", "Poly", "PWL", "Table", "law_from_dict", "StickSlipPlant", "LuGre",
+           "ModelI", "ModelII", "Model", "load_model", "model_from_dict", "PARAMETERS", "PRESETS"]

@@ -1,0 +1,349 @@
+"""Simulation: ``simulate(model, duration, temperature=..., input=...)`` on the C core.
+
+Solvers are objects you pass in (``Dopri5()``, ``Rodas4()``, ``AutoSwitch()``), separate from the
+step-size controller (``StepSizeController(rtol=..., atol=...)``). Results come on a uniform
+output grid from the solver's dense output, with per-cycle step sizes for periodic inputs.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _core
+from ._io import atomic_write
+from .errors import InputError, SolverError, TemperatureRangeWarning
+from .models import PARAMETERS, Model, ModelI, ModelII, check_friction_values
+from .waveforms import Sampled, Waveform, Zero
+
+# ---------------------------------------------------------------------------------------------
+# Solvers and the step-size controller
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Dopri5:
+    """Dormand-Prince 5(4), explicit, 4th-order dense output. Best for non-stiff models."""
+
+    code = 1
+    name = "dopri5"
+
+
+@dataclass(frozen=True)
+class Rodas4:
+    """Rodas4 (Hairer-Wanner), a 4(3) L-stable Rosenbrock method with analytic Jacobian and
+    3rd-order dense output. For stiff models (stiff bristles, light end effectors)."""
+
+    code = 2
+    name = "rodas4"
+
+
+@dataclass(frozen=True)
+class AutoSwitch:
+    """Dopri5 until its stiffness test fires, then Rodas4 for the rest of the run (default)."""
+
+    code = 0
+    name = "auto"
+
+
+SOLVERS = {"auto": AutoSwitch, "dopri5": Dopri5, "rodas4": Rodas4}
+
+
+@dataclass(frozen=True)
+class StepSizeController:
+    """Error control: a step is accepted when the RMS over states of
+    ``err_i / (atol_i + rtol * |y_i|)`` is at most 1.
+
+    ``atol=None`` scales the absolute tolerance to each state: ``rtol`` times its characteristic
+    magnitude (stage stroke for positions, stroke x natural frequency for velocities, fc/sigma0
+    for the bristle deflection), so that micrometre motions are controlled as tightly as metres.
+    """
+
+    rtol: float = 1e-6
+    atol: float | tuple | None = None
+    first_step: float | None = None
+    max_step: float | None = None
+    max_steps: int = 10_000_000
+
+    def __post_init__(self):
+        if not (isinstance(self.rtol, (int, float)) and 0 < self.rtol < 1):
+            raise InputError(f"rtol must be between 0 and 1, got {self.rtol!r}")
+        if self.max_steps < 1:
+            raise InputError(f"max_steps must be positive, got {self.max_steps!r}")
+
+
+# ---------------------------------------------------------------------------------------------
+# Results
+# ---------------------------------------------------------------------------------------------
+
+_CHANNELS = ("time", "input", "stage_displacement", "stage_velocity", "displacement", "velocity",
+             "relative_displacement", "relative_velocity", "friction_force", "temperature")
+
+
+@dataclass(eq=False)
+class SimulationResult:
+    """Plain arrays with named fields (SI units; temperature in degC).
+
+    ``displacement``/``velocity`` are the driven body's (the end effector's);
+    ``relative_displacement`` is x_e - x_p; ``states`` holds the friction model's internal
+    states (columns named by ``state_names``). For periodic inputs ``cycle_times`` are the
+    period starts, ``step_sizes[k]`` the displacement over cycle k, ``mean_velocity`` the mean
+    of the step sizes times the frequency."""
+
+    time: np.ndarray
+    input: np.ndarray
+    stage_displacement: np.ndarray
+    stage_velocity: np.ndarray
+    displacement: np.ndarray
+    velocity: np.ndarray
+    relative_displacement: np.ndarray
+    relative_velocity: np.ndarray
+    friction_force: np.ndarray
+    temperature: np.ndarray
+    states: np.ndarray
+    state_names: tuple
+    state_units: tuple
+    cycle_times: np.ndarray
+    step_sizes: np.ndarray
+    mean_velocity: float
+    input_unit: str = "V"
+    stats: dict = field(default_factory=dict)
+
+    def columns(self) -> dict:
+        """The CSV columns of SPEC 7, header -> array."""
+        cols = {
+            "time[s]": self.time,
+            f"input[{self.input_unit}]": self.input,
+            "stage_displacement[m]": self.stage_displacement,
+            "displacement[m]": self.displacement,
+            "velocity[m/s]": self.velocity,
+            "friction_force[N]": self.friction_force,
+            "temperature[C]": self.temperature,
+        }
+        for j, (name, unit) in enumerate(zip(self.state_names, self.state_units)):
+            cols[f"{name}[{unit}]"] = self.states[:, j]
+        return cols
+
+    def to_dataframe(self):
+        """A pandas DataFrame of every output (pandas is an optional dependency)."""
+        try:
+            import pandas as pd
+        except ImportError:  # pragma: no cover - depends on the environment
+            raise ImportError("to_dataframe() needs pandas: pip install 'thermofriction[dataframe]'") from None
+        data = {name: getattr(self, name) for name in _CHANNELS}
+        for j, name in enumerate(self.state_names):
+            data[name] = self.states[:, j]
+        return pd.DataFrame(data)
+
+    def to_csv(self, path):
+        """Writes the SPEC 7 simulation CSV atomically."""
+        cols = self.columns()
+        table = np.column_stack(list(cols.values()))
+        with atomic_write(path, "w", newline="") as fh:
+            fh.write(",".join(cols) + "\n")
+            np.savetxt(fh, table, delimiter=",", fmt="%.12g")
+
+    def __repr__(self):
+        return (f"SimulationResult({len(self.time)} samples over {self.time[-1] - self.time[0]:.6g} s, "
+                f"final displacement {self.displacement[-1]:.6g} m, {len(self.step_sizes)} cycles)")
+
+
+# ---------------------------------------------------------------------------------------------
+# The model as the C core sees it
+# ---------------------------------------------------------------------------------------------
+
+def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> dict:
+    """The dict the binding unpacks into a tf_model (see _core.c)."""
+    c, k, T_em = model.plant.physical()
+    values = model.friction.values()
+    values.setdefault("fs", values.get("fc", 0.0))
+    values.setdefault("vs", 1e-3)
+    params = np.zeros(len(PARAMETERS))
+    for i, name in enumerate(PARAMETERS):
+        v = values.get(name)
+        params[i] = 0.0 if v is None else v
+    laws = None
+    if isinstance(model.thermal, ModelI):
+        laws = [model.thermal.laws[n]._core_tuple() if n in model.thermal.laws else None for n in PARAMETERS]
+        if model.friction.fs is None and "fs" not in model.thermal.laws and "fc" in model.thermal.laws:
+            laws[PARAMETERS.index("fs")] = laws[PARAMETERS.index("fc")]  # no Stribeck: fs follows fc
+    T_const, T_t, T_v = math.nan, None, None
+    if isinstance(temperature, Sampled):
+        T_t, T_v = temperature.time, temperature.value
+    elif temperature is not None:
+        T_const = float(temperature)
+    waveform = input if input is not None else (model.input or Zero())
+    return {
+        "plant": 0, "m": model.plant.mass, "c": c, "k": k, "T_em": T_em, "m_e": model.plant.end_effector_mass,
+        "friction": model.friction.core_code, "params": params,
+        "thermal": 1 if isinstance(model.thermal, ModelI) else 2 if isinstance(model.thermal, ModelII) else 0,
+        "laws": laws,
+        "dF": model.thermal.dF._core_tuple() if isinstance(model.thermal, ModelII) else None,
+        "dF_form": 1 if isinstance(model.thermal, ModelII) and model.thermal.form == "offset" else 0,
+        "input": waveform._core_tuple(), "T_const": T_const, "T_t": T_t, "T_v": T_v,
+    }
+
+
+def as_temperature(temperature):
+    """A number, a ``Sampled`` signal, or a (times, values) pair -> number or Sampled."""
+    if temperature is None or isinstance(temperature, Sampled):
+        return temperature
+    if isinstance(temperature, (tuple, list)) and len(temperature) == 2:
+        return Sampled(np.asarray(temperature[0], float), np.asarray(temperature[1], float))
+    try:
+        T = float(temperature)
+    except (TypeError, ValueError):
+        raise InputError(f"temperature must be a number [degC] or (times, values), got {temperature!r}") from None
+    if not math.isfinite(T):
+        raise InputError(f"temperature must be finite, got {temperature!r}")
+    return T
+
+
+def check_temperatures(model: Model, temperature):
+    """Warns for temperatures outside a law's calibrated range; raises where the model is
+    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain)."""
+    if model.thermal is None:
+        return
+    if temperature is None:
+        raise InputError("the model depends on temperature: give a temperature (e.g. --temperature 35)")
+    if isinstance(temperature, Sampled):
+        lo, hi = float(temperature.value.min()), float(temperature.value.max())
+        Ts = np.unique(np.concatenate([temperature.value, np.linspace(lo, hi, 201)]))
+    else:
+        Ts = np.array([float(temperature)])
+    laws = dict(model.laws)
+    if isinstance(model.thermal, ModelII):
+        laws["dF"] = model.thermal.dF
+    for name, law in laws.items():
+        if not law.in_range(Ts):
+            warnings.warn(f"temperature {Ts.min():g}..{Ts.max():g} C is outside the range {law.range[0]:g}.."
+                          f"{law.range[1]:g} C that the law for '{name}' was calibrated on",
+                          TemperatureRangeWarning, stacklevel=3)
+    if isinstance(model.thermal, ModelI):
+        for T in (Ts.min(), Ts.max()) if len(Ts) > 1 else Ts:
+            check_friction_values(model.parameters_at(T), f"Model I at {T:g} C")
+        if len(Ts) > 2:
+            for name, law in model.laws.items():
+                vals = law(Ts)
+                if name in ("sigma0", "fc") and np.any(vals <= 0):
+                    T_bad = Ts[np.argmax(vals <= 0)]
+                    raise InputError(f"Model I: '{name}' is not positive at {T_bad:g} C ({law(T_bad):g})")
+    if isinstance(model.thermal, ModelII) and model.thermal.form == "scale":
+        lam = np.atleast_1d(model.thermal_factor(Ts))
+        if np.any(lam <= 0):
+            i = int(np.argmin(lam))
+            raise InputError(f"Model II: lambda(T) = 1 + dF(T)/F_ref is {lam[i]:.4g} <= 0 at {Ts[i]:g} C "
+                             f"(dF = {model.thermal.dF(Ts[i]):.4g} N, F_ref = fc = {model.reference_force():.4g} N): "
+                             f"the thermal term would reverse friction")
+
+
+# ---------------------------------------------------------------------------------------------
+# simulate
+# ---------------------------------------------------------------------------------------------
+
+def _grid(duration, sample_rate):
+    if not (duration > 0 and math.isfinite(duration)):
+        raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
+    if not (sample_rate > 0 and math.isfinite(sample_rate)):
+        raise InputError(f"sample rate must be positive, got {sample_rate!r}")
+    n = int(math.floor(duration * sample_rate * (1 + 1e-12))) + 1
+    if n > 200_000_000:
+        raise InputError(f"{n} output samples requested: lower the duration or the sample rate")
+    t = np.arange(n) / sample_rate
+    return t
+
+
+def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
+             sample_rate: float = 10_000.0, t_eval=None, solver=None,
+             controller: StepSizeController | None = None) -> SimulationResult:
+    """Simulates ``model`` from rest.
+
+    temperature: constant [degC], a ``Sampled`` signal, or (times, values); required for
+        thermal models.
+    input: a waveform overriding the model's ``[input]``.
+    duration, sample_rate: a uniform output grid from 0 to duration; or t_eval, any
+        non-decreasing grid starting at the initial time.
+    solver: ``AutoSwitch()`` (default), ``Dopri5()`` or ``Rodas4()``.
+    controller: ``StepSizeController`` (tolerances, step limits).
+    """
+    solver = solver or AutoSwitch()
+    if isinstance(solver, str):
+        if solver not in SOLVERS:
+            raise InputError(f"unknown solver '{solver}' (one of: {', '.join(SOLVERS)})")
+        solver = SOLVERS[solver]()
+    controller = controller or StepSizeController()
+    temperature = as_temperature(temperature)
+    check_temperatures(model, temperature)
+    waveform = input if input is not None else (model.input or Zero())
+    if t_eval is not None:
+        t_grid = np.ascontiguousarray(t_eval, dtype=float)
+        if t_grid.ndim != 1 or t_grid.size < 1 or np.any(np.diff(t_grid) < 0) or not np.all(np.isfinite(t_grid)):
+            raise InputError("t_eval must be a non-empty, non-decreasing array of finite times")
+    else:
+        if duration is None:
+            raise InputError("give a duration (seconds) or t_eval")
+        t_grid = _grid(float(duration), float(sample_rate))
+    t0, t1 = float(t_grid[0]), float(t_grid[-1])
+
+    # period boundaries join the grid so that per-cycle step sizes are exact, not interpolated
+    period = waveform.period
+    cycle_times = np.empty(0)
+    if period is not None:
+        k0 = math.ceil(t0 / period - 1e-9)
+        cycle_times = np.arange(k0, math.floor(t1 / period + 1e-9) + 1) * period
+    t_all = np.union1d(t_grid, cycle_times) if cycle_times.size else t_grid
+    nstate = 4 + model.friction.nstate
+    nch = _core.NFIXED_OUTPUTS + model.friction.nstate
+    out = np.empty((t_all.size, nch))
+    atol = controller.atol
+    if atol is not None:
+        atol = np.broadcast_to(np.asarray(atol, float), (nstate,)).copy()
+        if np.any(atol <= 0):
+            raise InputError("atol must be positive")
+    spec = core_spec(model, temperature, waveform)
+    try:
+        stats = _core.simulate(spec, t_all, out, solver.code, float(controller.rtol), atol,
+                               float(controller.first_step or 0.0), float(controller.max_step or 0.0),
+                               int(controller.max_steps))
+    except _core.SolverError as e:
+        message, status, t_fail, h_fail, state, stiff = e.args
+        names = ("x_p", "v_p", "x_e", "v_e") + tuple(model.friction.state_names)
+        where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, state))
+        hint = ""
+        if status == 3:
+            hint = f"; raise max_steps (now {controller.max_steps})"
+            if stiff:
+                hint = "; the problem looks stiff: use the stiff solver (Rodas4, --method rodas4)" + hint
+        elif status in (1, 2):
+            hint = "; check the parameters for extreme or inconsistent values"
+        raise SolverError(f"integration failed at t = {t_fail:.9g} s (step {h_fail:.3g} s): {message}; "
+                          f"state {where}{hint}", time=t_fail, state=state) from None
+    stats["solver"] = {0: "auto", 1: "dopri5", 2: "rodas4"}[stats.pop("method")]
+    if cycle_times.size:
+        on_grid = np.isin(t_all, t_grid)
+        at_cycles = np.searchsorted(t_all, cycle_times)
+        x_cycles = out[at_cycles, 4]
+        out = out[on_grid]
+    else:
+        x_cycles = np.empty(0)
+    steps = np.diff(x_cycles)
+    cols = {name: np.ascontiguousarray(out[:, i]) for i, name in enumerate(_CHANNELS)}
+    if temperature is None:
+        cols["temperature"][:] = math.nan
+    return SimulationResult(
+        **cols,
+        states=np.ascontiguousarray(out[:, len(_CHANNELS):]),
+        state_names=model.friction.state_names,
+        state_units=model.friction.state_units,
+        cycle_times=cycle_times,
+        step_sizes=steps,
+        mean_velocity=float(steps.mean() / period) if steps.size else math.nan,
+        stats=stats,
+    )
+
+
+__all__ = ["simulate", "SimulationResult", "Dopri5", "Rodas4", "AutoSwitch", "StepSizeController", "SOLVERS",
+           "core_spec"]

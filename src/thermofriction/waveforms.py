@@ -1,0 +1,342 @@
+"""Input waveforms (SPEC 6): what drives a plant, in volts (or newtons, or metres).
+
+Each waveform is evaluated by the C core, so the integrator and these objects agree exactly,
+and exposes its corner times (where it or its slope jumps); the integrator stops at every one.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import MISSING, dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from . import _core
+from .errors import InputError
+
+_ZERO, _SAWTOOTH, _SINE, _SQUARE, _STEP, _SAMPLED = range(6)
+
+
+def _finite(name, value, where):
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: '{name}' must be a number, got {value!r}") from None
+    if not math.isfinite(value):
+        raise InputError(f"{where}: '{name}' must be finite, got {value!r}")
+    return value
+
+
+def _positive(name, value, where):
+    value = _finite(name, value, where)
+    if value <= 0:
+        raise InputError(f"{where}: '{name}' must be positive, got {value!r}")
+    return value
+
+
+class Waveform:
+    """Common interface: ``w(t)``, ``w.corners(t0, t1)``, ``w.period``, ``w.to_dict()``."""
+
+    kind = "zero"
+    period: float | None = None
+
+    def _core_tuple(self):
+        raise NotImplementedError
+
+    def __call__(self, t):
+        t = np.ascontiguousarray(np.atleast_1d(t), dtype=float)
+        out = np.empty_like(t)
+        _core.waveform_eval(self._core_tuple(), t, out)
+        return out
+
+    def corners(self, t0: float, t1: float) -> np.ndarray:
+        """Corner times in [t0, t1]."""
+        out = np.empty(2)
+        return np.array(_core.waveform_eval(self._core_tuple(), np.array([t0, t1], float), out))
+
+    def to_dict(self) -> dict:
+        d = {"waveform": self.kind}
+        d.update({f.name: getattr(self, f.name) for f in fields(self)})
+        return d
+
+    def spec(self) -> str:
+        """The ``--input`` form of this waveform."""
+        return self.kind + ":" + ",".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "waveform")
+
+
+@dataclass(frozen=True)
+class Zero(Waveform):
+    kind = "zero"
+
+    def _core_tuple(self):
+        return (_ZERO, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, None, None)
+
+
+@dataclass(frozen=True)
+class Sawtooth(Waveform):
+    """Rises linearly for ``rise`` of each period from ``offset`` to ``offset + amplitude``,
+    falls linearly in the rest. ``direction=-1`` mirrors it in time (fast rise, slow fall),
+    which drives a stick-slip actuator the other way with the same, unipolar voltage range."""
+
+    amplitude: float
+    frequency: float
+    rise: float = 0.99
+    offset: float = 0.0
+    direction: int = 1
+    kind = "sawtooth"
+
+    def __post_init__(self):
+        w = "sawtooth"
+        object.__setattr__(self, "amplitude", _finite("amplitude", self.amplitude, w))
+        object.__setattr__(self, "frequency", _positive("frequency", self.frequency, w))
+        object.__setattr__(self, "offset", _finite("offset", self.offset, w))
+        rise = _finite("rise", self.rise, w)
+        if not 0 < rise < 1:
+            raise InputError(f"sawtooth: 'rise' must be between 0 and 1 (exclusive), got {rise!r}")
+        object.__setattr__(self, "rise", rise)
+        if self.direction not in (1, -1):
+            raise InputError(f"sawtooth: 'direction' must be +1 or -1, got {self.direction!r}")
+        object.__setattr__(self, "direction", int(self.direction))
+
+    @property
+    def period(self):
+        return 1.0 / self.frequency
+
+    def _core_tuple(self):
+        return (_SAWTOOTH, self.amplitude, self.frequency, self.rise, self.offset, float(self.direction),
+                0.0, 0.0, None, None)
+
+
+@dataclass(frozen=True)
+class Sine(Waveform):
+    """``offset + amplitude * sin(2 pi frequency t)``: starts at ``offset``, rising."""
+
+    amplitude: float
+    frequency: float
+    offset: float = 0.0
+    kind = "sine"
+
+    def __post_init__(self):
+        object.__setattr__(self, "amplitude", _finite("amplitude", self.amplitude, "sine"))
+        object.__setattr__(self, "frequency", _positive("frequency", self.frequency, "sine"))
+        object.__setattr__(self, "offset", _finite("offset", self.offset, "sine"))
+
+    @property
+    def period(self):
+        return 1.0 / self.frequency
+
+    def _core_tuple(self):
+        return (_SINE, self.amplitude, self.frequency, 0.0, self.offset, 1.0, 0.0, 0.0, None, None)
+
+
+@dataclass(frozen=True)
+class Square(Waveform):
+    """Between ``offset`` and ``offset + amplitude``: ramps up over ``slew`` seconds at the start
+    of each period, holds, ramps down over ``slew`` at ``duty`` of the period, holds."""
+
+    amplitude: float
+    frequency: float
+    slew: float
+    offset: float = 0.0
+    duty: float = 0.5
+    kind = "square"
+
+    def __post_init__(self):
+        w = "square"
+        object.__setattr__(self, "amplitude", _finite("amplitude", self.amplitude, w))
+        f = _positive("frequency", self.frequency, w)
+        object.__setattr__(self, "frequency", f)
+        slew = _positive("slew", self.slew, w)
+        duty = _finite("duty", self.duty, w)
+        if not 0 < duty < 1:
+            raise InputError(f"square: 'duty' must be between 0 and 1 (exclusive), got {duty!r}")
+        if slew >= duty / f or slew >= (1 - duty) / f:
+            raise InputError(f"square: 'slew' ({slew!r} s) must be shorter than the high and low parts of the period")
+        object.__setattr__(self, "slew", slew)
+        object.__setattr__(self, "duty", duty)
+        object.__setattr__(self, "offset", _finite("offset", self.offset, w))
+
+    @property
+    def period(self):
+        return 1.0 / self.frequency
+
+    def _core_tuple(self):
+        return (_SQUARE, self.amplitude, self.frequency, self.duty, self.offset, 1.0, self.slew, 0.0, None, None)
+
+
+@dataclass(frozen=True)
+class Step(Waveform):
+    """``offset`` before ``time``, ``offset + amplitude`` after, ramped over ``slew`` seconds
+    (``slew=0``: an ideal step, which the integrator handles exactly by stopping there)."""
+
+    amplitude: float
+    time: float = 0.0
+    slew: float = 0.0
+    offset: float = 0.0
+    kind = "step"
+
+    def __post_init__(self):
+        object.__setattr__(self, "amplitude", _finite("amplitude", self.amplitude, "step"))
+        object.__setattr__(self, "time", _finite("time", self.time, "step"))
+        slew = _finite("slew", self.slew, "step")
+        if slew < 0:
+            raise InputError(f"step: 'slew' must not be negative, got {slew!r}")
+        object.__setattr__(self, "slew", slew)
+        object.__setattr__(self, "offset", _finite("offset", self.offset, "step"))
+
+    def _core_tuple(self):
+        return (_STEP, self.amplitude, 0.0, 0.0, self.offset, 1.0, self.slew, self.time, None, None)
+
+
+@dataclass(frozen=True, eq=False)
+class Sampled(Waveform):
+    """Linear interpolation through (time, value) pairs; held constant beyond the ends.
+    ``file`` records where the samples came from, for saving a model."""
+
+    time: np.ndarray
+    value: np.ndarray
+    file: str | None = field(default=None)
+    kind = "sampled"
+
+    def __post_init__(self):
+        t = np.ascontiguousarray(self.time, dtype=float)
+        v = np.ascontiguousarray(self.value, dtype=float)
+        where = f"sampled waveform{f' {self.file}' if self.file else ''}"
+        if t.ndim != 1 or t.shape != v.shape or t.size < 2:
+            raise InputError(f"{where}: needs at least two (time, value) pairs of equal length")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+            raise InputError(f"{where}: times and values must be finite")
+        if np.any(np.diff(t) <= 0):
+            i = int(np.argmax(np.diff(t) <= 0)) + 1
+            raise InputError(f"{where}: time must increase strictly (sample {i + 1}: {t[i]!r} after {t[i - 1]!r})")
+        object.__setattr__(self, "time", t)
+        object.__setattr__(self, "value", v)
+
+    def to_dict(self):
+        if self.file:
+            return {"waveform": "sampled", "file": self.file}
+        return {"waveform": "sampled", "time": self.time.tolist(), "value": self.value.tolist()}
+
+    def spec(self):
+        if not self.file:
+            raise InputError("a sampled waveform without a file has no --input form")
+        return f"sampled:file={self.file}"
+
+    def _core_tuple(self):
+        return (_SAMPLED, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, self.time, self.value)
+
+    @classmethod
+    def from_csv(cls, path, base_dir=None):
+        """Reads ``time[s]`` and one value column (see SPEC 6)."""
+        p = Path(path)
+        if base_dir is not None and not p.is_absolute():
+            p = Path(base_dir) / p
+        time, value = read_two_column_csv(p, "time")
+        return cls(time, value, file=str(path))
+
+
+def read_two_column_csv(path: Path, first: str):
+    """A CSV with a header ``first[unit]`` and one value column; time units s or ms."""
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror})") from None
+    rows = [r for r in rows if r and any(c.strip() for c in r)]
+    if len(rows) < 3:
+        raise InputError(f"{path}: needs a header row and at least two data rows")
+    header = [h.strip() for h in rows[0]]
+    if len(header) != 2:
+        raise InputError(f"{path}: line 1: expected two columns ({first}[s] and a value), got {len(header)}")
+    name, _, unit = header[0].partition("[")
+    unit = unit.rstrip("]") or "s"
+    if name.strip() != first:
+        raise InputError(f"{path}: line 1: the first column must be '{first}[s]', got '{header[0]}'")
+    scale = {"s": 1.0, "ms": 1e-3}.get(unit)
+    if scale is None:
+        raise InputError(f"{path}: line 1: unknown time unit '{unit}' (use s or ms)")
+    data = np.empty((len(rows) - 1, 2))
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) != 2:
+            raise InputError(f"{path}: line {i}: expected 2 values, got {len(row)}")
+        for j, cell in enumerate(row):
+            try:
+                data[i - 2, j] = float(cell)
+            except ValueError:
+                raise InputError(f"{path}: line {i}, column '{header[j]}': not a number: {cell.strip()!r}") from None
+            if not math.isfinite(data[i - 2, j]):
+                raise InputError(f"{path}: line {i}, column '{header[j]}': not finite: {cell.strip()!r}")
+    bad = np.nonzero(np.diff(data[:, 0]) <= 0)[0]
+    if bad.size:
+        raise InputError(f"{path}: line {bad[0] + 3}: time must increase strictly")
+    return data[:, 0] * scale, data[:, 1]
+
+
+_KINDS = {"sawtooth": Sawtooth, "sine": Sine, "square": Square, "step": Step}
+
+
+def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Waveform:
+    """Builds a waveform from a model file's ``[input]`` table or a parsed ``--input`` spec."""
+    d = dict(d)
+    kind = d.pop("waveform", None)
+    if kind is None:
+        raise InputError(f"{where}: missing 'waveform' (one of: {', '.join([*_KINDS, 'sampled'])})")
+    if kind == "sampled":
+        if "file" in d:
+            extra = set(d) - {"file"}
+            if extra:
+                raise InputError(f"{where}: unknown key(s) for sampled: {', '.join(sorted(extra))}")
+            return Sampled.from_csv(d["file"], base_dir)
+        extra = set(d) - {"time", "value"}
+        if extra or not {"time", "value"} <= set(d):
+            raise InputError(f"{where}: sampled takes 'file', or 'time' and 'value' arrays")
+        try:
+            return Sampled(np.asarray(d["time"], float), np.asarray(d["value"], float))
+        except (TypeError, ValueError):
+            raise InputError(f"{where}: sampled 'time' and 'value' must be arrays of numbers") from None
+    cls = _KINDS.get(kind)
+    if cls is None:
+        raise InputError(f"{where}: unknown waveform '{kind}' (one of: {', '.join([*_KINDS, 'sampled'])})")
+    names = [f.name for f in fields(cls)]
+    unknown = set(d) - set(names)
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) for {kind}: {', '.join(sorted(unknown))} "
+                         f"(allowed: {', '.join(names)})")
+    missing = [f.name for f in fields(cls) if f.default is MISSING and f.name not in d]
+    if missing:
+        raise InputError(f"{where}: {kind} needs {', '.join(missing)}")
+    try:
+        return cls(**d)
+    except InputError as e:
+        raise InputError(f"{where}: {e}") from None
+
+
+def parse_waveform(spec: str) -> Waveform:
+    """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
+    ``sampled:file=u.csv``."""
+    where = f"--input '{spec}'"
+    kind, sep, rest = spec.strip().partition(":")
+    d: dict = {"waveform": kind.strip()}
+    if rest.strip():
+        for item in rest.split(","):
+            key, eq, value = item.partition("=")
+            key = key.strip()
+            if not eq or not key:
+                raise InputError(f"{where}: expected key=value, got '{item.strip()}'")
+            if key in d:
+                raise InputError(f"{where}: '{key}' given twice")
+            if key == "file":
+                d[key] = value.strip()
+                continue
+            try:
+                num = float(value)
+            except ValueError:
+                raise InputError(f"{where}: '{key}' must be a number, got '{value.strip()}'") from None
+            d[key] = int(num) if key == "direction" and num.is_integer() else num
+    return waveform_from_dict(d, where)
+
+
+__all__ = ["Waveform", "Zero", "Sawtooth", "Sine", "Square", "Step", "Sampled", "parse_waveform",
+           "waveform_from_dict", "read_two_column_csv"]
