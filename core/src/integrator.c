@@ -5,14 +5,21 @@
  * RODAS4: Hairer & Wanner's 6-stage Rosenbrock method of order 4(3), L-stable and stiffly
  *   accurate, with its 3rd-order dense output (Solving ODEs II, IV.7), analytic state
  *   Jacobian, predictive (Gustafsson) step control.
- * AUTO: DOPRI5 until its stiffness test fires (15 of the last steps near the stability
- *   boundary), then RODAS4 for the rest of the run. */
+ * AUTO: DOPRI5 until its stiffness test fires (15 steps in a row near the stability
+ *   boundary); then RODAS4 on probation: after PROBE_STEPS steps its work per simulated
+ *   second is compared with DOPRI5's over its last window, and the cheaper method goes on.
+ *   A failed probe doubles the number of explicit steps before the next one. The stiffness
+ *   test alone is not enough for friction models: at every velocity reversal LuGre's |v|
+ *   makes a kink that costs a Rosenbrock method (whose order needs the exact Jacobian) more
+ *   than it saves, even for stiff bristles. */
 #include "thermofriction/integrator.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+enum { PROBE_STEPS = 200, WINDOW_STEPS = 200, FIRST_LOCK = 2000 };
 
 /* ---- Dormand-Prince 5(4) ---- */
 static const double
@@ -269,6 +276,12 @@ static double initial_step(work *w, double t, const double *y, const double *f0,
     return fmin(100.0 * h0, h1);
 }
 
+/* Work in right-hand-side evaluations, counting a Jacobian and an LU as a few of them. */
+static double work_units(const tf_solver_stats *st)
+{
+    return (double)st->rhs_evals + 3.0 * st->jac_evals + 1.0 * st->decompositions;
+}
+
 static int fail(work *w, int status, double t, double h)
 {
     w->st->status = status;
@@ -333,6 +346,9 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     long next = 0;
     double h = 0.0, facold = 1e-4, hold = 0.0, errold = 1.0;
     int first_rodas = 1, reject = 0, iasti = 0, nonsti = 0;
+    /* AUTO bookkeeping: the explicit method's recent cost, the probe, the lock-out */
+    double win_t = t, win_work = 0.0, explicit_rate = 0.0, probe_t = 0.0, probe_work = 0.0;
+    long win_steps = 0, probe_steps = 0, lock_steps = 0, lock_len = FIRST_LOCK;
     if (!f0 || !yd) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
 
     while (next < n_out && t_out[next] <= t) emit(next, t_out[next], y, emit_ctx), next++;
@@ -425,15 +441,43 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                         nonsti = 0;
                         if (++iasti >= 15) {
                             st->stiff_suspected = 1;
-                            if (opt->method == TF_METHOD_AUTO) {
+                            if (opt->method == TF_METHOD_AUTO && lock_steps <= 0 && t_new > win_t) {
+                                explicit_rate = (work_units(st) - win_work) / (t_new - win_t);
                                 method = TF_METHOD_RODAS4;
+                                first_rodas = 1;
                                 st->switch_time = t_new;
+                                probe_t = t_new;
+                                probe_work = work_units(st);
+                                probe_steps = 0;
+                                iasti = 0;
                             }
                         }
                     } else if (++nonsti >= 6) {
                         iasti = 0;
                     }
                     memcpy(f0, w.k[6], sizeof(double) * n); /* FSAL */
+                    if (lock_steps > 0) lock_steps--;
+                    if (++win_steps >= WINDOW_STEPS && method == TF_METHOD_DOPRI5) {
+                        win_steps = 0;
+                        win_t = t_new;
+                        win_work = work_units(st);
+                    }
+                }
+                if (method == TF_METHOD_RODAS4 && opt->method == TF_METHOD_AUTO && probe_steps >= 0 &&
+                    ++probe_steps >= PROBE_STEPS) {
+                    double rodas_rate = (work_units(st) - probe_work) / (t_new - probe_t);
+                    if (rodas_rate >= explicit_rate) { /* the stiff method does not pay: go back */
+                        method = TF_METHOD_DOPRI5;
+                        st->switch_time = -1.0;
+                        lock_steps = lock_len;
+                        lock_len *= 2;
+                        win_steps = 0;
+                        win_t = t_new;
+                        win_work = work_units(st);
+                        iasti = nonsti = 0; /* f0 = f(t_new, y1) is current: Rodas4 computed it */
+                    } else {
+                        probe_steps = -1; /* it pays: stay */
+                    }
                 }
                 if (reject) hnew = fmin(hnew, h);
                 reject = 0;
