@@ -355,8 +355,11 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     if (!all_finite(y, n)) { status = fail(&w, TF_ERR_NONFINITE, t, 0.0); goto done; }
 
     while (t < t_end) {
+        /* what is left may be a rounding residue (a corner computed one ulp before the grid's
+         * end): nothing to integrate, and a step that small would count as an underflow */
+        if (t_end - t <= 64.0 * DBL_EPSILON * fabs(t_end)) break;
         double seg_end = ode->next_corner ? fmin(ode->next_corner(t, ode->ctx), t_end) : t_end;
-        if (!(seg_end > t)) seg_end = t_end;
+        if (!(seg_end > t) || t_end - seg_end <= 64.0 * DBL_EPSILON * fabs(t_end)) seg_end = t_end;
         /* restart at every corner: the derivative may jump there */
         w.t_clamp = INFINITY;
         if (rhs(&w, t, y, f0)) { status = fail(&w, TF_ERR_NONFINITE, t, h); goto done; }

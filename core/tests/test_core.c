@@ -261,8 +261,34 @@ static void test_frictionless_step_response(void)
     }
 }
 
+static void emit_none(long i, double t, const double *y, void *ctx) { (void)i; (void)t; (void)y; (void)ctx; }
+
+static void test_grid_end_one_ulp_past_a_corner(void)
+{
+    /* the last output time can sit a rounding error past a corner: no spurious underflow */
+    tf_model m;
+    paper_like(&m, 35.0);
+    m.input.rise = 0.999;
+    tf_model_prepare(&m);
+    double atol[5], y[5];
+    tf_model_state_scale(&m, atol);
+    for (int i = 0; i < 5; i++) atol[i] *= 1e-6;
+    tf_ode ode = {5, &m, tf_model_rhs, tf_model_jac, tf_model_next_corner};
+    tf_solver_options opt = {TF_METHOD_DOPRI5, 1e-6, atol, 0, 0, 1000000};
+    tf_solver_stats st;
+    double corner = 3.0 / 5.0;
+    double ends[3] = {nextafter(corner, 1.0), nextafter(nextafter(corner, 1.0), 1.0), nextafter(corner, 0.0)};
+    for (int k = 0; k < 3; k++) {
+        double t[2] = {0.0, ends[k]};
+        tf_model_initial_state(&m, y);
+        int status = tf_solve(&ode, &opt, t, 2, y, emit_none, 0, &st);
+        CHECK(status == TF_OK, "end %.17g next to the corner %.17g: status %d", ends[k], corner, status);
+    }
+}
+
 int main(void)
 {
+    test_grid_end_one_ulp_past_a_corner();
     test_oscillator_dense_output(TF_METHOD_DOPRI5);
     test_oscillator_dense_output(TF_METHOD_RODAS4);
     test_stiff_prothero_robinson();

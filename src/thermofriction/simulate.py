@@ -217,11 +217,12 @@ def check_temperatures(model: Model, temperature):
     laws = dict(model.laws)
     if isinstance(model.thermal, ModelII):
         laws["dF"] = model.thermal.dF
-    for name, law in laws.items():
-        if not law.in_range(Ts):
-            warnings.warn(f"temperature {Ts.min():g}..{Ts.max():g} C is outside the range {law.range[0]:g}.."
-                          f"{law.range[1]:g} C that the law for '{name}' was calibrated on",
-                          TemperatureRangeWarning, stacklevel=3)
+    outside = [f"'{name}' ({law.range[0]:g}..{law.range[1]:g} C)" for name, law in laws.items()
+               if not law.in_range(Ts)]
+    if outside:
+        span = f"{Ts[0]:g} C" if len(Ts) == 1 else f"{Ts.min():g}..{Ts.max():g} C"
+        warnings.warn(f"temperature {span} is outside the calibrated range of the law(s) for "
+                      f"{', '.join(outside)}", TemperatureRangeWarning, stacklevel=3)
     if isinstance(model.thermal, ModelI):
         for T in (Ts.min(), Ts.max()) if len(Ts) > 1 else Ts:
             check_friction_values(model.parameters_at(T), f"Model I at {T:g} C")

@@ -1,0 +1,165 @@
+"""The ``thermofriction`` command line: a thin layer over the library (SPEC 8).
+
+Every error is one line on stderr naming the file, key or value, with exit status 2 for
+usage and data errors and 1 for failed computations; outputs are written atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+import warnings
+
+from . import __version__
+from .errors import InputError, ThermofrictionError
+from .models import PRESETS, load_model
+from .simulate import SOLVERS, StepSizeController, simulate
+from .waveforms import Sampled, parse_waveform
+
+
+def _positive_float(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (v > 0 and math.isfinite(v)):
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
+    return v
+
+
+def _finite_float(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"must be finite, got {text!r}")
+    return v
+
+
+def _positive_int(text):
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text!r}")
+    return v
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="thermofriction",
+        description="Temperature-aware friction models for precision motion systems "
+                    "(Li et al., Rev. Sci. Instrum. 80, 045104, 2009, and beyond).",
+        epilog="Exit status: 0 success, 1 a computation failed, 2 bad usage or data.")
+    p.add_argument("--version", action="version", version=f"thermofriction {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    s = sub.add_parser(
+        "simulate", help="simulate a model file (or a preset) and write the SPEC 7 CSV",
+        description="Simulate an actuator from rest and write time, input, stage and end-effector "
+                    "displacement, velocity, friction force, temperature and internal states (SI units, "
+                    "temperature in C) on a uniform grid. Without -o, prints a summary.",
+        epilog=f"MODEL is a model file (TOML) or a preset name: {', '.join(PRESETS)}. "
+               "Input specs: sawtooth:amplitude=A,frequency=F[,rise=0.99,offset=0,direction=1] | "
+               "sine:amplitude=A,frequency=F[,offset=0] | square:amplitude=A,frequency=F,slew=S[,offset=0,duty=0.5] | "
+               "step:amplitude=A[,time=0,slew=0,offset=0] | sampled:file=PATH (CSV with time[s] and one value column).")
+    s.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
+    temp = s.add_mutually_exclusive_group()
+    temp.add_argument("--temperature", type=_finite_float, metavar="C",
+                      help="constant interface temperature [C] (required for thermal models)")
+    temp.add_argument("--temperature-file", metavar="F.csv",
+                      help="temperature signal: CSV with time[s] and temperature[C], linearly interpolated")
+    s.add_argument("--input", metavar="SPEC", help="input waveform, overriding the model's [input]")
+    s.add_argument("--duration", type=_positive_float, default=2.0, metavar="S",
+                   help="simulated time [s] (default: 2)")
+    s.add_argument("--sample-rate", type=_positive_float, default=10_000.0, metavar="HZ",
+                   help="output sample rate [Hz] (default: 10000)")
+    s.add_argument("-o", "--output", metavar="OUT.csv", help="CSV output file ('-' for standard output)")
+    s.add_argument("--method", choices=sorted(SOLVERS), default="auto",
+                   help="integrator: dopri5 (explicit), rodas4 (stiff), auto (default: dopri5, trying rodas4 "
+                        "when it detects stiffness and keeping it only where it is cheaper)")
+    s.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
+    s.add_argument("--atol", type=_positive_float, default=None,
+                   help="absolute tolerance for every state (default: rtol times each state's scale)")
+    s.add_argument("--max-steps", type=_positive_int, default=10_000_000, metavar="N",
+                   help="step limit (default: 10000000)")
+    s.set_defaults(run=cmd_simulate)
+    return p
+
+
+def cmd_simulate(args) -> int:
+    model = load_model(args.model)
+    temperature = args.temperature
+    if args.temperature_file:
+        temperature = Sampled.from_csv(args.temperature_file)
+    waveform = parse_waveform(args.input) if args.input else None
+    if waveform is None and model.input is None:
+        raise InputError(f"{args.model}: the model has no [input]: give --input")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    controller = StepSizeController(rtol=args.rtol, atol=args.atol, max_steps=args.max_steps)
+    t0 = time.perf_counter()
+    res = simulate(model, args.duration, temperature=temperature, input=waveform, sample_rate=args.sample_rate,
+                   solver=SOLVERS[args.method](), controller=controller)
+    elapsed = time.perf_counter() - t0
+    if args.output == "-":
+        import io
+        buf = io.StringIO()
+        cols = res.columns()
+        buf.write(",".join(cols) + "\n")
+        import numpy as np
+        np.savetxt(buf, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12g")
+        sys.stdout.write(buf.getvalue())
+        return 0
+    if args.output:
+        res.to_csv(args.output)
+    out = sys.stdout
+    name = model.name or args.model
+    T = (f"{temperature:g} C" if isinstance(temperature, float) else
+         f"from {args.temperature_file}" if temperature is not None else "not used")
+    print(f"{name}: {args.duration:g} s at temperature {T}, {len(res.time)} samples", file=out)
+    print(f"  final displacement  {res.displacement[-1] * 1e6:.6g} um", file=out)
+    if res.step_sizes.size:
+        print(f"  step per cycle      {res.step_sizes.mean() * 1e6:.6g} um (mean of {res.step_sizes.size}), "
+              f"last {res.step_sizes[-1] * 1e6:.6g} um", file=out)
+        print(f"  mean velocity       {res.mean_velocity * 1e6:.6g} um/s", file=out)
+    st = res.stats
+    print(f"  solver              {st['solver']}: {st['steps']} steps, {st['rejected']} rejected, "
+          f"{elapsed * 1e3:.1f} ms", file=out)
+    if args.output:
+        print(f"  wrote               {args.output}", file=out)
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    caught = []
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        caught.append(f"warning: {message}")
+        print(f"thermofriction: warning: {message}", file=sys.stderr)
+
+    warnings.showwarning = show
+    try:
+        return args.run(args)
+    except ThermofrictionError as e:
+        print(f"thermofriction: error: {e}", file=sys.stderr)
+        return e.exit_status
+    except KeyboardInterrupt:
+        print("thermofriction: interrupted; no output was written", file=sys.stderr)
+        return 130
+    except MemoryError:
+        print("thermofriction: error: out of memory (lower --duration or --sample-rate)", file=sys.stderr)
+        return 1
+    except BrokenPipeError:
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
