@@ -30,3 +30,11 @@ class SolverError(ComputationError):
 
 class TemperatureRangeWarning(UserWarning):
     """A temperature law was evaluated outside the range it was calibrated on."""
+
+
+def unknown_keys(keys, allowed, what="") -> str:
+    """``unknown key 'x' for lugre (allowed: a, b)`` -- one wording for every unknown-key error."""
+    keys = sorted(keys)
+    names = ", ".join(f"'{k}'" for k in keys)
+    head = f"unknown key {names}" if len(keys) == 1 else f"unknown keys {names}"
+    return f"{head}{f' for {what}' if what else ''} (allowed: {', '.join(allowed)})"

@@ -19,7 +19,7 @@ import tomli_w
 
 from . import _core
 from ._io import atomic_write
-from .errors import InputError
+from .errors import InputError, unknown_keys
 from .waveforms import Waveform, waveform_from_dict
 
 # ---------------------------------------------------------------------------------------------
@@ -200,8 +200,7 @@ def law_from_dict(d, where: str) -> Law:
     keys = _LAW_KEYS[kind]
     unknown = set(d) - set(keys) - {"law", "range"}
     if unknown:
-        raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} for law '{kind}' "
-                         f"(allowed: {', '.join(keys)}, range)")
+        raise InputError(f"{where}: {unknown_keys(unknown, [*keys, 'range'], f'law {kind!r}')}")
     missing = [k for k in keys if k not in d]
     if missing:
         raise InputError(f"{where}: law '{kind}' needs {', '.join(missing)}")
@@ -300,8 +299,7 @@ class StickSlipPlant:
         names = {sym: name for name, sym in cls._SYMBOLS.items()}
         unknown = set(d) - set(names)
         if unknown:
-            raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(allowed: type, {', '.join(names)})")
+            raise InputError(f"{where}: {unknown_keys(unknown, ['type', *names])}")
         for req in ("m", "m_e"):
             if req not in d:
                 raise InputError(f"{where}: missing '{req}'")
@@ -366,8 +364,7 @@ class LuGre:
         allowed = [f.name for f in fields(cls)]
         unknown = set(d) - set(allowed)
         if unknown:
-            raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} for lugre "
-                             f"(allowed: {', '.join(allowed)})")
+            raise InputError(f"{where}: {unknown_keys(unknown, ['model', *allowed], 'lugre')}")
         for k, v in d.items():
             d[k] = _num(v, where, k)
         kw = {k: d.get(k) for k in cls.required}
@@ -551,8 +548,7 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
     try:
         unknown = set(d) - _TOP_KEYS
         if unknown:
-            raise InputError(f"unknown key(s) or section(s) {', '.join(sorted(unknown))} "
-                             f"(allowed: {', '.join(sorted(_TOP_KEYS))})")
+            raise InputError(unknown_keys(unknown, sorted(_TOP_KEYS), "a model file"))
         for sec in ("plant", "friction"):
             if not isinstance(d.get(sec), dict):
                 raise InputError(f"missing section [{sec}]")
@@ -574,21 +570,19 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
                     raise InputError(f"'{k}' is given both as a number in [friction] and as a law in "
                                      f"[thermal]; give it once")
                 if k not in PARAMETERS:
-                    raise InputError(f"[thermal]: unknown key '{k}' (a Model I law must be named after a "
-                                     f"friction parameter: {', '.join(PARAMETERS)})")
+                    raise InputError(f"[thermal]: {unknown_keys([k], ['model', *PARAMETERS], 'Model I')}")
                 laws[k] = law_from_dict(v, f"[thermal] {k}")
             thermal = ModelI(laws)
         elif tkind == "II":
             unknown = set(th) - {"dF", "form"}
             if unknown:
-                raise InputError(f"[thermal]: unknown key(s) {', '.join(sorted(unknown))} for Model II "
-                                 f"(allowed: dF, form)")
+                raise InputError(f"[thermal]: {unknown_keys(unknown, ['model', 'dF', 'form'], 'Model II')}")
             if "dF" not in th:
                 raise InputError("[thermal]: Model II needs 'dF', a law of temperature")
             thermal = ModelII(law_from_dict(th["dF"], "[thermal] dF"), th.get("form", "scale"))
         elif tkind == "none":
             if th:
-                raise InputError(f"[thermal]: unknown key(s) {', '.join(sorted(th))} for model \"none\"")
+                raise InputError(f"[thermal]: {unknown_keys(th, ['model'], 'model none')}")
             thermal = None
         else:
             raise InputError(f"[thermal]: 'model' must be \"none\", \"I\" or \"II\", got {tkind!r}")

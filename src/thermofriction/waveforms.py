@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _core
-from .errors import InputError
+from .errors import InputError, unknown_keys
 
 _ZERO, _SAWTOOTH, _SINE, _SQUARE, _STEP, _SAMPLED = range(6)
 
@@ -287,7 +287,7 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
         if "file" in d:
             extra = set(d) - {"file"}
             if extra:
-                raise InputError(f"{where}: unknown key(s) for sampled: {', '.join(sorted(extra))}")
+                raise InputError(f"{where}: {unknown_keys(extra, ['file'], 'sampled')}")
             return Sampled.from_csv(d["file"], base_dir)
         extra = set(d) - {"time", "value"}
         if extra or not {"time", "value"} <= set(d):
@@ -302,8 +302,7 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
     names = [f.name for f in fields(cls)]
     unknown = set(d) - set(names)
     if unknown:
-        raise InputError(f"{where}: unknown key(s) for {kind}: {', '.join(sorted(unknown))} "
-                         f"(allowed: {', '.join(names)})")
+        raise InputError(f"{where}: {unknown_keys(unknown, names, kind)}")
     missing = [f.name for f in fields(cls) if f.default is MISSING and f.name not in d]
     if missing:
         raise InputError(f"{where}: {kind} needs {', '.join(missing)}")
