@@ -6,4 +6,5 @@
 #include "thermofriction/friction.h"
 #include "thermofriction/plant.h"
 #include "thermofriction/integrator.h"
+#include "thermofriction/sensitivity.h"
 #endif

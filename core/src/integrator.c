@@ -338,7 +338,9 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
 
     work w;
     if (setup(&w, ode, opt, st)) { st->status = TF_ERR_NO_MEMORY; return TF_ERR_NO_MEMORY; }
-    int method = opt->method == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : opt->method;
+    /* without a Jacobian (e.g. sensitivity systems) only the explicit method applies */
+    const int requested = ode->jac ? opt->method : TF_METHOD_DOPRI5;
+    int method = requested == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : requested;
     double t = t_out[0], t_end = t_out[n_out - 1];
     double *f0 = (double *)malloc(sizeof(double) * n);
     double *yd = (double *)malloc(sizeof(double) * n);
@@ -444,7 +446,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                         nonsti = 0;
                         if (++iasti >= 15) {
                             st->stiff_suspected = 1;
-                            if (opt->method == TF_METHOD_AUTO && lock_steps <= 0 && t_new > win_t) {
+                            if (requested == TF_METHOD_AUTO && lock_steps <= 0 && t_new > win_t) {
                                 explicit_rate = (work_units(st) - win_work) / (t_new - win_t);
                                 method = TF_METHOD_RODAS4;
                                 first_rodas = 1;
@@ -466,7 +468,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                         win_work = work_units(st);
                     }
                 }
-                if (method == TF_METHOD_RODAS4 && opt->method == TF_METHOD_AUTO && probe_steps >= 0 &&
+                if (method == TF_METHOD_RODAS4 && requested == TF_METHOD_AUTO && probe_steps >= 0 &&
                     ++probe_steps >= PROBE_STEPS) {
                     double rodas_rate = (work_units(st) - probe_work) / (t_new - probe_t);
                     if (rodas_rate >= explicit_rate) { /* the stiff method does not pay: go back */

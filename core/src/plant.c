@@ -21,9 +21,11 @@ double tf_model_temperature(const tf_model *model, double t)
 void tf_model_params_at(const tf_model *model, double T, double *p)
 {
     memcpy(p, model->p, sizeof(double) * TF_NPARAM);
+    if (model->fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
     if (model->thermal != TF_THERMAL_MODEL_I) return;
     for (int i = 0; i < TF_NPARAM; i++)
         if (model->law[i].kind != TF_LAW_NONE) p[i] = tf_law_eval(&model->law[i], T, 0);
+    if (model->fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
 }
 
 double tf_model_lambda(const tf_model *model, double T)
@@ -49,14 +51,17 @@ static const double *params(tf_model *m, double T, double *lambda, double *dF)
     return m->cache_p;
 }
 
-/* F' and, when jac is given, its partials (overwriting the base model's partials). */
-static double friction(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac)
+/* F' and, when jac is given, its partials (overwriting the base model's partials). The base
+ * model's parameter partials go to dp, untouched by the thermal factor (the caller applies it). */
+static double friction_full(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac,
+                            tf_friction_param_partials *dp, double *F_base)
 {
     double lambda, dF;
     const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
     double v = y[VE] - y[VP];
     int nz = tf_friction_nstate(m->friction);
-    double F = tf_friction_eval(m->friction, p, v, y + NMECH, dz, jac);
+    double F = tf_friction_eval(m->friction, p, v, y + NMECH, dz, jac, dp);
+    if (F_base) *F_base = F;
     if (lambda != 1.0) {
         F *= lambda;
         if (jac) {
@@ -71,6 +76,11 @@ static double friction(tf_model *m, double t, const double *y, double *dz, tf_fr
         if (jac) jac->dF_dv += dF * (1.0 - s * s) / vs;
     }
     return F;
+}
+
+static double friction(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac)
+{
+    return friction_full(m, t, y, dz, jac, 0, 0);
 }
 
 double tf_model_friction(const tf_model *model, double t, const double *y)
@@ -144,6 +154,46 @@ int tf_model_jac(double t, const double *y, double *J, void *ctx)
         J_(NMECH + j, NMECH + j) = d.ddz_dz[j];
     }
 #undef J_
+    return 0;
+}
+
+int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
+                         const tf_target *targets, int np, double *fp)
+{
+    int n = tf_model_nstate(m), nz = n - NMECH;
+    tf_model_rhs(t, y, dy, m);
+    if (J) tf_model_jac(t, y, J, m);
+    if (!np) return 0;
+    tf_friction_param_partials dp;
+    double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
+    double T = tf_model_temperature(m, t);
+    params(m, T, &lambda, &dF_offset);
+    friction_full(m, t, y, dz, 0, &dp, &Fb);
+    if (m->fs_follows_fc) { /* one parameter moves both */
+        dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
+        for (int j = 0; j < nz; j++) dp.ddz_dp[j][TF_P_FC] += dp.ddz_dp[j][TF_P_FS];
+    }
+    int scale = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_SCALE;
+    double Fref = tf_friction_reference_force(m->friction, m->p);
+    for (int k = 0; k < np; k++) {
+        const tf_target *tg = &targets[k];
+        double dF = 0.0, chain = 1.0; /* dF'/dtheta and d(param)/dtheta */
+        int i = tg->param;
+        if (tg->kind == TF_TARGET_DF) {
+            double dlaw = tf_law_coef_derivative(&m->dF, tg->coef, T);
+            if (scale) dF = Fb / Fref * dlaw;
+            else dF = dlaw * tanh((y[VE] - y[VP]) / m->cache_p[TF_P_VSMOOTH]);
+        } else {
+            if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T);
+            dF = chain * dp.dF_dp[i] * (scale ? lambda : 1.0);
+            if (scale && i == TF_P_FC) dF -= (lambda - 1.0) / Fref * Fb; /* F_ref = fc; dF(T) = (lambda-1) F_ref */
+        }
+        for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
+        fp[VP * np + k] = dF / m->m;
+        fp[VE * np + k] = -dF / m->m_e;
+        if (tg->kind != TF_TARGET_DF)
+            for (int j = 0; j < nz; j++) fp[(NMECH + j) * np + k] = chain * dp.ddz_dp[j][i];
+    }
     return 0;
 }
 

@@ -86,3 +86,35 @@ double tf_law_eval(const tf_law *law, double T, double *dvalue_dT)
     if (dvalue_dT) *dvalue_dT = d;
     return v;
 }
+
+int tf_law_ncoef(const tf_law *law)
+{
+    switch (law->kind) {
+    case TF_LAW_CONST: return 1;
+    case TF_LAW_LINEAR: case TF_LAW_EXP: return 2;
+    case TF_LAW_POLY: case TF_LAW_PWL: return law->n;
+    default: return 0;
+    }
+}
+
+double tf_law_coef_derivative(const tf_law *law, int coef, double T)
+{
+    if (coef < 0 || coef >= tf_law_ncoef(law)) return NAN;
+    switch (law->kind) {
+    case TF_LAW_CONST: return 1.0;
+    case TF_LAW_LINEAR: return coef == 0 ? T : 1.0;
+    case TF_LAW_EXP: return coef == 0 ? exp(law->b * T) : law->a * T * exp(law->b * T);
+    case TF_LAW_POLY: return pow(T, coef);
+    case TF_LAW_PWL: {
+        int n = law->n;
+        if (n == 1) return 1.0;
+        const double *x = law->x;
+        int i = T <= x[0] ? 0 : (T >= x[n - 1] ? n - 2 : segment(n, x, T));
+        double s = (T - x[i]) / (x[i + 1] - x[i]); /* outside [x0, xn]: the end segment, extended */
+        if (coef == i) return 1.0 - s;
+        if (coef == i + 1) return s;
+        return 0.0;
+    }
+    default: return NAN;
+    }
+}

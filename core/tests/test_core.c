@@ -184,7 +184,7 @@ static void test_lugre_steady_sliding(void)
     for (int i = 0; i < 4; i++) {
         double v = vs[i], g = tf_stribeck(p, v, 0);
         double z = (v > 0 ? g : -g) / p[TF_P_SIGMA0], dz;
-        double F = tf_friction_eval(TF_FRICTION_LUGRE, p, v, &z, &dz, 0);
+        double F = tf_friction_eval(TF_FRICTION_LUGRE, p, v, &z, &dz, 0, 0);
         CHECK(fabs(dz) < 1e-12 && fabs(F - ((v > 0 ? g : -g) + 0.4 * v)) < 1e-12, "LuGre steady sliding at v=%g", v);
     }
 }
@@ -286,8 +286,54 @@ static void test_grid_end_one_ulp_past_a_corner(void)
     }
 }
 
+static void test_parameter_derivatives_vs_finite_differences(void)
+{
+    /* df/dtheta of tf_model_derivatives against central differences of the right-hand side */
+    double dFx[3] = {30.0, 38.4, 41.5}, dFy[3] = {0.0, -0.145, -0.4775};
+    for (int form = 0; form < 3; form++) {
+        tf_model m;
+        paper_like(&m, 36.0);
+        m.p[TF_P_FS] = 1.4 * m.p[TF_P_FC];
+        m.p[TF_P_SIGMA2] = 0.3;
+        m.p[TF_P_VD] = 2e-3;
+        m.T_const = 36.0;
+        tf_target tg[8] = {{TF_TARGET_PARAM, TF_P_SIGMA0, 0}, {TF_TARGET_PARAM, TF_P_SIGMA1, 0},
+                           {TF_TARGET_PARAM, TF_P_FC, 0},     {TF_TARGET_PARAM, TF_P_FS, 0},
+                           {TF_TARGET_PARAM, TF_P_VS, 0},     {TF_TARGET_PARAM, TF_P_VD, 0},
+                           {TF_TARGET_PARAM, TF_P_SIGMA2, 0}, {TF_TARGET_DF, 0, 1}};
+        int np = 7;
+        if (form > 0) {
+            m.thermal = TF_THERMAL_MODEL_II;
+            m.dF = (tf_law){TF_LAW_PWL, 0, 0, 3, dFx, dFy, 0};
+            m.dF_form = form == 1 ? TF_DF_SCALE : TF_DF_OFFSET;
+            np = 8;
+        }
+        tf_model_prepare(&m);
+        double y[5] = {1e-7, 2e-3, 3e-7, -1e-3, 2e-7}, dy[5], fp[5 * 8], f1[5], f2[5];
+        tf_model_derivatives(&m, 0.01, y, dy, 0, tg, np, fp);
+        double worst = 0;
+        for (int k = 0; k < np; k++) {
+            double *slot = tg[k].kind == TF_TARGET_DF ? &dFy[tg[k].coef] : &m.p[tg[k].param];
+            double save = *slot, h = 1e-6 * fabs(save);
+            *slot = save + h; tf_model_prepare(&m); tf_model_rhs(0.01, y, f1, &m);
+            *slot = save - h; tf_model_prepare(&m); tf_model_rhs(0.01, y, f2, &m);
+            *slot = save; tf_model_prepare(&m);
+            for (int i = 0; i < 5; i++) {
+                double fd = (f1[i] - f2[i]) / (2 * h), an = fp[i * np + k];
+                double err = fabs(fd - an) / (fabs(fd) + fabs(an) + 1e-300);
+                if (fabs(fd - an) > 1e-6 * (fabs(fd) + fabs(an)) + 1e-9 * fabs(dy[i]) / fabs(save)) {
+                    worst = fmax(worst, err);
+                    printf("  form %d target %d state %d: fd %g analytic %g\n", form, k, i, fd, an);
+                }
+            }
+        }
+        CHECK(worst == 0, "parameter derivatives (thermal form %d): worst relative error %g", form, worst);
+    }
+}
+
 int main(void)
 {
+    test_parameter_derivatives_vs_finite_differences();
     test_grid_end_one_ulp_past_a_corner();
     test_oscillator_dense_output(TF_METHOD_DOPRI5);
     test_oscillator_dense_output(TF_METHOD_RODAS4);

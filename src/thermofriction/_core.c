@@ -111,7 +111,8 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
     if (get_int(spec, "plant", &m->plant) || get_double(spec, "m", &m->m) || get_double(spec, "c", &m->c) ||
         get_double(spec, "k", &m->k) || get_double(spec, "T_em", &m->T_em) || get_double(spec, "m_e", &m->m_e) ||
         get_int(spec, "friction", &m->friction) || get_int(spec, "thermal", &m->thermal) ||
-        get_int(spec, "dF_form", &m->dF_form) || get_double(spec, "T_const", &m->T_const))
+        get_int(spec, "dF_form", &m->dF_form) || get_double(spec, "T_const", &m->T_const) ||
+        get_int(spec, "fs_follows_fc", &m->fs_follows_fc))
         return -1;
     if (tf_friction_nstate(m->friction) < 0) { PyErr_SetString(PyExc_ValueError, "unknown friction model"); return -1; }
     Py_ssize_t np;
@@ -214,6 +215,104 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
                            st.decompositions, "method", st.method_used, "switch_time", st.switch_time);
 done:
     if (have_out) PyBuffer_Release(&outv);
+    arena_free(&a);
+    return result;
+}
+
+typedef struct {
+    const tf_model *model;
+    double *out, *sens;
+    int nch, n, np;
+} sens_emit_ctx;
+
+static void emit_sensitivities(long i, double t, const double *Y, void *ctx)
+{
+    sens_emit_ctx *e = (sens_emit_ctx *)ctx;
+    tf_model_outputs(e->model, t, Y, e->out + (size_t)i * e->nch);
+    memcpy(e->sens + (size_t)i * e->n * e->np, Y + e->n, sizeof(double) * e->n * e->np);
+}
+
+/* simulate_sensitivities(spec, targets, t_out, out, sens, rtol, atol|None, h0, hmax, max_steps)
+ * targets: int32 array (np, 3) of (kind, param, coef); sens: float64 (n_out, n, np). */
+static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *tg_obj, *t_obj, *out_obj, *sens_obj, *atol_obj;
+    double rtol, h0, hmax;
+    long max_steps;
+    if (!PyArg_ParseTuple(args, "OOOOOdOddl", &spec, &tg_obj, &t_obj, &out_obj, &sens_obj, &rtol, &atol_obj, &h0,
+                          &hmax, &max_steps))
+        return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    Py_buffer outv = {0}, sensv = {0}, tgv = {0};
+    int have_out = 0, have_sens = 0, have_tg = 0;
+    double *atol = NULL, *Y = NULL;
+    if (parse_model(&a, spec, &m)) goto done;
+    if (PyObject_GetBuffer(tg_obj, &tgv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) goto done;
+    have_tg = 1;
+    if (tgv.itemsize != 4 || tgv.len % 12 != 0 || tgv.len == 0) {
+        PyErr_SetString(PyExc_ValueError, "targets must be an int32 array of shape (np, 3)");
+        goto done;
+    }
+    int np = (int)(tgv.len / 12);
+    if (np > TF_MAX_TARGETS) { PyErr_Format(PyExc_ValueError, "at most %d targets", TF_MAX_TARGETS); goto done; }
+    tf_target targets[TF_MAX_TARGETS];
+    const int *ti = (const int *)tgv.buf;
+    for (int k = 0; k < np; k++) {
+        targets[k] = (tf_target){ti[3 * k], ti[3 * k + 1], ti[3 * k + 2]};
+        const tf_law *law = targets[k].kind == TF_TARGET_DF ? &m.dF
+                            : targets[k].kind == TF_TARGET_LAW && targets[k].param >= 0 && targets[k].param < TF_NPARAM
+                                ? &m.law[targets[k].param] : NULL;
+        int bad = targets[k].kind < 0 || targets[k].kind > 2 || targets[k].param < 0 || targets[k].param >= TF_NPARAM;
+        if (!bad && law && (targets[k].coef < 0 || targets[k].coef >= tf_law_ncoef(law))) bad = 1;
+        if (bad) { PyErr_Format(PyExc_ValueError, "target %d is not valid for this model", k); goto done; }
+    }
+    Py_ssize_t n_out, n_atol;
+    const double *t_out = get_array(&a, t_obj, &n_out, "t_out");
+    if (PyErr_Occurred()) goto done;
+    if (n_out < 1) { PyErr_SetString(PyExc_ValueError, "t_out is empty"); goto done; }
+    int n = tf_model_nstate(&m), nch = tf_model_noutput(&m), N = n * (1 + np);
+    if (PyObject_GetBuffer(out_obj, &outv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
+    have_out = 1;
+    if (PyObject_GetBuffer(sens_obj, &sensv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
+    have_sens = 1;
+    if (outv.len != (Py_ssize_t)(8 * n_out * nch) || sensv.len != (Py_ssize_t)(8 * n_out * n * np)) {
+        PyErr_SetString(PyExc_ValueError, "out or sens has the wrong size");
+        goto done;
+    }
+    atol = PyMem_Malloc(sizeof(double) * N);
+    Y = PyMem_Calloc(N, sizeof(double));
+    if (!atol || !Y) { PyErr_NoMemory(); goto done; }
+    const double *atol_in = get_array(&a, atol_obj, &n_atol, "atol");
+    if (PyErr_Occurred()) goto done;
+    if (!atol_in || n_atol != N) { PyErr_Format(PyExc_ValueError, "atol must have %d values", N); goto done; }
+    memcpy(atol, atol_in, sizeof(double) * N);
+    tf_model_initial_state(&m, Y); /* and S(0) = 0: the initial state does not depend on theta */
+    tf_sensitivity_system sys = {&m, np, targets};
+    tf_ode ode = tf_sensitivity_ode(&sys);
+    tf_solver_options opt = {TF_METHOD_DOPRI5, rtol, atol, h0, hmax, max_steps};
+    tf_solver_stats st;
+    sens_emit_ctx ec = {&m, (double *)outv.buf, (double *)sensv.buf, nch, n, np};
+    int status;
+    Py_BEGIN_ALLOW_THREADS
+    status = tf_solve(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st);
+    Py_END_ALLOW_THREADS
+    if (status != TF_OK) {
+        PyObject *state = PyTuple_New(n);
+        for (int i = 0; i < n && state; i++) PyTuple_SET_ITEM(state, i, PyFloat_FromDouble(Y[i]));
+        PyObject *exc_args = Py_BuildValue("(siddNi)", tf_status_message(status), status, st.t_fail, st.h_fail,
+                                           state, st.stiff_suspected);
+        if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+        goto done;
+    }
+    result = Py_BuildValue("{s:l,s:l,s:l}", "steps", st.steps, "rejected", st.rejected, "rhs_evals", st.rhs_evals);
+done:
+    PyMem_Free(atol);
+    PyMem_Free(Y);
+    if (have_out) PyBuffer_Release(&outv);
+    if (have_sens) PyBuffer_Release(&sensv);
+    if (have_tg) PyBuffer_Release(&tgv);
     arena_free(&a);
     return result;
 }
@@ -325,6 +424,8 @@ static PyObject *py_nstate(PyObject *self, PyObject *args)
 
 static PyMethodDef methods[] = {
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
+    {"simulate_sensitivities", py_simulate_sensitivities, METH_VARARGS,
+     "Integrate a model and its forward sensitivities to the given targets."},
     {"rhs_jac", py_rhs_jac, METH_VARARGS, "Right-hand side and Jacobian at one state; returns the friction force."},
     {"law_eval", py_law_eval, METH_VARARGS, "Evaluate a temperature law and its slope on an array of T."},
     {"waveform_eval", py_waveform_eval, METH_VARARGS, "Evaluate a waveform on an array of t; returns its corners."},

@@ -168,8 +168,6 @@ def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> 
     laws = None
     if isinstance(model.thermal, ModelI):
         laws = [model.thermal.laws[n]._core_tuple() if n in model.thermal.laws else None for n in PARAMETERS]
-        if model.friction.fs is None and "fs" not in model.thermal.laws and "fc" in model.thermal.laws:
-            laws[PARAMETERS.index("fs")] = laws[PARAMETERS.index("fc")]  # no Stribeck: fs follows fc
     T_const, T_t, T_v = math.nan, None, None
     if isinstance(temperature, Sampled):
         T_t, T_v = temperature.time, temperature.value
@@ -179,6 +177,7 @@ def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> 
     return {
         "plant": 0, "m": model.plant.mass, "c": c, "k": k, "T_em": T_em, "m_e": model.plant.end_effector_mass,
         "friction": model.friction.core_code, "params": params,
+        "fs_follows_fc": int(model.friction.fs is None and "fs" not in model.laws),
         "thermal": 1 if isinstance(model.thermal, ModelI) else 2 if isinstance(model.thermal, ModelII) else 0,
         "laws": laws,
         "dF": model.thermal.dF._core_tuple() if isinstance(model.thermal, ModelII) else None,

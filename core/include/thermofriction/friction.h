@@ -39,14 +39,21 @@ typedef struct {
     double ddz_dz[TF_MAX_FRICTION_STATES];
 } tf_friction_partials;
 
+/* Partial derivatives with respect to the parameters, for forward sensitivities. */
+typedef struct {
+    double dF_dp[TF_NPARAM];
+    double ddz_dp[TF_MAX_FRICTION_STATES][TF_NPARAM];
+} tf_friction_param_partials;
+
 int tf_friction_nstate(int kind);
 /* Steady sliding friction level used by Model II's scale form (fc for LuGre). */
 double tf_friction_reference_force(int kind, const double *p);
 /* Stribeck curve g(v) = fc + (fs - fc) exp(-|v/vs|^delta), and dg/dv in *dg when not NULL. */
 double tf_stribeck(const double *p, double v, double *dg);
-/* Force and state rates; partials when jac is not NULL. */
+/* Force and state rates; state partials when jac is not NULL, parameter partials when dp
+ * is not NULL. */
 double tf_friction_eval(int kind, const double *p, double v, const double *z, double *dz,
-                        tf_friction_partials *jac);
+                        tf_friction_partials *jac, tf_friction_param_partials *dp);
 
 #ifdef __cplusplus
 }

@@ -37,6 +37,7 @@ typedef struct {
 
     int friction;               /* tf_friction_kind */
     double p[TF_NPARAM];        /* parameters (temperature-independent values) */
+    int fs_follows_fc;          /* fs = fc at every temperature: no Stribeck effect */
 
     int thermal;                /* tf_thermal_kind */
     tf_law law[TF_NPARAM];      /* Model I: TF_LAW_NONE keeps p[i] */
@@ -69,6 +70,22 @@ double tf_model_lambda(const tf_model *model, double T);
 /* Friction force F' at (t, state). */
 double tf_model_friction(const tf_model *model, double t, const double *y);
 void tf_model_initial_state(const tf_model *model, double *y);
+/* What a sensitivity is taken with respect to. */
+typedef enum {
+    TF_TARGET_PARAM = 0, /* friction parameter `param` given as a number */
+    TF_TARGET_LAW = 1,   /* coefficient `coef` of the Model I law of parameter `param` */
+    TF_TARGET_DF = 2     /* coefficient `coef` of Model II's dF law */
+} tf_target_kind;
+
+typedef struct {
+    int kind, param, coef;
+} tf_target;
+
+/* Right-hand side, and, where the pointers are not NULL, its Jacobian (n x n, row-major) and
+ * its derivatives with respect to the np targets (n x np, row-major). */
+int tf_model_derivatives(tf_model *model, double t, const double *y, double *dy, double *J,
+                         const tf_target *targets, int np, double *fp);
+
 /* Characteristic magnitude of each state, for default absolute tolerances. */
 void tf_model_state_scale(const tf_model *model, double *scale);
 

@@ -29,6 +29,13 @@ typedef struct {
 /* Value of the law at T; its derivative with respect to T in *dvalue_dT when not NULL. */
 double tf_law_eval(const tf_law *law, double T, double *dvalue_dT);
 
+/* Derivative of the law's value at T with respect to its coefficient number `coef`:
+ * const: value; linear, exp: a (0), b (1); poly: c[coef]; pwl: values[coef].
+ * NAN for table laws (their slopes depend on the values nonlinearly) and bad indices. */
+double tf_law_coef_derivative(const tf_law *law, int coef, double T);
+/* Number of coefficients tf_law_coef_derivative takes. */
+int tf_law_ncoef(const tf_law *law);
+
 /* Node slopes of the shape-preserving cubic through (x, y) (Fritsch-Carlson with the
  * weighted harmonic mean of Fritsch and Butland; the end slopes by the three-point
  * rule, limited to keep the shape). Written once at set-up, read by tf_law_eval. */

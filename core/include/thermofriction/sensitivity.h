@@ -1,0 +1,32 @@
+/* Forward sensitivities: the state y and S = dy/dtheta integrated together,
+ *   y' = f(t, y),   S' = (df/dy) S + df/dtheta,
+ * so that an identification gets the exact Jacobian of its residuals (to solver tolerance)
+ * from one integration instead of one per parameter. */
+#ifndef THERMOFRICTION_SENSITIVITY_H
+#define THERMOFRICTION_SENSITIVITY_H
+
+#include "integrator.h"
+#include "plant.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TF_MAX_TARGETS 32
+
+typedef struct {
+    tf_model *model;
+    int np;
+    const tf_target *targets;
+} tf_sensitivity_system;
+
+/* Augmented right-hand side: Y = [y (n), S (n x np, row-major)]. */
+int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *system);
+double tf_sensitivity_next_corner(double t, void *system);
+/* An ODE over the augmented state, for tf_solve with the explicit method (no Jacobian). */
+tf_ode tf_sensitivity_ode(tf_sensitivity_system *system);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

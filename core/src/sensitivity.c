@@ -1,0 +1,34 @@
+/* Forward sensitivity equations of a model (see sensitivity.h). */
+#include "thermofriction/sensitivity.h"
+
+#include <string.h>
+
+int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
+{
+    tf_sensitivity_system *s = (tf_sensitivity_system *)ctx;
+    int n = tf_model_nstate(s->model), np = s->np;
+    double J[(TF_MAX_FRICTION_STATES + 4) * (TF_MAX_FRICTION_STATES + 4)];
+    double *fp = dY + n; /* df/dtheta lands where dS goes, then J S is added */
+    tf_model_derivatives(s->model, t, Y, dY, J, s->targets, np, fp);
+    const double *S = Y + n;
+    for (int r = 0; r < n; r++) {
+        const double *Jr = J + r * n;
+        for (int c = 0; c < n; c++) {
+            double a = Jr[c];
+            if (a == 0.0) continue; /* J is sparse: most products vanish */
+            for (int k = 0; k < np; k++) fp[r * np + k] += a * S[c * np + k];
+        }
+    }
+    return 0;
+}
+
+double tf_sensitivity_next_corner(double t, void *ctx)
+{
+    return tf_model_next_corner(t, ((tf_sensitivity_system *)ctx)->model);
+}
+
+tf_ode tf_sensitivity_ode(tf_sensitivity_system *s)
+{
+    tf_ode ode = {tf_model_nstate(s->model) * (1 + s->np), s, tf_sensitivity_rhs, 0, tf_sensitivity_next_corner};
+    return ode;
+}
