@@ -415,6 +415,25 @@ done:
     return result;
 }
 
+/* state_scale(spec) -> tuple: each state's characteristic magnitude (default tolerances) */
+static PyObject *py_state_scale(PyObject *self, PyObject *args)
+{
+    PyObject *spec;
+    if (!PyArg_ParseTuple(args, "O", &spec)) return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    if (parse_model(&a, spec, &m) == 0) {
+        double scale[TF_MAX_FRICTION_STATES + 8];
+        int n = tf_model_nstate(&m);
+        tf_model_state_scale(&m, scale);
+        result = PyTuple_New(n);
+        for (int i = 0; i < n && result; i++) PyTuple_SET_ITEM(result, i, PyFloat_FromDouble(scale[i]));
+    }
+    arena_free(&a);
+    return result;
+}
+
 static PyObject *py_nstate(PyObject *self, PyObject *args)
 {
     int kind;
@@ -429,6 +448,7 @@ static PyMethodDef methods[] = {
     {"rhs_jac", py_rhs_jac, METH_VARARGS, "Right-hand side and Jacobian at one state; returns the friction force."},
     {"law_eval", py_law_eval, METH_VARARGS, "Evaluate a temperature law and its slope on an array of T."},
     {"waveform_eval", py_waveform_eval, METH_VARARGS, "Evaluate a waveform on an array of t; returns its corners."},
+    {"state_scale", py_state_scale, METH_VARARGS, "Characteristic magnitude of each state."},
     {"friction_nstate", py_nstate, METH_VARARGS, "Number of internal states of a friction model."},
     {NULL, NULL, 0, NULL}};
 

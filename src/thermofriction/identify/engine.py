@@ -1,0 +1,335 @@
+"""The least-squares engine: residuals of simulated against measured displacement, their exact
+Jacobian from the C core's forward sensitivities, a multi-start global phase, trust-region
+Levenberg-Marquardt (SciPy ``least_squares``), and uncertainty from the Jacobian at the optimum."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from scipy import optimize, stats
+
+from .. import _core
+from ..errors import ComputationError, InputError
+from ..models import Model
+from ..simulate import core_spec
+from ..waveforms import Sampled, Waveform
+from .parameters import Parameters, target_of, unit_of, with_values
+
+_DISPLACEMENT = 4   # output channel of the driven body's displacement (plant.h)
+_X_E = 2            # its state index
+_MAX_STEPS = 2_000_000
+
+
+@dataclasses.dataclass
+class Trace:
+    """One measured run, ready to fit: the model is driven by ``waveform`` at ``temperature``."""
+
+    name: str
+    time: np.ndarray
+    displacement: np.ndarray
+    temperature: float | Sampled
+    waveform: Waveform
+    role: str = "fit"
+    nominal_temperature: float = math.nan
+
+
+def experiment_waveform(exp, model: Model) -> Waveform:
+    """The input that drove an experiment: the manifest's, the model's when it reproduces the
+    recorded voltage (to 1 % of its range), else the recorded voltage itself."""
+    w = getattr(exp, "input", None)
+    if w is not None:
+        return w
+    if model.input is not None:
+        u = model.input(exp.time)
+        if np.max(np.abs(u - exp.voltage)) <= 0.01 * max(float(np.ptp(exp.voltage)), 1e-12):
+            return model.input
+    return Sampled(exp.time, exp.voltage)
+
+
+def make_traces(experiments, model: Model):
+    traces = []
+    for exp in experiments:
+        T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
+        traces.append(Trace(exp.file, np.ascontiguousarray(exp.time, float),
+                            np.ascontiguousarray(exp.displacement, float), T, experiment_waveform(exp, model),
+                            getattr(exp, "role", "fit"), float(exp.temperature)))
+    return traces
+
+
+_POOL = None
+
+
+def pool() -> ThreadPoolExecutor:
+    """One pool for all fits: the C core releases the GIL, so threads use every core."""
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=os.cpu_count() or 1, thread_name_prefix="thermofriction")
+    return _POOL
+
+
+class Problem:
+    """Residuals r(theta) (offset of each trace profiled out) and their Jacobian dr/dtheta."""
+
+    def __init__(self, model: Model, names, traces, rtol=1e-8, parallel=True):
+        self.model = model
+        self.names = list(names)
+        self.targets = np.array([target_of(model, n) for n in self.names], dtype=np.int32).reshape(-1, 3)
+        self.traces = traces
+        self.rtol = rtol
+        self.parallel = parallel
+        self.n_points = sum(len(t.time) for t in traces)
+        self.nfev = 0
+        self.njev = 0
+
+    def _run(self, trace: Trace, theta, jac):
+        model = with_values(self.model, dict(zip(self.names, theta)))
+        spec = core_spec(model, trace.temperature, trace.waveform)
+        n_out = len(trace.time)
+        out = np.empty((n_out, _core.NFIXED_OUTPUTS + model.friction.nstate))
+        try:
+            if not jac:
+                _core.simulate(spec, trace.time, out, 1, self.rtol, None, 0.0, 0.0, _MAX_STEPS)
+                S = None
+            else:
+                scale = np.asarray(_core.state_scale(spec))
+                atol_y = self.rtol * scale
+                atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
+                nstate = len(scale)
+                sens = np.empty((n_out, nstate, len(theta)))
+                _core.simulate_sensitivities(spec, self.targets, trace.time, out, sens, self.rtol,
+                                             np.concatenate([atol_y, atol_s.ravel()]), 0.0, 0.0, _MAX_STEPS)
+                S = sens[:, _X_E, :]
+        except _core.SolverError:
+            return None, None
+        d = out[:, _DISPLACEMENT] - trace.displacement
+        r = d - d.mean()
+        if S is not None:
+            S = S - S.mean(axis=0)
+        return r, S
+
+    def evaluate(self, theta, jac=False):
+        """(r, J) at theta; r is None when a simulation failed (the parameters are implausible)."""
+        theta = np.asarray(theta, float)
+        if self.parallel and len(self.traces) > 1:
+            results = list(pool().map(lambda tr: self._run(tr, theta, jac), self.traces))
+        else:
+            results = [self._run(tr, theta, jac) for tr in self.traces]
+        self.nfev += 1
+        self.njev += int(jac)
+        if any(r is None for r, _ in results):
+            return None, None
+        r = np.concatenate([r for r, _ in results])
+        J = np.concatenate([S for _, S in results]) if jac else None
+        return r, J
+
+    def per_trace(self, theta):
+        results = [self._run(tr, np.asarray(theta, float), False) for tr in self.traces]
+        return [r for r, _ in results]
+
+
+@dataclasses.dataclass
+class Transform:
+    """Positive parameters are fitted as log(theta), the others as theta / |theta0|."""
+
+    log: np.ndarray
+    scale: np.ndarray
+
+    def to_phi(self, theta):
+        theta = np.asarray(theta, float)
+        return np.where(self.log, np.log(np.where(self.log, theta, 1.0)), theta / self.scale)
+
+    def to_theta(self, phi):
+        phi = np.asarray(phi, float)
+        return np.where(self.log, np.exp(np.where(self.log, phi, 0.0)), phi * self.scale)
+
+    def dtheta_dphi(self, theta):
+        return np.where(self.log, theta, self.scale)
+
+    def bounds(self, params, theta0):
+        """Bounds in phi; a log parameter stays within e^+-30 of its initial value, so that
+        a parameter the data do not determine cannot run off to 0 or infinity."""
+        lo = np.array([p.min for p in params])
+        hi = np.array([p.max for p in params])
+        with np.errstate(divide="ignore"):
+            lo_phi = np.where(self.log, np.log(np.maximum(lo, 0.0)), lo / self.scale)
+            hi_phi = np.where(self.log, np.log(hi), hi / self.scale)
+        start = self.to_phi(theta0)
+        lo_phi = np.where(self.log, np.maximum(lo_phi, start - 30.0), lo_phi)
+        hi_phi = np.where(self.log, np.minimum(hi_phi, start + 30.0), hi_phi)
+        return lo_phi, hi_phi
+
+
+def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight):
+    cache = {}
+
+    def both(phi):
+        key = phi.tobytes()
+        if key not in cache:
+            cache.clear()
+            theta = transform.to_theta(phi)
+            r, J = problem.evaluate(theta, jac=True)
+            if r is None:  # a failed simulation: a large, flat residual pushes the step back
+                r = np.full(problem.n_points, 1e3 * max(_y_scale(problem), 1e-12))
+                J = np.zeros((problem.n_points, len(phi)))
+            else:
+                J = J * transform.dtheta_dphi(theta)[None, :]
+            cache[key] = (r, J)
+        return cache[key]
+
+    # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
+    # along directions the data do not determine
+    tol = 1e-12 if tight else max(1e-10, 10 * problem.rtol)
+    return optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
+                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-12 if tight else 1e-10,
+                                  max_nfev=max_nfev)
+
+
+def _y_scale(problem):
+    return max(float(np.ptp(t.displacement)) for t in problem.traces)
+
+
+@dataclasses.dataclass
+class FitOutcome:
+    theta: np.ndarray
+    r: np.ndarray
+    J: np.ndarray
+    nfev: int
+    njev: int
+    success: bool
+    message: str
+    starts: int
+    wall_time: float
+
+
+def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=60,
+        tight=False, progress=None) -> FitOutcome:
+    """Fits the varying parameters; returns the optimum with its residuals and Jacobian."""
+    t_start = time.perf_counter()
+    varying = params.varying
+    if not varying:
+        raise InputError("no parameter to fit (all are fixed)")
+    names = [p.name for p in varying]
+    theta0 = np.array([p.value for p in varying])
+    transform = Transform(np.array([p.positive for p in varying]),
+                          np.array([abs(v) if v != 0 else 1.0 for v in theta0]))
+    lo, hi = transform.bounds(varying, theta0)
+    phi0 = np.clip(transform.to_phi(theta0), lo, hi)
+    one_trace = len(traces) == 1
+
+    # global phase: screen a Latin hypercube around the initial guess (a decade either way for
+    # log parameters, +-100 % for the others) by cost alone, then refine the best few
+    candidates = [phi0]
+    if starts > 1:
+        width = np.where(transform.log, math.log(10.0), 1.0)
+        sample = stats.qmc.LatinHypercube(d=len(phi0), seed=seed).random(starts - 1)
+        for u in sample:
+            candidates.append(np.clip(phi0 + (2 * u - 1) * width, lo + 1e-9, hi - 1e-9))
+    screen = Problem(model, names, traces, rtol=max(rtol, 1e-6), parallel=not one_trace)
+
+    def cost(phi):
+        r, _ = screen.evaluate(transform.to_theta(phi))
+        return math.inf if r is None else float(r @ r)
+
+    if len(candidates) > 1:
+        costs = list(pool().map(cost, candidates)) if one_trace else [cost(c) for c in candidates]
+        order = np.argsort(costs)
+        n_refine = min(max(os.cpu_count() or 1, 2), 3) if one_trace else 1  # one per core
+        chosen = [candidates[i] for i in order[:n_refine] if math.isfinite(costs[i])]
+        if not any(np.array_equal(c, phi0) for c in chosen):
+            chosen.append(phi0)
+    else:
+        chosen = [phi0]
+    if progress:
+        progress(f"{len(candidates)} starts screened; refining {len(chosen)}")
+
+    def run(phi_start):
+        # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
+        # half the cost per run), then polish at the requested tolerance
+        problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
+        if rtol < 1e-6:
+            coarse = Problem(model, names, traces, rtol=1e-6, parallel=not one_trace)
+            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False)
+            phi_start = first.x
+            problem.nfev, problem.njev = coarse.nfev, coarse.njev
+        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight else 15, tight)
+        return res, problem
+
+    if one_trace and len(chosen) > 1:
+        runs = list(pool().map(run, chosen))
+    else:
+        runs = [run(c) for c in chosen]
+    best, best_problem = min(runs, key=lambda rp: rp[0].cost)
+    theta = transform.to_theta(best.x)
+    r, J = best_problem.evaluate(theta, jac=True)
+    if r is None:
+        raise ComputationError("the fit ended where the model cannot be simulated; try another initial guess")
+    nfev = screen.nfev + sum(p.nfev for _, p in runs)
+    njev = sum(p.njev for _, p in runs)
+    return FitOutcome(theta, r, J, nfev, njev, bool(best.success and best.status > 0), best.message,
+                      len(candidates), time.perf_counter() - t_start)
+
+
+def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
+    """Standard errors, 95 % intervals and correlations from the Jacobian at the optimum.
+
+    cov = s^2 (J^T J)^-1 by SVD of the column-scaled Jacobian; a direction the data do not
+    determine (singular value below 1e-9 of the largest) gives the parameters on it an infinite
+    error instead of a falsely tight one. s^2 is inflated by (1 + rho)/(1 - rho), rho the residuals'
+    lag-1 autocorrelation, so that coloured (non-white) residuals do not make the intervals
+    too narrow. Returns the correlation matrix and warnings."""
+    varying = params.varying
+    theta, r, J = outcome.theta, outcome.r, outcome.J
+    n, p = J.shape
+    dof = max(n - p - len(traces), 1)
+    s2 = float(r @ r) / dof
+    rhos, start = [], 0
+    for tr in traces:
+        seg = r[start:start + len(tr.time)]
+        start += len(tr.time)
+        if len(seg) > 3 and np.dot(seg, seg) > 0:
+            rhos.append(float(np.dot(seg[1:], seg[:-1]) / np.dot(seg, seg)))
+    rho = min(max(float(np.mean(rhos)) if rhos else 0.0, 0.0), 0.99)
+    inflation = (1 + rho) / (1 - rho)
+    col = np.linalg.norm(J, axis=0)
+    col[col == 0] = 1.0
+    U, S, Vt = np.linalg.svd(J / col, full_matrices=False)
+    bad = S <= S[0] * 1e-9 if S.size and S[0] > 0 else np.ones_like(S, bool)
+    inv = np.where(bad, 0.0, 1.0 / np.where(bad, 1.0, S) ** 2)
+    cov = (Vt.T * inv) @ Vt / np.outer(col, col) * s2 * inflation
+    var = np.diag(cov).copy()
+    loading = (Vt[bad] ** 2).sum(axis=0) if bad.any() else np.zeros(p)
+    var[loading > 1e-6] = math.inf
+    se = np.sqrt(var)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    corr[~np.isfinite(corr)] = np.nan
+    np.fill_diagonal(corr, 1.0)
+    tq = stats.t.ppf(0.975, dof)
+    warnings = []
+    for i, par in enumerate(varying):
+        par.value = float(theta[i])
+        par.stderr = float(se[i])
+        if not math.isfinite(se[i]):
+            par.ci95 = (0.0 if par.positive else -math.inf, math.inf)
+            warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)")
+            continue
+        if par.positive:
+            f = math.exp(min(tq * se[i] / theta[i], 700.0))
+            par.ci95 = (theta[i] / f, theta[i] * f)
+        else:
+            par.ci95 = (theta[i] - tq * se[i], theta[i] + tq * se[i])
+        if se[i] > 0.5 * abs(theta[i]):
+            rel = f"{100 * se[i] / abs(theta[i]):.0f} % of its value" if theta[i] else f"{se[i]:.3g} around 0"
+            warnings.append(f"'{par.name}' is poorly determined by these data (standard error {rel})")
+    for par in params.values():
+        if not par.vary:
+            par.stderr, par.ci95 = 0.0, (par.value, par.value)
+        if not par.unit:
+            par.unit = unit_of(model, par.name)
+    return corr, warnings, {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho,
+                            "variance_inflation": inflation}

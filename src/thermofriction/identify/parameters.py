@@ -1,0 +1,195 @@
+"""Fit parameters as objects (value, bounds, ``vary``, and after a fit ``stderr`` and ``ci95``),
+and their mapping onto a model: a friction parameter given as a number (``sigma0``), a
+coefficient of a Model I law (``sigma0.a``, ``fc.values[2]``) or of Model II's ``dF`` (``dF.values[1]``)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+
+import numpy as np
+
+from ..errors import InputError
+from ..models import PARAMETER_UNITS, PARAMETERS, PWL, Const, Exp, Law, Linear, Model, ModelI, ModelII, Poly, Table
+
+_TARGET_PARAM, _TARGET_LAW, _TARGET_DF = 0, 1, 2
+
+
+@dataclasses.dataclass
+class Parameter:
+    name: str
+    value: float
+    min: float = -math.inf
+    max: float = math.inf
+    vary: bool = True
+    unit: str = ""
+    stderr: float | None = None
+    ci95: tuple | None = None
+    init_value: float | None = None
+
+    @property
+    def positive(self) -> bool:
+        """Fitted in log space (so it stays positive) when its lower bound is >= 0."""
+        return self.min >= 0 and self.value > 0
+
+    def to_dict(self):
+        def f(x):
+            return None if x is None else (float(x) if math.isfinite(x) else ("inf" if x > 0 else "-inf"))
+        ci = None if self.ci95 is None else [f(self.ci95[0]), f(self.ci95[1])]
+        return {"value": f(self.value), "stderr": f(self.stderr), "ci95": ci, "unit": self.unit,
+                "vary": self.vary}
+
+    def __repr__(self):
+        err = "" if self.stderr is None else f" +/- {self.stderr:.3g}"
+        fixed = "" if self.vary else " (fixed)"
+        return f"<Parameter {self.name!r} = {self.value:.6g}{err} {self.unit}{fixed}>"
+
+
+class Parameters(dict):
+    """An ordered set of :class:`Parameter`, like lmfit's."""
+
+    def add(self, name, value, *, min=-math.inf, max=math.inf, vary=True, unit=""):
+        if not (min <= value <= max):
+            raise InputError(f"initial value of '{name}' ({value!r}) is outside its bounds [{min!r}, {max!r}]")
+        self[name] = Parameter(name, float(value), float(min), float(max), bool(vary), unit, init_value=float(value))
+        return self[name]
+
+    @property
+    def varying(self):
+        return [p for p in self.values() if p.vary]
+
+    def valuesdict(self):
+        return {k: p.value for k, p in self.items()}
+
+    def to_dict(self):
+        return {k: p.to_dict() for k, p in self.items()}
+
+
+# -- names <-> model ----------------------------------------------------------------------------
+
+_COEF_NAMES = {"const": ["value"], "linear": ["a", "b"], "exp": ["a", "b"]}
+
+
+def law_coefficient_names(law: Law):
+    if isinstance(law, Table):
+        return []  # the PCHIP slopes depend on the values nonlinearly: no sensitivities
+    if isinstance(law, PWL):
+        return [f"values[{i}]" for i in range(len(law.values))]
+    if isinstance(law, Poly):
+        return [f"c[{i}]" for i in range(len(law.c))]
+    return list(_COEF_NAMES[law.kind])
+
+
+def law_coefficients(law: Law):
+    if isinstance(law, PWL):
+        return list(law.values)
+    if isinstance(law, Poly):
+        return list(law.c)
+    if isinstance(law, Const):
+        return [law.value]
+    return [law.a, law.b]
+
+
+def law_with_coefficients(law: Law, coefs) -> Law:
+    coefs = [float(c) for c in coefs]
+    if isinstance(law, PWL):
+        return dataclasses.replace(law, values=np.array(coefs))
+    if isinstance(law, Poly):
+        return dataclasses.replace(law, c=np.array(coefs))
+    if isinstance(law, Const):
+        return dataclasses.replace(law, value=coefs[0])
+    return dataclasses.replace(law, a=coefs[0], b=coefs[1])
+
+
+def _split(name):
+    m = re.fullmatch(r"([A-Za-z_0-9]+)(?:\.(.+))?", name)
+    if not m:
+        raise InputError(f"not a parameter name: '{name}'")
+    return m.group(1), m.group(2)
+
+
+def target_of(model: Model, name: str):
+    """(kind, parameter index, coefficient index) of the C core's sensitivity target."""
+    base, coef = _split(name)
+    if base == "dF":
+        if not isinstance(model.thermal, ModelII):
+            raise InputError(f"'{name}': the model has no Model II dF law")
+        names = law_coefficient_names(model.thermal.dF)
+        if coef not in names:
+            raise InputError(f"'{name}': dF ({model.thermal.dF.kind}) has coefficients {', '.join(names) or 'none'}")
+        return (_TARGET_DF, 0, names.index(coef))
+    if base not in PARAMETERS:
+        raise InputError(f"'{name}' is not a parameter ({', '.join(PARAMETERS)}, 'dF', or 'p.coefficient')")
+    idx = PARAMETERS.index(base)
+    if coef is None:
+        if base in model.laws:
+            raise InputError(f"'{base}' follows a law in this model: fit its coefficients "
+                             f"({', '.join(base + '.' + c for c in law_coefficient_names(model.laws[base]))})")
+        return (_TARGET_PARAM, idx, 0)
+    if base not in model.laws:
+        raise InputError(f"'{name}': '{base}' has no law in this model")
+    names = law_coefficient_names(model.laws[base])
+    if coef not in names:
+        raise InputError(f"'{name}': the law of '{base}' has coefficients {', '.join(names) or 'none'}")
+    return (_TARGET_LAW, idx, names.index(coef))
+
+
+def get_value(model: Model, name: str) -> float:
+    kind, idx, coef = target_of(model, name)
+    if kind == _TARGET_DF:
+        return float(law_coefficients(model.thermal.dF)[coef])
+    if kind == _TARGET_LAW:
+        return float(law_coefficients(model.laws[PARAMETERS[idx]])[coef])
+    values = model.friction.values()
+    base = PARAMETERS[idx]
+    if base == "fs" and "fs" not in values:
+        return float(values["fc"])
+    if base not in values:
+        raise InputError(f"'{name}' has no value in this model")
+    return float(values[base])
+
+
+def with_values(model: Model, values: dict) -> Model:
+    """A copy of ``model`` with the named parameters set."""
+    friction = {}
+    laws = dict(model.laws)
+    dF = model.thermal.dF if isinstance(model.thermal, ModelII) else None
+    for name, v in values.items():
+        kind, idx, coef = target_of(model, name)
+        if kind == _TARGET_PARAM:
+            friction[PARAMETERS[idx]] = float(v)
+        elif kind == _TARGET_LAW:
+            p = PARAMETERS[idx]
+            c = law_coefficients(laws[p])
+            c[coef] = v
+            laws[p] = law_with_coefficients(laws[p], c)
+        else:
+            c = law_coefficients(dF)
+            c[coef] = v
+            dF = law_with_coefficients(dF, c)
+    thermal = model.thermal
+    if isinstance(thermal, ModelI):
+        thermal = ModelI(laws)
+    elif isinstance(thermal, ModelII):
+        thermal = dataclasses.replace(thermal, dF=dF)
+    return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **friction), thermal=thermal)
+
+
+def unit_of(model: Model, name: str) -> str:
+    base, coef = _split(name)
+    unit = "N" if base == "dF" else PARAMETER_UNITS.get(base, "")
+    if coef is None:
+        return unit
+    law = model.thermal.dF if base == "dF" else model.laws.get(base)
+    if isinstance(law, Linear) and coef == "a":
+        return f"{unit}/C"
+    if isinstance(law, Exp) and coef == "b":
+        return "1/C"
+    if isinstance(law, Poly) and coef != "c[0]":
+        return f"{unit}/C^{coef[2:-1]}"
+    return unit
+
+
+__all__ = ["Parameter", "Parameters", "target_of", "get_value", "with_values", "law_coefficient_names",
+           "law_coefficients", "law_with_coefficients", "unit_of", "Exp", "Linear"]

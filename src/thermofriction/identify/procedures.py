@@ -1,0 +1,384 @@
+"""Identification procedures: a base friction model, Model I and Model II (SPEC 5), built on
+the engine's fit()."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+from scipy import optimize
+
+from ..errors import InputError
+from ..models import PWL, Const, Exp, Linear, LuGre, Model, ModelI, ModelII
+from ..simulate import simulate
+from .engine import fit, make_traces, uncertainty
+from .parameters import Parameters, get_value, law_coefficient_names, law_coefficients, unit_of, with_values
+from .result import FitResult
+
+DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")
+
+
+def _result(method, model, params, outcome, traces, t0, extra_warnings=(), details=None):
+    corr, warns, stats = uncertainty(params, outcome, traces, model)
+    values = {p.name: p.value for p in params.values()}
+    fitted = with_values(model, values)
+    per, start = [], 0
+    for tr in traces:
+        seg = outcome.r[start:start + len(tr.time)]
+        start += len(tr.time)
+        per.append({"file": tr.name, "temperature": tr.nominal_temperature, "role": tr.role,
+                    "rmse": float(np.sqrt(np.mean(seg ** 2)))})
+    cost = float(outcome.r @ outcome.r)
+    return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
+                     rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
+                     njev=outcome.njev, starts=outcome.starts, wall_time=time.perf_counter() - t0,
+                     success=outcome.success, message=str(outcome.message), experiments=per,
+                     warnings=list(extra_warnings) + warns, statistics=stats, details=details or {})
+
+
+def _friction_parameters(model: Model, names, fixed=()):
+    params = Parameters()
+    for name in names:
+        v = get_value(model, name)
+        positive = not name.startswith("dF") and "." not in name
+        params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
+                   unit=unit_of(model, name))
+    return params
+
+
+def base_model(model: Model, temperature=None) -> Model:
+    """The model without its thermal extension: a Model I's laws evaluated at ``temperature``."""
+    if isinstance(model.thermal, ModelI):
+        if temperature is None:
+            lo_hi = model.temperature_range()
+            temperature = 0.5 * (lo_hi[0] + lo_hi[1]) if lo_hi else 35.0
+        p = model.parameters_at(temperature)
+        fr = dataclasses.replace(model.friction, **{k: p[k] for k in model.laws})
+        return dataclasses.replace(model, friction=fr, thermal=None)
+    return dataclasses.replace(model, thermal=None)
+
+
+def fit_friction(experiments, model: Model, parameters=None, *, method="base", **opts) -> FitResult:
+    """Fits the named friction parameters (default sigma0, sigma1, fc) of ``model`` jointly on
+    ``experiments``: one set of values shared by all of them."""
+    t0 = time.perf_counter()
+    traces = make_traces(experiments, model)
+    if isinstance(parameters, Parameters):
+        params = parameters
+    else:
+        params = _friction_parameters(model, parameters or DEFAULT_FRICTION_PARAMETERS)
+    outcome = fit(model, params, traces, **opts)
+    return _result(method, model, params, outcome, traces, t0)
+
+
+# -- laws of temperature -------------------------------------------------------------------------
+
+def _aicc(ssr, n, k):
+    if ssr <= 0:
+        ssr = 1e-300
+    aic = n * math.log(ssr / n) + 2 * k
+    return aic + 2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else aic
+
+
+def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None):
+    """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
+    lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
+    kind is better by more than 2 (a difference the data support). Returns (law, table)."""
+    T, values = np.asarray(T, float), np.asarray(values, float)
+    w = np.ones_like(values)
+    if stderr is not None:
+        se = np.asarray(stderr, float)
+        ok = np.isfinite(se) & (se > 0)
+        if ok.all():
+            w = 1.0 / se
+            w = w / w.mean()
+    rng = (float(T.min()), float(T.max()))
+    table, best = {}, None
+    for kind in kinds:
+        if kind == "linear":
+            A = np.column_stack([T, np.ones_like(T)]) * w[:, None]
+            coef, *_ = np.linalg.lstsq(A, values * w, rcond=None)
+            law = Linear(float(coef[0]), float(coef[1]), range=rng)
+            k = 2
+        elif kind == "exp":
+            if np.any(values <= 0) or len(T) < 2:
+                continue
+            b0, la0 = np.polyfit(T, np.log(values), 1, w=w)
+            res = optimize.least_squares(lambda c: (c[0] * np.exp(c[1] * T) - values) * w,
+                                         [math.exp(la0), b0], x_scale=[math.exp(la0), max(abs(b0), 1e-3)])
+            law = Exp(float(res.x[0]), float(res.x[1]), range=rng)
+            k = 2
+        elif kind == "const":
+            law = Const(float(np.average(values, weights=w ** 2)), range=rng)
+            k = 1
+        else:
+            raise InputError(f"unknown law kind '{kind}' for a Model I parameter (linear, exp, const)")
+        ssr = float(np.sum(((law(T) - values) * w) ** 2))
+        table[kind] = {"aicc": _aicc(ssr, len(T), k), "law": law.to_dict()}
+        if best is None or table[kind]["aicc"] < table[best[0]]["aicc"]:
+            best = (kind, law)
+    if best is None:
+        raise InputError("no law could be fitted")
+    if prefer in table and prefer != best[0] and table[prefer]["aicc"] - table[best[0]]["aicc"] <= 2.0:
+        from ..models import law_from_dict
+        return law_from_dict(table[prefer]["law"], "law"), table
+    return best[1], table
+
+
+def segmented_fit(T, values, weights=None):
+    """Two linear segments meeting at an estimated breakpoint (the paper's Fig. 6): a grid
+    search over the breakpoint, linear least squares at each. Returns (breakpoint, law)."""
+    T, values = np.asarray(T, float), np.asarray(values, float)
+    w = np.ones_like(T) if weights is None else np.asarray(weights, float)
+    order = np.argsort(T)
+    T, values, w = T[order], values[order], w[order]
+    best = None
+    for tb in np.linspace(T[1], T[-2], 200) if len(T) >= 4 else []:
+        A = np.column_stack([np.ones_like(T), T - tb, np.maximum(T - tb, 0.0)]) * w[:, None]
+        coef, *_ = np.linalg.lstsq(A, values * w, rcond=None)
+        ssr = float(np.sum((A @ coef - values * w) ** 2))
+        if best is None or ssr < best[0]:
+            best = (ssr, tb, coef)
+    if best is None:
+        raise InputError("a segmented fit needs at least 4 temperatures")
+    _, tb, (c0, c1, c2) = best
+    knots = np.array([T[0], tb, T[-1]])
+    vals = c0 + c1 * (knots - tb) + c2 * np.maximum(knots - tb, 0.0)
+    return float(tb), PWL(knots, vals, range=(float(T[0]), float(T[-1]))), best[0]
+
+
+def _groups(experiments):
+    """Fit experiments grouped by temperature (0.05 C apart count as one)."""
+    exps = sorted(experiments, key=lambda e: e.temperature)
+    groups = []
+    for e in exps:
+        if groups and abs(e.temperature - groups[-1][0].temperature) < 0.05:
+            groups[-1].append(e)
+        else:
+            groups.append([e])
+    return groups
+
+
+def _fit_parameter_names(model):
+    if isinstance(model.thermal, ModelI) and model.laws:
+        return [n for n in DEFAULT_FRICTION_PARAMETERS if n in model.laws] or list(DEFAULT_FRICTION_PARAMETERS)
+    return list(DEFAULT_FRICTION_PARAMETERS)
+
+
+def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, **opts) -> FitResult:
+    """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
+    ``laws`` names one), then a joint refinement of the law coefficients on all experiments."""
+    t0 = time.perf_counter()
+    groups = _groups(experiments)
+    if len(groups) < 2:
+        raise InputError("Model I needs fit experiments at two or more temperatures")
+    names = _fit_parameter_names(init)
+    per_T, previous, held, warns = [], None, [], []
+    for i, group in enumerate(groups):
+        T = float(np.mean([e.temperature for e in group]))
+        base = base_model(init, T) if previous is None else previous
+        base = dataclasses.replace(base, thermal=None)
+        if held:  # parameters the data cannot determine follow the initial model's law
+            base = base.with_friction(**{n: base_model(init, T).friction.values()[n] for n in held})
+        if progress:
+            progress(f"Model I: fitting {', '.join(n for n in names if n not in held)} at {T:.4g} C")
+        first = dict(opts)
+        if previous is not None:  # continuation from the neighbouring temperature
+            first["starts"] = 1
+        res = fit_friction(group, base, _friction_parameters(base, names, fixed=held),
+                           method=f"base at {T:.4g} C", **first)
+        if i == 0:
+            undetermined = [n for n in names if not math.isfinite(res.parameters[n].stderr)
+                            or res.parameters[n].stderr > abs(res.parameters[n].value)]
+            if undetermined and len(undetermined) < len(names):
+                held = undetermined
+                warns.append(f"{', '.join(held)} cannot be determined from these data (standard error above 100 % "
+                             f"at {T:.4g} C): held at the initial model's law")
+                res = fit_friction(group, base.with_friction(**{n: base_model(init, T).friction.values()[n]
+                                                                for n in held}),
+                                   _friction_parameters(base, names, fixed=held), method=f"base at {T:.4g} C", **opts)
+        previous = res.model
+        per_T.append((T, res))
+    details = {"per_temperature": [
+        {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse": r.rmse,
+         "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
+    Ts = np.array([T for T, _ in per_T])
+    new_laws, law_tables = {}, {}
+    for n in names:
+        if n in held:
+            new_laws[n] = init.laws[n] if n in init.laws else Const(init.friction.values()[n])
+            law_tables[n] = {"chosen": "held at the initial model", "law": new_laws[n].to_dict()}
+            continue
+        vals = np.array([r.parameters[n].value for _, r in per_T])
+        ses = np.array([r.parameters[n].stderr for _, r in per_T])
+        kinds = (laws or {}).get(n)
+        kinds = (kinds,) if isinstance(kinds, str) else (kinds or ("linear", "exp"))
+        prefer = init.laws[n].kind if n in init.laws else None
+        law, table = fit_law(Ts, vals, ses, kinds, prefer=prefer)
+        new_laws[n] = law
+        law_tables[n] = {"chosen": law.kind, "candidates": table, "temperatures": Ts, "values": vals,
+                         "stderr": ses}
+    details["laws"] = law_tables
+    friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in names})
+    model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
+    if not refine:
+        params = Parameters()
+        for n, law in new_laws.items():
+            for cname, v in zip(_coef_names(law), _coef_values(law)):
+                params.add(f"{n}.{cname}", v, unit=unit_of(model, f"{n}.{cname}"))
+        res = FitResult("model-i", model, params, np.full((0, 0), np.nan), math.nan, math.nan, 0,
+                        sum(r.nfev for _, r in per_T), sum(r.njev for _, r in per_T), 0,
+                        time.perf_counter() - t0, True, "per-temperature fits and laws (no joint refinement)",
+                        warnings=warns, details=details)
+        return res
+    if progress:
+        progress("Model I: joint refinement of the law coefficients on all experiments")
+    params = Parameters()
+    for n, law in new_laws.items():
+        for cname, v in zip(_coef_names(law), _coef_values(law)):
+            name = f"{n}.{cname}"
+            positive = law.kind == "exp" and cname == "a" and v > 0
+            params.add(name, v, min=0.0 if positive else -math.inf, unit=unit_of(model, name), vary=n not in held)
+    traces = make_traces(experiments, model)
+    ropts = dict(opts)
+    ropts["starts"] = 1
+    ropts.setdefault("max_nfev", 30)
+    outcome = fit(model, params, traces, **ropts)
+    res = _result("model-i", model, params, outcome, traces, t0, warns, details)
+    res.nfev += sum(r.nfev for _, r in per_T)
+    res.njev += sum(r.njev for _, r in per_T)
+    return res
+
+
+_coef_names = law_coefficient_names
+_coef_values = law_coefficients
+
+
+def _final_displacement(exp):
+    """Net displacement of a run: mean of its last 1 % minus mean of its first 1 % (robust to noise)."""
+    k = max(len(exp.displacement) // 100, 1)
+    return float(np.mean(exp.displacement[-k:]) - np.mean(exp.displacement[:k]))
+
+
+def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True,
+                      progress=None, **opts) -> FitResult:
+    """Model II. ``procedure="paper"``: base model at the reference temperature; displacement
+    against temperature by a segmented linear fit with an estimated breakpoint; displacement
+    against dF by simulation; composed dF(T). ``"direct"``: dF fitted per temperature on the
+    trajectories, then a law (linear or two segments by AICc) and a joint refinement.
+    ``"both"``: the direct result, with the paper's in ``alternatives["paper"]``."""
+    if procedure not in ("direct", "paper", "both"):
+        raise InputError(f"Model II procedure must be 'direct', 'paper' or 'both', got {procedure!r}")
+    t0 = time.perf_counter()
+    groups = _groups(experiments)
+    if len(groups) < 2:
+        raise InputError("Model II needs fit experiments at two or more temperatures")
+    if reference_temperature is None:
+        ref_group = groups[0]
+    else:
+        ref_group = min(groups, key=lambda g: abs(g[0].temperature - reference_temperature))
+    T_ref = float(np.mean([e.temperature for e in ref_group]))
+    if progress:
+        progress(f"Model II: base model at the reference temperature {T_ref:.4g} C")
+    base_init = base_model(init, T_ref)
+    base_fit = fit_friction(ref_group, base_init, _fit_parameter_names(base_init),
+                            method=f"base at {T_ref:.4g} C", **opts)
+    base = base_fit.model
+    details = {"reference_temperature": T_ref, "base": base_fit.to_dict()}
+    results = {}
+    if procedure in ("paper", "both"):
+        results["paper"] = _model_ii_paper(groups, base, T_ref, details, t0, progress)
+    if procedure in ("direct", "both"):
+        results["direct"] = _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts)
+    main = results["direct" if procedure != "paper" else "paper"]
+    if procedure == "both":
+        main.alternatives["paper"] = results["paper"]
+    main.wall_time = time.perf_counter() - t0
+    return main
+
+
+def _model_ii_paper(groups, base, T_ref, details, t0, progress):
+    if progress:
+        progress("Model II (paper): displacement against temperature and against dF")
+    Ts = np.array([np.mean([e.temperature for e in g]) for g in groups])
+    D = np.array([np.mean([_final_displacement(e) for e in g]) for g in groups])
+    tb, D_law, _ = segmented_fit(Ts, D)
+    # displacement against dF, by simulating the base model with a constant dF
+    ref = groups[0][0]
+    fc = base.reference_force()
+    dFs = np.linspace(-0.5 * fc, 0.2 * fc, 8)
+    from .engine import experiment_waveform
+    waveform = experiment_waveform(ref, base)
+    D_sim = []
+    for dF in dFs:
+        m = dataclasses.replace(base, thermal=ModelII(Const(float(dF))))
+        res = simulate(m, t_eval=ref.time, temperature=T_ref, input=waveform)
+        D_sim.append(res.displacement[-1] - res.displacement[0])
+    D_sim = np.array(D_sim)
+    beta, alpha = np.polyfit(dFs, D_sim, 1)
+    r2 = 1 - np.sum((alpha + beta * dFs - D_sim) ** 2) / np.sum((D_sim - D_sim.mean()) ** 2)
+    knots = D_law.T
+    dF_knots = (D_law.values - alpha) / beta
+    law = PWL(knots, dF_knots, range=(float(Ts.min()), float(Ts.max())))
+    model = dataclasses.replace(base, thermal=ModelII(law))
+    details["paper"] = {"temperatures": Ts, "displacement": D, "breakpoint": tb,
+                        "displacement_law": D_law.to_dict(), "dF_grid": dFs, "displacement_vs_dF": D_sim,
+                        "linear_fit": {"slope": beta, "intercept": alpha, "r2": r2}, "dF_law": law.to_dict()}
+    params = Parameters()
+    for i, v in enumerate(dF_knots):
+        params.add(f"dF.values[{i}]", float(v), unit="N")
+    warns = [] if r2 > 0.98 else [f"displacement is not linear in dF (R^2 = {r2:.3f}): the paper's procedure "
+                                  f"assumes it is"]
+    return FitResult("model-ii (paper)", model, params, np.full((len(params), len(params)), np.nan), math.nan,
+                     math.nan, 0, len(dFs), 0, 0, time.perf_counter() - t0, True,
+                     "paper's procedure (no trajectory fit, no intervals)", warnings=warns, details=details)
+
+
+def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts):
+    per_T = []
+    popts = dict(opts)
+    popts["starts"] = 1
+    for g in groups:
+        T = float(np.mean([e.temperature for e in g]))
+        if progress:
+            progress(f"Model II (direct): dF at {T:.4g} C")
+        m = dataclasses.replace(base, thermal=ModelII(Const(0.0)))
+        params = Parameters()
+        params.add("dF.value", 0.0, min=-0.95 * base.reference_force(), unit="N")
+        r = fit_friction(g, m, params, method=f"dF at {T:.4g} C", **popts)
+        per_T.append((T, r))
+    Ts = np.array([T for T, _ in per_T])
+    vals = np.array([r.parameters["dF.value"].value for _, r in per_T])
+    ses = np.array([r.parameters["dF.value"].stderr for _, r in per_T])
+    w = 1.0 / ses if np.all(np.isfinite(ses) & (ses > 0)) else np.ones_like(ses)
+    w = w / w.mean()
+    candidates = {}
+    A = np.column_stack([Ts, np.ones_like(Ts)]) * w[:, None]
+    coef, *_ = np.linalg.lstsq(A, vals * w, rcond=None)
+    lin = PWL([Ts.min(), Ts.max()], [coef[0] * Ts.min() + coef[1], coef[0] * Ts.max() + coef[1]],
+              range=(float(Ts.min()), float(Ts.max())))
+    candidates["linear"] = (lin, _aicc(float(np.sum(((lin(Ts) - vals) * w) ** 2)), len(Ts), 2))
+    if len(Ts) >= 4:
+        tb, seg, ssr = segmented_fit(Ts, vals, w)
+        candidates["two segments"] = (seg, _aicc(ssr, len(Ts), 4))
+    chosen = min(candidates, key=lambda k: candidates[k][1])
+    law = candidates[chosen][0]
+    details["direct"] = {"temperatures": Ts, "dF": vals, "stderr": ses, "chosen": chosen,
+                         "candidates": {k: {"aicc": a, "law": l.to_dict()} for k, (l, a) in candidates.items()}}
+    model = dataclasses.replace(base, thermal=ModelII(law))
+    params = Parameters()
+    for i, v in enumerate(law.values):
+        params.add(f"dF.values[{i}]", float(v), unit="N")
+    if not refine:
+        return FitResult("model-ii (direct)", model, params, np.full((len(params),) * 2, np.nan), math.nan,
+                         math.nan, 0, sum(r.nfev for _, r in per_T), 0, 0, time.perf_counter() - t0, True,
+                         "per-temperature dF and law (no joint refinement)", details=details)
+    if progress:
+        progress("Model II (direct): joint refinement of dF(T) on all experiments")
+    traces = make_traces(experiments, model)
+    outcome = fit(model, params, traces, **popts)
+    res = _result("model-ii (direct)", model, params, outcome, traces, t0, details=details)
+    res.nfev += sum(r.nfev for _, r in per_T)
+    return res

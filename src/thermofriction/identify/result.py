@@ -1,0 +1,152 @@
+"""What a fit returns: the fitted model, parameters with errors and intervals, a readable
+report, the JSON of SPEC 7, and an HTML table for notebooks."""
+
+from __future__ import annotations
+
+import dataclasses
+import html
+import json
+import math
+
+import numpy as np
+
+from .._io import atomic_write
+from ..models import Model
+from .parameters import Parameters
+
+
+def _num(x):
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else ("inf" if x > 0 else "-inf" if x < 0 else "nan")
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (float, np.floating)):
+        return _num(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.bool_,)):
+        return bool(obj)
+    return obj
+
+
+@dataclasses.dataclass
+class FitResult:
+    method: str
+    model: Model
+    parameters: Parameters
+    correlation: np.ndarray
+    cost: float                 # sum of squared residuals [m^2]
+    rmse: float                 # [m]
+    n_points: int
+    nfev: int
+    njev: int
+    starts: int
+    wall_time: float            # [s]
+    success: bool
+    message: str
+    experiments: list = dataclasses.field(default_factory=list)
+    warnings: list = dataclasses.field(default_factory=list)
+    statistics: dict = dataclasses.field(default_factory=dict)
+    details: dict = dataclasses.field(default_factory=dict)
+    alternatives: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def aicc(self) -> float:
+        """Akaike's criterion, corrected for small samples, of the trajectory fit."""
+        n, k = self.n_points, len(self.parameters.varying)
+        if n - k - 1 <= 0 or self.cost <= 0:
+            return math.nan
+        return n * math.log(self.cost / n) + 2 * k + 2 * k * (k + 1) / (n - k - 1)
+
+    def to_dict(self) -> dict:
+        names = [p.name for p in self.parameters.varying]
+        d = {
+            "method": self.method,
+            "success": self.success,
+            "message": self.message,
+            "parameters": self.parameters.to_dict(),
+            "correlation": {"names": names, "matrix": self.correlation},
+            "cost": self.cost,
+            "rmse": self.rmse,
+            "aicc": self.aicc,
+            "n_points": self.n_points,
+            "iterations": self.nfev,
+            "jacobian_evaluations": self.njev,
+            "starts": self.starts,
+            "wall_time": self.wall_time,
+            "experiments": self.experiments,
+            "warnings": self.warnings,
+            "statistics": self.statistics,
+            "details": self.details,
+            "model": self.model.to_dict(),
+        }
+        if self.alternatives:
+            d["alternatives"] = {k: v.to_dict() for k, v in self.alternatives.items()}
+        return _jsonable(d)
+
+    def to_json(self, path=None) -> str:
+        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
+        if path is not None:
+            with atomic_write(path, "w") as fh:
+                fh.write(text + "\n")
+        return text
+
+    def _rows(self):
+        for p in self.parameters.values():
+            if p.stderr is None or not p.vary:
+                err, ci, rel = "", "", "fixed" if not p.vary else ""
+            else:
+                err = f"{p.stderr:.4g}"
+                rel = f"{100 * p.stderr / abs(p.value):.2g} %" if p.value and math.isfinite(p.stderr) else ""
+                ci = f"[{p.ci95[0]:.5g}, {p.ci95[1]:.5g}]"
+            yield p.name, f"{p.value:.6g}", err, rel, ci, p.unit
+
+    def report(self) -> str:
+        """A table like lmfit's fit report."""
+        lines = [f"[[Fit: {self.method}]]",
+                 f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
+                 f"    data points      = {self.n_points}",
+                 f"    rmse             = {self.rmse * 1e9:.4g} nm",
+                 f"    evaluations      = {self.nfev} (Jacobians {self.njev}), starts = {self.starts}",
+                 f"    wall time        = {self.wall_time:.3g} s",
+                 "[[Parameters]]"]
+        rows = list(self._rows())
+        w = [max(len(r[i]) for r in rows + [("name", "value", "stderr", "rel", "95 % interval", "unit")])
+             for i in range(6)]
+        head = ("name", "value", "stderr", "rel", "95 % interval", "unit")
+        lines.append("    " + "  ".join(h.ljust(w[i]) for i, h in enumerate(head)))
+        for r in rows:
+            lines.append("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)))
+        names = [p.name for p in self.parameters.varying]
+        pairs = [(names[i], names[j], self.correlation[i, j]) for i in range(len(names))
+                 for j in range(i + 1, len(names)) if np.isfinite(self.correlation[i, j])
+                 and abs(self.correlation[i, j]) > 0.5]
+        if pairs:
+            lines.append("[[Correlations]] (|C| > 0.5)")
+            for a, b, c in sorted(pairs, key=lambda x: -abs(x[2])):
+                lines.append(f"    C({a}, {b}) = {c:+.3f}")
+        if self.warnings:
+            lines.append("[[Warnings]]")
+            lines.extend(f"    {w}" for w in self.warnings)
+        return "\n".join(lines)
+
+    def __str__(self):
+        return self.report()
+
+    def _repr_html_(self):
+        head = "".join(f"<th>{h}</th>" for h in ("name", "value", "stderr", "rel", "95 % interval", "unit"))
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self._rows())
+        warn = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
+        return (f"<div><b>Fit: {html.escape(self.method)}</b> — {'converged' if self.success else 'not converged'}, "
+                f"rmse {self.rmse * 1e9:.4g} nm, {self.wall_time:.3g} s"
+                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+                + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
