@@ -183,9 +183,10 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
 
     # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
     # along directions the data do not determine
-    tol = 1e-12 if tight else max(1e-10, 10 * problem.rtol)
+    # (tight: down to the solver's own floor, for checks against noise-free data)
+    tol = 1e-15 if tight else max(1e-10, 10 * problem.rtol)
     return optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
-                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-12 if tight else 1e-10,
+                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-15 if tight else 1e-10,
                                   max_nfev=max_nfev)
 
 
