@@ -14,6 +14,7 @@ from .models import (PARAMETERS, PRESETS, PWL, Const, Exp, Law, Linear, LuGre, M
                      StickSlipPlant, Table, load_model)
 from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
 from .waveforms import Sampled, Sawtooth, Sine, Square, Step, Waveform, parse_waveform
+from .identify import FitResult, Parameter, Parameters, identify
 
 __version__ = "0.1.0"
 
@@ -23,4 +24,5 @@ __all__ = [
     "StickSlipPlant", "Table", "load_model",
     "AutoSwitch", "Dopri5", "Rodas4", "SimulationResult", "StepSizeController", "simulate",
     "Sampled", "Sawtooth", "Sine", "Square", "Step", "Waveform", "parse_waveform",
+    "FitResult", "Parameter", "Parameters", "identify",
 ]

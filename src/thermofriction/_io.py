@@ -22,6 +22,9 @@ def atomic_write(path, mode="w", **kwargs):
     try:
         with os.fdopen(fd, mode, **kwargs) as fh:
             yield fh
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 is for the temporary file, not the output
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):

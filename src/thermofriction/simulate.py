@@ -146,6 +146,18 @@ class SimulationResult:
             fh.write(",".join(cols) + "\n")
             np.savetxt(fh, table, delimiter=",", fmt="%.12g")
 
+    def _repr_html_(self):
+        rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
+                ("final displacement", f"{self.displacement[-1] * 1e6:.6g} µm"),
+                ("peak friction force", f"{np.max(np.abs(self.friction_force)):.4g} N")]
+        if self.step_sizes.size:
+            rows += [("cycles", f"{self.step_sizes.size}"),
+                     ("mean step per cycle", f"{self.step_sizes.mean() * 1e6:.6g} µm"),
+                     ("mean velocity", f"{self.mean_velocity * 1e6:.6g} µm/s")]
+        rows.append(("solver", f"{self.stats.get('solver', '?')}: {self.stats.get('steps', '?')} steps"))
+        body = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{v}</td></tr>" for k, v in rows)
+        return f"<table><caption>SimulationResult</caption>{body}</table>"
+
     def __repr__(self):
         return (f"SimulationResult({len(self.time)} samples over {self.time[-1] - self.time[0]:.6g} s, "
                 f"final displacement {self.displacement[-1]:.6g} m, {len(self.step_sizes)} cycles)")

@@ -1,0 +1,167 @@
+"""Validation (SPEC 9): how well a model predicts measured displacements, per experiment."""
+
+from __future__ import annotations
+
+import dataclasses
+import html
+import json
+import math
+import warnings
+
+import numpy as np
+
+from ._io import atomic_write
+from .errors import InputError, TemperatureRangeWarning
+from .identify.engine import experiment_waveform
+from .models import Model
+from .simulate import simulate
+
+
+def _align(x):
+    """Displacement relative to its start (mean of the first 1 %: a sensor's zero is arbitrary)."""
+    k = max(len(x) // 100, 1)
+    return x - np.mean(x[:k])
+
+
+def step_sizes(time, x, period):
+    """Displacement over each whole period, read off by linear interpolation at k * period."""
+    if period is None:
+        return np.empty(0)
+    k0 = math.ceil(time[0] / period - 1e-9)
+    k1 = math.floor(time[-1] / period + 1e-9)
+    if k1 - k0 < 1:
+        return np.empty(0)
+    return np.diff(np.interp(np.arange(k0, k1 + 1) * period, time, x))
+
+
+@dataclasses.dataclass
+class Prediction:
+    """One experiment: the measurement, the model's prediction and the SPEC 9 metrics."""
+
+    file: str
+    temperature: float
+    role: str
+    time: np.ndarray
+    measured: np.ndarray
+    predicted: np.ndarray
+    max_error_pct: float
+    rmse: float
+    nrmse: float
+    final_error_pct: float
+    step_error_pct: float
+    step_error: float
+    measured_steps: np.ndarray
+    predicted_steps: np.ndarray
+
+    def metrics(self) -> dict:
+        return {"file": self.file, "temperature": self.temperature, "role": self.role,
+                "max_error_pct": self.max_error_pct, "rmse": self.rmse, "nrmse": self.nrmse,
+                "final_error_pct": self.final_error_pct, "step_error_pct": self.step_error_pct,
+                "step_error": self.step_error}
+
+
+def predict(model: Model, exp) -> Prediction:
+    T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
+    waveform = experiment_waveform(exp, model)
+    res = simulate(model, t_eval=exp.time, temperature=T, input=waveform)
+    meas = _align(np.asarray(exp.displacement, float))
+    pred = res.displacement - res.displacement[0]
+    err = pred - meas
+    span = float(np.max(meas) - np.min(meas)) or 1e-300
+    rmse = float(np.sqrt(np.mean(err ** 2)))
+    net = meas[-1] - meas[0]
+    ms = step_sizes(exp.time, meas, waveform.period)
+    ps = step_sizes(exp.time, pred, waveform.period)
+    if ms.size:
+        step_err = float(np.mean(np.abs(ps - ms)))
+        step_pct = 100 * step_err / (abs(float(np.mean(ms))) or 1e-300)
+    else:
+        step_err = step_pct = math.nan
+    return Prediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time), meas, pred,
+                      100 * float(np.max(np.abs(err))) / span, rmse, rmse / span,
+                      100 * float(err[-1]) / (abs(net) or 1e-300), step_pct, step_err, ms, ps)
+
+
+@dataclasses.dataclass
+class ValidationResult:
+    model: Model
+    predictions: list
+    warnings: list
+
+    @property
+    def experiments(self):
+        return [p.metrics() for p in self.predictions]
+
+    def summary(self) -> dict:
+        out = {}
+        for role in ("fit", "validate"):
+            ps = [p for p in self.predictions if p.role == role]
+            if ps:
+                out[role] = {"max_error_pct": max(p.max_error_pct for p in ps),
+                             "mean_max_error_pct": float(np.mean([p.max_error_pct for p in ps])),
+                             "rmse": float(np.sqrt(np.mean([p.rmse ** 2 for p in ps]))),
+                             "n": len(ps)}
+        return out
+
+    def to_dict(self) -> dict:
+        from .identify.result import _jsonable
+        return _jsonable({"model": self.model.name, "experiments": self.experiments, "summary": self.summary(),
+                          "warnings": self.warnings})
+
+    def to_json(self, path=None) -> str:
+        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
+        if path is not None:
+            with atomic_write(path, "w") as fh:
+                fh.write(text + "\n")
+        return text
+
+    _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
+                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm]", "rmse", "{:.4g}"),
+                ("NRMSE", "nrmse", "{:.3g}"), ("final error [%]", "final_error_pct", "{:+.3g}"),
+                ("step error [%]", "step_error_pct", "{:.3g}"))
+
+    def rows(self):
+        for m in self.experiments:
+            yield [fmt.format(m[key] * 1e9 if key == "rmse" else m[key]) for _, key, fmt in self._COLUMNS]
+
+    def table(self) -> str:
+        head = [c[0] for c in self._COLUMNS]
+        rows = list(self.rows())
+        w = [max(len(r[i]) for r in rows + [head]) for i in range(len(head))]
+        lines = ["  ".join(h.ljust(w[i]) for i, h in enumerate(head))]
+        lines += ["  ".join(c.ljust(w[i]) for i, c in enumerate(r)) for r in rows]
+        return "\n".join(lines)
+
+    def print_table(self, title=None):
+        """A rich table on the terminal."""
+        from rich.console import Console
+        from rich.table import Table
+        t = Table(title=title or f"Validation of {self.model.name or 'the model'}")
+        for name, _, _ in self._COLUMNS:
+            t.add_column(name, justify="left" if name in ("file", "role") else "right")
+        for r in self.rows():
+            t.add_row(*r)
+        Console().print(t)
+
+    def _repr_html_(self):
+        head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.rows())
+        return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def validate(model: Model, data, experiments=None) -> ValidationResult:
+    """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
+    errors of SPEC 9. Temperatures outside a law's calibrated range are reported as warnings."""
+    exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
+    if not exps:
+        raise InputError("the dataset has no experiments")
+    caught, preds = [], []
+    for exp in exps:
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always", TemperatureRangeWarning)
+            preds.append(predict(model, exp))
+        caught += [f"{exp.file}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
+    return ValidationResult(model, preds, caught)
+
+
+__all__ = ["validate", "ValidationResult", "Prediction", "predict", "step_sizes"]
