@@ -11,6 +11,7 @@ import html
 import io
 import math
 import platform
+import re
 import sys
 from pathlib import Path
 
@@ -106,6 +107,7 @@ class Figures:
         fig.savefig(buf, format="svg", bbox_inches="tight")
         svg = buf.getvalue()
         svg = svg[svg.index("<svg"):]
+        svg = re.sub(r"<metadata>.*?</metadata>", "", svg, flags=re.S)  # RDF boilerplate, a date: noise
         if self.folder:
             with atomic_write(self.folder / f"{name}.svg", "w") as fh:
                 fh.write(svg)
