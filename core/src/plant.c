@@ -38,7 +38,8 @@ double tf_model_lambda(const tf_model *model, double T)
 /* Parameters, scale factor and offset force at temperature T, cached per temperature. */
 static const double *params(tf_model *m, double T, double *lambda, double *dF)
 {
-    if (!m->cache_valid || m->cache_T != T) {
+    /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
+    if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
         tf_model_params_at(m, T, m->cache_p);
         m->cache_lambda = tf_model_lambda(m, T);
         m->cache_dF = (m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET)

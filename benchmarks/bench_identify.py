@@ -1,0 +1,131 @@
+"""Identification speed on a dataset like the paper's: 5 temperatures, 2 s each at 10 kHz,
+20 nm noise. Measures, in one run on this machine:
+
+1. Model I end to end (per-temperature fits, laws, joint refinement) and Model II end to end
+   (direct procedure), each from the paper's preset while the data come from a perturbed truth;
+2. the core of both -- fitting sigma0, sigma1, fc at one temperature -- by thermofriction and by
+   a plain SciPy pipeline (solve_ivp LSODA rtol 1e-6 on the reference right-hand side +
+   least_squares with finite differences), from the same initial guess, and the ratio.
+
+Run: python benchmarks/bench_identify.py [--baseline-evals N] (default 40: the baseline's budget)
+"""
+
+import argparse
+import dataclasses
+import math
+import sys
+import time
+import types
+from pathlib import Path
+
+import numpy as np
+from scipy import optimize
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import reference  # noqa: E402  (the plain NumPy/SciPy implementation the tests use)
+
+import thermofriction as tf  # noqa: E402
+from thermofriction.identify import fit_friction, identify  # noqa: E402
+
+TEMPS = (30.8, 33.9, 35.7, 38.4, 41.5)
+
+
+def experiments(model, seed):
+    rng = np.random.default_rng(seed)
+    out = []
+    for T in TEMPS:
+        r = tf.simulate(model, 2.0, temperature=T, controller=tf.StepSizeController(rtol=1e-10))
+        out.append(types.SimpleNamespace(file=f"T{T}.csv", time=r.time, voltage=r.input, temperature=T, role="fit",
+                                         displacement=r.displacement + 20e-9 * rng.standard_normal(r.time.size)))
+    return types.SimpleNamespace(experiments=out, fit=out)
+
+
+def perturbed_model_i():
+    m = tf.load_model("li2009-model-i")
+    laws = dict(m.laws)
+    laws["sigma0"] = dataclasses.replace(laws["sigma0"], a=laws["sigma0"].a * 1.25)
+    laws["fc"] = dataclasses.replace(laws["fc"], a=laws["fc"].a * 0.85)
+    return dataclasses.replace(m, thermal=tf.ModelI(laws))
+
+
+def perturbed_model_ii():
+    m = tf.load_model("li2009-model-ii")
+    dF = m.thermal.dF
+    return dataclasses.replace(m, thermal=tf.ModelII(dataclasses.replace(dF, values=dF.values * 1.2)),
+                               friction=dataclasses.replace(m.friction, sigma0=m.friction.sigma0 * 0.8))
+
+
+def baseline_fit(exp, start, max_nfev, rtol):
+    """The plain pipeline: log-parameters, residuals from solve_ivp(LSODA), 2-point differences."""
+    names = ("sigma0", "sigma1", "fc")
+    x0 = np.log([getattr(start.friction, n) for n in names])
+    count = {"sims": 0}
+
+    def residuals(x):
+        m = start.with_friction(**dict(zip(names, np.exp(x))))
+        count["sims"] += 1
+        r = reference.reference_simulate(m, exp.time, exp.temperature, method="LSODA", rtol=rtol,
+                                         piecewise=False).displacement
+        d = r - exp.displacement
+        return d - d.mean()
+
+    t0 = time.perf_counter()
+    res = optimize.least_squares(residuals, x0, jac="2-point", method="trf", x_scale="jac", max_nfev=max_nfev)
+    return res, time.perf_counter() - t0, count["sims"], dict(zip(names, np.exp(res.x)))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--baseline-evals", type=int, default=40)
+    args = ap.parse_args()
+    print("Identification benchmark (2 cores), dataset: 5 temperatures x 2 s at 10 kHz, 20 nm noise\n")
+
+    truth_i = perturbed_model_i()
+    data_i = experiments(truth_i, 1)
+    t0 = time.perf_counter()
+    fit_i = identify(data_i, "model-i", init="li2009-model-i")
+    t_i = time.perf_counter() - t0
+    print(f"Model I end to end   {t_i:6.2f} s   rmse {fit_i.rmse * 1e9:.1f} nm   (target < 30 s)")
+    for name in ("sigma0.a", "sigma0.b", "fc.a", "fc.b"):
+        p = fit_i.parameters[name]
+        true = {"sigma0.a": truth_i.laws["sigma0"].a, "sigma0.b": truth_i.laws["sigma0"].b,
+                "fc.a": truth_i.laws["fc"].a, "fc.b": truth_i.laws["fc"].b}[name]
+        print(f"    {name:9s} {p.value:12.6g}  95 % [{p.ci95[0]:.6g}, {p.ci95[1]:.6g}]  truth {true:.6g}")
+
+    truth_ii = perturbed_model_ii()
+    data_ii = experiments(truth_ii, 2)
+    t0 = time.perf_counter()
+    fit_ii = identify(data_ii, "model-ii", init="li2009-base")
+    t_ii = time.perf_counter() - t0
+    T = np.array(TEMPS)
+    dev = np.max(np.abs(fit_ii.model.thermal.dF(T) - truth_ii.thermal.dF(T)))
+    print(f"Model II end to end  {t_ii:6.2f} s   rmse {fit_ii.rmse * 1e9:.1f} nm   max |dF - truth| "
+          f"{dev * 1e3:.2f} mN   (target < 10 s)\n")
+
+    exp = data_i.experiments[2]
+    p = truth_i.parameters_at(exp.temperature)
+    truth = tf.Model(truth_i.plant, tf.LuGre(p["sigma0"], p["sigma1"], p["fc"]), input=truth_i.input)
+    start = truth.with_friction(sigma0=p["sigma0"] * 2, sigma1=p["sigma1"] / 2, fc=p["fc"] * 1.5)
+    t0 = time.perf_counter()
+    ours = fit_friction([exp], start)
+    t_ours = time.perf_counter() - t0
+    print(f"One temperature ({exp.temperature} C), sigma0, sigma1, fc from (2x, 1/2x, 1.5x) the truth:")
+    print(f"  thermofriction      {t_ours:8.2f} s  {ours.nfev:4d} simulations  rmse {ours.rmse * 1e9:7.2f} nm  "
+          f"sigma0 {ours.parameters['sigma0'].value:.5g}  fc {ours.parameters['fc'].value:.5g}")
+    for rtol in (1e-6, 1e-8):
+        res, t_base, sims, vals = baseline_fit(exp, start, args.baseline_evals, rtol)
+        rmse = math.sqrt(np.mean(res.fun ** 2))
+        ok = res.status > 0 and rmse < 1.1 * ours.rmse
+        status = ("converged to the noise floor" if ok else "stopped away from the optimum" if res.status > 0
+                  else f"ran out of its {args.baseline_evals} evaluations")
+        print(f"  SciPy, LSODA {rtol:.0e} {t_base:8.2f} s  {sims:4d} simulations  rmse {rmse * 1e9:7.2f} nm  "
+              f"sigma0 {vals['sigma0']:.5g}  fc {vals['fc']:.5g}  ({status})")
+        print(f"      ratio (baseline time / ours) {t_base / t_ours:.0f}x"
+              + ("" if ok else "; the baseline did not reach the optimum, so this understates it") +
+              f"; per simulation {t_base / sims * 1e3:.0f} ms vs ours {t_ours / max(ours.nfev, 1) * 1e3:.1f} ms "
+              f"(ours with sensitivities)")
+    print(f"  truth{' ' * 56}sigma0 {p['sigma0']:.5g}  fc {p['fc']:.5g}")
+
+
+if __name__ == "__main__":
+    main()
