@@ -19,8 +19,7 @@ $(VENV)/.installed: $(BIN)/python $(SOURCES)
 install: $(VENV)/.installed
 
 demo: install
-	mkdir -p thermofriction-demo
-	$(BIN)/thermofriction simulate li2009-model-i --temperature 35.7 -o thermofriction-demo/li2009-model-i-35.7C.csv
+	$(BIN)/thermofriction demo
 
 test: install
 	$(BIN)/python -m pytest -q

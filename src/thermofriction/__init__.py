@@ -15,6 +15,9 @@ from .models import (PARAMETERS, PRESETS, PWL, Const, Exp, Law, Linear, LuGre, M
 from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
 from .waveforms import Sampled, Sawtooth, Sine, Square, Step, Waveform, parse_waveform
 from .identify import FitResult, Parameter, Parameters, identify
+from .data import Dataset, Experiment, load_dataset, save_dataset, synthesize
+from .validate import validate
+from .report import report
 
 __version__ = "0.1.0"
 
@@ -25,4 +28,5 @@ __all__ = [
     "AutoSwitch", "Dopri5", "Rodas4", "SimulationResult", "StepSizeController", "simulate",
     "Sampled", "Sawtooth", "Sine", "Square", "Step", "Waveform", "parse_waveform",
     "FitResult", "Parameter", "Parameters", "identify",
+    "Dataset", "Experiment", "load_dataset", "save_dataset", "synthesize", "validate", "report",
 ]
