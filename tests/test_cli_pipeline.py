@@ -1,8 +1,11 @@
 """The whole workflow from the command line: synth, identify, validate, report, and demo."""
 
 import json
+from pathlib import Path
 
 import pytest
+
+import thermofriction as tf
 
 from conftest import run_cli
 
@@ -60,3 +63,21 @@ def test_demo_runs_the_main_job(tmp_path):
     held = {k: v[k]["summary"]["validate"]["max_error_pct"] for k in v}
     assert held["model-i"] < held["base"] and held["model-ii"] < held["base"]
     assert "report:" in out.stdout
+
+
+def test_identify_plant_from_a_recorded_stage(tmp_path):
+    """xi, wn, K from the stage record of a synthetic experiment: the stage alone (the end effector's
+    friction negligible, as when the paper measured its step responses); the preset's plant is the truth."""
+    folder = tmp_path / "d"
+    stage = tmp_path / "stage.toml"
+    stage.write_text((Path(tf.models.preset_path("li2009-base"))).read_text()
+                     .replace("sigma0 = 1945575.887588102", "sigma0 = 1e-9").replace("fc = 0.8992595121614437", "fc = 1e-12")
+                     .replace("sigma1 = 2.305", "sigma1 = 0.0"))
+    assert run_cli("synth", stage, "--temperatures", "30", "--duration", "0.05", "--sample-rate",
+                   "100000", "--noise", "1e-9", "--record-stage", "-o", folder).returncode == 0
+    out = run_cli("identify", folder, "--method", "plant", "--json", tmp_path / "p.json")
+    assert out.returncode == 0, out.stderr
+    p = json.loads((tmp_path / "p.json").read_text())["parameters"]
+    for name, true in (("damping_ratio", 0.2488), ("natural_frequency", 6685.5), ("gain", 0.096e-6)):
+        lo, hi = p[name]["ci95"]
+        assert lo <= true <= hi, (name, p[name])

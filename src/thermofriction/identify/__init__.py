@@ -11,17 +11,18 @@ from ..models import Model, load_model
 from .engine import fit, make_traces, uncertainty
 from .parameters import Parameter, Parameters
 from .procedures import base_model, fit_friction, fit_law, identify_model_i, identify_model_ii, segmented_fit
+from .plant import PlantFit, fit_plant, step_response
 from .result import FitResult
 
-METHODS = ("base", "model-i", "model-ii")
+METHODS = ("plant", "base", "model-i", "model-ii")
 
 
 def identify(data, method="model-i", init=None, *, parameters=None, procedure="direct", laws=None, refine=True,
              reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
-    method: "base" (one friction model for all experiments, no thermal model), "model-i" or
-        "model-ii".
+    method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
+        (one friction model for all experiments, no thermal model), "model-i" or "model-ii".
     init: the initial model (its plant, masses and input are kept); a model, a file or a preset
         name. Default: the paper's preset for the method.
     parameters: names (or a Parameters object) to fit for "base"; default sigma0, sigma1, fc.
@@ -32,13 +33,15 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
     if method not in METHODS:
         raise InputError(f"unknown method '{method}' (one of: {', '.join(METHODS)})")
     if init is None:
-        init = {"base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii"}[method]
+        init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii"}[method]
     if not isinstance(init, Model):
         init = load_model(init)
     experiments = getattr(data, "fit", data)
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
+    if method == "plant":
+        return _identify_plant(getattr(data, "experiments", data), init)
     if method == "base":
         model = base_model(init)
         return fit_friction(experiments, model, parameters, method="base", progress=progress, **opts)
@@ -50,5 +53,28 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
                              refine=refine, progress=progress, **opts)
 
 
-__all__ = ["identify", "FitResult", "Parameter", "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit",
+def _identify_plant(experiments, init):
+    import dataclasses
+    import math
+
+    import numpy as np
+
+    staged = [e for e in experiments if getattr(e, "stage_displacement", None) is not None]
+    if not staged:
+        raise InputError("no experiment records the stage displacement (a stage_displacement[um] column): "
+                         "the plant fit needs it")
+    exp = staged[0]
+    pf = fit_plant(exp.time, exp.voltage, exp.stage_displacement)
+    model = dataclasses.replace(init, plant=pf.plant(init.plant.mass, init.plant.end_effector_mass))
+    n = len(pf.parameters)
+    return FitResult("plant", model, pf.parameters, np.full((n, n), np.nan), pf.rmse ** 2 * pf.n_points, pf.rmse,
+                     pf.n_points, 0, 0, 1, pf.wall_time, True, f"fitted on {exp.file}",
+                     experiments=[{"file": exp.file, "temperature": exp.temperature, "role": exp.role,
+                                   "rmse": pf.rmse}],
+                     warnings=[] if len(staged) == 1 else [f"fitted on {exp.file}; {len(staged) - 1} more "
+                                                            f"experiment(s) with a stage record were not used"],
+                     details={"note": "the equivalent masses m and m_e are kept from the initial model"})
+
+
+__all__ = ["fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter", "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit",
            "identify_model_i", "identify_model_ii", "base_model", "make_traces", "uncertainty", "METHODS"]
