@@ -143,6 +143,16 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
     return 0;
 }
 
+/* SolverError(message, status, t_fail, h_fail, state, stiff_suspected) */
+static void raise_solver_error(int status, const tf_solver_stats *st, const double *y, int n)
+{
+    PyObject *state = PyTuple_New(n);
+    for (int i = 0; i < n && state; i++) PyTuple_SET_ITEM(state, i, PyFloat_FromDouble(y[i]));
+    PyObject *exc_args = Py_BuildValue("(siddNi)", tf_status_message(status), status, st->t_fail, st->h_fail,
+                                       state, st->stiff_suspected);
+    if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+}
+
 typedef struct {
     const tf_model *model;
     double *out;
@@ -203,11 +213,7 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     status = tf_solve(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st);
     Py_END_ALLOW_THREADS
     if (status != TF_OK) {
-        PyObject *state = PyTuple_New(n);
-        for (int i = 0; i < n && state; i++) PyTuple_SET_ITEM(state, i, PyFloat_FromDouble(y[i]));
-        PyObject *exc_args = Py_BuildValue("(siddNi)", tf_status_message(status), status, st.t_fail, st.h_fail,
-                                           state, st.stiff_suspected);
-        if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+        raise_solver_error(status, &st, y, n);
         goto done;
     }
     result = Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:i,s:d}", "steps", st.steps, "rejected", st.rejected,
@@ -299,11 +305,7 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     status = tf_solve(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st);
     Py_END_ALLOW_THREADS
     if (status != TF_OK) {
-        PyObject *state = PyTuple_New(n);
-        for (int i = 0; i < n && state; i++) PyTuple_SET_ITEM(state, i, PyFloat_FromDouble(Y[i]));
-        PyObject *exc_args = Py_BuildValue("(siddNi)", tf_status_message(status), status, st.t_fail, st.h_fail,
-                                           state, st.stiff_suspected);
-        if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+        raise_solver_error(status, &st, Y, n);
         goto done;
     }
     result = Py_BuildValue("{s:l,s:l,s:l}", "steps", st.steps, "rejected", st.rejected, "rhs_evals", st.rhs_evals);

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import contextlib
+import json
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -30,3 +32,32 @@ def atomic_write(path, mode="w", **kwargs):
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def jsonable(obj):
+    """Plain JSON types: arrays to lists, non-finite floats to "inf"/"-inf"/"nan" strings (JSON
+    has none), numpy scalars to Python ones."""
+    import numpy as np
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        return x if math.isfinite(x) else ("inf" if x > 0 else "-inf" if x < 0 else "nan")
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
+def dump_json(data: dict, path=None) -> str:
+    """JSON text of ``data``; written atomically to ``path`` when given."""
+    text = json.dumps(jsonable(data), indent=2, allow_nan=False)
+    if path is not None:
+        with atomic_write(path, "w") as fh:
+            fh.write(text + "\n")
+    return text

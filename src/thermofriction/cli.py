@@ -19,24 +19,21 @@ from .simulate import SOLVERS, StepSizeController, simulate
 from .waveforms import Sampled, parse_waveform
 
 
-def _positive_float(text):
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (v > 0 and math.isfinite(v)):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
-    return v
+def _number(positive):
+    """An argparse type: a finite float, positive when asked."""
+    def parse(text):
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        if not math.isfinite(v) or (positive and v <= 0):
+            raise argparse.ArgumentTypeError(f"must be a {'positive' if positive else 'finite'} number, got {text!r}")
+        return v
+    return parse
 
 
-def _finite_float(text):
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"must be finite, got {text!r}")
-    return v
+_positive_float = _number(positive=True)
+_finite_float = _number(positive=False)
 
 
 def _positive_int(text):

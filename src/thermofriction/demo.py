@@ -53,12 +53,8 @@ def run_demo(folder="thermofriction-demo", progress=None, command=None) -> dict:
         v = validate(fits[key].model, data)
         validation[key] = v.to_dict()
         entries.append(Entry(label, fits[key].model, fits[key].to_dict(), v))
-    import json
-
-    from ._io import atomic_write
-    with atomic_write(folder / "validation.json", "w") as fh:
-        json.dump(validation, fh, indent=2)
-        fh.write("\n")
+    from ._io import dump_json
+    dump_json(validation, folder / "validation.json")
     report(entries, data, folder / "report.html", command=command or "thermofriction demo",
            title="thermofriction demo — the paper's actuator at 30.8-41.5 °C")
     timings["validate and report"] = time.perf_counter() - t1

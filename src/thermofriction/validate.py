@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import dataclasses
 import html
-import json
 import math
 import warnings
 
 import numpy as np
 
-from ._io import atomic_write
+from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning
 from .identify.engine import experiment_waveform
 from .models import Model
@@ -109,16 +108,12 @@ class ValidationResult:
         return out
 
     def to_dict(self) -> dict:
-        from .identify.result import _jsonable
-        return _jsonable({"model": self.model.name, "experiments": self.experiments, "summary": self.summary(),
-                          "warnings": self.warnings})
+        return jsonable({"model": self.model.name, "experiments": self.experiments, "summary": self.summary(),
+                         "warnings": self.warnings})
 
     def to_json(self, path=None) -> str:
-        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
-        if path is not None:
-            with atomic_write(path, "w") as fh:
-                fh.write(text + "\n")
-        return text
+        """The metrics of SPEC 9 as JSON, written atomically to ``path`` when given."""
+        return dump_json(self.to_dict(), path)
 
     _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
                 ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm]", "rmse", "{:.4g}"),

@@ -5,37 +5,13 @@ from __future__ import annotations
 
 import dataclasses
 import html
-import json
 import math
 
 import numpy as np
 
-from .._io import atomic_write
+from .._io import dump_json, jsonable
 from ..models import Model
 from .parameters import Parameters
-
-
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else ("inf" if x > 0 else "-inf" if x < 0 else "nan")
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, (float, np.floating)):
-        return _num(obj)
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.bool_,)):
-        return bool(obj)
-    return obj
 
 
 @dataclasses.dataclass
@@ -91,14 +67,11 @@ class FitResult:
         }
         if self.alternatives:
             d["alternatives"] = {k: v.to_dict() for k, v in self.alternatives.items()}
-        return _jsonable(d)
+        return jsonable(d)
 
     def to_json(self, path=None) -> str:
-        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
-        if path is not None:
-            with atomic_write(path, "w") as fh:
-                fh.write(text + "\n")
-        return text
+        """The results of SPEC 7 as JSON, written atomically to ``path`` when given."""
+        return dump_json(self.to_dict(), path)
 
     def _rows(self):
         for p in self.parameters.values():
