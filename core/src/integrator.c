@@ -9,9 +9,10 @@
  *   boundary); then RODAS4 on probation: after PROBE_STEPS steps its work per simulated
  *   second is compared with DOPRI5's over its last window, and the cheaper method goes on.
  *   A failed probe doubles the number of explicit steps before the next one. The stiffness
- *   test alone is not enough for friction models: at every velocity reversal LuGre's |v|
- *   makes a kink that costs a Rosenbrock method (whose order needs the exact Jacobian) more
- *   than it saves, even for stiff bristles. */
+ *   test says only that the explicit method sits at its stability limit, not that the stiff one
+ *   will be cheaper: at every velocity reversal LuGre's |v| puts a kink in the right-hand side
+ *   that both methods pay for, so the choice is made on measured work.
+ */
 #include "thermofriction/integrator.h"
 
 #include <float.h>
@@ -102,7 +103,7 @@ static int all_finite(const double *v, int n)
 }
 
 /* ---- dense LU with partial pivoting, for the small systems of a Rosenbrock stage ---- */
-static int lu_factor(double *A, int n, int *piv)
+int tf_lu_factor(double *A, int n, int *piv)
 {
     for (int k = 0; k < n; k++) {
         int p = k;
@@ -111,8 +112,10 @@ static int lu_factor(double *A, int n, int *piv)
             if (fabs(A[i * n + k]) > big) { big = fabs(A[i * n + k]); p = i; }
         piv[k] = p;
         if (big == 0.0 || !isfinite(big)) return 1;
+        /* LINPACK style: only the trailing columns move; the multipliers of earlier columns stay
+         * where they were made, matching lu_solve, which interleaves interchanges and elimination */
         if (p != k)
-            for (int j = 0; j < n; j++) { double tmp = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = tmp; }
+            for (int j = k; j < n; j++) { double tmp = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = tmp; }
         double inv = 1.0 / A[k * n + k];
         for (int i = k + 1; i < n; i++) {
             double l = A[i * n + k] *= inv;
@@ -123,7 +126,7 @@ static int lu_factor(double *A, int n, int *piv)
     return 0;
 }
 
-static void lu_solve(const double *A, int n, const int *piv, double *b)
+void tf_lu_solve(const double *A, int n, const int *piv, double *b)
 {
     for (int k = 0; k < n; k++) {
         if (piv[k] != k) { double tmp = b[k]; b[k] = b[piv[k]]; b[piv[k]] = tmp; }
@@ -204,40 +207,40 @@ static double rodas4_step(work *w, double t, double h, const double *y, const do
     for (i = 0; i < n * n; i++) W[i] = -w->J[i];
     for (i = 0; i < n; i++) W[i * n + i] += 1.0 / (ro_gamma * h);
     w->st->decompositions++;
-    if (lu_factor(W, n, w->piv)) return -2;
+    if (tf_lu_factor(W, n, w->piv)) return -2;
 
     for (i = 0; i < n; i++) k[0][i] = f0[i] + h * ro_g1 * ft[i];
-    lu_solve(W, n, w->piv, k[0]);
+    tf_lu_solve(W, n, w->piv, k[0]);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a21 * k[0][i];
     if (rhs(w, t + ro_c2 * h, yt, fs)) return -1;
     for (i = 0; i < n; i++) k[1][i] = fs[i] + h * ro_g2 * ft[i] + ro_c21 * k[0][i] / h;
-    lu_solve(W, n, w->piv, k[1]);
+    tf_lu_solve(W, n, w->piv, k[1]);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a31 * k[0][i] + ro_a32 * k[1][i];
     if (rhs(w, t + ro_c3 * h, yt, fs)) return -1;
     for (i = 0; i < n; i++) k[2][i] = fs[i] + h * ro_g3 * ft[i] + (ro_c31 * k[0][i] + ro_c32 * k[1][i]) / h;
-    lu_solve(W, n, w->piv, k[2]);
+    tf_lu_solve(W, n, w->piv, k[2]);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a41 * k[0][i] + ro_a42 * k[1][i] + ro_a43 * k[2][i];
     if (rhs(w, t + ro_c4 * h, yt, fs)) return -1;
     for (i = 0; i < n; i++)
         k[3][i] = fs[i] + h * ro_g4 * ft[i] + (ro_c41 * k[0][i] + ro_c42 * k[1][i] + ro_c43 * k[2][i]) / h;
-    lu_solve(W, n, w->piv, k[3]);
+    tf_lu_solve(W, n, w->piv, k[3]);
 
     for (i = 0; i < n; i++)
         yt[i] = y[i] + ro_a51 * k[0][i] + ro_a52 * k[1][i] + ro_a53 * k[2][i] + ro_a54 * k[3][i];
     if (rhs(w, t + h, yt, fs)) return -1;
     for (i = 0; i < n; i++)
         k[4][i] = fs[i] + (ro_c51 * k[0][i] + ro_c52 * k[1][i] + ro_c53 * k[2][i] + ro_c54 * k[3][i]) / h;
-    lu_solve(W, n, w->piv, k[4]);
+    tf_lu_solve(W, n, w->piv, k[4]);
 
     for (i = 0; i < n; i++) yt[i] += k[4][i];
     if (rhs(w, t + h, yt, fs)) return -1;
     for (i = 0; i < n; i++)
         k[5][i] = fs[i] + (ro_c61 * k[0][i] + ro_c62 * k[1][i] + ro_c63 * k[2][i] + ro_c64 * k[3][i] +
                            ro_c65 * k[4][i]) / h;
-    lu_solve(W, n, w->piv, k[5]);
+    tf_lu_solve(W, n, w->piv, k[5]);
 
     for (i = 0; i < n; i++) w->y1[i] = yt[i] + k[5][i];
     double err = wnorm(w, k[5], y, w->y1);

@@ -331,8 +331,36 @@ static void test_parameter_derivatives_vs_finite_differences(void)
     }
 }
 
+static void test_lu_solves_systems_that_need_pivoting_in_later_columns(void)
+{
+    /* pseudo-random 6x6 systems with a known solution; residual and solution error are checked
+     * (a solve that mixes up where the interchanges happened fails the moment a pivot is taken
+     * after the first column) */
+    unsigned long seed = 12345;
+    double worst = 0.0;
+    int pivots_after_first = 0;
+    for (int trial = 0; trial < 200; trial++) {
+        int n = 6, piv[6];
+        double A[36], LU[36], x[6], b[6];
+        for (int i = 0; i < n * n; i++) {
+            seed = seed * 6364136223846793005UL + 1442695040888963407UL;
+            A[i] = ((double)(seed >> 11) / 9007199254740992.0) * 2.0 - 1.0;
+        }
+        for (int i = 0; i < n; i++) x[i] = i + 1.0;
+        for (int i = 0; i < n; i++) { b[i] = 0; for (int j = 0; j < n; j++) b[i] += A[i * n + j] * x[j]; }
+        memcpy(LU, A, sizeof A);
+        if (tf_lu_factor(LU, n, piv)) continue;
+        for (int k = 1; k < n; k++) pivots_after_first += piv[k] != k;
+        tf_lu_solve(LU, n, piv, b);
+        for (int i = 0; i < n; i++) worst = fmax(worst, fabs(b[i] - x[i]) / (i + 1.0));
+    }
+    CHECK(pivots_after_first > 50, "the test must exercise later pivots (%d)", pivots_after_first);
+    CHECK(worst < 1e-8, "LU solve error %g", worst);
+}
+
 int main(void)
 {
+    test_lu_solves_systems_that_need_pivoting_in_later_columns();
     test_parameter_derivatives_vs_finite_differences();
     test_grid_end_one_ulp_past_a_corner();
     test_oscillator_dense_output(TF_METHOD_DOPRI5);

@@ -60,6 +60,11 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
 
 const char *tf_status_message(int status);
 
+/* Dense LU with partial pivoting (row-major n x n, in place) and the matching solve; used by
+ * Rodas4's stages. tf_lu_factor returns nonzero for a singular matrix. */
+int tf_lu_factor(double *A, int n, int *piv);
+void tf_lu_solve(const double *A, int n, const int *piv, double *b);
+
 #ifdef __cplusplus
 }
 #endif
