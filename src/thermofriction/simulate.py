@@ -306,7 +306,12 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     if period is not None:
         k0 = math.ceil(t0 / period - 1e-9)
         cycle_times = np.arange(k0, math.floor(t1 / period + 1e-9) + 1) * period
-    t_all = np.union1d(t_grid, cycle_times) if cycle_times.size else t_grid
+    # cycle starts usually fall on the grid already; only the others are inserted (O(n), no sort)
+    tol = 1e-12 * max(1.0, abs(t1))
+    on_grid_at = np.minimum(np.searchsorted(t_grid, cycle_times - tol), t_grid.size - 1)
+    hit = np.abs(t_grid[on_grid_at] - cycle_times) <= tol
+    extra = cycle_times[~hit]
+    t_all = np.insert(t_grid, np.searchsorted(t_grid, extra), extra) if extra.size else t_grid
     nstate = 4 + model.friction.nstate
     nch = _core.NFIXED_OUTPUTS + model.friction.nstate
     out = np.empty((t_all.size, nch))
@@ -335,10 +340,11 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
                           f"state {where}{hint}", time=t_fail, state=state) from None
     stats["solver"] = {0: "auto", 1: "dopri5", 2: "rodas4"}[stats.pop("method")]
     if cycle_times.size:
-        on_grid = np.isin(t_all, t_grid)
-        at_cycles = np.searchsorted(t_all, cycle_times)
+        at_cycles = np.searchsorted(t_all, cycle_times - tol)
         x_cycles = out[at_cycles, 4]
-        out = out[on_grid]
+        if extra.size:
+            inserted = np.searchsorted(t_grid, extra) + np.arange(extra.size)
+            out = np.delete(out, inserted, axis=0)
     else:
         x_cycles = np.empty(0)
     steps = np.diff(x_cycles)
