@@ -67,12 +67,15 @@ def _identify_plant(experiments, init):
     pf = fit_plant(exp.time, exp.voltage, exp.stage_displacement)
     model = dataclasses.replace(init, plant=pf.plant(init.plant.mass, init.plant.end_effector_mass))
     n = len(pf.parameters)
-    return FitResult("plant", model, pf.parameters, np.full((n, n), np.nan), pf.rmse ** 2 * pf.n_points, pf.rmse,
+    corr = np.asarray(pf.correlation, float)[:n, :n] if getattr(pf, "correlation", None) is not None \
+        else np.full((n, n), np.nan)
+    return FitResult("plant", model, pf.parameters, corr, pf.rmse ** 2 * pf.n_points, pf.rmse,
                      pf.n_points, 0, 0, 1, pf.wall_time, True, f"fitted on {exp.file}",
                      experiments=[{"file": exp.file, "temperature": exp.temperature, "role": exp.role,
                                    "rmse": pf.rmse}],
-                     warnings=[] if len(staged) == 1 else [f"fitted on {exp.file}; {len(staged) - 1} more "
-                                                            f"experiment(s) with a stage record were not used"],
+                     warnings=list(getattr(pf, "warnings", [])) + (
+                         [] if len(staged) == 1 else [f"fitted on {exp.file}; {len(staged) - 1} more "
+                                                      f"experiment(s) with a stage record were not used"]),
                      details={"note": "the equivalent masses m and m_e are kept from the initial model"})
 
 

@@ -1,11 +1,28 @@
-"""The plant from a stage response: xi, wn and K of x'' + 2 xi wn x' + wn^2 x = K wn^2 u(t), the way
-the paper obtained them (Eqs. 3-4), from any recorded input (a step, a sawtooth...)."""
+"""The plant from a stage response: xi, wn and K of
+
+    x'' + 2 xi wn x' + wn^2 x = K wn^2 u(t)
+
+the way the paper obtained them (Eqs. 3-4), from any recorded input (a step, a sawtooth...).
+
+The response is computed exactly for the sampled input (no ODE solver): the state-space model is
+discretised with the matrix exponential, with a first-order hold (``hold="foh"``, exact for an
+input that is linear between samples: ramps, sawtooths, steps with a slew) or a zero-order hold
+(``hold="zoh"``, exact for an input that is constant between samples: ideal steps at a sample
+instant). The stage starts at rest at zero, as in ``tf.simulate``.
+
+The gain K and the sensor's zero offset enter linearly: they are solved for exactly at every
+(xi, wn) (variable projection), and xi, wn are found by a coarse grid then Levenberg-Marquardt in
+log space. Standard errors and 95 % intervals come from the full Jacobian in (xi, wn, K, offset)
+at the optimum, cov = s^2 (J^T J)^-1, with s^2 inflated by (1 + rho) / (1 - rho) for residuals
+with lag-1 autocorrelation rho > 0 (as in the friction fits); a direction the data cannot
+determine gets an infinite interval and a warning.
+"""
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import time
+import time as _time
 
 import numpy as np
 from scipy import linalg, optimize, signal, stats
@@ -13,13 +30,19 @@ from scipy import linalg, optimize, signal, stats
 from ..errors import InputError
 from .parameters import Parameters
 
+NAMES = ("damping_ratio", "natural_frequency", "gain")
+UNITS = {"damping_ratio": "", "natural_frequency": "rad/s", "gain": "m/V"}
+UNIFORM_TOLERANCE = 1e-6  # relative spread of the sampling intervals treated as uniform sampling
+
 
 def step_response(time, xi, wn, K, amplitude, t_step=0.0):
-    """Exact response of the second-order stage to a step of ``amplitude`` volts at ``t_step``."""
+    """Exact response of the stage, at rest at zero, to a step of ``amplitude`` volts at ``t_step``:
+    underdamped (xi < 1), critically damped or overdamped."""
     tau = np.clip(np.asarray(time, float) - t_step, 0.0, None)
     if xi < 1:
-        wd = wn * math.sqrt(1 - xi ** 2)
-        g = 1 - np.exp(-xi * wn * tau) * (np.cos(wd * tau) + xi / math.sqrt(1 - xi ** 2) * np.sin(wd * tau))
+        r = math.sqrt(1 - xi ** 2)
+        wd = wn * r
+        g = 1 - np.exp(-xi * wn * tau) * (np.cos(wd * tau) + xi / r * np.sin(wd * tau))
     elif xi == 1:
         g = 1 - np.exp(-wn * tau) * (1 + wn * tau)
     else:
@@ -29,127 +52,334 @@ def step_response(time, xi, wn, K, amplitude, t_step=0.0):
     return K * amplitude * g
 
 
-def unit_gain_response(time, voltage, xi, wn):
-    """Response with K = 1 to the recorded voltage, exact for piecewise-linear input: the
-    first-order-hold discretisation of the state-space model on each sampling interval."""
-    t = np.asarray(time, float)
-    u = np.asarray(voltage, float)
+def _phi2(z):
+    """e^z - 1 - z, accurate for small |z| (complex)."""
+    if abs(z) > 0.5:
+        return np.exp(z) - 1 - z
+    term, total = z * z / 2, 0j
+    for k in range(3, 40):
+        total += term
+        if abs(term) <= 1e-18 * abs(total):
+            break
+        term *= z / k
+    return total
+
+
+def _discretisation_expm(xi, wn, h):
     A = np.array([[0.0, 1.0], [-wn * wn, -2 * xi * wn]])
     B = np.array([0.0, wn * wn])
-    dt = np.diff(t)
-    if np.ptp(dt) > 1e-9 * dt.mean():
-        raise InputError("the plant fit needs uniformly sampled data")
-    h = float(dt.mean())
-    # augmented exponential gives Phi, Gamma0 (zero-order part) and Gamma1 (ramp part) at once
     M = np.zeros((4, 4))
     M[:2, :2] = A * h
     M[:2, 2] = B * h
     M[2, 3] = 1.0
     E = linalg.expm(M)
-    Phi, G0, G1 = E[:2, :2], E[:2, 2], E[:2, 3]
-    # x[k+1] = Phi x[k] + G0 u[k] + G1 (u[k+1] - u[k]). With w[k] = x[k] - G1 u[k] this is the
-    # ordinary discrete system w[k+1] = Phi w[k] + Bt u[k], y[k] = C w[k] + C G1 u[k]: one lfilter
-    # call, plus the free response of w[0] = -G1 u[0] (the stage starts at rest).
-    Bt = Phi @ G1 + G0 - G1
+    return E[:2, :2], E[:2, 2], E[:2, 3]
+
+
+def _discretisation(xi, wn, h):
+    """Phi, Gamma0 (held part) and Gamma1 (ramp part) of the sampled system:
+    x[k+1] = Phi x[k] + Gamma0 u[k] + Gamma1 (u[k+1] - u[k]), with Phi = e^{Ah},
+    Gamma0 = A^-1 (Phi - I) B and Gamma1 = A^-2 (Phi - I - A h) B / h. e^{Ah} by Sylvester's formula
+    over the two poles, with Phi - I and Phi - I - Ah formed from expm1-like functions so that
+    oversampled records (wn h << 1) lose no digits; near a double pole, the matrix exponential."""
+    A = np.array([[0.0, 1.0], [-wn * wn, -2 * xi * wn]])
+    B = np.array([0.0, wn * wn])
+    disc = complex(xi * xi - 1) ** 0.5
+    p1, p2 = wn * (-xi + disc), wn * (-xi - disc)
+    if abs(p1 - p2) < 1e-3 * wn:  # Sylvester loses |p|/|p1 - p2| digits; 1e3 eps is fine
+        return _discretisation_expm(xi, wn, h)
+    I = np.eye(2)
+    d = p1 - p2
+    A1, A2 = (A - p2 * I) / d, (A - p1 * I) / d   # e^{At} = A1 e^{p1 t} - A2 e^{p2 t}
+    Pm1 = (A1 * np.expm1(p1 * h) - A2 * np.expm1(p2 * h)).real          # Phi - I
+    Pm2 = (A1 * _phi2(p1 * h) - A2 * _phi2(p2 * h)).real                # Phi - I - A h
+    Ainv = np.array([[-2 * xi / wn, -1.0 / (wn * wn)], [1.0, 0.0]])
+    G0 = Ainv @ (Pm1 @ B)
+    G1 = Ainv @ (Ainv @ (Pm2 @ B)) / h
+    return I + Pm1, G0, G1
+
+
+def _uniform_response(u, xi, wn, h, hold):
+    """Unit-gain response on a uniform grid of step h, the stage at rest at zero at the first sample."""
+    Phi, G0, G1 = _discretisation(xi, wn, h)
     C = np.array([1.0, 0.0])
+    if hold == "zoh":
+        num, den = signal.ss2tf(Phi, G0[:, None], C[None, :], np.zeros((1, 1)))
+        return signal.lfilter(num[0], den, u)
+    # first-order hold. With w[k] = x[k] - G1 u[k] the recursion is the ordinary discrete system
+    # w[k+1] = Phi w[k] + Bt u[k], y[k] = C w[k] + C G1 u[k]: one lfilter call, plus the free
+    # response of w[0] = -G1 u[0] (x[0] = 0).
+    Bt = Phi @ G1 + G0 - G1
     num, den = signal.ss2tf(Phi, Bt[:, None], C[None, :], np.array([[C @ G1]]))
-    y = signal.lfilter(num[0], den, u)
+    if u[0] == 0:
+        return signal.lfilter(num[0], den, u)
+    # f[k] = C Phi^k w0 is a zero-input response of the filter (Cayley-Hamilton): start the filter
+    # in the state that produces it. No eigenvectors, so a double pole (xi = 1) is fine.
     w0 = -G1 * u[0]
-    if np.any(w0):
-        ev, V = np.linalg.eig(Phi)
-        coef = np.linalg.solve(V, w0)
-        k = np.arange(len(t))
-        y = y + np.real((C @ V) @ (coef[:, None] * ev[:, None] ** k[None, :]))
-    return y
+    f0, f1 = C @ w0, C @ (Phi @ w0)
+    return signal.lfilter(num[0], den, u, zi=np.array([f0, f1 + den[1] * f0]))[0]
+
+
+def unit_gain_response(time, voltage, xi, wn, hold="foh"):
+    """Response with K = 1 to the recorded voltage, the stage at rest at zero at the first sample:
+    exact for an input linear between samples (``hold="foh"``) or constant between samples
+    (``"zoh"``). Sampling that is not uniform (within 1e-6) is simulated on a uniform grid at the
+    median interval and interpolated back (second-order accurate)."""
+    t = np.asarray(time, float)
+    u = np.asarray(voltage, float)
+    if hold not in ("foh", "zoh"):
+        raise InputError(f"hold must be 'foh' or 'zoh', got {hold!r}")
+    n = t.size
+    h = (t[-1] - t[0]) / (n - 1)
+    dt = np.diff(t)
+    if np.max(np.abs(dt - h)) <= UNIFORM_TOLERANCE * h:
+        return _uniform_response(u, xi, wn, h, hold)
+    hm = float(np.median(dt))
+    grid = t[0] + hm * np.arange(int(math.ceil((t[-1] - t[0]) / hm - 1e-9)) + 1)
+    if hold == "zoh":
+        ug = u[np.clip(np.searchsorted(t, grid, side="right") - 1, 0, n - 1)]
+    else:
+        ug = np.interp(grid, t, u)
+    return np.interp(t, grid, _uniform_response(ug, xi, wn, hm, hold))
+
+
+def _is_uniform(t):
+    h = (t[-1] - t[0]) / (t.size - 1)
+    return bool(np.max(np.abs(np.diff(t) - h)) <= UNIFORM_TOLERANCE * h)
 
 
 @dataclasses.dataclass
 class PlantFit:
+    """The fitted plant: values, standard errors and 95 % intervals (in ``parameters``, and as
+    ``stderr`` / ``ci95`` dicts), the correlation matrix of (xi, wn, K), and the fit statistics."""
+
     damping_ratio: float
-    natural_frequency: float
-    gain: float
+    natural_frequency: float              # [rad/s]
+    gain: float                           # [m/V]
     parameters: Parameters
-    rmse: float
+    rmse: float                           # [m]
     n_points: int
-    wall_time: float
+    wall_time: float                      # [s]
+    offset: float = 0.0                   # [m] the sensor's zero, profiled out
+    covariance: np.ndarray | None = None  # of (xi, wn, K)
+    correlation: np.ndarray | None = None
+    cost: float = math.nan                # sum of squared residuals [m^2]
+    nfev: int = 0
+    success: bool = True
+    message: str = ""
+    hold: str = "foh"
+    warnings: list = dataclasses.field(default_factory=list)
+    statistics: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def stderr(self) -> dict:
+        return {k: self.parameters[k].stderr for k in NAMES}
+
+    @property
+    def ci95(self) -> dict:
+        return {k: tuple(self.parameters[k].ci95) for k in NAMES}
+
+    def modal_parameters(self):
+        """(xi, wn, K), as ``StickSlipPlant.modal_parameters()``."""
+        return self.damping_ratio, self.natural_frequency, self.gain
 
     def plant(self, mass, end_effector_mass):
+        """A ``StickSlipPlant`` with the fitted xi, wn, K and the given masses (a stage response
+        cannot tell the masses)."""
         from ..models import StickSlipPlant
         return StickSlipPlant(mass=mass, end_effector_mass=end_effector_mass, damping_ratio=self.damping_ratio,
                               natural_frequency=self.natural_frequency, gain=self.gain)
 
-    def to_dict(self):
-        return {"parameters": self.parameters.to_dict(), "rmse": self.rmse, "n_points": self.n_points,
-                "wall_time": self.wall_time}
+    def to_dict(self) -> dict:
+        """JSON-ready (SPEC 7): each parameter as {"value", "stderr", "ci95": [lo, hi], ...}."""
+        from .._io import jsonable
+        corr = None if self.correlation is None else self.correlation
+        return jsonable({"parameters": self.parameters.to_dict(),
+                         "correlation": {"names": list(NAMES), "matrix": corr},
+                         "offset": self.offset, "rmse": self.rmse, "cost": self.cost, "n_points": self.n_points,
+                         "iterations": self.nfev, "success": self.success, "message": self.message,
+                         "hold": self.hold, "wall_time": self.wall_time, "warnings": self.warnings,
+                         "statistics": self.statistics})
 
-    def report(self):
-        lines = ["[[Plant fit]]", f"    rmse = {self.rmse * 1e9:.4g} nm, {self.n_points} points"]
+    def report(self) -> str:
+        """A table like lmfit's fit report."""
+        lines = ["[[Plant fit]]",
+                 f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
+                 f"    data points      = {self.n_points}",
+                 f"    rmse             = {self.rmse * 1e9:.4g} nm",
+                 f"    sensor offset    = {self.offset * 1e9:.4g} nm (profiled)",
+                 f"    input hold       = {self.hold}",
+                 f"    evaluations      = {self.nfev}",
+                 f"    wall time        = {self.wall_time:.3g} s",
+                 "[[Parameters]]"]
+        head = ("name", "value", "stderr", "rel", "95 % interval", "unit")
+        rows = []
         for p in self.parameters.values():
-            lines.append(f"    {p.name:18s} {p.value:12.6g} +/- {p.stderr:.3g}  95 % [{p.ci95[0]:.6g}, {p.ci95[1]:.6g}] {p.unit}")
+            if p.stderr is None:
+                rows.append((p.name, f"{p.value:.7g}", "", "", "", p.unit))
+                continue
+            rel = f"{100 * p.stderr / abs(p.value):.2g} %" if p.value and math.isfinite(p.stderr) else ""
+            rows.append((p.name, f"{p.value:.7g}", f"{p.stderr:.4g}", rel,
+                         f"[{p.ci95[0]:.6g}, {p.ci95[1]:.6g}]", p.unit))
+        w = [max(len(r[i]) for r in rows + [head]) for i in range(len(head))]
+        lines.append("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(head)).rstrip())
+        lines.extend("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)).rstrip() for r in rows)
+        if self.correlation is not None:
+            pairs = [(NAMES[i], NAMES[j], self.correlation[i, j]) for i in range(3) for j in range(i + 1, 3)
+                     if np.isfinite(self.correlation[i, j]) and abs(self.correlation[i, j]) > 0.1]
+            if pairs:
+                lines.append("[[Correlations]] (|C| > 0.1)")
+                lines.extend(f"    C({a}, {b}) = {c:+.3f}" for a, b, c in sorted(pairs, key=lambda x: -abs(x[2])))
+        if self.warnings:
+            lines.append("[[Warnings]]")
+            lines.extend(f"    {w}" for w in self.warnings)
         return "\n".join(lines)
 
+    def __str__(self):
+        return self.report()
 
-def fit_plant(time_s, voltage, stage_displacement, initial=None) -> PlantFit:
-    """Fits xi, wn [rad/s], K [m/V] to a measured stage displacement. K and the sensor's offset
-    enter linearly and are solved for exactly at every (xi, wn); those two are found by a grid
-    over frequency and damping, then least squares in log space. Intervals come from the full
-    Jacobian at the optimum."""
-    t0 = time.perf_counter()
-    t = np.asarray(time_s, float)
-    u = np.asarray(voltage, float)
-    y = np.asarray(stage_displacement, float)
+
+def _initial(initial):
+    """(xi, wn) from an initial guess: a sequence (xi, wn[, K]) or a dict with those names."""
+    if isinstance(initial, dict):
+        try:
+            xi, wn = initial["damping_ratio"], initial["natural_frequency"]
+        except KeyError:
+            raise InputError("initial must give 'damping_ratio' and 'natural_frequency'") from None
+    else:
+        try:
+            xi, wn = (float(v) for v in list(initial)[:2])
+        except (TypeError, ValueError):
+            raise InputError(f"initial must be (xi, wn[, K]), got {initial!r}") from None
+    if not (xi > 0 and wn > 0 and math.isfinite(xi) and math.isfinite(wn)):
+        raise InputError(f"initial xi and wn must be positive, got {xi!r}, {wn!r}")
+    return float(xi), float(wn)
+
+
+def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") -> PlantFit:
+    """Fits xi, wn [rad/s] and K [m/V] to a measured stage displacement [m] under a measured
+    voltage [V] (any input that moves the stage: a step, a sawtooth...).
+
+    initial: optional (xi, wn[, K]) or dict; default: the best of a coarse grid over wn (from
+        about one period per record to the Nyquist frequency) and xi (0.01 to 3); K is always
+        solved for exactly.
+    hold: how the input behaves between samples, "foh" (linear; default) or "zoh" (constant)."""
+    t0 = _time.perf_counter()
+    t = np.asarray(time, float).ravel()
+    u = np.asarray(voltage, float).ravel()
+    y = np.asarray(stage_displacement, float).ravel()
+    if hold not in ("foh", "zoh"):
+        raise InputError(f"hold must be 'foh' or 'zoh', got {hold!r}")
     if not (t.shape == u.shape == y.shape) or t.size < 20:
         raise InputError("the plant fit needs time, voltage and stage displacement of equal length (>= 20 samples)")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise InputError("the plant fit needs finite time, voltage and stage displacement")
+    if np.any(np.diff(t) <= 0):
+        raise InputError("the plant fit needs strictly increasing time")
     if np.ptp(u) == 0:
         raise InputError("the recorded voltage is constant: a plant fit needs an input that moves the stage")
+    if np.ptp(y) == 0:
+        raise InputError("the recorded stage displacement is constant: nothing to fit")
+    warns = []
+    if not _is_uniform(t):
+        warns.append("sampling is not uniform: the response was simulated on a uniform grid and interpolated")
+
+    ym = float(y.mean())
+    yc = y - ym
+    evals = [0]
 
     def linear_part(xi, wn):
-        g = unit_gain_response(t, u, xi, wn)
-        A = np.column_stack([g, np.ones_like(g)])
-        coef, *_ = np.linalg.lstsq(A, y, rcond=None)
-        return coef, A @ coef - y
+        evals[0] += 1
+        g = unit_gain_response(t, u, xi, wn, hold)
+        # K and the offset: linear least squares on [g 1], solved centred (well conditioned, exact,
+        # and fast for 10^6 points)
+        gm = float(g.mean())
+        gc = g - gm
+        gg = float(gc @ gc)
+        k = float(gc @ yc) / gg if gg > 0 else 0.0
+        coef = np.array([k, ym - k * gm])
+        return coef, g, k * g + coef[1] - y
+
+    def cost(xi, wn):
+        r = linear_part(xi, wn)[2]
+        return float(r @ r)
+
+    h = float(np.median(np.diff(t)))
+    nyq = math.pi / h
+    if initial is None:
+        duration = float(t[-1] - t[0])
+        lo = max(2 * math.pi / duration, 1e-6 * nyq)
+        xis = (0.01, 0.03, 0.07, 0.15, 0.25, 0.4, 0.6, 0.85, 1.2, 2.0, 3.0)
+        wns = np.geomspace(lo, 0.9 * nyq, max(24, int(12 * math.log10(0.9 * nyq / lo)) + 1))
+        costs = np.array([[cost(xi, wn) for xi in xis] for wn in wns])
+        i, j = np.unravel_index(int(np.argmin(costs)), costs.shape)
+        guess = (xis[j], float(wns[i]))
+    else:
+        guess = _initial(initial)
 
     def residual(phi):
-        return linear_part(math.exp(phi[0]), math.exp(phi[1]))[1]
+        return linear_part(math.exp(phi[0]), math.exp(phi[1]))[2]
 
-    if initial is None:
-        nyq = math.pi / float(np.mean(np.diff(t)))
-        best = None
-        for wn in np.geomspace(2 * math.pi * 5, 0.5 * nyq, 40):
-            for xi in (0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 1.0, 1.5):
-                r = linear_part(xi, wn)[1]
-                c = float(r @ r)
-                if best is None or c < best[0]:
-                    best = (c, xi, wn)
-        initial = best[1:]
-    res = optimize.least_squares(residual, np.log(initial[:2]), method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    scale = max(float(np.sqrt(np.mean(y * y))), 1e-300)  # residuals in units of the signal: a tame problem
+    res = optimize.least_squares(lambda p: residual(p) / scale, np.log(guess), method="lm",
+                                 xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=1000)
     xi, wn = (math.exp(v) for v in res.x)
-    (K, offset), r = linear_part(xi, wn)
-    # full Jacobian in (xi, wn, K, offset) by central differences of the exact response
-    def model(theta):
-        return theta[2] * unit_gain_response(t, u, theta[0], theta[1]) + theta[3]
-    theta = np.array([xi, wn, K, offset])
+    (K, offset), g, r = linear_part(xi, wn)
+
+    # the full Jacobian in (xi, wn, K, offset): central differences for xi and wn (the response is
+    # smooth and cheap), exact columns for the linear K and offset
     J = np.empty((t.size, 4))
-    for k in range(4):
-        h = 1e-6 * max(abs(theta[k]), 1e-12)
-        tp, tm = theta.copy(), theta.copy()
-        tp[k] += h
-        tm[k] -= h
-        J[:, k] = (model(tp) - model(tm)) / (2 * h)
-    dof = max(t.size - 4, 1)
-    s2 = float(r @ r) / dof
-    col = np.linalg.norm(J, axis=0)  # scale columns first: volts and rad/s differ by 10 decades
+    d = 1e-6 * xi
+    J[:, 0] = K * (unit_gain_response(t, u, xi + d, wn, hold) - unit_gain_response(t, u, xi - d, wn, hold)) / (2 * d)
+    d = 1e-6 * wn
+    J[:, 1] = K * (unit_gain_response(t, u, xi, wn + d, hold) - unit_gain_response(t, u, xi, wn - d, hold)) / (2 * d)
+    J[:, 2] = g
+    J[:, 3] = 1.0
+    n, p = t.size, 4
+    dof = max(n - p, 1)
+    sse = float(r @ r)
+    # as in the friction fits: coloured residuals (model error, quantisation) carry less
+    # information than white ones; inflate s^2 by (1 + rho) / (1 - rho), rho their lag-1 autocorrelation
+    rho = min(max(float(r[1:] @ r[:-1]) / sse, 0.0), 0.99) if sse > 0 else 0.0
+    inflation = (1 + rho) / (1 - rho)
+    s2 = sse / dof * inflation
+    col = np.linalg.norm(J, axis=0)  # scale the columns first: rad/s and m/V differ by 10 decades
     col[col == 0] = 1.0
-    Js = J / col
-    cov = s2 * np.linalg.pinv(Js.T @ Js) / np.outer(col, col)
-    se = np.sqrt(np.clip(np.diag(cov), 0, None))
-    tq = stats.t.ppf(0.975, dof)
+    _, sv, Vt = np.linalg.svd(J / col, full_matrices=False)
+    keep = sv > 1e-10 * sv[0]
+    cov_s = (Vt[keep].T / sv[keep] ** 2) @ Vt[keep]
+    cov = s2 * cov_s / np.outer(col, col)
+    null = np.abs(Vt[~keep]).max(axis=0) > 1e-6 if np.any(~keep) else np.zeros(p, bool)
+    var = np.where(null, np.inf, np.clip(np.diag(cov), 0.0, None))
+    se = np.sqrt(var)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))
+    corr[null, :] = np.nan
+    corr[:, null] = np.nan
+    tq = float(stats.t.ppf(0.975, dof))
     params = Parameters()
-    for name, unit, v, e in (("damping_ratio", "", xi, se[0]), ("natural_frequency", "rad/s", wn, se[1]),
-                             ("gain", "m/V", K, se[2])):
-        p = params.add(name, v, unit=unit)
-        p.stderr, p.ci95 = float(e), (v - tq * e, v + tq * e)
-    return PlantFit(xi, wn, K, params, math.sqrt(float(r @ r) / t.size), int(t.size), time.perf_counter() - t0)
+    for k, (name, v) in enumerate(zip(NAMES, (xi, wn, K))):
+        par = params.add(name, v, unit=UNITS[name])
+        par.stderr = float(se[k])
+        par.ci95 = (v - tq * se[k], v + tq * se[k])
+        if null[k]:
+            warns.append(f"{name} is not determined by this record: its interval is infinite")
+    if wn > 0.5 * nyq:
+        warns.append(f"natural_frequency {wn:.4g} rad/s is above half the Nyquist frequency ({nyq:.4g} rad/s): "
+                     f"sample faster")
+    if 2 * math.pi / wn > 0.5 * (t[-1] - t[0]):
+        warns.append("the record is shorter than two natural periods: record longer")
+    if rho > 0.5:
+        warns.append(f"the residuals are strongly correlated (lag-1 autocorrelation {rho:.2f}): the model "
+                     f"does not explain the record fully; intervals widened by {math.sqrt(inflation):.2g}x")
+    success = bool(res.status > 0)
+    if not success:
+        warns.append(f"the optimiser stopped early: {res.message}")
+    return PlantFit(xi, wn, float(K), params, math.sqrt(sse / n), int(n), _time.perf_counter() - t0,
+                    offset=float(offset), covariance=cov[:3, :3], correlation=corr[:3, :3], cost=sse,
+                    nfev=evals[0], success=success, message=str(res.message), hold=hold, warnings=warns,
+                    statistics={"dof": dof, "residual_std": math.sqrt(sse / dof), "autocorrelation": rho,
+                                "variance_inflation": inflation})
 
 
 __all__ = ["fit_plant", "step_response", "unit_gain_response", "PlantFit"]
