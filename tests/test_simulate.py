@@ -207,3 +207,21 @@ def test_law_outside_its_range_warns(model_i):
 def test_thermal_model_without_temperature_is_an_input_error(model_i):
     with pytest.raises(tf.InputError, match="temperature"):
         tf.simulate(model_i, 0.1)
+
+
+def test_anti_damped_offset_form_warns_and_passive_one_does_not(model_ii):
+    """The paper's dF < 0 in the offset form is a negative damping dF/v_smooth near v = 0 far
+    stronger than sigma1 (the differential tests show default tolerances miss 0.1 % there); a
+    positive dF is passive and must not warn."""
+    import warnings as _w
+    from thermofriction.models import ModelII
+    offset = tf.Model(model_ii.plant, model_ii.friction, ModelII(model_ii.thermal.dF, "offset"), model_ii.input)
+    with pytest.warns(tf.ConditioningWarning, match="anti-damped"):
+        tf.simulate(offset, 0.01, temperature=40.0)
+    passive = tf.Model(model_ii.plant, model_ii.friction, ModelII(tf.Const(0.3), "offset"), model_ii.input)
+    with _w.catch_warnings():
+        _w.simplefilter("error", tf.ConditioningWarning)
+        tf.simulate(passive, 0.01, temperature=40.0)
+    with _w.catch_warnings():
+        _w.simplefilter("error", tf.ConditioningWarning)
+        tf.simulate(model_ii, 0.01, temperature=40.0)  # the scale form

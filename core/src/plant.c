@@ -113,6 +113,15 @@ void tf_model_state_scale(const tf_model *model, double *scale)
     double X = fabs(model->T_em) * input_peak(&model->input) / model->k;
     if (!(X > 0.0)) X = 1e-6;
     double V = X * sqrt(model->k / model->m);
+    /* Friction can change over a velocity band far narrower than the stroke's velocity scale (the
+       offset form's smoothed sign, the Stribeck curve): resolve velocities to 1e-3 of that band,
+       otherwise the default atol lets the solver step across it (0.2 % error found by the
+       differential tests on the offset form). */
+    double band = V;
+    if (model->thermal == TF_THERMAL_MODEL_II && model->dF_form == TF_DF_OFFSET && p[TF_P_VSMOOTH] > 0.0)
+        band = p[TF_P_VSMOOTH];
+    if (p[TF_P_FS] != p[TF_P_FC] && p[TF_P_VS] > 0.0 && p[TF_P_VS] < band) band = p[TF_P_VS];
+    if (1e3 * band < V) V = 1e3 * band;
     double Z = (p[TF_P_SIGMA0] > 0.0 && p[TF_P_FC] > 0.0) ? p[TF_P_FC] / p[TF_P_SIGMA0] : 1e-3 * X;
     scale[XP] = scale[XE] = X;
     scale[VP] = scale[VE] = V;

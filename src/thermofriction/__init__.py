@@ -9,7 +9,7 @@ Simulate actuators with LuGre friction and thermal extensions (Li et al., Rev. S
     res.time, res.displacement, res.step_sizes
 """
 
-from .errors import ComputationError, InputError, SolverError, TemperatureRangeWarning, ThermofrictionError
+from .errors import ComputationError, ConditioningWarning, InputError, SolverError, TemperatureRangeWarning, ThermofrictionError
 from .models import (PARAMETERS, PRESETS, PWL, Const, Exp, Law, Linear, LuGre, Model, ModelI, ModelII, Poly,
                      StickSlipPlant, Table, load_model)
 from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
@@ -22,7 +22,7 @@ from .report import report
 __version__ = "0.1.0"
 
 __all__ = [
-    "ComputationError", "InputError", "SolverError", "TemperatureRangeWarning", "ThermofrictionError",
+    "ComputationError", "ConditioningWarning", "InputError", "SolverError", "TemperatureRangeWarning", "ThermofrictionError",
     "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "LuGre", "Model", "ModelI", "ModelII", "Poly",
     "StickSlipPlant", "Table", "load_model",
     "AutoSwitch", "Dopri5", "Rodas4", "SimulationResult", "StepSizeController", "simulate",

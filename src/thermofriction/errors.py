@@ -32,6 +32,10 @@ class TemperatureRangeWarning(UserWarning):
     """A temperature law was evaluated outside the range it was calibrated on."""
 
 
+class ConditioningWarning(UserWarning):
+    """The model is ill-conditioned where it will be simulated (default tolerances may not be enough)."""
+
+
 def unknown_keys(keys, allowed, what="") -> str:
     """``unknown key 'x' for lugre (allowed: a, b)`` -- one wording for every unknown-key error."""
     keys = sorted(keys)

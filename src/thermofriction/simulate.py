@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _core
 from ._io import atomic_write
-from .errors import InputError, SolverError, TemperatureRangeWarning
+from .errors import ConditioningWarning, InputError, SolverError, TemperatureRangeWarning
 from .models import PARAMETERS, Model, ModelI, ModelII, check_friction_values
 from .waveforms import Sampled, Waveform, Zero
 
@@ -250,6 +250,20 @@ def check_temperatures(model: Model, temperature):
             raise InputError(f"Model II: lambda(T) = 1 + dF(T)/F_ref is {lam[i]:.4g} <= 0 at {Ts[i]:g} C "
                              f"(dF = {model.thermal.dF(Ts[i]):.4g} N, F_ref = fc = {model.reference_force():.4g} N): "
                              f"the thermal term would reverse friction")
+    if isinstance(model.thermal, ModelII) and model.thermal.form == "offset":
+        # dF(T) tanh(v / v_smooth) with dF < 0 is a negative damping dF/v_smooth near v = 0; stronger
+        # than the bristles' own damping it makes the sticking state repelling (found by the
+        # differential tests: the explicit solver needs rtol <= 1e-7 there, an L-stable one
+        # finds another solution).
+        dF = np.atleast_1d(model.thermal.dF(Ts))
+        i = int(np.argmin(dF))
+        p = model.parameters_at(Ts[i])
+        damping = p["sigma1"] + p["sigma2"]
+        if dF[i] < 0 and -dF[i] / p["v_smooth"] > damping:
+            warnings.warn(f"Model II offset form: dF = {dF[i]:.4g} N at {Ts[i]:g} C is anti-damped near v = 0 "
+                          f"(dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against sigma1 + sigma2 = "
+                          f"{damping:.3g} N s/m); the solution is ill-conditioned: use Dopri5 with rtol <= 1e-8, "
+                          f"or the scale form", ConditioningWarning, stacklevel=3)
 
 
 # ---------------------------------------------------------------------------------------------
