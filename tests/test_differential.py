@@ -311,6 +311,16 @@ def test_waveforms_match_reference(name):
     np.testing.assert_allclose(w(t), out, rtol=0, atol=0)
 
 
+def test_corners_include_one_exactly_at_the_start():
+    """Oracle: independent reference implementation of the corner lists, on closed intervals
+    [t0, t1] that start exactly on a corner (Waveform.corners promises [t0, t1])."""
+    for w, t0, t1 in [(WAVES["sawtooth+"], 0.2, 1.0), (WAVES["square"], 0.1, 0.5), (WAVES["step"], 0.01, 1.0),
+                      (WAVES["sampled"], 0.15, 1.0), (WAVES["sawtooth+0.7"], 0.0, 0.5)]:
+        np.testing.assert_allclose(w.corners(t0, t1), R.waveform_corners(w, t0, t1, include_start=True),
+                                   rtol=1e-13, atol=1e-13)
+        assert w.corners(t0, t1)[0] == pytest.approx(t0, abs=1e-12)
+
+
 def test_sawtooth_directions_are_mirror_images():
     """Oracle: the definition of direction = -1 (SPEC 6: mirrored in time), via the reference:
     u_-(t) = u_+(P - t) on each period, with u_-(0) = offset; and the C core agrees."""

@@ -4,6 +4,7 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include <math.h>
 #include <string.h>
 
 #include "thermofriction.h"
@@ -402,10 +403,14 @@ static PyObject *py_waveform_eval(PyObject *self, PyObject *args)
     for (Py_ssize_t i = 0; i < nt; i++) ((double *)vv.buf)[i] = tf_waveform_value(&w, t[i]);
     result = PyList_New(0);
     if (nt > 0 && result) {
-        double c = t[0] - 1e-300;
+        /* start a little before t[0]: next_corner skips corners within 1e-12 (relative) of its
+           argument, and a corner exactly at t[0] belongs in [t[0], t[-1]] */
+        double margin = 1e-12 * fmax(1.0, fabs(t[0]));
+        double c = t[0] - 3.0 * margin;
         for (int guard = 0; guard < 1000000; guard++) {
             c = tf_waveform_next_corner(&w, c);
             if (!(c <= t[nt - 1])) break;
+            if (c < t[0] - margin) continue;
             PyObject *f = PyFloat_FromDouble(c);
             PyList_Append(result, f);
             Py_DECREF(f);
