@@ -105,7 +105,9 @@ BAD = [
         'fc = { law = "exp", a = 106.04, b = -0.159 }', "").replace('model = "lugre"', 'model = "lugre"\nfc = 0.5'),
      "'fs'"),
     ("unknown thermal model", GOOD.replace('model = "I"', 'model = "III"'), "III"),
-    ("friction model not yet available", GOOD.replace('"lugre"', '"gms"'), "gms"),
+    ("unknown friction model", GOOD.replace('"lugre"', '"bristle"'), "bristle"),
+    ("GMS without element arrays", GOOD.replace('"lugre"', '"gms"'), "'k'"),
+    ("unknown plant type", GOOD.replace('"stick-slip"', '"flexure"'), "flexure"),
 ]
 
 

@@ -4,12 +4,21 @@
 #include <math.h>
 #include <string.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 static double sgn(double v) { return (v > 0) - (v < 0); }
 
-int tf_friction_nstate(int kind)
+int tf_friction_nstate(int kind, int n_elements)
 {
     switch (kind) {
-    case TF_FRICTION_LUGRE: return 1;
+    case TF_FRICTION_LUGRE:
+    case TF_FRICTION_DAHL:
+    case TF_FRICTION_ELASTOPLASTIC: return 1;
+    case TF_FRICTION_COULOMB:
+    case TF_FRICTION_STRIBECK: return 0;
+    case TF_FRICTION_GMS: return (n_elements >= 1 && n_elements <= TF_MAX_FRICTION_STATES) ? n_elements : -1;
     default: return -1;
     }
 }
@@ -90,11 +99,137 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
     return s0 * z[0] + s1 * zd + s2 * v;
 }
 
-double tf_friction_eval(int kind, const double *p, double v, const double *z, double *dz,
-                        tf_friction_partials *jac, tf_friction_param_partials *dp)
+/* Static maps: F = G(v) s(v) + sigma2 v with the sign smoothed over v_smooth, s = tanh(v / v_smooth),
+ * G = fc (Coulomb) or g(v) (Stribeck). */
+static double static_map(int stribeck, const double *p, double v, tf_friction_partials *jac)
 {
+    double vsm = p[TF_P_VSMOOTH], s2 = p[TF_P_SIGMA2];
+    double dG = 0.0;
+    double G = stribeck ? tf_stribeck(p, v, jac ? &dG : 0) : p[TF_P_FC];
+    double s = tanh(v / vsm);
+    if (jac) jac->dF_dv = G * (1.0 - s * s) / vsm + dG * s + s2;
+    return G * s + s2 * v;
+}
+
+/* Dahl (1968): z' = v - sigma0 |v| z / fc, F = sigma0 z. */
+static double dahl(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac)
+{
+    double s0 = p[TF_P_SIGMA0], fc = p[TF_P_FC];
+    dz[0] = v - s0 * fabs(v) * z[0] / fc;
+    if (jac) {
+        jac->ddz_dz[0] = -s0 * fabs(v) / fc;
+        jac->ddz_dv[0] = 1.0 - s0 * sgn(v) * z[0] / fc;
+        jac->dF_dz[0] = s0;
+        jac->dF_dv = 0.0;
+    }
+    return s0 * z[0];
+}
+
+/* Elasto-plastic (Dupont et al. 2002): z' = v - alpha(z, v) sigma0 |v| z / g(v). alpha is zero
+ * below the break-away deflection z_ba and when z opposes v (purely elastic: no drift under
+ * small forces), one from the steady deflection z_ss = g(v)/sigma0 on, and a half sine between. */
+static double elastoplastic(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac)
+{
+    double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2], vd = p[TF_P_VD], zba = p[TF_P_ZBA];
+    double dg = 0.0;
+    double g = tf_stribeck(p, v, jac ? &dg : 0);
+    double zss = g / s0, az = fabs(z[0]);
+    double alpha = 0.0, da_dz = 0.0, da_dzss = 0.0;
+    if (z[0] * v > 0.0 && az > zba) {
+        if (az >= zss) {
+            alpha = 1.0;
+        } else {
+            double width = zss - zba;
+            double u = (az - 0.5 * (zss + zba)) / width;
+            double du_dz = sgn(z[0]) / width, du_dzss = (zba - az) / (width * width);
+            alpha = 0.5 * sin(M_PI * u) + 0.5;
+            double da_du = 0.5 * M_PI * cos(M_PI * u);
+            da_dz = da_du * du_dz;
+            da_dzss = da_du * du_dzss;
+        }
+    }
+    double r = s0 * fabs(v) / g;
+    double zd = v - alpha * r * z[0];
+    double s1 = p[TF_P_SIGMA1], ds1 = 0.0;
+    if (vd > 0.0) {
+        double q = v / vd;
+        s1 *= exp(-q * q);
+        ds1 = -2.0 * q / vd * s1;
+    }
+    dz[0] = zd;
+    if (jac) {
+        double dr = s0 * (sgn(v) * g - fabs(v) * dg) / (g * g);
+        double da_dv = da_dzss * dg / s0;
+        jac->ddz_dz[0] = -r * (alpha + z[0] * da_dz);
+        jac->ddz_dv[0] = 1.0 - z[0] * (da_dv * r + alpha * dr);
+        jac->dF_dz[0] = s0 + s1 * jac->ddz_dz[0];
+        jac->dF_dv = ds1 * zd + s1 * jac->ddz_dv[0] + s2;
+    }
+    return s0 * z[0] + s1 * zd + s2 * v;
+}
+
+/* Generalized Maxwell-slip (Al-Bender, Lampaert and Swevers 2005): F = sum F_i + sigma2 v. */
+static double gms(const double *p, const tf_gms_elements *el, double v, const double *z, double *dz,
+                  tf_friction_partials *jac)
+{
+    double C = p[TF_P_C], dg = 0.0;
+    double g = tf_stribeck(p, v, jac ? &dg : 0);
+    double F = p[TF_P_SIGMA2] * v;
+    for (int i = 0; i < el->n; i++) {
+        F += z[i];
+        if (el->mode[i] == 0) {
+            dz[i] = el->k[i] * v;
+            if (jac) { jac->ddz_dz[i] = 0.0; jac->ddz_dv[i] = el->k[i]; }
+        } else {
+            dz[i] = C * (el->mode[i] * el->w[i] - z[i] / g);
+            if (jac) { jac->ddz_dz[i] = -C / g; jac->ddz_dv[i] = C * z[i] * dg / (g * g); }
+        }
+        if (jac) jac->dF_dz[i] = 1.0;
+    }
+    if (jac) jac->dF_dv = p[TF_P_SIGMA2];
+    return F;
+}
+
+double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
+                        double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
+{
+    if (kind == TF_FRICTION_LUGRE) return lugre(p, v, z, dz, jac, dp);
+    if (dp) memset(dp, 0, sizeof *dp);
     switch (kind) {
-    case TF_FRICTION_LUGRE: return lugre(p, v, z, dz, jac, dp);
+    case TF_FRICTION_COULOMB: return static_map(0, p, v, jac);
+    case TF_FRICTION_STRIBECK: return static_map(1, p, v, jac);
+    case TF_FRICTION_DAHL: return dahl(p, v, z, dz, jac);
+    case TF_FRICTION_ELASTOPLASTIC: return elastoplastic(p, v, z, dz, jac);
+    case TF_FRICTION_GMS: return gms(p, el, v, z, dz, jac);
     default: return NAN;
+    }
+}
+
+int tf_friction_nevent(int kind, const tf_gms_elements *el)
+{
+    return kind == TF_FRICTION_GMS && el ? el->n : 0;
+}
+
+void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
+                        double *g_out)
+{
+    if (kind != TF_FRICTION_GMS) return;
+    double g = tf_stribeck(p, v, 0);
+    for (int i = 0; i < el->n; i++)
+        g_out[i] = el->mode[i] == 0 ? fabs(z[i]) - el->w[i] * g : -el->mode[i] * v;
+}
+
+void tf_friction_update_modes(int kind, const double *p, tf_gms_elements *el, double v, const double *z)
+{
+    if (kind != TF_FRICTION_GMS) return;
+    double g = tf_stribeck(p, v, 0);
+    for (int i = 0; i < el->n; i++) {
+        if (el->mode[i] == 0) {
+            /* at capacity and pushed further: it breaks loose (a rounding margin, so that the
+               state at a located event counts as reached) */
+            if (z[i] * v > 0.0 && fabs(z[i]) >= el->w[i] * g * (1.0 - 1e-9)) el->mode[i] = (v > 0) - (v < 0);
+        } else if (el->mode[i] * v <= 0.0) {
+            el->mode[i] = 0; /* the motion reversed (or stopped): it sticks where it is */
+        }
     }
 }

@@ -328,16 +328,70 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     return 0;
 }
 
+/* The earliest upward zero crossing of the event functions within an accepted step [t, t + h]
+ * (g0 at t, g1 at the step's end y1), as a fraction s of h, located on the dense output by the
+ * Illinois method to a few ulps of t; the right end of the final bracket, so that the crossing
+ * has happened there. -1 if no function crosses. */
+static double locate_event(work *w, int method, int ne, double t, double h, const double *g0, double t_new,
+                           const double *y1, double *g1, double *gm, double *ym)
+{
+    const tf_ode *ode = w->ode;
+    ode->events(t_new, y1, g1, ode->ctx);
+    int any = 0;
+    for (int i = 0; i < ne; i++) any |= g0[i] < 0.0 && g1[i] >= 0.0;
+    if (!any) return -1.0;
+    double sa = 0.0, sb = (t_new - t) / h;
+    /* the crossing function with the earliest linear estimate brackets the search */
+    int idx = -1;
+    double best = INFINITY;
+    for (int i = 0; i < ne; i++)
+        if (g0[i] < 0.0 && g1[i] >= 0.0) {
+            double s = sb * g0[i] / (g0[i] - g1[i]);
+            if (s < best) { best = s; idx = i; }
+        }
+    double ga = g0[idx], gb = g1[idx];
+    int side = 0;
+    double tol = 4.0 * DBL_EPSILON * fmax(fabs(t), fabs(h)) / fabs(h);
+    for (int it = 0; it < 200 && sb - sa > tol; it++) {
+        double s = sa + (sb - sa) * ga / (ga - gb);
+        if (!(s > sa && s < sb)) s = 0.5 * (sa + sb);
+        if (method == TF_METHOD_RODAS4) rodas4_dense(w, s, ym); else dopri5_dense(w, s, ym);
+        ode->events(t + s * h, ym, gm, ode->ctx);
+        /* another function crossing earlier takes over the bracket */
+        int hit = -1;
+        for (int i = 0; i < ne; i++)
+            if (g0[i] < 0.0 && gm[i] >= 0.0 && (hit < 0 || gm[i] > gm[hit])) hit = i;
+        if (hit >= 0) {
+            sb = s;
+            gb = gm[hit];
+            if (hit != idx) { idx = hit; ga = g0[idx]; side = 0; }
+            if (side == 1) ga *= 0.5;
+            side = 1;
+        } else {
+            sa = s;
+            ga = gm[idx];
+            if (side == -1) gb *= 0.5;
+            side = -1;
+        }
+    }
+    return sb;
+}
+
 int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
              double *y, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *st)
 {
     memset(st, 0, sizeof *st);
     st->switch_time = -1.0;
     int n = ode->n;
-    if (n <= 0 || n_out < 1 || !(opt->rtol > 0) || !opt->atol || opt->max_steps <= 0)
+    if (n < 0 || n_out < 1 || !(opt->rtol > 0) || (n > 0 && !opt->atol) || opt->max_steps <= 0)
         return fail(&(work){.st = st}, TF_ERR_BAD_ARGUMENT, t_out[0], 0.0);
     for (long i = 1; i < n_out; i++)
         if (!(t_out[i] >= t_out[i - 1])) return fail(&(work){.st = st}, TF_ERR_BAD_ARGUMENT, t_out[i], 0.0);
+    if (n == 0) { /* nothing to integrate (a static friction map under prescribed motion) */
+        for (long i = 0; i < n_out; i++) emit(i, t_out[i], y, emit_ctx);
+        st->method_used = opt->method;
+        return TF_OK;
+    }
 
     work w;
     if (setup(&w, ode, opt, st)) { st->status = TF_ERR_NO_MEMORY; return TF_ERR_NO_MEMORY; }
@@ -347,6 +401,8 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     double t = t_out[0], t_end = t_out[n_out - 1];
     double *f0 = (double *)malloc(sizeof(double) * n);
     double *yd = (double *)malloc(sizeof(double) * n);
+    const int ne = ode->events ? ode->nevent : 0;
+    double *g0 = (double *)malloc(sizeof(double) * (ne + 1) * 3), *g1 = g0 + ne + 1, *gm = g1 + ne + 1;
     int status = TF_OK;
     long next = 0;
     double h = 0.0, facold = 1e-4, hold = 0.0, errold = 1.0;
@@ -354,7 +410,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     /* AUTO bookkeeping: the explicit method's recent cost, the probe, the lock-out */
     double win_t = t, win_work = 0.0, explicit_rate = 0.0, probe_t = 0.0, probe_work = 0.0;
     long win_steps = 0, probe_steps = 0, lock_steps = 0, lock_len = FIRST_LOCK;
-    if (!f0 || !yd) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
+    if (!f0 || !yd || !g0) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
 
     while (next < n_out && t_out[next] <= t) emit(next, t_out[next], y, emit_ctx), next++;
     if (!all_finite(y, n)) { status = fail(&w, TF_ERR_NONFINITE, t, 0.0); goto done; }
@@ -365,8 +421,10 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
         if (t_end - t <= 64.0 * DBL_EPSILON * fabs(t_end)) break;
         double seg_end = ode->next_corner ? fmin(ode->next_corner(t, ode->ctx), t_end) : t_end;
         if (!(seg_end > t) || t_end - seg_end <= 64.0 * DBL_EPSILON * fabs(t_end)) seg_end = t_end;
-        /* restart at every corner: the derivative may jump there */
+        /* restart at every corner (the derivative may jump there) and every event */
         w.t_clamp = INFINITY;
+        if (ode->on_restart) ode->on_restart(t, y, ode->ctx);
+        if (ne) ode->events(t, y, g0, ode->ctx);
         if (rhs(&w, t, y, f0)) { status = fail(&w, TF_ERR_NONFINITE, t, h); goto done; }
         if (h <= 0.0) {
             h = opt->h0 > 0 ? opt->h0 : initial_step(&w, t, y, f0, method == TF_METHOD_DOPRI5 ? 5 : 4, opt->hmax);
@@ -409,6 +467,29 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
             }
             if (err <= 1.0) {
                 double t_new = last ? seg_end : t + h;
+                if (ne) { /* an event inside the step: end the step there, emit up to it, restart */
+                    double s_ev = locate_event(&w, method, ne, t, h, g0, t_new, w.y1, g1, gm, yd);
+                    if (s_ev >= 0.0) {
+                        double t_ev = s_ev >= 1.0 ? t_new : t + s_ev * h;
+                        while (next < n_out && t_out[next] <= t_ev) {
+                            double s = (t_out[next] - t) / h;
+                            if (method == TF_METHOD_RODAS4) rodas4_dense(&w, s, yd); else dopri5_dense(&w, s, yd);
+                            emit(next, t_out[next], yd, emit_ctx);
+                            next++;
+                        }
+                        if (s_ev >= 1.0) memcpy(y, w.y1, sizeof(double) * n);
+                        else if (method == TF_METHOD_RODAS4) rodas4_dense(&w, s_ev, y);
+                        else dopri5_dense(&w, s_ev, y);
+                        st->steps++;
+                        st->events++;
+                        h = fmax(h * s_ev, 1e-6 * h); /* the next segment starts with a step like this one */
+                        t = t_ev;
+                        first_rodas = 1;
+                        reject = 0;
+                        break;
+                    }
+                    memcpy(g0, g1, sizeof(double) * ne);
+                }
                 while (next < n_out && t_out[next] <= t_new) {
                     double s = (t_out[next] - t) / h;
                     if (method == TF_METHOD_RODAS4) rodas4_dense(&w, s, yd); else dopri5_dense(&w, s, yd);
@@ -507,6 +588,7 @@ done:
     st->method_used = method;
     free(f0);
     free(yd);
+    free(g0);
     free(w.block);
     return status;
 }

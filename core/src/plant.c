@@ -1,16 +1,35 @@
-/* Plants (SPEC 3.1) with friction and thermal extension, as one ODE system. */
+/* Plants (SPEC 3) with friction and thermal extension, as one ODE system. */
 #include "thermofriction/plant.h"
 
 #include <math.h>
 #include <string.h>
 
-enum { XP = 0, VP, XE, VE, NMECH };
+/* State indices: stick-slip x_p, v_p, x_e, v_e; mass x, v (X, V); prescribed none. */
+enum { XP = 0, VP, XE, VE };
+enum { X = 0, V };
+
+static int nmech(const tf_model *m)
+{
+    return m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
+}
+
+static int nfric(const tf_model *m) { return tf_friction_nstate(m->friction, m->gms.n); }
 
 void tf_model_prepare(tf_model *model) { model->cache_valid = 0; }
 
-int tf_model_nstate(const tf_model *model) { return NMECH + tf_friction_nstate(model->friction); }
+int tf_model_nstate(const tf_model *model) { return nmech(model) + nfric(model); }
 
-int tf_model_noutput(const tf_model *model) { return TF_OUT_NFIXED + tf_friction_nstate(model->friction); }
+int tf_model_noutput(const tf_model *model) { return TF_OUT_NFIXED + nfric(model); }
+
+/* Relative sliding velocity v_r of the driven body on its driving surface. */
+static double relative_velocity(const tf_model *m, double t, const double *y)
+{
+    switch (m->plant) {
+    case TF_PLANT_STICK_SLIP: return y[VE] - y[VP];
+    case TF_PLANT_MASS: return y[V];
+    default: return tf_waveform_slope(&m->input, t);
+    }
+}
 
 double tf_model_temperature(const tf_model *model, double t)
 {
@@ -54,14 +73,16 @@ static const double *params(tf_model *m, double T, double *lambda, double *dF)
 
 /* F' and, when jac is given, its partials (overwriting the base model's partials). The base
  * model's parameter partials go to dp, untouched by the thermal factor (the caller applies it). */
+/* F' and, when jac is given, its partials (overwriting the base model's partials). The base
+ * model's parameter partials go to dp, untouched by the thermal factor (the caller applies it). */
 static double friction_full(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac,
                             tf_friction_param_partials *dp, double *F_base)
 {
     double lambda, dF;
     const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
-    double v = y[VE] - y[VP];
-    int nz = tf_friction_nstate(m->friction);
-    double F = tf_friction_eval(m->friction, p, v, y + NMECH, dz, jac, dp);
+    double v = relative_velocity(m, t, y);
+    int nz = nfric(m);
+    double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
     if (F_base) *F_base = F;
     if (lambda != 1.0) {
         F *= lambda;
@@ -110,59 +131,106 @@ void tf_model_state_scale(const tf_model *model, double *scale)
 {
     double p[TF_NPARAM];
     tf_model_params_at(model, tf_model_temperature(model, 0.0), p);
-    double X = fabs(model->T_em) * input_peak(&model->input) / model->k;
-    if (!(X > 0.0)) X = 1e-6;
-    double V = X * sqrt(model->k / model->m);
-    /* Friction can change over a velocity band far narrower than the stroke's velocity scale (the
-       offset form's smoothed sign, the Stribeck curve): resolve velocities to 1e-3 of that band,
-       otherwise the default atol lets the solver step across it (0.2 % error found by the
-       differential tests on the offset form). */
-    double band = V;
-    if (model->thermal == TF_THERMAL_MODEL_II && model->dF_form == TF_DF_OFFSET && p[TF_P_VSMOOTH] > 0.0)
-        band = p[TF_P_VSMOOTH];
-    if (p[TF_P_FS] != p[TF_P_FC] && p[TF_P_VS] > 0.0 && p[TF_P_VS] < band) band = p[TF_P_VS];
-    if (1e3 * band < V) V = 1e3 * band;
-    double Z = (p[TF_P_SIGMA0] > 0.0 && p[TF_P_FC] > 0.0) ? p[TF_P_FC] / p[TF_P_SIGMA0] : 1e-3 * X;
-    scale[XP] = scale[XE] = X;
-    scale[VP] = scale[VE] = V;
-    for (int j = 0; j < tf_friction_nstate(model->friction); j++) scale[NMECH + j] = Z;
+    const tf_waveform *w = &model->input;
+    double upeak = input_peak(w);
+    double period = (w->kind == TF_WAVE_SAWTOOTH || w->kind == TF_WAVE_SINE || w->kind == TF_WAVE_SQUARE)
+                        ? 1.0 / w->frequency : 1.0;
+    double Xs, Vs; /* motion scales of the driven body */
+    switch (model->plant) {
+    case TF_PLANT_STICK_SLIP:
+        Xs = fabs(model->T_em) * upeak / model->k;
+        if (!(Xs > 0.0)) Xs = 1e-6;
+        Vs = Xs * sqrt(model->k / model->m);
+        break;
+    case TF_PLANT_MASS: { /* the spring's pull speed, or the input force's and friction's acceleration */
+        double Fs = fmax(upeak, p[TF_P_FC]);
+        Vs = model->v_0 > 0.0 ? model->v_0 : Fs / model->m * period;
+        if (!(Vs > 0.0)) Vs = 1e-6;
+        Xs = Vs * period;
+        break;
+    }
+    default: /* prescribed: the motion itself */
+        Xs = upeak > 0.0 ? upeak : 1e-6;
+        Vs = Xs / period;
+    }
+    /* Friction can change over a velocity band far narrower than the motion's velocity scale (the
+       offset form's smoothed sign, the Stribeck curve, a smoothed static map): resolve velocities to
+       1e-3 of that band, otherwise the default atol lets the solver step across it (0.2 % error
+       found by the differential tests on the offset form). */
+    double band = Vs;
+    int static_map = model->friction == TF_FRICTION_COULOMB || model->friction == TF_FRICTION_STRIBECK;
+    if (((model->thermal == TF_THERMAL_MODEL_II && model->dF_form == TF_DF_OFFSET) || static_map) &&
+        p[TF_P_VSMOOTH] > 0.0)
+        band = fmin(band, p[TF_P_VSMOOTH]);
+    if (p[TF_P_FS] != p[TF_P_FC] && p[TF_P_VS] > 0.0) band = fmin(band, p[TF_P_VS]);
+    if (1e3 * band < Vs) Vs = 1e3 * band;
+    /* internal states: the presliding deflection fc/sigma0 (GMS: each element's force w_i fc) */
+    double Z = (p[TF_P_SIGMA0] > 0.0 && p[TF_P_FC] > 0.0) ? p[TF_P_FC] / p[TF_P_SIGMA0] : 1e-3 * Xs;
+    int nm = nmech(model), nz = nfric(model);
+    if (model->plant == TF_PLANT_STICK_SLIP) {
+        scale[XP] = scale[XE] = Xs;
+        scale[VP] = scale[VE] = Vs;
+    } else if (model->plant == TF_PLANT_MASS) {
+        /* positions down to the presliding deflection: a mass may only creep */
+        scale[X] = model->friction == TF_FRICTION_GMS || static_map ? Xs : fmin(Xs, Z);
+        scale[V] = Vs;
+    }
+    for (int j = 0; j < nz; j++)
+        scale[nm + j] = model->friction == TF_FRICTION_GMS ? p[TF_P_FC] * fmax(model->gms.w[j], 1e-3) : Z;
 }
 
 int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
-    double u = tf_waveform_value(&m->input, t);
-    double F = friction(m, t, y, dy + NMECH, 0);
-    dy[XP] = y[VP];
-    dy[VP] = (-m->c * y[VP] - m->k * y[XP] + m->T_em * u + F) / m->m;
-    dy[XE] = y[VE];
-    dy[VE] = -F / m->m_e;
+    int nm = nmech(m);
+    double F = friction(m, t, y, dy + nm, 0);
+    if (m->plant == TF_PLANT_STICK_SLIP) {
+        double u = tf_waveform_value(&m->input, t);
+        dy[XP] = y[VP];
+        dy[VP] = (-m->c * y[VP] - m->k * y[XP] + m->T_em * u + F) / m->m;
+        dy[XE] = y[VE];
+        dy[VE] = -F / m->m_e;
+    } else if (m->plant == TF_PLANT_MASS) {
+        double f = tf_waveform_value(&m->input, t) + m->k_s * (m->v_0 * t - y[X]);
+        dy[X] = y[V];
+        dy[V] = (f - F) / m->m;
+    }
     return 0;
 }
 
 int tf_model_jac(double t, const double *y, double *J, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
-    int n = tf_model_nstate(m), nz = n - NMECH;
+    int n = tf_model_nstate(m), nm = nmech(m), nz = n - nm;
     double dz[TF_MAX_FRICTION_STATES];
     tf_friction_partials d;
     friction(m, t, y, dz, &d);
     memset(J, 0, sizeof(double) * n * n);
 #define J_(i, j) J[(i) * n + (j)]
-    J_(XP, VP) = 1.0;
-    J_(VP, XP) = -m->k / m->m;
-    J_(VP, VP) = (-m->c - d.dF_dv) / m->m;
-    J_(VP, VE) = d.dF_dv / m->m;
-    J_(XE, VE) = 1.0;
-    J_(VE, VP) = d.dF_dv / m->m_e;
-    J_(VE, VE) = -d.dF_dv / m->m_e;
-    for (int j = 0; j < nz; j++) {
-        J_(VP, NMECH + j) = d.dF_dz[j] / m->m;
-        J_(VE, NMECH + j) = -d.dF_dz[j] / m->m_e;
-        J_(NMECH + j, VP) = -d.ddz_dv[j];
-        J_(NMECH + j, VE) = d.ddz_dv[j];
-        J_(NMECH + j, NMECH + j) = d.ddz_dz[j];
+    if (m->plant == TF_PLANT_STICK_SLIP) {
+        J_(XP, VP) = 1.0;
+        J_(VP, XP) = -m->k / m->m;
+        J_(VP, VP) = (-m->c - d.dF_dv) / m->m;
+        J_(VP, VE) = d.dF_dv / m->m;
+        J_(XE, VE) = 1.0;
+        J_(VE, VP) = d.dF_dv / m->m_e;
+        J_(VE, VE) = -d.dF_dv / m->m_e;
+        for (int j = 0; j < nz; j++) {
+            J_(VP, nm + j) = d.dF_dz[j] / m->m;
+            J_(VE, nm + j) = -d.dF_dz[j] / m->m_e;
+            J_(nm + j, VP) = -d.ddz_dv[j];
+            J_(nm + j, VE) = d.ddz_dv[j];
+        }
+    } else if (m->plant == TF_PLANT_MASS) {
+        J_(X, V) = 1.0;
+        J_(V, X) = -m->k_s / m->m;
+        J_(V, V) = -d.dF_dv / m->m;
+        for (int j = 0; j < nz; j++) {
+            J_(V, nm + j) = -d.dF_dz[j] / m->m;
+            J_(nm + j, V) = d.ddz_dv[j];
+        }
     }
+    for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d.ddz_dz[j];
 #undef J_
     return 0;
 }
@@ -170,7 +238,7 @@ int tf_model_jac(double t, const double *y, double *J, void *ctx)
 int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
                          const tf_target *targets, int np, double *fp)
 {
-    int n = tf_model_nstate(m), nz = n - NMECH;
+    int n = tf_model_nstate(m), nm = nmech(m), nz = n - nm;
     tf_model_rhs(t, y, dy, m);
     if (J) tf_model_jac(t, y, J, m);
     if (!np) return 0;
@@ -185,6 +253,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
     }
     int scale = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_SCALE;
     double Fref = tf_friction_reference_force(m->friction, m->p);
+    double v = relative_velocity(m, t, y);
     for (int k = 0; k < np; k++) {
         const tf_target *tg = &targets[k];
         double dF = 0.0, chain = 1.0; /* dF'/dtheta and d(param)/dtheta */
@@ -192,17 +261,21 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         if (tg->kind == TF_TARGET_DF) {
             double dlaw = tf_law_coef_derivative(&m->dF, tg->coef, T);
             if (scale) dF = Fb / Fref * dlaw;
-            else dF = dlaw * tanh((y[VE] - y[VP]) / m->cache_p[TF_P_VSMOOTH]);
+            else dF = dlaw * tanh(v / m->cache_p[TF_P_VSMOOTH]);
         } else {
             if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T);
             dF = chain * dp.dF_dp[i] * (scale ? lambda : 1.0);
             if (scale && i == TF_P_FC) dF -= (lambda - 1.0) / Fref * Fb; /* F_ref = fc; dF(T) = (lambda-1) F_ref */
         }
         for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
-        fp[VP * np + k] = dF / m->m;
-        fp[VE * np + k] = -dF / m->m_e;
+        if (m->plant == TF_PLANT_STICK_SLIP) {
+            fp[VP * np + k] = dF / m->m;
+            fp[VE * np + k] = -dF / m->m_e;
+        } else if (m->plant == TF_PLANT_MASS) {
+            fp[V * np + k] = -dF / m->m;
+        }
         if (tg->kind != TF_TARGET_DF)
-            for (int j = 0; j < nz; j++) fp[(NMECH + j) * np + k] = chain * dp.ddz_dp[j][i];
+            for (int j = 0; j < nz; j++) fp[(nm + j) * np + k] = chain * dp.ddz_dp[j][i];
     }
     return 0;
 }
@@ -215,18 +288,51 @@ double tf_model_next_corner(double t, void *ctx)
     return c;
 }
 
+int tf_model_nevent(const tf_model *model) { return tf_friction_nevent(model->friction, &model->gms); }
+
+void tf_model_events(double t, const double *y, double *g, void *ctx)
+{
+    tf_model *m = (tf_model *)ctx;
+    double lambda, dF;
+    const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
+    tf_friction_events(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m), g);
+}
+
+void tf_model_on_restart(double t, const double *y, void *ctx)
+{
+    tf_model *m = (tf_model *)ctx;
+    double lambda, dF;
+    const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
+    tf_friction_update_modes(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m));
+}
+
+tf_ode tf_model_ode(tf_model *model)
+{
+    tf_ode ode = {tf_model_nstate(model), model, tf_model_rhs, tf_model_jac, tf_model_next_corner,
+                  tf_model_nevent(model), tf_model_events, tf_model_on_restart};
+    if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
+    return ode;
+}
+
 void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
 {
-    int nz = tf_friction_nstate(model->friction);
+    int nm = nmech(model), nz = nfric(model);
+    double u = tf_waveform_value(&model->input, t);
     out[TF_OUT_TIME] = t;
-    out[TF_OUT_INPUT] = tf_waveform_value(&model->input, t);
-    out[TF_OUT_STAGE_DISPLACEMENT] = y[XP];
-    out[TF_OUT_STAGE_VELOCITY] = y[VP];
-    out[TF_OUT_DISPLACEMENT] = y[XE];
-    out[TF_OUT_VELOCITY] = y[VE];
-    out[TF_OUT_RELATIVE_DISPLACEMENT] = y[XE] - y[XP];
-    out[TF_OUT_RELATIVE_VELOCITY] = y[VE] - y[VP];
+    out[TF_OUT_INPUT] = u;
+    double xp = 0.0, vp = 0.0, x, v;
+    switch (model->plant) {
+    case TF_PLANT_STICK_SLIP: xp = y[XP]; vp = y[VP]; x = y[XE]; v = y[VE]; break;
+    case TF_PLANT_MASS: x = y[X]; v = y[V]; break;
+    default: x = u; v = tf_waveform_slope(&model->input, t);
+    }
+    out[TF_OUT_STAGE_DISPLACEMENT] = xp;
+    out[TF_OUT_STAGE_VELOCITY] = vp;
+    out[TF_OUT_DISPLACEMENT] = x;
+    out[TF_OUT_VELOCITY] = v;
+    out[TF_OUT_RELATIVE_DISPLACEMENT] = x - xp;
+    out[TF_OUT_RELATIVE_VELOCITY] = v - vp;
     out[TF_OUT_FRICTION_FORCE] = tf_model_friction(model, t, y);
     out[TF_OUT_TEMPERATURE] = tf_model_temperature(model, t);
-    for (int j = 0; j < nz; j++) out[TF_OUT_NFIXED + j] = y[NMECH + j];
+    for (int j = 0; j < nz; j++) out[TF_OUT_NFIXED + j] = y[nm + j];
 }

@@ -29,6 +29,7 @@ double tf_sensitivity_next_corner(double t, void *ctx)
 
 tf_ode tf_sensitivity_ode(tf_sensitivity_system *s)
 {
-    tf_ode ode = {tf_model_nstate(s->model) * (1 + s->np), s, tf_sensitivity_rhs, 0, tf_sensitivity_next_corner};
+    tf_ode ode = {.n = tf_model_nstate(s->model) * (1 + s->np), .ctx = s, .rhs = tf_sensitivity_rhs,
+                  .next_corner = tf_sensitivity_next_corner};
     return ode;
 }

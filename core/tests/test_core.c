@@ -184,7 +184,7 @@ static void test_lugre_steady_sliding(void)
     for (int i = 0; i < 4; i++) {
         double v = vs[i], g = tf_stribeck(p, v, 0);
         double z = (v > 0 ? g : -g) / p[TF_P_SIGMA0], dz;
-        double F = tf_friction_eval(TF_FRICTION_LUGRE, p, v, &z, &dz, 0, 0);
+        double F = tf_friction_eval(TF_FRICTION_LUGRE, p, 0, v, &z, &dz, 0, 0);
         CHECK(fabs(dz) < 1e-12 && fabs(F - ((v > 0 ? g : -g) + 0.4 * v)) < 1e-12, "LuGre steady sliding at v=%g", v);
     }
 }
@@ -242,7 +242,7 @@ static void test_frictionless_step_response(void)
     tf_model_state_scale(&m, atol);
     for (int i = 0; i < n; i++) atol[i] *= 1e-8;
     tf_model_initial_state(&m, y);
-    tf_ode ode = {n, &m, tf_model_rhs, tf_model_jac, tf_model_next_corner};
+    tf_ode ode = tf_model_ode(&m);
     long N = 201;
     double t[201], xp[201];
     for (int i = 0; i < N; i++) t[i] = 5e-3 * i / (N - 1);
@@ -273,7 +273,7 @@ static void test_grid_end_one_ulp_past_a_corner(void)
     double atol[5], y[5];
     tf_model_state_scale(&m, atol);
     for (int i = 0; i < 5; i++) atol[i] *= 1e-6;
-    tf_ode ode = {5, &m, tf_model_rhs, tf_model_jac, tf_model_next_corner};
+    tf_ode ode = tf_model_ode(&m);
     tf_solver_options opt = {TF_METHOD_DOPRI5, 1e-6, atol, 0, 0, 1000000};
     tf_solver_stats st;
     double corner = 3.0 / 5.0;

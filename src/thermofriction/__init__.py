@@ -1,6 +1,7 @@
 """thermofriction: temperature-aware friction models for precision motion systems.
 
-Simulate actuators with LuGre friction and thermal extensions (Li et al., Rev. Sci. Instrum. 80,
+Simulate actuators with LuGre (and Coulomb, Stribeck, Dahl, elasto-plastic, GMS) friction and thermal
+extensions (Li et al., Rev. Sci. Instrum. 80,
 045104, 2009) on a compiled C core::
 
     import thermofriction as tf
@@ -9,9 +10,11 @@ Simulate actuators with LuGre friction and thermal extensions (Li et al., Rev. S
     res.time, res.displacement, res.step_sizes
 """
 
-from .errors import ComputationError, ConditioningWarning, InputError, SolverError, TemperatureRangeWarning, ThermofrictionError
-from .models import (PARAMETERS, PRESETS, PWL, Const, Exp, Law, Linear, LuGre, Model, ModelI, ModelII, Poly,
-                     StickSlipPlant, Table, load_model)
+from .errors import (ComputationError, ConditioningWarning, InputError, SolverError, TemperatureRangeWarning,
+                     ThermofrictionError)
+from .models import (GMS, PARAMETERS, PRESETS, PWL, Const, Coulomb, Dahl, ElastoPlastic, Exp, Law, Linear, LuGre,
+                     MassPlant, Model, ModelI, ModelII, Poly, PrescribedMotion, StickSlipPlant, Stribeck, Table,
+                     load_model)
 from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
 from .waveforms import Sampled, Sawtooth, Sine, Square, Step, Waveform, parse_waveform
 from .identify import FitResult, Parameter, Parameters, identify
@@ -22,9 +25,12 @@ from .report import report
 __version__ = "0.1.0"
 
 __all__ = [
-    "ComputationError", "ConditioningWarning", "InputError", "SolverError", "TemperatureRangeWarning", "ThermofrictionError",
-    "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "LuGre", "Model", "ModelI", "ModelII", "Poly",
-    "StickSlipPlant", "Table", "load_model",
+    "ComputationError", "ConditioningWarning", "InputError", "SolverError", "TemperatureRangeWarning",
+    "ThermofrictionError",
+    "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "Model", "ModelI", "ModelII", "Poly", "Table",
+    "load_model",
+    "StickSlipPlant", "MassPlant", "PrescribedMotion",
+    "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
     "AutoSwitch", "Dopri5", "Rodas4", "SimulationResult", "StepSizeController", "simulate",
     "Sampled", "Sawtooth", "Sine", "Square", "Step", "Waveform", "parse_waveform",
     "FitResult", "Parameter", "Parameters", "identify",

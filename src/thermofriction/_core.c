@@ -6,6 +6,7 @@
 
 #include <math.h>
 #include <string.h>
+#include <time.h>
 
 #include "thermofriction.h"
 
@@ -115,7 +116,34 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
         get_int(spec, "dF_form", &m->dF_form) || get_double(spec, "T_const", &m->T_const) ||
         get_int(spec, "fs_follows_fc", &m->fs_follows_fc))
         return -1;
-    if (tf_friction_nstate(m->friction) < 0) { PyErr_SetString(PyExc_ValueError, "unknown friction model"); return -1; }
+    PyObject *gk = PyDict_GetItemString(spec, "gms_k"), *gw = PyDict_GetItemString(spec, "gms_w");
+    if (gk && gk != Py_None) {
+        Py_ssize_t nk, nw;
+        const double *k = get_array(a, gk, &nk, "gms_k");
+        if (PyErr_Occurred()) return -1;
+        const double *w = get_array(a, gw, &nw, "gms_w");
+        if (PyErr_Occurred()) return -1;
+        if (nk != nw || nk < 1 || nk > TF_MAX_FRICTION_STATES) {
+            PyErr_Format(PyExc_ValueError, "gms_k and gms_w must have the same length, 1..%d", TF_MAX_FRICTION_STATES);
+            return -1;
+        }
+        m->gms.n = (int)nk;
+        memcpy(m->gms.k, k, sizeof(double) * nk);
+        memcpy(m->gms.w, w, sizeof(double) * nk);
+        PyObject *gm = PyDict_GetItemString(spec, "gms_mode"); /* optional: tests set the modes */
+        if (gm && gm != Py_None) {
+            Py_ssize_t nm;
+            const double *mode = get_array(a, gm, &nm, "gms_mode");
+            if (PyErr_Occurred()) return -1;
+            if (nm != nk) { PyErr_SetString(PyExc_ValueError, "gms_mode must have one value per element"); return -1; }
+            for (Py_ssize_t i = 0; i < nk; i++) m->gms.mode[i] = (mode[i] > 0) - (mode[i] < 0);
+        }
+    }
+    if (get_double(spec, "k_s", &m->k_s) || get_double(spec, "v_0", &m->v_0)) return -1;
+    if (tf_friction_nstate(m->friction, m->gms.n) < 0) {
+        PyErr_SetString(PyExc_ValueError, "unknown friction model");
+        return -1;
+    }
     Py_ssize_t np;
     const double *p = get_array(a, PyDict_GetItemString(spec, "params"), &np, "params");
     if (PyErr_Occurred()) return -1;
@@ -205,7 +233,7 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     }
     double y[TF_MAX_FRICTION_STATES + 8];
     tf_model_initial_state(&m, y);
-    tf_ode ode = {n, &m, tf_model_rhs, tf_model_jac, tf_model_next_corner};
+    tf_ode ode = tf_model_ode(&m);
     tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps};
     tf_solver_stats st;
     emit_ctx ec = {&m, (double *)outv.buf, nch};
@@ -217,9 +245,10 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
         raise_solver_error(status, &st, y, n);
         goto done;
     }
-    result = Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:i,s:d}", "steps", st.steps, "rejected", st.rejected,
+    result = Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:i,s:d,s:l}", "steps", st.steps, "rejected", st.rejected,
                            "rhs_evals", st.rhs_evals, "jac_evals", st.jac_evals, "decompositions",
-                           st.decompositions, "method", st.method_used, "switch_time", st.switch_time);
+                           st.decompositions, "method", st.method_used, "switch_time", st.switch_time,
+                           "events", st.events);
 done:
     if (have_out) PyBuffer_Release(&outv);
     arena_free(&a);
@@ -355,6 +384,39 @@ done:
     return result;
 }
 
+/* time_rhs(spec, t, y, n_evals) -> seconds per right-hand-side evaluation, timed in C (benchmarks) */
+static PyObject *py_time_rhs(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *y_obj;
+    double t;
+    long n_evals;
+    if (!PyArg_ParseTuple(args, "OdOl", &spec, &t, &y_obj, &n_evals)) return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    if (parse_model(&a, spec, &m)) goto done;
+    int n = tf_model_nstate(&m);
+    Py_ssize_t ny;
+    const double *y = get_array(&a, y_obj, &ny, "y");
+    if (PyErr_Occurred()) goto done;
+    if (ny != n || n_evals < 1) { PyErr_Format(PyExc_ValueError, "y must have %d values, n_evals >= 1", n); goto done; }
+    double dy[TF_MAX_FRICTION_STATES + 8], sink = 0.0;
+    struct timespec t0, t1;
+    Py_BEGIN_ALLOW_THREADS
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (long i = 0; i < n_evals; i++) {
+        tf_model_rhs(t + 1e-12 * (double)(i & 1023), y, dy, &m);
+        sink += dy[n - 1];
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    Py_END_ALLOW_THREADS
+    double secs = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    result = Py_BuildValue("(dd)", secs / (double)n_evals, sink);
+done:
+    arena_free(&a);
+    return result;
+}
+
 /* law_eval(law, T, value_out, slope_out) */
 static PyObject *py_law_eval(PyObject *self, PyObject *args)
 {
@@ -441,22 +503,15 @@ static PyObject *py_state_scale(PyObject *self, PyObject *args)
     return result;
 }
 
-static PyObject *py_nstate(PyObject *self, PyObject *args)
-{
-    int kind;
-    if (!PyArg_ParseTuple(args, "i", &kind)) return NULL;
-    return PyLong_FromLong(tf_friction_nstate(kind));
-}
-
 static PyMethodDef methods[] = {
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
     {"simulate_sensitivities", py_simulate_sensitivities, METH_VARARGS,
      "Integrate a model and its forward sensitivities to the given targets."},
     {"rhs_jac", py_rhs_jac, METH_VARARGS, "Right-hand side and Jacobian at one state; returns the friction force."},
+    {"time_rhs", py_time_rhs, METH_VARARGS, "Seconds per right-hand-side evaluation, timed in C (benchmarks)."},
     {"law_eval", py_law_eval, METH_VARARGS, "Evaluate a temperature law and its slope on an array of T."},
     {"waveform_eval", py_waveform_eval, METH_VARARGS, "Evaluate a waveform on an array of t; returns its corners."},
     {"state_scale", py_state_scale, METH_VARARGS, "Characteristic magnitude of each state."},
-    {"friction_nstate", py_nstate, METH_VARARGS, "Number of internal states of a friction model."},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_core", "thermofriction C core binding", -1, methods};

@@ -291,11 +291,7 @@ class StickSlipPlant:
     @classmethod
     def from_dict(cls, d: dict, where="[plant]"):
         d = dict(d)
-        kind = d.pop("type", None)
-        if kind != "stick-slip":
-            if kind in ("mass", "prescribed"):
-                raise InputError(f"{where}: plant type '{kind}' is not available yet (only 'stick-slip')")
-            raise InputError(f"{where}: 'type' must be \"stick-slip\", got {kind!r}")
+        d.pop("type", None)
         names = {sym: name for name, sym in cls._SYMBOLS.items()}
         unknown = set(d) - set(names)
         if unknown:
@@ -306,18 +302,137 @@ class StickSlipPlant:
         return cls(**{names[k]: v for k, v in d.items()})
 
 
+@dataclass(frozen=True)
+class MassPlant:
+    """Single-mass stage (SPEC 3.2): ``m x'' = f(t) + k_s (v_0 t - x) - F``, v_r = x'.
+
+    f(t) is the input waveform, a force [N] (none: zero). With ``spring_stiffness`` k_s [N/m] and
+    ``pull_velocity`` v_0 [m/s] a spring pulled at constant speed drives the mass (the stick-slip
+    benchmark of Canudas de Wit et al. 1995); both forces add when both are given."""
+
+    mass: float
+    spring_stiffness: float = 0.0
+    pull_velocity: float = 0.0
+
+    type = "mass"
+    _SYMBOLS = {"mass": "m", "spring_stiffness": "k_s", "pull_velocity": "v_0"}
+
+    def __post_init__(self):
+        for name, sym in self._SYMBOLS.items():
+            v = _num(getattr(self, name), "[plant]", sym)
+            if name == "mass" and v <= 0:
+                raise InputError(f"[plant]: 'm' must be positive, got {v!r}")
+            if name == "spring_stiffness" and v < 0:
+                raise InputError(f"[plant]: 'k_s' must not be negative, got {v!r}")
+            object.__setattr__(self, name, v)
+        if self.pull_velocity != 0 and self.spring_stiffness == 0:
+            raise InputError("[plant]: 'v_0' pulls through a spring: give 'k_s' too")
+
+    def to_dict(self) -> dict:
+        d = {"type": self.type, "m": self.mass}
+        if self.spring_stiffness:
+            d.update(k_s=self.spring_stiffness, v_0=self.pull_velocity)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[plant]"):
+        d = dict(d)
+        d.pop("type", None)
+        names = {sym: name for name, sym in cls._SYMBOLS.items()}
+        unknown = set(d) - set(names)
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, ['type', *names], 'a mass plant')}")
+        if "m" not in d:
+            raise InputError(f"{where}: missing 'm'")
+        return cls(**{names[k]: v for k, v in d.items()})
+
+
+@dataclass(frozen=True)
+class PrescribedMotion:
+    """Prescribed motion (SPEC 3.3): the relative displacement x_r(t) is the input waveform [m]
+    and v_r its slope; the friction model is driven by it (hysteresis loops, Stribeck curves,
+    break-away tests). The waveform must be continuous (a step needs a slew time)."""
+
+    type = "prescribed"
+
+    def to_dict(self) -> dict:
+        return {"type": self.type}
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[plant]"):
+        unknown = set(d) - {"type"}
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, ['type'], 'prescribed motion')}")
+        return cls()
+
+
+PLANTS = {"stick-slip": StickSlipPlant, "mass": MassPlant, "prescribed": PrescribedMotion}
+PLANT_CODES = {"stick-slip": 0, "mass": 1, "prescribed": 2}
+
+
+def plant_from_dict(d: dict, where="[plant]"):
+    kind = d.get("type")
+    if kind not in PLANTS:
+        raise InputError(f"{where}: 'type' must be one of {', '.join(repr(k) for k in PLANTS)}, got {kind!r}")
+    return PLANTS[kind].from_dict(d, where)
+
+
 # ---------------------------------------------------------------------------------------------
 # Friction models
 # ---------------------------------------------------------------------------------------------
 
 #: Parameter order of the C core (friction.h, tf_param).
-PARAMETERS = ("sigma0", "sigma1", "sigma2", "fc", "fs", "vs", "delta", "vd", "v_smooth", "z_ba")
+PARAMETERS = ("sigma0", "sigma1", "sigma2", "fc", "fs", "vs", "delta", "vd", "v_smooth", "z_ba", "C")
 PARAMETER_UNITS = {"sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m", "fc": "N", "fs": "N", "vs": "m/s",
-                   "delta": "-", "vd": "m/s", "v_smooth": "m/s", "z_ba": "m"}
+                   "delta": "-", "vd": "m/s", "v_smooth": "m/s", "z_ba": "m", "C": "N/s"}
+
+
+class _Friction:
+    """What every friction model shares: parameters as dataclass fields (None where a Model I law
+    gives the value), ``values()``, the file form, and the state layout."""
+
+    model = ""
+    core_code = -1
+    required: tuple = ()
+    nstate = 0
+    state_names: tuple = ()
+    state_units: tuple = ()
+    #: parameters that are arrays, not numbers (never a law of temperature)
+    arrays: tuple = ()
+
+    def values(self) -> dict:
+        """Parameters given as numbers (None-valued ones omitted)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+
+    def to_dict(self) -> dict:
+        d = {"model": self.model}
+        for k, v in self.values().items():
+            d[k] = [float(x) for x in v] if k in self.arrays else v
+        return d
+
+    def with_values(self, **values):
+        return replace(self, **values)
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[friction]"):
+        d = dict(d)
+        d.pop("model", None)
+        allowed = [f.name for f in fields(cls)]
+        unknown = set(d) - set(allowed)
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, ['model', *allowed], cls.model)}")
+        for k, v in d.items():
+            d[k] = tuple(_num_array(v, where, k)) if k in cls.arrays else _num(v, where, k)
+        for k in cls.arrays:
+            if k not in d:
+                raise InputError(f"{where}: missing '{k}' (an array, one value per element)")
+        kw = {k: d.get(k) for k in cls.required}
+        kw.update({k: v for k, v in d.items() if k not in cls.required})
+        return cls(**kw)
 
 
 @dataclass(frozen=True)
-class LuGre:
+class LuGre(_Friction):
     """LuGre friction (Canudas de Wit et al. 1995), SPEC 4::
 
         z' = v - sigma0 |v| z / g(v),   F = sigma0 z + sigma1(v) z' + sigma2 v
@@ -345,35 +460,138 @@ class LuGre:
     state_units = ("m",)
     required = ("sigma0", "sigma1", "fc")
 
-    def values(self) -> dict:
-        """Parameters given as numbers (None-valued ones omitted)."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
 
-    def to_dict(self) -> dict:
-        d = {"model": self.model}
-        d.update(self.values())
-        return d
+@dataclass(frozen=True)
+class Coulomb(_Friction):
+    """Coulomb + viscous friction, a static map: ``F = fc s(v) + sigma2 v`` with the sign smoothed
+    over ``v_smooth`` [m/s], ``s(v) = tanh(v / v_smooth)`` (no sticking: below v_smooth the
+    force is viscous-like, fc/v_smooth N s/m)."""
 
-    def with_values(self, **values) -> "LuGre":
-        return replace(self, **values)
+    fc: float | None
+    sigma2: float | None = 0.0
+    v_smooth: float | None = 1e-6
 
-    @classmethod
-    def from_dict(cls, d: dict, where="[friction]"):
-        d = dict(d)
-        d.pop("model", None)
-        allowed = [f.name for f in fields(cls)]
-        unknown = set(d) - set(allowed)
-        if unknown:
-            raise InputError(f"{where}: {unknown_keys(unknown, ['model', *allowed], 'lugre')}")
-        for k, v in d.items():
-            d[k] = _num(v, where, k)
-        kw = {k: d.get(k) for k in cls.required}
-        kw.update({k: v for k, v in d.items() if k not in cls.required})
-        return cls(**kw)
+    model = "coulomb"
+    core_code = 1
+    required = ("fc",)
 
 
-FRICTION_MODELS = {"lugre": LuGre}
-_NOT_YET = ("coulomb", "stribeck", "dahl", "elastoplastic", "gms")
+@dataclass(frozen=True)
+class Stribeck(_Friction):
+    """Static Stribeck map: ``F = g(v) s(v) + sigma2 v``, g the Stribeck curve of SPEC 4 and
+    ``s(v) = tanh(v / v_smooth)``."""
+
+    fc: float | None
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    sigma2: float | None = 0.0
+    v_smooth: float | None = 1e-6
+
+    model = "stribeck"
+    core_code = 2
+    required = ("fc",)
+
+
+@dataclass(frozen=True)
+class Dahl(_Friction):
+    """Dahl (1968): ``z' = v - sigma0 |v| z / fc``, ``F = sigma0 z`` -- presliding hysteresis
+    with a Coulomb level, no Stribeck effect, no viscous term."""
+
+    sigma0: float | None
+    fc: float | None
+    v_smooth: float | None = 1e-6
+
+    model = "dahl"
+    core_code = 3
+    nstate = 1
+    state_names = ("z",)
+    state_units = ("m",)
+    required = ("sigma0", "fc")
+
+
+@dataclass(frozen=True)
+class ElastoPlastic(_Friction):
+    """Elasto-plastic friction (Dupont, Hayward, Armstrong and Altpeter 2002): LuGre with
+    ``z' = v - alpha(z, v) sigma0 |v| z / g(v)``. alpha is 0 for |z| <= z_ba (and whenever z
+    opposes v: purely elastic, so small oscillating forces cause no drift), 1 from the steady
+    deflection g(v)/sigma0 on, and a half sine between. Needs 0 <= z_ba < fc/sigma0."""
+
+    sigma0: float | None
+    sigma1: float | None
+    fc: float | None
+    z_ba: float | None
+    sigma2: float | None = 0.0
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    vd: float | None = None
+    v_smooth: float | None = 1e-6
+
+    model = "elastoplastic"
+    core_code = 4
+    nstate = 1
+    state_names = ("z",)
+    state_units = ("m",)
+    required = ("sigma0", "sigma1", "fc", "z_ba")
+
+
+@dataclass(frozen=True)
+class GMS(_Friction):
+    """Generalized Maxwell-slip (Al-Bender, Lampaert and Swevers 2005): N elementary blocks with
+    stiffnesses ``k`` [N/m] and capacity fractions ``w`` (summing to one), ``F = sum F_i + sigma2 v``.
+
+    A stuck element follows the motion, ``F_i' = k_i v``, until |F_i| reaches its capacity
+    ``w_i g(v)``; then it slips, ``F_i' = C (sgn(v) w_i - F_i / g(v))`` (rate ``C`` [N/s]), until
+    the motion reverses and it sticks again. The switches are events the integrator locates and
+    restarts at -- no regularisation -- so presliding hysteresis keeps its return-point memory.
+    (SPEC 4 prints the slip law as ``sgn(v) C (w_i - F_i/g)``; that is the same for v > 0 and
+    unstable for v < 0, so the sign is applied to the capacity instead.)"""
+
+    k: tuple
+    w: tuple
+    C: float | None
+    fc: float | None
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    sigma2: float | None = 0.0
+    v_smooth: float | None = 1e-6
+
+    model = "gms"
+    core_code = 5
+    required = ("k", "w", "C", "fc")
+    arrays = ("k", "w")
+    _MAX_ELEMENTS = 64
+
+    def __post_init__(self):
+        k, w = tuple(float(x) for x in self.k), tuple(float(x) for x in self.w)
+        if len(k) != len(w) or not 1 <= len(k) <= self._MAX_ELEMENTS:
+            raise InputError(f"[friction]: 'k' and 'w' must have the same length, 1 to {self._MAX_ELEMENTS} "
+                             f"elements (got {len(k)} and {len(w)})")
+        for name, arr in (("k", k), ("w", w)):
+            for i, x in enumerate(arr):
+                if not (math.isfinite(x) and x > 0):
+                    raise InputError(f"[friction]: '{name}[{i}]' must be positive, got {x!r}")
+        if abs(sum(w) - 1.0) > 1e-9:
+            raise InputError(f"[friction]: the GMS weights 'w' must sum to one, got {sum(w):.12g}")
+        object.__setattr__(self, "k", k)
+        object.__setattr__(self, "w", w)
+
+    @property
+    def nstate(self):
+        return len(self.k)
+
+    @property
+    def state_names(self):
+        return tuple(f"F_{i + 1}" for i in range(len(self.k)))
+
+    @property
+    def state_units(self):
+        return ("N",) * len(self.k)
+
+
+FRICTION_MODELS = {cls.model: cls for cls in (LuGre, Coulomb, Stribeck, Dahl, ElastoPlastic, GMS)}
 
 
 def check_friction_values(values: dict, where: str):
@@ -389,7 +607,13 @@ def check_friction_values(values: dict, where: str):
     need("delta", lambda v: v > 0, "positive")
     need("vd", lambda v: v > 0, "positive")
     need("v_smooth", lambda v: v > 0, "positive")
-    fs, fc = values.get("fs"), values.get("fc")
+    need("C", lambda v: v > 0, "positive")
+    need("z_ba", lambda v: v >= 0, "non-negative")
+    z_ba, sigma0, fc = values.get("z_ba"), values.get("sigma0"), values.get("fc")
+    if z_ba is not None and sigma0 and fc and not z_ba < fc / sigma0:
+        raise InputError(f"{where}: 'z_ba' ({z_ba!r} m) must be below the steady deflection fc/sigma0 "
+                         f"({fc / sigma0:.6g} m): the elasto-plastic model breaks away before it")
+    fs = values.get("fs")
     if fs is not None and fc is not None and fs < fc:
         raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r})")
     if fs is not None and fc is not None and fs != fc:
@@ -443,8 +667,8 @@ class ModelII:
 class Model:
     """One actuator: plant, friction model, thermal extension (or None) and input (or None)."""
 
-    plant: StickSlipPlant
-    friction: LuGre
+    plant: StickSlipPlant | MassPlant | PrescribedMotion
+    friction: LuGre | Coulomb | Stribeck | Dahl | ElastoPlastic | GMS
     thermal: ModelI | ModelII | None = None
     input: Waveform | None = None
     name: str | None = None
@@ -552,10 +776,8 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
         for sec in ("plant", "friction"):
             if not isinstance(d.get(sec), dict):
                 raise InputError(f"missing section [{sec}]")
-        plant = StickSlipPlant.from_dict(d["plant"])
+        plant = plant_from_dict(d["plant"])
         fmodel = d["friction"].get("model")
-        if fmodel in _NOT_YET:
-            raise InputError(f"[friction]: model '{fmodel}' is not available yet (only 'lugre')")
         if fmodel not in FRICTION_MODELS:
             raise InputError(f"[friction]: 'model' must be one of {', '.join(FRICTION_MODELS)}, got {fmodel!r}")
         th = d.get("thermal", {"model": "none"})
@@ -627,5 +849,6 @@ def load_model(source) -> Model:
     return model_from_dict(data, source, base_dir)
 
 
-__all__ = ["Law", "Const", "Linear", "Exp", "Poly", "PWL", "Table", "law_from_dict", "StickSlipPlant", "LuGre",
+__all__ = ["Law", "Const", "Linear", "Exp", "Poly", "PWL", "Table", "law_from_dict", "StickSlipPlant", "MassPlant",
+           "PrescribedMotion", "plant_from_dict", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
            "ModelI", "ModelII", "Model", "load_model", "model_from_dict", "PARAMETERS", "PRESETS"]

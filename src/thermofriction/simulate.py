@@ -16,8 +16,9 @@ import numpy as np
 from . import _core
 from ._io import atomic_write
 from .errors import ConditioningWarning, InputError, SolverError, TemperatureRangeWarning
-from .models import PARAMETERS, Model, ModelI, ModelII, check_friction_values
-from .waveforms import Sampled, Waveform, Zero
+from .models import (GMS, PARAMETERS, PLANT_CODES, MassPlant, Model, ModelI, ModelII, PrescribedMotion, StickSlipPlant,
+                     check_friction_values)
+from .waveforms import Sampled, Sawtooth, Step, Waveform, Zero
 
 # ---------------------------------------------------------------------------------------------
 # Solvers and the step-size controller
@@ -87,16 +88,17 @@ _CHANNELS = ("time", "input", "stage_displacement", "stage_velocity", "displacem
 class SimulationResult:
     """Plain arrays with named fields (SI units; temperature in degC).
 
-    ``displacement``/``velocity`` are the driven body's (the end effector's);
-    ``relative_displacement`` is x_e - x_p; ``states`` holds the friction model's internal
+    ``displacement``/``velocity`` are the driven body's (the end effector's, the mass's, or the
+    prescribed motion); ``relative_displacement`` is x_e - x_p (the stage fields are None for
+    plants without a stage); ``states`` holds the friction model's internal
     states (columns named by ``state_names``). For periodic inputs ``cycle_times`` are the
     period starts, ``step_sizes[k]`` the displacement over cycle k, ``mean_velocity`` the mean
     of the step sizes times the frequency."""
 
     time: np.ndarray
     input: np.ndarray
-    stage_displacement: np.ndarray
-    stage_velocity: np.ndarray
+    stage_displacement: np.ndarray | None
+    stage_velocity: np.ndarray | None
     displacement: np.ndarray
     velocity: np.ndarray
     relative_displacement: np.ndarray
@@ -117,7 +119,7 @@ class SimulationResult:
         cols = {
             "time[s]": self.time,
             f"input[{self.input_unit}]": self.input,
-            "stage_displacement[m]": self.stage_displacement,
+            "stage_displacement[m]": self.stage_displacement,  # stick-slip only (SPEC 7)
             "displacement[m]": self.displacement,
             "velocity[m/s]": self.velocity,
             "friction_force[N]": self.friction_force,
@@ -125,7 +127,7 @@ class SimulationResult:
         }
         for j, (name, unit) in enumerate(zip(self.state_names, self.state_units)):
             cols[f"{name}[{unit}]"] = self.states[:, j]
-        return cols
+        return {k: v for k, v in cols.items() if v is not None}
 
     def to_dataframe(self):
         """A pandas DataFrame of every output (pandas is an optional dependency)."""
@@ -133,7 +135,7 @@ class SimulationResult:
             import pandas as pd
         except ImportError:  # pragma: no cover - depends on the environment
             raise ImportError("to_dataframe() needs pandas: pip install 'thermofriction[dataframe]'") from None
-        data = {name: getattr(self, name) for name in _CHANNELS}
+        data = {name: getattr(self, name) for name in _CHANNELS if getattr(self, name) is not None}
         for j, name in enumerate(self.state_names):
             data[name] = self.states[:, j]
         return pd.DataFrame(data)
@@ -169,8 +171,15 @@ class SimulationResult:
 
 def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> dict:
     """The dict the binding unpacks into a tf_model (see _core.c)."""
-    c, k, T_em = model.plant.physical()
-    values = model.friction.values()
+    plant = model.plant
+    c = k = T_em = m_e = k_s = v_0 = 0.0
+    m = 1.0
+    if isinstance(plant, StickSlipPlant):
+        c, k, T_em = plant.physical()
+        m, m_e = plant.mass, plant.end_effector_mass
+    elif isinstance(plant, MassPlant):
+        m, k_s, v_0 = plant.mass, plant.spring_stiffness, plant.pull_velocity
+    values = {k_: v for k_, v in model.friction.values().items() if k_ not in model.friction.arrays}
     values.setdefault("fs", values.get("fc", 0.0))
     values.setdefault("vs", 1e-3)
     params = np.zeros(len(PARAMETERS))
@@ -187,8 +196,10 @@ def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> 
         T_const = float(temperature)
     waveform = input if input is not None else (model.input or Zero())
     return {
-        "plant": 0, "m": model.plant.mass, "c": c, "k": k, "T_em": T_em, "m_e": model.plant.end_effector_mass,
+        "plant": PLANT_CODES[plant.type], "m": m, "c": c, "k": k, "T_em": T_em, "m_e": m_e, "k_s": k_s, "v_0": v_0,
         "friction": model.friction.core_code, "params": params,
+        "gms_k": np.array(model.friction.k, float) if isinstance(model.friction, GMS) else None,
+        "gms_w": np.array(model.friction.w, float) if isinstance(model.friction, GMS) else None,
         "fs_follows_fc": int(model.friction.fs is None and "fs" not in model.laws),
         "thermal": 1 if isinstance(model.thermal, ModelI) else 2 if isinstance(model.thermal, ModelII) else 0,
         "laws": laws,
@@ -211,6 +222,21 @@ def as_temperature(temperature):
     if not math.isfinite(T):
         raise InputError(f"temperature must be finite, got {temperature!r}")
     return T
+
+
+#: The plant's mechanical states, before the friction model's (C core order).
+MECHANICAL_STATES = {"stick-slip": ("x_p", "v_p", "x_e", "v_e"), "mass": ("x", "v"), "prescribed": ()}
+
+
+def check_prescribed_motion(waveform: Waveform):
+    """Prescribed motion needs a continuous displacement: its slope is the sliding velocity."""
+    if isinstance(waveform, Zero):
+        raise InputError("prescribed motion needs an input waveform, the displacement x_r(t) in metres "
+                         "(e.g. --input sine:amplitude=1e-6,frequency=1)")
+    if isinstance(waveform, Step) and waveform.slew <= 0:
+        raise InputError("prescribed motion: an ideal step has no finite velocity; give the step a slew time")
+    if isinstance(waveform, Sawtooth) and waveform.rise in (0.0, 1.0):
+        raise InputError("prescribed motion: a sawtooth with rise 0 or 1 jumps; use 0 < rise < 1")
 
 
 def check_temperatures(model: Model, temperature):
@@ -326,7 +352,10 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     hit = np.abs(t_grid[on_grid_at] - cycle_times) <= tol
     extra = cycle_times[~hit]
     t_all = np.insert(t_grid, np.searchsorted(t_grid, extra), extra) if extra.size else t_grid
-    nstate = 4 + model.friction.nstate
+    if isinstance(model.plant, PrescribedMotion):
+        check_prescribed_motion(waveform)
+    nmech = MECHANICAL_STATES[model.plant.type]
+    nstate = len(nmech) + model.friction.nstate
     nch = _core.NFIXED_OUTPUTS + model.friction.nstate
     out = np.empty((t_all.size, nch))
     atol = controller.atol
@@ -341,7 +370,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
                                int(controller.max_steps))
     except _core.SolverError as e:
         message, status, t_fail, h_fail, state, stiff = e.args
-        names = ("x_p", "v_p", "x_e", "v_e") + tuple(model.friction.state_names)
+        names = nmech + tuple(model.friction.state_names)
         where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, state))
         hint = ""
         if status == 3:
@@ -363,6 +392,8 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         x_cycles = np.empty(0)
     steps = np.diff(x_cycles)
     cols = {name: np.ascontiguousarray(out[:, i]) for i, name in enumerate(_CHANNELS)}
+    if not isinstance(model.plant, StickSlipPlant):  # no stage: the driving surface is fixed (or the motion given)
+        cols["stage_displacement"] = cols["stage_velocity"] = None
     if temperature is None:
         cols["temperature"][:] = math.nan
     return SimulationResult(
@@ -373,6 +404,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         cycle_times=cycle_times,
         step_sizes=steps,
         mean_velocity=float(steps.mean() / period) if steps.size else math.nan,
+        input_unit={"stick-slip": "V", "mass": "N", "prescribed": "m"}[model.plant.type],
         stats=stats,
     )
 

@@ -21,14 +21,31 @@ typedef enum {
     TF_P_VD,         /* sigma1 velocity scale [m/s]; <= 0: sigma1 constant */
     TF_P_VSMOOTH,    /* velocity band of smoothed signs [m/s] */
     TF_P_ZBA,        /* elasto-plastic break-away deflection [m] */
+    TF_P_C,          /* GMS: rate at which a slipping element's force approaches its capacity [N/s] */
     TF_NPARAM
 } tf_param;
 
 typedef enum {
-    TF_FRICTION_LUGRE = 0
+    TF_FRICTION_LUGRE = 0,         /* z' = v - sigma0 |v| z / g(v); F = sigma0 z + sigma1(v) z' + sigma2 v */
+    TF_FRICTION_COULOMB = 1,       /* F = fc s(v) + sigma2 v; s = tanh(v / v_smooth) */
+    TF_FRICTION_STRIBECK = 2,      /* F = g(v) s(v) + sigma2 v */
+    TF_FRICTION_DAHL = 3,          /* z' = v - sigma0 |v| z / fc; F = sigma0 z */
+    TF_FRICTION_ELASTOPLASTIC = 4, /* LuGre with alpha(z, v) on the relaxation term (Dupont et al. 2002) */
+    TF_FRICTION_GMS = 5            /* N Maxwell-slip elements, each stuck or slipping (Al-Bender et al. 2005) */
 } tf_friction_kind;
 
 #define TF_MAX_FRICTION_STATES 64
+
+/* The elements of a Generalized Maxwell-slip model: stiffness k_i [N/m], capacity fraction w_i
+ * (sum 1) and mode: 0 stuck (F_i' = k_i v), +1 or -1 slipping that way
+ * (F_i' = C (mode w_i - F_i / g(v))). The mode is a discrete state: the integrator changes it
+ * only at located events (tf_friction_events) and restarts, so no step straddles a switch. */
+typedef struct {
+    int n;
+    double k[TF_MAX_FRICTION_STATES];
+    double w[TF_MAX_FRICTION_STATES];
+    int mode[TF_MAX_FRICTION_STATES];
+} tf_gms_elements;
 
 /* Partial derivatives of one evaluation. State coupling is diagonal for every model
  * (each state's rate depends on v and on that state only), so dzdot/dz is a vector. */
@@ -45,15 +62,25 @@ typedef struct {
     double ddz_dp[TF_MAX_FRICTION_STATES][TF_NPARAM];
 } tf_friction_param_partials;
 
-int tf_friction_nstate(int kind);
-/* Steady sliding friction level used by Model II's scale form (fc for LuGre). */
+/* Number of internal states (n_elements is read for GMS only); -1 for an unknown kind. */
+int tf_friction_nstate(int kind, int n_elements);
+/* Steady sliding friction level used by Model II's scale form: fc for every model (GMS: the
+ * element capacities w_i g(v) sum to g(v) -> fc). */
 double tf_friction_reference_force(int kind, const double *p);
 /* Stribeck curve g(v) = fc + (fs - fc) exp(-|v/vs|^delta), and dg/dv in *dg when not NULL. */
 double tf_stribeck(const double *p, double v, double *dg);
 /* Force and state rates; state partials when jac is not NULL, parameter partials when dp
- * is not NULL. */
-double tf_friction_eval(int kind, const double *p, double v, const double *z, double *dz,
-                        tf_friction_partials *jac, tf_friction_param_partials *dp);
+ * is not NULL (LuGre only: others report zeros). gms is read for TF_FRICTION_GMS only. */
+double tf_friction_eval(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
+                        double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
+
+/* Discrete modes (GMS). Event functions cross zero upwards where a mode must change: a stuck
+ * element when |F_i| reaches w_i g(v), a slipping one when v reverses. tf_friction_update_modes
+ * sets every mode consistent with (v, z): called at every restart of the integration. */
+int tf_friction_nevent(int kind, const tf_gms_elements *gms);
+void tf_friction_events(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
+                        double *g);
+void tf_friction_update_modes(int kind, const double *p, tf_gms_elements *gms, double v, const double *z);
 
 #ifdef __cplusplus
 }

@@ -14,6 +14,13 @@ typedef struct {
     int (*rhs)(double t, const double *y, double *dy, void *ctx);
     int (*jac)(double t, const double *y, double *J, void *ctx); /* row-major n x n */
     double (*next_corner)(double t, void *ctx);                  /* may be NULL */
+    /* Discrete modes (may be 0/NULL): nevent event functions g(t, y) that cross zero upwards
+     * where a mode must change. After every accepted step the driver locates the earliest
+     * crossing on the dense output, ends the step there and restarts; on_restart(t, y) is
+     * called at every restart (start, corners, events) to set the modes for what follows. */
+    int nevent;
+    void (*events)(double t, const double *y, double *g, void *ctx);
+    void (*on_restart)(double t, const double *y, void *ctx);
 } tf_ode;
 
 typedef enum {
@@ -41,7 +48,7 @@ typedef enum {
 } tf_status;
 
 typedef struct {
-    long steps, rejected, rhs_evals, jac_evals, decompositions;
+    long steps, rejected, rhs_evals, jac_evals, decompositions, events;
     int method_used;     /* the method at the end (AUTO may switch) */
     double switch_time;  /* when AUTO switched to Rodas4; -1 if it did not */
     int stiff_suspected; /* explicit method saw stiffness */

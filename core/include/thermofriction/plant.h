@@ -4,6 +4,7 @@
 #define THERMOFRICTION_PLANT_H
 
 #include "friction.h"
+#include "integrator.h"
 #include "thermal.h"
 #include "waveform.h"
 
@@ -12,16 +13,18 @@ extern "C" {
 #endif
 
 typedef enum {
-    TF_PLANT_STICK_SLIP = 0 /* SPEC 3.1: states x_p, v_p, x_e, v_e, then friction states */
+    TF_PLANT_STICK_SLIP = 0, /* SPEC 3.1: states x_p, v_p, x_e, v_e, then friction states */
+    TF_PLANT_MASS = 1,       /* SPEC 3.2: m x'' = u(t) + k_s (v_0 t - x) - F, v_r = x'; states x, v, then friction */
+    TF_PLANT_PRESCRIBED = 2  /* SPEC 3.3: x_r = u(t) [m] given, v_r = u'(t); friction states only */
 } tf_plant_kind;
 
 /* Output channels, in this order, then the friction states. */
 typedef enum {
     TF_OUT_TIME = 0,
     TF_OUT_INPUT,
-    TF_OUT_STAGE_DISPLACEMENT,
+    TF_OUT_STAGE_DISPLACEMENT,    /* the driving surface (0 for the mass and prescribed plants) */
     TF_OUT_STAGE_VELOCITY,
-    TF_OUT_DISPLACEMENT,          /* driven body: end effector */
+    TF_OUT_DISPLACEMENT,          /* driven body: end effector, mass, or the prescribed motion */
     TF_OUT_VELOCITY,
     TF_OUT_RELATIVE_DISPLACEMENT, /* x_e - x_p */
     TF_OUT_RELATIVE_VELOCITY,     /* v_r = v_e - v_p */
@@ -32,11 +35,14 @@ typedef enum {
 
 typedef struct {
     int plant;
-    /* stick-slip, physical form: m x_p'' + c x_p' + k x_p = T_em u + F ; m_e x_e'' = -F */
+    /* stick-slip, physical form: m x_p'' + c x_p' + k x_p = T_em u + F ; m_e x_e'' = -F
+       mass: m x'' = u + k_s (v_0 t - x) - F (k_s = 0: force-driven only) */
     double m, c, k, T_em, m_e;
+    double k_s, v_0;
 
     int friction;               /* tf_friction_kind */
     double p[TF_NPARAM];        /* parameters (temperature-independent values) */
+    tf_gms_elements gms;        /* GMS elements and their modes (changed by the integrator's events) */
     int fs_follows_fc;          /* fs = fc at every temperature: no Stribeck effect */
 
     int thermal;                /* tf_thermal_kind */
@@ -94,6 +100,12 @@ int tf_model_rhs(double t, const double *y, double *dy, void *model);
 int tf_model_jac(double t, const double *y, double *J, void *model);
 /* Earliest time after t where the input or the temperature signal has a corner. */
 double tf_model_next_corner(double t, void *model);
+/* Discrete modes of the friction model (GMS): event functions and the update at restarts. */
+int tf_model_nevent(const tf_model *model);
+void tf_model_events(double t, const double *y, double *g, void *model);
+void tf_model_on_restart(double t, const double *y, void *model);
+/* The model as an ODE system for tf_solve (right-hand side, Jacobian, corners, events). */
+tf_ode tf_model_ode(tf_model *model);
 /* Writes the output channels at (t, y). */
 void tf_model_outputs(const tf_model *model, double t, const double *y, double *out);
 
