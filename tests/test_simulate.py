@@ -225,3 +225,66 @@ def test_anti_damped_offset_form_warns_and_passive_one_does_not(model_ii):
     with _w.catch_warnings():
         _w.simplefilter("error", tf.ConditioningWarning)
         tf.simulate(model_ii, 0.01, temperature=40.0)  # the scale form
+
+
+CANUDAS = dict(sigma0=1e5, sigma1=1e5 ** 0.5, fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4)
+
+
+def test_lugre_passivity_condition_warns_for_large_sigma1_and_not_with_vd_or_the_paper():
+    """Oracle: the dissipativity inequality F v >= d/dt(sigma0 z^2/2) on |z| <= fs/sigma0 --
+    at high speed it reduces to sigma1 <= sigma2 fc/(fs - fc) (0.8 N s/m for the Canudas de Wit
+    1995 set, whose sigma1 = 316 violates it); a velocity-dependent sigma1 (vd) restores it, and
+    the paper's LuGre (fs = fc) satisfies it."""
+    import warnings as _w
+    spring = tf.MassPlant(1.0, 2.0, 0.1)
+    with pytest.warns(tf.PassivityWarning, match=r"sigma1 <= sigma2 fc/\(fs - fc\) = 0\.8"):
+        tf.simulate(tf.Model(spring, tf.LuGre(**CANUDAS)), 0.01)
+    from thermofriction.models import dissipativity_violation
+    v_bad, _ = dissipativity_violation("lugre", CANUDAS)
+    # the quadratic's minimum at the edge |z| = fs/sigma0 turns negative where fs^2/g + v (sigma1 + sigma2 -
+    # sigma1 fs / g) = 0, g ~ fc: v = fs^2 / (fc (sigma1 (fs - fc)/fc - sigma2)) = 0.01428 m/s
+    assert v_bad == pytest.approx(1.5 ** 2 / (1e5 ** 0.5 * 0.5 - 0.4), rel=0.02)
+    just_passive = dict(CANUDAS, sigma1=0.8 * 0.999)
+    assert dissipativity_violation("lugre", just_passive) is None
+    assert dissipativity_violation("lugre", dict(CANUDAS, sigma1=0.8 * 1.2)) is not None
+    with _w.catch_warnings():
+        _w.simplefilter("error", tf.PassivityWarning)
+        tf.simulate(tf.Model(spring, tf.LuGre(**CANUDAS, vd=1e-3)), 0.01)
+        tf.simulate(tf.load_model("li2009-base"), 0.01)
+        tf.simulate(tf.load_model("li2009-model-i"), 0.01, temperature=35.0)
+
+
+def test_identification_and_datasets_refuse_what_they_cannot_do_with_a_clear_message():
+    """Identification is implemented for LuGre on the stick-slip actuator; datasets record that
+    actuator. Other models and plants simulate, and say so when asked for more."""
+    base = tf.load_model("li2009-base")
+    synthetic_experiments = tf.synthesize(base, [30.0], duration=0.2, sample_rate=2000)
+    dahl = tf.Model(base.plant, tf.Dahl(sigma0=2e6, fc=0.9), input=base.input)
+    with pytest.raises(tf.InputError, match="'dahl' friction is not available yet"):
+        tf.identify(synthetic_experiments, method="base", init=dahl)
+    mass = tf.Model(tf.MassPlant(1.0, 2.0, 0.1), tf.LuGre(**CANUDAS))
+    with pytest.raises(tf.InputError, match="'mass' plant"):
+        tf.identify(synthetic_experiments, method="base", init=mass)
+    with pytest.raises(tf.InputError, match="stick-slip actuator"):
+        tf.synthesize(mass, [30.0], input=tf.Sine(1.0, 1.0))
+
+
+def test_prescribed_motion_needs_a_continuous_displacement():
+    model = tf.Model(tf.PrescribedMotion(), tf.Dahl(sigma0=1e5, fc=1.0))
+    with pytest.raises(tf.InputError, match="needs an input waveform"):
+        tf.simulate(model, 0.1)
+    with pytest.raises(tf.InputError, match="slew"):
+        tf.simulate(model, 0.1, input=tf.Step(1e-6, time=0.05))
+
+
+def test_static_map_under_prescribed_motion_needs_no_integration():
+    """Oracle: the Coulomb map itself, F = fc tanh(v/v_smooth) + sigma2 v, at the prescribed
+    sine's analytic velocity (no state: the samples are evaluated directly)."""
+    import numpy as np
+    model = tf.Model(tf.PrescribedMotion(), tf.Coulomb(fc=2.0, sigma2=0.5, v_smooth=1e-4), input=tf.Sine(1e-3, 2.0))
+    res = tf.simulate(model, 1.0, sample_rate=1000)
+    v = 1e-3 * 2 * np.pi * 2.0 * np.cos(2 * np.pi * 2.0 * res.time)
+    np.testing.assert_allclose(res.velocity, v, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(res.friction_force, 2.0 * np.tanh(v / 1e-4) + 0.5 * v, rtol=1e-12, atol=1e-12)
+    assert res.stats["steps"] == 0 and res.stage_displacement is None
+    assert "stage_displacement[m]" not in res.columns() and "input[m]" in res.columns()

@@ -10,7 +10,8 @@ extensions (Li et al., Rev. Sci. Instrum. 80,
     res.time, res.displacement, res.step_sizes
 """
 
-from .errors import (ComputationError, ConditioningWarning, InputError, SolverError, TemperatureRangeWarning,
+from .errors import (ComputationError, ConditioningWarning, InputError, PassivityWarning, SolverError,
+                     TemperatureRangeWarning,
                      ThermofrictionError)
 from .models import (GMS, PARAMETERS, PRESETS, PWL, Const, Coulomb, Dahl, ElastoPlastic, Exp, Law, Linear, LuGre,
                      MassPlant, Model, ModelI, ModelII, Poly, PrescribedMotion, StickSlipPlant, Stribeck, Table,
@@ -25,7 +26,7 @@ from .report import report
 __version__ = "0.1.0"
 
 __all__ = [
-    "ComputationError", "ConditioningWarning", "InputError", "SolverError", "TemperatureRangeWarning",
+    "ComputationError", "ConditioningWarning", "InputError", "PassivityWarning", "SolverError", "TemperatureRangeWarning",
     "ThermofrictionError",
     "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "Model", "ModelI", "ModelII", "Poly", "Table",
     "load_model",

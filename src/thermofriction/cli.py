@@ -12,9 +12,11 @@ import sys
 import time
 import warnings
 
+import numpy as np
+
 from . import __version__
 from .errors import InputError, ThermofrictionError
-from .models import PRESETS, load_model
+from .models import PRESETS, MassPlant, load_model
 from .simulate import SOLVERS, StepSizeController, simulate
 from .waveforms import Sampled, parse_waveform
 
@@ -58,13 +60,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser(
         "simulate", help="simulate a model file (or a preset) and write the SPEC 7 CSV",
-        description="Simulate an actuator from rest and write time, input, stage and end-effector "
-                    "displacement, velocity, friction force, temperature and internal states (SI units, "
-                    "temperature in C) on a uniform grid. Without -o, prints a summary.",
+        description="Simulate a model from rest -- a stick-slip actuator, a single mass (force-driven or "
+                    "spring-pulled) or prescribed motion, with any friction model (lugre, coulomb, stribeck, "
+                    "dahl, elastoplastic, gms) -- and write time, input, displacements, velocity, friction "
+                    "force, temperature and internal states (SI units, temperature in C) on a uniform grid. "
+                    "Without -o, prints a summary.",
         epilog=f"MODEL is a model file (TOML) or a preset name: {', '.join(PRESETS)}. "
                "Input specs: sawtooth:amplitude=A,frequency=F[,rise=0.99,offset=0,direction=1] | "
                "sine:amplitude=A,frequency=F[,offset=0] | square:amplitude=A,frequency=F,slew=S[,offset=0,duty=0.5] | "
-               "step:amplitude=A[,time=0,slew=0,offset=0] | sampled:file=PATH (CSV with time[s] and one value column).")
+               "step:amplitude=A[,time=0,slew=0,offset=0] | sampled:file=PATH (CSV with time[s] and one value column). "
+               "The input is a voltage [V] for the stick-slip plant, a force [N] for the mass, the displacement [m] "
+               "for prescribed motion.")
     s.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
     temp = s.add_mutually_exclusive_group()
     temp.add_argument("--temperature", type=_finite_float, metavar="C",
@@ -163,7 +169,8 @@ def cmd_simulate(args) -> int:
     if args.temperature_file:
         temperature = Sampled.from_csv(args.temperature_file)
     waveform = parse_waveform(args.input) if args.input else None
-    if waveform is None and model.input is None:
+    spring_pulled = isinstance(model.plant, MassPlant) and model.plant.spring_stiffness > 0
+    if waveform is None and model.input is None and not spring_pulled:
         raise InputError(f"{args.model}: the model has no [input]: give --input")
     if args.rtol >= 1:
         raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
@@ -177,7 +184,6 @@ def cmd_simulate(args) -> int:
         buf = io.StringIO()
         cols = res.columns()
         buf.write(",".join(cols) + "\n")
-        import numpy as np
         np.savetxt(buf, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12g")
         sys.stdout.write(buf.getvalue())
         return 0
@@ -189,12 +195,14 @@ def cmd_simulate(args) -> int:
          f"from {args.temperature_file}" if temperature is not None else "not used")
     print(f"{name}: {args.duration:g} s at temperature {T}, {len(res.time)} samples", file=out)
     print(f"  final displacement  {res.displacement[-1] * 1e6:.6g} um", file=out)
+    print(f"  peak friction force {np.max(np.abs(res.friction_force)):.6g} N", file=out)
     if res.step_sizes.size:
         print(f"  step per cycle      {res.step_sizes.mean() * 1e6:.6g} um (mean of {res.step_sizes.size}), "
               f"last {res.step_sizes[-1] * 1e6:.6g} um", file=out)
         print(f"  mean velocity       {res.mean_velocity * 1e6:.6g} um/s", file=out)
     st = res.stats
-    print(f"  solver              {st['solver']}: {st['steps']} steps, {st['rejected']} rejected, "
+    events = f", {st['events']} stick/slip switches" if st.get("events") else ""
+    print(f"  solver              {st['solver']}: {st['steps']} steps, {st['rejected']} rejected{events}, "
           f"{elapsed * 1e3:.1f} ms", file=out)
     if args.output:
         print(f"  wrote               {args.output}", file=out)

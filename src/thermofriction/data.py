@@ -22,7 +22,7 @@ import tomli_w
 
 from ._io import atomic_write
 from .errors import InputError, unknown_keys
-from .models import Model, load_model
+from .models import Model, load_model, require_actuator
 from .simulate import StepSizeController, simulate
 from .waveforms import Sampled, Waveform, parse_waveform
 
@@ -465,6 +465,7 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
     Seeded and reproducible: each experiment draws from its own stream
     (``default_rng([seed, i])`` for the i-th fit temperature, ``[seed, j, 1]`` for the j-th
     validate one), so adding an experiment changes no other."""
+    require_actuator(model, "synthesize")
     waveform = input if input is not None else model.input
     if waveform is None:
         raise InputError(f"{'model ' + repr(model.name) if model.name else 'the model'} has no [input] "

@@ -32,6 +32,10 @@ class TemperatureRangeWarning(UserWarning):
     """A temperature law was evaluated outside the range it was calibrated on."""
 
 
+class PassivityWarning(UserWarning):
+    """A friction model's parameters violate a passivity/dissipativity condition (it can create energy)."""
+
+
 class ConditioningWarning(UserWarning):
     """The model is ill-conditioned where it will be simulated (default tolerances may not be enough)."""
 

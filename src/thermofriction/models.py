@@ -622,6 +622,50 @@ def check_friction_values(values: dict, where: str):
             raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}")
 
 
+def stribeck_curve(values: dict, v):
+    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fs = fc: no Stribeck effect), NumPy, for checks and reports."""
+    fc = values["fc"]
+    fs = values.get("fs", fc)
+    fs = fc if fs is None else fs
+    if fs == fc:
+        return np.full_like(np.asarray(v, float), fc)
+    return fc + (fs - fc) * np.exp(-np.abs(np.asarray(v, float) / values["vs"]) ** values.get("delta", 2.0))
+
+
+def dissipativity_violation(model_name: str, values: dict):
+    """Where a LuGre-type model (LuGre, elasto-plastic) may create energy, or None.
+
+    Sufficient condition checked: with the bristle energy V = sigma0 z^2 / 2 as storage function,
+    F v - V' = sigma0 a z^2 - sigma1(v) a v z + (sigma1(v) + sigma2) v^2 (a = sigma0 |v| / g(v))
+    must be >= 0 for every |z| <= fs/sigma0 (the invariant set of z) at every velocity. It fails
+    when sigma1 is large against sigma2 and the Stribeck drop (fs - fc)/fc -- at high speed it
+    needs sigma1 <= sigma2 fc / (fs - fc) -- which is why a constant, large sigma1 makes LuGre
+    non-passive (Barabanov and Ortega 2000) and a velocity-dependent sigma1(v) = sigma1
+    exp(-(v/vd)^2) (Olsson 1996) restores it. Returns (velocity, message) for the lowest failing
+    speed on a log grid from 1 nm/s to 100 m/s. (For the elasto-plastic model, alpha <= 1 only
+    lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
+    if model_name not in ("lugre", "elastoplastic"):
+        return None
+    s0, s1, s2, fc = values["sigma0"], values["sigma1"], values.get("sigma2", 0.0) or 0.0, values["fc"]
+    fs = values.get("fs") if values.get("fs") is not None else fc
+    v = np.logspace(-9, 2, 1101)
+    g = stribeck_curve(values, v)
+    vd = values.get("vd")
+    s1v = s1 * np.exp(-(v / vd) ** 2) if vd else np.full_like(v, s1)
+    zmax = fs / s0
+    a = s0 * v / g
+    z_star = np.minimum(s1v * v / (2 * s0), zmax)  # the minimiser of the quadratic in z, within the set
+    q = s0 * a * z_star ** 2 - s1v * a * v * z_star + (s1v + s2) * v ** 2
+    bad = q < -1e-12 * (s1v + s2 + 1e-300) * v ** 2
+    if not np.any(bad):
+        return None
+    v_bad = float(v[np.argmax(bad)])
+    return v_bad, (f"not dissipative above |v| = {v_bad:.3g} m/s (condition: F v >= d/dt(sigma0 z^2/2) for "
+                   f"|z| <= fs/sigma0; at high speed sigma1 <= sigma2 fc/(fs - fc) = "
+                   f"{(s2 * fc / (fs - fc)) if fs > fc else float('inf'):.3g} N s/m, sigma1 = {s1:.3g}): the model "
+                   f"can create energy; give vd (sigma1(v) = sigma1 exp(-(v/vd)^2)), or raise sigma2")
+
+
 # ---------------------------------------------------------------------------------------------
 # Thermal extensions
 # ---------------------------------------------------------------------------------------------
@@ -816,6 +860,13 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
         return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"))
     except InputError as e:
         raise InputError(f"{source}: {e}") from None
+
+
+def require_actuator(model: Model, task: str):
+    """Datasets (SPEC 7) record a stick-slip actuator: voltage in, end-effector displacement out."""
+    if not isinstance(model.plant, StickSlipPlant):
+        raise InputError(f"{task} works on the stick-slip actuator (datasets record its voltage and displacement); "
+                         f"this model's plant is '{model.plant.type}'")
 
 
 PRESETS = ("li2009-model-i", "li2009-model-ii", "li2009-base")

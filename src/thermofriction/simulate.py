@@ -15,9 +15,9 @@ import numpy as np
 
 from . import _core
 from ._io import atomic_write
-from .errors import ConditioningWarning, InputError, SolverError, TemperatureRangeWarning
+from .errors import ConditioningWarning, InputError, PassivityWarning, SolverError, TemperatureRangeWarning
 from .models import (GMS, PARAMETERS, PLANT_CODES, MassPlant, Model, ModelI, ModelII, PrescribedMotion, StickSlipPlant,
-                     check_friction_values)
+                     check_friction_values, dissipativity_violation)
 from .waveforms import Sampled, Sawtooth, Step, Waveform, Zero
 
 # ---------------------------------------------------------------------------------------------
@@ -200,7 +200,7 @@ def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> 
         "friction": model.friction.core_code, "params": params,
         "gms_k": np.array(model.friction.k, float) if isinstance(model.friction, GMS) else None,
         "gms_w": np.array(model.friction.w, float) if isinstance(model.friction, GMS) else None,
-        "fs_follows_fc": int(model.friction.fs is None and "fs" not in model.laws),
+        "fs_follows_fc": int(getattr(model.friction, "fs", None) is None and "fs" not in model.laws),
         "thermal": 1 if isinstance(model.thermal, ModelI) else 2 if isinstance(model.thermal, ModelII) else 0,
         "laws": laws,
         "dF": model.thermal.dF._core_tuple() if isinstance(model.thermal, ModelII) else None,
@@ -239,10 +239,22 @@ def check_prescribed_motion(waveform: Waveform):
         raise InputError("prescribed motion: a sawtooth with rise 0 or 1 jumps; use 0 < rise < 1")
 
 
+def check_passivity(model: Model, temperatures=(math.nan,)):
+    """Warns (PassivityWarning) when a LuGre-type model can create energy at these temperatures."""
+    for T in temperatures:
+        found = dissipativity_violation(model.friction.model, model.parameters_at(T))
+        if found:
+            where = f" at {T:g} C" if isinstance(model.thermal, ModelI) else ""
+            warnings.warn(f"{model.friction.model}{where}: {found[1]}", PassivityWarning, stacklevel=4)
+            return
+
+
 def check_temperatures(model: Model, temperature):
     """Warns for temperatures outside a law's calibrated range; raises where the model is
-    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain)."""
+    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
+    Warns where a LuGre-type model is not dissipative."""
     if model.thermal is None:
+        check_passivity(model)
         return
     if temperature is None:
         raise InputError("the model depends on temperature: give a temperature (e.g. --temperature 35)")
@@ -269,6 +281,7 @@ def check_temperatures(model: Model, temperature):
                 if name in ("sigma0", "fc") and np.any(vals <= 0):
                     T_bad = Ts[np.argmax(vals <= 0)]
                     raise InputError(f"Model I: '{name}' is not positive at {T_bad:g} C ({law(T_bad):g})")
+    check_passivity(model, (Ts.min(), Ts.max()) if isinstance(model.thermal, ModelI) else (math.nan,))
     if isinstance(model.thermal, ModelII) and model.thermal.form == "scale":
         lam = np.atleast_1d(model.thermal_factor(Ts))
         if np.any(lam <= 0):

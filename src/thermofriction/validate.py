@@ -12,7 +12,7 @@ import numpy as np
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning
 from .identify.engine import experiment_waveform
-from .models import Model
+from .models import Model, require_actuator
 from .simulate import StepSizeController, simulate
 
 
@@ -152,6 +152,7 @@ class ValidationResult:
 def validate(model: Model, data, experiments=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors of SPEC 9. Temperatures outside a law's calibrated range are reported as warnings."""
+    require_actuator(model, "validate")
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")

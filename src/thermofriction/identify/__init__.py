@@ -7,7 +7,7 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from ..models import Model, load_model
+from ..models import Model, StickSlipPlant, load_model
 from .engine import fit, make_traces, uncertainty
 from .parameters import Parameter, Parameters
 from .procedures import base_model, fit_friction, fit_law, identify_model_i, identify_model_ii, segmented_fit
@@ -36,6 +36,12 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
         init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii"}[method]
     if not isinstance(init, Model):
         init = load_model(init)
+    if not isinstance(init.plant, StickSlipPlant):
+        raise InputError(f"identification works on the stick-slip actuator (datasets record its voltage and "
+                         f"displacement); a '{init.plant.type}' plant can be simulated but not identified yet")
+    if method != "plant" and init.friction.model != "lugre":
+        raise InputError(f"identification of '{init.friction.model}' friction is not available yet (LuGre only); "
+                         f"every friction model can be simulated")
     experiments = getattr(data, "fit", data)
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
