@@ -148,3 +148,52 @@ def test_model_from_dict_is_data_only():
     model = model_from_dict(d)
     assert model.thermal is None and model.friction.fs is None
     assert model.parameters_at(20.0)["fs"] == 0.5
+
+
+LIBRARY = {
+    "coulomb-mass": tf.Model(tf.MassPlant(2.0), tf.Coulomb(fc=1.0, sigma2=0.1, v_smooth=1e-5), input=tf.Sine(3.0, 1.0)),
+    "stribeck-prescribed": tf.Model(tf.PrescribedMotion(), tf.Stribeck(fc=1.0, fs=1.4, vs=2e-3, delta=1.5),
+                                    input=tf.Sine(1e-3, 0.5)),
+    "dahl-stick-slip": tf.Model(tf.load_model("li2009-base").plant, tf.Dahl(sigma0=2e6, fc=0.9),
+                                input=tf.Sawtooth(30, 5, rise=0.999)),
+    "elastoplastic-spring": tf.Model(tf.MassPlant(1.0, 2.0, 0.1),
+                                     tf.ElastoPlastic(sigma0=1e5, sigma1=300.0, fc=1.0, z_ba=5e-6, fs=1.5, vs=1e-3,
+                                                      sigma2=0.4, vd=1e-3)),
+    "gms-model-i": tf.Model(tf.PrescribedMotion(), tf.GMS(k=(1e5, 3e5), w=(0.25, 0.75), C=None, fc=1.0),
+                            tf.ModelI({"C": tf.Linear(-1.0, 100.0)}), input=tf.Sine(2e-5, 1.0)),
+    "gms-model-ii": tf.Model(tf.MassPlant(1.0, 2.0, 0.1), tf.GMS(k=(1e5, 3e5, 1e6), w=(0.2, 0.3, 0.5), C=50.0, fc=1.0),
+                             tf.ModelII(tf.Linear(-0.01, 0.3))),
+}
+
+
+@pytest.mark.parametrize("name", list(LIBRARY))
+def test_every_friction_model_and_plant_round_trips_through_its_file(name, tmp_path):
+    model = LIBRARY[name]
+    model.save(tmp_path / "m.toml")
+    again = tf.load_model(tmp_path / "m.toml")
+    assert again == model and again.to_toml() == model.to_toml()
+    res = tf.simulate(again, 0.05, temperature=35.0 if again.thermal else None, sample_rate=2000)
+    assert np.all(np.isfinite(res.friction_force)) and res.states.shape[1] == model.friction.nstate
+
+
+@pytest.mark.parametrize("text, match", [
+    ('[plant]\ntype = "mass"\nm = 1.0\nv_0 = 0.1\n[friction]\nmodel = "coulomb"\nfc = 1.0\n', "'k_s'"),
+    ('[plant]\ntype = "prescribed"\nm = 1.0\n[friction]\nmodel = "dahl"\nsigma0 = 1e5\nfc = 1.0\n', "'m'"),
+    ('[plant]\ntype = "mass"\nm = 1.0\n[friction]\nmodel = "gms"\nk = [1e5, 2e5]\nw = [0.5, 0.4]\nC = 10.0\nfc = 1.0\n',
+     "sum to one"),
+    ('[plant]\ntype = "mass"\nm = 1.0\n[friction]\nmodel = "gms"\nk = [1e5, -2e5]\nw = [0.5, 0.5]\nC = 10.0\nfc = 1.0\n',
+     r"'k\[1\]' must be positive"),
+    ('[plant]\ntype = "mass"\nm = 1.0\n[friction]\nmodel = "gms"\nk = [1e5]\nw = [1.0]\nC = 10.0\nfc = 1.0\n'
+     'sigma1 = 2.0\n', "'sigma1'"),
+    ('[plant]\ntype = "mass"\nm = 1.0\n[friction]\nmodel = "elastoplastic"\nsigma0 = 1e5\nsigma1 = 300.0\nfc = 1.0\n'
+     'z_ba = 2e-5\n', "z_ba"),
+    ('[plant]\ntype = "mass"\nm = 1.0\n[friction]\nmodel = "stribeck"\nfc = 1.0\nfs = 0.5\nvs = 1e-3\n', "'fs'"),
+    ('[plant]\ntype = "mass"\nm = 1.0\n[friction]\nmodel = "dahl"\nsigma0 = 1e5\nfc = 1.0\n[thermal]\nmodel = "I"\n'
+     'sigma1 = { law = "const", value = 1.0 }\n', "'sigma1' is not a parameter of dahl"),
+])
+def test_library_model_files_are_checked_and_errors_name_the_key(text, match, tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(tf.InputError, match=match) as e:
+        tf.load_model(path)
+    assert str(path) in str(e.value)
