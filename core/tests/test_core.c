@@ -358,6 +358,61 @@ static void test_lu_solves_systems_that_need_pivoting_in_later_columns(void)
     CHECK(worst < 1e-8, "LU solve error %g", worst);
 }
 
+typedef struct { int dim; double *F; const tf_model *m; } force_record;
+static void emit_force(long i, double t, const double *y, void *ctx)
+{
+    force_record *r = (force_record *)ctx;
+    r->F[i] = tf_model_friction(r->m, t, y);
+}
+
+static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
+{
+    /* One GMS element under prescribed motion x = v t: it sticks (F = k v t) until F reaches its
+     * capacity w fc at t* = w fc / (k v), exactly: the switch is a located event, then it slips
+     * (F -> w fc at rate C) and, when the motion reverses at the sawtooth's corner, sticks again
+     * (F falls at k v' from where it was). Analytic solution, every method. */
+    tf_model m;
+    memset(&m, 0, sizeof m);
+    m.plant = TF_PLANT_PRESCRIBED;
+    m.friction = TF_FRICTION_GMS;
+    m.p[TF_P_FC] = m.p[TF_P_FS] = 2.0;
+    m.p[TF_P_VS] = 1e-3;
+    m.p[TF_P_DELTA] = 2.0;
+    m.p[TF_P_C] = 50.0;
+    m.p[TF_P_VSMOOTH] = 1e-6;
+    m.gms.n = 1;
+    m.gms.k[0] = 1e5;
+    m.gms.w[0] = 1.0;
+    m.T_const = NAN;
+    /* up at 1e-4 m/s for 0.6 s, down for 0.4 s (sawtooth, amplitude 6e-5 m, 1 Hz, rise 0.6) */
+    m.input = (tf_waveform){TF_WAVE_SAWTOOTH, 6e-5, 1.0, 0.6, 0.0, 1.0, 0, 0, 0, 0, 0};
+    tf_model_prepare(&m);
+    double v = 1e-4, k = 1e5, fc = 2.0, t_star = fc / (k * v); /* 0.2 s */
+    double t[6] = {0.0, 0.1, t_star, 0.4, 0.6, 0.7};
+    double exact[6];
+    exact[0] = 0.0;
+    exact[1] = k * v * 0.1;
+    exact[2] = fc;
+    exact[3] = fc; /* slipping at capacity: F' = C (1 - F / fc) = 0 */
+    exact[4] = fc;
+    double vdown = -6e-5 / 0.4;
+    exact[5] = fc + k * vdown * 0.1; /* stuck again after the reversal */
+    for (int method = 1; method <= 2; method++) {
+        double y[1] = {0.0}, atol[1] = {1e-12}, F[6];
+        force_record r = {1, F, &m};
+        tf_ode ode = tf_model_ode(&m);
+        tf_solver_options opt = {method, 1e-9, atol, 0, 0, 100000};
+        tf_solver_stats st;
+        memset(m.gms.mode, 0, sizeof m.gms.mode);
+        int status = tf_solve(&ode, &opt, t, 6, y, emit_force, &r, &st);
+        double worst = 0.0;
+        for (int i = 0; i < 6; i++) worst = fmax(worst, fabs(F[i] - exact[i]));
+        CHECK(status == TF_OK && worst < 1e-6 * fc && st.events >= 2,
+              "GMS single element, method %d: status %d, worst force error %g N, %ld events", method, status, worst,
+              st.events);
+    }
+}
+
 int main(void)
 {
     test_lu_solves_systems_that_need_pivoting_in_later_columns();
@@ -371,6 +426,7 @@ int main(void)
     test_lugre_steady_sliding();
     test_jacobian_vs_finite_differences();
     test_frictionless_step_response();
+    test_gms_element_breaks_loose_exactly_at_its_capacity();
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
