@@ -207,7 +207,7 @@ double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, do
 
 int tf_friction_nevent(int kind, const tf_gms_elements *el)
 {
-    return kind == TF_FRICTION_GMS && el ? el->n : 0;
+    return kind == TF_FRICTION_GMS && el ? 2 * el->n : 0;
 }
 
 void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
@@ -215,8 +215,22 @@ void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, do
 {
     if (kind != TF_FRICTION_GMS) return;
     double g = tf_stribeck(p, v, 0);
-    for (int i = 0; i < el->n; i++)
-        g_out[i] = el->mode[i] == 0 ? fabs(z[i]) - el->w[i] * g : -el->mode[i] * v;
+    /* A stuck element has one function per capacity, F_i - w_i g and -F_i - w_i g, rather than
+     * |F_i| - w_i g: an element that sticks again at its capacity (a reversal) starts that
+     * function at zero, where no upward crossing can be seen, but must still be caught at the
+     * opposite capacity. Neither depends on sgn(v), which at a corner of prescribed motion is
+     * already the next segment's. A slipping element's first function is -s v (the motion
+     * reverses); its second is inactive. */
+    for (int i = 0; i < el->n; i++) {
+        double cap = el->w[i] * g;
+        if (el->mode[i] == 0) {
+            g_out[2 * i] = z[i] - cap;
+            g_out[2 * i + 1] = -z[i] - cap;
+        } else {
+            g_out[2 * i] = -el->mode[i] * v;
+            g_out[2 * i + 1] = -1.0;
+        }
+    }
 }
 
 void tf_friction_update_modes(int kind, const double *p, tf_gms_elements *el, double v, const double *z)

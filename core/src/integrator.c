@@ -419,7 +419,8 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
         /* what is left may be a rounding residue (a corner computed one ulp before the grid's
          * end): nothing to integrate, and a step that small would count as an underflow */
         if (t_end - t <= 64.0 * DBL_EPSILON * fabs(t_end)) break;
-        double seg_end = ode->next_corner ? fmin(ode->next_corner(t, ode->ctx), t_end) : t_end;
+        double corner = ode->next_corner ? ode->next_corner(t, ode->ctx) : INFINITY;
+        double seg_end = fmin(corner, t_end);
         if (!(seg_end > t) || t_end - seg_end <= 64.0 * DBL_EPSILON * fabs(t_end)) seg_end = t_end;
         /* restart at every corner (the derivative may jump there) and every event */
         w.t_clamp = INFINITY;
@@ -469,6 +470,12 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                 double t_new = last ? seg_end : t + h;
                 if (ne) { /* an event inside the step: end the step there, emit up to it, restart */
                     double s_ev = locate_event(&w, method, ne, t, h, g0, t_new, w.y1, g1, gm, yd);
+                    /* an event located within the corner margin of the corner that ends this
+                     * segment is taken at the corner: a restart just before it would find the
+                     * corner already passed and integrate across it */
+                    if (s_ev >= 0.0 && s_ev < 1.0 && last && seg_end == corner &&
+                        !(ode->next_corner(t + s_ev * h, ode->ctx) <= corner))
+                        s_ev = 1.0;
                     if (s_ev >= 0.0) {
                         double t_ev = s_ev >= 1.0 ? t_new : t + s_ev * h;
                         while (next < n_out && t_out[next] <= t_ev) {

@@ -284,6 +284,7 @@ double tf_model_next_corner(double t, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double c = tf_waveform_next_corner(&m->input, t);
+    if (m->plant == TF_PLANT_PRESCRIBED) c = fmin(c, tf_waveform_next_reversal(&m->input, t));
     if (m->T_n > 0) c = fmin(c, tf_pwl_next_knot(m->T_n, m->T_t, t));
     return c;
 }
@@ -303,7 +304,14 @@ void tf_model_on_restart(double t, const double *y, void *ctx)
     tf_model *m = (tf_model *)ctx;
     double lambda, dF;
     const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
-    tf_friction_update_modes(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m));
+    double v = relative_velocity(m, t, y);
+    if (m->plant == TF_PLANT_PRESCRIBED) {
+        /* a prescribed motion keeps one direction between restarts (corners and reversals), but
+         * at a sine's extremum v(t) is rounding noise: take the direction from inside the segment */
+        double tc = tf_model_next_corner(t, m);
+        if (isfinite(tc)) v = copysign(fabs(v), tf_waveform_slope(&m->input, 0.5 * (t + tc)));
+    }
+    tf_friction_update_modes(m->friction, p, &m->gms, v, y + nmech(m));
 }
 
 tf_ode tf_model_ode(tf_model *model)

@@ -172,3 +172,10 @@ double tf_waveform_next_corner(const tf_waveform *w, double t)
         return INFINITY;
     }
 }
+
+double tf_waveform_next_reversal(const tf_waveform *w, double t)
+{
+    if (w->kind != TF_WAVE_SINE || !(w->frequency > 0)) return INFINITY; /* the others: corners */
+    double c[2] = {0.25, 0.75};
+    return periodic_next(t, w->frequency, c, 2);
+}

@@ -74,8 +74,9 @@ double tf_stribeck(const double *p, double v, double *dg);
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
 
-/* Discrete modes (GMS). Event functions cross zero upwards where a mode must change: a stuck
- * element when |F_i| reaches w_i g(v), a slipping one when v reverses. tf_friction_update_modes
+/* Discrete modes (GMS). Event functions (two per element) cross zero upwards where a mode must
+ * change: a stuck element when F_i reaches +w_i g(v) or -w_i g(v), a slipping one when v
+ * reverses. tf_friction_update_modes
  * sets every mode consistent with (v, z): called at every restart of the integration. */
 int tf_friction_nevent(int kind, const tf_gms_elements *gms);
 void tf_friction_events(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,

@@ -35,6 +35,11 @@ double tf_waveform_value(const tf_waveform *w, double t);
 double tf_waveform_slope(const tf_waveform *w, double t);
 /* Smallest corner strictly later than t (by more than a rounding margin); INFINITY if none. */
 double tf_waveform_next_corner(const tf_waveform *w, double t);
+/* First time > t (by more than the corner margin) at which a smooth waveform's slope changes
+ * sign (the sine's extrema); INFINITY for the piecewise-linear ones, whose slope changes sign
+ * only at corners. A prescribed motion restarts the integration there: v(t) is then no state
+ * the error control could follow, and a step must not carry a reversal inside it. */
+double tf_waveform_next_reversal(const tf_waveform *w, double t);
 
 /* Piecewise-linear signal helpers shared by sampled waveforms and sampled temperatures. */
 double tf_pwl_value(int n, const double *x, const double *y, double t);
