@@ -7,6 +7,7 @@ between two runs (thermal extensions, return-point memory).
 """
 
 import math
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -378,6 +379,28 @@ def test_model_ii_scale_form_scales_every_base_model_by_1_plus_dF_over_fc(name):
     np.testing.assert_allclose(r_ii.friction_force, lam * r_base.friction_force, rtol=0, atol=1e-9 * scale)
     if base.nstate:  # the internal states are the base model's
         np.testing.assert_allclose(r_ii.states, r_base.states, rtol=0, atol=1e-9 * np.max(np.abs(r_base.states)))
+
+
+@pytest.mark.parametrize("friction, dF, warns, damping", [
+    (tf.Dahl(sigma0=SIGMA0, fc=FC), -0.3, True, 0.0),  # no damping of its own at v = 0
+    (tf.GMS(k=(1e5,), w=(1.0,), C=20.0, fc=FC, sigma2=0.4), -0.3, True, 0.4),
+    (tf.Coulomb(fc=FC, sigma2=0.4), -0.3, False, 0.4 + 1e6),  # its smoothed sign: fs/v_smooth
+    (tf.Stribeck(fc=FC, fs=1.5, vs=1e-3), -0.3, False, 1.5e6),
+    (tf.Coulomb(fc=FC), -1.2, True, 1e6),  # |dF| beyond fs: anti-damped even so
+], ids=["dahl", "gms", "coulomb", "stribeck", "coulomb-dF>fs"])
+def test_model_ii_offset_form_conditioning_check_counts_each_models_own_damping(friction, dF, warns, damping):
+    """Linearisation at v = 0 (SPEC 5.2, offset form): F' = F_base + dF tanh(v/v_smooth) has the
+    slope dF/v_smooth there; with dF < 0 it is anti-damped where that outweighs the base model's
+    own damping (sigma1 + sigma2; fs/v_smooth + sigma2 for a static map's smoothed sign). The check
+    must hold for models without sigma1 (it raised KeyError for them) and name the damping."""
+    model = tf.Model(tf.MassPlant(1.0), friction, thermal=tf.ModelII(tf.Const(dF), form="offset"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tf.simulate(model, 0.01, temperature=35.0, sample_rate=1000)
+    cond = [w for w in caught if issubclass(w.category, tf.ConditioningWarning)]
+    assert bool(cond) == warns
+    if warns:
+        assert f"= {damping:.3g} N s/m" in str(cond[0].message)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -297,10 +297,16 @@ def check_temperatures(model: Model, temperature):
         dF = np.atleast_1d(model.thermal.dF(Ts))
         i = int(np.argmin(dF))
         p = model.parameters_at(Ts[i])
-        damping = p["sigma1"] + p["sigma2"]
+        # the base model's own damping at v = 0: bristle and viscous damping (models without
+        # sigma1 have none), and for a static map the slope of its smoothed sign, fs / v_smooth
+        damping = p.get("sigma1", 0.0) + p.get("sigma2", 0.0)
+        what = "sigma1 + sigma2"
+        if model.friction.model in ("coulomb", "stribeck"):
+            damping += p["fs"] / p["v_smooth"]
+            what = "sigma2 + fs/v_smooth"
         if dF[i] < 0 and -dF[i] / p["v_smooth"] > damping:
             warnings.warn(f"Model II offset form: dF = {dF[i]:.4g} N at {Ts[i]:g} C is anti-damped near v = 0 "
-                          f"(dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against sigma1 + sigma2 = "
+                          f"(dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against {what} = "
                           f"{damping:.3g} N s/m); the solution is ill-conditioned: use Dopri5 with rtol <= 1e-8, "
                           f"or the scale form", ConditioningWarning, stacklevel=3)
 
