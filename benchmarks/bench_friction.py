@@ -1,6 +1,6 @@
 """Cost of the friction models on this machine (a script, not a test).
 
-    /work/venv/bin/python benchmarks/bench_friction.py          (from the repository root)
+    .venv/bin/python benchmarks/bench_friction.py          (from the repository root)
 
 Every model runs on the spring-pulled mass of Canudas de Wit et al. (1995): m = 1 kg, k_s = 2 N/m,
 v_0 = 0.1 m/s, with the paper's LuGre parameters (sigma0 = 1e5 N/m, sigma1 = sqrt(1e5) N s/m,

@@ -460,14 +460,8 @@ SIM_CASES.update({
 SOLVERS = {"auto": tf.AutoSwitch(), "dopri5": tf.Dopri5(), "rodas4": tf.Rodas4()}
 SLOW_CASES: set = set()
 
-GMS_STEPS_OVER_STRIBECK_WINDOW = (
-    "library bug (accuracy): while |v| >> vs a slipping GMS element's force derivative C (s w_i - F_i/g(v)) is "
-    "exactly 0 (g(v) = fc to the last bit), so every solver's error estimate lets steps grow across the ~3 ms "
-    "in which v crosses the Stribeck band before the reversal; the elements then stick at w_i fc instead of "
-    "~w_i g(v -> 0), and the next break-away comes late: 2.0e-3 of the displacement range at default "
-    "tolerances (and still at rtol 1e-10 for Dopri5); the reference converges to 2e-12 with max_step 1 ms")
-# (name, solver): (reason, exception raised or None)
-KNOWN = {("mass-force-square-gms", s): (GMS_STEPS_OVER_STRIBECK_WINDOW, None) for s in SOLVERS}
+# (name, solver): (reason, exception raised or None) -- known misses, marked strict xfail
+KNOWN: dict = {}
 
 
 def _sim_params():

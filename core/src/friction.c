@@ -220,7 +220,10 @@ void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, do
      * function at zero, where no upward crossing can be seen, but must still be caught at the
      * opposite capacity. Neither depends on sgn(v), which at a corner of prescribed motion is
      * already the next segment's. A slipping element's first function is -s v (the motion
-     * reverses); its second is inactive. */
+     * reverses); its second, 3 vs - |v|, restarts the integration where v enters the Stribeck
+     * band: outside it a slipping element's force rate is exactly zero (g = fc to the last
+     * bit), so no error estimate would stop a step from carrying v across the whole band. */
+    double band = (p[TF_P_FS] != p[TF_P_FC] && p[TF_P_VS] > 0.0) ? 3.0 * p[TF_P_VS] : -1.0;
     for (int i = 0; i < el->n; i++) {
         double cap = el->w[i] * g;
         if (el->mode[i] == 0) {
@@ -228,7 +231,7 @@ void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, do
             g_out[2 * i + 1] = -z[i] - cap;
         } else {
             g_out[2 * i] = -el->mode[i] * v;
-            g_out[2 * i + 1] = -1.0;
+            g_out[2 * i + 1] = band > 0.0 ? band - fabs(v) : -1.0;
         }
     }
 }
