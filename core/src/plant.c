@@ -344,3 +344,183 @@ void tf_model_outputs(const tf_model *model, double t, const double *y, double *
     out[TF_OUT_TEMPERATURE] = tf_model_temperature(model, t);
     for (int j = 0; j < nz; j++) out[TF_OUT_NFIXED + j] = y[nm + j];
 }
+
+/* ---- model check (the C side of the Python package's parameter checks) ---- */
+
+static int pos(double x) { return isfinite(x) && x > 0.0; }
+static int nonneg(double x) { return isfinite(x) && x >= 0.0; }
+
+/* The friction parameters the model uses, at one temperature. */
+static const char *check_friction_params(const tf_model *m, const double *p, int offset_form)
+{
+    int k = m->friction;
+    int stribeck = k == TF_FRICTION_STRIBECK || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC ||
+                   k == TF_FRICTION_GMS;
+    if (!pos(p[TF_P_FC])) return "fc";
+    if (k != TF_FRICTION_DAHL && !nonneg(p[TF_P_SIGMA2])) return "sigma2";
+    if (k == TF_FRICTION_DAHL || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
+        if (!pos(p[TF_P_SIGMA0])) return "sigma0";
+    }
+    if (k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
+        if (!nonneg(p[TF_P_SIGMA1])) return "sigma1";
+        if (isnan(p[TF_P_VD]) || p[TF_P_VD] == INFINITY) return "vd"; /* <= 0: sigma1 constant */
+    }
+    if (stribeck) {
+        if (!isfinite(p[TF_P_FS]) || p[TF_P_FS] < p[TF_P_FC]) return "fs";
+        if (p[TF_P_FS] != p[TF_P_FC] && !pos(p[TF_P_VS])) return "vs";
+        if (p[TF_P_FS] != p[TF_P_FC] && !pos(p[TF_P_DELTA])) return "delta";
+    }
+    if ((k == TF_FRICTION_COULOMB || k == TF_FRICTION_STRIBECK || offset_form) && !pos(p[TF_P_VSMOOTH]))
+        return "v_smooth";
+    if (k == TF_FRICTION_ELASTOPLASTIC && !(nonneg(p[TF_P_ZBA]) && p[TF_P_ZBA] < p[TF_P_FC] / p[TF_P_SIGMA0]))
+        return "z_ba";
+    if (k == TF_FRICTION_GMS && !pos(p[TF_P_C])) return "C";
+    return 0;
+}
+
+static const char *check_at(const tf_model *m, double T)
+{
+    double p[TF_NPARAM];
+    tf_model_params_at(m, T, p);
+    int offset = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET;
+    const char *bad = check_friction_params(m, p, offset);
+    if (bad) return bad;
+    if (m->thermal == TF_THERMAL_MODEL_II) {
+        double dF = tf_law_eval(&m->dF, T, 0);
+        if (!isfinite(dF)) return "dF";
+        double lambda = tf_model_lambda(m, T);
+        if (m->dF_form == TF_DF_SCALE && !(isfinite(lambda) && lambda > 0.0)) return "dF (lambda <= 0 or not finite)";
+    }
+    return 0;
+}
+
+static int law_ok(const tf_law *L)
+{
+    if (L->kind < TF_LAW_NONE || L->kind > TF_LAW_TABLE) return 0;
+    if (L->kind == TF_LAW_POLY && (L->n < 1 || !L->y)) return 0;
+    if (L->kind == TF_LAW_PWL || L->kind == TF_LAW_TABLE) {
+        if (L->n < 2 || !L->x || !L->y || (L->kind == TF_LAW_TABLE && !L->d)) return 0;
+        for (int i = 0; i < L->n; i++)
+            if (!isfinite(L->x[i]) || !isfinite(L->y[i]) || (i && !(L->x[i] > L->x[i - 1]))) return 0;
+    }
+    return 1;
+}
+
+static const char *check_input(const tf_model *m)
+{
+    const tf_waveform *w = &m->input;
+    int prescribed = m->plant == TF_PLANT_PRESCRIBED;
+    if (w->kind == TF_WAVE_ZERO) return 0;
+    if (w->kind == TF_WAVE_SAMPLED) {
+        if (w->n < 2 || !w->t || !w->v) return "input (sampled: at least two points)";
+        for (int i = 0; i < w->n; i++)
+            if (!isfinite(w->t[i]) || !isfinite(w->v[i]) || (i && !(w->t[i] > w->t[i - 1])) ||
+                (i && prescribed && !isfinite((w->v[i] - w->v[i - 1]) / (w->t[i] - w->t[i - 1]))))
+                return "input (sampled: finite values and slopes, strictly increasing times)";
+        return 0;
+    }
+    if (!isfinite(w->amplitude) || !isfinite(w->offset)) return "input (amplitude, offset)";
+    switch (w->kind) {
+    case TF_WAVE_SAWTOOTH:
+        if (!pos(w->frequency)) return "input (frequency)";
+        if (!(w->rise > 0.0 && w->rise < 1.0) && !(!prescribed && (w->rise == 0.0 || w->rise == 1.0)))
+            return "input (rise)";
+        if (w->direction != 1.0 && w->direction != -1.0) return "input (direction)";
+        /* a prescribed motion's velocity is the slope: it must be finite on both flanks */
+        if (prescribed && !(isfinite(w->amplitude * w->frequency / w->rise) &&
+                            isfinite(w->amplitude * w->frequency / (1.0 - w->rise))))
+            return "input (rise: slope not finite)";
+        return 0;
+    case TF_WAVE_SINE:
+        if (!pos(w->frequency)) return "input (frequency)";
+        if (prescribed && !isfinite(6.283185307179586 * w->frequency * w->amplitude)) return "input (slope not finite)";
+        return 0;
+    case TF_WAVE_SQUARE: {
+        if (!pos(w->frequency)) return "input (frequency)";
+        double P = 1.0 / w->frequency;
+        if (!(w->rise > 0.0 && w->rise < 1.0)) return "input (duty)";
+        if (!nonneg(w->slew) || (prescribed && !(w->slew > 0.0)) ||
+            !(w->slew < fmin(w->rise, 1.0 - w->rise) * P))
+            return "input (slew)";
+        if (prescribed && !isfinite(w->amplitude / w->slew)) return "input (slew: slope not finite)";
+        return 0;
+    }
+    case TF_WAVE_STEP:
+        if (!isfinite(w->t0)) return "input (time)";
+        if (!nonneg(w->slew) || (prescribed && !(w->slew > 0.0))) return "input (slew)";
+        if (prescribed && !isfinite(w->amplitude / w->slew)) return "input (slew: slope not finite)";
+        return 0;
+    default:
+        return "input (kind)";
+    }
+}
+
+int tf_model_check(const tf_model *m, const char **what)
+{
+    const char *bad = 0;
+    switch (m->plant) {
+    case TF_PLANT_STICK_SLIP:
+        if (!pos(m->m)) bad = "m";
+        else if (!nonneg(m->c)) bad = "c";
+        else if (!pos(m->k)) bad = "k";
+        else if (!isfinite(m->T_em)) bad = "T_em";
+        else if (!pos(m->m_e)) bad = "m_e";
+        break;
+    case TF_PLANT_MASS:
+        if (!pos(m->m)) bad = "m";
+        else if (!nonneg(m->k_s)) bad = "k_s";
+        else if (!isfinite(m->v_0)) bad = "v_0";
+        break;
+    case TF_PLANT_PRESCRIBED:
+        if (m->input.kind == TF_WAVE_ZERO) bad = "input (prescribed motion needs one)";
+        break;
+    default:
+        bad = "plant";
+    }
+    if (!bad && (m->friction < TF_FRICTION_LUGRE || m->friction > TF_FRICTION_GMS)) bad = "friction";
+    if (!bad && m->friction == TF_FRICTION_GMS) {
+        double sum = 0.0;
+        if (m->gms.n < 1 || m->gms.n > TF_MAX_FRICTION_STATES) bad = "gms.n (1 to 64 elements)";
+        for (int i = 0; !bad && i < m->gms.n; i++) {
+            if (!pos(m->gms.k[i])) bad = "gms.k";
+            else if (!pos(m->gms.w[i])) bad = "gms.w";
+            sum += m->gms.w[i];
+        }
+        if (!bad && !(fabs(sum - 1.0) <= 1e-9)) bad = "gms.w (must sum to one)";
+    }
+    if (!bad && (m->thermal < TF_THERMAL_NONE || m->thermal > TF_THERMAL_MODEL_II)) bad = "thermal";
+    if (!bad && m->thermal == TF_THERMAL_MODEL_I)
+        for (int i = 0; !bad && i < TF_NPARAM; i++)
+            if (!law_ok(&m->law[i])) bad = "law";
+    if (!bad && m->thermal == TF_THERMAL_MODEL_II) {
+        if (m->dF.kind == TF_LAW_NONE || !law_ok(&m->dF)) bad = "dF";
+        else if (m->dF_form != TF_DF_SCALE && m->dF_form != TF_DF_OFFSET) bad = "dF form";
+    }
+    if (!bad) bad = check_input(m);
+    if (!bad && m->T_n > 0) {
+        if (m->T_n < 2 || !m->T_t || !m->T_v) bad = "temperature (sampled: at least two points)";
+        for (int i = 0; !bad && i < m->T_n; i++)
+            if (!isfinite(m->T_t[i]) || !isfinite(m->T_v[i]) || (i && !(m->T_t[i] > m->T_t[i - 1])))
+                bad = "temperature (finite values, strictly increasing times)";
+    }
+    if (!bad && m->thermal != TF_THERMAL_NONE) {
+        if (m->T_n > 0) {
+            /* the temperature sweeps [min, max] of its samples: the knots and a fine grid */
+            double lo = INFINITY, hi = -INFINITY;
+            for (int i = 0; !bad && i < m->T_n; i++) {
+                lo = fmin(lo, m->T_v[i]);
+                hi = fmax(hi, m->T_v[i]);
+                bad = check_at(m, m->T_v[i]);
+            }
+            for (int j = 0; !bad && j <= 64; j++) bad = check_at(m, lo + (hi - lo) * j / 64.0);
+        } else if (!isfinite(m->T_const)) {
+            bad = "temperature";
+        } else {
+            bad = check_at(m, m->T_const);
+        }
+    } else if (!bad) {
+        bad = check_at(m, NAN);
+    }
+    if (what) *what = bad;
+    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
+}

@@ -182,6 +182,19 @@ static void raise_solver_error(int status, const tf_solver_stats *st, const doub
     if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
 }
 
+/* The C core's own model check, after Python's: a refusal here means the two disagree (a bug),
+ * reported as a SolverError with TF_ERR_BAD_ARGUMENT naming the field. */
+static int check_model(const tf_model *m)
+{
+    const char *what = 0;
+    if (tf_model_check(m, &what) == TF_OK) return 0;
+    char message[160];
+    snprintf(message, sizeof message, "the C core's model check refused '%s'", what ? what : "?");
+    PyObject *exc_args = Py_BuildValue("(siddNi)", message, TF_ERR_BAD_ARGUMENT, 0.0, 0.0, PyTuple_New(0), 0);
+    if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+    return -1;
+}
+
 typedef struct {
     const tf_model *model;
     double *out;
@@ -231,6 +244,7 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
         tf_model_state_scale(&m, atol);
         for (int i = 0; i < n; i++) atol[i] *= rtol;
     }
+    if (check_model(&m)) goto done;
     double y[TF_MAX_FRICTION_STATES + 8];
     tf_model_initial_state(&m, y);
     tf_ode ode = tf_model_ode(&m);

@@ -61,7 +61,8 @@ typedef struct {
 typedef void (*tf_emit_fn)(long i, double t, const double *y, void *ctx);
 
 /* Integrates from (t_out[0], y0) through t_out[n_out-1]; y0 is overwritten by the final
- * state (or the state at failure). t_out must be non-decreasing. Returns a tf_status. */
+ * state (or the state at failure). t_out must be non-decreasing, finite and within +-1e12 s
+ * (else TF_ERR_BAD_ARGUMENT). Returns a tf_status. */
 int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
              double *y0, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *stats);
 

@@ -66,6 +66,17 @@ typedef struct {
 /* Invalidate the cached parameters after changing a model's fields. */
 void tf_model_prepare(tf_model *model);
 
+/* Checks a model before it is simulated: every number the plant, friction model, thermal
+ * extension, input and temperature use is finite and in its domain (SPEC 3-5: masses,
+ * stiffnesses, sigma0, fc, C, v_smooth > 0; damping, sigma1, sigma2, z_ba >= 0; fs >= fc;
+ * vs > 0 where fs != fc; elasto-plastic z_ba < fc/sigma0; 1..64 GMS elements with k_i, w_i > 0
+ * summing to one; Model I parameters and Model II's lambda checked at the constant temperature
+ * or over the sampled one; periodic inputs with a positive frequency; for prescribed motion a
+ * continuous input). Returns TF_OK, or TF_ERR_BAD_ARGUMENT with the offending field's name in
+ * *what (a static string; may be NULL). tf_solve does not call it: callers that build models
+ * from user data must (the Python package checks the same rules, with messages). */
+int tf_model_check(const tf_model *model, const char **what);
+
 int tf_model_nstate(const tf_model *model);
 int tf_model_noutput(const tf_model *model);
 double tf_model_temperature(const tf_model *model, double t);
