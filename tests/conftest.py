@@ -1,9 +1,16 @@
+import os
 import subprocess
 import sys
 
 import pytest
 
 import thermofriction as tf
+
+# run_cli's subprocesses may run in another folder (cwd=tmp_path): a relative PYTHONPATH such as
+# PYTHONPATH=src must still find the same package the tests import
+if os.environ.get("PYTHONPATH"):
+    os.environ["PYTHONPATH"] = os.pathsep.join(os.path.abspath(p) for p in os.environ["PYTHONPATH"].split(os.pathsep)
+                                               if p)
 
 
 @pytest.fixture(scope="session")

@@ -17,7 +17,7 @@ import numpy as np
 from . import __version__
 from .errors import InputError, ThermofrictionError
 from .models import PRESETS, MassPlant, load_model
-from .simulate import SOLVERS, StepSizeController, simulate
+from .simulate import MAX_SAMPLES, SOLVERS, StepSizeController, simulate
 from .waveforms import Sampled, parse_waveform
 
 
@@ -91,6 +91,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="absolute tolerance for every state (default: rtol times each state's scale)")
     s.add_argument("--max-steps", type=_positive_int, default=10_000_000, metavar="N",
                    help="step limit (default: 10000000)")
+    s.add_argument("--max-samples", type=_positive_int, default=MAX_SAMPLES, metavar="N",
+                   help=f"limit on output samples, duration x sample rate + 1, each ~184 bytes in memory "
+                        f"(default: {MAX_SAMPLES})")
     s.set_defaults(run=cmd_simulate)
 
     i = sub.add_parser(
@@ -177,7 +180,7 @@ def cmd_simulate(args) -> int:
     controller = StepSizeController(rtol=args.rtol, atol=args.atol, max_steps=args.max_steps)
     t0 = time.perf_counter()
     res = simulate(model, args.duration, temperature=temperature, input=waveform, sample_rate=args.sample_rate,
-                   solver=SOLVERS[args.method](), controller=controller)
+                   solver=SOLVERS[args.method](), controller=controller, max_samples=args.max_samples)
     elapsed = time.perf_counter() - t0
     if args.output == "-":
         import io
@@ -329,6 +332,21 @@ def cmd_demo(args) -> int:
     return 0
 
 
+#: each command's output files (argparse dests); their folders must exist before any work starts,
+#: so that a long run does not fail at the end, or write one output and not the next
+_OUTPUT_FILES = {"simulate": ("output",), "identify": ("output", "json"), "validate": ("json",), "report": ("output",)}
+
+
+def _check_output_folders(args):
+    from pathlib import Path
+    for dest in _OUTPUT_FILES.get(args.command, ()):
+        path = getattr(args, dest, None)
+        if path and path != "-":
+            folder = Path(path).parent
+            if not folder.is_dir():
+                raise InputError(f"{path}: folder {folder} does not exist")
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -340,6 +358,7 @@ def main(argv=None) -> int:
 
     warnings.showwarning = show
     try:
+        _check_output_folders(args)
         return args.run(args)
     except ThermofrictionError as e:
         print(f"thermofriction: error: {e}", file=sys.stderr)

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import io
 import math
+import os
 import tomllib
 import warnings
 from pathlib import Path, PurePosixPath
@@ -36,6 +36,22 @@ SAMPLING_TOLERANCE = 0.01           # relative deviation of an interval from the
 TEMPERATURE_RANGE = (-100.0, 300.0)  # [degC] what a temperature sensor on an actuator can plausibly read
 TEMPERATURE_VARIES = 0.5            # [degC] peak-to-peak above which a recorded temperature is a signal
 ROLES = ("fit", "validate")
+MAX_ROWS = 10_000_000               # data rows per experiment file; ~1.5 GB peak at the limit (docs/limits.md)
+MAX_ROWS_ENV = "THERMOFRICTION_MAX_ROWS"
+
+
+def max_rows() -> int:
+    """The row limit of experiment files: ``THERMOFRICTION_MAX_ROWS`` when set, else ``MAX_ROWS``."""
+    text = os.environ.get(MAX_ROWS_ENV, "").strip()
+    if not text:
+        return MAX_ROWS
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise InputError(f"{MAX_ROWS_ENV}={text!r}: must be a positive whole number of rows")
+    return n
 
 
 @dataclasses.dataclass(eq=False)
@@ -202,28 +218,44 @@ def read_experiment_csv(path) -> dict:
         raise InputError(f"{path}: is a folder, not an experiment CSV file") from None
     except OSError as e:
         raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    except ValueError as e:  # a NUL byte in the path
+        raise InputError(f"{str(path)!r}: not a usable file name ({e})") from None
+    rows = raw.count(b"\n") + (not raw.endswith(b"\n")) - 1  # data rows, blank lines included
+    limit = max_rows()
+    if rows > limit:
+        raise InputError(f"{path}: {rows} data rows, more than the limit of {limit} (each row takes ~150 bytes "
+                         f"of memory while loading): downsample the file, or raise the limit with the "
+                         f"environment variable {MAX_ROWS_ENV}=N")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
         line = raw[:e.start].count(b"\n") + 1
         raise InputError(f"{path}: line {line}: not UTF-8 text") from None
-    if not text.strip():
+    del raw  # ~0.4 GB for 10 M rows
+    if not text or text.isspace():  # (no copy, unlike strip())
         raise InputError(f"{path}: empty file (an experiment needs a header row such as "
                          f"time[s],voltage[V],displacement[um] and at least {MIN_SAMPLES} data rows)")
     head, _, body = text.partition("\n")
+    del text
     if not head.strip():
         raise InputError(f"{path}: line 1: blank; the first line must be the header row, "
                          f"e.g. time[s],voltage[V],displacement[um]")
-    cols = _parse_header(path, next(csv.reader([head.rstrip("\r")])))
+    try:
+        header = next(csv.reader([head.rstrip("\r")]))
+    except csv.Error as e:  # e.g. a field beyond the csv module's size limit
+        raise InputError(f"{path}: line 1: not a valid CSV header row ({e})") from None
+    cols = _parse_header(path, header)
     ncol = len(cols)
-    if not body.strip():
+    if not body or body.isspace():
         raise InputError(f"{path}: no data rows (only the header)")
 
     arr = None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:  # the fast path; on any failure the exact scanner finds and names the bad cell
-            arr = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2, dtype=float)
+            # from the file, not io.StringIO(body): that holds 4 bytes per character (3 GB at 10 M rows)
+            arr = np.loadtxt(path, delimiter=",", comments=None, ndmin=2, dtype=float, skiprows=1,
+                             encoding="utf-8-sig")
         except ValueError:
             arr = None
     if arr is None or arr.ndim != 2 or arr.shape[1] != ncol:
@@ -280,7 +312,8 @@ def _is_inside(f: str) -> bool:
 
 
 def _check_temperature(T, where):
-    if isinstance(T, bool) or not isinstance(T, (int, float)) or not math.isfinite(T):
+    # (an int is always finite, and math.isfinite would overflow on one beyond the float range)
+    if isinstance(T, bool) or not isinstance(T, (int, float)) or (isinstance(T, float) and not math.isfinite(T)):
         raise InputError(f"{where}: 'temperature' must be a number [C], got {T!r}")
     lo, hi = TEMPERATURE_RANGE
     if not lo <= T <= hi:
@@ -309,6 +342,8 @@ def load_dataset(path) -> Dataset:
         raise InputError(f"{manifest}: TOML syntax error: {e}") from None
     except (OSError, UnicodeDecodeError) as e:
         raise InputError(f"{manifest}: cannot read ({e})") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
+        raise InputError(f"{manifest}: TOML nested too deeply") from None
     unknown = set(meta) - set(_MANIFEST_KEYS)
     if unknown:
         raise InputError(f"{manifest}: {unknown_keys(unknown, _MANIFEST_KEYS)}")
@@ -335,12 +370,15 @@ def load_dataset(path) -> Dataset:
         f = e.get("file")
         if f is None:
             raise InputError(f"{where}: missing 'file' (the experiment's CSV, relative to the dataset folder)")
-        if not isinstance(f, str) or not f.strip():
+        if not isinstance(f, str) or not f.strip() or not f.isprintable():
             raise InputError(f"{where}: 'file' must be a file name, got {f!r}")
-        target = (folder / f).resolve()
-        if not _is_inside(f) or root not in (target, *target.parents):
+        try:
+            target = (folder / f).resolve()
+        except (OSError, ValueError, RuntimeError):  # a NUL byte, a name too long, a symlink loop
+            target = None
+        if target is None or not _is_inside(f) or root not in (target, *target.parents):
             raise InputError(f"{where}: file '{f}' must be a relative path inside the dataset folder "
-                             f"(no absolute paths, no '..')")
+                             f"(no absolute paths, no '..', no symbolic links leading out)")
         role = e.get("role", "fit")
         if role not in ROLES:
             raise InputError(f"{where}: 'role' must be \"fit\" or \"validate\", got {role!r}")

@@ -43,6 +43,6 @@ class ConditioningWarning(UserWarning):
 def unknown_keys(keys, allowed, what="") -> str:
     """``unknown key 'x' for lugre (allowed: a, b)`` -- one wording for every unknown-key error."""
     keys = sorted(keys)
-    names = ", ".join(f"'{k}'" for k in keys)
+    names = ", ".join(repr(k) for k in keys)  # repr: a key with a line break stays on one line
     head = f"unknown key {names}" if len(keys) == 1 else f"unknown keys {names}"
     return f"{head}{f' for {what}' if what else ''} (allowed: {', '.join(allowed)})"

@@ -32,7 +32,10 @@ _LAW_CODES = {"const": 1, "linear": 2, "exp": 3, "poly": 4, "pwl": 5, "table": 6
 def _num(value, where, key):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(f"{where}: '{key}' must be a number, got {value!r}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond the float range, e.g. 10**400
+        raise InputError(f"{where}: '{key}' must be finite, got an integer too large for a number") from None
     if not math.isfinite(value):
         raise InputError(f"{where}: '{key}' must be finite, got {value!r}")
     return value
@@ -195,7 +198,7 @@ def law_from_dict(d, where: str) -> Law:
     if not isinstance(d, dict):
         raise InputError(f"{where}: a law must be a table such as {{ law = \"linear\", a = ..., b = ... }}")
     kind = d.get("law")
-    if kind not in _LAW_CLASSES:
+    if not isinstance(kind, str) or kind not in _LAW_CLASSES:
         raise InputError(f"{where}: 'law' must be one of {', '.join(_LAW_CLASSES)}, got {kind!r}")
     keys = _LAW_KEYS[kind]
     unknown = set(d) - set(keys) - {"law", "range"}
@@ -372,7 +375,7 @@ PLANT_CODES = {"stick-slip": 0, "mass": 1, "prescribed": 2}
 
 def plant_from_dict(d: dict, where="[plant]"):
     kind = d.get("type")
-    if kind not in PLANTS:
+    if not isinstance(kind, str) or kind not in PLANTS:
         raise InputError(f"{where}: 'type' must be one of {', '.join(repr(k) for k in PLANTS)}, got {kind!r}")
     return PLANTS[kind].from_dict(d, where)
 
@@ -822,7 +825,7 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
                 raise InputError(f"missing section [{sec}]")
         plant = plant_from_dict(d["plant"])
         fmodel = d["friction"].get("model")
-        if fmodel not in FRICTION_MODELS:
+        if not isinstance(fmodel, str) or fmodel not in FRICTION_MODELS:
             raise InputError(f"[friction]: 'model' must be one of {', '.join(FRICTION_MODELS)}, got {fmodel!r}")
         th = d.get("thermal", {"model": "none"})
         if not isinstance(th, dict):
@@ -853,6 +856,9 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
         else:
             raise InputError(f"[thermal]: 'model' must be \"none\", \"I\" or \"II\", got {tkind!r}")
         friction = FRICTION_MODELS[fmodel].from_dict(d["friction"])
+        if isinstance(thermal, ModelI):  # a law replaces the parameter's default (e.g. sigma2 = 0)
+            names = [f.name for f in fields(friction)]
+            friction = replace(friction, **{k: None for k in thermal.laws if k in names})
         inp = waveform_from_dict(d["input"], "[input]", base_dir) if "input" in d else None
         for key in ("name", "description"):
             if key in d and not isinstance(d[key], str):
@@ -880,12 +886,16 @@ def load_model(source) -> Model:
     """Loads a model file, or a shipped preset by name (see ``PRESETS``)."""
     source = os.fspath(source)
     p = Path(source)
-    if not p.exists() and source in PRESETS:
+    try:
+        exists = p.exists()
+    except (OSError, ValueError) as e:  # a name too long for the file system, a NUL byte
+        raise InputError(f"{source[:200]!r}: not a usable file name ({getattr(e, 'strerror', None) or e})") from None
+    if not exists and source in PRESETS:
         ref = preset_path(source)
         text = ref.read_text()
         base_dir = None
     else:
-        if not p.exists():
+        if not exists:
             hint = f" (presets: {', '.join(PRESETS)})" if os.sep not in source and not source.endswith(".toml") else ""
             raise InputError(f"{source}: no such file{hint}")
         try:
@@ -897,6 +907,8 @@ def load_model(source) -> Model:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{source}: TOML syntax error: {e}") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
+        raise InputError(f"{source}: TOML nested too deeply") from None
     return model_from_dict(data, source, base_dir)
 
 

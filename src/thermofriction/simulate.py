@@ -315,21 +315,35 @@ def check_temperatures(model: Model, temperature):
 # simulate
 # ---------------------------------------------------------------------------------------------
 
-def _grid(duration, sample_rate):
+#: Default limit on output samples: each takes ~8 x (8 + internal states) bytes of outputs and about
+#: twice that at the peak (README "Speed": 184 MB for 1,000,001 samples), so 10 million need ~2 GB.
+MAX_SAMPLES = 10_000_000
+
+
+def _check_samples(n, max_samples, what):
+    if max_samples is not None and n > max_samples:
+        raise InputError(f"{n} output samples requested ({what}), above the limit of {max_samples} "
+                         f"(~{n * 184 / 1e9:.3g} GB of memory): lower the duration or the sample rate, or raise "
+                         f"the limit (--max-samples N; max_samples=N in Python, None for no limit)")
+
+
+def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
     if not (duration > 0 and math.isfinite(duration)):
         raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
     if not (sample_rate > 0 and math.isfinite(sample_rate)):
         raise InputError(f"sample rate must be positive, got {sample_rate!r}")
-    n = int(math.floor(duration * sample_rate * (1 + 1e-12))) + 1
-    if n > 200_000_000:
-        raise InputError(f"{n} output samples requested: lower the duration or the sample rate")
+    x = duration * sample_rate * (1 + 1e-12)
+    if not math.isfinite(x) or x >= 2.0 ** 62:
+        raise InputError(f"duration {duration:g} s x sample rate {sample_rate:g} Hz is too many output samples: lower the duration or the sample rate")
+    n = int(math.floor(x)) + 1
+    _check_samples(n, max_samples, f"duration {duration:g} s x sample rate {sample_rate:g} Hz + 1")
     t = np.arange(n) / sample_rate
     return t
 
 
 def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
              sample_rate: float = 10_000.0, t_eval=None, solver=None,
-             controller: StepSizeController | None = None) -> SimulationResult:
+             controller: StepSizeController | None = None, max_samples: int | None = MAX_SAMPLES) -> SimulationResult:
     """Simulates ``model`` from rest.
 
     temperature: constant [degC], a ``Sampled`` signal, or (times, values); required for
@@ -339,6 +353,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         non-decreasing grid starting at the initial time.
     solver: ``AutoSwitch()`` (default), ``Dopri5()`` or ``Rodas4()``.
     controller: ``StepSizeController`` (tolerances, step limits).
+    max_samples: the most output samples allowed (default 10 million, ~2 GB); None for no limit.
     """
     solver = solver or AutoSwitch()
     if isinstance(solver, str):
@@ -353,10 +368,11 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         t_grid = np.ascontiguousarray(t_eval, dtype=float)
         if t_grid.ndim != 1 or t_grid.size < 1 or np.any(np.diff(t_grid) < 0) or not np.all(np.isfinite(t_grid)):
             raise InputError("t_eval must be a non-empty, non-decreasing array of finite times")
+        _check_samples(t_grid.size, max_samples, "t_eval")
     else:
         if duration is None:
             raise InputError("give a duration (seconds) or t_eval")
-        t_grid = _grid(float(duration), float(sample_rate))
+        t_grid = _grid(float(duration), float(sample_rate), max_samples)
     t0, t1 = float(t_grid[0]), float(t_grid[-1])
 
     # period boundaries join the grid so that per-cycle step sizes are exact, not interpolated
@@ -391,16 +407,43 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         message, status, t_fail, h_fail, state, stiff = e.args
         names = nmech + tuple(model.friction.state_names)
         where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, state))
-        hint = ""
+        try:
+            u = float(waveform(t_fail)[0])
+            where += f"; input {u:.6g}"
+        except Exception:  # noqa: BLE001 - the input value is a courtesy, never a second error
+            pass
+        stiff_hint = ("the problem looks stiff: use the stiff solver, Rodas4() or AutoSwitch() "
+                      "(--method rodas4 or --method auto)")
+        explicit = isinstance(solver, Dopri5)
         if status == 3:
-            hint = f"; raise max_steps (now {controller.max_steps})"
-            if stiff:
-                hint = "; the problem looks stiff: use the stiff solver (Rodas4, --method rodas4)" + hint
-        elif status in (1, 2):
-            hint = "; check the parameters for extreme or inconsistent values"
-        raise SolverError(f"integration failed at t = {t_fail:.9g} s (step {h_fail:.3g} s): {message}; "
-                          f"state {where}{hint}", time=t_fail, state=state) from None
+            hint = (f"{stiff_hint}; or " if stiff else
+                    "the run is long for its time scales: " if not explicit else
+                    "the run is long for its time scales or stiff (try --method rodas4 or auto): ")
+            hint += f"raise max_steps (--max-steps, now {controller.max_steps}) or shorten the duration"
+        elif status == 1:
+            hint = ("likely cause: extreme parameter or input values (an overflow) or a model that is "
+                    "unstable with these parameters; check them")
+        elif status == 2:
+            hint = ("likely cause: extreme parameter or input values, or a solution that blows up or "
+                    "jumps faster than the time resolution; check them")
+            if stiff and explicit:
+                hint = f"{stiff_hint}; or {hint}"
+        elif status == 5:
+            hint = "out of memory: lower the duration or the sample rate"
+        else:
+            hint = "this is a bug if the inputs were checked; please report it"
+        raise SolverError(f"integration failed at t = {t_fail:.9g} s (step {h_fail:.3g} s, {solver.name}): "
+                          f"{message}; state {where}; {hint}", time=t_fail, state=state) from None
     stats["solver"] = {0: "auto", 1: "dopri5", 2: "rodas4"}[stats.pop("method")]
+    # the C core keeps the states finite; an output computed from finite but extreme values
+    # (e.g. a 1e165 m amplitude) may still overflow: refuse it rather than return it
+    finite = np.isfinite(out)
+    finite[:, _CHANNELS.index("temperature")] = True  # NaN by design without a thermal part
+    if not finite.all():
+        row, col = np.argwhere(~finite)[0]
+        raise SolverError(f"the output '{(_CHANNELS + tuple(model.friction.state_names))[col]}' is not finite at "
+                          f"t = {t_all[row]:.9g} s ({out[row, col]}): likely cause: extreme parameter or input "
+                          f"values (an overflow); check them", time=float(t_all[row]))
     if cycle_times.size:
         at_cycles = np.searchsorted(t_all, cycle_times - tol)
         x_cycles = out[at_cycles, 4]
@@ -429,4 +472,4 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
 
 
 __all__ = ["simulate", "SimulationResult", "Dopri5", "Rodas4", "AutoSwitch", "StepSizeController", "SOLVERS",
-           "core_spec"]
+           "core_spec", "MAX_SAMPLES"]

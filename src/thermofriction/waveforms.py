@@ -24,6 +24,8 @@ def _finite(name, value, where):
         value = float(value)
     except (TypeError, ValueError):
         raise InputError(f"{where}: '{name}' must be a number, got {value!r}") from None
+    except OverflowError:  # an integer beyond the float range, e.g. 10**400
+        raise InputError(f"{where}: '{name}' must be finite, got an integer too large for a number") from None
     if not math.isfinite(value):
         raise InputError(f"{where}: '{name}' must be finite, got {value!r}")
     return value
@@ -210,7 +212,7 @@ class Sampled(Waveform):
             raise InputError(f"{where}: times and values must be finite")
         if np.any(np.diff(t) <= 0):
             i = int(np.argmax(np.diff(t) <= 0)) + 1
-            raise InputError(f"{where}: time must increase strictly (sample {i + 1}: {t[i]!r} after {t[i - 1]!r})")
+            raise InputError(f"{where}: time must increase strictly (sample {i + 1}: {float(t[i])!r} after {float(t[i - 1])!r})")
         object.__setattr__(self, "time", t)
         object.__setattr__(self, "value", v)
 
@@ -240,38 +242,48 @@ class Sampled(Waveform):
 def read_two_column_csv(path: Path, first: str):
     """A CSV with a header ``first[unit]`` and one value column; time units s or ms."""
     try:
-        with open(path, newline="") as fh:
-            rows = list(csv.reader(fh))
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            reader = csv.reader(fh)
+            numbered = [(reader.line_num, r) for r in reader]  # line_num: the file's line where the row ends
     except OSError as e:
-        raise InputError(f"{path}: cannot read ({e.strerror})") from None
-    rows = [r for r in rows if r and any(c.strip() for c in r)]
+        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    except UnicodeDecodeError as e:
+        raise InputError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start})") from None
+    except ValueError as e:  # a NUL byte in the path
+        raise InputError(f"{str(path)!r}: not a usable file name ({e})") from None
+    except csv.Error as e:
+        raise InputError(f"{path}: line {reader.line_num}: not a valid CSV row ({e})") from None
+    numbered = [(n, r) for n, r in numbered if r and any(c.strip() for c in r)]
+    lines = [n for n, _ in numbered]
+    rows = [r for _, r in numbered]
     if len(rows) < 3:
         raise InputError(f"{path}: needs a header row and at least two data rows")
     header = [h.strip() for h in rows[0]]
     if len(header) != 2:
-        raise InputError(f"{path}: line 1: expected two columns ({first}[s] and a value), got {len(header)}")
+        raise InputError(f"{path}: line {lines[0]}: expected two columns ({first}[s] and a value), got {len(header)}")
     name, _, unit = header[0].partition("[")
     unit = unit.rstrip("]") or "s"
     if name.strip() != first:
-        raise InputError(f"{path}: line 1: the first column must be '{first}[s]', got '{header[0]}'")
+        raise InputError(f"{path}: line {lines[0]}: the first column must be '{first}[s]', got '{header[0]}'")
     scale = {"s": 1.0, "ms": 1e-3}.get(unit)
     if scale is None:
-        raise InputError(f"{path}: line 1: unknown time unit '{unit}' (use s or ms)")
+        raise InputError(f"{path}: line {lines[0]}: unknown time unit '{unit}' (use s or ms)")
     data = np.empty((len(rows) - 1, 2))
-    for i, row in enumerate(rows[1:], start=2):
+    for k, (i, row) in enumerate(zip(lines[1:], rows[1:]), start=2):
         if len(row) != 2:
             raise InputError(f"{path}: line {i}: expected 2 values, got {len(row)}")
         for j, cell in enumerate(row):
             try:
-                data[i - 2, j] = float(cell)
+                data[k - 2, j] = float(cell)
             except ValueError:
                 raise InputError(f"{path}: line {i}, column '{header[j]}': not a number: {cell.strip()!r}") from None
-            if not math.isfinite(data[i - 2, j]):
+            if not math.isfinite(data[k - 2, j]):
                 raise InputError(f"{path}: line {i}, column '{header[j]}': not finite: {cell.strip()!r}")
-    bad = np.nonzero(np.diff(data[:, 0]) <= 0)[0]
+    t = data[:, 0] * scale
+    bad = np.nonzero(np.diff(t) <= 0)[0]  # after scaling: ms to s can merge neighbouring values
     if bad.size:
-        raise InputError(f"{path}: line {bad[0] + 3}: time must increase strictly")
-    return data[:, 0] * scale, data[:, 1]
+        raise InputError(f"{path}: line {lines[bad[0] + 2]}: time must increase strictly")
+    return t, data[:, 1]
 
 
 _KINDS = {"sawtooth": Sawtooth, "sine": Sine, "square": Square, "step": Step}
@@ -279,6 +291,8 @@ _KINDS = {"sawtooth": Sawtooth, "sine": Sine, "square": Square, "step": Step}
 
 def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Waveform:
     """Builds a waveform from a model file's ``[input]`` table or a parsed ``--input`` spec."""
+    if not isinstance(d, dict):
+        raise InputError(f"{where}: must be a table such as {{ waveform = \"sawtooth\", amplitude = 30, frequency = 5 }}")
     d = dict(d)
     kind = d.pop("waveform", None)
     if kind is None:
@@ -288,15 +302,19 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
             extra = set(d) - {"file"}
             if extra:
                 raise InputError(f"{where}: {unknown_keys(extra, ['file'], 'sampled')}")
+            if not isinstance(d["file"], str) or not d["file"].strip():
+                raise InputError(f"{where}: sampled 'file' must be a file name, got {d['file']!r}")
             return Sampled.from_csv(d["file"], base_dir)
         extra = set(d) - {"time", "value"}
-        if extra or not {"time", "value"} <= set(d):
+        if extra:
+            raise InputError(f"{where}: {unknown_keys(extra, ['file', 'time', 'value'], 'sampled')}")
+        if not {"time", "value"} <= set(d):
             raise InputError(f"{where}: sampled takes 'file', or 'time' and 'value' arrays")
         try:
             return Sampled(np.asarray(d["time"], float), np.asarray(d["value"], float))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InputError(f"{where}: sampled 'time' and 'value' must be arrays of numbers") from None
-    cls = _KINDS.get(kind)
+    cls = _KINDS.get(kind) if isinstance(kind, str) else None
     if cls is None:
         raise InputError(f"{where}: unknown waveform '{kind}' (one of: {', '.join([*_KINDS, 'sampled'])})")
     names = [f.name for f in fields(cls)]
@@ -315,7 +333,9 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
 def parse_waveform(spec: str) -> Waveform:
     """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
     ``sampled:file=u.csv``."""
-    where = f"--input '{spec}'"
+    where = f"--input {spec!r}"
+    if not spec.isprintable():  # so that every message below, which quotes parts of it, is one line
+        raise InputError(f"{where}: contains a control character (a line break, tab or NUL)")
     kind, sep, rest = spec.strip().partition(":")
     d: dict = {"waveform": kind.strip()}
     if rest.strip():
