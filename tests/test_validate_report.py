@@ -117,3 +117,17 @@ def test_report_in_a_real_browser_has_no_console_errors_and_every_figure_shows(w
     keep = Path(__file__).resolve().parents[1] / "build" / "report-screenshot.png"
     keep.parent.mkdir(exist_ok=True)
     keep.write_bytes(shot.read_bytes())
+
+
+def test_a_fit_that_did_not_converge_says_so_in_the_report(model_i, tmp_path):
+    """Never silently: an entry whose fit did not converge (success False in its JSON) is named,
+    with the optimiser's message, in the report's warnings; a converged one is not."""
+    from thermofriction.report import Entry
+
+    data = dataset(model_i, [32.0, 38.0], [35.0], duration=0.2)
+    fits = [Entry("stalled", model_i, {"success": False, "message": "maximum evaluations reached"}),
+            Entry("fine", model_i, {"success": True, "message": "converged"})]
+    text = report(fits, data, tmp_path / "r.html")
+    assert "stalled: the fit did not converge: maximum evaluations reached" in text
+    assert "fine: the fit did not converge" not in text
+    assert (tmp_path / "r.html").read_text() == text

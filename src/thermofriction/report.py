@@ -341,7 +341,9 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
     card_html = "".join(f'<div class="card"><div class="k">{html.escape(k)}</div><div class="v">{html.escape(v)}'
                         f'</div><div class="s">{html.escape(s)}</div></div>' for k, v, s in cards)
     parts.append(f'<div class="cards">{card_html}</div>')
-    warns = [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + (e.fit or {}).get("warnings", [])]
+    warns = [f"{e.label}: the fit did not converge: {(e.fit or {}).get('message', '')}" for e in entries
+             if (e.fit or {}).get("success") is False]  # never silently: first, and in every report
+    warns += [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + (e.fit or {}).get("warnings", [])]
     if warns:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
