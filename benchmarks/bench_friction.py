@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -46,6 +45,8 @@ import numpy as np
 import thermofriction as tf
 from thermofriction import _core
 from thermofriction.simulate import core_spec
+
+from _timing import core_timer  # benchmarks/ is the script's folder, first on sys.path
 
 SIGMA0, SIGMA1, SIGMA2 = 1e5, math.sqrt(1e5), 0.4
 FC, FS, VS = 1.0, 1.5, 1e-3
@@ -117,20 +118,9 @@ def part_i():
 def part_ii(duration=10.0, rate=1000.0, repeats=5):
     print(f"\n(ii) tf.simulate, {duration:g} s of stick-slip (k_s = 2 N/m, v0 = 0.1 m/s), output at "
           f"{rate / 1000:g} kHz, default solver and tolerances; best of {repeats}")
-    tfs = sys.modules["thermofriction.simulate"]
-    core_simulate = tfs._core.simulate
-    core_time = []
-
-    def timed(*args):  # the integration itself (C), separated from simulate()'s Python around it
-        t0 = time.perf_counter()
-        try:
-            return core_simulate(*args)
-        finally:
-            core_time.append(time.perf_counter() - t0)
 
     rows = []
-    tfs._core.simulate = timed
-    try:
+    with core_timer() as core_time:  # the integration itself (C), apart from simulate()'s Python
         for name, friction in MODELS.items():
             model = tf.Model(PLANT, friction)
             runs = []
@@ -144,8 +134,6 @@ def part_ii(duration=10.0, rate=1000.0, repeats=5):
             onset = np.flatnonzero(v > 10 * VS)
             rows.append((name, wall, c, res.stats, res.time[onset[0]] if onset.size else math.nan,
                          float(res.friction_force.max()), float(v.max())))
-    finally:
-        tfs._core.simulate = core_simulate
     ref = rows[0][1]
     w = max(len(r[0]) for r in rows)
     print(f"    {'model':{w}s}  {'wall [ms]':>9s}  {'C core [ms]':>11s}  {'steps':>6s}  {'rejected':>8s}  "

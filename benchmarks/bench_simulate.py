@@ -32,6 +32,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import thermofriction as tf  # noqa: E402
 import reference as R  # noqa: E402
+from _timing import core_timer  # noqa: E402  (benchmarks/ is the script's folder, first on sys.path)
 
 T_C = 35.7
 DURATION = 2.0
@@ -122,24 +123,12 @@ def part_i():
 
 def part_ii():
     print("\n(ii) cost against simulated time (Model I preset at 35.7 C, 10 kHz output, default solver)")
-    tfs = sys.modules["thermofriction.simulate"]  # the module (the package exports the function under its name)
-
-    core_time = []
-    core_simulate = tfs._core.simulate
-
-    def timed(*args):  # the integration itself (C), separated from simulate()'s Python around it
-        t0 = time.perf_counter()
-        try:
-            return core_simulate(*args)
-        finally:
-            core_time.append(time.perf_counter() - t0)
 
     model = tf.load_model("li2009-model-i")
     print(f"    {'simulated [s]':>13s}  {'wall [s]':>9s}  {'per simulated s [ms]':>20s}  {'in C core [s]':>13s}  "
           f"{'C per sim. s [ms]':>17s}  {'steps':>8s}")
     per, per_c = [], []
-    tfs._core.simulate = timed
-    try:
+    with core_timer() as core_time:  # the integration itself (C), apart from simulate()'s Python
         for d, n in ((1.0, 7), (10.0, 3), (100.0, 2)):
             walls = []
             for _ in range(n):
@@ -152,8 +141,6 @@ def part_ii():
             per_c.append(tc / d)
             print(f"    {d:13g}  {t:9.4f}  {1e3 * t / d:20.3f}  {tc:13.4f}  {1e3 * tc / d:17.3f}  "
                   f"{res.stats['steps']:8d}")
-    finally:
-        tfs._core.simulate = core_simulate
     print(f"    growth of the time per simulated second, 100 s / 1 s: whole call {per[2] / per[0]:.2f}, "
           f"C core {per_c[2] / per_c[0]:.2f} (1 = linear)")
 

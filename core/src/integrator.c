@@ -280,7 +280,6 @@ static double initial_step(work *w, double t, const double *y, const double *f0,
     return fmin(100.0 * h0, h1);
 }
 
-/* Work in right-hand-side evaluations, counting a Jacobian and an LU as a few of them. */
 /* Work in right-hand-side evaluations, for AUTO's choice. Deterministic (counted, not timed),
  * so that the same problem always takes the same path. An analytic Jacobian costs a few rhs
  * evaluations plus its n^2 entries; a dense LU ~n^3/3 flops, about one rhs evaluation of a

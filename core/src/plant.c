@@ -394,15 +394,21 @@ static const char *check_at(const tf_model *m, double T)
     return 0;
 }
 
+/* n >= 2 points with finite values and strictly increasing finite times (knots). */
+static int knots_ok(int n, const double *x, const double *y)
+{
+    if (n < 2 || !x || !y) return 0;
+    for (int i = 0; i < n; i++)
+        if (!isfinite(x[i]) || !isfinite(y[i]) || (i && !(x[i] > x[i - 1]))) return 0;
+    return 1;
+}
+
 static int law_ok(const tf_law *L)
 {
     if (L->kind < TF_LAW_NONE || L->kind > TF_LAW_TABLE) return 0;
     if (L->kind == TF_LAW_POLY && (L->n < 1 || !L->y)) return 0;
-    if (L->kind == TF_LAW_PWL || L->kind == TF_LAW_TABLE) {
-        if (L->n < 2 || !L->x || !L->y || (L->kind == TF_LAW_TABLE && !L->d)) return 0;
-        for (int i = 0; i < L->n; i++)
-            if (!isfinite(L->x[i]) || !isfinite(L->y[i]) || (i && !(L->x[i] > L->x[i - 1]))) return 0;
-    }
+    if (L->kind == TF_LAW_PWL || L->kind == TF_LAW_TABLE)
+        return knots_ok(L->n, L->x, L->y) && (L->kind != TF_LAW_TABLE || L->d);
     return 1;
 }
 
@@ -412,11 +418,10 @@ static const char *check_input(const tf_model *m)
     int prescribed = m->plant == TF_PLANT_PRESCRIBED;
     if (w->kind == TF_WAVE_ZERO) return 0;
     if (w->kind == TF_WAVE_SAMPLED) {
-        if (w->n < 2 || !w->t || !w->v) return "input (sampled: at least two points)";
-        for (int i = 0; i < w->n; i++)
-            if (!isfinite(w->t[i]) || !isfinite(w->v[i]) || (i && !(w->t[i] > w->t[i - 1])) ||
-                (i && prescribed && !isfinite((w->v[i] - w->v[i - 1]) / (w->t[i] - w->t[i - 1]))))
-                return "input (sampled: finite values and slopes, strictly increasing times)";
+        if (!knots_ok(w->n, w->t, w->v)) return "input (sampled: two or more finite points, times increasing)";
+        for (int i = 1; prescribed && i < w->n; i++)
+            if (!isfinite((w->v[i] - w->v[i - 1]) / (w->t[i] - w->t[i - 1])))
+                return "input (sampled: slope not finite)";
         return 0;
     }
     if (!isfinite(w->amplitude) || !isfinite(w->offset)) return "input (amplitude, offset)";
@@ -497,12 +502,8 @@ int tf_model_check(const tf_model *m, const char **what)
         else if (m->dF_form != TF_DF_SCALE && m->dF_form != TF_DF_OFFSET) bad = "dF form";
     }
     if (!bad) bad = check_input(m);
-    if (!bad && m->T_n > 0) {
-        if (m->T_n < 2 || !m->T_t || !m->T_v) bad = "temperature (sampled: at least two points)";
-        for (int i = 0; !bad && i < m->T_n; i++)
-            if (!isfinite(m->T_t[i]) || !isfinite(m->T_v[i]) || (i && !(m->T_t[i] > m->T_t[i - 1])))
-                bad = "temperature (finite values, strictly increasing times)";
-    }
+    if (!bad && m->T_n > 0 && !knots_ok(m->T_n, m->T_t, m->T_v))
+        bad = "temperature (sampled: two or more finite points, times increasing)";
     if (!bad && m->thermal != TF_THERMAL_NONE) {
         if (m->T_n > 0) {
             /* the temperature sweeps [min, max] of its samples: the knots and a fine grid */

@@ -1,0 +1,27 @@
+"""Shared by the benchmark scripts: time the C integrator apart from simulate()'s Python around it."""
+
+import contextlib
+import sys
+import time
+
+
+@contextlib.contextmanager
+def core_timer():
+    """While active, every call of the C integrator (``thermofriction._core.simulate``, as
+    ``thermofriction.simulate`` calls it) appends its wall time [s] to the yielded list."""
+    tfs = sys.modules["thermofriction.simulate"]  # the module (the package exports the function under its name)
+    core_simulate = tfs._core.simulate
+    times = []
+
+    def timed(*args):
+        t0 = time.perf_counter()
+        try:
+            return core_simulate(*args)
+        finally:
+            times.append(time.perf_counter() - t0)
+
+    tfs._core.simulate = timed
+    try:
+        yield times
+    finally:
+        tfs._core.simulate = core_simulate
