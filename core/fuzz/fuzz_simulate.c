@@ -238,8 +238,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     if (!valid) return 0;
     int n = tf_model_nstate(&m);
-    if (n < 0 || n > TF_MAX_FRICTION_STATES + 4) FAIL("state count out of range");
-    double y[TF_MAX_FRICTION_STATES + 4], atol[TF_MAX_FRICTION_STATES + 4];
+    if (n < 0 || n > TF_MAX_STATES) FAIL("state count out of range");
+    double y[TF_MAX_STATES], atol[TF_MAX_STATES];
     tf_model_initial_state(&m, y);
     tf_model_state_scale(&m, atol);
     double rtol = pow(10.0, -(double)(2 + byte(&r) % 9));

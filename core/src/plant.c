@@ -15,11 +15,26 @@ static int nmech(const tf_model *m)
 
 static int nfric(const tf_model *m) { return tf_friction_nstate(m->friction, m->gms.n); }
 
+static int has_work(const tf_model *m) { return m->heat.on || m->work; }
+
 void tf_model_prepare(tf_model *model) { model->cache_valid = 0; }
 
-int tf_model_nstate(const tf_model *model) { return nmech(model) + nfric(model); }
+int tf_model_nstate(const tf_model *model)
+{
+    return nmech(model) + nfric(model) + (model->heat.on != 0) + has_work(model);
+}
 
-int tf_model_noutput(const tf_model *model) { return TF_OUT_NFIXED + nfric(model); }
+int tf_model_noutput(const tf_model *model) { return TF_OUT_NFIXED + nfric(model) + has_work(model); }
+
+int tf_model_temperature_index(const tf_model *model)
+{
+    return model->heat.on ? nmech(model) + nfric(model) : -1;
+}
+
+int tf_model_work_index(const tf_model *model)
+{
+    return has_work(model) ? nmech(model) + nfric(model) + (model->heat.on != 0) : -1;
+}
 
 /* Relative sliding velocity v_r of the driven body on its driving surface. */
 static double relative_velocity(const tf_model *m, double t, const double *y)
@@ -31,8 +46,9 @@ static double relative_velocity(const tf_model *m, double t, const double *y)
     }
 }
 
-double tf_model_temperature(const tf_model *model, double t)
+double tf_model_temperature(const tf_model *model, double t, const double *y)
 {
+    if (model->heat.on) return y[nmech(model) + nfric(model)];
     if (model->T_n > 0) return tf_pwl_value(model->T_n, model->T_t, model->T_v, t);
     return model->T_const;
 }
@@ -71,15 +87,14 @@ static const double *params(tf_model *m, double T, double *lambda, double *dF)
     return m->cache_p;
 }
 
-/* F' and, when jac is given, its partials (overwriting the base model's partials). The base
- * model's parameter partials go to dp, untouched by the thermal factor (the caller applies it). */
-/* F' and, when jac is given, its partials (overwriting the base model's partials). The base
- * model's parameter partials go to dp, untouched by the thermal factor (the caller applies it). */
-static double friction_full(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac,
-                            tf_friction_param_partials *dp, double *F_base)
+/* F' at temperature T and, when jac is given, its partials (overwriting the base model's
+ * partials). The base model's parameter partials go to dp, untouched by the thermal factor
+ * (the caller applies it). */
+static double friction_at(tf_model *m, double T, double t, const double *y, double *dz, tf_friction_partials *jac,
+                          tf_friction_param_partials *dp, double *F_base)
 {
     double lambda, dF;
-    const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
+    const double *p = params(m, T, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
     double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
@@ -102,7 +117,7 @@ static double friction_full(tf_model *m, double t, const double *y, double *dz, 
 
 static double friction(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac)
 {
-    return friction_full(m, t, y, dz, jac, 0, 0);
+    return friction_at(m, tf_model_temperature(m, t, y), t, y, dz, jac, 0, 0);
 }
 
 double tf_model_friction(const tf_model *model, double t, const double *y)
@@ -114,6 +129,7 @@ double tf_model_friction(const tf_model *model, double t, const double *y)
 void tf_model_initial_state(const tf_model *model, double *y)
 {
     memset(y, 0, sizeof(double) * tf_model_nstate(model));
+    if (model->heat.on) y[tf_model_temperature_index(model)] = model->heat.T_0;
 }
 
 static double input_peak(const tf_waveform *w)
@@ -130,7 +146,7 @@ static double input_peak(const tf_waveform *w)
 void tf_model_state_scale(const tf_model *model, double *scale)
 {
     double p[TF_NPARAM];
-    tf_model_params_at(model, tf_model_temperature(model, 0.0), p);
+    tf_model_params_at(model, model->heat.on ? model->heat.T_0 : tf_model_temperature(model, 0.0, 0), p);
     const tf_waveform *w = &model->input;
     double upeak = input_peak(w);
     double period = (w->kind == TF_WAVE_SAWTOOTH || w->kind == TF_WAVE_SINE || w->kind == TF_WAVE_SQUARE)
@@ -177,6 +193,25 @@ void tf_model_state_scale(const tf_model *model, double *scale)
     }
     for (int j = 0; j < nz; j++)
         scale[nm + j] = model->friction == TF_FRICTION_GMS ? p[TF_P_FC] * fmax(model->gms.w[j], 1e-3) : Z;
+    /* temperature to rtol kelvin; work to rtol of friction times the stroke (one cycle's worth) */
+    if (model->heat.on) scale[tf_model_temperature_index(model)] = 1.0;
+    if (has_work(model)) {
+        double W = fabs(p[TF_P_FC]) * Xs;
+        scale[tf_model_work_index(model)] = W > 0.0 && isfinite(W) ? W : 1e-9;
+    }
+}
+
+/* Heat balance (SPEC 5.3) and frictional work from the friction power P = |F' v_r|. */
+static void heat_rates(const tf_model *m, double t, const double *y, double F, double *dy)
+{
+    double P = fabs(F * relative_velocity(m, t, y));
+    if (m->heat.on) {
+        const tf_heat *h = &m->heat;
+        int iT = tf_model_temperature_index(m);
+        double P_ext = h->P_ext.kind == TF_WAVE_ZERO ? 0.0 : tf_waveform_value(&h->P_ext, t);
+        dy[iT] = (h->eta * P - (y[iT] - h->T_amb) / h->R_th + P_ext) / h->C_th;
+    }
+    if (has_work(m)) dy[tf_model_work_index(m)] = P;
 }
 
 int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
@@ -184,6 +219,7 @@ int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
     tf_model *m = (tf_model *)ctx;
     int nm = nmech(m);
     double F = friction(m, t, y, dy + nm, 0);
+    if (has_work(m)) heat_rates(m, t, y, F, dy);
     if (m->plant == TF_PLANT_STICK_SLIP) {
         double u = tf_waveform_value(&m->input, t);
         dy[XP] = y[VP];
@@ -198,10 +234,59 @@ int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
     return 0;
 }
 
+/* dv_r/dy for the mechanical states (prescribed motion: none). */
+static void velocity_partials(const tf_model *m, double *dv_dy)
+{
+    memset(dv_dy, 0, sizeof(double) * TF_MAX_STATES);
+    if (m->plant == TF_PLANT_STICK_SLIP) dv_dy[VE] = 1.0, dv_dy[VP] = -1.0;
+    else if (m->plant == TF_PLANT_MASS) dv_dy[V] = 1.0;
+}
+
+/* The rows of the temperature and work states, and the temperature column of every row, of the
+ * Jacobian. dF'/dT and dz'/dT come from a central difference in T: the laws are smooth and
+ * most base models have no analytic parameter partials (h = 1e-3 K: truncation ~1e-8 relative
+ * for the paper's laws, far below what Rodas4's Newton-free stages need). */
+static void heat_jacobian(tf_model *m, double t, const double *y, const tf_friction_partials *d, double *J)
+{
+    int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
+    int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
+    double T = tf_model_temperature(m, t, y);
+    double dz[TF_MAX_FRICTION_STATES], dzp[TF_MAX_FRICTION_STATES], dzm[TF_MAX_FRICTION_STATES];
+    double F = friction_at(m, T, t, y, dz, 0, 0, 0), v = relative_velocity(m, t, y);
+    double s = (F * v > 0.0) - (F * v < 0.0);
+    double dv_dy[TF_MAX_STATES], dP[TF_MAX_STATES]; /* dP/dy, P = |F v| */
+    velocity_partials(m, dv_dy);
+    for (int k = 0; k < n; k++) dP[k] = s * (v * d->dF_dv + F) * dv_dy[k];
+    for (int j = 0; j < nz; j++) dP[nm + j] += s * v * d->dF_dz[j];
+    double dF_dT = 0.0, ddz_dT[TF_MAX_FRICTION_STATES] = {0};
+    if (m->heat.on && m->thermal != TF_THERMAL_NONE) {
+        const double h = 1e-3;
+        double Fp = friction_at(m, T + h, t, y, dzp, 0, 0, 0), Fm = friction_at(m, T - h, t, y, dzm, 0, 0, 0);
+        dF_dT = (Fp - Fm) / (2 * h);
+        for (int j = 0; j < nz; j++) ddz_dT[j] = (dzp[j] - dzm[j]) / (2 * h);
+    }
+#define J_(i, j) J[(i) * n + (j)]
+    if (m->heat.on) {
+        dP[iT] = s * v * dF_dT;
+        if (m->plant == TF_PLANT_STICK_SLIP) {
+            J_(VP, iT) = dF_dT / m->m;
+            J_(VE, iT) = -dF_dT / m->m_e;
+        } else if (m->plant == TF_PLANT_MASS) {
+            J_(V, iT) = -dF_dT / m->m;
+        }
+        for (int j = 0; j < nz; j++) J_(nm + j, iT) = ddz_dT[j];
+        const tf_heat *h = &m->heat;
+        for (int k = 0; k < n; k++) J_(iT, k) = h->eta * dP[k] / h->C_th;
+        J_(iT, iT) -= 1.0 / (h->R_th * h->C_th);
+    }
+    for (int k = 0; k < n; k++) J_(iW, k) = dP[k];
+#undef J_
+}
+
 int tf_model_jac(double t, const double *y, double *J, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
-    int n = tf_model_nstate(m), nm = nmech(m), nz = n - nm;
+    int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     double dz[TF_MAX_FRICTION_STATES];
     tf_friction_partials d;
     friction(m, t, y, dz, &d);
@@ -232,21 +317,23 @@ int tf_model_jac(double t, const double *y, double *J, void *ctx)
     }
     for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d.ddz_dz[j];
 #undef J_
+    if (has_work(m)) heat_jacobian(m, t, y, &d, J);
     return 0;
 }
 
 int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
                          const tf_target *targets, int np, double *fp)
 {
-    int n = tf_model_nstate(m), nm = nmech(m), nz = n - nm;
+    int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
+    int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
     tf_model_rhs(t, y, dy, m);
     if (J) tf_model_jac(t, y, J, m);
     if (!np) return 0;
     tf_friction_param_partials dp;
     double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
-    double T = tf_model_temperature(m, t);
+    double T = tf_model_temperature(m, t, y);
     params(m, T, &lambda, &dF_offset);
-    friction_full(m, t, y, dz, 0, &dp, &Fb);
+    double F = friction_at(m, T, t, y, dz, 0, &dp, &Fb);
     if (m->fs_follows_fc) { /* one parameter moves both */
         dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
         for (int j = 0; j < nz; j++) dp.ddz_dp[j][TF_P_FC] += dp.ddz_dp[j][TF_P_FS];
@@ -254,10 +341,22 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
     int scale = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_SCALE;
     double Fref = tf_friction_reference_force(m->friction, m->p);
     double v = relative_velocity(m, t, y);
+    double s = (F * v > 0.0) - (F * v < 0.0); /* d|F v|/dF = s v */
     for (int k = 0; k < np; k++) {
         const tf_target *tg = &targets[k];
         double dF = 0.0, chain = 1.0; /* dF'/dtheta and d(param)/dtheta */
         int i = tg->param;
+        for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
+        if (tg->kind == TF_TARGET_HEAT) { /* only the heat balance depends on these */
+            const tf_heat *h = &m->heat;
+            if (!h->on) continue;
+            double rate = dy[iT];
+            fp[iT * np + k] = i == TF_HEAT_C_TH   ? -rate / h->C_th
+                              : i == TF_HEAT_R_TH ? (y[iT] - h->T_amb) / (h->R_th * h->R_th * h->C_th)
+                              : i == TF_HEAT_ETA  ? fabs(F * v) / h->C_th
+                              : i == TF_HEAT_T_AMB ? 1.0 / (h->R_th * h->C_th) : 0.0;
+            continue;
+        }
         if (tg->kind == TF_TARGET_DF) {
             double dlaw = tf_law_coef_derivative(&m->dF, tg->coef, T);
             if (scale) dF = Fb / Fref * dlaw;
@@ -267,7 +366,6 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
             dF = chain * dp.dF_dp[i] * (scale ? lambda : 1.0);
             if (scale && i == TF_P_FC) dF -= (lambda - 1.0) / Fref * Fb; /* F_ref = fc; dF(T) = (lambda-1) F_ref */
         }
-        for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
         if (m->plant == TF_PLANT_STICK_SLIP) {
             fp[VP * np + k] = dF / m->m;
             fp[VE * np + k] = -dF / m->m_e;
@@ -276,6 +374,8 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         }
         if (tg->kind != TF_TARGET_DF)
             for (int j = 0; j < nz; j++) fp[(nm + j) * np + k] = chain * dp.ddz_dp[j][i];
+        if (iT >= 0) fp[iT * np + k] = m->heat.eta * s * v * dF / m->heat.C_th;
+        if (iW >= 0) fp[iW * np + k] = s * v * dF;
     }
     return 0;
 }
@@ -285,7 +385,11 @@ double tf_model_next_corner(double t, void *ctx)
     tf_model *m = (tf_model *)ctx;
     double c = tf_waveform_next_corner(&m->input, t);
     if (m->plant == TF_PLANT_PRESCRIBED) c = fmin(c, tf_waveform_next_reversal(&m->input, t));
-    if (m->T_n > 0) c = fmin(c, tf_pwl_next_knot(m->T_n, m->T_t, t));
+    if (m->heat.on) {
+        if (m->heat.P_ext.kind != TF_WAVE_ZERO) c = fmin(c, tf_waveform_next_corner(&m->heat.P_ext, t));
+    } else if (m->T_n > 0) {
+        c = fmin(c, tf_pwl_next_knot(m->T_n, m->T_t, t));
+    }
     return c;
 }
 
@@ -295,7 +399,7 @@ void tf_model_events(double t, const double *y, double *g, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double lambda, dF;
-    const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
+    const double *p = params(m, tf_model_temperature(m, t, y), &lambda, &dF);
     tf_friction_events(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m), g);
 }
 
@@ -303,7 +407,7 @@ void tf_model_on_restart(double t, const double *y, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double lambda, dF;
-    const double *p = params(m, tf_model_temperature(m, t), &lambda, &dF);
+    const double *p = params(m, tf_model_temperature(m, t, y), &lambda, &dF);
     double v = relative_velocity(m, t, y);
     if (m->plant == TF_PLANT_PRESCRIBED) {
         /* a prescribed motion keeps one direction between restarts (corners and reversals), but
@@ -341,8 +445,9 @@ void tf_model_outputs(const tf_model *model, double t, const double *y, double *
     out[TF_OUT_RELATIVE_DISPLACEMENT] = x - xp;
     out[TF_OUT_RELATIVE_VELOCITY] = v - vp;
     out[TF_OUT_FRICTION_FORCE] = tf_model_friction(model, t, y);
-    out[TF_OUT_TEMPERATURE] = tf_model_temperature(model, t);
+    out[TF_OUT_TEMPERATURE] = tf_model_temperature(model, t, y);
     for (int j = 0; j < nz; j++) out[TF_OUT_NFIXED + j] = y[nm + j];
+    if (has_work(model)) out[TF_OUT_NFIXED + nz] = y[tf_model_work_index(model)];
 }
 
 /* ---- model check (the C side of the Python package's parameter checks) ---- */
@@ -412,10 +517,8 @@ static int law_ok(const tf_law *L)
     return 1;
 }
 
-static const char *check_input(const tf_model *m)
+static const char *check_waveform(const tf_waveform *w, int prescribed)
 {
-    const tf_waveform *w = &m->input;
-    int prescribed = m->plant == TF_PLANT_PRESCRIBED;
     if (w->kind == TF_WAVE_ZERO) return 0;
     if (w->kind == TF_WAVE_SAMPLED) {
         if (!knots_ok(w->n, w->t, w->v)) return "input (sampled: two or more finite points, times increasing)";
@@ -501,11 +604,23 @@ int tf_model_check(const tf_model *m, const char **what)
         if (m->dF.kind == TF_LAW_NONE || !law_ok(&m->dF)) bad = "dF";
         else if (m->dF_form != TF_DF_SCALE && m->dF_form != TF_DF_OFFSET) bad = "dF form";
     }
-    if (!bad) bad = check_input(m);
+    if (!bad) bad = check_waveform(&m->input, m->plant == TF_PLANT_PRESCRIBED);
+    if (!bad && m->heat.on) {
+        const tf_heat *h = &m->heat;
+        if (!pos(h->C_th)) bad = "heat.C_th";
+        else if (!pos(h->R_th)) bad = "heat.R_th";
+        else if (!(nonneg(h->eta) && h->eta <= 1.0)) bad = "heat.eta (0 to 1)";
+        else if (!isfinite(h->T_amb)) bad = "heat.T_amb";
+        else if (!isfinite(h->T_0)) bad = "heat.T_0";
+        else if (check_waveform(&h->P_ext, 0)) bad = "heat.P_ext";
+    }
     if (!bad && m->T_n > 0 && !knots_ok(m->T_n, m->T_t, m->T_v))
         bad = "temperature (sampled: two or more finite points, times increasing)";
     if (!bad && m->thermal != TF_THERMAL_NONE) {
-        if (m->T_n > 0) {
+        if (m->heat.on) { /* the temperature is a state: where it starts and where it tends */
+            bad = check_at(m, m->heat.T_0);
+            if (!bad) bad = check_at(m, m->heat.T_amb);
+        } else if (m->T_n > 0) {
             /* the temperature sweeps [min, max] of its samples: the knots and a fine grid */
             double lo = INFINITY, hi = -INFINITY;
             for (int i = 0; !bad && i < m->T_n; i++) {

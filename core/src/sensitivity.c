@@ -7,7 +7,7 @@ int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
 {
     tf_sensitivity_system *s = (tf_sensitivity_system *)ctx;
     int n = tf_model_nstate(s->model), np = s->np;
-    double J[(TF_MAX_FRICTION_STATES + 4) * (TF_MAX_FRICTION_STATES + 4)];
+    double J[TF_MAX_STATES * TF_MAX_STATES];
     double *fp = dY + n; /* df/dtheta lands where dS goes, then J S is added */
     tf_model_derivatives(s->model, t, Y, dY, J, s->targets, np, fp);
     const double *S = Y + n;

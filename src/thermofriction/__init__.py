@@ -13,7 +13,7 @@ extensions (Li et al., Rev. Sci. Instrum. 80,
 from .errors import (ComputationError, ConditioningWarning, InputError, PassivityWarning, SolverError,
                      TemperatureRangeWarning,
                      ThermofrictionError)
-from .models import (GMS, PARAMETERS, PRESETS, PWL, Const, Coulomb, Dahl, ElastoPlastic, Exp, Law, Linear, LuGre,
+from .models import (GMS, PARAMETERS, PRESETS, PWL, Const, Coulomb, Dahl, ElastoPlastic, Exp, Heat, Law, Linear, LuGre,
                      MassPlant, Model, ModelI, ModelII, Poly, PrescribedMotion, StickSlipPlant, Stribeck, Table,
                      load_model)
 from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
@@ -29,7 +29,7 @@ __all__ = [
     "ComputationError", "ConditioningWarning", "InputError", "PassivityWarning", "SolverError", "TemperatureRangeWarning",
     "ThermofrictionError",
     "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "Model", "ModelI", "ModelII", "Poly", "Table",
-    "load_model",
+    "Heat", "load_model",
     "StickSlipPlant", "MassPlant", "PrescribedMotion",
     "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
     "AutoSwitch", "Dopri5", "Rodas4", "SimulationResult", "StepSizeController", "simulate",

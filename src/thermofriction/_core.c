@@ -169,6 +169,20 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
     if (PyErr_Occurred()) return -1;
     if (nt != nv) { PyErr_SetString(PyExc_ValueError, "temperature times and values differ in length"); return -1; }
     m->T_n = (int)nt;
+    /* optional: heat = (C_th, R_th, eta, T_amb, T_0, P_ext waveform or None); work = 0/1 */
+    PyObject *heat = PyDict_GetItemString(spec, "heat");
+    if (heat && heat != Py_None) {
+        PyObject *P_ext = NULL;
+        tf_heat *h = &m->heat;
+        if (!PyArg_ParseTuple(heat, "dddddO", &h->C_th, &h->R_th, &h->eta, &h->T_amb, &h->T_0, &P_ext)) return -1;
+        h->on = 1;
+        if (P_ext != Py_None && parse_waveform(a, P_ext, &h->P_ext)) return -1;
+    }
+    PyObject *work = PyDict_GetItemString(spec, "work");
+    if (work && work != Py_None) {
+        m->work = PyObject_IsTrue(work);
+        if (m->work < 0) return -1;
+    }
     return 0;
 }
 
@@ -234,7 +248,7 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
         PyErr_Format(PyExc_ValueError, "out must be a float64 array of shape (%zd, %d)", n_out, nch);
         goto done;
     }
-    double atol[TF_MAX_FRICTION_STATES + 8];
+    double atol[TF_MAX_STATES];
     const double *atol_in = get_array(&a, atol_obj, &n_atol, "atol");
     if (PyErr_Occurred()) goto done;
     if (atol_in) {
@@ -245,7 +259,7 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
         for (int i = 0; i < n; i++) atol[i] *= rtol;
     }
     if (check_model(&m)) goto done;
-    double y[TF_MAX_FRICTION_STATES + 8];
+    double y[TF_MAX_STATES];
     tf_model_initial_state(&m, y);
     tf_ode ode = tf_model_ode(&m);
     tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps};
@@ -314,7 +328,8 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
         const tf_law *law = targets[k].kind == TF_TARGET_DF ? &m.dF
                             : targets[k].kind == TF_TARGET_LAW && targets[k].param >= 0 && targets[k].param < TF_NPARAM
                                 ? &m.law[targets[k].param] : NULL;
-        int bad = targets[k].kind < 0 || targets[k].kind > 2 || targets[k].param < 0 || targets[k].param >= TF_NPARAM;
+        int bad = targets[k].kind < 0 || targets[k].kind > 3 || targets[k].param < 0 ||
+                  targets[k].param >= (targets[k].kind == TF_TARGET_HEAT ? TF_HEAT_NPARAM : TF_NPARAM);
         if (!bad && law && (targets[k].coef < 0 || targets[k].coef >= tf_law_ncoef(law))) bad = 1;
         if (bad) { PyErr_Format(PyExc_ValueError, "target %d is not valid for this model", k); goto done; }
     }
@@ -414,7 +429,7 @@ static PyObject *py_time_rhs(PyObject *self, PyObject *args)
     const double *y = get_array(&a, y_obj, &ny, "y");
     if (PyErr_Occurred()) goto done;
     if (ny != n || n_evals < 1) { PyErr_Format(PyExc_ValueError, "y must have %d values, n_evals >= 1", n); goto done; }
-    double dy[TF_MAX_FRICTION_STATES + 8], sink = 0.0;
+    double dy[TF_MAX_STATES], sink = 0.0;
     struct timespec t0, t1;
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
@@ -507,7 +522,7 @@ static PyObject *py_state_scale(PyObject *self, PyObject *args)
     tf_model m;
     PyObject *result = NULL;
     if (parse_model(&a, spec, &m) == 0) {
-        double scale[TF_MAX_FRICTION_STATES + 8];
+        double scale[TF_MAX_STATES];
         int n = tf_model_nstate(&m);
         tf_model_state_scale(&m, scale);
         result = PyTuple_New(n);

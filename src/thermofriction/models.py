@@ -707,12 +707,94 @@ class ModelII:
 
 
 # ---------------------------------------------------------------------------------------------
+# Self-heating
+# ---------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Heat:
+    """Lumped thermal model of the friction interface (SPEC 5.3): the temperature becomes a state,
+
+        C_th T' = eta |F v_r| - (T - T_amb) / R_th + P_ext(t),    T(0) = T_0.
+
+    ``heat_capacity`` C_th [J/K], ``thermal_resistance`` R_th [K/W] to ambient, ``heat_fraction``
+    eta (0..1) of the friction power that heats the interface, ``ambient_temperature`` T_amb
+    [degC] (None: the temperature given to ``simulate``), ``initial_temperature`` T_0 (None:
+    T_amb), ``external_heat`` P_ext(t) [W] (a waveform, e.g. the paper's heater; None: none).
+    """
+
+    heat_capacity: float
+    thermal_resistance: float
+    heat_fraction: float = 1.0
+    ambient_temperature: float | None = None
+    initial_temperature: float | None = None
+    external_heat: Waveform | None = None
+
+    _SYMBOLS = {"heat_capacity": "C_th", "thermal_resistance": "R_th", "heat_fraction": "eta",
+                "ambient_temperature": "T_amb", "initial_temperature": "T_0", "external_heat": "P_ext"}
+
+    def __post_init__(self):
+        where = "[heat]"
+        for name in ("heat_capacity", "thermal_resistance", "heat_fraction", "ambient_temperature",
+                     "initial_temperature"):
+            v = getattr(self, name)
+            if v is None and name in ("ambient_temperature", "initial_temperature"):
+                continue
+            sym = self._SYMBOLS[name]
+            v = _num(v, where, sym)
+            if name in ("heat_capacity", "thermal_resistance") and not v > 0:
+                raise InputError(f"{where}: '{sym}' must be positive, got {v!r}")
+            if name == "heat_fraction" and not 0 <= v <= 1:
+                raise InputError(f"{where}: 'eta' must be between 0 and 1, got {v!r}")
+            object.__setattr__(self, name, v)
+        if self.external_heat is not None and not isinstance(self.external_heat, Waveform):
+            raise InputError(f"{where}: 'P_ext' must be a waveform")
+
+    @property
+    def time_constant(self) -> float:
+        """R_th C_th [s]."""
+        return self.thermal_resistance * self.heat_capacity
+
+    def resolved(self, temperature=None) -> "Heat":
+        """This model with T_amb (``temperature`` overrides the file's) and T_0 filled in."""
+        T_amb = self.ambient_temperature if temperature is None else float(temperature)
+        if T_amb is None:
+            raise InputError("[heat]: no ambient temperature: give 'T_amb' or a temperature (e.g. --temperature 30)")
+        T_0 = self.initial_temperature if self.initial_temperature is not None else T_amb
+        return replace(self, ambient_temperature=T_amb, initial_temperature=T_0)
+
+    def to_dict(self) -> dict:
+        d = {}
+        for name, sym in self._SYMBOLS.items():
+            v = getattr(self, name)
+            if v is not None:
+                d[sym] = v.to_dict() if isinstance(v, Waveform) else v
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[heat]", base_dir=None):
+        if not isinstance(d, dict):
+            raise InputError(f"{where} must be a section")
+        names = {sym: name for name, sym in cls._SYMBOLS.items()}
+        unknown = set(d) - set(names)
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, list(names), 'the heat model')}")
+        for req in ("C_th", "R_th"):
+            if req not in d:
+                raise InputError(f"{where}: missing '{req}'")
+        kw = {names[k]: v for k, v in d.items()}
+        if "external_heat" in kw:
+            kw["external_heat"] = waveform_from_dict(kw["external_heat"], f"{where} P_ext", base_dir)
+        return cls(**kw)
+
+
+# ---------------------------------------------------------------------------------------------
 # The model
 # ---------------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class Model:
-    """One actuator: plant, friction model, thermal extension (or None) and input (or None)."""
+    """One actuator: plant, friction model, thermal extension (or None), input (or None) and
+    lumped thermal model of self-heating (or None)."""
 
     plant: StickSlipPlant | MassPlant | PrescribedMotion
     friction: LuGre | Coulomb | Stribeck | Dahl | ElastoPlastic | GMS
@@ -720,6 +802,7 @@ class Model:
     input: Waveform | None = None
     name: str | None = None
     description: str | None = None
+    heat: Heat | None = None
 
     def __post_init__(self):
         laws = self.thermal.laws if isinstance(self.thermal, ModelI) else {}
@@ -739,6 +822,8 @@ class Model:
         if isinstance(self.thermal, ModelII):
             if not isinstance(self.thermal.dF, Law):
                 raise InputError("[thermal]: 'dF' must be a law")
+        if self.heat is not None and not isinstance(self.heat, Heat):
+            raise InputError("'heat' must be a Heat model (the [heat] section)")
 
     def _number_values(self):
         v = self.friction.values()
@@ -794,6 +879,8 @@ class Model:
         d["plant"] = self.plant.to_dict()
         d["friction"] = self.friction.to_dict()
         d["thermal"] = self.thermal.to_dict() if self.thermal else {"model": "none"}
+        if self.heat is not None:
+            d["heat"] = self.heat.to_dict()
         if self.input is not None:
             d["input"] = self.input.to_dict()
         return d
@@ -811,7 +898,7 @@ class Model:
         return replace(self, friction=self.friction.with_values(**values))
 
 
-_TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "input"}
+_TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "heat", "input"}
 
 
 def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
@@ -860,10 +947,11 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
             names = [f.name for f in fields(friction)]
             friction = replace(friction, **{k: None for k in thermal.laws if k in names})
         inp = waveform_from_dict(d["input"], "[input]", base_dir) if "input" in d else None
+        heat = Heat.from_dict(d["heat"], "[heat]", base_dir) if "heat" in d else None
         for key in ("name", "description"):
             if key in d and not isinstance(d[key], str):
                 raise InputError(f"'{key}' must be a string")
-        return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"))
+        return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"), heat)
     except InputError as e:
         raise InputError(f"{source}: {e}") from None
 
@@ -914,4 +1002,4 @@ def load_model(source) -> Model:
 
 __all__ = ["Law", "Const", "Linear", "Exp", "Poly", "PWL", "Table", "law_from_dict", "StickSlipPlant", "MassPlant",
            "PrescribedMotion", "plant_from_dict", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
-           "ModelI", "ModelII", "Model", "load_model", "model_from_dict", "PARAMETERS", "PRESETS"]
+           "ModelI", "ModelII", "Heat", "Model", "load_model", "model_from_dict", "PARAMETERS", "PRESETS"]

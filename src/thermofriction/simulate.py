@@ -93,7 +93,9 @@ class SimulationResult:
     plants without a stage); ``states`` holds the friction model's internal
     states (columns named by ``state_names``). For periodic inputs ``cycle_times`` are the
     period starts, ``step_sizes[k]`` the displacement over cycle k, ``mean_velocity`` the mean
-    of the step sizes times the frequency."""
+    of the step sizes times the frequency. ``friction_work`` [J] is the friction force's work
+    integral of |F v_r| dt from the start (with a heat model, or ``friction_work=True``; else
+    None); with a heat model ``temperature`` is the interface temperature state."""
 
     time: np.ndarray
     input: np.ndarray
@@ -113,6 +115,7 @@ class SimulationResult:
     mean_velocity: float
     input_unit: str = "V"
     stats: dict = field(default_factory=dict)
+    friction_work: np.ndarray | None = None
 
     def columns(self) -> dict:
         """The CSV columns of SPEC 7, header -> array."""
@@ -127,6 +130,7 @@ class SimulationResult:
         }
         for j, (name, unit) in enumerate(zip(self.state_names, self.state_units)):
             cols[f"{name}[{unit}]"] = self.states[:, j]
+        cols["friction_work[J]"] = self.friction_work
         return {k: v for k, v in cols.items() if v is not None}
 
     def to_dataframe(self):
@@ -138,6 +142,8 @@ class SimulationResult:
         data = {name: getattr(self, name) for name in _CHANNELS if getattr(self, name) is not None}
         for j, name in enumerate(self.state_names):
             data[name] = self.states[:, j]
+        if self.friction_work is not None:
+            data["friction_work"] = self.friction_work
         return pd.DataFrame(data)
 
     def to_csv(self, path):
@@ -169,8 +175,9 @@ class SimulationResult:
 # The model as the C core sees it
 # ---------------------------------------------------------------------------------------------
 
-def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> dict:
-    """The dict the binding unpacks into a tf_model (see _core.c)."""
+def core_spec(model: Model, temperature=None, input: Waveform | None = None, friction_work: bool = False) -> dict:
+    """The dict the binding unpacks into a tf_model (see _core.c). With a heat model the
+    temperature, if given, is the ambient one (a number)."""
     plant = model.plant
     c = k = T_em = m_e = k_s = v_0 = 0.0
     m = 1.0
@@ -190,7 +197,12 @@ def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> 
     if isinstance(model.thermal, ModelI):
         laws = [model.thermal.laws[n]._core_tuple() if n in model.thermal.laws else None for n in PARAMETERS]
     T_const, T_t, T_v = math.nan, None, None
-    if isinstance(temperature, Sampled):
+    heat = None
+    if model.heat is not None:
+        h = model.heat.resolved(temperature)
+        heat = (h.heat_capacity, h.thermal_resistance, h.heat_fraction, h.ambient_temperature,
+                h.initial_temperature, h.external_heat._core_tuple() if h.external_heat is not None else None)
+    elif isinstance(temperature, Sampled):
         T_t, T_v = temperature.time, temperature.value
     elif temperature is not None:
         T_const = float(temperature)
@@ -206,6 +218,7 @@ def core_spec(model: Model, temperature=None, input: Waveform | None = None) -> 
         "dF": model.thermal.dF._core_tuple() if isinstance(model.thermal, ModelII) else None,
         "dF_form": 1 if isinstance(model.thermal, ModelII) and model.thermal.form == "offset" else 0,
         "input": waveform._core_tuple(), "T_const": T_const, "T_t": T_t, "T_v": T_v,
+        "heat": heat, "work": int(bool(friction_work)),
     }
 
 
@@ -311,6 +324,17 @@ def check_temperatures(model: Model, temperature):
                           f"or the scale form", ConditioningWarning, stacklevel=3)
 
 
+def _check_heated_temperatures(model: Model, time, temperature):
+    """With self-heating the temperature range is known only after the run: warn where it left a
+    law's calibrated range, refuse a run that crossed a temperature where the model is invalid."""
+    lo, hi = float(np.min(temperature)), float(np.max(temperature))
+    try:
+        check_temperatures(model, Sampled(np.array([0.0, 1.0]), np.array([lo, hi])) if hi > lo else lo)
+    except InputError as e:
+        raise SolverError(f"self-heating took the temperature to {lo:.4g}..{hi:.4g} C, where the model is "
+                          f"invalid: {e}") from None
+
+
 # ---------------------------------------------------------------------------------------------
 # simulate
 # ---------------------------------------------------------------------------------------------
@@ -343,17 +367,21 @@ def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
 
 def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
              sample_rate: float = 10_000.0, t_eval=None, solver=None,
-             controller: StepSizeController | None = None, max_samples: int | None = MAX_SAMPLES) -> SimulationResult:
+             controller: StepSizeController | None = None, max_samples: int | None = MAX_SAMPLES,
+             friction_work: bool = False) -> SimulationResult:
     """Simulates ``model`` from rest.
 
     temperature: constant [degC], a ``Sampled`` signal, or (times, values); required for
-        thermal models.
+        thermal models. With a heat model (``model.heat``) the temperature is a state: a number
+        given here is the ambient temperature T_amb (overriding the model's).
     input: a waveform overriding the model's ``[input]``.
     duration, sample_rate: a uniform output grid from 0 to duration; or t_eval, any
         non-decreasing grid starting at the initial time.
     solver: ``AutoSwitch()`` (default), ``Dopri5()`` or ``Rodas4()``.
     controller: ``StepSizeController`` (tolerances, step limits).
     max_samples: the most output samples allowed (default 10 million, ~2 GB); None for no limit.
+    friction_work: also integrate the friction work W = integral |F v_r| dt (always done with a
+        heat model), returned as ``friction_work``.
     """
     solver = solver or AutoSwitch()
     if isinstance(solver, str):
@@ -362,7 +390,18 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         solver = SOLVERS[solver]()
     controller = controller or StepSizeController()
     temperature = as_temperature(temperature)
-    check_temperatures(model, temperature)
+    heat = None
+    if model.heat is not None:
+        if isinstance(temperature, Sampled):
+            raise InputError("the model has a [heat] section, so its temperature is a state: give the ambient "
+                             "temperature as a number (--temperature C), not a temperature signal")
+        heat = model.heat.resolved(temperature)
+        T_start = sorted({heat.initial_temperature, heat.ambient_temperature})
+        check_temperatures(model, T_start[0] if len(T_start) == 1 else Sampled(np.array([0.0, 1.0]),
+                                                                                np.array(T_start)))
+    else:
+        check_temperatures(model, temperature)
+    friction_work = bool(friction_work) or heat is not None
     waveform = input if input is not None else (model.input or Zero())
     if t_eval is not None:
         t_grid = np.ascontiguousarray(t_eval, dtype=float)
@@ -390,22 +429,23 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     if isinstance(model.plant, PrescribedMotion):
         check_prescribed_motion(waveform)
     nmech = MECHANICAL_STATES[model.plant.type]
-    nstate = len(nmech) + model.friction.nstate
-    nch = _core.NFIXED_OUTPUTS + model.friction.nstate
+    extra_states = ("T",) * (heat is not None) + ("W",) * friction_work
+    nstate = len(nmech) + model.friction.nstate + len(extra_states)
+    nch = _core.NFIXED_OUTPUTS + model.friction.nstate + friction_work
     out = np.empty((t_all.size, nch))
     atol = controller.atol
     if atol is not None:
         atol = np.broadcast_to(np.asarray(atol, float), (nstate,)).copy()
         if np.any(atol <= 0):
             raise InputError("atol must be positive")
-    spec = core_spec(model, temperature, waveform)
+    spec = core_spec(model, temperature, waveform, friction_work)
     try:
         stats = _core.simulate(spec, t_all, out, solver.code, float(controller.rtol), atol,
                                float(controller.first_step or 0.0), float(controller.max_step or 0.0),
                                int(controller.max_steps))
     except _core.SolverError as e:
         message, status, t_fail, h_fail, state, stiff = e.args
-        names = nmech + tuple(model.friction.state_names)
+        names = nmech + tuple(model.friction.state_names) + extra_states
         where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, state))
         try:
             u = float(waveform(t_fail)[0])
@@ -441,7 +481,8 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     finite[:, _CHANNELS.index("temperature")] = True  # NaN by design without a thermal part
     if not finite.all():
         row, col = np.argwhere(~finite)[0]
-        raise SolverError(f"the output '{(_CHANNELS + tuple(model.friction.state_names))[col]}' is not finite at "
+        raise SolverError(f"the output '{(_CHANNELS + tuple(model.friction.state_names) + ('friction_work',))[col]}' "
+                          f"is not finite at "
                           f"t = {t_all[row]:.9g} s ({out[row, col]}): likely cause: extreme parameter or input "
                           f"values (an overflow); check them", time=float(t_all[row]))
     if cycle_times.size:
@@ -456,11 +497,15 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     cols = {name: np.ascontiguousarray(out[:, i]) for i, name in enumerate(_CHANNELS)}
     if not isinstance(model.plant, StickSlipPlant):  # no stage: the driving surface is fixed (or the motion given)
         cols["stage_displacement"] = cols["stage_velocity"] = None
-    if temperature is None:
+    if temperature is None and heat is None:
         cols["temperature"][:] = math.nan
+    if heat is not None and model.thermal is not None:
+        _check_heated_temperatures(model, cols["time"], cols["temperature"])
+    nfric = model.friction.nstate
     return SimulationResult(
         **cols,
-        states=np.ascontiguousarray(out[:, len(_CHANNELS):]),
+        friction_work=np.ascontiguousarray(out[:, len(_CHANNELS) + nfric]) if friction_work else None,
+        states=np.ascontiguousarray(out[:, len(_CHANNELS):len(_CHANNELS) + nfric]),
         state_names=model.friction.state_names,
         state_units=model.friction.state_units,
         cycle_times=cycle_times,

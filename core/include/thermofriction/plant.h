@@ -18,7 +18,8 @@ typedef enum {
     TF_PLANT_PRESCRIBED = 2  /* SPEC 3.3: x_r = u(t) [m] given, v_r = u'(t); friction states only */
 } tf_plant_kind;
 
-/* Output channels, in this order, then the friction states. */
+/* Output channels, in this order, then the friction states, then the frictional work (where
+ * the model has that state). */
 typedef enum {
     TF_OUT_TIME = 0,
     TF_OUT_INPUT,
@@ -32,6 +33,23 @@ typedef enum {
     TF_OUT_TEMPERATURE,
     TF_OUT_NFIXED
 } tf_output_channel;
+
+/* Lumped thermal model (SPEC 5.3). With `on` set the temperature is a state,
+ *   C_th T' = eta |F' v_r| - (T - T_amb) / R_th + P_ext(t),   T(0) = T_0,
+ * and the model's T_const / T_n are not used. |F' v_r| counts all the friction force's power as
+ * heat, including what a bristle model stores and returns elastically (SPEC's reading). */
+typedef struct {
+    int on;
+    double C_th;       /* heat capacity [J/K] */
+    double R_th;       /* thermal resistance to ambient [K/W] */
+    double eta;        /* fraction of the frictional power that heats the interface, 0..1 */
+    double T_amb;      /* ambient temperature [degC] */
+    double T_0;        /* initial temperature [degC] */
+    tf_waveform P_ext; /* external heat input [W]; TF_WAVE_ZERO: none */
+} tf_heat;
+
+/* The most states a model has: 4 mechanical, the friction states, temperature, frictional work. */
+#define TF_MAX_STATES (TF_MAX_FRICTION_STATES + 6)
 
 typedef struct {
     int plant;
@@ -52,10 +70,17 @@ typedef struct {
 
     tf_waveform input;          /* voltage u(t) [V] */
 
-    /* Temperature [degC]: constant T_const, or sampled (T_n > 1) with linear interpolation. */
+    /* Temperature [degC]: constant T_const, or sampled (T_n > 1) with linear interpolation;
+       or, with heat.on, a state of the lumped thermal model. */
     double T_const;
     int T_n;
     const double *T_t, *T_v;
+    tf_heat heat;
+
+    /* States after the friction states: the temperature (heat.on), then the frictional work
+       W = integral of |F' v_r| dt [J] (heat.on or work set): per-cycle dissipation to solver
+       tolerance, for energy balances and the two-time-scale method. */
+    int work;
 
     /* Parameters at the last temperature seen, so a constant temperature costs no law
      * evaluations per step. Zero-initialise the struct (or call tf_model_prepare). */
@@ -79,7 +104,12 @@ int tf_model_check(const tf_model *model, const char **what);
 
 int tf_model_nstate(const tf_model *model);
 int tf_model_noutput(const tf_model *model);
-double tf_model_temperature(const tf_model *model, double t);
+/* Temperature at (t, y): the state with a heat model (y must then be given), else the
+ * constant or sampled signal (y may be NULL). */
+double tf_model_temperature(const tf_model *model, double t, const double *y);
+/* Index of the temperature state and of the frictional-work state; -1 where there is none. */
+int tf_model_temperature_index(const tf_model *model);
+int tf_model_work_index(const tf_model *model);
 /* Parameters at temperature T (Model I laws applied). */
 void tf_model_params_at(const tf_model *model, double T, double *p);
 /* The thermal factor lambda(T) of Model II's scale form (1 otherwise). */
@@ -91,8 +121,11 @@ void tf_model_initial_state(const tf_model *model, double *y);
 typedef enum {
     TF_TARGET_PARAM = 0, /* friction parameter `param` given as a number */
     TF_TARGET_LAW = 1,   /* coefficient `coef` of the Model I law of parameter `param` */
-    TF_TARGET_DF = 2     /* coefficient `coef` of Model II's dF law */
+    TF_TARGET_DF = 2,    /* coefficient `coef` of Model II's dF law */
+    TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param */
 } tf_target_kind;
+
+typedef enum { TF_HEAT_C_TH = 0, TF_HEAT_R_TH, TF_HEAT_ETA, TF_HEAT_T_AMB, TF_HEAT_NPARAM } tf_heat_param;
 
 typedef struct {
     int kind, param, coef;
