@@ -229,7 +229,7 @@ def test_two_time_scale_on_prescribed_sawtooth_sliding_is_the_exact_exponential(
     heat = dataclasses.replace(HEAT, thermal_resistance=2000.0, heat_capacity=0.002)
     model = Model(PrescribedMotion(), Coulomb(fc=FC, v_smooth=1e-9), heat=heat, input=saw)
     res = simulate_heating(model, 20.0, method=TwoTimeScale(points=5))
-    v = 2 * A * f / 0.5 * 0.5  # |slope| on each flank: A / (rise/f) = 2 A f for rise 0.5
+    v = 2 * A * f  # the slope on each flank: A / (rise / f) with rise 0.5
     F = FC * math.tanh(v / 1e-9)
     np.testing.assert_allclose(res.table.cycle_work, 2 * A * F, rtol=1e-9)
     rise = heat.thermal_resistance * heat.heat_fraction * 2 * A * F * f

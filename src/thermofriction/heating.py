@@ -166,8 +166,10 @@ def simulate_heating(model: Model, duration: float, *, input: Waveform | None = 
 
 def _full(model, heat, waveform, n_cycles, idx, method: Full) -> HeatingResult:
     t0 = _time.perf_counter()
+    # a long run needs more steps than simulate's default limit: ~70 per cycle for the paper's actuator
+    controller = method.controller or StepSizeController(max_steps=max(10_000_000, 1000 * n_cycles))
     res = simulate(dataclasses.replace(model, heat=heat), t_eval=np.arange(n_cycles + 1) * waveform.period,
-                   input=waveform, controller=method.controller, max_samples=None)
+                   input=waveform, controller=controller, max_samples=None)
     seconds = _time.perf_counter() - t0
     steps = np.append(res.step_sizes, res.step_sizes[-1])
     return HeatingResult(res.time[idx], res.temperature[idx], res.displacement[idx], steps[idx],

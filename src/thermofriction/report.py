@@ -424,3 +424,81 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None) ->
 
 
 __all__ = ["report", "render", "Entry", "data_hash"]
+
+
+# -- self-heating (SPEC 5.3) ----------------------------------------------------------------------
+
+def heating_report(runs, path, *, figures_dir=None, title=None, command=None) -> str:
+    """Writes an HTML report of long heated runs: ``runs`` is a list of dicts with ``label``,
+    ``result`` (a HeatingResult, the prediction with self-heating), optionally ``reference`` (the
+    full simulation on the same grid) and ``constant`` (the displacement predicted at the start
+    temperature, on the same grid). Figures: temperature rise, step-size drift, and the error of
+    the constant-temperature prediction; a table of the figures that matter."""
+    plt = _plt()
+    figs = Figures(figures_dir)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    parts = []
+    fig, ax = plt.subplots(figsize=(7, 3.4))
+    for i, r in enumerate(runs):
+        res = r["result"]
+        ax.plot(res.time, res.temperature, color=colors[i % len(colors)], label=r["label"])
+        if r.get("reference") is not None:
+            ax.plot(r["reference"].time, r["reference"].temperature, ":", color="k", lw=1)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("interface temperature [°C]")
+    ax.legend()
+    temp_fig = figs.render(fig, "heating_temperature", "Temperature of the friction interface (lines: two-time-scale "
+                           "method; dotted: the full simulation through every cycle).")
+    fig, ax = plt.subplots(figsize=(7, 3.4))
+    for i, r in enumerate(runs):
+        res = r["result"]
+        ax.plot(res.time, res.step_size * 1e6, color=colors[i % len(colors)], label=r["label"])
+        if r.get("reference") is not None:
+            ref = r["reference"]
+            ax.plot(ref.time, ref.step_size * 1e6, ":", color="k", lw=1)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("step per cycle [µm]")
+    ax.legend()
+    step_fig = figs.render(fig, "heating_step_size", "Step size drift as the interface heats (dotted: full simulation).")
+    fig, ax = plt.subplots(figsize=(7, 3.4))
+    rows = []
+    for i, r in enumerate(runs):
+        res, ref, const = r["result"], r.get("reference"), r.get("constant")
+        truth = ref if ref is not None else res
+        if const is not None:
+            err = (const - truth.displacement) / np.maximum(np.abs(truth.displacement), 1e-300) * 100
+            ax.plot(truth.time[1:], err[1:], color=colors[i % len(colors)], label=r["label"])
+        rows.append([r["label"], _fmt(res.temperature[-1] - res.temperature[0], "{:.3g}"),
+                     _fmt(res.step_size[0] * 1e6, "{:.4g}"), _fmt(res.step_size[-1] * 1e6, "{:.4g}"),
+                     _fmt(truth.displacement[-1] * 1e3, "{:.5g}"),
+                     _fmt(None if const is None else (const[-1] - truth.displacement[-1]) * 1e3, "{:+.4g}"),
+                     _fmt(None if ref is None else np.max(np.abs(res.temperature - ref.temperature)), "{:.2g}"),
+                     _fmt(None if ref is None else abs(res.displacement[-1] - ref.displacement[-1])
+                          / abs(ref.displacement[-1]) * 100, "{:.2g}"),
+                     _fmt(res.stats.get("seconds"), "{:.3g}"),
+                     _fmt(None if ref is None else ref.stats.get("seconds"), "{:.3g}")])
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("constant-temperature error [%]")
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.legend()
+    err_fig = figs.render(fig, "heating_constant_temperature_error", "Error of the displacement predicted at the "
+                          "start temperature (no self-heating), relative to the prediction with self-heating.")
+    parts.append("<section><h2>Summary</h2>" + _table(
+        ["run", "temperature rise [K]", "first step [µm]", "last step [µm]", "displacement [mm]",
+         "constant-T error [mm]", "max |ΔT| vs full [K]", "displacement error vs full [%]",
+         "two-time-scale [s]", "full [s]"], rows) + "</section>")
+    parts.append("<section><h2>Temperature</h2>" + temp_fig + "</section>")
+    parts.append("<section><h2>Step size</h2>" + step_fig + err_fig + "</section>")
+    name = html.escape(title or "thermofriction — self-heating")
+    footer = " · ".join(f"{k} {v}" for k, v in _versions().items()) + (
+        f"<br>command: <code>{html.escape(command)}</code>" if command else "")
+    text = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
+            f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
+            f"<body><header><h1>{name}</h1><p>{', '.join(html.escape(r['label']) for r in runs)}</p></header>"
+            f"<main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
+    with atomic_write(path, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    return text
+
+
+__all__ += ["heating_report"]
