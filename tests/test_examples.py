@@ -187,3 +187,18 @@ def test_main_prints_every_experiment(capsys, tmp_path):
         assert head in out
     if plot:
         assert len(list(tmp_path.glob("canudas1995_*.png"))) == 4
+
+
+def test_self_heating_example_writes_its_report(tmp_path):
+    """examples/self_heating.py end to end (shortened to 20 s): the HTML report holds its three
+    figures and the summary, and the 500 Hz run heats far more than the 5 Hz one."""
+    import self_heating
+    out = tmp_path / "sh.html"
+    self_heating.main(["-o", str(out), "--duration", "20", "--figures", str(tmp_path / "fig")])
+    text = out.read_text()
+    for name in ("heating_temperature", "heating_step_size", "heating_constant_temperature_error"):
+        assert f'id="fig-{name}"' in text
+        assert (tmp_path / "fig" / f"{name}.png").stat().st_size > 1000
+    runs = [self_heating.run(f, 20.0, full=False) for f in (5.0, 500.0)]
+    rise = [r["result"].temperature[-1] - 30.0 for r in runs]
+    assert rise[1] > 20 * rise[0] > 0
