@@ -353,7 +353,10 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     if (PyErr_Occurred()) goto done;
     if (!atol_in || n_atol != N) { PyErr_Format(PyExc_ValueError, "atol must have %d values", N); goto done; }
     memcpy(atol, atol_in, sizeof(double) * N);
-    tf_model_initial_state(&m, Y); /* and S(0) = 0: the initial state does not depend on theta */
+    tf_model_initial_state(&m, Y); /* and S(0) = 0: the initial state does not depend on theta, */
+    for (int k = 0; k < np; k++)   /* except on the initial temperature */
+        if (targets[k].kind == TF_TARGET_HEAT && targets[k].param == TF_HEAT_T_0 && m.heat.on)
+            Y[n + tf_model_temperature_index(&m) * np + k] = 1.0;
     tf_sensitivity_system sys = {&m, np, targets};
     tf_ode ode = tf_sensitivity_ode(&sys);
     tf_solver_options opt = {TF_METHOD_DOPRI5, rtol, atol, h0, hmax, max_steps};

@@ -104,9 +104,10 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Writes FITTED.toml (loadable by simulate) and, with --json, the results of SPEC 7. "
                "The initial model provides the plant (masses, xi, wn, K) and the input waveform.")
     i.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
-    i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii"), default="model-i",
+    i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
-                        "model for all temperatures), model-i or model-ii (default: model-i)")
+                        "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
+                        "[heat] section's C_th, R_th, eta from recorded temperature[C] columns)")
     i.add_argument("--friction", choices=("lugre",), default="lugre", help="base friction model (default: lugre)")
     i.add_argument("--init", metavar="MODEL.toml",
                    help="initial model: file or preset (default: the paper's preset for the method)")

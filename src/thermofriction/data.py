@@ -529,8 +529,8 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
         raise InputError(f"sample_rate must be positive [Hz], got {sample_rate!r}")
     if duration * sample_rate + 1 < MIN_SAMPLES:
         raise InputError(f"duration x sample_rate gives fewer than {MIN_SAMPLES} samples")
-    if record_temperature is None:
-        record_temperature = temperature_noise > 0
+    if record_temperature is None:  # a self-heating model's temperature is an output: always recorded
+        record_temperature = temperature_noise > 0 or model.heat is not None
     runs = [(T, "fit", [int(seed), i]) for i, T in enumerate(fit_T)]
     runs += [(T, "validate", [int(seed), j, 1]) for j, T in enumerate(val_T)]
     label = model.name or "model"
@@ -553,7 +553,8 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
             stage = res.stage_displacement + noise * rng.standard_normal(res.time.size)
             if quantization > 0:
                 stage = np.round(stage / quantization) * quantization
-        sig = T + temperature_noise * rng.standard_normal(res.time.size) if record_temperature else None
+        T_true = res.temperature if model.heat is not None else T  # with [heat], T is the ambient one
+        sig = T_true + temperature_noise * rng.standard_normal(res.time.size) if record_temperature else None
         effects = [f"noise {noise:g} m"]
         if quantization:
             effects.append(f"quantisation {quantization:g} m")

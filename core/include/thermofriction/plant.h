@@ -125,7 +125,9 @@ typedef enum {
     TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param */
 } tf_target_kind;
 
-typedef enum { TF_HEAT_C_TH = 0, TF_HEAT_R_TH, TF_HEAT_ETA, TF_HEAT_T_AMB, TF_HEAT_NPARAM } tf_heat_param;
+/* TF_HEAT_T_0 enters through the initial state only (S_T(0) = 1): its right-hand-side partials are
+ * zero, and whoever starts a sensitivity integration sets that column (the binding does). */
+typedef enum { TF_HEAT_C_TH = 0, TF_HEAT_R_TH, TF_HEAT_ETA, TF_HEAT_T_AMB, TF_HEAT_T_0, TF_HEAT_NPARAM } tf_heat_param;
 
 typedef struct {
     int kind, param, coef;

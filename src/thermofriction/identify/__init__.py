@@ -10,11 +10,12 @@ from ..errors import InputError
 from ..models import Model, StickSlipPlant, load_model
 from .engine import fit, make_traces, uncertainty
 from .parameters import Parameter, Parameters
-from .procedures import base_model, fit_friction, fit_law, identify_model_i, identify_model_ii, segmented_fit
+from .procedures import (base_model, fit_friction, fit_law, identify_heat, identify_model_i, identify_model_ii,
+                         segmented_fit)
 from .plant import PlantFit, fit_plant, step_response
 from .result import FitResult
 
-METHODS = ("plant", "base", "model-i", "model-ii")
+METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
 
 def identify(data, method="model-i", init=None, *, parameters=None, procedure="direct", laws=None, refine=True,
@@ -33,7 +34,8 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
     if method not in METHODS:
         raise InputError(f"unknown method '{method}' (one of: {', '.join(METHODS)})")
     if init is None:
-        init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii"}[method]
+        init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii",
+                "heat": "li2009-self-heating"}[method]
     if not isinstance(init, Model):
         init = load_model(init)
     if not isinstance(init.plant, StickSlipPlant):
@@ -48,6 +50,8 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
     opts = dict(rtol=rtol, starts=starts, seed=seed)
     if method == "plant":
         return _identify_plant(getattr(data, "experiments", data), init)
+    if method == "heat":
+        return identify_heat(experiments, init, parameters, progress=progress, **opts)
     if method == "base":
         model = base_model(init)
         return fit_friction(experiments, model, parameters, method="base", progress=progress, **opts)
@@ -86,4 +90,4 @@ def _identify_plant(experiments, init):
 
 
 __all__ = ["fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter", "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit",
-           "identify_model_i", "identify_model_ii", "base_model", "make_traces", "uncertainty", "METHODS"]
+           "identify_model_i", "identify_model_ii", "identify_heat", "base_model", "make_traces", "uncertainty", "METHODS"]

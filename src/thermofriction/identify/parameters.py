@@ -13,7 +13,11 @@ import numpy as np
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, PARAMETERS, PWL, Const, Exp, Law, Linear, Model, ModelI, ModelII, Poly, Table
 
-_TARGET_PARAM, _TARGET_LAW, _TARGET_DF = 0, 1, 2
+_TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT = 0, 1, 2, 3
+#: The lumped thermal model's fittable parameters (SPEC 5.3): symbol -> (Heat field, unit); the
+#: order is the C core's tf_heat_param
+HEAT_PARAMETERS = {"C_th": ("heat_capacity", "J/K", 0), "R_th": ("thermal_resistance", "K/W", 1),
+                   "eta": ("heat_fraction", "", 2), "T_0": ("initial_temperature", "C", 4)}
 
 
 @dataclasses.dataclass
@@ -112,6 +116,10 @@ def _split(name):
 def target_of(model: Model, name: str):
     """(kind, parameter index, coefficient index) of the C core's sensitivity target."""
     base, coef = _split(name)
+    if base in HEAT_PARAMETERS and coef is None:
+        if model.heat is None:
+            raise InputError(f"'{name}': the model has no [heat] section")
+        return (_TARGET_HEAT, HEAT_PARAMETERS[base][2], 0)
     if base == "dF":
         if not isinstance(model.thermal, ModelII):
             raise InputError(f"'{name}': the model has no Model II dF law")
@@ -137,6 +145,8 @@ def target_of(model: Model, name: str):
 
 def get_value(model: Model, name: str) -> float:
     kind, idx, coef = target_of(model, name)
+    if kind == _TARGET_HEAT:
+        return float(getattr(model.heat, HEAT_PARAMETERS[name][0]))
     if kind == _TARGET_DF:
         return float(law_coefficients(model.thermal.dF)[coef])
     if kind == _TARGET_LAW:
@@ -155,9 +165,12 @@ def with_values(model: Model, values: dict) -> Model:
     friction = {}
     laws = dict(model.laws)
     dF = model.thermal.dF if isinstance(model.thermal, ModelII) else None
+    heat = {}
     for name, v in values.items():
         kind, idx, coef = target_of(model, name)
-        if kind == _TARGET_PARAM:
+        if kind == _TARGET_HEAT:
+            heat[HEAT_PARAMETERS[name][0]] = float(v)
+        elif kind == _TARGET_PARAM:
             friction[PARAMETERS[idx]] = float(v)
         elif kind == _TARGET_LAW:
             p = PARAMETERS[idx]
@@ -173,11 +186,14 @@ def with_values(model: Model, values: dict) -> Model:
         thermal = ModelI(laws)
     elif isinstance(thermal, ModelII):
         thermal = dataclasses.replace(thermal, dF=dF)
-    return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **friction), thermal=thermal)
+    return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **friction), thermal=thermal,
+                               heat=dataclasses.replace(model.heat, **heat) if heat else model.heat)
 
 
 def unit_of(model: Model, name: str) -> str:
     base, coef = _split(name)
+    if base in HEAT_PARAMETERS:
+        return HEAT_PARAMETERS[base][1]
     unit = "N" if base == "dF" else PARAMETER_UNITS.get(base, "")
     if coef is None:
         return unit
@@ -191,5 +207,5 @@ def unit_of(model: Model, name: str) -> str:
     return unit
 
 
-__all__ = ["Parameter", "Parameters", "target_of", "get_value", "with_values", "law_coefficient_names",
+__all__ = ["HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "law_coefficient_names",
            "law_coefficients", "law_with_coefficients", "unit_of", "Exp", "Linear"]

@@ -26,10 +26,13 @@ def _result(method, model, params, outcome, traces, t0, extra_warnings=(), detai
     fitted = with_values(model, values)
     per, start = [], 0
     for tr in traces:
-        seg = outcome.r[start:start + len(tr.time)]
-        start += len(tr.time)
+        n = len(tr.time)
+        seg = outcome.r[start:start + tr.n_residuals]
+        start += tr.n_residuals
         per.append({"file": tr.name, "temperature": tr.nominal_temperature, "role": tr.role,
-                    "rmse": float(np.sqrt(np.mean(seg ** 2)))})
+                    "rmse": float(np.sqrt(np.mean(seg[:n] ** 2)))})
+        if tr.measured_temperature is not None:  # [K], unweighted
+            per[-1]["temperature_rmse"] = float(np.sqrt(np.mean(seg[n:] ** 2))) / tr.temperature_weight
     cost = float(outcome.r @ outcome.r)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
                      rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
@@ -71,6 +74,61 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", *
         params = _friction_parameters(model, parameters or DEFAULT_FRICTION_PARAMETERS)
     outcome = fit(model, params, traces, **opts)
     return _result(method, model, params, outcome, traces, t0)
+
+
+DEFAULT_HEAT_PARAMETERS = ("C_th", "R_th", "eta")
+
+
+def identify_heat(experiments, init: Model, parameters=None, **opts) -> FitResult:
+    """Fits the lumped thermal model (SPEC 5.3) -- by default C_th, R_th and eta; friction
+    parameters named too are fitted jointly -- to the recorded temperatures and displacements.
+
+    The two records have different units and noise, so the fit runs twice: first with each
+    record weighted by its range, then with each weighted by its residual scatter at that first
+    optimum (so that both carry unit variance, which the intervals assume), from there.
+    Without a known heat input (the model's P_ext) the records fix only eta R_th and R_th C_th:
+    then one of the three gets an infinite interval and a warning, as it should."""
+    if init.heat is None:
+        raise InputError("the heat fit needs an initial model with a [heat] section (C_th, R_th, eta guesses)")
+    t0 = time.perf_counter()
+    traces = make_traces(experiments, init)
+    starts = [tr.initial_temperature for tr in traces]
+    names = list(parameters or DEFAULT_HEAT_PARAMETERS)
+    if parameters is None and max(starts) - min(starts) < 0.1:
+        # every run starts at one temperature (thermal equilibrium): estimate it with the rest, the
+        # displacement pins it far better than a thermometer's first samples (0.3 um/K per cycle)
+        names.append("T_0")
+        init = dataclasses.replace(init, heat=dataclasses.replace(init.heat, initial_temperature=float(np.mean(starts))))
+    if isinstance(parameters, Parameters):
+        params = parameters
+    else:
+        params = Parameters()
+        for name in names:
+            v = get_value(init, name)
+            if name == "T_0":
+                params.add(name, v, unit="C")
+            else:
+                params.add(name, v, min=0.0, max=1.0 if name == "eta" else math.inf, unit=unit_of(init, name))
+    for tr in traces:  # first pass: each record by its range
+        tr.temperature_weight = max(float(np.ptp(tr.displacement)), 1e-12) / max(
+            float(np.ptp(tr.measured_temperature)), 1e-3)
+    first = fit(init, params, traces, **opts)
+    model = with_values(init, dict(zip([p.name for p in params.varying], first.theta)))
+    start = 0
+    for tr in traces:  # second pass: each record by its residual scatter
+        n = len(tr.time)
+        seg = first.r[start:start + 2 * n]
+        start += 2 * n
+        sx = float(np.sqrt(np.mean(seg[:n] ** 2)))
+        sT = float(np.sqrt(np.mean(seg[n:] ** 2))) / tr.temperature_weight
+        tr.temperature_weight = max(sx, 1e-15) / max(sT, 1e-9)
+    for p, v in zip(params.varying, first.theta):
+        p.value = float(min(max(v, p.min), p.max))
+    outcome = fit(model, params, traces, **dict(opts, starts=1))
+    outcome.nfev += first.nfev
+    outcome.njev += first.njev
+    return _result("heat", init, params, outcome, traces, t0,
+                   details={"temperature_weights_m_per_K": [tr.temperature_weight for tr in traces]})
 
 
 # -- laws of temperature -------------------------------------------------------------------------
