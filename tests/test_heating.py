@@ -333,3 +333,18 @@ def test_heat_fit_through_the_command_line_and_validate(tmp_path):
     assert fitted.heat.heat_capacity == pytest.approx(5e-5, rel=0.02)
     v = tf.validate(fitted, tf.load_dataset(tmp_path / "data"))
     assert v.experiments[0]["max_error_pct"] < 0.1
+
+
+def test_simulate_command_line_with_a_heat_model(tmp_path):
+    """thermofriction simulate on the self-heating preset: --temperature is the ambient one, the
+    summary says where the temperature went, the CSV has the temperature and friction_work columns."""
+    from conftest import run_cli
+    out = tmp_path / "run.csv"
+    r = run_cli("simulate", "li2009-self-heating", "--temperature", "31", "--duration", "0.2", "--sample-rate",
+                "5000", "--input", "sawtooth:amplitude=30,frequency=500,rise=0.999", "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "self-heating from 31 C" in r.stdout and "ambient 31 C" in r.stdout
+    header = out.read_text().splitlines()[0].split(",")
+    assert header[-1] == "friction_work[J]"
+    T = np.loadtxt(out, delimiter=",", skiprows=1)[:, header.index("temperature[C]")]
+    assert T[0] == 31.0 and T[-1] > 31.05

@@ -195,9 +195,13 @@ def cmd_simulate(args) -> int:
         res.to_csv(args.output)
     out = sys.stdout
     name = model.name or args.model
-    T = (f"{temperature:g} C" if isinstance(temperature, float) else
-         f"from {args.temperature_file}" if temperature is not None else "not used")
-    print(f"{name}: {args.duration:g} s at temperature {T}, {len(res.time)} samples", file=out)
+    if model.heat is not None:  # the temperature is a state: say where it went
+        T = (f"self-heating from {res.temperature[0]:.4g} C to {res.temperature[-1]:.4g} C (peak "
+             f"{res.temperature.max():.4g} C), ambient {model.heat.resolved(temperature).ambient_temperature:g} C")
+    else:
+        T = "at temperature " + (f"{temperature:g} C" if isinstance(temperature, float) else
+                                 f"from {args.temperature_file}" if temperature is not None else "not used")
+    print(f"{name}: {args.duration:g} s {T}, {len(res.time)} samples", file=out)
     print(f"  final displacement  {res.displacement[-1] * 1e6:.6g} um", file=out)
     print(f"  peak friction force {np.max(np.abs(res.friction_force)):.6g} N", file=out)
     if res.step_sizes.size:
