@@ -225,6 +225,19 @@ def law_from_dict(d, where: str) -> Law:
 # Plants
 # ---------------------------------------------------------------------------------------------
 
+def _by_symbol(cls, d: dict, where: str, required, what="", extra=()) -> dict:
+    """A section keyed by the SPEC's symbols (``cls._SYMBOLS``: field -> symbol) as keyword
+    arguments of ``cls``; unknown and missing keys are named."""
+    names = {sym: name for name, sym in cls._SYMBOLS.items()}
+    unknown = set(d) - set(names)
+    if unknown:
+        raise InputError(f"{where}: {unknown_keys(unknown, [*extra, *names], what)}")
+    for req in required:
+        if req not in d:
+            raise InputError(f"{where}: missing '{req}'")
+    return {names[k]: v for k, v in d.items()}
+
+
 @dataclass(frozen=True)
 class StickSlipPlant:
     """Piezoelectric stick-slip actuator (SPEC 3.1): a stage (equivalent ``mass``, ``damping``,
@@ -295,14 +308,7 @@ class StickSlipPlant:
     def from_dict(cls, d: dict, where="[plant]"):
         d = dict(d)
         d.pop("type", None)
-        names = {sym: name for name, sym in cls._SYMBOLS.items()}
-        unknown = set(d) - set(names)
-        if unknown:
-            raise InputError(f"{where}: {unknown_keys(unknown, ['type', *names])}")
-        for req in ("m", "m_e"):
-            if req not in d:
-                raise InputError(f"{where}: missing '{req}'")
-        return cls(**{names[k]: v for k, v in d.items()})
+        return cls(**_by_symbol(cls, d, where, ("m", "m_e"), extra=("type",)))
 
 
 @dataclass(frozen=True)
@@ -774,14 +780,7 @@ class Heat:
     def from_dict(cls, d: dict, where="[heat]", base_dir=None):
         if not isinstance(d, dict):
             raise InputError(f"{where} must be a section")
-        names = {sym: name for name, sym in cls._SYMBOLS.items()}
-        unknown = set(d) - set(names)
-        if unknown:
-            raise InputError(f"{where}: {unknown_keys(unknown, list(names), 'the heat model')}")
-        for req in ("C_th", "R_th"):
-            if req not in d:
-                raise InputError(f"{where}: missing '{req}'")
-        kw = {names[k]: v for k, v in d.items()}
+        kw = _by_symbol(cls, d, where, ("C_th", "R_th"), what="the heat model")
         if "external_heat" in kw:
             kw["external_heat"] = waveform_from_dict(kw["external_heat"], f"{where} P_ext", base_dir)
         return cls(**kw)
