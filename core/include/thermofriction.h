@@ -7,4 +7,6 @@
 #include "thermofriction/plant.h"
 #include "thermofriction/integrator.h"
 #include "thermofriction/sensitivity.h"
+#include "thermofriction/realtime.h"
+#include "thermofriction/control.h"
 #endif

@@ -21,7 +21,7 @@ from .waveforms import Sampled, Sawtooth, Sine, Square, Step, Waveform, parse_wa
 from .identify import FitResult, Parameter, Parameters, identify
 from .data import Dataset, Experiment, load_dataset, save_dataset, synthesize
 from .validate import validate
-from . import heating
+from . import control, heating
 from .report import report
 
 __version__ = "0.1.0"

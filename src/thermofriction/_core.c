@@ -535,7 +535,61 @@ static PyObject *py_state_scale(PyObject *self, PyObject *args)
     return result;
 }
 
+/* loop(plant_spec, T_plant, comp_spec|None, T_comp, compensation, observer_gain, mass, (kp, ki, kd, tau_d),
+ *      dt, substeps, x_ref, v_ref, x_out, u_out, F_out): the closed loop of control.h */
+static PyObject *py_loop(PyObject *self, PyObject *args)
+{
+    PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *outs[3];
+    double T_plant, T_comp, gain, mass, kp, ki, kd, tau_d, dt;
+    int compensation, substeps;
+    if (!PyArg_ParseTuple(args, "OdOdidd(dddd)diOOOOO", &plant_spec, &T_plant, &comp_spec, &T_comp, &compensation,
+                          &gain, &mass, &kp, &ki, &kd, &tau_d, &dt, &substeps, &xr_obj, &vr_obj, &outs[0], &outs[1],
+                          &outs[2]))
+        return NULL;
+    arena a = {0}, b = {0};
+    tf_model pm, cm;
+    tf_rt_friction *rt = PyMem_Malloc(2 * sizeof(tf_rt_friction)); /* ~3 kB each: not on the stack */
+    PyObject *result = NULL;
+    Py_buffer views[3];
+    int nviews = 0;
+    if (!rt) { PyErr_NoMemory(); goto done; }
+    if (parse_model(&a, plant_spec, &pm)) goto done;
+    if (comp_spec != Py_None && parse_model(&b, comp_spec, &cm)) goto done;
+    Py_ssize_t n, nv;
+    const double *x_ref = get_array(&a, xr_obj, &n, "x_ref");
+    if (PyErr_Occurred()) goto done;
+    const double *v_ref = get_array(&a, vr_obj, &nv, "v_ref");
+    if (PyErr_Occurred()) goto done;
+    if (n < 1 || nv != n) { PyErr_SetString(PyExc_ValueError, "x_ref and v_ref: same length, >= 1"); goto done; }
+    double *out[3];
+    for (int k = 0; k < 3; k++) {
+        if (PyObject_GetBuffer(outs[k], &views[k], PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+        nviews++;
+        if (views[k].len != 8 * n) { PyErr_SetString(PyExc_ValueError, "outputs: one float64 per period"); goto done; }
+        out[k] = (double *)views[k].buf;
+    }
+    if (tf_rt_from_model(&rt[0], &pm) || (comp_spec != Py_None && tf_rt_from_model(&rt[1], &cm))) {
+        PyErr_SetString(PyExc_ValueError, "bad friction model");
+        goto done;
+    }
+    tf_loop loop = {mass, &rt[0], T_plant, {0}, comp_spec == Py_None ? TF_COMP_NONE : compensation,
+                    &rt[1], T_comp, gain, dt, substeps};
+    tf_pid_init(&loop.pid, kp, ki, kd, tau_d);
+    int status;
+    Py_BEGIN_ALLOW_THREADS
+    status = tf_loop_run(&loop, (long)n, x_ref, v_ref, out[0], out[1], out[2]);
+    Py_END_ALLOW_THREADS
+    result = PyLong_FromLong(status);
+done:
+    for (int k = 0; k < nviews; k++) PyBuffer_Release(&views[k]);
+    PyMem_Free(rt);
+    arena_free(&a);
+    arena_free(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
+    {"loop", py_loop, METH_VARARGS, "The closed-loop stage simulation of control.h (fixed step)."},
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
     {"simulate_sensitivities", py_simulate_sensitivities, METH_VARARGS,
      "Integrate a model and its forward sensitivities to the given targets."},

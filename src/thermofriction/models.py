@@ -962,7 +962,7 @@ def require_actuator(model: Model, task: str):
                          f"this model's plant is '{model.plant.type}'")
 
 
-PRESETS = ("li2009-model-i", "li2009-model-ii", "li2009-base", "li2009-self-heating", "canudas1995")
+PRESETS = ("li2009-model-i", "li2009-model-ii", "li2009-base", "li2009-self-heating", "canudas1995", "stage-model-i")
 
 
 def preset_path(name: str):

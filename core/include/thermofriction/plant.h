@@ -51,7 +51,7 @@ typedef struct {
 /* The most states a model has: 4 mechanical, the friction states, temperature, frictional work. */
 #define TF_MAX_STATES (TF_MAX_FRICTION_STATES + 6)
 
-typedef struct {
+typedef struct tf_model_s {
     int plant;
     /* stick-slip, physical form: m x_p'' + c x_p' + k x_p = T_em u + F ; m_e x_e'' = -F
        mass: m x'' = u + k_s (v_0 t - x) - F (k_s = 0: force-driven only) */

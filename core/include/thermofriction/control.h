@@ -1,0 +1,70 @@
+/* Friction compensation for position control loops, and a fixed-step closed-loop simulation of a
+ * single-mass stage (SPEC 3.2) that uses them. Allocation-free, plain C99 + libm.
+ *
+ *   - tf_pid: a PID on the position error with a first-order filter on the derivative.
+ *   - Feed-forward compensation: the friction model driven by the reference velocity,
+ *     u_ff = F(v_ref, T) -- a tf_rt_friction stepped with tf_rt_step.
+ *   - Observer-based compensation (Canudas de Wit et al. 1995, Sec. IV): the LuGre state is
+ *     estimated from the measured velocity v and position error e = x - x_ref,
+ *         z^' = v - sigma0 |v| z^ / g(v) - k e,   F^ = sigma0 z^ + sigma1 z^' + sigma2 v,
+ *     and F^ is added to the control; with k > 0 the estimation error is dissipated (their
+ *     Lyapunov argument). Both take the measured temperature T, so that Model I / II parameters
+ *     follow it. */
+#ifndef THERMOFRICTION_CONTROL_H
+#define THERMOFRICTION_CONTROL_H
+
+#include "realtime.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    double kp, ki, kd;  /* u = kp e + ki int e + kd de/dt, e = x_ref - x */
+    double tau_d;       /* derivative filter time constant [s] (0: none) */
+    double integral, d_filtered, e_prev;
+    int started;
+} tf_pid;
+
+void tf_pid_init(tf_pid *c, double kp, double ki, double kd, double tau_d);
+double tf_pid_step(tf_pid *c, double e, double dt);
+
+/* Observer-based LuGre compensation: advances z^ (in f->z) by dt and returns F^ [N].
+ * v: measured velocity [m/s]; e = x - x_ref [m]; k: observer gain [1/s]; T: temperature [degC].
+ * For LuGre, Dahl and elasto-plastic models (one internal state). */
+double tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double dt);
+
+typedef enum {
+    TF_COMP_NONE = 0,
+    TF_COMP_FEEDFORWARD = 1, /* F(v_ref, T_comp) */
+    TF_COMP_OBSERVER = 2     /* F^(v, e, T_comp) */
+} tf_compensation_kind;
+
+/* A position-controlled single mass m x'' = u - F(v, z, T_plant): PID on e = x_ref - x at the
+ * control period dt, plus compensation from `comp` told the temperature T_comp; the plant's own
+ * friction `plant` at T_plant, integrated with `substeps` steps per period (semi-implicit Euler
+ * for x, v; tf_rt_step for the friction states), u held over the period (zero-order hold). */
+typedef struct {
+    double mass;
+    tf_rt_friction *plant;
+    double T_plant;
+    tf_pid pid;
+    int compensation;
+    tf_rt_friction *comp;
+    double T_comp;
+    double observer_gain;
+    double dt;
+    int substeps;
+} tf_loop;
+
+/* Runs n control periods from rest at x = x_ref[0]. x_ref, v_ref: the reference at each period
+ * start. Writes, when not NULL, per period: x (position at the period start), u (the control
+ * held over it, compensation included), F_comp (the compensation in it). Returns TF_OK, or
+ * TF_ERR_NONFINITE if the loop goes unstable. */
+int tf_loop_run(tf_loop *loop, long n, const double *x_ref, const double *v_ref, double *x, double *u,
+                double *F_comp);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
