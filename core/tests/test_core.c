@@ -413,8 +413,57 @@ static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
     }
 }
 
+/* Real-time API (realtime.h, control.h). */
+static void rt_lugre(tf_rt_friction *f)
+{
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
+    p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_VSMOOTH] = 1e-6;
+    CHECK(tf_rt_init(f, TF_FRICTION_LUGRE, p, NULL) == TF_OK, "tf_rt_init");
+}
+
+static void test_rt_exact_for_constant_velocity_and_stable_at_large_steps(void)
+{
+    /* Oracle (analytic): at constant v, z(t) = z_ss (1 - exp(-sigma0 |v| t / g(v))), z_ss = g/sigma0:
+     * the exponential step is exact for any dt, and F -> g(v) + sigma2 v in sliding. */
+    static tf_rt_friction f;
+    double v = 2e-3, g = 1.0 + 0.5 * exp(-4.0), zss = g / 1e5;
+    double dts[] = {1e-6, 1e-4, 1e-2};
+    for (int k = 0; k < 3; k++) {
+        rt_lugre(&f);
+        double t = 0.0, worst = 0.0, F = 0.0;
+        for (int i = 0; i < 2000; i++) {
+            F = tf_rt_step(&f, v, NAN, dts[k]);
+            t += dts[k];
+            worst = fmax(worst, fabs(f.z[0] - zss * -expm1(-1e5 * v * t / g)) / zss);
+        }
+        CHECK(worst < 1e-12, "rt LuGre at dt %g: z off the exact solution by %g", dts[k], worst);
+        if (dts[k] >= 1e-4) CHECK(fabs(F - (g + 0.4 * v)) < 1e-9, "rt LuGre sliding force %g at dt %g", F, dts[k]);
+    }
+}
+
+static void test_rt_observer_converges(void)
+{
+    /* Oracle (analytic): with e = 0 the observer error z^ - z of LuGre at constant v decays as
+     * exp(-sigma0 |v| t / g(v)); from z^(0) = -z_ss it is below 1e-9 z_ss after 25 time constants. */
+    static tf_rt_friction plant, obs;
+    rt_lugre(&plant);
+    rt_lugre(&obs);
+    double v = 2e-3, g = 1.0 + 0.5 * exp(-4.0), tau = g / (1e5 * v), dt = 1e-5;
+    obs.z[0] = -g / 1e5;
+    double F = 0.0, Fh = 0.0;
+    for (int i = 0; i < (int)(25 * tau / dt); i++) {
+        F = tf_rt_step(&plant, v, NAN, dt);
+        Fh = tf_observer_step(&obs, v, 0.0, 100.0, NAN, dt);
+    }
+    CHECK(fabs(obs.z[0] - plant.z[0]) < 1e-9 * g / 1e5, "observer error %g", obs.z[0] - plant.z[0]);
+    CHECK(fabs(Fh - F) < 1e-8, "observer force %g vs %g", Fh, F);
+}
+
 int main(void)
 {
+    test_rt_exact_for_constant_velocity_and_stable_at_large_steps();
+    test_rt_observer_converges();
     test_lu_solves_systems_that_need_pivoting_in_later_columns();
     test_parameter_derivatives_vs_finite_differences();
     test_grid_end_one_ulp_past_a_corner();

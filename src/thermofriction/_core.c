@@ -588,7 +588,45 @@ done:
     return result;
 }
 
+/* rt_steps(spec, T, v, dt, F_out) -> seconds: tf_rt_step over the velocities v (one per step),
+ * the forces into F_out, timed in C (benchmarks) */
+static PyObject *py_rt_steps(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *v_obj, *F_obj;
+    double T, dt;
+    if (!PyArg_ParseTuple(args, "OdOdO", &spec, &T, &v_obj, &dt, &F_obj)) return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    Py_buffer Fv;
+    int have_F = 0;
+    tf_rt_friction *f = PyMem_Malloc(sizeof *f);
+    if (!f) { PyErr_NoMemory(); goto done; }
+    if (parse_model(&a, spec, &m)) goto done;
+    Py_ssize_t n;
+    const double *v = get_array(&a, v_obj, &n, "v");
+    if (PyErr_Occurred()) goto done;
+    if (PyObject_GetBuffer(F_obj, &Fv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
+    have_F = 1;
+    if (Fv.len != 8 * n) { PyErr_SetString(PyExc_ValueError, "F_out: one float64 per velocity"); goto done; }
+    if (tf_rt_from_model(f, &m)) { PyErr_SetString(PyExc_ValueError, "bad friction model"); goto done; }
+    double *F = (double *)Fv.buf;
+    struct timespec t0, t1;
+    Py_BEGIN_ALLOW_THREADS
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (Py_ssize_t i = 0; i < n; i++) F[i] = tf_rt_step(f, v[i], T, dt);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    Py_END_ALLOW_THREADS
+    result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+done:
+    if (have_F) PyBuffer_Release(&Fv);
+    PyMem_Free(f);
+    arena_free(&a);
+    return result;
+}
+
 static PyMethodDef methods[] = {
+    {"rt_steps", py_rt_steps, METH_VARARGS, "tf_rt_step over an array of velocities; returns seconds (timed in C)."},
     {"loop", py_loop, METH_VARARGS, "The closed-loop stage simulation of control.h (fixed step)."},
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
     {"simulate_sensitivities", py_simulate_sensitivities, METH_VARARGS,

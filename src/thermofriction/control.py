@@ -138,6 +138,16 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
     return LoopResult(reference.time, x_ref, outs[0], outs[1], outs[2])
 
 
+def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None):
+    """The real-time model (realtime.h: tf_rt_step) stepped at ``dt`` through the sliding velocities
+    ``velocity`` (one per step, held over it): returns (forces, seconds spent in C)."""
+    v = np.ascontiguousarray(velocity, float)
+    F = np.empty_like(v)
+    T = math.nan if temperature is None else float(temperature)
+    seconds = _core.rt_steps(core_spec(model, temperature), T, v, float(dt), F)
+    return F, seconds
+
+
 def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), calibration: float = 30.0,
                          observer_gain: float = 100.0, pid: PID = DEFAULT_PID):
     """Tracking errors with no compensation, temperature-blind compensation (the model told
@@ -159,4 +169,4 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
 
 
 __all__ = ["PID", "FeedForward", "Observer", "Reference", "sine_reference", "point_to_point", "LoopResult",
-           "simulate_loop", "compare_compensation", "DEFAULT_PID"]
+           "simulate_loop", "compare_compensation", "friction_steps", "DEFAULT_PID"]
