@@ -100,3 +100,47 @@ def test_fuzz_target_runs_30_seconds_without_a_finding(tmp_path):
                          capture_output=True, text=True, timeout=seconds + 300)
     assert out.returncode == 0 and "Done" in out.stderr, out.stderr[-4000:]
     assert not list(tmp_path.glob("crash-*")) and not list(tmp_path.glob("timeout-*"))
+
+
+# ---------------------------------------------------------------------------------------------
+# Installed library (issue 8): cmake --install, find_package(thermofriction), the C example
+# ---------------------------------------------------------------------------------------------
+
+EXAMPLE = CORE.parent / "examples" / "c"
+
+
+def test_installed_library_builds_the_c_example_and_it_matches_python(tmp_path):
+    """The core installs (static and shared libraries, headers, a CMake package config); the example
+    under examples/c finds it with find_package(thermofriction), links the shared library, runs the
+    10 kHz loop, and prints the same tracking errors as thermofriction.control.compare_compensation
+    on the same loop (oracle: the Python package through its binding; agreement to 1e-9)."""
+    import numpy as np
+
+    import thermofriction as tf
+    from thermofriction import control as C
+
+    build_core(tmp_path / "build", "-DCMAKE_BUILD_TYPE=Release")
+    prefix = tmp_path / "prefix"
+    subprocess.run(["cmake", "--install", str(tmp_path / "build"), "--prefix", str(prefix)], check=True,
+                   capture_output=True)
+    libdir = next(p for p in (prefix / "lib", prefix / "lib64") if p.exists())
+    assert (libdir / "libthermofriction.a").exists() and any(libdir.glob("libthermofriction.so*"))
+    assert (libdir / "cmake" / "thermofriction" / "thermofrictionConfig.cmake").exists()
+    assert (prefix / "include" / "thermofriction" / "realtime.h").exists()
+    ex = tmp_path / "example"
+    subprocess.run(["cmake", "-S", str(EXAMPLE), "-B", str(ex), f"-DCMAKE_PREFIX_PATH={prefix}"], check=True,
+                   capture_output=True)
+    subprocess.run(["cmake", "--build", str(ex)], check=True, capture_output=True)
+    out = subprocess.run([str(ex / "closed_loop")], capture_output=True, text=True,
+                         env=dict(os.environ, LD_LIBRARY_PATH=str(libdir)))
+    assert out.returncode == 0, out.stderr
+    printed = {}
+    for line in out.stdout.splitlines()[1:]:
+        T, rest = line.split(maxsplit=1)
+        name, rms, mx = rest.rsplit(maxsplit=2)
+        printed[(float(T), name.strip())] = (float(rms), float(mx))
+    assert len(printed) == 10
+    stage = tf.load_model("stage-model-i")
+    for row in C.compare_compensation(stage, [C.sine_reference(1e-3, 0.5, 4.0)]):
+        rms, mx = printed[(row["temperature"], row["compensation"])]
+        np.testing.assert_allclose([rms, mx], [row["rms_error"], row["max_error"]], rtol=1e-9)
