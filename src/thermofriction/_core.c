@@ -588,13 +588,13 @@ done:
     return result;
 }
 
-/* rt_steps(spec, T, v, dt, F_out) -> seconds: tf_rt_step over the velocities v (one per step),
- * the forces into F_out, timed in C (benchmarks) */
+/* rt_steps(spec, T, v, dt, F_out) -> seconds: tf_rt_step over the velocities v (one per step) at
+ * temperature T (a number, or an array with one per step), the forces into F_out, timed in C */
 static PyObject *py_rt_steps(PyObject *self, PyObject *args)
 {
-    PyObject *spec, *v_obj, *F_obj;
-    double T, dt;
-    if (!PyArg_ParseTuple(args, "OdOdO", &spec, &T, &v_obj, &dt, &F_obj)) return NULL;
+    PyObject *spec, *v_obj, *F_obj, *T_obj;
+    double dt;
+    if (!PyArg_ParseTuple(args, "OOOdO", &spec, &T_obj, &v_obj, &dt, &F_obj)) return NULL;
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
@@ -609,12 +609,22 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     if (PyObject_GetBuffer(F_obj, &Fv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
     have_F = 1;
     if (Fv.len != 8 * n) { PyErr_SetString(PyExc_ValueError, "F_out: one float64 per velocity"); goto done; }
+    double T_const = NAN;
+    const double *T = NULL;
+    if (PyFloat_Check(T_obj)) {
+        T_const = PyFloat_AsDouble(T_obj);
+    } else {
+        Py_ssize_t nT;
+        T = get_array(&a, T_obj, &nT, "T");
+        if (PyErr_Occurred()) goto done;
+        if (nT != n) { PyErr_SetString(PyExc_ValueError, "T: a number or one per velocity"); goto done; }
+    }
     if (tf_rt_from_model(f, &m)) { PyErr_SetString(PyExc_ValueError, "bad friction model"); goto done; }
     double *F = (double *)Fv.buf;
     struct timespec t0, t1;
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (Py_ssize_t i = 0; i < n; i++) F[i] = tf_rt_step(f, v[i], T, dt);
+    for (Py_ssize_t i = 0; i < n; i++) F[i] = tf_rt_step(f, v[i], T ? T[i] : T_const, dt);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     Py_END_ALLOW_THREADS
     result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));

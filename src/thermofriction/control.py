@@ -140,11 +140,17 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
 
 def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None):
     """The real-time model (realtime.h: tf_rt_step) stepped at ``dt`` through the sliding velocities
-    ``velocity`` (one per step, held over it): returns (forces, seconds spent in C)."""
+    ``velocity`` (one per step, held over it) at ``temperature`` (a number, or one per step):
+    returns (forces, seconds spent in C)."""
     v = np.ascontiguousarray(velocity, float)
     F = np.empty_like(v)
-    T = math.nan if temperature is None else float(temperature)
-    seconds = _core.rt_steps(core_spec(model, temperature), T, v, float(dt), F)
+    if temperature is None or np.ndim(temperature) == 0:
+        T = math.nan if temperature is None else float(temperature)
+        spec_T = temperature
+    else:  # one temperature per step
+        T = np.ascontiguousarray(temperature, float)
+        spec_T = float(T[0])
+    seconds = _core.rt_steps(core_spec(model, spec_T), T, v, float(dt), F)
     return F, seconds
 
 
