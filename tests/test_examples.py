@@ -202,3 +202,15 @@ def test_self_heating_example_writes_its_report(tmp_path):
     runs = [self_heating.run(f, 20.0, full=False) for f in (5.0, 500.0)]
     rise = [r["result"].temperature[-1] - 30.0 for r in runs]
     assert rise[1] > 20 * rise[0] > 0
+
+
+def test_compensation_example_prints_its_table_and_writes_its_report(tmp_path):
+    """examples/compensation.py end to end: 20 rows (2 references x 2 temperatures x 5 cases), the HTML
+    report with its table and one figure per reference."""
+    import compensation
+    out = tmp_path / "c.html"
+    rows = compensation.main(["-o", str(out), "--figures", str(tmp_path / "fig")])
+    assert len(rows) == 20
+    text = out.read_text()
+    assert "observer, aware" in text and 'id="fig-control_error_0"' in text and 'id="fig-control_error_1"' in text
+    assert (tmp_path / "fig" / "control_error_1.png").stat().st_size > 1000

@@ -489,16 +489,53 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
          "two-time-scale [s]", "full [s]"], rows) + "</section>")
     parts.append("<section><h2>Temperature</h2>" + temp_fig + "</section>")
     parts.append("<section><h2>Step size</h2>" + step_fig + err_fig + "</section>")
-    name = html.escape(title or "thermofriction — self-heating")
+    return _write_page(path, title or "thermofriction — self-heating", ", ".join(r["label"] for r in runs), parts,
+                       command)
+
+
+def _write_page(path, title, subtitle, parts, command=None) -> str:
+    """A standalone report page (the main report's style) written atomically; returns the HTML."""
+    name = html.escape(title)
     footer = " · ".join(f"{k} {v}" for k, v in _versions().items()) + (
         f"<br>command: <code>{html.escape(command)}</code>" if command else "")
     text = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
             f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
-            f"<body><header><h1>{name}</h1><p>{', '.join(html.escape(r['label']) for r in runs)}</p></header>"
+            f"<body><header><h1>{name}</h1><p>{html.escape(subtitle)}</p></header>"
             f"<main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
     with atomic_write(path, "w", encoding="utf-8") as fh:
         fh.write(text)
     return text
 
 
-__all__ += ["heating_report"]
+# -- friction compensation in closed loop -----------------------------------------------------------
+
+def control_report(rows, path, *, figures_dir=None, title=None, command=None) -> str:
+    """Writes an HTML report of thermofriction.control.compare_compensation's rows: the table of RMS
+    and maximum tracking errors per reference, stage temperature and compensation, and for each
+    reference the tracking error over time at the hottest temperature."""
+    plt = _plt()
+    figs = Figures(figures_dir)
+    table = [[r["reference"], _fmt(r["temperature"], "{:.1f}"), r["compensation"], _fmt(r["rms_error"] * 1e6, "{:.3g}"),
+              _fmt(r["max_error"] * 1e6, "{:.3g}")] for r in rows]
+    parts = ["<section><h2>Tracking error</h2>" + _table(
+        ["reference", "stage T [°C]", "compensation", "RMS error [µm]", "max error [µm]"], table) +
+        "<p style='font-size:13px;color:#4a5266'>Blind: the compensation's model is told the calibration "
+        "temperature (30 °C); aware: the measured temperature.</p></section>"]
+    hottest = max(r["temperature"] for r in rows)
+    for i, name in enumerate(dict.fromkeys(r["reference"] for r in rows)):
+        fig, ax = plt.subplots(figsize=(7, 3.4))
+        for r in rows:
+            if r["reference"] == name and r["temperature"] == hottest:
+                res = r["result"]
+                ax.plot(res.time, res.error * 1e6, label=r["compensation"], lw=1)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("tracking error [µm]")
+        ax.set_yscale("symlog", linthresh=0.1)
+        ax.legend(fontsize=8)
+        parts.append("<section><h2>" + html.escape(name) + "</h2>" + figs.render(
+            fig, f"control_error_{i}", f"Tracking error at {hottest:g} °C, {name}: no compensation, and "
+            f"feed-forward or observer compensation, temperature-blind or temperature-aware.") + "</section>")
+    return _write_page(path, title or "thermofriction — friction compensation", "closed-loop tracking", parts, command)
+
+
+__all__ += ["heating_report", "control_report"]
