@@ -460,8 +460,25 @@ static void test_rt_observer_converges(void)
     CHECK(fabs(Fh - F) < 1e-8, "observer force %g vs %g", Fh, F);
 }
 
+static void test_rt_parameter_update_and_reset(void)
+{
+    /* Oracle (analytic): in steady sliding F = g(v) + sigma2 v, so raising sigma2 by 1 N s/m at run
+     * time raises F by v at once; reset returns the state to rest (F = sigma2 v + sigma1 v at z = 0). */
+    static tf_rt_friction f;
+    rt_lugre(&f);
+    double v = 0.1, F0 = 0.0, F1;
+    for (int i = 0; i < 100; i++) F0 = tf_rt_step(&f, v, NAN, 1e-3);
+    CHECK(tf_rt_set_param(&f, TF_P_SIGMA2, 1.4) == TF_OK, "set_param");
+    F1 = tf_rt_step(&f, v, NAN, 1e-3);
+    CHECK(fabs(F1 - F0 - v) < 1e-12, "sigma2 update: %g -> %g", F0, F1);
+    CHECK(tf_rt_set_param(&f, TF_NPARAM, 1.0) == TF_ERR_BAD_ARGUMENT, "bad parameter index accepted");
+    tf_rt_reset(&f);
+    CHECK(f.z[0] == 0.0 && fabs(tf_rt_step(&f, v, NAN, 0.0) - (1.4 + 316.2) * v) < 1e-12, "reset to rest");
+}
+
 int main(void)
 {
+    test_rt_parameter_update_and_reset();
     test_rt_exact_for_constant_velocity_and_stable_at_large_steps();
     test_rt_observer_converges();
     test_lu_solves_systems_that_need_pivoting_in_later_columns();
