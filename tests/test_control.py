@@ -19,21 +19,14 @@ from thermofriction import control as C
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference as R  # noqa: E402
+from conftest import every_friction_model  # noqa: E402
 
-CANUDAS = dict(sigma0=1e5, sigma1=math.sqrt(1e5), sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
-MODELS = {
-    "coulomb": lambda: tf.Coulomb(fc=1.0, sigma2=0.4, v_smooth=1e-4),
-    "stribeck": lambda: tf.Stribeck(fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4, v_smooth=1e-4),
-    "dahl": lambda: tf.Dahl(sigma0=1e5, fc=1.0),
-    "lugre": lambda: tf.LuGre(**CANUDAS),
-    "elastoplastic": lambda: tf.ElastoPlastic(**CANUDAS, z_ba=3e-6),
-    "gms": lambda: tf.GMS(k=[5e4, 3e4, 2e4], w=[0.3, 0.3, 0.4], C=20.0, fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4),
-}
+MODELS = every_friction_model()
 A, W = 20e-6, 2 * math.pi * 5.0  # prescribed motion x = A sin(W t): +-0.63 mm/s, 5 Hz
 
 
 def prescribed(kind, thermal=None):
-    friction = MODELS[kind]()
+    friction = MODELS[kind]
     if thermal == "I":
         friction = dataclasses.replace(friction, fc=None)
         return tf.Model(tf.PrescribedMotion(), friction, tf.ModelI({"fc": tf.Exp(a=1.0 / math.exp(-0.159 * 30),

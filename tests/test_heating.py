@@ -22,6 +22,7 @@ from thermofriction.simulate import core_spec
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference as R  # noqa: E402
+from conftest import every_friction_model  # noqa: E402
 
 V_SLIDE = 1e-3  # m/s
 FC = 0.5        # N
@@ -350,15 +351,7 @@ def test_simulate_command_line_with_a_heat_model(tmp_path):
     assert T[0] == 31.0 and T[-1] > 31.05
 
 
-CANUDAS = dict(sigma0=1e5, sigma1=math.sqrt(1e5), sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
-EVERY_FRICTION = {
-    "coulomb": lambda: tf.Coulomb(fc=1.0, sigma2=0.4, v_smooth=1e-4),
-    "stribeck": lambda: tf.Stribeck(fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4, v_smooth=1e-4),
-    "dahl": lambda: tf.Dahl(sigma0=1e5, fc=1.0),
-    "lugre": lambda: tf.LuGre(**CANUDAS),
-    "elastoplastic": lambda: tf.ElastoPlastic(**CANUDAS, z_ba=5e-6),
-    "gms": lambda: tf.GMS(k=[5e4, 3e4, 2e4], w=[0.3, 0.3, 0.4], C=20.0, fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4),
-}
+EVERY_FRICTION = every_friction_model()
 
 
 @pytest.mark.parametrize("kind", list(EVERY_FRICTION))
@@ -367,7 +360,7 @@ def test_every_friction_model_heats_with_its_energy_balanced(kind):
     the spring-pulled mass of Canudas de Wit et al. (1995) in stick-slip for 10 s heats its
     interface, and C_th (T - T_0) + int (T - T_amb)/R_th dt = eta W to 1e-5 of the stored heat
     (the loss integral by Simpson's rule on a 20 kHz grid)."""
-    friction = dataclasses.replace(EVERY_FRICTION[kind](), fc=None)
+    friction = dataclasses.replace(EVERY_FRICTION[kind], fc=None)
     law = ModelI({"fc": Exp(a=1.0 / math.exp(-0.01 * 25.0), b=-0.01)})  # 1 N at 25 C
     heat = Heat(heat_capacity=0.2, thermal_resistance=20.0, heat_fraction=0.9, ambient_temperature=25.0)
     model = Model(tf.MassPlant(1.0, 2.0, 0.1), friction, law, heat=heat)
