@@ -26,19 +26,18 @@ double tf_pid_step(tf_pid *c, double e, double dt)
 
 double tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double dt)
 {
-    double p[TF_NPARAM], lambda, dF, dz[TF_MAX_FRICTION_STATES];
-    tf_rt_params_at(f, T, p, &lambda, &dF);
+    double lambda, dF, dz[TF_MAX_FRICTION_STATES];
+    tf_model *m = &f->model;
+    const double *p = tf_model_params_cached(m, T, &lambda, &dF);
     double extra = -k * e;
-    double F = tf_rt_advance(f->kind, p, &f->gms, f->z, v, dt, &extra, dz);
+    double F = tf_rt_advance(m->friction, p, &m->gms, f->z, v, dt, &extra, dz);
     /* the observer's own z^' in the damping term: F^ = sigma0 z^ + sigma1 z^' + sigma2 v */
-    if (f->kind == TF_FRICTION_LUGRE || f->kind == TF_FRICTION_ELASTOPLASTIC) {
+    if (m->friction == TF_FRICTION_LUGRE || m->friction == TF_FRICTION_ELASTOPLASTIC) {
         double s1 = p[TF_P_SIGMA1];
         if (p[TF_P_VD] > 0.0) s1 *= exp(-(v / p[TF_P_VD]) * (v / p[TF_P_VD]));
         F += s1 * extra;
     }
-    F *= lambda;
-    if (dF != 0.0) F += dF * tanh(v / p[TF_P_VSMOOTH]);
-    return F;
+    return tf_rt_thermal_force(F, v, p, lambda, dF);
 }
 
 int tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, double *x_out, double *u_out,

@@ -71,7 +71,7 @@ double tf_model_lambda(const tf_model *model, double T)
 }
 
 /* Parameters, scale factor and offset force at temperature T, cached per temperature. */
-static const double *params(tf_model *m, double T, double *lambda, double *dF)
+const double *tf_model_params_cached(tf_model *m, double T, double *lambda, double *dF)
 {
     /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
     if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
@@ -94,7 +94,7 @@ static double friction_at(tf_model *m, double T, double t, const double *y, doub
                           tf_friction_param_partials *dp, double *F_base)
 {
     double lambda, dF;
-    const double *p = params(m, T, &lambda, &dF);
+    const double *p = tf_model_params_cached(m, T, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
     double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
@@ -332,7 +332,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
     tf_friction_param_partials dp;
     double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
     double T = tf_model_temperature(m, t, y);
-    params(m, T, &lambda, &dF_offset);
+    tf_model_params_cached(m, T, &lambda, &dF_offset);
     double F = friction_at(m, T, t, y, dz, 0, &dp, &Fb);
     if (m->fs_follows_fc) { /* one parameter moves both */
         dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
@@ -399,7 +399,7 @@ void tf_model_events(double t, const double *y, double *g, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double lambda, dF;
-    const double *p = params(m, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, y), &lambda, &dF);
     tf_friction_events(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m), g);
 }
 
@@ -407,7 +407,7 @@ void tf_model_on_restart(double t, const double *y, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double lambda, dF;
-    const double *p = params(m, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, y), &lambda, &dF);
     double v = relative_velocity(m, t, y);
     if (m->plant == TF_PLANT_PRESCRIBED) {
         /* a prescribed motion keeps one direction between restarts (corners and reversals), but

@@ -95,10 +95,6 @@ class HeatingResult:
     table: CycleTable | None = None
     stats: dict = field(default_factory=dict)
 
-    def columns(self) -> dict:
-        return {"time[s]": self.time, "temperature[C]": self.temperature, "displacement[m]": self.displacement,
-                "step_size[m]": self.step_size, "friction_work[J]": self.friction_work}
-
 
 def _periodic_input(model: Model, input: Waveform | None) -> Waveform:
     waveform = input if input is not None else model.input

@@ -11,7 +11,7 @@ import numpy as np
 
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning
-from .identify.engine import experiment_waveform, heated_trace
+from .identify.engine import ambient_temperature, experiment_waveform, recorded_start_temperature
 from .models import Model, require_actuator
 from .simulate import StepSizeController, simulate
 
@@ -64,13 +64,13 @@ class Prediction:
 def predict(model: Model, exp, rtol=1e-8) -> Prediction:
     """Simulates one experiment (at rtol 1e-8: predictions should carry no solver error worth
     mentioning next to a measurement's) and computes its metrics."""
-    T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
     if model.heat is not None:  # the temperature is the model's own: from the run's start, at ambient
-        tr = heated_trace(exp, model) if getattr(exp, "temperature_signal", None) is not None else None
-        T = model.heat.ambient_temperature if model.heat.ambient_temperature is not None else exp.temperature
-        if tr is not None and model.heat.initial_temperature is None:
-            model = dataclasses.replace(model, heat=dataclasses.replace(model.heat,
-                                                                        initial_temperature=tr.initial_temperature))
+        T = ambient_temperature(exp, model)
+        T0 = recorded_start_temperature(exp)
+        if T0 is not None and model.heat.initial_temperature is None:
+            model = dataclasses.replace(model, heat=dataclasses.replace(model.heat, initial_temperature=T0))
+    else:
+        T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
     waveform = experiment_waveform(exp, model)
     res = simulate(model, t_eval=exp.time, temperature=T, input=waveform, controller=StepSizeController(rtol=rtol))
     pred = res.displacement - res.displacement[0]

@@ -51,7 +51,7 @@ typedef struct {
 /* The most states a model has: 4 mechanical, the friction states, temperature, frictional work. */
 #define TF_MAX_STATES (TF_MAX_FRICTION_STATES + 6)
 
-typedef struct tf_model_s {
+typedef struct {
     int plant;
     /* stick-slip, physical form: m x_p'' + c x_p' + k x_p = T_em u + F ; m_e x_e'' = -F
        mass: m x'' = u + k_s (v_0 t - x) - F (k_s = 0: force-driven only) */
@@ -114,6 +114,10 @@ int tf_model_work_index(const tf_model *model);
 void tf_model_params_at(const tf_model *model, double T, double *p);
 /* The thermal factor lambda(T) of Model II's scale form (1 otherwise). */
 double tf_model_lambda(const tf_model *model, double T);
+/* Parameters at T (as tf_model_params_at), Model II's *lambda and offset force *dF_offset, cached
+ * in the model for the last T: a constant temperature costs no law evaluation. The pointer is into
+ * the model's cache, valid until the next call with another T. */
+const double *tf_model_params_cached(tf_model *model, double T, double *lambda, double *dF_offset);
 /* Friction force F' at (t, state). */
 double tf_model_friction(const tf_model *model, double t, const double *y);
 void tf_model_initial_state(const tf_model *model, double *y);

@@ -28,6 +28,7 @@
 #define THERMOFRICTION_REALTIME_H
 
 #include "friction.h"
+#include "plant.h"
 #include "thermal.h"
 
 #ifdef __cplusplus
@@ -35,18 +36,10 @@ extern "C" {
 #endif
 
 typedef struct {
-    int kind;                      /* tf_friction_kind */
-    double p[TF_NPARAM];           /* parameters at run time (those without a law) */
-    int fs_follows_fc;             /* fs = fc at every temperature (no Stribeck effect) */
-    int thermal;                   /* tf_thermal_kind */
-    tf_law law[TF_NPARAM];         /* Model I laws (TF_LAW_NONE: the parameter keeps p[i]) */
-    tf_law dF;                     /* Model II thermal-induced friction [N] */
-    int dF_form;                   /* tf_df_form */
-    tf_gms_elements gms;           /* GMS elements and modes */
+    /* the friction model and its thermal extension, as the simulator holds them (plant.h; the
+       plant fields are unused), with its per-temperature parameter cache */
+    tf_model model;
     double z[TF_MAX_FRICTION_STATES]; /* internal states */
-    /* parameters at the last temperature, so a constant temperature costs no law evaluation */
-    int cache_valid;
-    double cache_T, cache_p[TF_NPARAM], cache_lambda, cache_dF;
 } tf_rt_friction;
 
 /* Sets up a model at rest. p: TF_NPARAM values (unused ones ignored); gms: the elements for
@@ -69,10 +62,12 @@ void tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, dou
  * advancing. */
 double tf_rt_step(tf_rt_friction *f, double v, double T, double dt);
 
-struct tf_model_s;
 /* The friction model and thermal extension of a simulation model (plant.h's tf_model), for
  * callers that already configure one; its laws' arrays must outlive f. */
-int tf_rt_from_model(tf_rt_friction *f, const struct tf_model_s *model);
+int tf_rt_from_model(tf_rt_friction *f, const tf_model *model);
+/* F' from the base model's force: Model II's scale factor and offset (SPEC 5.2) as
+ * tf_rt_params_at gives them, at sliding velocity v with parameters p. */
+double tf_rt_thermal_force(double F_base, double v, const double *p, double lambda, double dF_offset);
 
 /* The core of tf_rt_step for callers that add terms to the state equation (observers): advances
  * z by one exponential-Euler step of z' = f(v, z) + extra[j] (extra may be NULL) with parameters

@@ -76,25 +76,39 @@ def make_traces(experiments, model: Model):
     return traces
 
 
-def heated_trace(exp, model: Model) -> Trace:
-    """A trace for a model with a [heat] section: the ambient temperature is the model's T_amb, else
-    the experiment's (manifest) temperature; the run starts where the recorded temperature starts
-    (smoothed against sensor noise); the record itself is a fitted output."""
+def ambient_temperature(exp, model: Model) -> float:
+    """The ambient temperature of a run of a model with a [heat] section: the model's T_amb, else
+    the experiment's (manifest) temperature."""
+    ambient = model.heat.ambient_temperature
+    return float(exp.temperature) if ambient is None else float(ambient)
+
+
+def recorded_start_temperature(exp) -> float | None:
+    """Where the recorded temperature starts (None without a record): a parabola through the first
+    2 % of the record, at the first sample (a plain mean there is biased by the heating already
+    under way: 0.1 K, micrometres of misfit, in tests)."""
     sig = getattr(exp, "temperature_signal", None)
     if sig is None:
-        raise InputError(f"{exp.file}: the model heats itself ([heat] section) but the experiment records no "
-                         f"temperature[C] column to fit it to")
-    sig = np.ascontiguousarray(sig, float)
-    ambient = model.heat.ambient_temperature
-    ambient = float(exp.temperature) if ambient is None else float(ambient)
-    # the start: a parabola through the first 2 % of the record, at the first sample (a plain mean
-    # there is biased by the heating already under way: 0.1 K, micrometres of misfit, in tests)
+        return None
+    sig = np.asarray(sig, float)
+    if len(sig) < 3:
+        return float(sig[0])
     k = max(3, len(sig) // 50)
     t = np.asarray(exp.time[:k], float) - float(exp.time[0])
-    T0 = float(np.polyval(np.polyfit(t, sig[:k], 2), 0.0)) if len(sig) >= 3 else float(sig[0])
+    return float(np.polyval(np.polyfit(t, sig[:k], 2), 0.0))
+
+
+def heated_trace(exp, model: Model) -> Trace:
+    """A trace for a model with a [heat] section: at its ambient temperature, from where the recorded
+    temperature starts; the record itself is a fitted output."""
+    T0 = recorded_start_temperature(exp)
+    if T0 is None:
+        raise InputError(f"{exp.file}: the model heats itself ([heat] section) but the experiment records no "
+                         f"temperature[C] column to fit it to")
     return Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.displacement, float),
-                 ambient, experiment_waveform(exp, model), getattr(exp, "role", "fit"), float(exp.temperature),
-                 measured_temperature=sig, initial_temperature=T0)
+                 ambient_temperature(exp, model), experiment_waveform(exp, model), getattr(exp, "role", "fit"),
+                 float(exp.temperature), measured_temperature=np.ascontiguousarray(exp.temperature_signal, float),
+                 initial_temperature=T0)
 
 
 _POOL = None
