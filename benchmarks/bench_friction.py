@@ -11,7 +11,7 @@ fc), elasto-plastic (LuGre's plus z_ba = 5 um, half of fc/sigma0), GMS with N = 
 initial presliding stiffness is LuGre's; C = 20 N/s; fc, fs, vs, sigma2 as LuGre).
 
 (i)  One right-hand-side evaluation (plant + friction) in the C core, timed in C by
-     thermofriction._core.time_rhs over 2 million calls, best of 7, in nanoseconds, with the ratio
+     thermofriction._bridge.time_rhs over 2 million calls, best of 7, in nanoseconds, with the ratio
      to LuGre, at two sliding velocities: v = vs = 1 mm/s (inside the Stribeck band) and
      v = 0.1 m/s (gross sliding, where exp(-(v/vs)^2) underflows to zero; most of a stick-slip
      cycle's slip phase is there). LuGre, Dahl: z = fc/(2 sigma0); elasto-plastic:
@@ -43,8 +43,7 @@ from pathlib import Path
 import numpy as np
 
 import thermofriction as tf
-from thermofriction import _core
-from thermofriction.simulate import core_spec
+from thermofriction import _bridge
 
 from _timing import core_timer  # benchmarks/ is the script's folder, first on sys.path
 
@@ -88,7 +87,7 @@ def state(friction, v):
 
 
 def time_rhs(spec, y, n_evals=2_000_000, repeats=7):
-    return min(_core.time_rhs(spec, 1.0, y, n_evals)[0] for _ in range(repeats))
+    return min(_bridge.time_rhs(spec, 1.0, y, n_evals)[0] for _ in range(repeats))
 
 
 def part_i():
@@ -97,7 +96,7 @@ def part_i():
     rows = []
     for name, friction in MODELS.items():
         model = tf.Model(PLANT, friction)
-        spec = core_spec(model, None, None)
+        spec = _bridge.model_spec(model, None, None)
         variants = [(name, spec)]
         if isinstance(friction, tf.GMS):
             n = len(friction.k)

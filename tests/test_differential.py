@@ -20,9 +20,8 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 import thermofriction as tf
-from thermofriction import _core
+from thermofriction import _bridge
 from thermofriction.models import ModelI, ModelII
-from thermofriction.simulate import core_spec
 from thermofriction.waveforms import Zero
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -103,7 +102,7 @@ def random_states(ref, n, rng, v_min=1e-9, vp_over_v=None):
 def core_rhs(spec, t, y, jac=False):
     dy = np.empty(5)
     J = np.empty((5, 5)) if jac else None
-    F = _core.rhs_jac(spec, float(t), np.ascontiguousarray(y, float), dy, J)
+    F = _bridge.rhs_jac(spec, float(t), np.ascontiguousarray(y, float), dy, J)
     return dy, F, J
 
 
@@ -131,7 +130,7 @@ def test_rhs_matches_reference(case):
     at every corner of the input and knot of the temperature."""
     make, temperature = RHS_CASES[case]
     model = make()
-    spec = core_spec(model, temperature, None)
+    spec = _bridge.model_spec(model, temperature, None)
     ref = R.ReferenceModel(model, temperature)
     rng = np.random.default_rng(zlib.crc32(case.encode()))
     times = list(rng.uniform(0.0, 1.0, 300))
@@ -158,7 +157,7 @@ def test_rhs_at_rest_and_in_steady_sliding():
     scaled by lambda(T) in Model II (Eq. 12) -- the sign convention of SPEC 2."""
     model = stribeck_model_ii("scale")
     T = 36.0
-    spec = core_spec(model, T, None)
+    spec = _bridge.model_spec(model, T, None)
     ref = R.ReferenceModel(model, T)
     p = ref.params(T)
     dy, F, _ = core_rhs(spec, 0.05, np.array([0.0, 0.0, 0.0, 0.0, 1e-7]))
@@ -185,7 +184,7 @@ def test_jacobian_matches_finite_differences_of_reference(case):
     kept away from the |v| kink at v = 0 by 1e6 finite-difference steps)."""
     make, temperature = RHS_CASES[case]
     model = make()
-    spec = core_spec(model, temperature, None)
+    spec = _bridge.model_spec(model, temperature, None)
     ref = R.ReferenceModel(model, temperature)
     X, V, Z = ref.scales()
     rng = np.random.default_rng(1 + zlib.crc32(case.encode()))
@@ -212,10 +211,7 @@ def test_jacobian_matches_finite_differences_of_reference(case):
 # ---------------------------------------------------------------------------------------------
 
 def core_law(law, T):
-    T = np.ascontiguousarray(T, float)
-    v, d = np.empty_like(T), np.empty_like(T)
-    _core.law_eval(law._core_tuple(), T, v, d)
-    return v, d
+    return _bridge.law_eval(law, np.ascontiguousarray(T, float))
 
 
 LAWS = {
@@ -297,8 +293,8 @@ def test_waveforms_match_reference(name):
     t = np.sort(np.concatenate([rng.uniform(-0.5, 2.5, 5000), corners_r, corners_r - 1e-9, corners_r + 1e-9,
                                 np.linspace(t0, t1, 2001)]))
     t = np.concatenate([[t0], t[(t > t0) & (t < t1)], [t1]])
-    out = np.empty_like(t)
-    corners_c = np.array(_core.waveform_eval(w._core_tuple(), t, out))
+    out = _bridge.waveform_eval(w, t)
+    corners_c = _bridge.waveform_corners(w, t[0], t[-1])
     ref = R.waveform_value(w, t)
     amp = abs(getattr(w, "amplitude", 0.0)) + abs(getattr(w, "offset", 0.0)) + float(
         np.max(np.abs(w.value)) if isinstance(w, tf.Sampled) else 0.0)
@@ -339,7 +335,7 @@ def test_state_scales_match_reference():
     for make, T in [(lambda: tf.load_model("li2009-model-i"), 35.7), (stribeck_base, None),
                     (lambda: tf.load_model("li2009-model-ii"), 33.0), (_offset_model, 40.0)]:
         model = make()
-        c = np.array(_core.state_scale(core_spec(model, T, None)))
+        c = _bridge.state_scale(_bridge.model_spec(model, T, None))
         X, V, Z = R.ReferenceModel(model, T).scales()
         np.testing.assert_allclose(c, [X, V, X, V, Z], rtol=1e-14)
 

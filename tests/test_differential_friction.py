@@ -23,9 +23,8 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
-from thermofriction import _core
+from thermofriction import _bridge
 from thermofriction.models import ModelI, ModelII
-from thermofriction.simulate import core_spec
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference as R  # noqa: E402
@@ -316,12 +315,12 @@ def core_eval(spec, t, y, jac=False):
     n = len(y)
     dy = np.empty(n)
     J = np.empty((n, n)) if jac else None
-    F = _core.rhs_jac(spec, float(t), np.ascontiguousarray(y, float), dy, J)
+    F = _bridge.rhs_jac(spec, float(t), np.ascontiguousarray(y, float), dy, J)
     return dy, F, J
 
 
 def _spec(model, temperature, modes):
-    spec = core_spec(model, temperature, None)
+    spec = _bridge.model_spec(model, temperature, None)
     if modes is not None:
         spec["gms_mode"] = np.array(modes, float)
     return spec

@@ -16,9 +16,8 @@ from scipy.integrate import simpson
 from scipy.optimize import brentq
 
 import thermofriction as tf
-from thermofriction import _core
+from thermofriction import _bridge
 from thermofriction.models import Coulomb, Exp, Heat, Linear, Model, ModelI, ModelII, PrescribedMotion
-from thermofriction.simulate import core_spec
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference as R  # noqa: E402
@@ -131,7 +130,7 @@ def test_heat_rows_and_temperature_column_of_the_jacobian():
     saw = tf.Sawtooth(amplitude=30, frequency=500, rise=0.999)
     for kind in ("I", "II"):
         model = paper_heated(kind, heater=tf.Step(amplitude=1e-3, time=0.0, slew=1.0))
-        spec = core_spec(model, 30.0, saw)
+        spec = _bridge.model_spec(model, 30.0, saw)
         for _ in range(40):
             t = float(rng.uniform(0, 2e-3))
             vp, ve = rng.normal(0, 1e-3, 2)
@@ -139,7 +138,7 @@ def test_heat_rows_and_temperature_column_of_the_jacobian():
             y = np.array([rng.normal(0, 1e-6), vp, rng.normal(0, 1e-6), ve, z, rng.uniform(30, 40), 1e-6])
             n = y.size
             dy, J = np.empty(n), np.empty((n, n))
-            _core.rhs_jac(spec, t, y, dy, J)
+            _bridge.rhs_jac(spec, t, y, dy, J)
             ref = R.ReferenceHeatedSystem(model, 30.0, saw)
             np.testing.assert_allclose(dy, ref.rhs(t, y), rtol=1e-10, atol=1e-12 * np.abs(dy).max())
             scale = np.array([1e-6, 1e-3, 1e-6, 1e-3, 1e-6, 1.0, 1e-6])  # x, v, x, v, z, T, W

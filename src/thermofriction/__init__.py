@@ -10,6 +10,7 @@ extensions (Li et al., Rev. Sci. Instrum. 80,
     res.time, res.displacement, res.step_sizes
 """
 
+from ._version import __version__
 from .errors import (ComputationError, ConditioningWarning, InputError, PassivityWarning, SolverError,
                      TemperatureRangeWarning,
                      ThermofrictionError)
@@ -24,7 +25,6 @@ from .validate import validate
 from . import control, heating
 from .report import report
 
-__version__ = "0.1.0"
 
 __all__ = [
     "ComputationError", "ConditioningWarning", "InputError", "PassivityWarning", "SolverError", "TemperatureRangeWarning",

@@ -635,6 +635,87 @@ done:
     return result;
 }
 
+/* The contract with Python, from one source: every enum constant of the core's headers with the
+ * name Python uses for it, grouped. thermofriction._bridge reads these; tests/test_bridge.py parses
+ * the headers and fails if a header constant is missing here or a name here is not in a header. */
+typedef struct {
+    const char *group, *name, *c_name;
+    long value;
+} tf_constant;
+
+#define C(group, name, sym) {group, name, #sym, (long)(sym)}
+static const tf_constant constants[] = {
+    C("parameter", "sigma0", TF_P_SIGMA0), C("parameter", "sigma1", TF_P_SIGMA1), C("parameter", "sigma2", TF_P_SIGMA2),
+    C("parameter", "fc", TF_P_FC), C("parameter", "fs", TF_P_FS), C("parameter", "vs", TF_P_VS),
+    C("parameter", "delta", TF_P_DELTA), C("parameter", "vd", TF_P_VD), C("parameter", "v_smooth", TF_P_VSMOOTH),
+    C("parameter", "z_ba", TF_P_ZBA), C("parameter", "C", TF_P_C),
+    C("plant", "stick-slip", TF_PLANT_STICK_SLIP), C("plant", "mass", TF_PLANT_MASS),
+    C("plant", "prescribed", TF_PLANT_PRESCRIBED),
+    C("friction", "lugre", TF_FRICTION_LUGRE), C("friction", "coulomb", TF_FRICTION_COULOMB),
+    C("friction", "stribeck", TF_FRICTION_STRIBECK), C("friction", "dahl", TF_FRICTION_DAHL),
+    C("friction", "elastoplastic", TF_FRICTION_ELASTOPLASTIC), C("friction", "gms", TF_FRICTION_GMS),
+    C("law", "none", TF_LAW_NONE), C("law", "const", TF_LAW_CONST), C("law", "linear", TF_LAW_LINEAR),
+    C("law", "exp", TF_LAW_EXP), C("law", "poly", TF_LAW_POLY), C("law", "pwl", TF_LAW_PWL),
+    C("law", "table", TF_LAW_TABLE),
+    C("thermal", "none", TF_THERMAL_NONE), C("thermal", "model-i", TF_THERMAL_MODEL_I),
+    C("thermal", "model-ii", TF_THERMAL_MODEL_II),
+    C("df_form", "scale", TF_DF_SCALE), C("df_form", "offset", TF_DF_OFFSET),
+    C("waveform", "zero", TF_WAVE_ZERO), C("waveform", "sawtooth", TF_WAVE_SAWTOOTH),
+    C("waveform", "sine", TF_WAVE_SINE), C("waveform", "square", TF_WAVE_SQUARE), C("waveform", "step", TF_WAVE_STEP),
+    C("waveform", "sampled", TF_WAVE_SAMPLED),
+    C("method", "auto", TF_METHOD_AUTO), C("method", "dopri5", TF_METHOD_DOPRI5), C("method", "rodas4", TF_METHOD_RODAS4),
+    C("status", "ok", TF_OK), C("status", "nonfinite", TF_ERR_NONFINITE),
+    C("status", "step_underflow", TF_ERR_STEP_UNDERFLOW), C("status", "max_steps", TF_ERR_MAX_STEPS),
+    C("status", "bad_argument", TF_ERR_BAD_ARGUMENT), C("status", "no_memory", TF_ERR_NO_MEMORY),
+    C("output", "time", TF_OUT_TIME), C("output", "input", TF_OUT_INPUT),
+    C("output", "stage_displacement", TF_OUT_STAGE_DISPLACEMENT), C("output", "stage_velocity", TF_OUT_STAGE_VELOCITY),
+    C("output", "displacement", TF_OUT_DISPLACEMENT), C("output", "velocity", TF_OUT_VELOCITY),
+    C("output", "relative_displacement", TF_OUT_RELATIVE_DISPLACEMENT),
+    C("output", "relative_velocity", TF_OUT_RELATIVE_VELOCITY), C("output", "friction_force", TF_OUT_FRICTION_FORCE),
+    C("output", "temperature", TF_OUT_TEMPERATURE),
+    C("target", "param", TF_TARGET_PARAM), C("target", "law", TF_TARGET_LAW), C("target", "dF", TF_TARGET_DF),
+    C("target", "heat", TF_TARGET_HEAT),
+    C("heat_parameter", "C_th", TF_HEAT_C_TH), C("heat_parameter", "R_th", TF_HEAT_R_TH),
+    C("heat_parameter", "eta", TF_HEAT_ETA), C("heat_parameter", "T_amb", TF_HEAT_T_AMB),
+    C("heat_parameter", "T_0", TF_HEAT_T_0),
+    C("compensation", "none", TF_COMP_NONE), C("compensation", "feedforward", TF_COMP_FEEDFORWARD),
+    C("compensation", "observer", TF_COMP_OBSERVER),
+    /* counts and capacities */
+    C("limit", "parameters", TF_NPARAM), C("limit", "fixed_outputs", TF_OUT_NFIXED),
+    C("limit", "heat_parameters", TF_HEAT_NPARAM), C("limit", "friction_states", TF_MAX_FRICTION_STATES),
+    C("limit", "states", TF_MAX_STATES), C("limit", "targets", TF_MAX_TARGETS),
+};
+#undef C
+
+/* CONSTANTS: {group: {name: value}}; C_NAMES: {C symbol: value} (for the contract test). */
+static int add_constants(PyObject *mod)
+{
+    PyObject *groups = PyDict_New(), *c_names = PyDict_New();
+    if (!groups || !c_names) goto fail;
+    for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++) {
+        const tf_constant *c = &constants[i];
+        PyObject *group = PyDict_GetItemString(groups, c->group); /* borrowed */
+        if (!group) {
+            group = PyDict_New();
+            if (!group || PyDict_SetItemString(groups, c->group, group) < 0) { Py_XDECREF(group); goto fail; }
+            Py_DECREF(group); /* the dict holds it */
+        }
+        PyObject *v = PyLong_FromLong(c->value);
+        if (!v) goto fail;
+        int bad = PyDict_SetItemString(group, c->name, v) < 0 || PyDict_SetItemString(c_names, c->c_name, v) < 0;
+        Py_DECREF(v);
+        if (bad) goto fail;
+    }
+    if (PyModule_AddObject(mod, "CONSTANTS", groups) < 0) goto fail;
+    groups = NULL;
+    if (PyModule_AddObject(mod, "C_NAMES", c_names) < 0) goto fail;
+    return 0;
+fail:
+    Py_XDECREF(groups);
+    Py_XDECREF(c_names);
+    return -1;
+}
+
 static PyMethodDef methods[] = {
     {"rt_steps", py_rt_steps, METH_VARARGS, "tf_rt_step over an array of velocities; returns seconds (timed in C)."},
     {"loop", py_loop, METH_VARARGS, "The closed-loop stage simulation of control.h (fixed step)."},
@@ -657,7 +738,6 @@ PyMODINIT_FUNC PyInit__core(void)
     SolverError = PyErr_NewException("thermofriction._core.SolverError", NULL, NULL);
     if (PyModule_AddObject(mod, "SolverError", SolverError) < 0) return NULL;
     Py_INCREF(SolverError);
-    PyModule_AddIntConstant(mod, "NPARAM", TF_NPARAM);
-    PyModule_AddIntConstant(mod, "NFIXED_OUTPUTS", TF_OUT_NFIXED);
+    if (add_constants(mod) < 0) return NULL;
     return mod;
 }

@@ -1,4 +1,4 @@
-"""The ``thermofriction`` command line: a thin layer over the library (SPEC 8).
+"""The ``thermofriction`` command line: a thin layer over the library (docs/cli.md).
 
 Every error is one line on stderr naming the file, key or value, with exit status 2 for
 usage and data errors and 1 for failed computations; outputs are written atomically.
@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from . import __version__
+from ._version import __version__
 from .errors import InputError, ThermofrictionError
 from .models import PRESETS, MassPlant, load_model
 from .simulate import MAX_SAMPLES, SOLVERS, StepSizeController, simulate
@@ -59,7 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
 
     s = sub.add_parser(
-        "simulate", help="simulate a model file (or a preset) and write the SPEC 7 CSV",
+        "simulate", help="simulate a model file (or a preset) and write the simulation CSV (docs/formats.md#simulation-output)",
         description="Simulate a model from rest -- a stick-slip actuator, a single mass (force-driven or "
                     "spring-pulled) or prescribed motion, with any friction model (lugre, coulomb, stribeck, "
                     "dahl, elastoplastic, gms) -- and write time, input, displacements, velocity, friction "
@@ -97,11 +97,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(run=cmd_simulate)
 
     i = sub.add_parser(
-        "identify", help="identify a model from a dataset (SPEC 7) and write the fitted model and results",
+        "identify", help="identify a model from a dataset (docs/formats.md#datasets) and write the fitted model and results",
         description="Fit a friction model (base), Model I or Model II to the 'fit' experiments of a dataset: "
                     "trust-region least squares with exact sensitivities from the C core, a multi-start "
                     "global phase, and standard errors, 95 % intervals and correlations at the optimum.",
-        epilog="Writes FITTED.toml (loadable by simulate) and, with --json, the results of SPEC 7. "
+        epilog="Writes FITTED.toml (loadable by simulate) and, with --json, the results JSON (docs/formats.md#results-json). "
                "The initial model provides the plant (masses, xi, wn, K) and the input waveform.")
     i.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
     i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
@@ -130,13 +130,13 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
     i.set_defaults(run=cmd_identify)
 
-    v = sub.add_parser("validate", help="predict every experiment of a dataset with a model: SPEC 9 metrics",
+    v = sub.add_parser("validate", help="predict every experiment of a dataset with a model: the metrics of docs/formats.md#validation-metrics",
                        description="Simulate each experiment of DATASET with MODEL and report the paper's maximum "
                                    "prediction error, RMSE, NRMSE, final-displacement error and per-cycle step-size "
                                    "error, as a table and (with --json) as JSON.")
     v.add_argument("model", metavar="MODEL.toml", help="model file or preset")
     v.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
-    v.add_argument("--json", metavar="METRICS.json", help="metrics as JSON (SPEC 9)")
+    v.add_argument("--json", metavar="METRICS.json", help="metrics as JSON (docs/formats.md#validation-metrics)")
     v.set_defaults(run=cmd_validate)
 
     r = sub.add_parser("report", help="an HTML report comparing models on a dataset",

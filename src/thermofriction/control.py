@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
+from . import _bridge
+from ._bridge import model_spec
 from .errors import InputError, SolverError
 from .models import MassPlant, Model
-from .simulate import core_spec
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,7 @@ class FeedForward:
 
     model: Model
     temperature: float | None = None
-    code = 1
+    kind = "feedforward"
 
 
 @dataclass(frozen=True)
@@ -51,7 +51,7 @@ class Observer:
     model: Model
     gain: float = 100.0
     temperature: float | None = None
-    code = 2
+    kind = "observer"
 
 
 @dataclass(frozen=True)
@@ -124,16 +124,15 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
     x_ref = np.ascontiguousarray(reference.position, float)
     v_ref = np.ascontiguousarray(reference.velocity, float)
     outs = [np.empty_like(x_ref) for _ in range(3)]
-    comp_spec, T_comp, code, gain = None, math.nan, 0, 0.0
+    comp_spec, T_comp, kind, gain = None, math.nan, "none", 0.0
     if compensation is not None:
         T_comp = temperature if compensation.temperature is None else compensation.temperature
-        comp_spec = core_spec(compensation.model, T_comp)
-        code = compensation.code
+        comp_spec = model_spec(compensation.model, T_comp)
+        kind = compensation.kind
         gain = float(getattr(compensation, "gain", 0.0))
-    status = _core.loop(core_spec(stage, temperature), float(temperature), comp_spec, float(T_comp), code, gain,
-                        float(stage.plant.mass), (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps),
-                        x_ref, v_ref, *outs)
-    if status != 0:
+    status = _bridge.loop(model_spec(stage, temperature), temperature, comp_spec, T_comp, kind, gain,
+                          stage.plant.mass, (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, substeps, x_ref, v_ref, *outs)
+    if status != "ok":
         raise SolverError("the closed loop went unstable (non-finite position): lower the gains or the control period")
     return LoopResult(reference.time, x_ref, outs[0], outs[1], outs[2])
 
@@ -150,7 +149,7 @@ def friction_steps(model: Model, velocity, dt: float, temperature: float | None 
     else:  # one temperature per step
         T = np.ascontiguousarray(temperature, float)
         spec_T = float(T[0])
-    seconds = _core.rt_steps(core_spec(model, spec_T), T, v, float(dt), F)
+    seconds = _bridge.rt_steps(model_spec(model, spec_T), T, v, dt, F)
     return F, seconds
 
 

@@ -1,4 +1,4 @@
-"""Self-heating over long runs (SPEC 5.3): ``simulate_heating(model, duration, method=...)``.
+"""Self-heating over long runs (docs/models.md#self-heating): ``simulate_heating(model, duration, method=...)``.
 
 Minutes of stepping at hundreds of hertz are 10^4-10^6 cycles of fast, stiff contact dynamics
 under a thermal time constant of seconds to minutes. Two methods behind one entry point:
@@ -30,7 +30,8 @@ from scipy.interpolate import PchipInterpolator
 
 from .errors import InputError, SolverError, TemperatureRangeWarning
 from .models import Model
-from .simulate import StepSizeController, _check_heated_temperatures, simulate
+from .drive import input_of
+from .simulate import StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
 
 
@@ -97,8 +98,8 @@ class HeatingResult:
 
 
 def _periodic_input(model: Model, input: Waveform | None) -> Waveform:
-    waveform = input if input is not None else model.input
-    if waveform is None or waveform.period is None:
+    waveform = input_of(model, input)
+    if waveform.period is None:
         raise InputError("simulate_heating needs a periodic input (e.g. a sawtooth): the two-time-scale method "
                          "averages over its cycles")
     return waveform
@@ -141,7 +142,7 @@ def simulate_heating(model: Model, duration: float, *, input: Waveform | None = 
     samples: the result holds about this many cycle starts, evenly spread.
     """
     if model.heat is None:
-        raise InputError("simulate_heating needs a model with a [heat] section (SPEC 5.3)")
+        raise InputError("simulate_heating needs a model with a [heat] section (docs/models.md#self-heating)")
     method = method or TwoTimeScale()
     if not (isinstance(duration, (int, float)) and duration > 0 and math.isfinite(duration)):
         raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
@@ -239,7 +240,7 @@ def _two_time_scale(model, heat, waveform, t_samples, method: TwoTimeScale) -> H
     T = out[:, 0]
     # the first cycles from rest step differently from the periodic state: add their excess
     x = out[:, 1] + np.where(t_samples >= method.warmup_cycles / f, probe.startup[0], 0.0)
-    _check_heated_temperatures(model, t_samples, T)
+    check_heated_temperatures(model, t_samples, T)
     return HeatingResult(t_samples, T, x, step_of(np.clip(T, T_min, T_max)), out[:, 2], f, "two-time-scale",
                          table, stats={"seconds": _time.perf_counter() - t0, "cycles_simulated": cycles,
                                        "table_points": table.temperature.size})

@@ -1,4 +1,4 @@
-"""Validation (SPEC 9): how well a model predicts measured displacements, per experiment."""
+"""Validation (docs/formats.md#validation-metrics): how well a model predicts measured displacements, per experiment."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning
-from .identify.engine import ambient_temperature, experiment_waveform, recorded_start_temperature
+from .drive import drive
 from .models import Model, require_actuator
 from .simulate import StepSizeController, simulate
 
@@ -37,7 +37,7 @@ def step_sizes(time, x, period):
 
 @dataclasses.dataclass
 class Prediction:
-    """One experiment: the measurement, the model's prediction and the SPEC 9 metrics."""
+    """One experiment: the measurement, the model's prediction and its metrics (docs/formats.md#validation-metrics)."""
 
     file: str
     temperature: float
@@ -64,15 +64,10 @@ class Prediction:
 def predict(model: Model, exp, rtol=1e-8) -> Prediction:
     """Simulates one experiment (at rtol 1e-8: predictions should carry no solver error worth
     mentioning next to a measurement's) and computes its metrics."""
-    if model.heat is not None:  # the temperature is the model's own: from the run's start, at ambient
-        T = ambient_temperature(exp, model)
-        T0 = recorded_start_temperature(exp)
-        if T0 is not None and model.heat.initial_temperature is None:
-            model = dataclasses.replace(model, heat=dataclasses.replace(model.heat, initial_temperature=T0))
-    else:
-        T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
-    waveform = experiment_waveform(exp, model)
-    res = simulate(model, t_eval=exp.time, temperature=T, input=waveform, controller=StepSizeController(rtol=rtol))
+    d = drive(exp, model, start="model")  # a self-heating model from its own T_0, else the record's start
+    waveform = d.waveform
+    res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=waveform,
+                   controller=StepSizeController(rtol=rtol))
     pred = res.displacement - res.displacement[0]
     meas = np.asarray(exp.displacement, float)
     meas = meas - _zero(meas, pred)
@@ -118,7 +113,7 @@ class ValidationResult:
                          "warnings": self.warnings})
 
     def to_json(self, path=None) -> str:
-        """The metrics of SPEC 9 as JSON, written atomically to ``path`` when given."""
+        """The metrics (docs/formats.md#validation-metrics) as JSON, written atomically to ``path`` when given."""
         return dump_json(self.to_dict(), path)
 
     _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
@@ -157,7 +152,7 @@ class ValidationResult:
 
 def validate(model: Model, data, experiments=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
-    errors of SPEC 9. Temperatures outside a law's calibrated range are reported as warnings."""
+    errors (docs/formats.md#validation-metrics). Temperatures outside a law's calibrated range are reported as warnings."""
     require_actuator(model, "validate")
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:

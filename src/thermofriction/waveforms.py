@@ -1,4 +1,4 @@
-"""Input waveforms (SPEC 6): what drives a plant, in volts (or newtons, or metres).
+"""Input waveforms (docs/formats.md#inputs): what drives a plant, in volts (or newtons, or metres).
 
 Each waveform is evaluated by the C core, so the integrator and these objects agree exactly,
 and exposes its corner times (where it or its slope jumps); the integrator stops at every one.
@@ -13,11 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _core
+from . import _bridge
 from .errors import InputError, unknown_keys
-
-_ZERO, _SAWTOOTH, _SINE, _SQUARE, _STEP, _SAMPLED = range(6)
-
 
 def _finite(name, value, where):
     try:
@@ -44,19 +41,17 @@ class Waveform:
     kind = "zero"
     period: float | None = None
 
-    def _core_tuple(self):
-        raise NotImplementedError
+    def core_fields(self) -> dict:
+        """The numbers the C core's tf_waveform takes (amplitude, frequency, rise, offset,
+        direction, slew, t0, t, v); absent ones are zero (direction: +1)."""
+        return {}
 
     def __call__(self, t):
-        t = np.ascontiguousarray(np.atleast_1d(t), dtype=float)
-        out = np.empty_like(t)
-        _core.waveform_eval(self._core_tuple(), t, out)
-        return out
+        return _bridge.waveform_eval(self, np.ascontiguousarray(np.atleast_1d(t), dtype=float))
 
     def corners(self, t0: float, t1: float) -> np.ndarray:
         """Corner times in [t0, t1]."""
-        out = np.empty(2)
-        return np.array(_core.waveform_eval(self._core_tuple(), np.array([t0, t1], float), out))
+        return _bridge.waveform_corners(self, t0, t1)
 
     def to_dict(self) -> dict:
         d = {"waveform": self.kind}
@@ -72,8 +67,8 @@ class Waveform:
 class Zero(Waveform):
     kind = "zero"
 
-    def _core_tuple(self):
-        return (_ZERO, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, None, None)
+    def core_fields(self):
+        return {}
 
 
 @dataclass(frozen=True)
@@ -106,9 +101,9 @@ class Sawtooth(Waveform):
     def period(self):
         return 1.0 / self.frequency
 
-    def _core_tuple(self):
-        return (_SAWTOOTH, self.amplitude, self.frequency, self.rise, self.offset, float(self.direction),
-                0.0, 0.0, None, None)
+    def core_fields(self):
+        return {"amplitude": self.amplitude, "frequency": self.frequency, "rise": self.rise, "offset": self.offset,
+                "direction": self.direction}
 
 
 @dataclass(frozen=True)
@@ -129,8 +124,8 @@ class Sine(Waveform):
     def period(self):
         return 1.0 / self.frequency
 
-    def _core_tuple(self):
-        return (_SINE, self.amplitude, self.frequency, 0.0, self.offset, 1.0, 0.0, 0.0, None, None)
+    def core_fields(self):
+        return {"amplitude": self.amplitude, "frequency": self.frequency, "offset": self.offset}
 
 
 @dataclass(frozen=True)
@@ -164,8 +159,9 @@ class Square(Waveform):
     def period(self):
         return 1.0 / self.frequency
 
-    def _core_tuple(self):
-        return (_SQUARE, self.amplitude, self.frequency, self.duty, self.offset, 1.0, self.slew, 0.0, None, None)
+    def core_fields(self):  # the core reads the duty cycle from 'rise'
+        return {"amplitude": self.amplitude, "frequency": self.frequency, "rise": self.duty, "offset": self.offset,
+                "slew": self.slew}
 
 
 @dataclass(frozen=True)
@@ -188,8 +184,8 @@ class Step(Waveform):
         object.__setattr__(self, "slew", slew)
         object.__setattr__(self, "offset", _finite("offset", self.offset, "step"))
 
-    def _core_tuple(self):
-        return (_STEP, self.amplitude, 0.0, 0.0, self.offset, 1.0, self.slew, self.time, None, None)
+    def core_fields(self):
+        return {"amplitude": self.amplitude, "offset": self.offset, "slew": self.slew, "t0": self.time}
 
 
 @dataclass(frozen=True, eq=False)
@@ -226,12 +222,12 @@ class Sampled(Waveform):
             raise InputError("a sampled waveform without a file has no --input form")
         return f"sampled:file={self.file}"
 
-    def _core_tuple(self):
-        return (_SAMPLED, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, self.time, self.value)
+    def core_fields(self):
+        return {"t": self.time, "v": self.value}
 
     @classmethod
     def from_csv(cls, path, base_dir=None):
-        """Reads ``time[s]`` and one value column (see SPEC 6)."""
+        """Reads ``time[s]`` and one value column (docs/formats.md#inputs)."""
         p = Path(path)
         if base_dir is not None and not p.is_absolute():
             p = Path(base_dir) / p

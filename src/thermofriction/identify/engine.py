@@ -13,16 +13,13 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 from scipy import optimize, stats
 
-from .. import _core
+from .. import _bridge
+from ..drive import drive
 from ..errors import ComputationError, InputError
 from ..models import Model
-from ..simulate import core_spec
 from ..waveforms import Sampled, Waveform
 from .parameters import Parameters, target_of, unit_of, with_values
 
-_DISPLACEMENT = 4   # output channel of the driven body's displacement (plant.h)
-_TEMPERATURE = 9    # output channel of the temperature
-_X_E = 2            # its state index
 _MAX_STEPS = 2_000_000
 
 
@@ -30,7 +27,7 @@ _MAX_STEPS = 2_000_000
 class Trace:
     """One measured run, ready to fit: the model is driven by ``waveform`` at ``temperature``.
 
-    With a heat model (SPEC 5.3) ``temperature`` is the ambient one, the run starts at
+    With a heat model (docs/models.md#self-heating) ``temperature`` is the ambient one, the run starts at
     ``initial_temperature``, and ``measured_temperature`` (the record) is fitted too: its residuals
     are multiplied by ``temperature_weight`` [m/K] to share the displacement residuals' scale."""
 
@@ -50,65 +47,19 @@ class Trace:
         return len(self.time) * (1 if self.measured_temperature is None else 2)
 
 
-def experiment_waveform(exp, model: Model) -> Waveform:
-    """The input that drove an experiment: the manifest's, the model's when it reproduces the
-    recorded voltage (to 1 % of its range), else the recorded voltage itself."""
-    w = getattr(exp, "input", None)
-    if w is not None:
-        return w
-    if model.input is not None:
-        u = model.input(exp.time)
-        if np.max(np.abs(u - exp.voltage)) <= 0.01 * max(float(np.ptp(exp.voltage)), 1e-12):
-            return model.input
-    return Sampled(exp.time, exp.voltage)
-
-
 def make_traces(experiments, model: Model):
+    """One trace per experiment, driven as :func:`thermofriction.drive.drive` says (a self-heating run
+    from where its record starts)."""
     traces = []
     for exp in experiments:
+        d = drive(exp, model, start="record")
+        trace = Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.displacement, float),
+                      d.temperature, d.waveform, getattr(exp, "role", "fit"), float(exp.temperature))
         if model.heat is not None:
-            traces.append(heated_trace(exp, model))
-            continue
-        T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
-        traces.append(Trace(exp.file, np.ascontiguousarray(exp.time, float),
-                            np.ascontiguousarray(exp.displacement, float), T, experiment_waveform(exp, model),
-                            getattr(exp, "role", "fit"), float(exp.temperature)))
+            trace.measured_temperature = d.measured_temperature
+            trace.initial_temperature = d.initial_temperature
+        traces.append(trace)
     return traces
-
-
-def ambient_temperature(exp, model: Model) -> float:
-    """The ambient temperature of a run of a model with a [heat] section: the model's T_amb, else
-    the experiment's (manifest) temperature."""
-    ambient = model.heat.ambient_temperature
-    return float(exp.temperature) if ambient is None else float(ambient)
-
-
-def recorded_start_temperature(exp) -> float | None:
-    """Where the recorded temperature starts (None without a record): a parabola through the first
-    2 % of the record, at the first sample (a plain mean there is biased by the heating already
-    under way: 0.1 K, micrometres of misfit, in tests)."""
-    sig = getattr(exp, "temperature_signal", None)
-    if sig is None:
-        return None
-    sig = np.asarray(sig, float)
-    if len(sig) < 3:
-        return float(sig[0])
-    k = max(3, len(sig) // 50)
-    t = np.asarray(exp.time[:k], float) - float(exp.time[0])
-    return float(np.polyval(np.polyfit(t, sig[:k], 2), 0.0))
-
-
-def heated_trace(exp, model: Model) -> Trace:
-    """A trace for a model with a [heat] section: at its ambient temperature, from where the recorded
-    temperature starts; the record itself is a fitted output."""
-    T0 = recorded_start_temperature(exp)
-    if T0 is None:
-        raise InputError(f"{exp.file}: the model heats itself ([heat] section) but the experiment records no "
-                         f"temperature[C] column to fit it to")
-    return Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.displacement, float),
-                 ambient_temperature(exp, model), experiment_waveform(exp, model), getattr(exp, "role", "fit"),
-                 float(exp.temperature), measured_temperature=np.ascontiguousarray(exp.temperature_signal, float),
-                 initial_temperature=T0)
 
 
 _POOL = None
@@ -143,32 +94,32 @@ class Problem:
             T0 = model.heat.initial_temperature if "T_0" in self.names else trace.initial_temperature
             model = dataclasses.replace(model, heat=dataclasses.replace(
                 model.heat, ambient_temperature=trace.temperature, initial_temperature=T0))
-        spec = core_spec(model, trace.temperature, trace.waveform)
+        spec = _bridge.model_spec(model, trace.temperature, trace.waveform)
         n_out = len(trace.time)
-        out = np.empty((n_out, _core.NFIXED_OUTPUTS + model.friction.nstate + heated))
+        out = np.empty((n_out, _bridge.n_outputs(model, heated)))
         try:
             if not jac:
-                _core.simulate(spec, trace.time, out, 1, self.rtol, None, 0.0, 0.0, _MAX_STEPS)
+                _bridge.run(spec, trace.time, out, method="dopri5", rtol=self.rtol, max_steps=_MAX_STEPS)
                 S = None
             else:
-                scale = np.asarray(_core.state_scale(spec))
+                scale = _bridge.state_scale(spec)
                 atol_y = self.rtol * scale
                 atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
                 nstate = len(scale)
                 sens = np.empty((n_out, nstate, len(theta)))
-                _core.simulate_sensitivities(spec, self.targets, trace.time, out, sens, self.rtol,
-                                             np.concatenate([atol_y, atol_s.ravel()]), 0.0, 0.0, _MAX_STEPS)
-                S = sens[:, _X_E, :]
-                S_T = sens[:, _X_E + 2 + model.friction.nstate, :] if heated else None
-        except _core.SolverError:
+                _bridge.run_sensitivities(spec, self.targets, trace.time, out, sens, rtol=self.rtol,
+                                          atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=_MAX_STEPS)
+                S = sens[:, _bridge.state_index(model, "x_e"), :]
+                S_T = sens[:, _bridge.state_index(model, "T"), :] if heated else None
+        except _bridge.CoreFailure:
             return None, None
-        d = out[:, _DISPLACEMENT] - trace.displacement
+        d = out[:, _bridge.OUTPUT_COLUMN["displacement"]] - trace.displacement
         r = d - d.mean()
         if S is not None:
             S = S - S.mean(axis=0)
         if trace.measured_temperature is not None:
             w = trace.temperature_weight
-            r = np.concatenate([r, w * (out[:, _TEMPERATURE] - trace.measured_temperature)])
+            r = np.concatenate([r, w * (out[:, _bridge.OUTPUT_COLUMN["temperature"]] - trace.measured_temperature)])
             if S is not None:
                 S = np.concatenate([S, w * S_T])
         return r, S

@@ -8,16 +8,17 @@ import dataclasses
 import math
 import re
 
-import numpy as np
 
+from .. import _bridge
 from ..errors import InputError
-from ..models import PARAMETER_UNITS, PARAMETERS, PWL, Const, Exp, Law, Linear, Model, ModelI, ModelII, Poly, Table
+from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
 
-_TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT = 0, 1, 2, 3
-#: The lumped thermal model's fittable parameters (SPEC 5.3): symbol -> (Heat field, unit); the
-#: order is the C core's tf_heat_param
-HEAT_PARAMETERS = {"C_th": ("heat_capacity", "J/K", 0), "R_th": ("thermal_resistance", "K/W", 1),
-                   "eta": ("heat_fraction", "", 2), "T_0": ("initial_temperature", "C", 4)}
+_TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT = (_bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat"))
+#: The lumped thermal model's fittable parameters (docs/models.md#self-heating): symbol -> (Heat
+#: field, unit, the C core's index)
+HEAT_PARAMETERS = {sym: (field, unit, _bridge.HEAT_PARAMETER_INDEX[sym]) for sym, field, unit in (
+    ("C_th", "heat_capacity", "J/K"), ("R_th", "thermal_resistance", "K/W"), ("eta", "heat_fraction", ""),
+    ("T_0", "initial_temperature", "C"))}
 
 
 @dataclasses.dataclass
@@ -72,40 +73,6 @@ class Parameters(dict):
 
 # -- names <-> model ----------------------------------------------------------------------------
 
-_COEF_NAMES = {"const": ["value"], "linear": ["a", "b"], "exp": ["a", "b"]}
-
-
-def law_coefficient_names(law: Law):
-    if isinstance(law, Table):
-        return []  # the PCHIP slopes depend on the values nonlinearly: no sensitivities
-    if isinstance(law, PWL):
-        return [f"values[{i}]" for i in range(len(law.values))]
-    if isinstance(law, Poly):
-        return [f"c[{i}]" for i in range(len(law.c))]
-    return list(_COEF_NAMES[law.kind])
-
-
-def law_coefficients(law: Law):
-    if isinstance(law, PWL):
-        return list(law.values)
-    if isinstance(law, Poly):
-        return list(law.c)
-    if isinstance(law, Const):
-        return [law.value]
-    return [law.a, law.b]
-
-
-def law_with_coefficients(law: Law, coefs) -> Law:
-    coefs = [float(c) for c in coefs]
-    if isinstance(law, PWL):
-        return dataclasses.replace(law, values=np.array(coefs))
-    if isinstance(law, Poly):
-        return dataclasses.replace(law, c=np.array(coefs))
-    if isinstance(law, Const):
-        return dataclasses.replace(law, value=coefs[0])
-    return dataclasses.replace(law, a=coefs[0], b=coefs[1])
-
-
 def _split(name):
     m = re.fullmatch(r"([A-Za-z_0-9]+)(?:\.(.+))?", name)
     if not m:
@@ -123,7 +90,7 @@ def target_of(model: Model, name: str):
     if base == "dF":
         if not isinstance(model.thermal, ModelII):
             raise InputError(f"'{name}': the model has no Model II dF law")
-        names = law_coefficient_names(model.thermal.dF)
+        names = model.thermal.dF.coefficient_names()
         if coef not in names:
             raise InputError(f"'{name}': dF ({model.thermal.dF.kind}) has coefficients {', '.join(names) or 'none'}")
         return (_TARGET_DF, 0, names.index(coef))
@@ -133,11 +100,11 @@ def target_of(model: Model, name: str):
     if coef is None:
         if base in model.laws:
             raise InputError(f"'{base}' follows a law in this model: fit its coefficients "
-                             f"({', '.join(base + '.' + c for c in law_coefficient_names(model.laws[base]))})")
+                             f"({', '.join(base + '.' + c for c in model.laws[base].coefficient_names())})")
         return (_TARGET_PARAM, idx, 0)
     if base not in model.laws:
         raise InputError(f"'{name}': '{base}' has no law in this model")
-    names = law_coefficient_names(model.laws[base])
+    names = model.laws[base].coefficient_names()
     if coef not in names:
         raise InputError(f"'{name}': the law of '{base}' has coefficients {', '.join(names) or 'none'}")
     return (_TARGET_LAW, idx, names.index(coef))
@@ -148,9 +115,9 @@ def get_value(model: Model, name: str) -> float:
     if kind == _TARGET_HEAT:
         return float(getattr(model.heat, HEAT_PARAMETERS[name][0]))
     if kind == _TARGET_DF:
-        return float(law_coefficients(model.thermal.dF)[coef])
+        return float(model.thermal.dF.coefficients()[coef])
     if kind == _TARGET_LAW:
-        return float(law_coefficients(model.laws[PARAMETERS[idx]])[coef])
+        return float(model.laws[PARAMETERS[idx]].coefficients()[coef])
     values = model.friction.values()
     base = PARAMETERS[idx]
     if base == "fs" and "fs" not in values:
@@ -174,13 +141,13 @@ def with_values(model: Model, values: dict) -> Model:
             friction[PARAMETERS[idx]] = float(v)
         elif kind == _TARGET_LAW:
             p = PARAMETERS[idx]
-            c = law_coefficients(laws[p])
+            c = laws[p].coefficients()
             c[coef] = v
-            laws[p] = law_with_coefficients(laws[p], c)
+            laws[p] = laws[p].with_coefficients(c)
         else:
-            c = law_coefficients(dF)
+            c = dF.coefficients()
             c[coef] = v
-            dF = law_with_coefficients(dF, c)
+            dF = dF.with_coefficients(c)
     thermal = model.thermal
     if isinstance(thermal, ModelI):
         thermal = ModelI(laws)
@@ -198,14 +165,7 @@ def unit_of(model: Model, name: str) -> str:
     if coef is None:
         return unit
     law = model.thermal.dF if base == "dF" else model.laws.get(base)
-    if isinstance(law, Linear) and coef == "a":
-        return f"{unit}/C"
-    if isinstance(law, Exp) and coef == "b":
-        return "1/C"
-    if isinstance(law, Poly) and coef != "c[0]":
-        return f"{unit}/C^{coef[2:-1]}"
-    return unit
+    return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "law_coefficient_names",
-           "law_coefficients", "law_with_coefficients", "unit_of", "Exp", "Linear"]
+__all__ = ["HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]

@@ -191,7 +191,7 @@ class PlantFit:
                               natural_frequency=self.natural_frequency, gain=self.gain)
 
     def to_dict(self) -> dict:
-        """JSON-ready (SPEC 7): each parameter as {"value", "stderr", "ci95": [lo, hi], ...}."""
+        """JSON-ready (docs/formats.md#results-json): each parameter as {"value", "stderr", "ci95": [lo, hi], ...}."""
         from .._io import jsonable
         corr = None if self.correlation is None else self.correlation
         return jsonable({"parameters": self.parameters.to_dict(),

@@ -1,4 +1,4 @@
-"""Identification procedures: a base friction model, Model I and Model II (SPEC 5), built on
+"""Identification procedures: a base friction model, Model I and Model II (docs/models.md#thermal-extensions), built on
 the engine's fit()."""
 
 from __future__ import annotations
@@ -8,13 +8,14 @@ import math
 import time
 
 import numpy as np
-from scipy import optimize
 
+from ..drive import experiment_waveform
 from ..errors import InputError
-from ..models import PWL, Const, Exp, Linear, LuGre, Model, ModelI, ModelII
+from ..models import PWL, Const, Model, ModelI, ModelII
 from ..simulate import simulate
 from .engine import fit, make_traces, uncertainty
-from .parameters import Parameters, get_value, law_coefficient_names, law_coefficients, unit_of, with_values
+from .laws import _aicc, fit_law, segmented_fit
+from .parameters import Parameters, get_value, unit_of, with_values
 from .result import FitResult
 
 DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")
@@ -80,7 +81,7 @@ DEFAULT_HEAT_PARAMETERS = ("C_th", "R_th", "eta")
 
 
 def identify_heat(experiments, init: Model, parameters=None, **opts) -> FitResult:
-    """Fits the lumped thermal model (SPEC 5.3) -- by default C_th, R_th and eta; friction
+    """Fits the lumped thermal model (docs/models.md#self-heating) -- by default C_th, R_th and eta; friction
     parameters named too are fitted jointly -- to the recorded temperatures and displacements.
 
     The two records have different units and noise, so the fit runs twice: first with each
@@ -129,82 +130,6 @@ def identify_heat(experiments, init: Model, parameters=None, **opts) -> FitResul
     outcome.njev += first.njev
     return _result("heat", init, params, outcome, traces, t0,
                    details={"temperature_weights_m_per_K": [tr.temperature_weight for tr in traces]})
-
-
-# -- laws of temperature -------------------------------------------------------------------------
-
-def _aicc(ssr, n, k):
-    if ssr <= 0:
-        ssr = 1e-300
-    aic = n * math.log(ssr / n) + 2 * k
-    return aic + 2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else aic
-
-
-def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None):
-    """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
-    lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
-    kind is better by more than 2 (a difference the data support). Returns (law, table)."""
-    T, values = np.asarray(T, float), np.asarray(values, float)
-    w = np.ones_like(values)
-    if stderr is not None:
-        se = np.asarray(stderr, float)
-        ok = np.isfinite(se) & (se > 0)
-        if ok.all():
-            w = 1.0 / se
-            w = w / w.mean()
-    rng = (float(T.min()), float(T.max()))
-    table, best = {}, None
-    for kind in kinds:
-        if kind == "linear":
-            A = np.column_stack([T, np.ones_like(T)]) * w[:, None]
-            coef, *_ = np.linalg.lstsq(A, values * w, rcond=None)
-            law = Linear(float(coef[0]), float(coef[1]), range=rng)
-            k = 2
-        elif kind == "exp":
-            if np.any(values <= 0) or len(T) < 2:
-                continue
-            b0, la0 = np.polyfit(T, np.log(values), 1, w=w)
-            res = optimize.least_squares(lambda c: (c[0] * np.exp(c[1] * T) - values) * w,
-                                         [math.exp(la0), b0], x_scale=[math.exp(la0), max(abs(b0), 1e-3)])
-            law = Exp(float(res.x[0]), float(res.x[1]), range=rng)
-            k = 2
-        elif kind == "const":
-            law = Const(float(np.average(values, weights=w ** 2)), range=rng)
-            k = 1
-        else:
-            raise InputError(f"unknown law kind '{kind}' for a Model I parameter (linear, exp, const)")
-        ssr = float(np.sum(((law(T) - values) * w) ** 2))
-        table[kind] = {"aicc": _aicc(ssr, len(T), k), "law": law.to_dict()}
-        if best is None or table[kind]["aicc"] < table[best[0]]["aicc"]:
-            best = (kind, law)
-    if best is None:
-        raise InputError("no law could be fitted")
-    if prefer in table and prefer != best[0] and table[prefer]["aicc"] - table[best[0]]["aicc"] <= 2.0:
-        from ..models import law_from_dict
-        return law_from_dict(table[prefer]["law"], "law"), table
-    return best[1], table
-
-
-def segmented_fit(T, values, weights=None):
-    """Two linear segments meeting at an estimated breakpoint (the paper's Fig. 6): a grid
-    search over the breakpoint, linear least squares at each. Returns (breakpoint, law)."""
-    T, values = np.asarray(T, float), np.asarray(values, float)
-    w = np.ones_like(T) if weights is None else np.asarray(weights, float)
-    order = np.argsort(T)
-    T, values, w = T[order], values[order], w[order]
-    best = None
-    for tb in np.linspace(T[1], T[-2], 200) if len(T) >= 4 else []:
-        A = np.column_stack([np.ones_like(T), T - tb, np.maximum(T - tb, 0.0)]) * w[:, None]
-        coef, *_ = np.linalg.lstsq(A, values * w, rcond=None)
-        ssr = float(np.sum((A @ coef - values * w) ** 2))
-        if best is None or ssr < best[0]:
-            best = (ssr, tb, coef)
-    if best is None:
-        raise InputError("a segmented fit needs at least 4 temperatures")
-    _, tb, (c0, c1, c2) = best
-    knots = np.array([T[0], tb, T[-1]])
-    vals = c0 + c1 * (knots - tb) + c2 * np.maximum(knots - tb, 0.0)
-    return float(tb), PWL(knots, vals, range=(float(T[0]), float(T[-1]))), best[0]
 
 
 def _groups(experiments):
@@ -284,7 +209,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     if not refine:
         params = Parameters()
         for n, law in new_laws.items():
-            for cname, v in zip(_coef_names(law), _coef_values(law)):
+            for cname, v in zip(law.coefficient_names(), law.coefficients()):
                 params.add(f"{n}.{cname}", v, unit=unit_of(model, f"{n}.{cname}"))
         res = FitResult("model-i", model, params, np.full((0, 0), np.nan), math.nan, math.nan, 0,
                         sum(r.nfev for _, r in per_T), sum(r.njev for _, r in per_T), 0,
@@ -295,7 +220,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         progress("Model I: joint refinement of the law coefficients on all experiments")
     params = Parameters()
     for n, law in new_laws.items():
-        for cname, v in zip(_coef_names(law), _coef_values(law)):
+        for cname, v in zip(law.coefficient_names(), law.coefficients()):
             name = f"{n}.{cname}"
             positive = law.kind == "exp" and cname == "a" and v > 0
             params.add(name, v, min=0.0 if positive else -math.inf, unit=unit_of(model, name), vary=n not in held)
@@ -310,8 +235,6 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     return res
 
 
-_coef_names = law_coefficient_names
-_coef_values = law_coefficients
 
 
 def _final_displacement(exp):
@@ -367,7 +290,6 @@ def _model_ii_paper(groups, base, T_ref, details, t0, progress):
     ref = groups[0][0]
     fc = base.reference_force()
     dFs = np.linspace(-0.5 * fc, 0.2 * fc, 8)
-    from .engine import experiment_waveform
     waveform = experiment_waveform(ref, base)
     D_sim = []
     for dF in dFs:

@@ -1,5 +1,5 @@
 """What a fit returns: the fitted model, parameters with errors and intervals, a readable
-report, the JSON of SPEC 7, and an HTML table for notebooks."""
+report, the results JSON (docs/formats.md#results-json), and an HTML table for notebooks."""
 
 from __future__ import annotations
 
@@ -70,7 +70,7 @@ class FitResult:
         return jsonable(d)
 
     def to_json(self, path=None) -> str:
-        """The results of SPEC 7 as JSON, written atomically to ``path`` when given."""
+        """The results as JSON (docs/formats.md#results-json), written atomically to ``path`` when given."""
         return dump_json(self.to_dict(), path)
 
     def _rows(self):

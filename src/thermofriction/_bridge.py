@@ -1,0 +1,255 @@
+"""The one door to the compiled C core.
+
+Only this module imports ``_core``. It
+
+- reads the contract from the core itself: the parameter order, the codes of plants, friction
+  models, laws, thermal extensions, waveforms, solvers, statuses and sensitivity targets, and the
+  output column layout (``_core.CONSTANTS``, set by the binding from the C headers; a test parses
+  the headers and fails if either side has a name the other lacks);
+- turns model objects into the core's description (``model_spec``), laws and waveforms into
+  theirs;
+- runs simulations, with or without forward sensitivities, and turns every failure status into a
+  :class:`CoreFailure` (a :class:`~thermofriction.errors.SolverError`) that names the status.
+
+Nothing else writes an integer code or a column index.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _core
+from .errors import SolverError
+
+_GROUPS = _core.CONSTANTS
+
+
+def _ordered(group: str) -> tuple:
+    """The names of a group in code order; the codes must be 0..n-1 (they index arrays)."""
+    codes = _GROUPS[group]
+    names = sorted(codes, key=codes.get)
+    if [codes[n] for n in names] != list(range(len(names))):  # pragma: no cover - a broken build
+        raise ImportError(f"the C core's {group} codes are not 0..{len(names) - 1}: {codes}")
+    return tuple(names)
+
+
+#: Friction parameters in the core's order (friction.h, tf_param).
+PARAMETERS = _ordered("parameter")
+PLANT_CODES = dict(_GROUPS["plant"])
+FRICTION_CODES = dict(_GROUPS["friction"])
+LAW_CODES = dict(_GROUPS["law"])
+THERMAL_CODES = dict(_GROUPS["thermal"])
+DF_FORM_CODES = dict(_GROUPS["df_form"])
+WAVEFORM_CODES = dict(_GROUPS["waveform"])
+METHOD_CODES = dict(_GROUPS["method"])
+METHOD_NAMES = {code: name for name, code in METHOD_CODES.items()}
+STATUS_NAMES = {code: name for name, code in _GROUPS["status"].items()}
+TARGET_CODES = dict(_GROUPS["target"])
+HEAT_PARAMETER_INDEX = dict(_GROUPS["heat_parameter"])
+COMPENSATION_CODES = dict(_GROUPS["compensation"])
+#: Output channels, in column order; after them come the friction states, then the friction work.
+OUTPUTS = _ordered("output")
+OUTPUT_COLUMN = {name: i for i, name in enumerate(OUTPUTS)}
+LIMITS = dict(_GROUPS["limit"])
+
+
+def n_outputs(model, friction_work: bool) -> int:
+    """Columns of a simulation's output array."""
+    return len(OUTPUTS) + model.friction.nstate + bool(friction_work)
+
+
+def state_index(model, name: str) -> int:
+    """Index of a state in the core's state vector: the plant's mechanical states, the friction
+    states, then the temperature (with a heat model) and the friction work."""
+    mechanical = MECHANICAL_STATES[model.plant.type]
+    if name in mechanical:
+        return mechanical.index(name)
+    if name == "T":
+        if model.heat is None:
+            raise ValueError("the model has no temperature state")
+        return len(mechanical) + model.friction.nstate
+    raise ValueError(f"no state '{name}'")
+
+
+#: The plant's mechanical states, before the friction model's (plant.h, the core's state order).
+MECHANICAL_STATES = {"stick-slip": ("x_p", "v_p", "x_e", "v_e"), "mass": ("x", "v"), "prescribed": ()}
+
+
+# -- descriptions ------------------------------------------------------------------------------
+
+def law_tuple(law):
+    """(kind, a, b, x, y) of a temperature law (thermal.h, tf_law)."""
+    fields = law.core_fields()
+    return (LAW_CODES[law.kind], float(fields.get("a", 0.0)), float(fields.get("b", 0.0)), fields.get("x"),
+            fields.get("y"))
+
+
+def waveform_tuple(waveform):
+    """(kind, amplitude, frequency, rise, offset, direction, slew, t0, t, v) (waveform.h)."""
+    f = waveform.core_fields()
+    return (WAVEFORM_CODES[waveform.kind], float(f.get("amplitude", 0.0)), float(f.get("frequency", 0.0)),
+            float(f.get("rise", 0.0)), float(f.get("offset", 0.0)), float(f.get("direction", 1.0)),
+            float(f.get("slew", 0.0)), float(f.get("t0", 0.0)), f.get("t"), f.get("v"))
+
+
+def _thermal_kind(model) -> str:
+    return {None: "none", "I": "model-i", "II": "model-ii"}[getattr(model.thermal, "model", None)]
+
+
+def model_spec(model, temperature=None, input=None, friction_work: bool = False) -> dict:
+    """The dict the binding unpacks into a tf_model (see _core.c). ``temperature``: a number, a
+    ``Sampled`` signal, or None; with a heat model, the ambient temperature (a number)."""
+    plant = model.plant
+    c = k = T_em = m_e = k_s = v_0 = 0.0
+    m = 1.0
+    if plant.type == "stick-slip":
+        c, k, T_em = plant.physical()
+        m, m_e = plant.mass, plant.end_effector_mass
+    elif plant.type == "mass":
+        m, k_s, v_0 = plant.mass, plant.spring_stiffness, plant.pull_velocity
+    friction = model.friction
+    values = {name: v for name, v in friction.values().items() if name not in friction.arrays}
+    values.setdefault("fs", values.get("fc", 0.0))
+    values.setdefault("vs", 1e-3)
+    params = np.array([0.0 if values.get(name) is None else values[name] for name in PARAMETERS], float)
+    thermal = _thermal_kind(model)
+    laws = None
+    if thermal == "model-i":
+        laws = [law_tuple(model.thermal.laws[n]) if n in model.thermal.laws else None for n in PARAMETERS]
+    T_const, T_t, T_v = math.nan, None, None
+    heat = None
+    if model.heat is not None:
+        h = model.heat.resolved(temperature)
+        heat = (h.heat_capacity, h.thermal_resistance, h.heat_fraction, h.ambient_temperature,
+                h.initial_temperature, waveform_tuple(h.external_heat) if h.external_heat is not None else None)
+    elif temperature is not None and getattr(temperature, "kind", None) == "sampled":
+        T_t, T_v = temperature.time, temperature.value
+    elif temperature is not None:
+        T_const = float(temperature)
+    waveform = input if input is not None else model.input
+    gms = friction.model == "gms"
+    return {
+        "plant": PLANT_CODES[plant.type], "m": m, "c": c, "k": k, "T_em": T_em, "m_e": m_e, "k_s": k_s, "v_0": v_0,
+        "friction": FRICTION_CODES[friction.model], "params": params,
+        "gms_k": np.array(friction.k, float) if gms else None,
+        "gms_w": np.array(friction.w, float) if gms else None,
+        "fs_follows_fc": int(getattr(friction, "fs", None) is None and "fs" not in model.laws),
+        "thermal": THERMAL_CODES[thermal],
+        "laws": laws,
+        "dF": law_tuple(model.thermal.dF) if thermal == "model-ii" else None,
+        "dF_form": DF_FORM_CODES[model.thermal.form] if thermal == "model-ii" else DF_FORM_CODES["scale"],
+        "input": waveform_tuple(waveform) if waveform is not None else _ZERO_WAVEFORM,
+        "T_const": T_const, "T_t": T_t, "T_v": T_v,
+        "heat": heat, "work": int(bool(friction_work)),
+    }
+
+
+_ZERO_WAVEFORM = (WAVEFORM_CODES["zero"], 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, None, None)
+
+
+# -- evaluations -------------------------------------------------------------------------------
+
+def law_eval(law, T: np.ndarray):
+    """(values, slopes) of a law on a contiguous float64 array of temperatures."""
+    v, d = np.empty_like(T), np.empty_like(T)
+    _core.law_eval(law_tuple(law), T, v, d)
+    return v, d
+
+
+def waveform_eval(waveform, t: np.ndarray) -> np.ndarray:
+    out = np.empty_like(t)
+    _core.waveform_eval(waveform_tuple(waveform), t, out)
+    return out
+
+
+def waveform_corners(waveform, t0: float, t1: float) -> np.ndarray:
+    out = np.empty(2)
+    return np.array(_core.waveform_eval(waveform_tuple(waveform), np.array([t0, t1], float), out))
+
+
+def state_scale(spec: dict) -> np.ndarray:
+    """Each state's characteristic magnitude (what default absolute tolerances scale with)."""
+    return np.asarray(_core.state_scale(spec))
+
+
+def rhs_jac(spec: dict, t: float, y, dy, J=None) -> float:
+    """Right-hand side into ``dy`` and Jacobian into ``J`` (if given) at one state; returns the
+    friction force there (differential tests)."""
+    return _core.rhs_jac(spec, float(t), y, dy, J)
+
+
+def time_rhs(spec: dict, t: float, y, n_evals: int):
+    """(seconds per right-hand-side evaluation, a checksum), timed in C (benchmarks)."""
+    return _core.time_rhs(spec, float(t), y, int(n_evals))
+
+
+# -- runs ----------------------------------------------------------------------------------------
+
+class CoreFailure(SolverError):
+    """The integrator stopped: ``status`` names why (``nonfinite``, ``step_underflow``, ``max_steps``,
+    ``bad_argument``, ``no_memory``); ``time``, ``step``, ``state`` and ``stiff`` say where."""
+
+    def __init__(self, message, status, time, step, state, stiff):
+        super().__init__(message, time=time, state=state)
+        self.core_message = message
+        self.status = status
+        self.step = step
+        self.stiff = bool(stiff)
+
+
+def _failure(e) -> CoreFailure:
+    message, status, t_fail, h_fail, state, stiff = e.args
+    return CoreFailure(message, STATUS_NAMES.get(status, f"status {status}"), t_fail, h_fail, tuple(state), stiff)
+
+
+def run(spec: dict, t: np.ndarray, out: np.ndarray, *, method: str = "auto", rtol: float = 1e-6, atol=None,
+        first_step: float = 0.0, max_step: float = 0.0, max_steps: int = 10_000_000) -> dict:
+    """Integrates the model ``spec`` from rest, writing its outputs at times ``t`` into ``out``
+    (shape (len(t), n_outputs)). Returns the solver's statistics, ``method`` the one that finished
+    the run. Raises CoreFailure."""
+    try:
+        stats = _core.simulate(spec, t, out, METHOD_CODES[method], float(rtol), atol, float(first_step),
+                               float(max_step), int(max_steps))
+    except _core.SolverError as e:
+        raise _failure(e) from None
+    stats["method"] = METHOD_NAMES[stats["method"]]
+    return stats
+
+
+def run_sensitivities(spec: dict, targets: np.ndarray, t: np.ndarray, out: np.ndarray, sens: np.ndarray, *,
+                      rtol: float, atol: np.ndarray, max_steps: int) -> dict:
+    """As :func:`run` (Dormand-Prince), with the forward sensitivities of every state to the
+    ``targets`` (int32 rows (kind, parameter, coefficient), see :func:`target`) into ``sens``
+    (shape (len(t), n_states, n_targets))."""
+    try:
+        return _core.simulate_sensitivities(spec, targets, t, out, sens, float(rtol), atol, 0.0, 0.0,
+                                            int(max_steps))
+    except _core.SolverError as e:
+        raise _failure(e) from None
+
+
+def target(kind: str, index: int = 0, coefficient: int = 0) -> tuple:
+    """A sensitivity target: ``kind`` one of ``param``, ``law``, ``dF``, ``heat``."""
+    return (TARGET_CODES[kind], int(index), int(coefficient))
+
+
+def loop(plant_spec, T_plant, comp_spec, T_comp, compensation: str, gain, mass, pid, dt, substeps, x_ref, v_ref,
+         x_out, u_out, F_out) -> str:
+    """The fixed-step closed loop of control.h; returns its status name."""
+    status = _core.loop(plant_spec, float(T_plant), comp_spec, float(T_comp), COMPENSATION_CODES[compensation],
+                        float(gain), float(mass), tuple(float(g) for g in pid), float(dt), int(substeps), x_ref,
+                        v_ref, x_out, u_out, F_out)
+    return STATUS_NAMES.get(status, f"status {status}")
+
+
+def rt_steps(spec, T, v, dt, F_out) -> float:
+    """tf_rt_step over the velocities ``v`` (T a number or one per step); seconds, timed in C."""
+    return _core.rt_steps(spec, T, v, float(dt), F_out)
+
+
+__all__ = ["PARAMETERS", "PLANT_CODES", "FRICTION_CODES", "LAW_CODES", "OUTPUTS", "OUTPUT_COLUMN", "MECHANICAL_STATES",
+           "model_spec", "law_tuple", "waveform_tuple", "run", "run_sensitivities", "CoreFailure", "target", "loop",
+           "rt_steps", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
+           "n_outputs", "state_index"]

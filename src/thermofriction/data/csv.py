@@ -1,0 +1,174 @@
+"""Reading one experiment CSV file: units in the headers (docs/formats.md#datasets), every value
+checked, errors naming the file, line and column."""
+
+from __future__ import annotations
+
+import csv
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
+
+def _parse_header(path, header):
+    """[(name, scale to SI, the header cell)] for the header row, or one InputError."""
+    cols = []
+    for j, raw in enumerate(header):
+        cell = raw.strip()
+        where = f"{path}: line 1, column {j + 1}"
+        name, br, unit = cell.partition("[")
+        name = name.strip()
+        if br:
+            if not unit.endswith("]"):
+                raise InputError(f"{where}: '{cell}' must be name[unit], e.g. displacement[um]")
+            unit = unit[:-1].strip()
+        else:
+            unit = _SI.get(name, "")
+        if not name:
+            raise InputError(f"{where}: empty column name (columns: {', '.join(_UNITS)})")
+        if name not in _UNITS:
+            raise InputError(f"{where}: unknown column '{name}' (columns: {', '.join(_UNITS)})")
+        if unit not in _UNITS[name]:
+            raise InputError(f"{where} ('{cell}'): unknown unit '{unit}' for {name} "
+                             f"(one of: {', '.join(u for u in _UNITS[name] if u != 'μm')})")
+        for k, c in enumerate(cols):
+            if c[0] == name:
+                raise InputError(f"{where}: duplicate column '{name}' (also column {k + 1})")
+        cols.append((name, _UNITS[name][unit], cell))
+    missing = [r for r in REQUIRED if r not in [c[0] for c in cols]]
+    if missing:
+        raise InputError(f"{path}: line 1: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
+                         f"(an experiment needs time[s], voltage[V], displacement[um])")
+    return cols
+
+
+def _scan(path, body, cols):
+    """The slow, exact reader: the data rows one by one, so that an error names its line and
+    column. Returns the array when every cell is a number."""
+    ncol = len(cols)
+    data = []
+    for i, line in enumerate(body.split("\n"), start=2):
+        if not line.strip():
+            continue
+        cells = line.rstrip("\r").split(",")
+        if len(cells) != ncol:
+            raise InputError(f"{path}: line {i}: {len(cells)} values, expected {ncol} "
+                             f"({', '.join(c[2] for c in cols)})")
+        row = []
+        for j, cell in enumerate(cells):
+            try:
+                v = float(cell)
+            except ValueError:
+                raise InputError(f"{path}: line {i}, column {j + 1} ({cols[j][2]}): not a number: "
+                                 f"{cell.strip()!r}") from None
+            row.append(v)
+        data.append(row)
+    return np.array(data, dtype=float).reshape(-1, ncol)
+
+
+def _line_of(body, row):
+    """The file's line number (header = 1) of data row ``row`` (0-based; blank lines skipped)."""
+    n = -1
+    for i, line in enumerate(body.split("\n"), start=2):
+        if line.strip():
+            n += 1
+            if n == row:
+                return i
+    return row + 2
+
+
+def read_experiment_csv(path) -> dict:
+    """Reads one experiment CSV (docs/formats.md) into SI arrays: a dict with ``time``, ``voltage``,
+    ``displacement`` and, where the file has them, ``temperature`` and ``stage_displacement``.
+
+    The format is strict; any problem is one InputError naming the file and, where it applies, the
+    line (the header is line 1) and the column."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{path}: is a folder, not an experiment CSV file") from None
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    except ValueError as e:  # a NUL byte in the path
+        raise InputError(f"{str(path)!r}: not a usable file name ({e})") from None
+    rows = raw.count(b"\n") + (not raw.endswith(b"\n")) - 1  # data rows, blank lines included
+    limit = max_rows()
+    if rows > limit:
+        raise InputError(f"{path}: {rows} data rows, more than the limit of {limit} (each row takes ~150 bytes "
+                         f"of memory while loading): downsample the file, or raise the limit with the "
+                         f"environment variable {MAX_ROWS_ENV}=N")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        line = raw[:e.start].count(b"\n") + 1
+        raise InputError(f"{path}: line {line}: not UTF-8 text") from None
+    del raw  # ~0.4 GB for 10 M rows
+    if not text or text.isspace():  # (no copy, unlike strip())
+        raise InputError(f"{path}: empty file (an experiment needs a header row such as "
+                         f"time[s],voltage[V],displacement[um] and at least {MIN_SAMPLES} data rows)")
+    head, _, body = text.partition("\n")
+    del text
+    if not head.strip():
+        raise InputError(f"{path}: line 1: blank; the first line must be the header row, "
+                         f"e.g. time[s],voltage[V],displacement[um]")
+    try:
+        header = next(csv.reader([head.rstrip("\r")]))
+    except csv.Error as e:  # e.g. a field beyond the csv module's size limit
+        raise InputError(f"{path}: line 1: not a valid CSV header row ({e})") from None
+    cols = _parse_header(path, header)
+    ncol = len(cols)
+    if not body or body.isspace():
+        raise InputError(f"{path}: no data rows (only the header)")
+
+    arr = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:  # the fast path; on any failure the exact scanner finds and names the bad cell
+            # from the file, not io.StringIO(body): that holds 4 bytes per character (3 GB at 10 M rows)
+            arr = np.loadtxt(path, delimiter=",", comments=None, ndmin=2, dtype=float, skiprows=1,
+                             encoding="utf-8-sig")
+        except ValueError:
+            arr = None
+    if arr is None or arr.ndim != 2 or arr.shape[1] != ncol:
+        arr = _scan(path, body, cols)
+    n = arr.shape[0]
+
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        r, j = (int(v) for v in np.argwhere(bad)[0])
+        raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cols[j][2]}): "
+                         f"not a finite number ({float(arr[r, j])})")
+    if n < MIN_SAMPLES:
+        raise InputError(f"{path}: {n} data row{'s' if n != 1 else ''}; an experiment needs at least "
+                         f"{MIN_SAMPLES} samples")
+    out = {name: arr[:, j] * scale for j, (name, scale, _) in enumerate(cols)}
+    jt = [c[0] for c in cols].index("time")
+    t = out["time"]
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        i = int(np.argmax(dt <= 0))
+        raise InputError(f"{path}: line {_line_of(body, i + 1)}, column {jt + 1} ({cols[jt][2]}): time must "
+                         f"increase strictly ({float(arr[i + 1, jt]):.10g} after {float(arr[i, jt]):.10g} "
+                         f"on line {_line_of(body, i)})")
+    med = float(np.median(dt))
+    irregular = np.abs(dt - med) > SAMPLING_TOLERANCE * med
+    if np.any(irregular):
+        i = int(np.argmax(irregular))
+        raise InputError(f"{path}: line {_line_of(body, i + 1)}, column {jt + 1} ({cols[jt][2]}): irregular "
+                         f"sampling: interval {dt[i]:.6g} s, median {med:.6g} s (the intervals may differ "
+                         f"by at most {100 * SAMPLING_TOLERANCE:g} %)")
+    if "temperature" in out:
+        jT = [c[0] for c in cols].index("temperature")
+        T = out["temperature"]
+        lo, hi = TEMPERATURE_RANGE
+        bad = (T < lo) | (T > hi)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise InputError(f"{path}: line {_line_of(body, i)}, column {jT + 1} ({cols[jT][2]}): {float(T[i]):g} C "
+                             f"is not a plausible temperature (expected {lo:g} to {hi:g} C)")
+    return out

@@ -1,0 +1,123 @@
+"""Experiments and datasets in memory (SI units, temperature in degC), and the limits that every
+reader applies."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..waveforms import Sampled, Waveform
+
+_LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9}  # micro sign and Greek mu
+_UNITS = {"time": {"s": 1.0, "ms": 1e-3}, "voltage": {"V": 1.0, "mV": 1e-3}, "displacement": _LENGTH,
+          "stage_displacement": _LENGTH, "temperature": {"C": 1.0}}
+_SI = {"time": "s", "voltage": "V", "displacement": "m", "stage_displacement": "m", "temperature": "C"}
+REQUIRED = ("time", "voltage", "displacement")
+MIN_SAMPLES = 10
+SAMPLING_TOLERANCE = 0.01           # relative deviation of an interval from the median interval
+TEMPERATURE_RANGE = (-100.0, 300.0)  # [degC] what a temperature sensor on an actuator can plausibly read
+TEMPERATURE_VARIES = 0.5            # [degC] peak-to-peak above which a recorded temperature is a signal
+ROLES = ("fit", "validate")
+MAX_ROWS = 10_000_000               # data rows per experiment file; ~1.5 GB peak at the limit (docs/limits.md)
+MAX_ROWS_ENV = "THERMOFRICTION_MAX_ROWS"
+
+
+def max_rows() -> int:
+    """The row limit of experiment files: ``THERMOFRICTION_MAX_ROWS`` when set, else ``MAX_ROWS``."""
+    text = os.environ.get(MAX_ROWS_ENV, "").strip()
+    if not text:
+        return MAX_ROWS
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise InputError(f"{MAX_ROWS_ENV}={text!r}: must be a positive whole number of rows")
+    return n
+
+
+@dataclasses.dataclass(eq=False)
+class Experiment:
+    """One measured run, in SI units (temperature in degC).
+
+    ``temperature`` is the manifest's value or else the mean of the recorded ``temperature_signal``;
+    ``input`` is the exact waveform when the manifest gives one (``input = "sawtooth:..."``), else
+    None (the recorded ``voltage`` is the input)."""
+
+    file: str
+    time: np.ndarray
+    voltage: np.ndarray
+    displacement: np.ndarray
+    temperature: float
+    temperature_signal: np.ndarray | None = None
+    stage_displacement: np.ndarray | None = None
+    role: str = "fit"
+    description: str = ""
+    input: Waveform | None = None
+
+    @property
+    def sample_rate(self) -> float:
+        """[Hz] from the median sampling interval."""
+        return float(1.0 / np.median(np.diff(self.time)))
+
+    @property
+    def duration(self) -> float:
+        """[s] from the first to the last sample."""
+        return float(self.time[-1] - self.time[0])
+
+    def temperature_input(self):
+        """What ``simulate(..., temperature=...)`` takes: the recorded temperature where it varies
+        beyond its sensor noise, else the constant ``temperature``. "Varies" means a peak-to-peak
+        above 0.5 C after a moving average over 2 % of the record (which removes white sensor noise
+        but keeps thermal changes, slow on that scale); the smoothed signal is what is returned,
+        as a ``Sampled`` waveform, so that sensor noise does not enter the simulation."""
+        sig = self.temperature_signal
+        if sig is None:
+            return self.temperature
+        smooth = _moving_average(np.asarray(sig, float), max(1, len(sig) // 50))
+        if float(np.ptp(smooth)) > TEMPERATURE_VARIES:
+            return Sampled(np.asarray(self.time, float), smooth)
+        return self.temperature
+
+
+def _moving_average(x, w):
+    """Centred moving average over ``w`` samples (made odd), the window truncated at the ends;
+    O(n) by cumulative sums."""
+    n = x.size
+    if w <= 1 or n < 3:
+        return x
+    half = w // 2
+    m = float(np.mean(x))
+    c = np.concatenate([[0.0], np.cumsum(x - m)])
+    i = np.arange(n)
+    lo, hi = np.clip(i - half, 0, n), np.clip(i + half + 1, 0, n)
+    return m + (c[hi] - c[lo]) / (hi - lo)
+
+
+@dataclasses.dataclass(eq=False)
+class Dataset:
+    """Experiments and where they came from (``path``: the folder, or None if not saved)."""
+
+    path: Path | None = None
+    name: str | None = None
+    description: str = ""
+    experiments: list = dataclasses.field(default_factory=list)
+
+    @property
+    def fit(self) -> list:
+        return [e for e in self.experiments if e.role == "fit"]
+
+    @property
+    def validate(self) -> list:
+        return [e for e in self.experiments if e.role == "validate"]
+
+    @property
+    def temperatures(self) -> list:
+        return [e.temperature for e in self.experiments]
+
+
+# -- experiment files -------------------------------------------------------------------------

@@ -1,0 +1,182 @@
+"""Dataset folders: a ``dataset.toml`` manifest naming its experiment CSV files
+(docs/formats.md#datasets); loading checks everything, saving writes atomically."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path, PurePosixPath
+
+import numpy as np
+import tomli_w
+
+from .._io import atomic_write
+from ..errors import InputError, unknown_keys
+from ..waveforms import parse_waveform
+from .csv import read_experiment_csv
+from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
+
+_MANIFEST_KEYS = ("name", "description", "experiment")
+_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input")
+
+
+def _is_inside(f: str) -> bool:
+    """Whether the manifest path ``f`` is a plain relative path that stays in its folder."""
+    rel = PurePosixPath(f.replace("\\", "/"))
+    return bool(f) and not (rel.is_absolute() or Path(f).is_absolute() or ".." in rel.parts
+                            or f.startswith("~") or (len(f) > 1 and f[1] == ":"))
+
+
+def _check_temperature(T, where):
+    # (an int is always finite, and math.isfinite would overflow on one beyond the float range)
+    if isinstance(T, bool) or not isinstance(T, (int, float)) or (isinstance(T, float) and not math.isfinite(T)):
+        raise InputError(f"{where}: 'temperature' must be a number [C], got {T!r}")
+    lo, hi = TEMPERATURE_RANGE
+    if not lo <= T <= hi:
+        raise InputError(f"{where}: temperature {T!r} C is not plausible (expected {lo:g} to {hi:g} C)")
+    return float(T)
+
+
+def load_dataset(path) -> Dataset:
+    """Reads a dataset folder (docs/formats.md): ``dataset.toml`` and the experiment files it lists,
+    all checked; any problem is one InputError naming the file (and its line, column or
+    ``[[experiment]] N`` entry)."""
+    folder = Path(path)
+    if folder.is_dir():
+        manifest = folder / "dataset.toml"
+    elif folder.name == "dataset.toml" and folder.is_file():
+        manifest, folder = folder, folder.parent
+    elif folder.exists():
+        raise InputError(f"{path}: not a dataset folder (a folder with a dataset.toml)")
+    else:
+        raise InputError(f"{path}: no such dataset folder")
+    if not manifest.is_file():
+        raise InputError(f"{folder}: no dataset.toml in this folder")
+    try:
+        meta = tomllib.loads(manifest.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{manifest}: TOML syntax error: {e}") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(f"{manifest}: cannot read ({e})") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
+        raise InputError(f"{manifest}: TOML nested too deeply") from None
+    unknown = set(meta) - set(_MANIFEST_KEYS)
+    if unknown:
+        raise InputError(f"{manifest}: {unknown_keys(unknown, _MANIFEST_KEYS)}")
+    name = meta.get("name")
+    if name is not None and not isinstance(name, str):
+        raise InputError(f"{manifest}: 'name' must be a string, got {name!r}")
+    description = meta.get("description", "")
+    if not isinstance(description, str):
+        raise InputError(f"{manifest}: 'description' must be a string, got {description!r}")
+    entries = meta.get("experiment")
+    if entries is None:
+        raise InputError(f"{manifest}: no [[experiment]] entries (a dataset needs at least one)")
+    if not isinstance(entries, list) or not entries:
+        raise InputError(f"{manifest}: 'experiment' must be a list of [[experiment]] tables (at least one)")
+    root = folder.resolve()
+    exps = []
+    for n, e in enumerate(entries, start=1):
+        where = f"{manifest}: [[experiment]] {n}"
+        if not isinstance(e, dict):
+            raise InputError(f"{where}: must be a table")
+        unknown = set(e) - set(_EXPERIMENT_KEYS)
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, _EXPERIMENT_KEYS)}")
+        f = e.get("file")
+        if f is None:
+            raise InputError(f"{where}: missing 'file' (the experiment's CSV, relative to the dataset folder)")
+        if not isinstance(f, str) or not f.strip() or not f.isprintable():
+            raise InputError(f"{where}: 'file' must be a file name, got {f!r}")
+        try:
+            target = (folder / f).resolve()
+        except (OSError, ValueError, RuntimeError):  # a NUL byte, a name too long, a symlink loop
+            target = None
+        if target is None or not _is_inside(f) or root not in (target, *target.parents):
+            raise InputError(f"{where}: file '{f}' must be a relative path inside the dataset folder "
+                             f"(no absolute paths, no '..', no symbolic links leading out)")
+        role = e.get("role", "fit")
+        if role not in ROLES:
+            raise InputError(f"{where}: 'role' must be \"fit\" or \"validate\", got {role!r}")
+        T = e.get("temperature")
+        if T is not None:
+            T = _check_temperature(T, where)
+        desc = e.get("description", "")
+        if not isinstance(desc, str):
+            raise InputError(f"{where}: 'description' must be a string, got {desc!r}")
+        inp = None
+        if "input" in e:
+            if not isinstance(e["input"], str):
+                raise InputError(f"{where}: 'input' must be a waveform spec such as "
+                                 f"\"sawtooth:amplitude=30,frequency=5\"")
+            try:
+                inp = parse_waveform(e["input"])
+            except InputError as err:
+                raise InputError(f"{where}: {err}") from None
+        cols = read_experiment_csv(folder / f)
+        sig = cols.get("temperature")
+        if T is None:
+            if sig is None:
+                raise InputError(f"{where}: no temperature: give 'temperature' or a temperature[C] column in {f}")
+            T = float(np.mean(sig))
+        exps.append(Experiment(file=f, time=cols["time"], voltage=cols["voltage"], displacement=cols["displacement"],
+                               temperature=T, temperature_signal=sig,
+                               stage_displacement=cols.get("stage_displacement"), role=role, description=desc,
+                               input=inp))
+    return Dataset(path=folder, name=name, description=description, experiments=exps)
+
+
+def save_dataset(dataset: Dataset, folder) -> Path:
+    """Writes ``folder`` (created if needed): one CSV per experiment (``time[s],voltage[V],
+    displacement[um]``, and ``temperature[C]`` and ``stage_displacement[um]`` where present, ten
+    significant digits) and ``dataset.toml``, each file atomically. Returns the folder and sets
+    ``dataset.path`` to it."""
+    folder = Path(folder)
+    files = [e.file for e in dataset.experiments]
+    if not files:
+        raise InputError("the dataset has no experiments to save")
+    for f in files:
+        if not isinstance(f, str) or not _is_inside(f):
+            raise InputError(f"experiment file '{f}' must be a relative path inside the dataset folder")
+    dup = sorted({f for f in files if files.count(f) > 1})
+    if dup:
+        raise InputError(f"two experiments would be written to the same file: {', '.join(dup)}")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        for f in files:
+            (folder / f).parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise InputError(f"{folder}: cannot create the dataset folder ({err.strerror or err})") from None
+    entries = []
+    for e in dataset.experiments:
+        cols = {"time[s]": e.time, "voltage[V]": e.voltage, "displacement[um]": np.asarray(e.displacement) * 1e6}
+        if e.temperature_signal is not None:
+            cols["temperature[C]"] = e.temperature_signal
+        if e.stage_displacement is not None:
+            cols["stage_displacement[um]"] = np.asarray(e.stage_displacement) * 1e6
+        try:
+            with atomic_write(folder / e.file, "w", newline="") as fh:
+                fh.write(",".join(cols) + "\n")
+                np.savetxt(fh, np.column_stack([np.asarray(v, float) for v in cols.values()]), delimiter=",",
+                           fmt="%.10g")
+        except OSError as err:
+            raise InputError(f"{folder / e.file}: cannot write ({err.strerror or err})") from None
+        entry = {"file": e.file, "temperature": float(e.temperature), "role": e.role}
+        if e.description:
+            entry["description"] = e.description
+        if e.input is not None:
+            entry["input"] = e.input.spec()
+        entries.append(entry)
+    meta = {}
+    if dataset.name:
+        meta["name"] = dataset.name
+    if dataset.description:
+        meta["description"] = dataset.description
+    meta["experiment"] = entries
+    try:
+        with atomic_write(folder / "dataset.toml", "w") as fh:
+            fh.write(tomli_w.dumps(meta))
+    except OSError as err:
+        raise InputError(f"{folder / 'dataset.toml'}: cannot write ({err.strerror or err})") from None
+    dataset.path = folder
+    return folder

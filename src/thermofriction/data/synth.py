@@ -1,0 +1,219 @@
+"""Synthetic datasets with realistic sensor effects (noise, quantisation, temperature-sensor
+noise), and the ``thermofriction synth`` command."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from ..models import Model, load_model, require_actuator
+from ..simulate import StepSizeController, simulate
+from ..waveforms import Sampled, parse_waveform
+from .experiments import MIN_SAMPLES, Dataset, Experiment
+from .files import _check_temperature, save_dataset
+
+def _nonneg(label, v):
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        raise InputError(f"{label} must be a number, got {v!r}") from None
+    if not (v >= 0 and math.isfinite(v)):
+        raise InputError(f"{label} must be a non-negative number, got {v!r}")
+    return v
+
+
+def _temperatures(values, label):
+    if values is None:
+        return []
+    if isinstance(values, (int, float, np.number)):
+        values = [values]
+    return [_check_temperature(float(T) if isinstance(T, np.number) else T, label) for T in values]
+
+
+def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_rate=10_000.0, input=None,
+               noise=20e-9, quantization=0.0, temperature_noise=0.0, drift=0.0, record_temperature=None,
+               record_stage=False, seed=0, name=None) -> Dataset:
+    """A dataset simulated from ``model`` at each temperature (role "fit") and at each ``validate``
+    temperature (role "validate"), with realistic sensor effects:
+
+    - white Gaussian displacement noise of std ``noise`` [m];
+    - a slow linear sensor drift of ``drift`` [m/s] with a random sign;
+    - quantisation of the displacement to multiples of ``quantization`` [m] (0: none);
+    - a recorded temperature column with sensor noise of std ``temperature_noise`` [C], when
+      ``record_temperature`` (default None: when ``temperature_noise`` > 0);
+    - the stage displacement, with the same noise and quantisation, when ``record_stage``.
+
+    The manifest's temperature is the true one. ``input`` defaults to the model's ``[input]``.
+    Seeded and reproducible: each experiment draws from its own stream
+    (``default_rng([seed, i])`` for the i-th fit temperature, ``[seed, j, 1]`` for the j-th
+    validate one), so adding an experiment changes no other."""
+    require_actuator(model, "synthesize")
+    waveform = input if input is not None else model.input
+    if waveform is None:
+        raise InputError(f"{'model ' + repr(model.name) if model.name else 'the model'} has no [input] "
+                         f"waveform: give input= (e.g. tf.Sawtooth(amplitude=30, frequency=5))")
+    fit_T = _temperatures(temperatures, "temperatures")
+    val_T = _temperatures(validate, "validate")
+    if not fit_T and not val_T:
+        raise InputError("give at least one temperature")
+    noise = _nonneg("noise", noise)
+    quantization = _nonneg("quantization", quantization)
+    temperature_noise = _nonneg("temperature_noise", temperature_noise)
+    try:
+        drift = float(drift)
+        duration = float(duration)
+        sample_rate = float(sample_rate)
+    except (TypeError, ValueError):
+        raise InputError("drift, duration and sample_rate must be numbers") from None
+    if not math.isfinite(drift):
+        raise InputError(f"drift must be a finite number [m/s], got {drift!r}")
+    if not (duration > 0 and math.isfinite(duration)):
+        raise InputError(f"duration must be positive [s], got {duration!r}")
+    if not (sample_rate > 0 and math.isfinite(sample_rate)):
+        raise InputError(f"sample_rate must be positive [Hz], got {sample_rate!r}")
+    if duration * sample_rate + 1 < MIN_SAMPLES:
+        raise InputError(f"duration x sample_rate gives fewer than {MIN_SAMPLES} samples")
+    if record_temperature is None:  # a self-heating model's temperature is an output: always recorded
+        record_temperature = temperature_noise > 0 or model.heat is not None
+    runs = [(T, "fit", [int(seed), i]) for i, T in enumerate(fit_T)]
+    runs += [(T, "validate", [int(seed), j, 1]) for j, T in enumerate(val_T)]
+    label = model.name or "model"
+    spec = "a sampled waveform" if isinstance(waveform, Sampled) else waveform.spec()
+    exps = []
+    used = set()
+    for T, role, stream in runs:
+        rng = np.random.default_rng(stream)
+        res = simulate(model, duration, temperature=T, input=waveform, sample_rate=sample_rate,
+                       controller=StepSizeController(rtol=1e-10))
+        x = res.displacement + noise * rng.standard_normal(res.time.size)
+        sign = 0
+        if drift:
+            sign = 1 if rng.random() < 0.5 else -1
+            x = x + sign * drift * (res.time - res.time[0])
+        if quantization > 0:
+            x = np.round(x / quantization) * quantization
+        stage = None
+        if record_stage:
+            stage = res.stage_displacement + noise * rng.standard_normal(res.time.size)
+            if quantization > 0:
+                stage = np.round(stage / quantization) * quantization
+        T_true = res.temperature if model.heat is not None else T  # with [heat], T is the ambient one
+        sig = T_true + temperature_noise * rng.standard_normal(res.time.size) if record_temperature else None
+        effects = [f"noise {noise:g} m"]
+        if quantization:
+            effects.append(f"quantisation {quantization:g} m")
+        if drift:
+            effects.append(f"drift {sign * drift:+g} m/s")
+        if record_temperature:
+            effects.append(f"temperature noise {temperature_noise:g} C")
+        desc = (f"synthesised from {label} at {T:g} C: input {spec}, {duration:g} s at {sample_rate:g} Hz, "
+                f"{', '.join(effects)}, seed {seed}")
+        stem = f"T{T:.10g}C{'-validate' if role == 'validate' else ''}"
+        file, k = f"{stem}.csv", 1
+        while file in used:
+            k += 1
+            file = f"{stem}-{k}.csv"
+        used.add(file)
+        exps.append(Experiment(file=file, time=res.time, voltage=res.input, displacement=x, temperature=T,
+                               temperature_signal=sig, stage_displacement=stage, role=role, description=desc,
+                               input=None if isinstance(waveform, Sampled) else waveform))
+    return Dataset(path=None, name=name or f"synthetic-{label}",
+                   description=f"synthesised by thermofriction from {label}", experiments=exps)
+
+
+# -- command line -----------------------------------------------------------------------------
+
+def _float_list(text, what):
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"{what}: expected comma-separated numbers, got '{text}'") from None
+    if not all(math.isfinite(v) for v in vals):
+        raise InputError(f"{what}: temperatures must be finite numbers, got '{text}'")
+    return vals
+
+
+def add_synth_command(subparsers):
+    """Registers ``thermofriction synth`` on an argparse subparsers object."""
+    s = subparsers.add_parser(
+        "synth", help="synthesise a measured dataset from a model, with realistic sensor effects",
+        description="Simulate MODEL at each temperature and write a dataset folder (docs/formats.md#datasets: dataset.toml "
+                    "and one experiment CSV per temperature) with white displacement noise, quantisation, "
+                    "an optional slow sensor drift, a noisy temperature record and the stage displacement. "
+                    "Seeded and reproducible: the same options give the same files, and each experiment "
+                    "has its own random stream, so adding a temperature changes no other experiment.",
+        epilog="example: thermofriction synth li2009-model-i --temperatures 30.8,33.9,35.7,38.4,41.5 "
+               "--validate 33,40 --noise 20e-9 --quantization 5e-9 -o data")
+    s.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name, e.g. li2009-model-i")
+    s.add_argument("--temperatures", required=True, metavar="C,C,...",
+                   help="temperatures [C] of the experiments with role 'fit', comma-separated")
+    s.add_argument("--validate", default="", metavar="C,C,...",
+                   help="temperatures [C] of held-out experiments (role 'validate'), comma-separated")
+    s.add_argument("--duration", type=float, default=2.0, metavar="S",
+                   help="length of each experiment [s] (default: 2)")
+    s.add_argument("--sample-rate", type=float, default=10_000.0, metavar="HZ",
+                   help="sampling rate of the recorded signals [Hz] (default: 10000)")
+    s.add_argument("--input", metavar="SPEC",
+                   help="input waveform, e.g. sawtooth:amplitude=30,frequency=5,rise=0.999 "
+                        "(default: the model's [input])")
+    s.add_argument("--noise", type=float, default=20e-9, metavar="M",
+                   help="standard deviation of the white displacement-sensor noise [m] (default: 2e-8)")
+    s.add_argument("--quantization", type=float, default=0.0, metavar="M",
+                   help="displacement-sensor resolution [m]: values are rounded to multiples of it "
+                        "(default: 0, none)")
+    s.add_argument("--temperature-noise", type=float, default=0.0, metavar="C",
+                   help="standard deviation of the temperature-sensor noise [C]; a non-zero value "
+                        "records a temperature[C] column (default: 0)")
+    s.add_argument("--drift", type=float, default=0.0, metavar="M_PER_S",
+                   help="slow linear displacement-sensor drift [m/s], with a random sign per experiment "
+                        "(default: 0)")
+    s.add_argument("--record-temperature", action="store_true", default=None,
+                   help="write a temperature[C] column (the true temperature plus --temperature-noise)")
+    s.add_argument("--record-stage", action="store_true",
+                   help="also write the stage displacement (stage_displacement[um], same noise), "
+                        "for identifying the plant")
+    s.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default: 0)")
+    s.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="dataset folder to write (created if needed; files in it are replaced)")
+    s.set_defaults(run=cmd_synth)
+    return s
+
+
+def cmd_synth(args) -> int:
+    """``thermofriction synth``: writes the dataset and prints one line per file."""
+    for opt, v in (("--duration", args.duration), ("--sample-rate", args.sample_rate)):
+        if not (v > 0 and math.isfinite(v)):
+            raise InputError(f"{opt} must be a positive number, got {v!r}")
+    for opt, v in (("--noise", args.noise), ("--quantization", args.quantization),
+                   ("--temperature-noise", args.temperature_noise)):
+        if not (v >= 0 and math.isfinite(v)):
+            raise InputError(f"{opt} must be a non-negative number, got {v!r}")
+    if not math.isfinite(args.drift):
+        raise InputError(f"--drift must be a finite number, got {args.drift!r}")
+    fit_T = _float_list(args.temperatures, "--temperatures")
+    if not fit_T:
+        raise InputError("--temperatures: give at least one temperature, e.g. --temperatures 30.8,35.7,41.5")
+    val_T = _float_list(args.validate or "", "--validate")
+    model = load_model(args.model)
+    waveform = parse_waveform(args.input) if args.input else None
+    if waveform is None and model.input is None:
+        raise InputError(f"{args.model}: the model has no [input] waveform: give --input, "
+                         f"e.g. --input sawtooth:amplitude=30,frequency=5")
+    try:
+        data = synthesize(model, fit_T, validate=val_T, duration=args.duration, sample_rate=args.sample_rate,
+                          input=waveform, noise=args.noise, quantization=args.quantization,
+                          temperature_noise=args.temperature_noise, drift=args.drift,
+                          record_temperature=args.record_temperature, record_stage=args.record_stage,
+                          seed=args.seed)
+    except InputError as e:
+        raise InputError(f"synth: {e}") from None
+    folder = save_dataset(data, args.output)
+    for e in data.experiments:
+        print(f"wrote {folder / e.file} ({e.role}, {e.temperature:g} C, {e.time.size} samples)")
+    print(f"wrote {folder / 'dataset.toml'} ({len(data.fit)} fit, {len(data.validate)} validate)")
+    return 0
+
+
+__all__ = ["synthesize", "add_synth_command", "cmd_synth"]

@@ -1,0 +1,296 @@
+"""Friction models (docs/models.md#friction-models): parameters as dataclass fields, their file
+form, their state layout, and the physical checks on their values."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from .._bridge import PARAMETERS
+from ..errors import InputError, unknown_keys
+from ._parse import num, num_array
+
+#: The unit of each friction parameter (the one table: files, reports and fit results use it).
+PARAMETER_UNITS = {"sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m", "fc": "N", "fs": "N", "vs": "m/s",
+                   "delta": "-", "vd": "m/s", "v_smooth": "m/s", "z_ba": "m", "C": "N/s"}
+
+
+class _Friction:
+    """What every friction model shares: parameters as dataclass fields (None where a Model I law
+    gives the value), ``values()``, the file form, and the state layout."""
+
+    model = ""
+    required: tuple = ()
+    nstate = 0
+    state_names: tuple = ()
+    state_units: tuple = ()
+    #: parameters that are arrays, not numbers (never a law of temperature)
+    arrays: tuple = ()
+
+    def values(self) -> dict:
+        """Parameters given as numbers (None-valued ones omitted)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+
+    def to_dict(self) -> dict:
+        d = {"model": self.model}
+        for k, v in self.values().items():
+            d[k] = [float(x) for x in v] if k in self.arrays else v
+        return d
+
+    def with_values(self, **values):
+        return replace(self, **values)
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[friction]"):
+        d = dict(d)
+        d.pop("model", None)
+        allowed = [f.name for f in fields(cls)]
+        unknown = set(d) - set(allowed)
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, ['model', *allowed], cls.model)}")
+        for k, v in d.items():
+            d[k] = tuple(num_array(v, where, k)) if k in cls.arrays else num(v, where, k)
+        for k in cls.arrays:
+            if k not in d:
+                raise InputError(f"{where}: missing '{k}' (an array, one value per element)")
+        kw = {k: d.get(k) for k in cls.required}
+        kw.update({k: v for k, v in d.items() if k not in cls.required})
+        return cls(**kw)
+
+
+@dataclass(frozen=True)
+class LuGre(_Friction):
+    """LuGre friction (Canudas de Wit et al. 1995), docs/models.md#friction-models::
+
+        z' = v - sigma0 |v| z / g(v),   F = sigma0 z + sigma1(v) z' + sigma2 v
+        g(v) = fc + (fs - fc) exp(-|v/vs|^delta),   sigma1(v) = sigma1 exp(-(v/vd)^2) if vd
+
+    A parameter that follows a Model I law is None here (the law lives in the thermal model).
+    ``fs`` defaults to ``fc`` (no Stribeck effect, the paper's case). ``v_smooth`` is the velocity
+    band of the smoothed sign used by Model II's offset form.
+    """
+
+    sigma0: float | None
+    sigma1: float | None
+    fc: float | None
+    sigma2: float | None = 0.0
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    vd: float | None = None
+    v_smooth: float = 1e-6
+
+    model = "lugre"
+    nstate = 1
+    state_names = ("z",)
+    state_units = ("m",)
+    required = ("sigma0", "sigma1", "fc")
+
+
+@dataclass(frozen=True)
+class Coulomb(_Friction):
+    """Coulomb + viscous friction, a static map: ``F = fc s(v) + sigma2 v`` with the sign smoothed
+    over ``v_smooth`` [m/s], ``s(v) = tanh(v / v_smooth)`` (no sticking: below v_smooth the
+    force is viscous-like, fc/v_smooth N s/m)."""
+
+    fc: float | None
+    sigma2: float | None = 0.0
+    v_smooth: float | None = 1e-6
+
+    model = "coulomb"
+    required = ("fc",)
+
+
+@dataclass(frozen=True)
+class Stribeck(_Friction):
+    """Static Stribeck map: ``F = g(v) s(v) + sigma2 v``, g the Stribeck curve of docs/models.md#friction-models and
+    ``s(v) = tanh(v / v_smooth)``."""
+
+    fc: float | None
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    sigma2: float | None = 0.0
+    v_smooth: float | None = 1e-6
+
+    model = "stribeck"
+    required = ("fc",)
+
+
+@dataclass(frozen=True)
+class Dahl(_Friction):
+    """Dahl (1968): ``z' = v - sigma0 |v| z / fc``, ``F = sigma0 z`` -- presliding hysteresis
+    with a Coulomb level, no Stribeck effect, no viscous term."""
+
+    sigma0: float | None
+    fc: float | None
+    v_smooth: float | None = 1e-6
+
+    model = "dahl"
+    nstate = 1
+    state_names = ("z",)
+    state_units = ("m",)
+    required = ("sigma0", "fc")
+
+
+@dataclass(frozen=True)
+class ElastoPlastic(_Friction):
+    """Elasto-plastic friction (Dupont, Hayward, Armstrong and Altpeter 2002): LuGre with
+    ``z' = v - alpha(z, v) sigma0 |v| z / g(v)``. alpha is 0 for |z| <= z_ba (and whenever z
+    opposes v: purely elastic, so small oscillating forces cause no drift), 1 from the steady
+    deflection g(v)/sigma0 on, and a half sine between. Needs 0 <= z_ba < fc/sigma0."""
+
+    sigma0: float | None
+    sigma1: float | None
+    fc: float | None
+    z_ba: float | None
+    sigma2: float | None = 0.0
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    vd: float | None = None
+    v_smooth: float | None = 1e-6
+
+    model = "elastoplastic"
+    nstate = 1
+    state_names = ("z",)
+    state_units = ("m",)
+    required = ("sigma0", "sigma1", "fc", "z_ba")
+
+
+@dataclass(frozen=True)
+class GMS(_Friction):
+    """Generalized Maxwell-slip (Al-Bender, Lampaert and Swevers 2005): N elementary blocks with
+    stiffnesses ``k`` [N/m] and capacity fractions ``w`` (summing to one), ``F = sum F_i + sigma2 v``.
+
+    A stuck element follows the motion, ``F_i' = k_i v``, until |F_i| reaches its capacity
+    ``w_i g(v)``; then it slips, ``F_i' = C (sgn(v) w_i - F_i / g(v))`` (rate ``C`` [N/s]), until
+    the motion reverses and it sticks again. The switches are events the integrator locates and
+    restarts at -- no regularisation -- so presliding hysteresis keeps its return-point memory.
+    (docs/models.md#friction-models prints the slip law as ``sgn(v) C (w_i - F_i/g)``; that is the same for v > 0 and
+    unstable for v < 0, so the sign is applied to the capacity instead.)"""
+
+    k: tuple
+    w: tuple
+    C: float | None
+    fc: float | None
+    fs: float | None = None
+    vs: float | None = None
+    delta: float | None = 2.0
+    sigma2: float | None = 0.0
+    v_smooth: float | None = 1e-6
+
+    model = "gms"
+    required = ("k", "w", "C", "fc")
+    arrays = ("k", "w")
+    _MAX_ELEMENTS = 64
+
+    def __post_init__(self):
+        k, w = tuple(float(x) for x in self.k), tuple(float(x) for x in self.w)
+        if len(k) != len(w) or not 1 <= len(k) <= self._MAX_ELEMENTS:
+            raise InputError(f"[friction]: 'k' and 'w' must have the same length, 1 to {self._MAX_ELEMENTS} "
+                             f"elements (got {len(k)} and {len(w)})")
+        for name, arr in (("k", k), ("w", w)):
+            for i, x in enumerate(arr):
+                if not (math.isfinite(x) and x > 0):
+                    raise InputError(f"[friction]: '{name}[{i}]' must be positive, got {x!r}")
+        if abs(sum(w) - 1.0) > 1e-9:
+            raise InputError(f"[friction]: the GMS weights 'w' must sum to one, got {sum(w):.12g}")
+        object.__setattr__(self, "k", k)
+        object.__setattr__(self, "w", w)
+
+    @property
+    def nstate(self):
+        return len(self.k)
+
+    @property
+    def state_names(self):
+        return tuple(f"F_{i + 1}" for i in range(len(self.k)))
+
+    @property
+    def state_units(self):
+        return ("N",) * len(self.k)
+
+
+FRICTION_MODELS = {cls.model: cls for cls in (LuGre, Coulomb, Stribeck, Dahl, ElastoPlastic, GMS)}
+
+
+def check_friction_values(values: dict, where: str):
+    """Physical checks on a full set of parameter values (numbers and laws evaluated)."""
+    def need(name, ok, what):
+        v = values.get(name)
+        if v is not None and not ok(v):
+            raise InputError(f"{where}: '{name}' must be {what}, got {v!r}")
+    need("sigma0", lambda v: v > 0, "positive")
+    need("sigma1", lambda v: v >= 0, "non-negative")
+    need("sigma2", lambda v: v >= 0, "non-negative")
+    need("fc", lambda v: v > 0, "positive")
+    need("delta", lambda v: v > 0, "positive")
+    need("vd", lambda v: v > 0, "positive")
+    need("v_smooth", lambda v: v > 0, "positive")
+    need("C", lambda v: v > 0, "positive")
+    need("z_ba", lambda v: v >= 0, "non-negative")
+    z_ba, sigma0, fc = values.get("z_ba"), values.get("sigma0"), values.get("fc")
+    if z_ba is not None and sigma0 and fc and not z_ba < fc / sigma0:
+        raise InputError(f"{where}: 'z_ba' ({z_ba!r} m) must be below the steady deflection fc/sigma0 "
+                         f"({fc / sigma0:.6g} m): the elasto-plastic model breaks away before it")
+    fs = values.get("fs")
+    if fs is not None and fc is not None and fs < fc:
+        raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r})")
+    if fs is not None and fc is not None and fs != fc:
+        vs = values.get("vs")
+        if vs is None or not vs > 0:
+            raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}")
+
+
+def stribeck_curve(values: dict, v):
+    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fs = fc: no Stribeck effect), NumPy, for checks and reports."""
+    fc = values["fc"]
+    fs = values.get("fs", fc)
+    fs = fc if fs is None else fs
+    if fs == fc:
+        return np.full_like(np.asarray(v, float), fc)
+    return fc + (fs - fc) * np.exp(-np.abs(np.asarray(v, float) / values["vs"]) ** values.get("delta", 2.0))
+
+
+def dissipativity_violation(model_name: str, values: dict):
+    """Where a LuGre-type model (LuGre, elasto-plastic) may create energy, or None.
+
+    Sufficient condition checked: with the bristle energy V = sigma0 z^2 / 2 as storage function,
+    F v - V' = sigma0 a z^2 - sigma1(v) a v z + (sigma1(v) + sigma2) v^2 (a = sigma0 |v| / g(v))
+    must be >= 0 for every |z| <= fs/sigma0 (the invariant set of z) at every velocity. It fails
+    when sigma1 is large against sigma2 and the Stribeck drop (fs - fc)/fc -- at high speed it
+    needs sigma1 <= sigma2 fc / (fs - fc) -- which is why a constant, large sigma1 makes LuGre
+    non-passive (Barabanov and Ortega 2000) and a velocity-dependent sigma1(v) = sigma1
+    exp(-(v/vd)^2) (Olsson 1996) restores it. Returns (velocity, message) for the lowest failing
+    speed on a log grid from 1 nm/s to 100 m/s. (For the elasto-plastic model, alpha <= 1 only
+    lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
+    if model_name not in ("lugre", "elastoplastic"):
+        return None
+    s0, s1, s2, fc = values["sigma0"], values["sigma1"], values.get("sigma2", 0.0) or 0.0, values["fc"]
+    fs = values.get("fs") if values.get("fs") is not None else fc
+    v = np.logspace(-9, 2, 1101)
+    g = stribeck_curve(values, v)
+    vd = values.get("vd")
+    s1v = s1 * np.exp(-(v / vd) ** 2) if vd else np.full_like(v, s1)
+    zmax = fs / s0
+    a = s0 * v / g
+    z_star = np.minimum(s1v * v / (2 * s0), zmax)  # the minimiser of the quadratic in z, within the set
+    q = s0 * a * z_star ** 2 - s1v * a * v * z_star + (s1v + s2) * v ** 2
+    bad = q < -1e-12 * (s1v + s2 + 1e-300) * v ** 2
+    if not np.any(bad):
+        return None
+    v_bad = float(v[np.argmax(bad)])
+    return v_bad, (f"not dissipative above |v| = {v_bad:.3g} m/s (condition: F v >= d/dt(sigma0 z^2/2) for "
+                   f"|z| <= fs/sigma0; at high speed sigma1 <= sigma2 fc/(fs - fc) = "
+                   f"{(s2 * fc / (fs - fc)) if fs > fc else float('inf'):.3g} N s/m, sigma1 = {s1:.3g}): the model "
+                   f"can create energy; give vd (sigma1(v) = sigma1 exp(-(v/vd)^2)), or raise sigma2")
+
+
+
+
+
+__all__ = ["PARAMETERS", "PARAMETER_UNITS", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
+           "FRICTION_MODELS", "check_friction_values", "stribeck_curve", "dissipativity_violation"]

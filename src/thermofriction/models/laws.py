@@ -1,0 +1,251 @@
+"""Temperature laws (docs/models.md#model-i): a parameter, or Model II's dF, as a function of the
+temperature T [degC].
+
+Each law owns its coefficients: their names in the model file (``keys``), the ones that can be
+fitted (``coefficient_names``), their values and units. Identification and the file reader ask the
+law; nothing else knows what a law's coefficients are. Values are computed by the C core, the code
+the simulator runs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from .. import _bridge
+from ..errors import InputError, unknown_keys
+from ._parse import num, num_array
+
+
+@dataclass(frozen=True, eq=False)
+class Law:
+    """A function of temperature T [degC]. ``range`` is the calibrated interval (or None)."""
+
+    kind = ""
+    #: the keys of the law's inline table in a model file, besides ``law`` and ``range``
+    keys = ()
+
+    def core_fields(self) -> dict:
+        """The numbers the C core's tf_law takes (a, b, x, y)."""
+        raise NotImplementedError
+
+    # -- coefficients ------------------------------------------------------------------------
+    def coefficient_names(self) -> list:
+        """Names of the coefficients that can be fitted (``a``, ``values[2]``, ...), in the order
+        of the C core's coefficient derivatives."""
+        return list(self.keys)
+
+    def coefficients(self) -> list:
+        """Every coefficient's value, in the order of :meth:`coefficient_names`."""
+        return [float(getattr(self, k)) for k in self.keys]
+
+    def with_coefficients(self, coefficients) -> "Law":
+        return dataclasses.replace(self, **dict(zip(self.keys, (float(c) for c in coefficients))))
+
+    def coefficient_unit(self, name: str, unit: str) -> str:
+        """The unit of coefficient ``name`` of a law whose value is in ``unit``."""
+        return unit
+
+    # -- values ------------------------------------------------------------------------------
+    def __call__(self, T):
+        return self.evaluate(T)[0]
+
+    def evaluate(self, T):
+        """(value, dvalue/dT) at T (scalars or arrays)."""
+        v, d = _bridge.law_eval(self, np.ascontiguousarray(np.atleast_1d(T), dtype=float))
+        if np.ndim(T) == 0:
+            return float(v[0]), float(d[0])
+        return v, d
+
+    def slope(self, T):
+        return self.evaluate(T)[1]
+
+    def in_range(self, T) -> bool:
+        rng = getattr(self, "range", None)
+        if rng is None:
+            return True
+        T = np.atleast_1d(T)
+        return bool(np.all((T >= rng[0] - 1e-9) & (T <= rng[1] + 1e-9)))
+
+    # -- file form ---------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {"law": self.kind}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "range":
+                if v is not None:
+                    d["range"] = [float(v[0]), float(v[1])]
+            elif isinstance(v, np.ndarray):
+                d[f.name] = v.tolist()
+            else:
+                d[f.name] = v
+        return d
+
+    @classmethod
+    def from_table(cls, d: dict, where: str, rng) -> "Law":
+        return cls(*(num(d[k], where, k) for k in cls.keys), range=rng)
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.to_dict() == other.to_dict()
+
+    def __repr__(self):
+        args = ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "law")
+        return f"{type(self).__name__}({args})"
+
+
+def _check_range(rng, where):
+    if rng is None:
+        return None
+    r = num_array(rng, where, "range", 2)
+    if len(r) != 2 or not r[0] < r[1]:
+        raise InputError(f"{where}: 'range' must be [low, high] with low < high, got {list(rng)!r}")
+    return (float(r[0]), float(r[1]))
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Const(Law):
+    value: float
+    range: tuple | None = None
+    kind = "const"
+    keys = ("value",)
+
+    def core_fields(self):
+        return {"a": self.value}
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Linear(Law):
+    """a T + b"""
+
+    a: float
+    b: float
+    range: tuple | None = None
+    kind = "linear"
+    keys = ("a", "b")
+
+    def core_fields(self):
+        return {"a": self.a, "b": self.b}
+
+    def coefficient_unit(self, name, unit):
+        return f"{unit}/C" if name == "a" else unit
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Exp(Law):
+    """a exp(b T)"""
+
+    a: float
+    b: float
+    range: tuple | None = None
+    kind = "exp"
+    keys = ("a", "b")
+
+    def core_fields(self):
+        return {"a": self.a, "b": self.b}
+
+    def coefficient_unit(self, name, unit):
+        return "1/C" if name == "b" else unit
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Poly(Law):
+    """sum c[i] T^i"""
+
+    c: np.ndarray
+    range: tuple | None = None
+    kind = "poly"
+    keys = ("c",)
+
+    def __post_init__(self):
+        object.__setattr__(self, "c", np.ascontiguousarray(self.c, dtype=float))
+
+    def core_fields(self):
+        return {"y": self.c}
+
+    def coefficient_names(self):
+        return [f"c[{i}]" for i in range(len(self.c))]
+
+    def coefficients(self):
+        return list(self.c)
+
+    def with_coefficients(self, coefficients):
+        return dataclasses.replace(self, c=np.array([float(c) for c in coefficients]))
+
+    def coefficient_unit(self, name, unit):
+        return unit if name == "c[0]" else f"{unit}/C^{name[2:-1]}"
+
+    @classmethod
+    def from_table(cls, d, where, rng):
+        return cls(num_array(d["c"], where, "c"), range=rng)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PWL(Law):
+    """Linear through (T[i], values[i]); extrapolated linearly with the end segments."""
+
+    T: np.ndarray
+    values: np.ndarray
+    range: tuple | None = None
+    kind = "pwl"
+    keys = ("T", "values")
+
+    def __post_init__(self):
+        object.__setattr__(self, "T", np.ascontiguousarray(self.T, dtype=float))
+        object.__setattr__(self, "values", np.ascontiguousarray(self.values, dtype=float))
+
+    def core_fields(self):
+        return {"x": self.T, "y": self.values}
+
+    def coefficient_names(self):
+        return [f"values[{i}]" for i in range(len(self.values))]
+
+    def coefficients(self):
+        return list(self.values)
+
+    def with_coefficients(self, coefficients):
+        return dataclasses.replace(self, values=np.array([float(c) for c in coefficients]))
+
+    @classmethod
+    def from_table(cls, d, where, rng):
+        T = num_array(d["T"], where, "T")
+        values = num_array(d["values"], where, "values")
+        if len(T) != len(values):
+            raise InputError(f"{where}: 'T' and 'values' must have the same length ({len(T)} != {len(values)})")
+        if np.any(np.diff(T) <= 0):
+            raise InputError(f"{where}: 'T' must increase strictly")
+        return cls(T, values, range=rng)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Table(PWL):
+    """Monotone cubic (PCHIP) through (T[i], values[i]); extrapolated linearly with the end slopes."""
+
+    kind = "table"
+
+    def coefficient_names(self):
+        return []  # the PCHIP slopes depend on the values nonlinearly: no sensitivities
+
+
+LAWS = {cls.kind: cls for cls in (Const, Linear, Exp, Poly, PWL, Table)}
+
+
+def law_from_dict(d, where: str) -> Law:
+    """A law from its inline table, e.g. ``{ law = "exp", a = 1.15e8, b = -0.136 }``."""
+    if not isinstance(d, dict):
+        raise InputError(f"{where}: a law must be a table such as {{ law = \"linear\", a = ..., b = ... }}")
+    kind = d.get("law")
+    if not isinstance(kind, str) or kind not in LAWS:
+        raise InputError(f"{where}: 'law' must be one of {', '.join(LAWS)}, got {kind!r}")
+    cls = LAWS[kind]
+    unknown = set(d) - set(cls.keys) - {"law", "range"}
+    if unknown:
+        raise InputError(f"{where}: {unknown_keys(unknown, [*cls.keys, 'range'], f'law {kind!r}')}")
+    missing = [k for k in cls.keys if k not in d]
+    if missing:
+        raise InputError(f"{where}: law '{kind}' needs {', '.join(missing)}")
+    return cls.from_table(d, where, _check_range(d.get("range"), where))
+
+
+__all__ = ["Law", "Const", "Linear", "Exp", "Poly", "PWL", "Table", "LAWS", "law_from_dict"]

@@ -1,0 +1,236 @@
+"""The model: one actuator (plant, friction model, thermal extension, input, self-heating), and
+its model file (TOML, docs/formats.md#model-files). ``load_model`` also takes the name of a
+shipped preset."""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from dataclasses import dataclass, fields, replace
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from .._io import atomic_write
+from ..errors import InputError, unknown_keys
+from ..waveforms import Waveform, waveform_from_dict
+from .friction import (FRICTION_MODELS, GMS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre, Stribeck,
+                       check_friction_values)
+from .laws import Law, law_from_dict
+from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
+from .thermal import Heat, ModelI, ModelII
+
+
+@dataclass(frozen=True)
+class Model:
+    """One actuator: plant, friction model, thermal extension (or None), input (or None) and
+    lumped thermal model of self-heating (or None)."""
+
+    plant: StickSlipPlant | MassPlant | PrescribedMotion
+    friction: LuGre | Coulomb | Stribeck | Dahl | ElastoPlastic | GMS
+    thermal: ModelI | ModelII | None = None
+    input: Waveform | None = None
+    name: str | None = None
+    description: str | None = None
+    heat: Heat | None = None
+
+    def __post_init__(self):
+        laws = self.thermal.laws if isinstance(self.thermal, ModelI) else {}
+        given = self.friction.values()
+        for pname, law in laws.items():
+            if pname not in PARAMETERS or pname not in [f.name for f in fields(self.friction)]:
+                raise InputError(f"[thermal]: '{pname}' is not a parameter of {self.friction.model}")
+            if pname in given:
+                raise InputError(f"'{pname}' is given both as a number in [friction] and as a law in "
+                                 f"[thermal]; give it once")
+            if not isinstance(law, Law):
+                raise InputError(f"[thermal]: '{pname}' must be a law")
+        for pname in self.friction.required:
+            if pname not in given and pname not in laws:
+                raise InputError(f"[friction]: missing '{pname}' (a number here, or a law in [thermal])")
+        check_friction_values(self._number_values(), "[friction]")
+        if isinstance(self.thermal, ModelII):
+            if not isinstance(self.thermal.dF, Law):
+                raise InputError("[thermal]: 'dF' must be a law")
+        if self.heat is not None and not isinstance(self.heat, Heat):
+            raise InputError("'heat' must be a Heat model (the [heat] section)")
+
+    def _number_values(self):
+        v = self.friction.values()
+        if "fs" not in v and "fc" in v:
+            v["fs"] = v["fc"]
+        return v
+
+    # -- parameters at a temperature ------------------------------------------------------
+    @property
+    def laws(self) -> dict:
+        return dict(self.thermal.laws) if isinstance(self.thermal, ModelI) else {}
+
+    def parameters_at(self, T: float) -> dict:
+        """Every friction parameter's value at temperature T (Model I laws applied)."""
+        v = self.friction.values()
+        for pname, law in self.laws.items():
+            v[pname] = law(float(T))
+        if "fs" not in v:
+            v["fs"] = v["fc"]
+        return v
+
+    def reference_force(self) -> float:
+        """F_ref of Model II's scale form: the base model's steady sliding friction level."""
+        return float(self.friction.fc)
+
+    def thermal_factor(self, T):
+        """lambda(T) = 1 + dF(T)/F_ref of Model II's scale form (1 for other models)."""
+        if not isinstance(self.thermal, ModelII) or self.thermal.form != "scale":
+            return np.ones_like(np.asarray(T, float)) if np.ndim(T) else 1.0
+        return 1.0 + self.thermal.dF(T) / self.reference_force()
+
+    @property
+    def depends_on_temperature(self) -> bool:
+        return self.thermal is not None
+
+    def temperature_range(self):
+        """The intersection of the calibrated ranges of the model's laws (None if none)."""
+        laws = list(self.laws.values())
+        if isinstance(self.thermal, ModelII):
+            laws.append(self.thermal.dF)
+        ranges = [law.range for law in laws if law.range is not None]
+        if not ranges:
+            return None
+        return (max(r[0] for r in ranges), min(r[1] for r in ranges))
+
+    # -- files ---------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {}
+        if self.name:
+            d["name"] = self.name
+        if self.description:
+            d["description"] = self.description
+        d["plant"] = self.plant.to_dict()
+        d["friction"] = self.friction.to_dict()
+        d["thermal"] = self.thermal.to_dict() if self.thermal else {"model": "none"}
+        if self.heat is not None:
+            d["heat"] = self.heat.to_dict()
+        if self.input is not None:
+            d["input"] = self.input.to_dict()
+        return d
+
+    def to_toml(self) -> str:
+        return tomli_w.dumps(self.to_dict())
+
+    def save(self, path):
+        """Writes the model file atomically (temporary file, then rename)."""
+        text = self.to_toml()
+        with atomic_write(path, "w") as fh:
+            fh.write(text)
+
+    def with_friction(self, **values) -> "Model":
+        return replace(self, friction=self.friction.with_values(**values))
+
+
+_TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "heat", "input"}
+
+
+def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
+    """Builds a model from a parsed model file; errors name the file and the key."""
+    try:
+        unknown = set(d) - _TOP_KEYS
+        if unknown:
+            raise InputError(unknown_keys(unknown, sorted(_TOP_KEYS), "a model file"))
+        for sec in ("plant", "friction"):
+            if not isinstance(d.get(sec), dict):
+                raise InputError(f"missing section [{sec}]")
+        plant = plant_from_dict(d["plant"])
+        fmodel = d["friction"].get("model")
+        if not isinstance(fmodel, str) or fmodel not in FRICTION_MODELS:
+            raise InputError(f"[friction]: 'model' must be one of {', '.join(FRICTION_MODELS)}, got {fmodel!r}")
+        th = d.get("thermal", {"model": "none"})
+        if not isinstance(th, dict):
+            raise InputError("[thermal] must be a section")
+        th = dict(th)
+        tkind = th.pop("model", "none")
+        if tkind == "I":
+            laws = {}
+            for k, v in th.items():
+                if k in d["friction"]:
+                    raise InputError(f"'{k}' is given both as a number in [friction] and as a law in "
+                                     f"[thermal]; give it once")
+                if k not in PARAMETERS:
+                    raise InputError(f"[thermal]: {unknown_keys([k], ['model', *PARAMETERS], 'Model I')}")
+                laws[k] = law_from_dict(v, f"[thermal] {k}")
+            thermal = ModelI(laws)
+        elif tkind == "II":
+            unknown = set(th) - {"dF", "form"}
+            if unknown:
+                raise InputError(f"[thermal]: {unknown_keys(unknown, ['model', 'dF', 'form'], 'Model II')}")
+            if "dF" not in th:
+                raise InputError("[thermal]: Model II needs 'dF', a law of temperature")
+            thermal = ModelII(law_from_dict(th["dF"], "[thermal] dF"), th.get("form", "scale"))
+        elif tkind == "none":
+            if th:
+                raise InputError(f"[thermal]: {unknown_keys(th, ['model'], 'model none')}")
+            thermal = None
+        else:
+            raise InputError(f"[thermal]: 'model' must be \"none\", \"I\" or \"II\", got {tkind!r}")
+        friction = FRICTION_MODELS[fmodel].from_dict(d["friction"])
+        if isinstance(thermal, ModelI):  # a law replaces the parameter's default (e.g. sigma2 = 0)
+            names = [f.name for f in fields(friction)]
+            friction = replace(friction, **{k: None for k in thermal.laws if k in names})
+        inp = waveform_from_dict(d["input"], "[input]", base_dir) if "input" in d else None
+        heat = Heat.from_dict(d["heat"], "[heat]", base_dir) if "heat" in d else None
+        for key in ("name", "description"):
+            if key in d and not isinstance(d[key], str):
+                raise InputError(f"'{key}' must be a string")
+        return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"), heat)
+    except InputError as e:
+        raise InputError(f"{source}: {e}") from None
+
+
+def require_actuator(model: Model, task: str):
+    """Datasets (docs/formats.md#datasets) record a stick-slip actuator: voltage in, end-effector displacement out."""
+    if not isinstance(model.plant, StickSlipPlant):
+        raise InputError(f"{task} works on the stick-slip actuator (datasets record its voltage and displacement); "
+                         f"this model's plant is '{model.plant.type}'")
+
+
+PRESETS = ("li2009-model-i", "li2009-model-ii", "li2009-base", "li2009-self-heating", "canudas1995", "stage-model-i")
+
+
+def preset_path(name: str):
+    return resources.files("thermofriction").joinpath("presets", f"{name}.toml")
+
+
+def load_model(source) -> Model:
+    """Loads a model file, or a shipped preset by name (see ``PRESETS``)."""
+    source = os.fspath(source)
+    p = Path(source)
+    try:
+        exists = p.exists()
+    except (OSError, ValueError) as e:  # a name too long for the file system, a NUL byte
+        raise InputError(f"{source[:200]!r}: not a usable file name ({getattr(e, 'strerror', None) or e})") from None
+    if not exists and source in PRESETS:
+        ref = preset_path(source)
+        text = ref.read_text()
+        base_dir = None
+    else:
+        if not exists:
+            hint = f" (presets: {', '.join(PRESETS)})" if os.sep not in source and not source.endswith(".toml") else ""
+            raise InputError(f"{source}: no such file{hint}")
+        try:
+            text = p.read_text()
+        except (OSError, UnicodeDecodeError) as e:
+            raise InputError(f"{source}: cannot read ({e})") from None
+        base_dir = p.parent
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{source}: TOML syntax error: {e}") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
+        raise InputError(f"{source}: TOML nested too deeply") from None
+    return model_from_dict(data, source, base_dir)
+
+
+
+__all__ = ["Model", "model_from_dict", "require_actuator", "PRESETS", "preset_path", "load_model"]

@@ -1,0 +1,160 @@
+"""Plants (docs/models.md#plants): what the friction acts in. The stick-slip actuator, a single
+mass, and prescribed motion."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import InputError, unknown_keys
+from ._parse import by_symbol, num
+
+
+@dataclass(frozen=True)
+class StickSlipPlant:
+    """Piezoelectric stick-slip actuator (docs/models.md#stick-slip-actuator): a stage (equivalent ``mass``, ``damping``,
+    ``stiffness``, driven through ``transducer_ratio`` T_em by the voltage) carrying, by friction,
+    an end effector of ``end_effector_mass``.
+
+    Give either the modal form (``damping_ratio`` xi, ``natural_frequency`` wn [rad/s], ``gain``
+    K [m/V]) or the physical one (``damping`` c, ``stiffness`` k, ``transducer_ratio`` T_em);
+    the other is derived (k = m wn^2, c = 2 xi wn m, T_em = K k). The form given is the form saved.
+    """
+
+    mass: float
+    end_effector_mass: float
+    damping_ratio: float | None = None
+    natural_frequency: float | None = None
+    gain: float | None = None
+    damping: float | None = None
+    stiffness: float | None = None
+    transducer_ratio: float | None = None
+
+    type = "stick-slip"
+    _MODAL = ("damping_ratio", "natural_frequency", "gain")
+    _PHYSICAL = ("damping", "stiffness", "transducer_ratio")
+    _SYMBOLS = {"mass": "m", "end_effector_mass": "m_e", "damping_ratio": "xi", "natural_frequency": "wn",
+                "gain": "K", "damping": "c", "stiffness": "k", "transducer_ratio": "T_em"}
+
+    def __post_init__(self):
+        where = "[plant]"
+        modal = [getattr(self, n) is not None for n in self._MODAL]
+        phys = [getattr(self, n) is not None for n in self._PHYSICAL]
+        if all(modal) == all(phys) or (any(modal) and any(phys)):
+            raise InputError(f"{where}: give either xi, wn and K (modal form) or c, k and T_em (physical form)")
+        for name in ("mass", "end_effector_mass", *(self._MODAL if all(modal) else self._PHYSICAL)):
+            sym = self._SYMBOLS[name]
+            v = num(getattr(self, name), where, sym)
+            if name in ("mass", "end_effector_mass", "natural_frequency", "stiffness") and v <= 0:
+                raise InputError(f"{where}: '{sym}' must be positive, got {v!r}")
+            if name in ("damping_ratio", "damping") and v < 0:
+                raise InputError(f"{where}: '{sym}' must not be negative, got {v!r}")
+            object.__setattr__(self, name, v)
+
+    @property
+    def modal(self) -> bool:
+        return self.damping_ratio is not None
+
+    def physical(self):
+        """(c, k, T_em) in SI units."""
+        if self.modal:
+            k = self.mass * self.natural_frequency ** 2
+            return 2 * self.damping_ratio * self.natural_frequency * self.mass, k, self.gain * k
+        return self.damping, self.stiffness, self.transducer_ratio
+
+    def modal_parameters(self):
+        """(xi, wn, K)."""
+        if self.modal:
+            return self.damping_ratio, self.natural_frequency, self.gain
+        c, k, T_em = self.physical()
+        wn = math.sqrt(k / self.mass)
+        return c / (2 * wn * self.mass), wn, T_em / k
+
+    def to_dict(self) -> dict:
+        d = {"type": self.type}
+        for name in ("mass", "end_effector_mass", *(self._MODAL if self.modal else self._PHYSICAL)):
+            d[self._SYMBOLS[name]] = getattr(self, name)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[plant]"):
+        d = dict(d)
+        d.pop("type", None)
+        return cls(**by_symbol(cls, d, where, ("m", "m_e"), extra=("type",)))
+
+
+@dataclass(frozen=True)
+class MassPlant:
+    """Single-mass stage (docs/models.md#mass-plant): ``m x'' = f(t) + k_s (v_0 t - x) - F``, v_r = x'.
+
+    f(t) is the input waveform, a force [N] (none: zero). With ``spring_stiffness`` k_s [N/m] and
+    ``pull_velocity`` v_0 [m/s] a spring pulled at constant speed drives the mass (the stick-slip
+    benchmark of Canudas de Wit et al. 1995); both forces add when both are given."""
+
+    mass: float
+    spring_stiffness: float = 0.0
+    pull_velocity: float = 0.0
+
+    type = "mass"
+    _SYMBOLS = {"mass": "m", "spring_stiffness": "k_s", "pull_velocity": "v_0"}
+
+    def __post_init__(self):
+        for name, sym in self._SYMBOLS.items():
+            v = num(getattr(self, name), "[plant]", sym)
+            if name == "mass" and v <= 0:
+                raise InputError(f"[plant]: 'm' must be positive, got {v!r}")
+            if name == "spring_stiffness" and v < 0:
+                raise InputError(f"[plant]: 'k_s' must not be negative, got {v!r}")
+            object.__setattr__(self, name, v)
+        if self.pull_velocity != 0 and self.spring_stiffness == 0:
+            raise InputError("[plant]: 'v_0' pulls through a spring: give 'k_s' too")
+
+    def to_dict(self) -> dict:
+        d = {"type": self.type, "m": self.mass}
+        if self.spring_stiffness:
+            d.update(k_s=self.spring_stiffness, v_0=self.pull_velocity)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[plant]"):
+        d = dict(d)
+        d.pop("type", None)
+        names = {sym: name for name, sym in cls._SYMBOLS.items()}
+        unknown = set(d) - set(names)
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, ['type', *names], 'a mass plant')}")
+        if "m" not in d:
+            raise InputError(f"{where}: missing 'm'")
+        return cls(**{names[k]: v for k, v in d.items()})
+
+
+@dataclass(frozen=True)
+class PrescribedMotion:
+    """Prescribed motion (docs/models.md#prescribed-motion): the relative displacement x_r(t) is the input waveform [m]
+    and v_r its slope; the friction model is driven by it (hysteresis loops, Stribeck curves,
+    break-away tests). The waveform must be continuous (a step needs a slew time)."""
+
+    type = "prescribed"
+
+    def to_dict(self) -> dict:
+        return {"type": self.type}
+
+    @classmethod
+    def from_dict(cls, d: dict, where="[plant]"):
+        unknown = set(d) - {"type"}
+        if unknown:
+            raise InputError(f"{where}: {unknown_keys(unknown, ['type'], 'prescribed motion')}")
+        return cls()
+
+
+PLANTS = {"stick-slip": StickSlipPlant, "mass": MassPlant, "prescribed": PrescribedMotion}
+
+
+def plant_from_dict(d: dict, where="[plant]"):
+    kind = d.get("type")
+    if not isinstance(kind, str) or kind not in PLANTS:
+        raise InputError(f"{where}: 'type' must be one of {', '.join(repr(k) for k in PLANTS)}, got {kind!r}")
+    return PLANTS[kind].from_dict(d, where)
+
+
+__all__ = ["StickSlipPlant", "MassPlant", "PrescribedMotion", "PLANTS", "plant_from_dict"]

@@ -1,0 +1,229 @@
+"""Simulation: ``simulate(model, duration, temperature=..., input=...)`` on the C core.
+
+Solvers are objects you pass in (``Dopri5()``, ``Rodas4()``, ``AutoSwitch()``), separate from the
+step-size controller (``StepSizeController(rtol=..., atol=...)``). Results come on a uniform
+output grid from the solver's dense output, with per-cycle step sizes for periodic inputs.
+
+``simulate`` is four steps: the output grid (with the period starts joined to it), the run on the
+core, the explanation of a failed run, and the packing of the outputs into a result.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import _bridge
+from ..drive import input_of
+from ..errors import InputError, SolverError
+from ..models import Model, PrescribedMotion, StickSlipPlant
+from ..waveforms import Sampled, Waveform
+from .checks import (as_temperature, check_heated_temperatures, check_passivity, check_prescribed_motion,
+                     check_temperatures)
+from .result import SimulationResult
+from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
+
+#: Default limit on output samples: each takes ~8 x (8 + internal states) bytes of outputs and about
+#: twice that at the peak (README "Speed": 184 MB for 1,000,001 samples), so 10 million need ~2 GB.
+MAX_SAMPLES = 10_000_000
+
+
+def _check_samples(n, max_samples, what):
+    if max_samples is not None and n > max_samples:
+        raise InputError(f"{n} output samples requested ({what}), above the limit of {max_samples} "
+                         f"(~{n * 184 / 1e9:.3g} GB of memory): lower the duration or the sample rate, or raise "
+                         f"the limit (--max-samples N; max_samples=N in Python, None for no limit)")
+
+
+def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
+    if not (duration > 0 and math.isfinite(duration)):
+        raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
+    if not (sample_rate > 0 and math.isfinite(sample_rate)):
+        raise InputError(f"sample rate must be positive, got {sample_rate!r}")
+    x = duration * sample_rate * (1 + 1e-12)
+    if not math.isfinite(x) or x >= 2.0 ** 62:
+        raise InputError(f"duration {duration:g} s x sample rate {sample_rate:g} Hz is too many output samples: lower the duration or the sample rate")
+    n = int(math.floor(x)) + 1
+    _check_samples(n, max_samples, f"duration {duration:g} s x sample rate {sample_rate:g} Hz + 1")
+    t = np.arange(n) / sample_rate
+    return t
+
+
+def output_grid(duration, sample_rate, t_eval, max_samples) -> np.ndarray:
+    """The requested output times: ``t_eval``, or a uniform grid from 0 to ``duration``."""
+    if t_eval is not None:
+        t_grid = np.ascontiguousarray(t_eval, dtype=float)
+        if t_grid.ndim != 1 or t_grid.size < 1 or np.any(np.diff(t_grid) < 0) or not np.all(np.isfinite(t_grid)):
+            raise InputError("t_eval must be a non-empty, non-decreasing array of finite times")
+        _check_samples(t_grid.size, max_samples, "t_eval")
+        return t_grid
+    if duration is None:
+        raise InputError("give a duration (seconds) or t_eval")
+    return _grid(float(duration), float(sample_rate), max_samples)
+
+
+class _Grid:
+    """The output grid with the input's period starts joined to it, so that per-cycle step sizes
+    are exact, not interpolated; ``unjoin`` removes the joined rows again."""
+
+    def __init__(self, t_grid: np.ndarray, period: float | None):
+        self.requested = t_grid
+        t0, t1 = float(t_grid[0]), float(t_grid[-1])
+        self.cycle_times = np.empty(0)
+        if period is not None:
+            k0 = math.ceil(t0 / period - 1e-9)
+            self.cycle_times = np.arange(k0, math.floor(t1 / period + 1e-9) + 1) * period
+        # cycle starts usually fall on the grid already; only the others are inserted (O(n), no sort)
+        self.tol = 1e-12 * max(1.0, abs(t1))
+        on_grid_at = np.minimum(np.searchsorted(t_grid, self.cycle_times - self.tol), t_grid.size - 1)
+        hit = np.abs(t_grid[on_grid_at] - self.cycle_times) <= self.tol
+        self.extra = self.cycle_times[~hit]
+        self.times = (np.insert(t_grid, np.searchsorted(t_grid, self.extra), self.extra) if self.extra.size
+                      else t_grid)
+
+    def at_cycles(self, column: np.ndarray) -> np.ndarray:
+        return column[np.searchsorted(self.times, self.cycle_times - self.tol)] if self.cycle_times.size else np.empty(0)
+
+    def unjoin(self, out: np.ndarray) -> np.ndarray:
+        if not self.extra.size:
+            return out
+        inserted = np.searchsorted(self.requested, self.extra) + np.arange(self.extra.size)
+        return np.delete(out, inserted, axis=0)
+
+
+def _explain(e: _bridge.CoreFailure, model: Model, solver, controller, waveform, state_names) -> SolverError:
+    """A failed run as one message: where, in which state, and what to try."""
+    where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(state_names, e.state))
+    try:
+        u = float(waveform(e.time)[0])
+        where += f"; input {u:.6g}"
+    except Exception:  # noqa: BLE001 - the input value is a courtesy, never a second error
+        pass
+    stiff_hint = ("the problem looks stiff: use the stiff solver, Rodas4() or AutoSwitch() "
+                  "(--method rodas4 or --method auto)")
+    explicit = isinstance(solver, Dopri5)
+    if e.status == "max_steps":
+        hint = (f"{stiff_hint}; or " if e.stiff else
+                "the run is long for its time scales: " if not explicit else
+                "the run is long for its time scales or stiff (try --method rodas4 or auto): ")
+        hint += f"raise max_steps (--max-steps, now {controller.max_steps}) or shorten the duration"
+    elif e.status == "nonfinite":
+        hint = ("likely cause: extreme parameter or input values (an overflow) or a model that is "
+                "unstable with these parameters; check them")
+    elif e.status == "step_underflow":
+        hint = ("likely cause: extreme parameter or input values, or a solution that blows up or "
+                "jumps faster than the time resolution; check them")
+        if e.stiff and explicit:
+            hint = f"{stiff_hint}; or {hint}"
+    elif e.status == "no_memory":
+        hint = "out of memory: lower the duration or the sample rate"
+    else:
+        hint = "this is a bug if the inputs were checked; please report it"
+    return SolverError(f"integration failed at t = {e.time:.9g} s (step {e.step:.3g} s, {solver.name}): "
+                       f"{e.core_message}; state {where}; {hint}", time=e.time, state=e.state)
+
+
+def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
+             sample_rate: float = 10_000.0, t_eval=None, solver=None,
+             controller: StepSizeController | None = None, max_samples: int | None = MAX_SAMPLES,
+             friction_work: bool = False) -> SimulationResult:
+    """Simulates ``model`` from rest.
+
+    temperature: constant [degC], a ``Sampled`` signal, or (times, values); required for
+        thermal models. With a heat model (``model.heat``) the temperature is a state: a number
+        given here is the ambient temperature T_amb (overriding the model's).
+    input: a waveform overriding the model's ``[input]``.
+    duration, sample_rate: a uniform output grid from 0 to duration; or t_eval, any
+        non-decreasing grid starting at the initial time.
+    solver: ``AutoSwitch()`` (default), ``Dopri5()`` or ``Rodas4()``.
+    controller: ``StepSizeController`` (tolerances, step limits).
+    max_samples: the most output samples allowed (default 10 million, ~2 GB); None for no limit.
+    friction_work: also integrate the friction work W = integral |F v_r| dt (always done with a
+        heat model), returned as ``friction_work``.
+    """
+    solver = solver or AutoSwitch()
+    if isinstance(solver, str):
+        if solver not in SOLVERS:
+            raise InputError(f"unknown solver '{solver}' (one of: {', '.join(SOLVERS)})")
+        solver = SOLVERS[solver]()
+    controller = controller or StepSizeController()
+    temperature = as_temperature(temperature)
+    heat = None
+    if model.heat is not None:
+        if isinstance(temperature, Sampled):
+            raise InputError("the model has a [heat] section, so its temperature is a state: give the ambient "
+                             "temperature as a number (--temperature C), not a temperature signal")
+        heat = model.heat.resolved(temperature)
+        T_start = sorted({heat.initial_temperature, heat.ambient_temperature})
+        check_temperatures(model, T_start[0] if len(T_start) == 1 else Sampled(np.array([0.0, 1.0]),
+                                                                                np.array(T_start)))
+    else:
+        check_temperatures(model, temperature)
+    friction_work = bool(friction_work) or heat is not None
+    waveform = input_of(model, input)
+    grid = _Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period)
+    if isinstance(model.plant, PrescribedMotion):
+        check_prescribed_motion(waveform)
+
+    # run
+    state_names = (_bridge.MECHANICAL_STATES[model.plant.type] + tuple(model.friction.state_names)
+                   + ("T",) * (heat is not None) + ("W",) * friction_work)
+    atol = controller.atol
+    if atol is not None:
+        atol = np.broadcast_to(np.asarray(atol, float), (len(state_names),)).copy()
+        if np.any(atol <= 0):
+            raise InputError("atol must be positive")
+    out = np.empty((grid.times.size, _bridge.n_outputs(model, friction_work)))
+    try:
+        stats = _bridge.run(_bridge.model_spec(model, temperature, waveform, friction_work), grid.times, out,
+                            method=solver.name, rtol=controller.rtol, atol=atol,
+                            first_step=controller.first_step or 0.0, max_step=controller.max_step or 0.0,
+                            max_steps=controller.max_steps)
+    except _bridge.CoreFailure as e:
+        raise _explain(e, model, solver, controller, waveform, state_names) from None
+    stats["solver"] = stats.pop("method")
+    return _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period)
+
+
+def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> SimulationResult:
+    """The output array as a result: refuses non-finite outputs, reads the step sizes at the period
+    starts, removes the joined rows, names the columns."""
+    # the C core keeps the states finite; an output computed from finite but extreme values
+    # (e.g. a 1e165 m amplitude) may still overflow: refuse it rather than return it
+    outputs = _bridge.OUTPUTS
+    finite = np.isfinite(out)
+    finite[:, _bridge.OUTPUT_COLUMN["temperature"]] = True  # NaN by design without a thermal part
+    if not finite.all():
+        row, col = np.argwhere(~finite)[0]
+        raise SolverError(f"the output '{(outputs + tuple(model.friction.state_names) + ('friction_work',))[col]}' "
+                          f"is not finite at "
+                          f"t = {grid.times[row]:.9g} s ({out[row, col]}): likely cause: extreme parameter or input "
+                          f"values (an overflow); check them", time=float(grid.times[row]))
+    steps = np.diff(grid.at_cycles(out[:, _bridge.OUTPUT_COLUMN["displacement"]]))
+    out = grid.unjoin(out)
+    cols = {name: np.ascontiguousarray(out[:, i]) for i, name in enumerate(outputs)}
+    if not isinstance(model.plant, StickSlipPlant):  # no stage: the driving surface is fixed (or the motion given)
+        cols["stage_displacement"] = cols["stage_velocity"] = None
+    if temperature is None and heat is None:
+        cols["temperature"][:] = math.nan
+    if heat is not None and model.thermal is not None:
+        check_heated_temperatures(model, cols["time"], cols["temperature"])
+    nfric = model.friction.nstate
+    return SimulationResult(
+        **cols,
+        friction_work=np.ascontiguousarray(out[:, len(outputs) + nfric]) if friction_work else None,
+        states=np.ascontiguousarray(out[:, len(outputs):len(outputs) + nfric]),
+        state_names=model.friction.state_names,
+        state_units=model.friction.state_units,
+        cycle_times=grid.cycle_times,
+        step_sizes=steps,
+        mean_velocity=float(steps.mean() / period) if steps.size else math.nan,
+        input_unit={"stick-slip": "V", "mass": "N", "prescribed": "m"}[model.plant.type],
+        stats=stats,
+    )
+
+
+__all__ = ["simulate", "SimulationResult", "Dopri5", "Rodas4", "AutoSwitch", "StepSizeController", "SOLVERS",
+           "MAX_SAMPLES", "as_temperature", "check_temperatures", "check_passivity", "check_prescribed_motion",
+           "check_heated_temperatures", "output_grid"]

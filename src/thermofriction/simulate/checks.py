@@ -1,0 +1,127 @@
+"""Checks before (and, with self-heating, after) a run: the temperature against the laws'
+ranges and the model's physical domain, dissipativity, and prescribed motion's continuity.
+Warnings for what may be wrong, InputError for what is."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ..errors import ConditioningWarning, InputError, PassivityWarning, SolverError, TemperatureRangeWarning
+from ..models import Model, ModelI, ModelII, check_friction_values, dissipativity_violation
+from ..waveforms import Sampled, Sawtooth, Step, Waveform, Zero
+
+
+def as_temperature(temperature):
+    """A number, a ``Sampled`` signal, or a (times, values) pair -> number or Sampled."""
+    if temperature is None or isinstance(temperature, Sampled):
+        return temperature
+    if isinstance(temperature, (tuple, list)) and len(temperature) == 2:
+        return Sampled(np.asarray(temperature[0], float), np.asarray(temperature[1], float))
+    try:
+        T = float(temperature)
+    except (TypeError, ValueError):
+        raise InputError(f"temperature must be a number [degC] or (times, values), got {temperature!r}") from None
+    if not math.isfinite(T):
+        raise InputError(f"temperature must be finite, got {temperature!r}")
+    return T
+
+
+def check_prescribed_motion(waveform: Waveform):
+    """Prescribed motion needs a continuous displacement: its slope is the sliding velocity."""
+    if isinstance(waveform, Zero):
+        raise InputError("prescribed motion needs an input waveform, the displacement x_r(t) in metres "
+                         "(e.g. --input sine:amplitude=1e-6,frequency=1)")
+    if isinstance(waveform, Step) and waveform.slew <= 0:
+        raise InputError("prescribed motion: an ideal step has no finite velocity; give the step a slew time")
+    if isinstance(waveform, Sawtooth) and waveform.rise in (0.0, 1.0):
+        raise InputError("prescribed motion: a sawtooth with rise 0 or 1 jumps; use 0 < rise < 1")
+
+
+def check_passivity(model: Model, temperatures=(math.nan,)):
+    """Warns (PassivityWarning) when a LuGre-type model can create energy at these temperatures."""
+    for T in temperatures:
+        found = dissipativity_violation(model.friction.model, model.parameters_at(T))
+        if found:
+            where = f" at {T:g} C" if isinstance(model.thermal, ModelI) else ""
+            warnings.warn(f"{model.friction.model}{where}: {found[1]}", PassivityWarning, stacklevel=4)
+            return
+
+
+def check_temperatures(model: Model, temperature):
+    """Warns for temperatures outside a law's calibrated range; raises where the model is
+    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
+    Warns where a LuGre-type model is not dissipative."""
+    if model.thermal is None:
+        check_passivity(model)
+        return
+    if temperature is None:
+        raise InputError("the model depends on temperature: give a temperature (e.g. --temperature 35)")
+    if isinstance(temperature, Sampled):
+        lo, hi = float(temperature.value.min()), float(temperature.value.max())
+        Ts = np.unique(np.concatenate([temperature.value, np.linspace(lo, hi, 201)]))
+    else:
+        Ts = np.array([float(temperature)])
+    laws = dict(model.laws)
+    if isinstance(model.thermal, ModelII):
+        laws["dF"] = model.thermal.dF
+    outside = [f"'{name}' ({law.range[0]:g}..{law.range[1]:g} C)" for name, law in laws.items()
+               if not law.in_range(Ts)]
+    if outside:
+        span = f"{Ts[0]:g} C" if len(Ts) == 1 else f"{Ts.min():g}..{Ts.max():g} C"
+        warnings.warn(f"temperature {span} is outside the calibrated range of the law(s) for "
+                      f"{', '.join(outside)}", TemperatureRangeWarning, stacklevel=3)
+    if isinstance(model.thermal, ModelI):
+        for T in (Ts.min(), Ts.max()) if len(Ts) > 1 else Ts:
+            check_friction_values(model.parameters_at(T), f"Model I at {T:g} C")
+        if len(Ts) > 2:
+            for name, law in model.laws.items():
+                vals = law(Ts)
+                if name in ("sigma0", "fc") and np.any(vals <= 0):
+                    T_bad = Ts[np.argmax(vals <= 0)]
+                    raise InputError(f"Model I: '{name}' is not positive at {T_bad:g} C ({law(T_bad):g})")
+    check_passivity(model, (Ts.min(), Ts.max()) if isinstance(model.thermal, ModelI) else (math.nan,))
+    if isinstance(model.thermal, ModelII) and model.thermal.form == "scale":
+        lam = np.atleast_1d(model.thermal_factor(Ts))
+        if np.any(lam <= 0):
+            i = int(np.argmin(lam))
+            raise InputError(f"Model II: lambda(T) = 1 + dF(T)/F_ref is {lam[i]:.4g} <= 0 at {Ts[i]:g} C "
+                             f"(dF = {model.thermal.dF(Ts[i]):.4g} N, F_ref = fc = {model.reference_force():.4g} N): "
+                             f"the thermal term would reverse friction")
+    if isinstance(model.thermal, ModelII) and model.thermal.form == "offset":
+        # dF(T) tanh(v / v_smooth) with dF < 0 is a negative damping dF/v_smooth near v = 0; stronger
+        # than the bristles' own damping it makes the sticking state repelling (found by the
+        # differential tests: the explicit solver needs rtol <= 1e-7 there, an L-stable one
+        # finds another solution).
+        dF = np.atleast_1d(model.thermal.dF(Ts))
+        i = int(np.argmin(dF))
+        p = model.parameters_at(Ts[i])
+        # the base model's own damping at v = 0: bristle and viscous damping (models without
+        # sigma1 have none), and for a static map the slope of its smoothed sign, fs / v_smooth
+        damping = p.get("sigma1", 0.0) + p.get("sigma2", 0.0)
+        what = "sigma1 + sigma2"
+        if model.friction.model in ("coulomb", "stribeck"):
+            damping += p["fs"] / p["v_smooth"]
+            what = "sigma2 + fs/v_smooth"
+        if dF[i] < 0 and -dF[i] / p["v_smooth"] > damping:
+            warnings.warn(f"Model II offset form: dF = {dF[i]:.4g} N at {Ts[i]:g} C is anti-damped near v = 0 "
+                          f"(dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against {what} = "
+                          f"{damping:.3g} N s/m); the solution is ill-conditioned: use Dopri5 with rtol <= 1e-8, "
+                          f"or the scale form", ConditioningWarning, stacklevel=3)
+
+
+def check_heated_temperatures(model: Model, time, temperature):
+    """With self-heating the temperature range is known only after the run: warn where it left a
+    law's calibrated range, refuse a run that crossed a temperature where the model is invalid."""
+    lo, hi = float(np.min(temperature)), float(np.max(temperature))
+    try:
+        check_temperatures(model, Sampled(np.array([0.0, 1.0]), np.array([lo, hi])) if hi > lo else lo)
+    except InputError as e:
+        raise SolverError(f"self-heating took the temperature to {lo:.4g}..{hi:.4g} C, where the model is "
+                          f"invalid: {e}") from None
+
+
+__all__ = ["as_temperature", "check_prescribed_motion", "check_passivity", "check_temperatures",
+           "check_heated_temperatures"]

@@ -1,0 +1,101 @@
+"""The result of a simulation: plain arrays with named fields."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._bridge import OUTPUTS
+from .._io import atomic_write
+
+
+@dataclass(eq=False)
+class SimulationResult:
+    """Plain arrays with named fields (SI units; temperature in degC).
+
+    ``displacement``/``velocity`` are the driven body's (the end effector's, the mass's, or the
+    prescribed motion); ``relative_displacement`` is x_e - x_p (the stage fields are None for
+    plants without a stage); ``states`` holds the friction model's internal
+    states (columns named by ``state_names``). For periodic inputs ``cycle_times`` are the
+    period starts, ``step_sizes[k]`` the displacement over cycle k, ``mean_velocity`` the mean
+    of the step sizes times the frequency. ``friction_work`` [J] is the friction force's work
+    integral of |F v_r| dt from the start (with a heat model, or ``friction_work=True``; else
+    None); with a heat model ``temperature`` is the interface temperature state."""
+
+    time: np.ndarray
+    input: np.ndarray
+    stage_displacement: np.ndarray | None
+    stage_velocity: np.ndarray | None
+    displacement: np.ndarray
+    velocity: np.ndarray
+    relative_displacement: np.ndarray
+    relative_velocity: np.ndarray
+    friction_force: np.ndarray
+    temperature: np.ndarray
+    states: np.ndarray
+    state_names: tuple
+    state_units: tuple
+    cycle_times: np.ndarray
+    step_sizes: np.ndarray
+    mean_velocity: float
+    input_unit: str = "V"
+    stats: dict = field(default_factory=dict)
+    friction_work: np.ndarray | None = None
+
+    def columns(self) -> dict:
+        """The CSV columns (docs/formats.md#simulation-output), header -> array."""
+        cols = {
+            "time[s]": self.time,
+            f"input[{self.input_unit}]": self.input,
+            "stage_displacement[m]": self.stage_displacement,  # stick-slip only
+            "displacement[m]": self.displacement,
+            "velocity[m/s]": self.velocity,
+            "friction_force[N]": self.friction_force,
+            "temperature[C]": self.temperature,
+        }
+        for j, (name, unit) in enumerate(zip(self.state_names, self.state_units)):
+            cols[f"{name}[{unit}]"] = self.states[:, j]
+        cols["friction_work[J]"] = self.friction_work
+        return {k: v for k, v in cols.items() if v is not None}
+
+    def to_dataframe(self):
+        """A pandas DataFrame of every output (pandas is an optional dependency)."""
+        try:
+            import pandas as pd
+        except ImportError:  # pragma: no cover - depends on the environment
+            raise ImportError("to_dataframe() needs pandas: pip install 'thermofriction[dataframe]'") from None
+        data = {name: getattr(self, name) for name in OUTPUTS if getattr(self, name) is not None}
+        for j, name in enumerate(self.state_names):
+            data[name] = self.states[:, j]
+        if self.friction_work is not None:
+            data["friction_work"] = self.friction_work
+        return pd.DataFrame(data)
+
+    def to_csv(self, path):
+        """Writes the simulation CSV (docs/formats.md#simulation-output) atomically."""
+        cols = self.columns()
+        table = np.column_stack(list(cols.values()))
+        with atomic_write(path, "w", newline="") as fh:
+            fh.write(",".join(cols) + "\n")
+            np.savetxt(fh, table, delimiter=",", fmt="%.12g")
+
+    def _repr_html_(self):
+        rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
+                ("final displacement", f"{self.displacement[-1] * 1e6:.6g} µm"),
+                ("peak friction force", f"{np.max(np.abs(self.friction_force)):.4g} N")]
+        if self.step_sizes.size:
+            rows += [("cycles", f"{self.step_sizes.size}"),
+                     ("mean step per cycle", f"{self.step_sizes.mean() * 1e6:.6g} µm"),
+                     ("mean velocity", f"{self.mean_velocity * 1e6:.6g} µm/s")]
+        rows.append(("solver", f"{self.stats.get('solver', '?')}: {self.stats.get('steps', '?')} steps"))
+        body = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{v}</td></tr>" for k, v in rows)
+        return f"<table><caption>SimulationResult</caption>{body}</table>"
+
+    def __repr__(self):
+        return (f"SimulationResult({len(self.time)} samples over {self.time[-1] - self.time[0]:.6g} s, "
+                f"final displacement {self.displacement[-1]:.6g} m, {len(self.step_sizes)} cycles)")
+
+
+
+__all__ = ["SimulationResult"]

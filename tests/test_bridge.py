@@ -1,0 +1,109 @@
+"""The contract between Python and the C core has one source: the headers. These tests walk both
+sides: every enum constant of the core's headers is exported by the binding and every exported name
+is in a header; the bridge is the only Python module that touches the compiled core."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import thermofriction as tf
+from thermofriction import _bridge, _core
+from thermofriction.simulate import SOLVERS
+
+ROOT = Path(__file__).resolve().parents[1]
+HEADERS = sorted((ROOT / "core" / "include").rglob("*.h"))
+PACKAGE = ROOT / "src" / "thermofriction"
+
+
+def header_enum_constants() -> dict:
+    """Every enumerator of every ``typedef enum { ... }`` in the public headers: name -> header."""
+    found = {}
+    for h in HEADERS:
+        text = re.sub(r"/\*.*?\*/", "", h.read_text(), flags=re.S)  # comments may mention names
+        for body in re.findall(r"enum\s*\w*\s*\{(.*?)\}", text, flags=re.S):
+            for item in body.split(","):
+                m = re.match(r"\s*(TF_[A-Z0-9_]+)", item)
+                if m:
+                    found[m.group(1)] = h.name
+    return found
+
+
+def test_headers_are_found():
+    """Guard for the walk itself: the parser sees the enums it must (a regex that matched nothing
+    would make the comparison below pass vacuously)."""
+    consts = header_enum_constants()
+    for name in ("TF_P_SIGMA0", "TF_PLANT_MASS", "TF_OUT_TEMPERATURE", "TF_ERR_MAX_STEPS", "TF_LAW_TABLE"):
+        assert name in consts
+    assert len(consts) > 50
+
+
+def test_every_header_constant_is_exported_and_nothing_else():
+    headers = set(header_enum_constants())
+    # the counts that close an enum are exported as limits, with the capacities defined by macro
+    exported = set(_core.C_NAMES)
+    missing = sorted(headers - exported)
+    extra = sorted(exported - headers - {"TF_MAX_FRICTION_STATES", "TF_MAX_STATES", "TF_MAX_TARGETS"})
+    assert not missing, f"header constants the binding does not export (add them to _core.c): {missing}"
+    assert not extra, f"exported names that are in no header: {extra}"
+
+
+def test_macro_limits_match_headers():
+    text = "\n".join(h.read_text() for h in HEADERS)
+    for name in ("TF_MAX_FRICTION_STATES", "TF_MAX_TARGETS"):
+        m = re.search(rf"#define\s+{name}\s+(\d+)", text)
+        assert m and int(m.group(1)) == _core.C_NAMES[name]
+
+
+def test_groups_are_dense_and_match_python_names():
+    """Every group's codes are 0..n-1, and the names Python uses elsewhere are the groups' names."""
+    for group, codes in _core.CONSTANTS.items():
+        if group == "limit":
+            continue
+        assert sorted(codes.values()) == list(range(len(codes))), group
+    assert set(_bridge.FRICTION_CODES) == set(tf.models.FRICTION_MODELS)
+    assert set(_bridge.PLANT_CODES) == set(tf.models.PLANTS)
+    assert set(_bridge.LAW_CODES) == set(tf.models.LAWS) | {"none"}
+    assert len(_bridge.PARAMETERS) == _core.CONSTANTS["limit"]["parameters"]
+    assert len(_bridge.OUTPUTS) == _core.CONSTANTS["limit"]["fixed_outputs"]
+    assert set(tf.models.PARAMETER_UNITS) == set(_bridge.PARAMETERS)
+    assert set(_bridge.METHOD_CODES) == set(SOLVERS)
+    for cls in tf.models.FRICTION_MODELS.values():  # every field of a friction model is a core parameter
+        names = {f for f in cls.__dataclass_fields__ if f not in cls.arrays}
+        assert names <= set(_bridge.PARAMETERS), (cls.model, names - set(_bridge.PARAMETERS))
+
+
+def test_only_the_bridge_imports_the_core():
+    offenders = []
+    for py in PACKAGE.rglob("*.py"):
+        if py.name == "_bridge.py":
+            continue
+        if re.search(r"^\s*from\s+\.+\s+import\s+.*\b_core\b|^\s*import\s+.*\b_core\b|\b_core\.", py.read_text(),
+                     flags=re.M):
+            offenders.append(str(py.relative_to(PACKAGE)))
+    assert not offenders, f"modules that call the compiled core directly: {offenders}"
+
+
+def test_output_columns_are_where_the_bridge_says():
+    """The displacement column of a run is the end effector's displacement (checked through a state
+    the core also reports: relative displacement = x_e - x_p)."""
+    model = tf.load_model("li2009-base")
+    res = tf.simulate(model, 0.05, input=tf.Sawtooth(30, 50, 0.99), sample_rate=2000)
+    np.testing.assert_allclose(res.relative_displacement, res.displacement - res.stage_displacement,
+                               rtol=0, atol=1e-12 * np.ptp(res.displacement))
+
+
+def test_failure_status_is_named():
+    """A run that hits its step limit is reported with the status's name, not a number."""
+    model = tf.load_model("li2009-base")
+    spec = _bridge.model_spec(model, None, tf.Sawtooth(30, 50, 0.99))
+    t = np.linspace(0, 0.1, 11)
+    out = np.empty((t.size, _bridge.n_outputs(model, False)))
+    with pytest.raises(_bridge.CoreFailure) as e:
+        _bridge.run(spec, t, out, method="dopri5", rtol=1e-8, max_steps=5)
+    assert e.value.status == "max_steps"
+    with pytest.raises(tf.SolverError, match="raise max_steps"):
+        tf.simulate(model, 0.1, input=tf.Sawtooth(30, 50, 0.99), controller=tf.StepSizeController(max_steps=5))
