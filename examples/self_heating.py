@@ -1,4 +1,4 @@
-"""Self-heating of the paper's actuator (SPEC 5.3): the li2009-self-heating preset stepping at 5, 50
+"""Self-heating of the paper's actuator (docs/models.md#self-heating): the li2009-self-heating preset stepping at 5, 50
 and 500 Hz for five minutes from 30 C. For each frequency: the interface temperature, the drift of
 the step per cycle, and the error of a prediction that ignores self-heating (the step size at
 30 C times the number of cycles); the two-time-scale method against the full simulation.
