@@ -77,7 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="constant interface temperature [C] (required for thermal models)")
     temp.add_argument("--temperature-file", metavar="F.csv",
                       help="temperature signal: CSV with time[s] and temperature[C], linearly interpolated")
-    s.add_argument("--input", metavar="SPEC", help="input waveform, overriding the model's [input]")
+    s.add_argument("--input", metavar="WAVEFORM", help="input waveform, overriding the model's [input]")
     s.add_argument("--duration", type=_positive_float, default=2.0, metavar="S",
                    help="simulated time [s] (default: 2)")
     s.add_argument("--sample-rate", type=_positive_float, default=10_000.0, metavar="HZ",

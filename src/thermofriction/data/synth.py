@@ -155,7 +155,7 @@ def add_synth_command(subparsers):
                    help="length of each experiment [s] (default: 2)")
     s.add_argument("--sample-rate", type=float, default=10_000.0, metavar="HZ",
                    help="sampling rate of the recorded signals [Hz] (default: 10000)")
-    s.add_argument("--input", metavar="SPEC",
+    s.add_argument("--input", metavar="WAVEFORM",
                    help="input waveform, e.g. sawtooth:amplitude=30,frequency=5,rise=0.999 "
                         "(default: the model's [input])")
     s.add_argument("--noise", type=float, default=20e-9, metavar="M",
