@@ -8,7 +8,9 @@ sides for solve_ivp.
                                                            scales of the C core's default tolerances
 
 States: stick-slip [x_p, v_p, x_e, v_e, *z], v_r = v_e - v_p (the end effector relative to the
-stage); the stage feels +F, the end effector -F (docs/models.md#conventions).
+stage); the stage feels +F, the end effector -F (docs/models.md#conventions). The friction comes
+from friction.py only. GMS switches between sticking and slipping at events (gms_events,
+gms_switch), with a scan of the dense output for crossings that come and go within one step.
 """
 
 from __future__ import annotations
