@@ -11,7 +11,7 @@
 (ii) The closed loop of thermofriction.control (stage-model-i preset, PID at 10 kHz with 10 plant
      substeps, observer compensation, 4 s of a 1 mm, 0.5 Hz sine): wall time in C through the binding,
      against the same loop written in plain Python (the LuGre exponential step, the PID and the
-     observer as scalar Python, as a user would first write it: tests/reference.py
+     observer as scalar Python, as a user would first write it: tests/reference/control.py
      reference_closed_loop), in the same process; ratio printed.
 """
 

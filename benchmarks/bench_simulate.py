@@ -5,7 +5,7 @@
 (i)   The Li (2009) Model I preset at 35.7 C, 2 s simulated, output at 10 kHz: tf.simulate (best of
       several runs) against SciPy's solve_ivp(method="LSODA", rtol=1e-6, atol=the same per-state
       scaled atol the C core uses by default) on the plain-Python reference right-hand side
-      (tests/reference.py), both across the whole interval in one call (what a SciPy user writes)
+      (tests/reference/), both across the whole interval in one call (what a SciPy user writes)
       and restarted at every corner of the sawtooth. Accuracy of each against a tight reference
       (DOP853, rtol 1e-10, piecewise), as max |x_e error| / (max x_e - min x_e); the speed ratio;
       and the ratio at matched accuracy (LSODA tightened until it is at least as accurate as we are).

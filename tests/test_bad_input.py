@@ -1,4 +1,4 @@
-"""Bad input, one table (issue 6, SPEC 8): every malformed-input class and every numerical failure,
+"""Bad input, one table (issue 6, docs/cli.md): every malformed-input class and every numerical failure,
 run through the command line as a user would.
 
 Each row checks (1) the exit status (2 usage/data, 1 failed computation), (2) one clear error line
@@ -124,7 +124,7 @@ SIMULATE = ["simulate", "{model}", "-o", "{out}", "--duration", "0.2", "--sample
 PRESET_I = ["simulate", "li2009-model-i", "--temperature", "35", "--duration", "0.2", "-o", "{out}"]
 
 ROWS = [
-    # experiment files (SPEC 7)
+    # experiment files (docs/formats.md#datasets)
     Row("missing column", VALIDATE, 2, [FIT, "line 1", "missing column displacement"], csv=drop_column(2)),
     Row("unknown unit", VALIDATE, 2, [FIT, "line 1", "column 3", "unknown unit 'furlong'"],
         csv=lambda L: [L[0].replace("[um]", "[furlong]"), *L[1:]]),
@@ -150,7 +150,7 @@ ROWS = [
         manifest=lambda t: t.replace(f'"{FIT}"', '"nowhere.csv"')),
     Row("missing dataset folder", ["validate", "li2009-model-i", "{work}/nodata", "--json", "{json}"], 2,
         ["nodata", "no such dataset folder"]),
-    # model files (SPEC 7)
+    # model files (docs/formats.md#model-files)
     Row("missing model file", ["simulate", "{work}/nowhere.toml", "-o", "{out}"], 2, ["nowhere.toml", "no such file"]),
     Row("unknown key", SIMULATE, 2, ["'mu'", "[friction]"], model=GOOD.replace("fc = 0.9", "fc = 0.9\nmu = 0.3")),
     Row("unknown law key", [*SIMULATE, "--temperature", "35"], 2, ["'c'", "exp"],
@@ -165,7 +165,7 @@ ROWS = [
         model=GOOD.replace("[friction]", "[friction")),
     Row("model [input] unknown kind", SIMULATE, 2, ["[input]", "unknown waveform 'triangle'"],
         model=GOOD.replace('"sawtooth"', '"triangle"')),
-    # waveform specs (SPEC 6, --input)
+    # waveform specs (docs/formats.md#inputs, --input)
     Row("waveform unknown kind", [*SIMULATE, "--input", "triangle:amplitude=1"], 2, ["unknown waveform 'triangle'"],
         model=GOOD),
     Row("waveform missing key", [*SIMULATE, "--input", "sawtooth:amplitude=30"], 2, ["sawtooth", "frequency"],

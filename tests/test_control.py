@@ -110,7 +110,7 @@ def test_loop_refuses_a_plant_it_cannot_drive():
 
 
 def test_closed_loop_matches_the_plain_python_reference():
-    """Oracle: independent reference implementation (tests/reference.py reference_closed_loop: the
+    """Oracle: independent reference implementation (tests/reference/ reference_closed_loop: the
     same loop as scalar Python, laws evaluated by the reference). The C loop's positions agree to
     1e-15 m over 1 s of the sine at 41.5 C with the observer (the same algorithm: rounding only)."""
     stage = tf.load_model("stage-model-i")

@@ -1,4 +1,4 @@
-"""Datasets (SPEC 7): reading, writing, synthesising, and one clear error per malformed input.
+"""Datasets (docs/formats.md#datasets): reading, writing, synthesising, and one clear error per malformed input.
 
 Oracles: the noise-free simulation of the same model (for the sensor effects), the values written
 (for the round trip), and the file text itself (for the line and column an error must name)."""

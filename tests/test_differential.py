@@ -1,6 +1,7 @@
-"""Differential tests: the C core against an independent reference implementation (tests/reference.py).
+"""Differential tests: the C core against an independent reference implementation (tests/reference/).
 
-The reference writes the same physics (SPEC 3.1, 4, 5, 6) again in plain Python/NumPy/SciPy --
+The reference writes the same physics (docs/models.md: #stick-slip-actuator, #friction-models,
+#thermal-extensions; docs/formats.md#inputs) again in plain Python/NumPy/SciPy --
 its own waveforms, laws (SciPy's PCHIP for tables), LuGre with Stribeck, vd and both Model II
 forms, and solve_ivp restarted at every corner -- without calling the C core. Each test's
 docstring names its oracle.
@@ -124,7 +125,7 @@ def magnitudes(ref, t, y):
 
 @pytest.mark.parametrize("case", list(RHS_CASES))
 def test_rhs_matches_reference(case):
-    """Oracle: independent reference implementation (tests/reference.py: LuGre + Stribeck, vd,
+    """Oracle: independent reference implementation (tests/reference/: LuGre + Stribeck, vd,
     sigma2, Model I laws / Model II scale and offset, sampled temperature, in plain Python).
     C rhs_jac and the reference agree to ~1e-12 relative at 300 random states and times, and
     at every corner of the input and knot of the temperature."""
@@ -154,7 +155,7 @@ def test_rhs_matches_reference(case):
 def test_rhs_at_rest_and_in_steady_sliding():
     """Oracle: independent reference implementation, plus closed forms: at v = 0 the LuGre state
     does not move (z' = 0); in steady sliding (z = g(v)/sigma0 sgn v) F = g(v) sgn v + sigma2 v,
-    scaled by lambda(T) in Model II (Eq. 12) -- the sign convention of SPEC 2."""
+    scaled by lambda(T) in Model II (Eq. 12) -- the sign convention of docs/models.md#conventions."""
     model = stribeck_model_ii("scale")
     T = 36.0
     spec = _bridge.model_spec(model, T, None)
@@ -252,7 +253,7 @@ def test_laws_match_reference_inside_and_outside_their_range(name):
 
 
 def test_table_law_is_scipy_pchip_inside():
-    """Oracle: scipy.interpolate.PchipInterpolator directly (independent of tests/reference.py),
+    """Oracle: scipy.interpolate.PchipInterpolator directly (independent of tests/reference/),
     on random monotone and non-monotone data."""
     rng = np.random.default_rng(7)
     for _ in range(20):
@@ -283,7 +284,7 @@ WAVES = {
 
 @pytest.mark.parametrize("name", list(WAVES))
 def test_waveforms_match_reference(name):
-    """Oracle: independent reference implementation of the SPEC 6 waveforms (including both
+    """Oracle: independent reference implementation of the waveforms of docs/formats.md#inputs (including both
     sawtooth directions), at 5000 random times, at every corner and just either side of it;
     and the C corner list equals the reference's."""
     w = WAVES[name]
@@ -318,7 +319,7 @@ def test_corners_include_one_exactly_at_the_start():
 
 
 def test_sawtooth_directions_are_mirror_images():
-    """Oracle: the definition of direction = -1 (SPEC 6: mirrored in time), via the reference:
+    """Oracle: the definition of direction = -1 (docs/formats.md#inputs: mirrored in time), via the reference:
     u_-(t) = u_+(P - t) on each period, with u_-(0) = offset; and the C core agrees."""
     up, down = tf.Sawtooth(30, 5, rise=0.9), tf.Sawtooth(30, 5, rise=0.9, direction=-1)
     t = np.linspace(0.0, 0.2, 4001)[1:-1]

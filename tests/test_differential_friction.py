@@ -1,13 +1,13 @@
 """Differential tests of the friction-model library: the C core against an independent reference.
 
-The oracle is tests/reference.py (ReferenceSystem, reference_simulate_system): the equations of
-SPEC 3.1-3.3, 4 and 5 written again in plain Python/NumPy/SciPy -- Coulomb and Stribeck static
-maps (tanh(v/v_smooth) sign), Dahl, LuGre, elasto-plastic (Dupont 2002), generalized Maxwell-slip
-(GMS: stick/slip switches as solve_ivp terminal events, restarted in the new modes), on the
-stick-slip actuator, the spring-pulled / force-driven mass and prescribed motion, with Model I
-laws and both Model II forms -- without calling the C core or the library's law and waveform
-evaluation. The reference itself is checked against closed forms first (section 0). Each test's
-docstring names its oracle.
+The oracle is tests/reference/ (ReferenceSystem, reference_simulate_system): the equations of
+docs/models.md (#plants, #friction-models, #thermal-extensions) written again in plain
+Python/NumPy/SciPy -- Coulomb and Stribeck static maps (tanh(v/v_smooth) sign), Dahl, LuGre,
+elasto-plastic (Dupont 2002), generalized Maxwell-slip (GMS: stick/slip switches as solve_ivp
+terminal events, restarted in the new modes), on the stick-slip actuator, the spring-pulled /
+force-driven mass and prescribed motion, with Model I laws and both Model II forms -- without
+calling the C core or the library's law and waveform evaluation. The reference itself is checked
+against closed forms first (section 0). Each test's docstring names its oracle.
 """
 
 from __future__ import annotations
@@ -156,8 +156,10 @@ def test_reference_dahl_and_lugre_ramp_closed_form():
 
 
 def test_reference_system_equals_the_lugre_actuator_reference():
-    """Oracle: the original reference (ReferenceModel, LuGre on the actuator), written separately:
-    ReferenceSystem gives the same rhs and, integrated, the same motion (1e-9 of the range)."""
+    """Oracle self-check: the reference's two drivers agree. reference_simulate (ReferenceModel, LuGre
+    on the actuator: t_eval output, the input taken at t) and reference_simulate_system (dense output,
+    the input's left limit at segment ends) share one friction implementation; they give the same
+    rhs and, integrated, the same motion (1e-9 of the range)."""
     model = tf.load_model("li2009-model-i")
     T = 35.0
     a, b = R.ReferenceModel(model, T), R.ReferenceSystem(model, T)
@@ -173,9 +175,10 @@ def test_reference_system_equals_the_lugre_actuator_reference():
 
 
 def test_reference_static_maps_and_elastoplastic_alpha():
-    """Oracle: the formulas of SPEC 4 evaluated directly: Coulomb fc tanh(v/v_smooth) + sigma2 v;
-    Stribeck g(v) tanh(v/v_smooth) + sigma2 v; the elasto-plastic alpha is 0 below z_ba and
-    for z against v, 1 at and beyond g(v)/sigma0, 1/2 halfway, and continuous."""
+    """Oracle: the formulas of docs/models.md#friction-models evaluated directly: Coulomb
+    fc tanh(v/v_smooth) + sigma2 v; Stribeck g(v) tanh(v/v_smooth) + sigma2 v; the elasto-plastic
+    alpha is 0 below z_ba and for z against v, 1 at and beyond g(v)/sigma0, 1/2 halfway, and
+    continuous."""
     for v in (-3e-3, -2e-5, 0.0, 7e-5, 1e-2):
         p = R.friction_params(mass_model("stribeck"), math.nan)
         g = 1.0 + 0.5 * math.exp(-((v / 1e-3) ** 2))
@@ -339,7 +342,7 @@ def _times(model, temperature, rng, n):
 
 @pytest.mark.parametrize("case", list(RHS_CASES))
 def test_rhs_matches_reference(case):
-    """Oracle: independent reference implementation (tests/reference.py, ReferenceSystem: every
+    """Oracle: independent reference implementation (tests/reference/, ReferenceSystem: every
     friction model on every plant, Model I laws, Model II forms, GMS modes given). The C rhs_jac's
     derivatives and friction force agree with it to 1e-12 of the terms' magnitudes at 200 random
     states and times (prescribed motion: v_r the input's slope at that time)."""
@@ -380,7 +383,7 @@ def fd_jacobian(ref, t, y, h):
     c.startswith("prescribed") and any(k in c for k in ("coulomb", "stribeck")))])
 def test_jacobian_matches_finite_differences_of_reference(case):
     """Oracle: five-point central finite differences of the independent reference implementation's
-    rhs (tests/reference.py, GMS modes held). The C analytic Jacobian agrees to 1e-6 of each row's
+    rhs (tests/reference/, GMS modes held). The C analytic Jacobian agrees to 1e-6 of each row's
     scale at 60 random states; steps are 1e-4 of each state's local scale (velocities: the
     smallest of |v_r| and the friction's velocity bands; elasto-plastic z kept 1e-3 of fc/sigma0
     away from alpha's switching deflections)."""
@@ -482,7 +485,7 @@ def sim_reference(name):
 
 @pytest.mark.parametrize("name, solver", list(_sim_params()))
 def test_simulation_matches_tight_reference(name, solver):
-    """Oracle: independent reference implementation (tests/reference.py, reference_simulate_system)
+    """Oracle: independent reference implementation (tests/reference/, reference_simulate_system)
     integrated by SciPy solve_ivp at rtol 1e-10 (per-state atol), restarted at every corner of the
     input and knot of the temperature and, for GMS, at every stick/slip switch (terminal events).
     At default tolerances every C solver keeps the driven body's displacement (the stage's too on

@@ -1,4 +1,5 @@
-"""The friction model library (SPEC 3.2, 3.3, 4, 5) against analytic solutions and known properties.
+"""The friction model library (docs/models.md: #mass-plant, #prescribed-motion, #friction-models,
+#thermal-extensions) against analytic solutions and known properties.
 
 Every test names its oracle in its docstring: a closed-form solution of the model's equations, a
 linearisation, or a structural property of the model (no drift, return-point memory, Masing's
@@ -21,7 +22,7 @@ SIGMA0 = 1e5  # N/m: presliding deflection fc/sigma0 = 10 um
 
 
 def stribeck_g(v, fc, fs, vs, delta=2.0):
-    """SPEC 4: g(v) = fc + (fs - fc) exp(-|v/vs|^delta)."""
+    """docs/models.md#friction-models: g(v) = fc + (fs - fc) exp(-|v/vs|^delta)."""
     return fc + (fs - fc) * np.exp(-np.abs(np.asarray(v, float) / vs) ** delta)
 
 
@@ -289,7 +290,7 @@ def test_gms_return_point_memory_after_a_closed_minor_loop__property():
     (tf.Stribeck(fc=1.0, fs=1.3, vs=5e-4, delta=1.0, v_smooth=2e-5), lambda v: stribeck_g(v, 1.0, 1.3, 5e-4, 1.0)),
 ], ids=["coulomb-viscous", "coulomb-wide-band", "stribeck", "stribeck-delta1"])
 def test_static_maps_match_their_formulas__analytic(friction, G):
-    """Definition (SPEC 4): F = fc tanh(v/v_smooth) + sigma2 v (Coulomb), F = g(v)
+    """Definition (docs/models.md#friction-models): F = fc tanh(v/v_smooth) + sigma2 v (Coulomb), F = g(v)
     tanh(v/v_smooth) + sigma2 v (Stribeck), at the prescribed velocity v = dx/dt of a sine."""
     X, f = 1e-3, 1.0  # peak velocity 6.3 mm/s, through the smoothing band and the Stribeck drop
     res = tf.simulate(prescribed(friction), 1.0, input=tf.Sine(amplitude=X, frequency=f), sample_rate=5000)
@@ -336,7 +337,7 @@ def thermal_input(plant):
 @pytest.mark.parametrize("plant", [tf.PrescribedMotion(), tf.MassPlant(0.1)], ids=["prescribed", "mass"])
 @pytest.mark.parametrize("name", list(BASE))
 def test_model_i_law_equals_base_model_with_the_laws_value(name, plant):
-    """Definition (SPEC 5.1): a Model I law on a parameter gives exactly the base model with the
+    """Definition (docs/models.md#model-i): a Model I law on a parameter gives exactly the base model with the
     law's value at that temperature; and the parameter matters (another value differs)."""
     base = BASE[name]
     laws = LAWS[name]
@@ -365,7 +366,7 @@ def test_model_i_law_equals_base_model_with_the_laws_value(name, plant):
 
 @pytest.mark.parametrize("name", list(BASE))
 def test_model_ii_scale_form_scales_every_base_model_by_1_plus_dF_over_fc(name):
-    """Definition (SPEC 5.2): F' = (1 + dF(T)/F_ref) F_base with F_ref = fc; under prescribed
+    """Definition (docs/models.md#model-ii): F' = (1 + dF(T)/F_ref) F_base with F_ref = fc; under prescribed
     motion the base model's state does not see the thermal factor, so the whole force record is
     scaled, pointwise, by lambda = 1 + (a T + b)/fc."""
     base = BASE[name]
@@ -389,7 +390,7 @@ def test_model_ii_scale_form_scales_every_base_model_by_1_plus_dF_over_fc(name):
     (tf.Coulomb(fc=FC), -1.2, True, 1e6),  # |dF| beyond fs: anti-damped even so
 ], ids=["dahl", "gms", "coulomb", "stribeck", "coulomb-dF>fs"])
 def test_model_ii_offset_form_conditioning_check_counts_each_models_own_damping(friction, dF, warns, damping):
-    """Linearisation at v = 0 (SPEC 5.2, offset form): F' = F_base + dF tanh(v/v_smooth) has the
+    """Linearisation at v = 0 (docs/models.md#model-ii, offset form): F' = F_base + dF tanh(v/v_smooth) has the
     slope dF/v_smooth there; with dF < 0 it is anti-damped where that outweighs the base model's
     own damping (sigma1 + sigma2; fs/v_smooth + sigma2 for a static map's smoothed sign). The check
     must hold for models without sigma1 (it raised KeyError for them) and name the damping."""
@@ -431,7 +432,7 @@ P = tf.PrescribedMotion()
         "z_ba=fc/sigma0", "z_ba>fc/sigma0", "lugre-sigma0=0", "dahl-sigma0<0", "ep-sigma0<0", "gms-k=0",
         "gms-k<0", "stage-k=0", "mass-k_s<0"])
 def test_bad_parameters_raise_input_error_naming_the_parameter(build, match):
-    """Physical domain (SPEC 4): fs >= fc, GMS weights sum to one, z_ba < fc/sigma0, positive
+    """Physical domain (docs/models.md#friction-models): fs >= fc, GMS weights sum to one, z_ba < fc/sigma0, positive
     stiffnesses; each violation is an InputError that names the parameter."""
     with pytest.raises(tf.InputError, match=match):
         build()
@@ -520,14 +521,15 @@ MODELS = list(FRICTION_TOML)
 
 
 def test_cli_simulates_each_friction_model_and_each_plant(tmp_path):
-    """Interface (SPEC 7, 8): a model file of each friction model, on the plants in turn (every
-    plant twice), simulates from the command line with exit status 0 and the SPEC 7 columns:
-    stage_displacement[m] only for the stick-slip plant, input[V]/[N]/[m] by plant, the model's
-    internal states last."""
+    """Interface (docs/formats.md#model-files, docs/cli.md): a model file of each friction model,
+    on the plants in turn (every plant twice), simulates from the command line with exit status 0
+    and the columns of docs/formats.md#simulation-output: stage_displacement[m] only for the
+    stick-slip plant, input[V]/[N]/[m] by plant, the model's internal states last."""
     run_matrix([(m, PLANTS[i % 3]) for i, m in enumerate(MODELS)], tmp_path)
 
 
 @pytest.mark.slow
 def test_cli_simulates_every_friction_model_on_every_plant(tmp_path):
-    """Interface (SPEC 7, 8): the full matrix, 6 friction models x 3 plants (18 interpreters)."""
+    """Interface (docs/formats.md#model-files, docs/cli.md): the full matrix, 6 friction models x
+    3 plants (18 interpreters)."""
     run_matrix([(m, p) for m in MODELS for p in PLANTS], tmp_path)

@@ -1,4 +1,4 @@
-"""Property-based tests (Hypothesis) of every parser of user data (SPEC 6-8, issue 6 "Hardening"):
+"""Property-based tests (Hypothesis) of every parser of user data (docs/formats.md, docs/cli.md, issue 6 "Hardening"):
 experiment CSV files, temperature / sampled-waveform CSV files, dataset manifests, model files,
 ``--input`` waveform specs, the model save/load round trip and the command line's handling of bad data.
 
@@ -90,7 +90,7 @@ edits_st = st.lists(st.tuples(st.floats(0, 1), st.sampled_from(["insert", "repla
 
 
 # =============================================================================================
-# 1. Experiment CSV files (SPEC 7)
+# 1. Experiment CSV files (docs/formats.md#datasets)
 # =============================================================================================
 
 UNITS = {"time": {"s": 1.0, "ms": 1e-3}, "voltage": {"V": 1.0, "mV": 1e-3},
@@ -392,7 +392,7 @@ def laws(draw):
 
 @st.composite
 def model_dicts(draw):
-    """A valid model file's contents (SPEC 7), as a dict."""
+    """A valid model file's contents (docs/formats.md#model-files), as a dict."""
     d = {}
     if draw(st.booleans()):
         d["name"] = draw(st.text(st.characters(blacklist_categories=("Cs",)), min_size=1, max_size=20))
@@ -560,7 +560,8 @@ def test_model_dict_never_crashes(scratch, d):
 @given(model_dicts(), st.sampled_from(["x", "unknown_key"]), st.sampled_from(["", "plant", "friction", "thermal",
                                                                                "input"]))
 def test_model_unknown_key_is_named(scratch, d, key, section):
-    """Property (SPEC 7 "Unknown keys are errors"): an unknown key anywhere is an InputError naming it."""
+    """Property (docs/formats.md#model-files: unknown keys are errors): an unknown key anywhere is
+    an InputError naming it."""
     if section:
         assume(isinstance(d.get(section), dict))
         d[section][key] = 1.0
@@ -763,7 +764,7 @@ def test_no_code_execution_from_data_files():
 
 
 # =============================================================================================
-# The command line (SPEC 8): bad data -> status 2, one line, no traceback, no output file
+# The command line (docs/cli.md): bad data -> status 2, one line, no traceback, no output file
 # =============================================================================================
 
 def _run_main(argv):
@@ -846,7 +847,7 @@ def bad_cli_cases(draw, folder):
 @settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
 @given(st.data())
 def test_cli_bad_data_in_process(tmp_path_factory, data):
-    """Property (SPEC 8): generated bad model files, --input specs, temperature files and datasets
+    """Property (docs/cli.md): generated bad model files, --input specs, temperature files and datasets
     make the command line exit with status 2, print one 'thermofriction: error:' line and no
     traceback, and write no output file (nor a temporary one)."""
     folder = tmp_path_factory.mktemp("cli")
@@ -858,7 +859,7 @@ def test_cli_bad_data_in_process(tmp_path_factory, data):
 @settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
 @given(st.data())
 def test_cli_bad_data_subprocess(tmp_path_factory, data):
-    """Property (SPEC 8), as a user runs it (a fresh interpreter): bad data -> status 2, one
+    """Property (docs/cli.md), as a user runs it (a fresh interpreter): bad data -> status 2, one
     message line, no traceback, no output file."""
     folder = tmp_path_factory.mktemp("cli-sub")
     argv, outputs = data.draw(bad_cli_cases(folder))

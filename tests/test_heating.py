@@ -1,5 +1,5 @@
-"""Self-heating (SPEC 5.3): the lumped thermal model in the C core, against closed forms, a
-conservation law and the independent reference implementation (tests/reference.py). Each test's
+"""Self-heating (docs/models.md#self-heating): the lumped thermal model in the C core, against closed forms, a
+conservation law and the independent reference implementation (tests/reference/). Each test's
 docstring names its oracle."""
 
 from __future__ import annotations
@@ -105,7 +105,7 @@ def test_energy_balance_on_the_paper_actuator():
 
 @pytest.mark.parametrize("kind", ["I", "II"])
 def test_heated_actuator_matches_the_reference(kind):
-    """Oracle: independent reference implementation (tests/reference.py ReferenceHeatedSystem,
+    """Oracle: independent reference implementation (tests/reference/ ReferenceHeatedSystem,
     solve_ivp LSODA at rtol 1e-10): the paper's actuator (Model I or II) heating itself at 500 Hz
     for 0.1 s (a small C_th, so the temperature rises ~2 K) agrees in temperature to 1e-5 K, in
     end-effector displacement to 1e-4 of the stroke and in frictional work to 1e-5 relative."""

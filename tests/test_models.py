@@ -1,4 +1,4 @@
-"""Model files (SPEC 7): exact round trips, every law kind, and clear errors for bad files."""
+"""Model files (docs/formats.md#model-files): exact round trips, every law kind, and clear errors for bad files."""
 
 import math
 

@@ -80,7 +80,7 @@ def test_frictionless_stage_step_response_is_exact_second_order__analytic(solver
 
 
 def test_model_i_is_the_base_model_with_parameters_at_T__definition(model_i):
-    """Definition (SPEC 5.1): Model I at a constant T is LuGre with its laws evaluated at T."""
+    """Definition (docs/models.md#model-i): Model I at a constant T is LuGre with its laws evaluated at T."""
     T = 36.2
     p = model_i.parameters_at(T)
     base = tf.Model(model_i.plant, tf.LuGre(sigma0=p["sigma0"], sigma1=p["sigma1"], fc=p["fc"]), input=model_i.input)
@@ -149,7 +149,7 @@ def test_mirrored_sawtooth_drives_the_end_effector_backwards__physics(model_i):
 
 
 def test_end_effector_feels_minus_F__sign_convention(model_i):
-    """SPEC 2: the end effector feels -F (m_e a_e = -F), where F resists the sliding v_r = v_e - v_p
+    """docs/models.md#conventions: the end effector feels -F (m_e a_e = -F), where F resists the sliding v_r = v_e - v_p
     (its steady-sliding sign is checked by the analytic tests above)."""
     res = tf.simulate(model_i, 0.4, temperature=38.0, sample_rate=200_000)
     accel = np.gradient(res.velocity, res.time)

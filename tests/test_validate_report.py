@@ -1,4 +1,4 @@
-"""Validation metrics (SPEC 9) and the HTML report, the latter opened in a real browser."""
+"""Validation metrics (docs/formats.md#validation-metrics) and the HTML report, the latter opened in a real browser."""
 
 import json
 import re

@@ -1,0 +1,133 @@
+"""The friction models (docs/models.md#friction-models) and the thermal extensions
+(docs/models.md#thermal-extensions), written again from their definitions. This is the only place
+the friction equations are written: every plant, the self-heating model and the LuGre actuator
+of the C core's first differential tests (ReferenceModel) evaluate them here.
+
+    FrictionParams, friction_params(model, T)      parameters at T (Model I laws applied)
+    stribeck_g, elastoplastic_alpha                the Stribeck curve, the elasto-plastic alpha
+    base_friction(kind, p, v, z, modes)            (F, [z_i']) of the friction model alone
+    thermal_friction(kind, p, v, z, modes)         (F', [z_i']) with Model II's scale or offset
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from thermofriction.models import ModelI, ModelII
+
+from .laws import law_value
+
+#: friction parameters a model may carry (the C core's list, read here by name from the model)
+_ALL_PARAMS = ("sigma0", "sigma1", "sigma2", "fc", "fs", "vs", "delta", "vd", "v_smooth", "z_ba", "C")
+
+
+@dataclass(frozen=True)
+class FrictionParams:
+    """One friction model's parameters at one temperature (Model I laws applied), plus Model II's
+    scale factor ``lam`` and offset force ``dF_offset``."""
+
+    sigma0: float
+    sigma1: float
+    sigma2: float
+    fc: float
+    fs: float
+    vs: float | None
+    delta: float
+    vd: float | None
+    v_smooth: float
+    z_ba: float
+    C: float
+    k: tuple
+    w: tuple
+    lam: float
+    dF_offset: float
+
+
+def friction_params(model, T) -> FrictionParams:
+    """The friction parameters of ``model`` at temperature T [degC] (NaN without a thermal model),
+    read from the friction object's attributes and the thermal model's laws."""
+    fr, th = model.friction, model.thermal
+    p = {n: getattr(fr, n, None) for n in _ALL_PARAMS}
+    laws = th.laws if isinstance(th, ModelI) else {}
+    for name, law in laws.items():
+        p[name] = law_value(law, T)
+    if p["fs"] is None:
+        p["fs"] = p["fc"]  # no Stribeck effect; fs follows fc (and fc's law)
+    defaults = {"sigma2": 0.0, "delta": 2.0, "sigma0": math.nan, "sigma1": 0.0, "z_ba": 0.0, "C": math.nan,
+                "v_smooth": 1e-6}
+    for name, value in defaults.items():
+        if p[name] is None:
+            p[name] = value
+    lam, off = 1.0, 0.0
+    if isinstance(th, ModelII):
+        dF = law_value(th.dF, T)
+        if th.form == "scale":
+            lam = 1.0 + dF / float(fr.fc)  # F_ref: the base model's steady sliding level, fc
+        else:
+            off = dF
+    f = {n: (None if p[n] is None else float(p[n])) for n in _ALL_PARAMS}
+    k = tuple(float(x) for x in getattr(fr, "k", ()))
+    w = tuple(float(x) for x in getattr(fr, "w", ()))
+    return FrictionParams(**f, k=k, w=w, lam=lam, dF_offset=off)
+
+
+def stribeck_g(p: FrictionParams, v):
+    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fc when fs == fc)."""
+    if p.fs == p.fc:
+        return p.fc
+    r = abs(v) / p.vs
+    return p.fc + (p.fs - p.fc) * (math.exp(-(r ** p.delta)) if r < 1e30 else 0.0)
+
+
+def elastoplastic_alpha(p: FrictionParams, z, v, g):
+    """Dupont et al. (2002): 0 while z and v have opposite signs or |z| <= z_ba; 1 for |z| at or
+    beyond the steady deflection z_ss = g(v)/sigma0; a half sine rising from 0 to 1 between."""
+    if not (z * v > 0.0):
+        return 0.0
+    az, z_ss = abs(z), g / p.sigma0
+    if az <= p.z_ba:
+        return 0.0
+    if az >= z_ss:
+        return 1.0
+    mid, half = 0.5 * (z_ss + p.z_ba), z_ss - p.z_ba
+    return 0.5 + 0.5 * math.sin(math.pi * (az - mid) / half)
+
+
+def base_friction(kind, p: FrictionParams, v, z, modes=()):
+    """(F, [z_i']) of the friction model alone (no thermal extension) at sliding velocity v and
+    internal states z. GMS ``modes``: 0 stuck, +1/-1 slipping in that direction."""
+    if kind == "coulomb":
+        return p.fc * math.tanh(v / p.v_smooth) + p.sigma2 * v, []
+    if kind == "stribeck":
+        return stribeck_g(p, v) * math.tanh(v / p.v_smooth) + p.sigma2 * v, []
+    if kind == "dahl":
+        return p.sigma0 * z[0], [v - p.sigma0 * abs(v) * z[0] / p.fc]
+    if kind in ("lugre", "elastoplastic"):
+        g = stribeck_g(p, v)
+        alpha = 1.0 if kind == "lugre" else elastoplastic_alpha(p, z[0], v, g)
+        zd = v - alpha * p.sigma0 * abs(v) * z[0] / g
+        s1 = p.sigma1 * math.exp(-((v / p.vd) ** 2)) if p.vd is not None else p.sigma1
+        return p.sigma0 * z[0] + s1 * zd + p.sigma2 * v, [zd]
+    if kind == "gms":
+        g = stribeck_g(p, v)
+        F, rates = p.sigma2 * v, []
+        for Fi, ki, wi, mi in zip(z, p.k, p.w, modes):
+            F += Fi
+            # stuck: a spring moving with the surface; slipping (direction mi = sgn v while it lasts):
+            # relaxes towards its capacity mi w_i g(v) at rate C
+            rates.append(ki * v if mi == 0 else p.C * (mi * wi - Fi / g))
+        return F, rates
+    raise TypeError(f"reference: unknown friction model {kind!r}")
+
+
+
+def thermal_friction(kind, p: FrictionParams, v, z, modes=()):
+    """(F', [z_i']): the friction model with Model II's thermal term (docs/models.md#model-ii):
+    the base force scaled by lam = 1 + dF(T)/fc, or dF(T) tanh(v/v_smooth) added (the offset
+    form). Model I needs nothing here: its laws are in p already."""
+    F, zd = base_friction(kind, p, v, z, modes)
+    F = p.lam * F
+    if p.dF_offset != 0.0:
+        F += p.dF_offset * math.tanh(v / p.v_smooth)
+    return F, zd
