@@ -1,5 +1,5 @@
-/* Temperature laws (SPEC 5.1, 7). */
-#include "thermofriction/thermal.h"
+/* Temperature laws (see law.h). */
+#include "thermofriction/law.h"
 
 #include <math.h>
 
