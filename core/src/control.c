@@ -35,7 +35,7 @@ double tf_observer_step(tf_rt_friction *f, double v, double e, double k, double 
     if (m->friction == TF_FRICTION_LUGRE || m->friction == TF_FRICTION_ELASTOPLASTIC) {
         F += tf_sigma1(p, v, 0, 0, 0) * extra;
     }
-    return tf_rt_thermal_force(F, v, p, lambda, dF);
+    return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 0, 0);
 }
 
 int tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, double *x_out, double *u_out,

@@ -34,20 +34,6 @@ typedef enum {
     TF_OUT_NFIXED
 } tf_output_channel;
 
-/* Lumped thermal model (SPEC 5.3). With `on` set the temperature is a state,
- *   C_th T' = eta |F' v_r| - (T - T_amb) / R_th + P_ext(t),   T(0) = T_0,
- * and the model's T_const / T_n are not used. |F' v_r| counts all the friction force's power as
- * heat, including what a bristle model stores and returns elastically (SPEC's reading). */
-typedef struct {
-    int on;
-    double C_th;       /* heat capacity [J/K] */
-    double R_th;       /* thermal resistance to ambient [K/W] */
-    double eta;        /* fraction of the frictional power that heats the interface, 0..1 */
-    double T_amb;      /* ambient temperature [degC] */
-    double T_0;        /* initial temperature [degC] */
-    tf_waveform P_ext; /* external heat input [W]; TF_WAVE_ZERO: none */
-} tf_heat;
-
 /* The most states a model has: 4 mechanical, the friction states, temperature, frictional work. */
 #define TF_MAX_STATES (TF_MAX_FRICTION_STATES + 6)
 
@@ -75,7 +61,7 @@ typedef struct {
     double T_const;
     int T_n;
     const double *T_t, *T_v;
-    tf_heat heat;
+    tf_heat heat;               /* the lumped heat balance (thermal.h) */
 
     /* States after the friction states: the temperature (heat.on), then the frictional work
        W = integral of |F' v_r| dt [J] (heat.on or work set): per-cycle dissipation to solver
@@ -126,12 +112,8 @@ typedef enum {
     TF_TARGET_PARAM = 0, /* friction parameter `param` given as a number */
     TF_TARGET_LAW = 1,   /* coefficient `coef` of the Model I law of parameter `param` */
     TF_TARGET_DF = 2,    /* coefficient `coef` of Model II's dF law */
-    TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param */
+    TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param (thermal.h) */
 } tf_target_kind;
-
-/* TF_HEAT_T_0 enters through the initial state only (S_T(0) = 1): its right-hand-side partials are
- * zero, and whoever starts a sensitivity integration sets that column (the binding does). */
-typedef enum { TF_HEAT_C_TH = 0, TF_HEAT_R_TH, TF_HEAT_ETA, TF_HEAT_T_AMB, TF_HEAT_T_0, TF_HEAT_NPARAM } tf_heat_param;
 
 typedef struct {
     int kind, param, coef;
