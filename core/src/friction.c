@@ -1,4 +1,4 @@
-/* Friction models (SPEC 4). */
+/* Friction models (docs/models.md#friction-models). */
 #include "thermofriction/friction.h"
 
 #include <math.h>

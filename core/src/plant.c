@@ -1,4 +1,4 @@
-/* Plants (SPEC 3) with friction and thermal extension, as one ODE system. */
+/* Plants (docs/models.md#plants) with friction and thermal extension, as one ODE system. */
 #include "thermofriction/plant.h"
 
 #include <math.h>

@@ -1,6 +1,6 @@
-/* Friction models (SPEC 4). A model maps relative velocity v, internal state z and parameters
- * p (already evaluated at the current temperature) to the force F that resists sliding and to
- * dz/dt. In steady sliding F has the sign of v. */
+/* Friction models (docs/models.md#friction-models). A model maps relative velocity v, internal
+ * state z and parameters p (already evaluated at the current temperature) to the force F that
+ * resists sliding and to dz/dt. In steady sliding F has the sign of v. */
 #ifndef THERMOFRICTION_FRICTION_H
 #define THERMOFRICTION_FRICTION_H
 

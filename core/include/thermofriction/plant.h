@@ -1,5 +1,6 @@
-/* Plants (SPEC 3) assembled with a friction model, its thermal extension, an input waveform
- * and a temperature signal into one ODE system: right-hand side, analytic Jacobian, outputs. */
+/* Plants (docs/models.md#plants) assembled with a friction model, its thermal extension, an input
+ * waveform and a temperature signal into one ODE system: right-hand side, analytic Jacobian,
+ * outputs. */
 #ifndef THERMOFRICTION_PLANT_H
 #define THERMOFRICTION_PLANT_H
 
@@ -13,9 +14,12 @@ extern "C" {
 #endif
 
 typedef enum {
-    TF_PLANT_STICK_SLIP = 0, /* SPEC 3.1: states x_p, v_p, x_e, v_e, then friction states */
-    TF_PLANT_MASS = 1,       /* SPEC 3.2: m x'' = u(t) + k_s (v_0 t - x) - F, v_r = x'; states x, v, then friction */
-    TF_PLANT_PRESCRIBED = 2  /* SPEC 3.3: x_r = u(t) [m] given, v_r = u'(t); friction states only */
+    /* docs/models.md#stick-slip-actuator: states x_p, v_p, x_e, v_e, then friction states */
+    TF_PLANT_STICK_SLIP = 0,
+    /* docs/models.md#mass-plant: m x'' = u(t) + k_s (v_0 t - x) - F, v_r = x'; states x, v, then friction */
+    TF_PLANT_MASS = 1,
+    /* docs/models.md#prescribed-motion: x_r = u(t) [m] given, v_r = u'(t); friction states only */
+    TF_PLANT_PRESCRIBED = 2
 } tf_plant_kind;
 
 /* Output channels, in this order, then the friction states, then the frictional work (where
@@ -78,14 +82,15 @@ typedef struct {
 void tf_model_prepare(tf_model *model);
 
 /* Checks a model before it is simulated: every number the plant, friction model, thermal
- * extension, input and temperature use is finite and in its domain (SPEC 3-5: masses,
- * stiffnesses, sigma0, fc, C, v_smooth > 0; damping, sigma1, sigma2, z_ba >= 0; fs >= fc;
- * vs > 0 where fs != fc; elasto-plastic z_ba < fc/sigma0; 1..64 GMS elements with k_i, w_i > 0
- * summing to one; Model I parameters and Model II's lambda checked at the constant temperature
- * or over the sampled one; periodic inputs with a positive frequency; for prescribed motion a
- * continuous input). Returns TF_OK, or TF_ERR_BAD_ARGUMENT with the offending field's name in
- * *what (a static string; may be NULL). tf_solve does not call it: callers that build models
- * from user data must (the Python package checks the same rules, with messages). */
+ * extension, input and temperature use is finite and in its domain (docs/models.md#plants,
+ * #friction-models, #thermal-extensions: masses, stiffnesses, sigma0, fc, C, v_smooth > 0;
+ * damping, sigma1, sigma2, z_ba >= 0; fs >= fc; vs > 0 where fs != fc; elasto-plastic z_ba <
+ * fc/sigma0; 1..64 GMS elements with k_i, w_i > 0 summing to one; Model I parameters and Model
+ * II's lambda checked at the constant temperature or over the sampled one; periodic inputs with a
+ * positive frequency; for prescribed motion a continuous input). Returns TF_OK, or
+ * TF_ERR_BAD_ARGUMENT with the offending field's name in *what (a static string; may be NULL).
+ * tf_solve does not call it: callers that build models from user data must (the Python package
+ * checks the same rules, with messages). */
 int tf_model_check(const tf_model *model, const char **what);
 
 int tf_model_nstate(const tf_model *model);
