@@ -15,17 +15,6 @@ void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, in
     if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
 }
 
-double tf_thermal_lambda(int thermal, int form, const tf_law *dF, double F_ref, double T)
-{
-    if (thermal != TF_THERMAL_MODEL_II || form != TF_DF_SCALE) return 1.0;
-    return 1.0 + tf_law_eval(dF, T, 0) / F_ref;
-}
-
-double tf_thermal_offset(int thermal, int form, const tf_law *dF, double T)
-{
-    return thermal == TF_THERMAL_MODEL_II && form == TF_DF_OFFSET ? tf_law_eval(dF, T, 0) : 0.0;
-}
-
 double tf_thermal_df_coef_partial(int form, const tf_law *dF, int coef, double T, double F_base, double F_ref,
                                   double v, double v_smooth)
 {

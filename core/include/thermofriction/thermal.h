@@ -40,10 +40,18 @@ void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, in
 /* ---- Model II: F' = lambda(T) F_base + dF_offset(T) s(v), s(v) = tanh(v / v_smooth) ---- */
 
 /* lambda(T) = 1 + dF(T) / F_ref in the scale form, 1 otherwise (no Model II, or the offset form).
- * F_ref: tf_friction_reference_force of the base parameters (fc). */
-double tf_thermal_lambda(int thermal, int form, const tf_law *dF, double F_ref, double T);
+ * F_ref: tf_friction_reference_force of the base parameters (fc). Inline, as tf_thermal_offset:
+ * both are on every cache miss of the parameters, i.e. every step at a changing temperature. */
+static inline double tf_thermal_lambda(int thermal, int form, const tf_law *dF, double F_ref, double T)
+{
+    if (thermal != TF_THERMAL_MODEL_II || form != TF_DF_SCALE) return 1.0;
+    return 1.0 + tf_law_eval(dF, T, 0) / F_ref;
+}
 /* dF(T) in the offset form, 0 otherwise. */
-double tf_thermal_offset(int thermal, int form, const tf_law *dF, double T);
+static inline double tf_thermal_offset(int thermal, int form, const tf_law *dF, double T)
+{
+    return thermal == TF_THERMAL_MODEL_II && form == TF_DF_OFFSET ? tf_law_eval(dF, T, 0) : 0.0;
+}
 
 /* F' from the base model's force F_base at sliding velocity v. With jac (the base model's partials
  * for nz states) not NULL, turns them into the partials of F' in place. Inline: it is on the
