@@ -2,6 +2,7 @@
 #ifndef THERMOFRICTION_H
 #define THERMOFRICTION_H
 #include "thermofriction/waveform.h"
+#include "thermofriction/law.h"
 #include "thermofriction/thermal.h"
 #include "thermofriction/friction.h"
 #include "thermofriction/plant.h"

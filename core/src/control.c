@@ -33,11 +33,9 @@ double tf_observer_step(tf_rt_friction *f, double v, double e, double k, double 
     double F = tf_rt_advance(m->friction, p, &m->gms, f->z, v, dt, &extra, dz);
     /* the observer's own z^' in the damping term: F^ = sigma0 z^ + sigma1 z^' + sigma2 v */
     if (m->friction == TF_FRICTION_LUGRE || m->friction == TF_FRICTION_ELASTOPLASTIC) {
-        double s1 = p[TF_P_SIGMA1];
-        if (p[TF_P_VD] > 0.0) s1 *= exp(-(v / p[TF_P_VD]) * (v / p[TF_P_VD]));
-        F += s1 * extra;
+        F += tf_sigma1(p, v, 0, 0, 0) * extra;
     }
-    return tf_rt_thermal_force(F, v, p, lambda, dF);
+    return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 0, 0);
 }
 
 int tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, double *x_out, double *u_out,

@@ -1,4 +1,4 @@
-/* Friction models (SPEC 4). */
+/* Friction models (docs/models.md#friction-models). */
 #include "thermofriction/friction.h"
 
 #include <math.h>
@@ -44,8 +44,7 @@ double tf_stribeck(const double *p, double v, double *dg)
 }
 
 /* LuGre (Canudas de Wit et al. 1995):
- *   z' = v - sigma0 |v| z / g(v),  F = sigma0 z + sigma1(v) z' + sigma2 v,
- *   sigma1(v) = sigma1 exp(-(v/vd)^2) when vd > 0. */
+ *   z' = v - sigma0 |v| z / g(v),  F = sigma0 z + sigma1(v) z' + sigma2 v  (sigma1(v): tf_sigma1). */
 /* Partial derivatives of g(v) with respect to fc, fs, vs, delta. */
 static void stribeck_param_partials(const double *p, double v, double *dg)
 {
@@ -65,17 +64,13 @@ static void stribeck_param_partials(const double *p, double v, double *dg)
 static double lugre(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac,
                     tf_friction_param_partials *dp)
 {
-    double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2], vd = p[TF_P_VD];
+    double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2];
     double dg;
     double g = tf_stribeck(p, v, jac ? &dg : 0);
     double r = s0 * fabs(v) / g; /* relaxation rate of z */
     double zd = v - r * z[0];
-    double s1 = p[TF_P_SIGMA1], ds1 = 0.0;
-    if (vd > 0.0) {
-        double q = v / vd;
-        s1 *= exp(-q * q);
-        ds1 = -2.0 * q / vd * s1;
-    }
+    double ds1, ds1_dsigma1 = 0.0, ds1_dvd = 0.0;
+    double s1 = tf_sigma1(p, v, &ds1, dp ? &ds1_dsigma1 : 0, dp ? &ds1_dvd : 0);
     dz[0] = zd;
     if (jac) {
         double dr = s0 * (sgn(v) * g - fabs(v) * dg) / (g * g);
@@ -92,9 +87,9 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
         dp->ddz_dp[0][TF_P_SIGMA0] = -fabs(v) * z[0] / g;
         for (int i = 0; i < TF_NPARAM; i++) dp->dF_dp[i] = s1 * dp->ddz_dp[0][i];
         dp->dF_dp[TF_P_SIGMA0] += z[0];
-        dp->dF_dp[TF_P_SIGMA1] = (vd > 0.0 ? exp(-(v / vd) * (v / vd)) : 1.0) * zd;
+        dp->dF_dp[TF_P_SIGMA1] = ds1_dsigma1 * zd;
         dp->dF_dp[TF_P_SIGMA2] = v;
-        dp->dF_dp[TF_P_VD] = vd > 0.0 ? s1 * 2.0 * v * v / (vd * vd * vd) * zd : 0.0;
+        dp->dF_dp[TF_P_VD] = ds1_dvd * zd;
     }
     return s0 * z[0] + s1 * zd + s2 * v;
 }
@@ -130,7 +125,7 @@ static double dahl(const double *p, double v, const double *z, double *dz, tf_fr
  * small forces), one from the steady deflection z_ss = g(v)/sigma0 on, and a half sine between. */
 static double elastoplastic(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac)
 {
-    double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2], vd = p[TF_P_VD], zba = p[TF_P_ZBA];
+    double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2], zba = p[TF_P_ZBA];
     double dg = 0.0;
     double g = tf_stribeck(p, v, jac ? &dg : 0);
     double zss = g / s0, az = fabs(z[0]);
@@ -150,12 +145,8 @@ static double elastoplastic(const double *p, double v, const double *z, double *
     }
     double r = s0 * fabs(v) / g;
     double zd = v - alpha * r * z[0];
-    double s1 = p[TF_P_SIGMA1], ds1 = 0.0;
-    if (vd > 0.0) {
-        double q = v / vd;
-        s1 *= exp(-q * q);
-        ds1 = -2.0 * q / vd * s1;
-    }
+    double ds1;
+    double s1 = tf_sigma1(p, v, &ds1, 0, 0);
     dz[0] = zd;
     if (jac) {
         double dr = s0 * (sgn(v) * g - fabs(v) * dg) / (g * g);

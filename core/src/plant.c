@@ -1,4 +1,4 @@
-/* Plants (SPEC 3) with friction and thermal extension, as one ODE system. */
+/* Plants (docs/models.md#plants) with friction and thermal extension, as one ODE system. */
 #include "thermofriction/plant.h"
 
 #include <math.h>
@@ -53,21 +53,17 @@ double tf_model_temperature(const tf_model *model, double t, const double *y)
     return model->T_const;
 }
 
+/* Model II's F_ref: from the base parameters, the same at every temperature. */
+static double reference_force(const tf_model *m) { return tf_friction_reference_force(m->friction, m->p); }
+
 void tf_model_params_at(const tf_model *model, double T, double *p)
 {
-    memcpy(p, model->p, sizeof(double) * TF_NPARAM);
-    if (model->fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
-    if (model->thermal != TF_THERMAL_MODEL_I) return;
-    for (int i = 0; i < TF_NPARAM; i++)
-        if (model->law[i].kind != TF_LAW_NONE) p[i] = tf_law_eval(&model->law[i], T, 0);
-    if (model->fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
+    tf_thermal_params(model->thermal, model->p, model->law, model->fs_follows_fc, T, p);
 }
 
 double tf_model_lambda(const tf_model *model, double T)
 {
-    if (model->thermal != TF_THERMAL_MODEL_II || model->dF_form != TF_DF_SCALE) return 1.0;
-    double Fref = tf_friction_reference_force(model->friction, model->p);
-    return 1.0 + tf_law_eval(&model->dF, T, 0) / Fref;
+    return tf_thermal_lambda(model->thermal, model->dF_form, &model->dF, reference_force(model), T);
 }
 
 /* Parameters, scale factor and offset force at temperature T, cached per temperature. */
@@ -77,8 +73,7 @@ const double *tf_model_params_cached(tf_model *m, double T, double *lambda, doub
     if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
         tf_model_params_at(m, T, m->cache_p);
         m->cache_lambda = tf_model_lambda(m, T);
-        m->cache_dF = (m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET)
-                          ? tf_law_eval(&m->dF, T, 0) : 0.0;
+        m->cache_dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
         m->cache_T = T;
         m->cache_valid = 1;
     }
@@ -88,8 +83,8 @@ const double *tf_model_params_cached(tf_model *m, double T, double *lambda, doub
 }
 
 /* F' at temperature T and, when jac is given, its partials (overwriting the base model's
- * partials). The base model's parameter partials go to dp, untouched by the thermal factor
- * (the caller applies it). */
+ * partials). The base model's parameter partials go to dp, untouched by Model II (the caller
+ * applies it: tf_thermal_param_partial). */
 static double friction_at(tf_model *m, double T, double t, const double *y, double *dz, tf_friction_partials *jac,
                           tf_friction_param_partials *dp, double *F_base)
 {
@@ -99,20 +94,7 @@ static double friction_at(tf_model *m, double T, double t, const double *y, doub
     int nz = nfric(m);
     double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
     if (F_base) *F_base = F;
-    if (lambda != 1.0) {
-        F *= lambda;
-        if (jac) {
-            jac->dF_dv *= lambda;
-            for (int j = 0; j < nz; j++) jac->dF_dz[j] *= lambda;
-        }
-    }
-    if (dF != 0.0) { /* offset form: dF along a smoothed sign of v */
-        double vs = p[TF_P_VSMOOTH];
-        double s = tanh(v / vs);
-        F += dF * s;
-        if (jac) jac->dF_dv += dF * (1.0 - s * s) / vs;
-    }
-    return F;
+    return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, nz, jac);
 }
 
 static double friction(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac)
@@ -201,15 +183,13 @@ void tf_model_state_scale(const tf_model *model, double *scale)
     }
 }
 
-/* Heat balance (SPEC 5.3) and frictional work from the friction power P = |F' v_r|. */
+/* Heat balance (thermal.h) and frictional work from the friction power P = |F' v_r|. */
 static void heat_rates(const tf_model *m, double t, const double *y, double F, double *dy)
 {
     double P = fabs(F * relative_velocity(m, t, y));
     if (m->heat.on) {
-        const tf_heat *h = &m->heat;
         int iT = tf_model_temperature_index(m);
-        double P_ext = h->P_ext.kind == TF_WAVE_ZERO ? 0.0 : tf_waveform_value(&h->P_ext, t);
-        dy[iT] = (h->eta * P - (y[iT] - h->T_amb) / h->R_th + P_ext) / h->C_th;
+        dy[iT] = tf_heat_rate(&m->heat, t, y[iT], P);
     }
     if (has_work(m)) dy[tf_model_work_index(m)] = P;
 }
@@ -275,9 +255,7 @@ static void heat_jacobian(tf_model *m, double t, const double *y, const tf_frict
             J_(V, iT) = -dF_dT / m->m;
         }
         for (int j = 0; j < nz; j++) J_(nm + j, iT) = ddz_dT[j];
-        const tf_heat *h = &m->heat;
-        for (int k = 0; k < n; k++) J_(iT, k) = h->eta * dP[k] / h->C_th;
-        J_(iT, iT) -= 1.0 / (h->R_th * h->C_th);
+        tf_heat_rate_jacobian(&m->heat, n, iT, dP, &J_(iT, 0));
     }
     for (int k = 0; k < n; k++) J_(iW, k) = dP[k];
 #undef J_
@@ -338,8 +316,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
         for (int j = 0; j < nz; j++) dp.ddz_dp[j][TF_P_FC] += dp.ddz_dp[j][TF_P_FS];
     }
-    int scale = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_SCALE;
-    double Fref = tf_friction_reference_force(m->friction, m->p);
+    double Fref = reference_force(m);
     double v = relative_velocity(m, t, y);
     double s = (F * v > 0.0) - (F * v < 0.0); /* d|F v|/dF = s v */
     for (int k = 0; k < np; k++) {
@@ -348,23 +325,14 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         int i = tg->param;
         for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
         if (tg->kind == TF_TARGET_HEAT) { /* only the heat balance depends on these */
-            const tf_heat *h = &m->heat;
-            if (!h->on) continue;
-            double rate = dy[iT];
-            fp[iT * np + k] = i == TF_HEAT_C_TH   ? -rate / h->C_th
-                              : i == TF_HEAT_R_TH ? (y[iT] - h->T_amb) / (h->R_th * h->R_th * h->C_th)
-                              : i == TF_HEAT_ETA  ? fabs(F * v) / h->C_th
-                              : i == TF_HEAT_T_AMB ? 1.0 / (h->R_th * h->C_th) : 0.0;
+            if (m->heat.on) fp[iT * np + k] = tf_heat_param_partial(&m->heat, i, y[iT], fabs(F * v), dy[iT]);
             continue;
         }
         if (tg->kind == TF_TARGET_DF) {
-            double dlaw = tf_law_coef_derivative(&m->dF, tg->coef, T);
-            if (scale) dF = Fb / Fref * dlaw;
-            else dF = dlaw * tanh(v / m->cache_p[TF_P_VSMOOTH]);
+            dF = tf_thermal_df_coef_partial(m->dF_form, &m->dF, tg->coef, T, Fb, Fref, v, m->cache_p[TF_P_VSMOOTH]);
         } else {
             if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T);
-            dF = chain * dp.dF_dp[i] * (scale ? lambda : 1.0);
-            if (scale && i == TF_P_FC) dF -= (lambda - 1.0) / Fref * Fb; /* F_ref = fc; dF(T) = (lambda-1) F_ref */
+            dF = tf_thermal_param_partial(m->thermal, m->dF_form, lambda, Fref, i, chain * dp.dF_dp[i], Fb);
         }
         if (m->plant == TF_PLANT_STICK_SLIP) {
             fp[VP * np + k] = dF / m->m;
@@ -374,8 +342,9 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         }
         if (tg->kind != TF_TARGET_DF)
             for (int j = 0; j < nz; j++) fp[(nm + j) * np + k] = chain * dp.ddz_dp[j][i];
-        if (iT >= 0) fp[iT * np + k] = m->heat.eta * s * v * dF / m->heat.C_th;
-        if (iW >= 0) fp[iW * np + k] = s * v * dF;
+        double dP = s * v * dF; /* of the friction power |F' v| */
+        if (iT >= 0) fp[iT * np + k] = tf_heat_rate_dP(&m->heat, dP);
+        if (iW >= 0) fp[iW * np + k] = dP;
     }
     return 0;
 }

@@ -73,8 +73,7 @@ void tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, dou
 
 double tf_rt_thermal_force(double F_base, double v, const double *p, double lambda, double dF_offset)
 {
-    double F = lambda * F_base;
-    return dF_offset != 0.0 ? F + dF_offset * tanh(v / p[TF_P_VSMOOTH]) : F;
+    return tf_thermal_force(F_base, v, p[TF_P_VSMOOTH], lambda, dF_offset, 0, 0);
 }
 
 double tf_rt_advance(int kind, const double *p, tf_gms_elements *gms, double *z, double v, double dt,
@@ -104,7 +103,8 @@ double tf_rt_step(tf_rt_friction *f, double v, double T, double dt)
     double lambda, dF, dz[TF_MAX_FRICTION_STATES];
     tf_model *m = &f->model;
     const double *p = tf_model_params_cached(m, T, &lambda, &dF);
-    return tf_rt_thermal_force(tf_rt_advance(m->friction, p, &m->gms, f->z, v, dt, 0, dz), v, p, lambda, dF);
+    double F = tf_rt_advance(m->friction, p, &m->gms, f->z, v, dt, 0, dz);
+    return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 0, 0);
 }
 
 int tf_rt_from_model(tf_rt_friction *f, const tf_model *m)

@@ -1,120 +1,46 @@
-/* Temperature laws (SPEC 5.1, 7). */
+/* Thermal extensions: Model I, Model II and the lumped heat balance (see thermal.h). */
 #include "thermofriction/thermal.h"
 
 #include <math.h>
+#include <string.h>
 
-static int segment(int n, const double *x, double T)
+void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, int fs_follows_fc, double T,
+                       double *p)
 {
-    int lo = 0, hi = n - 1;
-    while (hi - lo > 1) {
-        int mid = lo + (hi - lo) / 2;
-        if (x[mid] <= T) lo = mid; else hi = mid;
-    }
-    return lo;
+    memcpy(p, p_base, sizeof(double) * TF_NPARAM);
+    if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
+    if (thermal != TF_THERMAL_MODEL_I) return;
+    for (int i = 0; i < TF_NPARAM; i++)
+        if (laws[i].kind != TF_LAW_NONE) p[i] = tf_law_eval(&laws[i], T, 0);
+    if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
 }
 
-static double sgn(double v) { return (v > 0) - (v < 0); }
-
-/* One-sided three-point end slope, limited so the end interval keeps its shape. */
-static double pchip_end(double h0, double h1, double m0, double m1)
+double tf_thermal_df_coef_partial(int form, const tf_law *dF, int coef, double T, double F_base, double F_ref,
+                                  double v, double v_smooth)
 {
-    double d = ((2.0 * h0 + h1) * m0 - h0 * m1) / (h0 + h1);
-    if (sgn(d) != sgn(m0)) return 0.0;
-    if (sgn(m0) != sgn(m1) && fabs(d) > 3.0 * fabs(m0)) return 3.0 * m0;
-    return d;
+    double dlaw = tf_law_coef_derivative(dF, coef, T);
+    return form == TF_DF_SCALE ? F_base / F_ref * dlaw : dlaw * tanh(v / v_smooth);
 }
 
-void tf_pchip_slopes(int n, const double *x, const double *y, double *d)
+double tf_heat_rate(const tf_heat *h, double t, double T, double P)
 {
-    if (n < 2) { if (n == 1) d[0] = 0.0; return; }
-    if (n == 2) { d[0] = d[1] = (y[1] - y[0]) / (x[1] - x[0]); return; }
-    for (int k = 1; k < n - 1; k++) {
-        double h0 = x[k] - x[k - 1], h1 = x[k + 1] - x[k];
-        double m0 = (y[k] - y[k - 1]) / h0, m1 = (y[k + 1] - y[k]) / h1;
-        if (m0 == 0.0 || m1 == 0.0 || sgn(m0) != sgn(m1)) { d[k] = 0.0; continue; }
-        double w1 = 2.0 * h1 + h0, w2 = h1 + 2.0 * h0;
-        d[k] = (w1 + w2) / (w1 / m0 + w2 / m1);
-    }
-    double h0 = x[1] - x[0], h1 = x[2] - x[1];
-    d[0] = pchip_end(h0, h1, (y[1] - y[0]) / h0, (y[2] - y[1]) / h1);
-    h0 = x[n - 1] - x[n - 2]; h1 = x[n - 2] - x[n - 3];
-    d[n - 1] = pchip_end(h0, h1, (y[n - 1] - y[n - 2]) / h0, (y[n - 2] - y[n - 3]) / h1);
+    double P_ext = h->P_ext.kind == TF_WAVE_ZERO ? 0.0 : tf_waveform_value(&h->P_ext, t);
+    return (h->eta * P - (T - h->T_amb) / h->R_th + P_ext) / h->C_th;
 }
 
-static double pwl(const tf_law *law, double T, double *dT)
+void tf_heat_rate_jacobian(const tf_heat *h, int n, int iT, const double *dP_dy, double *row)
 {
-    const double *x = law->x, *y = law->y;
-    int n = law->n;
-    if (n == 1) { *dT = 0.0; return y[0]; }
-    int i = T <= x[0] ? 0 : (T >= x[n - 1] ? n - 2 : segment(n, x, T));
-    double slope = (y[i + 1] - y[i]) / (x[i + 1] - x[i]);
-    *dT = slope;
-    return y[i] + slope * (T - x[i]);
+    for (int k = 0; k < n; k++) row[k] = tf_heat_rate_dP(h, dP_dy[k]);
+    row[iT] -= 1.0 / (h->R_th * h->C_th);
 }
 
-static double table(const tf_law *law, double T, double *dT)
+double tf_heat_param_partial(const tf_heat *h, int param, double T, double P, double rate)
 {
-    const double *x = law->x, *y = law->y, *d = law->d;
-    int n = law->n;
-    if (n == 1) { *dT = 0.0; return y[0]; }
-    if (T < x[0]) { *dT = d[0]; return y[0] + d[0] * (T - x[0]); }
-    if (T > x[n - 1]) { *dT = d[n - 1]; return y[n - 1] + d[n - 1] * (T - x[n - 1]); }
-    int i = segment(n, x, T);
-    if (i > n - 2) i = n - 2;
-    double h = x[i + 1] - x[i], s = (T - x[i]) / h;
-    double s2 = s * s, s3 = s2 * s;
-    double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
-    double dh00 = 6 * s2 - 6 * s, dh10 = 3 * s2 - 4 * s + 1, dh01 = -6 * s2 + 6 * s, dh11 = 3 * s2 - 2 * s;
-    *dT = (dh00 * y[i] + dh01 * y[i + 1]) / h + dh10 * d[i] + dh11 * d[i + 1];
-    return h00 * y[i] + h10 * h * d[i] + h01 * y[i + 1] + h11 * h * d[i + 1];
-}
-
-double tf_law_eval(const tf_law *law, double T, double *dvalue_dT)
-{
-    double v = 0.0, d = 0.0;
-    switch (law->kind) {
-    case TF_LAW_CONST: v = law->a; break;
-    case TF_LAW_LINEAR: v = law->a * T + law->b; d = law->a; break;
-    case TF_LAW_EXP: v = law->a * exp(law->b * T); d = law->b * v; break;
-    case TF_LAW_POLY:
-        for (int i = law->n - 1; i >= 0; i--) { d = d * T + v; v = v * T + law->y[i]; }
-        break;
-    case TF_LAW_PWL: v = pwl(law, T, &d); break;
-    case TF_LAW_TABLE: v = table(law, T, &d); break;
-    default: break;
-    }
-    if (dvalue_dT) *dvalue_dT = d;
-    return v;
-}
-
-int tf_law_ncoef(const tf_law *law)
-{
-    switch (law->kind) {
-    case TF_LAW_CONST: return 1;
-    case TF_LAW_LINEAR: case TF_LAW_EXP: return 2;
-    case TF_LAW_POLY: case TF_LAW_PWL: return law->n;
-    default: return 0;
-    }
-}
-
-double tf_law_coef_derivative(const tf_law *law, int coef, double T)
-{
-    if (coef < 0 || coef >= tf_law_ncoef(law)) return NAN;
-    switch (law->kind) {
-    case TF_LAW_CONST: return 1.0;
-    case TF_LAW_LINEAR: return coef == 0 ? T : 1.0;
-    case TF_LAW_EXP: return coef == 0 ? exp(law->b * T) : law->a * T * exp(law->b * T);
-    case TF_LAW_POLY: return pow(T, coef);
-    case TF_LAW_PWL: {
-        int n = law->n;
-        if (n == 1) return 1.0;
-        const double *x = law->x;
-        int i = T <= x[0] ? 0 : (T >= x[n - 1] ? n - 2 : segment(n, x, T));
-        double s = (T - x[i]) / (x[i + 1] - x[i]); /* outside [x0, xn]: the end segment, extended */
-        if (coef == i) return 1.0 - s;
-        if (coef == i + 1) return s;
-        return 0.0;
-    }
-    default: return NAN;
+    switch (param) {
+    case TF_HEAT_C_TH: return -rate / h->C_th;
+    case TF_HEAT_R_TH: return (T - h->T_amb) / (h->R_th * h->R_th * h->C_th);
+    case TF_HEAT_ETA: return P / h->C_th;
+    case TF_HEAT_T_AMB: return 1.0 / (h->R_th * h->C_th);
+    default: return 0.0; /* T_0: through the initial state only */
     }
 }

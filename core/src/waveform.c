@@ -1,4 +1,4 @@
-/* Input waveforms (SPEC 6). */
+/* Input waveforms (docs/formats.md#inputs). */
 #include "thermofriction/waveform.h"
 
 #include <math.h>

@@ -476,8 +476,63 @@ static void test_rt_parameter_update_and_reset(void)
     CHECK(f.z[0] == 0.0 && fabs(tf_rt_step(&f, v, NAN, 0.0) - (1.4 + 316.2) * v) < 1e-12, "reset to rest");
 }
 
+/* The shared helpers of friction.h and thermal.h against central differences: sigma1(v) in v,
+ * sigma1 and vd; Model II's force in v (offset form); the heat balance in T and its parameters. */
+static void test_sigma1_thermal_force_and_heat_rate_partials(void)
+{
+    double p[TF_NPARAM] = {0}, q[TF_NPARAM];
+    p[TF_P_SIGMA1] = 3.0; p[TF_P_VD] = 2e-3;
+    double v = 1.3e-3, d_dv, d_ds1, d_dvd;
+    double s1 = tf_sigma1(p, v, &d_dv, &d_ds1, &d_dvd);
+    CHECK(fabs(s1 - 3.0 * exp(-(v / 2e-3) * (v / 2e-3))) < 1e-15, "sigma1(v)");
+    double h = 1e-9;
+    CHECK(fabs(d_dv - (tf_sigma1(p, v + h, 0, 0, 0) - tf_sigma1(p, v - h, 0, 0, 0)) / (2 * h)) < 1e-6 * fabs(d_dv),
+          "dsigma1/dv");
+    memcpy(q, p, sizeof q); q[TF_P_SIGMA1] += 1e-6;
+    CHECK(fabs(d_ds1 - (tf_sigma1(q, v, 0, 0, 0) - s1) / 1e-6) < 1e-8, "dsigma1/dsigma1");
+    memcpy(q, p, sizeof q); q[TF_P_VD] += 1e-10;
+    double fd = tf_sigma1(q, v, 0, 0, 0);
+    q[TF_P_VD] -= 2e-10;
+    fd = (fd - tf_sigma1(q, v, 0, 0, 0)) / 2e-10;
+    CHECK(fabs(d_dvd - fd) < 1e-6 * fabs(d_dvd), "dsigma1/dvd");
+    p[TF_P_VD] = 0.0;
+    CHECK(tf_sigma1(p, v, &d_dv, &d_ds1, &d_dvd) == 3.0 && d_dv == 0.0 && d_ds1 == 1.0 && d_dvd == 0.0,
+          "sigma1 constant for vd <= 0");
+
+    tf_friction_partials jac;
+    memset(&jac, 0, sizeof jac);
+    jac.dF_dv = 2.0; jac.dF_dz[0] = 5.0;
+    double vs = 1e-4, lambda = 0.8, off = 0.3, Fb = 1.5;
+    double F = tf_thermal_force(Fb, v, vs, lambda, off, 1, &jac);
+    CHECK(F == lambda * Fb + off * tanh(v / vs), "Model II force");
+    double dv = 1e-9, Fp = tf_thermal_force(Fb + 2.0 * dv, v + dv, vs, lambda, off, 0, 0),
+           Fm = tf_thermal_force(Fb - 2.0 * dv, v - dv, vs, lambda, off, 0, 0);
+    CHECK(fabs(jac.dF_dv - (Fp - Fm) / (2 * dv)) < 1e-6 * fabs(jac.dF_dv) && jac.dF_dz[0] == 5.0 * lambda,
+          "Model II force partials");
+
+    tf_heat heat;
+    memset(&heat, 0, sizeof heat);
+    heat.on = 1; heat.C_th = 0.01; heat.R_th = 200.0; heat.eta = 0.8; heat.T_amb = 25.0;
+    double T = 31.0, P = 0.02, rate = tf_heat_rate(&heat, 0.0, T, P);
+    CHECK(fabs(rate - (0.8 * P - (T - 25.0) / 200.0) / 0.01) < 1e-12, "heat rate");
+    double row[3], dP[3] = {0.0, 0.5, 0.0};
+    tf_heat_rate_jacobian(&heat, 3, 2, dP, row);
+    CHECK(fabs(row[1] - 0.8 * 0.5 / 0.01) < 1e-12 && fabs(row[2] + 1.0 / (200.0 * 0.01)) < 1e-12, "heat Jacobian row");
+    double *field[] = {&heat.C_th, &heat.R_th, &heat.eta, &heat.T_amb};
+    for (int k = 0; k < 4; k++) {
+        double x = *field[k], e = 1e-7 * fabs(x);
+        *field[k] = x + e; double rp = tf_heat_rate(&heat, 0.0, T, P);
+        *field[k] = x - e; double rm = tf_heat_rate(&heat, 0.0, T, P);
+        *field[k] = x;
+        double d = tf_heat_param_partial(&heat, k, T, P, rate);
+        CHECK(fabs(d - (rp - rm) / (2 * e)) < 1e-6 * fabs(d), "heat parameter partial %d", k);
+    }
+    CHECK(tf_heat_param_partial(&heat, TF_HEAT_T_0, T, P, rate) == 0.0, "T_0 enters through the initial state");
+}
+
 int main(void)
 {
+    test_sigma1_thermal_force_and_heat_rate_partials();
     test_rt_parameter_update_and_reset();
     test_rt_exact_for_constant_velocity_and_stable_at_large_steps();
     test_rt_observer_converges();

@@ -1,5 +1,5 @@
 /* Friction compensation for position control loops, and a fixed-step closed-loop simulation of a
- * single-mass stage (SPEC 3.2) that uses them. Allocation-free, plain C99 + libm.
+ * single-mass stage (docs/models.md#mass-plant) that uses them. Allocation-free, plain C99 + libm.
  *
  *   - tf_pid: a PID on the position error with a first-order filter on the derivative.
  *   - Feed-forward compensation: the friction model driven by the reference velocity,

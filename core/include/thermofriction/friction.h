@@ -1,8 +1,10 @@
-/* Friction models (SPEC 4). A model maps relative velocity v, internal state z and parameters
- * p (already evaluated at the current temperature) to the force F that resists sliding and to
- * dz/dt. In steady sliding F has the sign of v. */
+/* Friction models (docs/models.md#friction-models). A model maps relative velocity v, internal
+ * state z and parameters p (already evaluated at the current temperature) to the force F that
+ * resists sliding and to dz/dt. In steady sliding F has the sign of v. */
 #ifndef THERMOFRICTION_FRICTION_H
 #define THERMOFRICTION_FRICTION_H
+
+#include <math.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -69,6 +71,25 @@ int tf_friction_nstate(int kind, int n_elements);
 double tf_friction_reference_force(int kind, const double *p);
 /* Stribeck curve g(v) = fc + (fs - fc) exp(-|v/vs|^delta), and dg/dv in *dg when not NULL. */
 double tf_stribeck(const double *p, double v, double *dg);
+/* LuGre's velocity-dependent damping (the bristle models: LuGre, elasto-plastic, the observer):
+ * sigma1(v) = sigma1 exp(-(v/vd)^2) when vd > 0, else sigma1. Its derivatives with respect to v, to
+ * the parameter sigma1 and to vd go where the pointers are not NULL. Inline: it is on every step. */
+static inline double tf_sigma1(const double *p, double v, double *d_dv, double *d_dsigma1, double *d_dvd)
+{
+    double vd = p[TF_P_VD], s1 = p[TF_P_SIGMA1];
+    if (!(vd > 0.0)) {
+        if (d_dv) *d_dv = 0.0;
+        if (d_dsigma1) *d_dsigma1 = 1.0;
+        if (d_dvd) *d_dvd = 0.0;
+        return s1;
+    }
+    double q = v / vd, e = exp(-q * q);
+    s1 *= e;
+    if (d_dv) *d_dv = -2.0 * q / vd * s1;
+    if (d_dsigma1) *d_dsigma1 = e;
+    if (d_dvd) *d_dvd = s1 * 2.0 * v * v / (vd * vd * vd);
+    return s1;
+}
 /* Force and state rates; state partials when jac is not NULL, parameter partials when dp
  * is not NULL (LuGre only: others report zeros). gms is read for TF_FRICTION_GMS only. */
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,

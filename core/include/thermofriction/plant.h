@@ -1,5 +1,6 @@
-/* Plants (SPEC 3) assembled with a friction model, its thermal extension, an input waveform
- * and a temperature signal into one ODE system: right-hand side, analytic Jacobian, outputs. */
+/* Plants (docs/models.md#plants) assembled with a friction model, its thermal extension, an input
+ * waveform and a temperature signal into one ODE system: right-hand side, analytic Jacobian,
+ * outputs. */
 #ifndef THERMOFRICTION_PLANT_H
 #define THERMOFRICTION_PLANT_H
 
@@ -13,9 +14,12 @@ extern "C" {
 #endif
 
 typedef enum {
-    TF_PLANT_STICK_SLIP = 0, /* SPEC 3.1: states x_p, v_p, x_e, v_e, then friction states */
-    TF_PLANT_MASS = 1,       /* SPEC 3.2: m x'' = u(t) + k_s (v_0 t - x) - F, v_r = x'; states x, v, then friction */
-    TF_PLANT_PRESCRIBED = 2  /* SPEC 3.3: x_r = u(t) [m] given, v_r = u'(t); friction states only */
+    /* docs/models.md#stick-slip-actuator: states x_p, v_p, x_e, v_e, then friction states */
+    TF_PLANT_STICK_SLIP = 0,
+    /* docs/models.md#mass-plant: m x'' = u(t) + k_s (v_0 t - x) - F, v_r = x'; states x, v, then friction */
+    TF_PLANT_MASS = 1,
+    /* docs/models.md#prescribed-motion: x_r = u(t) [m] given, v_r = u'(t); friction states only */
+    TF_PLANT_PRESCRIBED = 2
 } tf_plant_kind;
 
 /* Output channels, in this order, then the friction states, then the frictional work (where
@@ -33,20 +37,6 @@ typedef enum {
     TF_OUT_TEMPERATURE,
     TF_OUT_NFIXED
 } tf_output_channel;
-
-/* Lumped thermal model (SPEC 5.3). With `on` set the temperature is a state,
- *   C_th T' = eta |F' v_r| - (T - T_amb) / R_th + P_ext(t),   T(0) = T_0,
- * and the model's T_const / T_n are not used. |F' v_r| counts all the friction force's power as
- * heat, including what a bristle model stores and returns elastically (SPEC's reading). */
-typedef struct {
-    int on;
-    double C_th;       /* heat capacity [J/K] */
-    double R_th;       /* thermal resistance to ambient [K/W] */
-    double eta;        /* fraction of the frictional power that heats the interface, 0..1 */
-    double T_amb;      /* ambient temperature [degC] */
-    double T_0;        /* initial temperature [degC] */
-    tf_waveform P_ext; /* external heat input [W]; TF_WAVE_ZERO: none */
-} tf_heat;
 
 /* The most states a model has: 4 mechanical, the friction states, temperature, frictional work. */
 #define TF_MAX_STATES (TF_MAX_FRICTION_STATES + 6)
@@ -75,7 +65,7 @@ typedef struct {
     double T_const;
     int T_n;
     const double *T_t, *T_v;
-    tf_heat heat;
+    tf_heat heat;               /* the lumped heat balance (thermal.h) */
 
     /* States after the friction states: the temperature (heat.on), then the frictional work
        W = integral of |F' v_r| dt [J] (heat.on or work set): per-cycle dissipation to solver
@@ -92,14 +82,15 @@ typedef struct {
 void tf_model_prepare(tf_model *model);
 
 /* Checks a model before it is simulated: every number the plant, friction model, thermal
- * extension, input and temperature use is finite and in its domain (SPEC 3-5: masses,
- * stiffnesses, sigma0, fc, C, v_smooth > 0; damping, sigma1, sigma2, z_ba >= 0; fs >= fc;
- * vs > 0 where fs != fc; elasto-plastic z_ba < fc/sigma0; 1..64 GMS elements with k_i, w_i > 0
- * summing to one; Model I parameters and Model II's lambda checked at the constant temperature
- * or over the sampled one; periodic inputs with a positive frequency; for prescribed motion a
- * continuous input). Returns TF_OK, or TF_ERR_BAD_ARGUMENT with the offending field's name in
- * *what (a static string; may be NULL). tf_solve does not call it: callers that build models
- * from user data must (the Python package checks the same rules, with messages). */
+ * extension, input and temperature use is finite and in its domain (docs/models.md#plants,
+ * #friction-models, #thermal-extensions: masses, stiffnesses, sigma0, fc, C, v_smooth > 0;
+ * damping, sigma1, sigma2, z_ba >= 0; fs >= fc; vs > 0 where fs != fc; elasto-plastic z_ba <
+ * fc/sigma0; 1..64 GMS elements with k_i, w_i > 0 summing to one; Model I parameters and Model
+ * II's lambda checked at the constant temperature or over the sampled one; periodic inputs with a
+ * positive frequency; for prescribed motion a continuous input). Returns TF_OK, or
+ * TF_ERR_BAD_ARGUMENT with the offending field's name in *what (a static string; may be NULL).
+ * tf_solve does not call it: callers that build models from user data must (the Python package
+ * checks the same rules, with messages). */
 int tf_model_check(const tf_model *model, const char **what);
 
 int tf_model_nstate(const tf_model *model);
@@ -126,12 +117,8 @@ typedef enum {
     TF_TARGET_PARAM = 0, /* friction parameter `param` given as a number */
     TF_TARGET_LAW = 1,   /* coefficient `coef` of the Model I law of parameter `param` */
     TF_TARGET_DF = 2,    /* coefficient `coef` of Model II's dF law */
-    TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param */
+    TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param (thermal.h) */
 } tf_target_kind;
-
-/* TF_HEAT_T_0 enters through the initial state only (S_T(0) = 1): its right-hand-side partials are
- * zero, and whoever starts a sensitivity integration sets that column (the binding does). */
-typedef enum { TF_HEAT_C_TH = 0, TF_HEAT_R_TH, TF_HEAT_ETA, TF_HEAT_T_AMB, TF_HEAT_T_0, TF_HEAT_NPARAM } tf_heat_param;
 
 typedef struct {
     int kind, param, coef;

@@ -57,16 +57,16 @@ void tf_rt_reset(tf_rt_friction *f);
 /* Parameters at temperature T [degC] into p[TF_NPARAM]; *lambda, *dF_offset (may be NULL). */
 void tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset);
 /* Advances the internal states by dt [s] at sliding velocity v [m/s] and temperature T [degC]
- * (ignored without a thermal model) and returns the friction force F [N] (SPEC 2's sign: the
- * force resisting sliding, with v's sign in steady sliding). dt <= 0 returns the force without
- * advancing. */
+ * (ignored without a thermal model) and returns the friction force F [N] (the sign convention of
+ * docs/models.md#conventions: the force resisting sliding, with v's sign in steady sliding).
+ * dt <= 0 returns the force without advancing. */
 double tf_rt_step(tf_rt_friction *f, double v, double T, double dt);
 
 /* The friction model and thermal extension of a simulation model (plant.h's tf_model), for
  * callers that already configure one; its laws' arrays must outlive f. */
 int tf_rt_from_model(tf_rt_friction *f, const tf_model *model);
-/* F' from the base model's force: Model II's scale factor and offset (SPEC 5.2) as
- * tf_rt_params_at gives them, at sliding velocity v with parameters p. */
+/* F' from the base model's force: Model II's scale factor and offset (docs/models.md#model-ii) as
+ * tf_rt_params_at gives them, at sliding velocity v with parameters p (tf_thermal_force, thermal.h). */
 double tf_rt_thermal_force(double F_base, double v, const double *p, double lambda, double dF_offset);
 
 /* The core of tf_rt_step for callers that add terms to the state equation (observers): advances

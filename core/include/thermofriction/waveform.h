@@ -1,4 +1,4 @@
-/* Input waveforms (SPEC 6): value, slope and corner times.
+/* Input waveforms (docs/formats.md#inputs): value, slope and corner times.
  * A corner is a time where the waveform or its slope jumps; integrators stop there. */
 #ifndef THERMOFRICTION_WAVEFORM_H
 #define THERMOFRICTION_WAVEFORM_H
