@@ -19,12 +19,21 @@ HEADERS = sorted((ROOT / "core" / "include").rglob("*.h"))
 PACKAGE = ROOT / "src" / "thermofriction"
 
 
+def header_parameter_list() -> list:
+    """The entries X(symbol, "name", "unit", ...) of friction.h's TF_PARAMETERS list."""
+    text = (ROOT / "core" / "include" / "thermofriction" / "friction.h").read_text()
+    block = re.search(r"#define TF_PARAMETERS\(X\)(.*?)\n\s*\n", text, flags=re.S).group(1)
+    return re.findall(r'X\((\w+),\s*"([^"]+)",\s*"([^"]+)"', block)
+
+
 def header_enum_constants() -> dict:
-    """Every enumerator of every ``typedef enum { ... }`` in the public headers: name -> header."""
-    found = {}
+    """Every enumerator of every ``typedef enum { ... }`` in the public headers (the parameter enum
+    expanded from its list): name -> header."""
+    found = {f"TF_P_{sym}": "friction.h" for sym, _, _ in header_parameter_list()}
     for h in HEADERS:
         text = re.sub(r"/\*.*?\*/", "", h.read_text(), flags=re.S)  # comments may mention names
         for body in re.findall(r"enum\s*\w*\s*\{(.*?)\}", text, flags=re.S):
+            body = re.sub(r"TF_PARAMETERS\(\w+\)", "", body)  # the parameter list, expanded above
             for item in body.split(","):
                 m = re.match(r"\s*(TF_[A-Z0-9_]+)", item)
                 if m:
@@ -49,6 +58,13 @@ def test_every_header_constant_is_exported_and_nothing_else():
     extra = sorted(exported - headers - {"TF_MAX_FRICTION_STATES", "TF_MAX_STATES", "TF_MAX_TARGETS"})
     assert not missing, f"header constants the binding does not export (add them to _core.c): {missing}"
     assert not extra, f"exported names that are in no header: {extra}"
+
+
+def test_parameter_names_and_units_come_from_the_header_list():
+    entries = header_parameter_list()
+    assert len(entries) == _core.CONSTANTS["limit"]["parameters"] >= 11
+    assert _bridge.PARAMETERS == tuple(name for _, name, _ in entries)
+    assert tf.models.PARAMETER_UNITS == {name: unit for _, name, unit in entries}
 
 
 def test_macro_limits_match_headers():

@@ -35,8 +35,9 @@ def _ordered(group: str) -> tuple:
     return tuple(names)
 
 
-#: Friction parameters in the core's order (friction.h, tf_param).
+#: Friction parameters in the core's order, and their units (friction.h, TF_PARAMETERS).
 PARAMETERS = _ordered("parameter")
+PARAMETER_UNITS = {name: _core.PARAMETER_UNITS[name] for name in PARAMETERS}
 PLANT_CODES = dict(_GROUPS["plant"])
 FRICTION_CODES = dict(_GROUPS["friction"])
 LAW_CODES = dict(_GROUPS["law"])

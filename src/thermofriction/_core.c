@@ -645,10 +645,9 @@ typedef struct {
 
 #define C(group, name, sym) {group, name, #sym, (long)(sym)}
 static const tf_constant constants[] = {
-    C("parameter", "sigma0", TF_P_SIGMA0), C("parameter", "sigma1", TF_P_SIGMA1), C("parameter", "sigma2", TF_P_SIGMA2),
-    C("parameter", "fc", TF_P_FC), C("parameter", "fs", TF_P_FS), C("parameter", "vs", TF_P_VS),
-    C("parameter", "delta", TF_P_DELTA), C("parameter", "vd", TF_P_VD), C("parameter", "v_smooth", TF_P_VSMOOTH),
-    C("parameter", "z_ba", TF_P_ZBA), C("parameter", "C", TF_P_C),
+#define PARAMETER(symbol, name, unit, meaning) C("parameter", name, TF_P_##symbol),
+    TF_PARAMETERS(PARAMETER)
+#undef PARAMETER
     C("plant", "stick-slip", TF_PLANT_STICK_SLIP), C("plant", "mass", TF_PLANT_MASS),
     C("plant", "prescribed", TF_PLANT_PRESCRIBED),
     C("friction", "lugre", TF_FRICTION_LUGRE), C("friction", "coulomb", TF_FRICTION_COULOMB),
@@ -706,6 +705,17 @@ static int add_constants(PyObject *mod)
         Py_DECREF(v);
         if (bad) goto fail;
     }
+    /* PARAMETER_UNITS: {name: unit}, from the same list as the indices */
+    PyObject *units = Py_BuildValue("{" 
+#define UNIT_FORMAT(symbol, name, unit, meaning) "s:s"
+                                    TF_PARAMETERS(UNIT_FORMAT)
+#undef UNIT_FORMAT
+                                    "}"
+#define UNIT_ARGS(symbol, name, unit, meaning) , name, unit
+                                    TF_PARAMETERS(UNIT_ARGS)
+#undef UNIT_ARGS
+    );
+    if (!units || PyModule_AddObject(mod, "PARAMETER_UNITS", units) < 0) { Py_XDECREF(units); goto fail; }
     if (PyModule_AddObject(mod, "CONSTANTS", groups) < 0) goto fail;
     groups = NULL;
     if (PyModule_AddObject(mod, "C_NAMES", c_names) < 0) goto fail;

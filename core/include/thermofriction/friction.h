@@ -10,22 +10,27 @@
 extern "C" {
 #endif
 
-/* Parameter indices: every model reads the ones it needs from one array, so that a
- * temperature law or a sensitivity can address any parameter by index. */
-typedef enum {
-    TF_P_SIGMA0 = 0, /* bristle stiffness [N/m] */
-    TF_P_SIGMA1,     /* bristle damping [N s/m] */
-    TF_P_SIGMA2,     /* viscous friction [N s/m] */
-    TF_P_FC,         /* Coulomb level [N] */
-    TF_P_FS,         /* static (stiction) level [N]; fs = fc turns the Stribeck effect off */
-    TF_P_VS,         /* Stribeck velocity [m/s] */
-    TF_P_DELTA,      /* Stribeck exponent [-] */
-    TF_P_VD,         /* sigma1 velocity scale [m/s]; <= 0: sigma1 constant */
-    TF_P_VSMOOTH,    /* velocity band of smoothed signs [m/s] */
-    TF_P_ZBA,        /* elasto-plastic break-away deflection [m] */
-    TF_P_C,          /* GMS: rate at which a slipping element's force approaches its capacity [N/s] */
-    TF_NPARAM
-} tf_param;
+/* The friction parameters, one line each: X(symbol, name in model files, unit, meaning). Every
+ * model reads the ones it needs from one array indexed by TF_P_<symbol>, so that a temperature law
+ * or a sensitivity can address any parameter by index. This list is the one source of the
+ * parameters: the enum below, the Python binding's parameter names and units, and so the package's
+ * model files, laws and identification all come from it. */
+#define TF_PARAMETERS(X)                                                                                \
+    X(SIGMA0, "sigma0", "N/m", "bristle stiffness")                                                     \
+    X(SIGMA1, "sigma1", "N s/m", "bristle damping")                                                     \
+    X(SIGMA2, "sigma2", "N s/m", "viscous friction")                                                    \
+    X(FC, "fc", "N", "Coulomb level")                                                                   \
+    X(FS, "fs", "N", "static (stiction) level; fs = fc turns the Stribeck effect off")                  \
+    X(VS, "vs", "m/s", "Stribeck velocity")                                                             \
+    X(DELTA, "delta", "-", "Stribeck exponent")                                                         \
+    X(VD, "vd", "m/s", "sigma1 velocity scale; <= 0: sigma1 constant")                                  \
+    X(VSMOOTH, "v_smooth", "m/s", "velocity band of smoothed signs")                                    \
+    X(ZBA, "z_ba", "m", "elasto-plastic break-away deflection")                                         \
+    X(C, "C", "N/s", "GMS: rate at which a slipping element's force approaches its capacity")
+
+#define TF_PARAMETER_ENUM_(symbol, name, unit, meaning) TF_P_##symbol,
+typedef enum { TF_PARAMETERS(TF_PARAMETER_ENUM_) TF_NPARAM } tf_param;
+#undef TF_PARAMETER_ENUM_
 
 typedef enum {
     TF_FRICTION_LUGRE = 0,         /* z' = v - sigma0 |v| z / g(v); F = sigma0 z + sigma1(v) z' + sigma2 v */

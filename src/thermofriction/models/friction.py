@@ -8,13 +8,12 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from .._bridge import PARAMETERS
+from .._bridge import PARAMETER_UNITS, PARAMETERS
 from ..errors import InputError, unknown_keys
 from ._parse import num, num_array
 
-#: The unit of each friction parameter (the one table: files, reports and fit results use it).
-PARAMETER_UNITS = {"sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m", "fc": "N", "fs": "N", "vs": "m/s",
-                   "delta": "-", "vd": "m/s", "v_smooth": "m/s", "z_ba": "m", "C": "N/s"}
+# PARAMETERS and PARAMETER_UNITS (the one table of units: files, reports and fit results use it) come
+# from the core's parameter list (friction.h, TF_PARAMETERS).
 
 
 class _Friction:
