@@ -291,7 +291,7 @@ def test_heat_identification_recovers_c_r_eta_with_a_known_heater():
         p = fit.parameters[name]
         assert p.ci95[0] <= true <= p.ci95[1], (name, p)
         assert abs(p.value - true) < 0.01 * true, (name, p)
-    assert fit.experiments[0]["rmse"] < 30e-9
+    assert fit.experiments[0]["rmse_offset_removed"] < 30e-9
     assert fit.experiments[0]["temperature_rmse"] < 0.03
     assert fit.model.heat.heat_capacity == pytest.approx(fit.parameters["C_th"].value)
 

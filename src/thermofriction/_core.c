@@ -313,6 +313,7 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     int have_out = 0, have_sens = 0, have_tg = 0;
     double *atol = NULL, *Y = NULL;
     if (parse_model(&a, spec, &m)) goto done;
+    if (check_model(&m)) goto done; /* a fit must never integrate a model the simulator would refuse */
     if (PyObject_GetBuffer(tg_obj, &tgv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) goto done;
     have_tg = 1;
     if (tgv.itemsize != 4 || tgv.len % 12 != 0 || tgv.len == 0) {

@@ -281,9 +281,11 @@ def cmd_validate(args) -> int:
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)
+    for f in res.failures:  # the others were still predicted; the exit status says some were not
+        print(f"thermofriction: {f.file}: not predicted: {f.reason}", file=sys.stderr)
     if args.json:
         print(f"wrote {args.json}")
-    return 0
+    return 1 if res.failures else 0
 
 
 def cmd_report(args) -> int:
@@ -332,7 +334,7 @@ def cmd_demo(args) -> int:
     for key, label in (("model-i", "Model I"), ("model-ii", "Model II"), ("base", "no thermal model")):
         s = out["validation"][key]["summary"].get("validate", {})
         print(f"  {label:17s} identified in {fits[key].wall_time:5.1f} s; held-out max error "
-              f"{s.get('max_error_pct', float('nan')):.3g} %, RMSE {s.get('rmse', float('nan')) * 1e9:.4g} nm")
+              f"{s.get('max_error_pct', float('nan')):.3g} %, RMSE {s.get('rmse_offset_removed', float('nan')) * 1e9:.4g} nm")
     print(f"  report: {out['report']}")
     return 0
 

@@ -10,8 +10,9 @@ import warnings
 import numpy as np
 
 from ._io import dump_json, jsonable
-from .errors import InputError, TemperatureRangeWarning
+from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from .drive import drive
+from .identify.quality import fit_quality
 from .models import Model, require_actuator
 from .simulate import StepSizeController, simulate
 
@@ -46,19 +47,33 @@ class Prediction:
     measured: np.ndarray
     predicted: np.ndarray
     max_error_pct: float
-    rmse: float
+    rmse: float                 # the mean offset removed: the same definition as identification's
     nrmse: float
     final_error_pct: float
     step_error_pct: float
     step_error: float
     measured_steps: np.ndarray
     predicted_steps: np.ndarray
+    fit_quality: dict | None = None
 
     def metrics(self) -> dict:
         return {"file": self.file, "temperature": self.temperature, "role": self.role,
-                "max_error_pct": self.max_error_pct, "rmse": self.rmse, "nrmse": self.nrmse,
+                "max_error_pct": self.max_error_pct, "rmse_offset_removed": self.rmse, "nrmse": self.nrmse,
                 "final_error_pct": self.final_error_pct, "step_error_pct": self.step_error_pct,
-                "step_error": self.step_error}
+                "step_error": self.step_error, "fit_quality": self.fit_quality}
+
+
+@dataclasses.dataclass
+class Failure:
+    """An experiment the model could not be run on, and why."""
+
+    file: str
+    temperature: float
+    role: str
+    reason: str
+
+    def metrics(self) -> dict:
+        return {"file": self.file, "temperature": self.temperature, "role": self.role, "failed": self.reason}
 
 
 def predict(model: Model, exp, rtol=1e-8) -> Prediction:
@@ -73,7 +88,9 @@ def predict(model: Model, exp, rtol=1e-8) -> Prediction:
     meas = meas - _zero(meas, pred)
     err = pred - meas
     span = float(np.max(meas) - np.min(meas)) or 1e-300
-    rmse = float(np.sqrt(np.mean(err ** 2)))
+    # RMSE as identification measures it: about the mean offset (the sensor's zero is arbitrary)
+    quality = fit_quality(err - err.mean(), meas)
+    rmse = quality["rmse"]
     net = meas[-1] - meas[0]
     ms = step_sizes(exp.time, meas, waveform.period)
     ps = step_sizes(exp.time, pred, waveform.period)
@@ -84,7 +101,7 @@ def predict(model: Model, exp, rtol=1e-8) -> Prediction:
         step_err = step_pct = math.nan
     return Prediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time), meas, pred,
                       100 * float(np.max(np.abs(err))) / span, rmse, rmse / span,
-                      100 * float(err[-1]) / (abs(net) or 1e-300), step_pct, step_err, ms, ps)
+                      100 * float(err[-1]) / (abs(net) or 1e-300), step_pct, step_err, ms, ps, quality)
 
 
 @dataclasses.dataclass
@@ -92,10 +109,17 @@ class ValidationResult:
     model: Model
     predictions: list
     warnings: list
+    #: experiments the model could not be run on (Failure: file, reason); the others are still computed
+    failures: list = dataclasses.field(default_factory=list)
 
     @property
     def experiments(self):
         return [p.metrics() for p in self.predictions]
+
+    @property
+    def complete(self) -> bool:
+        """Every experiment was predicted."""
+        return not self.failures
 
     def summary(self) -> dict:
         out = {}
@@ -104,26 +128,26 @@ class ValidationResult:
             if ps:
                 out[role] = {"max_error_pct": max(p.max_error_pct for p in ps),
                              "mean_max_error_pct": float(np.mean([p.max_error_pct for p in ps])),
-                             "rmse": float(np.sqrt(np.mean([p.rmse ** 2 for p in ps]))),
+                             "rmse_offset_removed": float(np.sqrt(np.mean([p.rmse ** 2 for p in ps]))),
                              "n": len(ps)}
         return out
 
     def to_dict(self) -> dict:
         return jsonable({"model": self.model.name, "experiments": self.experiments, "summary": self.summary(),
-                         "warnings": self.warnings})
+                         "failed": [f.metrics() for f in self.failures], "warnings": self.warnings})
 
     def to_json(self, path=None) -> str:
         """The metrics (docs/formats.md#validation-metrics) as JSON, written atomically to ``path`` when given."""
         return dump_json(self.to_dict(), path)
 
     _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
-                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm]", "rmse", "{:.4g}"),
+                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm], offset removed", "rmse_offset_removed", "{:.4g}"),
                 ("NRMSE", "nrmse", "{:.3g}"), ("final error [%]", "final_error_pct", "{:+.3g}"),
                 ("step error [%]", "step_error_pct", "{:.3g}"))
 
     def rows(self):
         for m in self.experiments:
-            yield [fmt.format(m[key] * 1e9 if key == "rmse" else m[key]) for _, key, fmt in self._COLUMNS]
+            yield [fmt.format(m[key] * 1e9 if key == "rmse_offset_removed" else m[key]) for _, key, fmt in self._COLUMNS]
 
     def table(self) -> str:
         head = [c[0] for c in self._COLUMNS]
@@ -157,13 +181,16 @@ def validate(model: Model, data, experiments=None) -> ValidationResult:
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")
-    caught, preds = [], []
+    caught, preds, failures = [], [], []
     for exp in exps:
         with warnings.catch_warnings(record=True) as w:
             warnings.simplefilter("always", TemperatureRangeWarning)
-            preds.append(predict(model, exp))
+            try:
+                preds.append(predict(model, exp))
+            except ThermofrictionError as e:  # one experiment the model cannot run: say why, go on
+                failures.append(Failure(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
         caught += [f"{exp.file}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
-    return ValidationResult(model, preds, caught)
+    return ValidationResult(model, preds, caught, failures)
 
 
-__all__ = ["validate", "ValidationResult", "Prediction", "predict", "step_sizes"]
+__all__ = ["validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]

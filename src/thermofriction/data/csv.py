@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..plausible import displacement_problem, kelvin_hint
 from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
 
 def _parse_header(path, header):
@@ -170,5 +171,12 @@ def read_experiment_csv(path) -> dict:
         if np.any(bad):
             i = int(np.argmax(bad))
             raise InputError(f"{path}: line {_line_of(body, i)}, column {jT + 1} ({cols[jT][2]}): {float(T[i]):g} C "
-                             f"is not a plausible temperature (expected {lo:g} to {hi:g} C)")
+                             f"is not a plausible temperature (expected {lo:g} to {hi:g} C{kelvin_hint(float(T[i]))})")
+    names = [c[0] for c in cols]
+    for name in ("displacement", "stage_displacement"):
+        if name in out:
+            j = names.index(name)
+            problem = displacement_problem(out[name], cols[j][2].partition("[")[2].rstrip("]"))
+            if problem:
+                raise InputError(f"{path}: column {j + 1} ({cols[j][2]}): {problem}")
     return out

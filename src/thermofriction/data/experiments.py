@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..plausible import TEMPERATURE_RANGE  # noqa: F401  [degC] one range for files, manifests and simulate
 from ..waveforms import Sampled, Waveform
 
 _LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9}  # micro sign and Greek mu
@@ -19,7 +20,6 @@ _SI = {"time": "s", "voltage": "V", "displacement": "m", "stage_displacement": "
 REQUIRED = ("time", "voltage", "displacement")
 MIN_SAMPLES = 10
 SAMPLING_TOLERANCE = 0.01           # relative deviation of an interval from the median interval
-TEMPERATURE_RANGE = (-100.0, 300.0)  # [degC] what a temperature sensor on an actuator can plausibly read
 TEMPERATURE_VARIES = 0.5            # [degC] peak-to-peak above which a recorded temperature is a signal
 ROLES = ("fit", "validate")
 MAX_ROWS = 10_000_000               # data rows per experiment file; ~1.5 GB peak at the limit (docs/limits.md)

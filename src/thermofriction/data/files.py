@@ -14,6 +14,7 @@ from .._io import atomic_write
 from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
+from ..plausible import kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "experiment")
@@ -33,7 +34,8 @@ def _check_temperature(T, where):
         raise InputError(f"{where}: 'temperature' must be a number [C], got {T!r}")
     lo, hi = TEMPERATURE_RANGE
     if not lo <= T <= hi:
-        raise InputError(f"{where}: temperature {T!r} C is not plausible (expected {lo:g} to {hi:g} C)")
+        raise InputError(f"{where}: temperature {T!r} C is not plausible (expected {lo:g} to {hi:g} C"
+                         f"{kelvin_hint(T)})")
     return float(T)
 
 

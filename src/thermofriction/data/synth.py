@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import Model, load_model, require_actuator
+from ..plausible import parse_length
 from ..simulate import StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
@@ -87,6 +88,13 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
         rng = np.random.default_rng(stream)
         res = simulate(model, duration, temperature=T, input=waveform, sample_rate=sample_rate,
                        controller=StepSizeController(rtol=1e-10))
+        span = float(np.ptp(res.displacement))
+        if record_stage and res.stage_displacement is not None:  # a plant test: the stage moves
+            span = max(span, float(np.ptp(res.stage_displacement)))
+        for what, v in (("noise", noise), ("quantization", quantization)):
+            if v > span > 0:  # 20 meant as nanometres but given in metres
+                raise InputError(f"{what} {v:g} m exceeds the simulated displacement range ({span:.3g} m) at "
+                                 f"{T:g} C: give it with a unit, e.g. 20nm")
         x = res.displacement + noise * rng.standard_normal(res.time.size)
         sign = 0
         if drift:
@@ -158,11 +166,12 @@ def add_synth_command(subparsers):
     s.add_argument("--input", metavar="WAVEFORM",
                    help="input waveform, e.g. sawtooth:amplitude=30,frequency=5,rise=0.999 "
                         "(default: the model's [input])")
-    s.add_argument("--noise", type=float, default=20e-9, metavar="M",
-                   help="standard deviation of the white displacement-sensor noise [m] (default: 2e-8)")
-    s.add_argument("--quantization", type=float, default=0.0, metavar="M",
-                   help="displacement-sensor resolution [m]: values are rounded to multiples of it "
-                        "(default: 0, none)")
+    s.add_argument("--noise", default="20nm", metavar="LENGTH",
+                   help="standard deviation of the white displacement-sensor noise [m], or with a unit "
+                        "(20nm, 0.02um) (default: 20nm)")
+    s.add_argument("--quantization", default="0", metavar="LENGTH",
+                   help="displacement-sensor resolution [m], or with a unit (5nm): values are rounded to "
+                        "multiples of it (default: 0, none)")
     s.add_argument("--temperature-noise", type=float, default=0.0, metavar="C",
                    help="standard deviation of the temperature-sensor noise [C]; a non-zero value "
                         "records a temperature[C] column (default: 0)")
@@ -186,6 +195,8 @@ def cmd_synth(args) -> int:
     for opt, v in (("--duration", args.duration), ("--sample-rate", args.sample_rate)):
         if not (v > 0 and math.isfinite(v)):
             raise InputError(f"{opt} must be a positive number, got {v!r}")
+    args.noise = parse_length(args.noise, "--noise")
+    args.quantization = parse_length(args.quantization, "--quantization")
     for opt, v in (("--noise", args.noise), ("--quantization", args.quantization),
                    ("--temperature-noise", args.temperature_noise)):
         if not (v >= 0 and math.isfinite(v)):

@@ -19,6 +19,7 @@ from ..errors import ComputationError, InputError
 from ..models import Model
 from ..waveforms import Sampled, Waveform
 from .parameters import Parameters, target_of, unit_of, with_values
+from .quality import ADEQUATE_RATIO, noise_level
 
 _MAX_STEPS = 2_000_000
 
@@ -89,6 +90,8 @@ class Problem:
 
     def _run(self, trace: Trace, theta, jac):
         model = with_values(self.model, dict(zip(self.names, theta)))
+        if model.unphysical_over_range():  # never step where the fitted model would not load or run
+            return None, None
         heated = model.heat is not None
         if heated:  # each run from its own start, unless the fit estimates one start for all (T_0)
             T0 = model.heat.initial_temperature if "T_0" in self.names else trace.initial_temperature
@@ -176,7 +179,10 @@ class Transform:
         return lo_phi, hi_phi
 
 
-def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight):
+def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale):
+    """SciPy's trust-region least squares on residuals divided by ``scale`` (the data's noise level):
+    its stopping tests then mean the same on every dataset, whatever the units and magnitudes
+    (on residuals in metres, an absolute gradient test is met at any start)."""
     cache = {}
 
     def both(phi):
@@ -190,7 +196,7 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
                 J = np.zeros((problem.n_points, len(phi)))
             else:
                 J = J * transform.dtheta_dphi(theta)[None, :]
-            cache[key] = (r, J)
+            cache[key] = (r / scale, J / scale)
         return cache[key]
 
     # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
@@ -204,6 +210,16 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
 
 def _y_scale(problem):
     return max(float(np.ptp(t.displacement)) for t in problem.traces)
+
+
+def residual_scale(traces) -> float:
+    """The scale residuals are measured in: the displacement noise estimated from the data (pooled
+    over the traces), at least 1e-6 of the largest displacement range (noise-free data)."""
+    noise = [noise_level(t.displacement) for t in traces]
+    noise = [s for s in noise if math.isfinite(s)]
+    pooled = math.sqrt(sum(s * s for s in noise) / len(noise)) if noise else 0.0
+    span = max(float(np.ptp(t.displacement)) for t in traces)
+    return max(pooled, 1e-6 * span, 1e-300)
 
 
 @dataclasses.dataclass
@@ -260,16 +276,20 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     if progress:
         progress(f"{len(candidates)} starts screened; refining {len(chosen)}")
 
+    scale = residual_scale(traces)
+
     def run(phi_start):
         # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
+        phi_first = phi_start
         if rtol < 1e-6:
             coarse = Problem(model, names, traces, rtol=1e-6, parallel=not one_trace)
-            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False)
+            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale)
             phi_start = first.x
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight else 15, tight)
+        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight else 15, tight, scale)
+        res.moved = bool(np.any(res.x != phi_first))
         return res, problem
 
     if one_trace and len(chosen) > 1:
@@ -283,8 +303,11 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         raise ComputationError("the fit ended where the model cannot be simulated; try another initial guess")
     nfev = screen.nfev + sum(p.nfev for _, p in runs)
     njev = sum(p.njev for _, p in runs)
-    return FitOutcome(theta, r, J, nfev, njev, bool(best.success and best.status > 0), best.message,
-                      len(candidates), time.perf_counter() - t_start)
+    success, message = bool(best.success and best.status > 0), best.message
+    if not best.moved and math.sqrt(float(r @ r) / r.size) > ADEQUATE_RATIO * scale:
+        # a small gradient at a start that does not fit the data is not convergence
+        success, message = False, f"stopped at its starting point ({message})"
+    return FitOutcome(theta, r, J, nfev, njev, success, message, len(candidates), time.perf_counter() - t_start)
 
 
 def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):

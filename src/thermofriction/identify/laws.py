@@ -10,6 +10,7 @@ from scipy import optimize
 
 from ..errors import InputError
 from ..models import PWL, Const, Exp, Linear
+from ..models.friction import in_domain
 
 def _aicc(ssr, n, k):
     if ssr <= 0:
@@ -18,10 +19,12 @@ def _aicc(ssr, n, k):
     return aic + 2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else aic
 
 
-def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None):
+def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parameter=None):
     """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
     lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
-    kind is better by more than 2 (a difference the data support). Returns (law, table)."""
+    kind is better by more than 2 (a difference the data support). A law that leaves the physical
+    domain of ``parameter`` (e.g. sigma1 < 0) anywhere in its range is not a candidate. Returns
+    (law, table)."""
     T, values = np.asarray(T, float), np.asarray(values, float)
     w = np.ones_like(values)
     if stderr is not None:
@@ -53,11 +56,16 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None):
             raise InputError(f"unknown law kind '{kind}' for a Model I parameter (linear, exp, const)")
         ssr = float(np.sum(((law(T) - values) * w) ** 2))
         table[kind] = {"aicc": _aicc(ssr, len(T), k), "law": law.to_dict()}
+        if parameter is not None and not in_domain(parameter, law(np.linspace(rng[0], rng[1], 41))).all():
+            table[kind]["excluded"] = f"leaves the physical domain of {parameter} within {rng[0]:g}..{rng[1]:g} C"
+            continue
         if best is None or table[kind]["aicc"] < table[best[0]]["aicc"]:
             best = (kind, law)
     if best is None:
-        raise InputError("no law could be fitted")
-    if prefer in table and prefer != best[0] and table[prefer]["aicc"] - table[best[0]]["aicc"] <= 2.0:
+        raise InputError("no law could be fitted" + (f" that keeps {parameter} physical over "
+                                                       f"{rng[0]:g}..{rng[1]:g} C" if parameter else ""))
+    if (prefer in table and prefer != best[0] and "excluded" not in table[prefer]
+            and table[prefer]["aicc"] - table[best[0]]["aicc"] <= 2.0):
         from ..models import law_from_dict
         return law_from_dict(table[prefer]["law"], "law"), table
     return best[1], table

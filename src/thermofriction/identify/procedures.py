@@ -13,9 +13,10 @@ from ..drive import experiment_waveform
 from ..errors import InputError
 from ..models import PWL, Const, Model, ModelI, ModelII
 from ..simulate import simulate
-from .engine import fit, make_traces, uncertainty
+from .engine import Problem, fit, make_traces, uncertainty
 from .laws import _aicc, fit_law, segmented_fit
 from .parameters import Parameters, get_value, unit_of, with_values
+from .quality import advice, fit_quality, pooled
 from .result import FitResult
 
 DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")
@@ -25,21 +26,33 @@ def _result(method, model, params, outcome, traces, t0, extra_warnings=(), detai
     corr, warns, stats = uncertainty(params, outcome, traces, model)
     values = {p.name: p.value for p in params.values()}
     fitted = with_values(model, values)
-    per, start = [], 0
+    per, qualities, start = [], [], 0
     for tr in traces:
         n = len(tr.time)
         seg = outcome.r[start:start + tr.n_residuals]
         start += tr.n_residuals
+        # the displacement residuals of a trace have their mean (the sensor's zero) removed
+        quality = fit_quality(seg[:n], tr.displacement)
+        qualities.append(quality)
         per.append({"file": tr.name, "temperature": tr.nominal_temperature, "role": tr.role,
-                    "rmse": float(np.sqrt(np.mean(seg[:n] ** 2)))})
+                    "rmse_offset_removed": quality["rmse"], "fit_quality": quality})
         if tr.measured_temperature is not None:  # [K], unweighted
             per[-1]["temperature_rmse"] = float(np.sqrt(np.mean(seg[n:] ** 2))) / tr.temperature_weight
+    overall = pooled(qualities, [len(tr.time) for tr in traces])
+    first = []
+    if not overall["adequate"]:
+        bad = [p["file"] for p, q in zip(per, qualities) if not q["adequate"]]
+        first.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
+                        f"noise estimated from the data ({overall['rmse'] * 1e9:.4g} nm against "
+                        f"{overall['noise'] * 1e9:.3g} nm; not adequate in {len(bad)} of {len(per)} experiments): "
+                        f"the model misses what the data show. Try: {advice(model)}")
     cost = float(outcome.r @ outcome.r)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
                      rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
                      njev=outcome.njev, starts=outcome.starts, wall_time=time.perf_counter() - t0,
                      success=outcome.success, message=str(outcome.message), experiments=per,
-                     warnings=list(extra_warnings) + warns, statistics=stats, details=details or {})
+                     warnings=first + list(extra_warnings) + warns, statistics=stats, details=details or {},
+                     fit_quality=overall)
 
 
 def _friction_parameters(model: Model, names, fixed=()):
@@ -185,7 +198,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         previous = res.model
         per_T.append((T, res))
     details = {"per_temperature": [
-        {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse": r.rmse,
+        {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
          "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
     Ts = np.array([T for T, _ in per_T])
     new_laws, law_tables = {}, {}
@@ -199,7 +212,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         kinds = (laws or {}).get(n)
         kinds = (kinds,) if isinstance(kinds, str) else (kinds or ("linear", "exp"))
         prefer = init.laws[n].kind if n in init.laws else None
-        law, table = fit_law(Ts, vals, ses, kinds, prefer=prefer)
+        law, table = fit_law(Ts, vals, ses, kinds, prefer=prefer, parameter=n)
         new_laws[n] = law
         law_tables[n] = {"chosen": law.kind, "candidates": table, "temperatures": Ts, "values": vals,
                          "stderr": ses}
@@ -285,7 +298,9 @@ def _model_ii_paper(groups, base, T_ref, details, t0, progress):
         progress("Model II (paper): displacement against temperature and against dF")
     Ts = np.array([np.mean([e.temperature for e in g]) for g in groups])
     D = np.array([np.mean([_final_displacement(e) for e in g]) for g in groups])
-    tb, D_law, _ = segmented_fit(Ts, D)
+    tb, D_law, ssr_seg = segmented_fit(Ts, D)
+    sst = float(np.sum((D - D.mean()) ** 2))
+    r2_seg = 1.0 - ssr_seg / sst if sst > 0 else math.nan
     # displacement against dF, by simulating the base model with a constant dF
     ref = groups[0][0]
     fc = base.reference_force()
@@ -311,24 +326,60 @@ def _model_ii_paper(groups, base, T_ref, details, t0, progress):
         params.add(f"dF.values[{i}]", float(v), unit="N")
     warns = [] if r2 > 0.98 else [f"displacement is not linear in dF (R^2 = {r2:.3f}): the paper's procedure "
                                   f"assumes it is"]
+    if not (r2_seg >= 0.9):
+        warns.append(f"the two-segment fit of displacement against temperature is poor (R^2 = {r2_seg:.3f}): the "
+                     f"paper's procedure assumes two straight segments")
+    success, message = True, "paper's procedure (no trajectory fit, no intervals)"
+    worst = float(np.max(np.abs(dF_knots)))
+    if not np.all(np.isfinite(dF_knots)) or worst >= fc or np.any(1.0 + dF_knots / fc <= 0):
+        # beyond the friction level the scale form reverses friction: not a model of these data
+        success = False
+        message = (f"refused: the paper's procedure gives |dF| up to {worst:.4g} N, beyond the friction level "
+                   f"fc = {fc:.4g} N (the displacement hardly depends on dF here; use --procedure direct)")
+        warns.insert(0, message)
+    details["paper"]["segmented_r2"] = r2_seg
     return FitResult("model-ii (paper)", model, params, np.full((len(params), len(params)), np.nan), math.nan,
-                     math.nan, 0, len(dFs), 0, 0, time.perf_counter() - t0, True,
-                     "paper's procedure (no trajectory fit, no intervals)", warnings=warns, details=details)
+                     math.nan, 0, len(dFs), 0, 0, time.perf_counter() - t0, success, message, warnings=warns,
+                     details=details)
+
+
+def _dF_start(group, m, fc, previous, opts):
+    """Where to start dF at one temperature: the cost in dF can have two minima (a stick-slip step
+    grows and then shrinks as friction falls), so scan it across the friction level, and keep the
+    neighbouring temperature's value (continuation) in the scan."""
+    grid = sorted(set(np.round(np.linspace(-0.9, 0.9, 13) * fc, 12)) | {0.0, float(previous)})
+    traces = make_traces(group, m)
+    problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), 1e-6))
+    costs = []
+    for v in grid:
+        r, _ = problem.evaluate(np.array([v]))
+        costs.append(math.inf if r is None else float(r @ r))
+    return float(grid[int(np.argmin(costs))]), {"grid": grid, "cost": costs}
 
 
 def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts):
     per_T = []
     popts = dict(opts)
     popts["starts"] = 1
-    for g in groups:
+    fc = base.reference_force()
+    # continuation outward from the reference temperature, where dF is smallest
+    order = sorted(range(len(groups)), key=lambda i: abs(float(np.mean([e.temperature for e in groups[i]])) - T_ref))
+    previous, fits, scans = 0.0, {}, {}
+    for i in order:
+        g = groups[i]
         T = float(np.mean([e.temperature for e in g]))
         if progress:
             progress(f"Model II (direct): dF at {T:.4g} C")
         m = dataclasses.replace(base, thermal=ModelII(Const(0.0)))
+        start, scans[T] = _dF_start(g, m, fc, previous, popts)
         params = Parameters()
-        params.add("dF.value", 0.0, min=-0.95 * base.reference_force(), unit="N")
-        r = fit_friction(g, m, params, method=f"dF at {T:.4g} C", **popts)
-        per_T.append((T, r))
+        # lambda = 1 + dF/fc stays positive: friction never reverses
+        params.add("dF.value", start, min=-0.95 * fc, max=10.0 * fc, unit="N")
+        r = fit_friction(g, dataclasses.replace(m, thermal=ModelII(Const(start))), params,
+                         method=f"dF at {T:.4g} C", **popts)
+        fits[i] = (T, r)
+        previous = r.parameters["dF.value"].value
+    per_T = [fits[i] for i in range(len(groups))]
     Ts = np.array([T for T, _ in per_T])
     vals = np.array([r.parameters["dF.value"].value for _, r in per_T])
     ses = np.array([r.parameters["dF.value"].stderr for _, r in per_T])
@@ -348,6 +399,7 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     details["direct"] = {"temperatures": Ts, "dF": vals, "stderr": ses, "chosen": chosen,
                          "candidates": {k: {"aicc": a, "law": l.to_dict()} for k, (l, a) in candidates.items()}}
     model = dataclasses.replace(base, thermal=ModelII(law))
+    details["direct"]["scans"] = [{"temperature": T, **scans[T]} for T in sorted(scans)]
     params = Parameters()
     for i, v in enumerate(law.values):
         params.add(f"dF.values[{i}]", float(v), unit="N")
@@ -356,9 +408,26 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
                          math.nan, 0, sum(r.nfev for _, r in per_T), 0, 0, time.perf_counter() - t0, True,
                          "per-temperature dF and law (no joint refinement)", details=details)
     if progress:
-        progress("Model II (direct): joint refinement of dF(T) on all experiments")
+        progress("Model II (direct): joint refinement of dF(T) and the base parameters on all experiments")
+    # The base parameters are refined with dF, so that dF's intervals carry their uncertainty. Scaling
+    # sigma0, sigma1, fc by 1/c and shifting dF by fc (1 - 1/c) leaves the scale form unchanged, so
+    # dF is pinned to zero at the reference temperature (its definition: the base model holds there).
+    knots = np.asarray(law.T)
+    at_ref = np.flatnonzero(np.abs(knots - T_ref) <= 0.05)
+    warns = []
+    if at_ref.size:
+        k = int(at_ref[0])
+        model = dataclasses.replace(model, thermal=ModelII(law.with_coefficients(
+            [0.0 if j == k else v for j, v in enumerate(law.values)])))
+        params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
+        params[f"dF.values[{k}]"].vary = False
+        for name in _fit_parameter_names(base):
+            params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
+    else:
+        warns.append(f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters "
+                     f"are held at their fit there, so dF's intervals do not include their uncertainty")
     traces = make_traces(experiments, model)
     outcome = fit(model, params, traces, **popts)
-    res = _result("model-ii (direct)", model, params, outcome, traces, t0, details=details)
+    res = _result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
     res.nfev += sum(r.nfev for _, r in per_T)
     return res

@@ -34,6 +34,13 @@ class FitResult:
     statistics: dict = dataclasses.field(default_factory=dict)
     details: dict = dataclasses.field(default_factory=dict)
     alternatives: dict = dataclasses.field(default_factory=dict)
+    #: residuals against the noise estimated from the data (identify/quality.py); None where not measured
+    fit_quality: dict | None = None
+
+    @property
+    def adequate(self) -> bool | None:
+        """Whether the residuals are at the measurement noise (None where not measured)."""
+        return None if self.fit_quality is None else bool(self.fit_quality["adequate"])
 
     @property
     def aicc(self) -> float:
@@ -52,7 +59,8 @@ class FitResult:
             "parameters": self.parameters.to_dict(),
             "correlation": {"names": names, "matrix": self.correlation},
             "cost": self.cost,
-            "rmse": self.rmse,
+            "rmse_offset_removed": self.rmse,
+            "fit_quality": self.fit_quality,
             "aicc": self.aicc,
             "n_points": self.n_points,
             "iterations": self.nfev,
@@ -85,10 +93,19 @@ class FitResult:
 
     def report(self) -> str:
         """A table like lmfit's fit report."""
-        lines = [f"[[Fit: {self.method}]]",
-                 f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
+        lines = [f"[[Fit: {self.method}]]"]
+        if self.adequate is False:  # first, in plain words
+            lines.append(f"    NOT ADEQUATE: residuals {self.fit_quality['ratio']:.3g} x the measurement noise "
+                         f"(see the first warning)")
+        lines += [f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
                  f"    data points      = {self.n_points}",
-                 f"    rmse             = {self.rmse * 1e9:.4g} nm",
+                 f"    rmse             = {self.rmse * 1e9:.4g} nm (each experiment's offset removed)"]
+        if self.fit_quality is not None:
+            q = self.fit_quality
+            lines.append(f"    noise (data)     = {q['noise'] * 1e9:.4g} nm; rmse/noise = {q['ratio']:.3g}, "
+                         f"lag-1 autocorrelation {q['autocorrelation']:.2f}, "
+                         f"{'adequate' if q['adequate'] else 'NOT adequate'}")
+        lines += [
                  f"    evaluations      = {self.nfev} (Jacobians {self.njev}), starts = {self.starts}",
                  f"    wall time        = {self.wall_time:.3g} s",
                  "[[Parameters]]"]

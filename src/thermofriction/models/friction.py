@@ -216,21 +216,29 @@ class GMS(_Friction):
 FRICTION_MODELS = {cls.model: cls for cls in (LuGre, Coulomb, Stribeck, Dahl, ElastoPlastic, GMS)}
 
 
+#: Where each parameter is physical (fs, vs: relative to fc, checked below).
+PARAMETER_DOMAIN = {"sigma0": "positive", "sigma1": "non-negative", "sigma2": "non-negative", "fc": "positive",
+                    "delta": "positive", "vd": "positive", "v_smooth": "positive", "C": "positive",
+                    "z_ba": "non-negative"}
+
+
+def in_domain(name: str, values) -> np.ndarray:
+    """Whether each value of parameter ``name`` is in its physical domain (True where it has none)."""
+    values = np.asarray(values, float)
+    domain = PARAMETER_DOMAIN.get(name)
+    if domain == "positive":
+        return np.isfinite(values) & (values > 0)
+    if domain == "non-negative":
+        return np.isfinite(values) & (values >= 0)
+    return np.isfinite(values)
+
+
 def check_friction_values(values: dict, where: str):
     """Physical checks on a full set of parameter values (numbers and laws evaluated)."""
-    def need(name, ok, what):
+    for name, domain in PARAMETER_DOMAIN.items():
         v = values.get(name)
-        if v is not None and not ok(v):
-            raise InputError(f"{where}: '{name}' must be {what}, got {v!r}")
-    need("sigma0", lambda v: v > 0, "positive")
-    need("sigma1", lambda v: v >= 0, "non-negative")
-    need("sigma2", lambda v: v >= 0, "non-negative")
-    need("fc", lambda v: v > 0, "positive")
-    need("delta", lambda v: v > 0, "positive")
-    need("vd", lambda v: v > 0, "positive")
-    need("v_smooth", lambda v: v > 0, "positive")
-    need("C", lambda v: v > 0, "positive")
-    need("z_ba", lambda v: v >= 0, "non-negative")
+        if v is not None and not in_domain(name, v):
+            raise InputError(f"{where}: '{name}' must be {domain}, got {v!r}")
     z_ba, sigma0, fc = values.get("z_ba"), values.get("sigma0"), values.get("fc")
     if z_ba is not None and sigma0 and fc and not z_ba < fc / sigma0:
         raise InputError(f"{where}: 'z_ba' ({z_ba!r} m) must be below the steady deflection fc/sigma0 "

@@ -16,8 +16,8 @@ import tomli_w
 from .._io import atomic_write
 from ..errors import InputError, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
-from .friction import (FRICTION_MODELS, GMS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre, Stribeck,
-                       check_friction_values)
+from .friction import (FRICTION_MODELS, GMS, PARAMETER_DOMAIN, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,
+                       Stribeck, check_friction_values, in_domain)
 from .laws import Law, law_from_dict
 from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
@@ -100,6 +100,26 @@ class Model:
         if not ranges:
             return None
         return (max(r[0] for r in ranges), min(r[1] for r in ranges))
+
+    def unphysical_over_range(self, points: int = 41) -> str | None:
+        """Where, over each law's declared range, the model leaves its physical domain (a Model I
+        parameter out of its domain, Model II's lambda <= 0), or None. A fitted model must pass this:
+        then it simulates anywhere in its range."""
+        for name, law in self.laws.items():
+            if law.range is None:
+                continue
+            T = np.linspace(law.range[0], law.range[1], points)
+            ok = in_domain(name, law(T))
+            if not ok.all():
+                i = int(np.argmin(ok))
+                return f"'{name}' is {float(law(T[i])):.4g} at {T[i]:.4g} C ({PARAMETER_DOMAIN.get(name, 'finite')} required)"
+        if isinstance(self.thermal, ModelII) and self.thermal.form == "scale" and self.thermal.dF.range is not None:
+            T = np.linspace(self.thermal.dF.range[0], self.thermal.dF.range[1], points)
+            lam = np.atleast_1d(self.thermal_factor(T))
+            if not np.all(np.isfinite(lam) & (lam > 0)):
+                i = int(np.argmin(np.where(np.isfinite(lam), lam, -np.inf)))
+                return f"Model II's lambda(T) = 1 + dF/fc is {lam[i]:.4g} at {T[i]:.4g} C (friction would reverse)"
+        return None
 
     # -- files ---------------------------------------------------------------------------
     def to_dict(self) -> dict:

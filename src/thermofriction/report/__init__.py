@@ -60,7 +60,7 @@ def comparison_rows(entries):
         v = s.get("validate", s.get("fit", {}))
         f = e.fit or {}
         rows.append([e.label, _fmt(v.get("max_error_pct")), _fmt(v.get("mean_max_error_pct")),
-                     _fmt(v.get("rmse", math.nan) * 1e9, "{:.4g}"), _fmt(s.get("fit", {}).get("max_error_pct")),
+                     _fmt(v.get("rmse_offset_removed", math.nan) * 1e9, "{:.4g}"), _fmt(s.get("fit", {}).get("max_error_pct")),
                      _fmt(f.get("aicc"), "{:.1f}"), _fmt(f.get("wall_time"), "{:.2f} s")])
     return rows
 
@@ -88,14 +88,23 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
     card_html = "".join(f'<div class="card"><div class="k">{html.escape(k)}</div><div class="v">{html.escape(v)}'
                         f'</div><div class="s">{html.escape(s)}</div></div>' for k, v, s in cards)
     parts.append(f'<div class="cards">{card_html}</div>')
-    warns = [f"{e.label}: the fit did not converge: {(e.fit or {}).get('message', '')}" for e in entries
-             if (e.fit or {}).get("success") is False]  # never silently: first, and in every report
-    warns += [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + (e.fit or {}).get("warnings", [])]
+    # never silently: a fit that misses the data, or did not converge, first, and in every report
+    fit_warnings = {e.label: list((e.fit or {}).get("warnings", [])) for e in entries}
+    warns = []
+    for e in entries:
+        if ((e.fit or {}).get("fit_quality") or {}).get("adequate") is False:
+            first = [w for w in fit_warnings[e.label] if w.startswith("the fit is not adequate")]
+            warns += [f"{e.label}: {w}" for w in first]
+            fit_warnings[e.label] = [w for w in fit_warnings[e.label] if w not in first]
+    warns += [f"{e.label}: the fit did not converge: {(e.fit or {}).get('message', '')}" for e in entries
+              if (e.fit or {}).get("success") is False]
+    warns += [f"{e.label}: {f.file} could not be predicted: {f.reason}" for e in entries for f in e.validation.failures]
+    warns += [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + fit_warnings[e.label]]
     if warns:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
     parts.append("<section><h2>Model comparison</h2>" + _table(
-        ["model", "max error, held out [%]", "mean max error, held out [%]", "RMSE, held out [nm]",
+        ["model", "max error, held out [%]", "mean max error, held out [%]", "RMSE, held out [nm] (offset removed)",
          "max error, fit [%]", "AICc", "identification time"], comparison_rows(entries)) +
         "<p style='font-size:13px;color:#4a5266'>Max error is the paper's maximum prediction error, "
         "max |x_sim − x_meas| / (max x_meas − min x_meas).</p></section>")
@@ -111,10 +120,10 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
     for e in entries:
         for m in e.validation.experiments:
             err_rows.append([e.label, m["file"], _fmt(m["temperature"], "{:.4g}"), m["role"],
-                             _fmt(m["max_error_pct"]), _fmt(m["rmse"] * 1e9, "{:.4g}"), _fmt(m["nrmse"]),
+                             _fmt(m["max_error_pct"]), _fmt(m["rmse_offset_removed"] * 1e9, "{:.4g}"), _fmt(m["nrmse"]),
                              _fmt(m["final_error_pct"], "{:+.3g}"), _fmt(m["step_error_pct"])])
     parts.append("<section><h2>Errors per experiment</h2>" + _table(
-        ["model", "file", "T [°C]", "role", "max error [%]", "RMSE [nm]", "NRMSE", "final error [%]",
+        ["model", "file", "T [°C]", "role", "max error [%]", "RMSE [nm] (offset removed)", "NRMSE", "final error [%]",
          "step error [%]"], err_rows) + "</section>")
     param_rows = []
     for e in entries:

@@ -11,21 +11,29 @@ import numpy as np
 
 from ..errors import ConditioningWarning, InputError, PassivityWarning, SolverError, TemperatureRangeWarning
 from ..models import Model, ModelI, ModelII, check_friction_values, dissipativity_violation
+from ..plausible import check_temperature
 from ..waveforms import Sampled, Sawtooth, Step, Waveform, Zero
 
 
 def as_temperature(temperature):
-    """A number, a ``Sampled`` signal, or a (times, values) pair -> number or Sampled."""
-    if temperature is None or isinstance(temperature, Sampled):
+    """A number, a ``Sampled`` signal, or a (times, values) pair -> number or Sampled; a temperature
+    that is not plausible in degC (e.g. one in kelvin) is refused, as in data files."""
+    if temperature is None:
+        return temperature
+    if isinstance(temperature, Sampled):
+        check_temperature(temperature.value, "temperature signal")
         return temperature
     if isinstance(temperature, (tuple, list)) and len(temperature) == 2:
-        return Sampled(np.asarray(temperature[0], float), np.asarray(temperature[1], float))
+        T = Sampled(np.asarray(temperature[0], float), np.asarray(temperature[1], float))
+        check_temperature(T.value, "temperature signal")
+        return T
     try:
         T = float(temperature)
     except (TypeError, ValueError):
         raise InputError(f"temperature must be a number [degC] or (times, values), got {temperature!r}") from None
     if not math.isfinite(T):
         raise InputError(f"temperature must be finite, got {temperature!r}")
+    check_temperature(T, "temperature")
     return T
 
 

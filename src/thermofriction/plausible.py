@@ -1,0 +1,82 @@
+"""Physical plausibility of what users give: temperatures that look like kelvin, displacements whose
+unit looks wrong, lengths with units on the command line. One rule for every entry point (data files,
+dataset manifests, ``simulate``), so that the same value is accepted or refused everywhere."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from .errors import InputError
+
+#: [degC] what a temperature sensor on an actuator can plausibly read
+TEMPERATURE_RANGE = (-100.0, 300.0)
+#: [m] a displacement record spanning less than this is below any displacement sensor's resolution
+#: (capacitive sensors resolve ~1e-10 m): its values are most likely in another unit than the header's
+MIN_DISPLACEMENT_SPAN = 1e-11
+
+_LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9, "pm": 1e-12}
+
+
+def temperature_problem(T) -> str | None:
+    """Why ``T`` [degC] (a number or array) is not a plausible temperature, or None."""
+    T = np.atleast_1d(np.asarray(T, float))
+    lo, hi = TEMPERATURE_RANGE
+    bad = ~np.isfinite(T) | (T < lo) | (T > hi)
+    if not bad.any():
+        return None
+    v = float(T[np.argmax(bad)])
+    return f"{v:g} C is not a plausible temperature (expected {lo:g} to {hi:g} C{kelvin_hint(v)})"
+
+
+def kelvin_hint(v: float) -> str:
+    """A temperature that reads like kelvin says so."""
+    try:
+        v = float(v)
+    except (TypeError, ValueError, OverflowError):
+        return ""
+    return f"; in kelvin? {v:g} K is {v - 273.15:.4g} C" if 200.0 <= v <= 600.0 else ""
+
+
+def check_temperature(T, where: str):
+    problem = temperature_problem(T)
+    if problem:
+        raise InputError(f"{where}: {problem}")
+
+
+def displacement_problem(x, unit: str) -> str | None:
+    """Why a displacement record (in metres, read under a ``[unit]`` header) does not look like one,
+    or None: a span below any sensor's resolution (values in metres under a [um] header), or fewer
+    than three distinct values (quantised away)."""
+    x = np.asarray(x, float)
+    span = float(np.ptp(x)) if x.size else 0.0
+    if span == 0.0:
+        return None  # a constant record is its own case (nothing to fit), said where it matters
+    if span < MIN_DISPLACEMENT_SPAN:
+        return (f"the displacement spans only {span:.3g} m, below any sensor's resolution: are the values in "
+                f"metres under a [{unit}] header? (give the unit the numbers are in)")
+    if np.unique(x[: min(x.size, 1_000_000)]).size < 3:
+        return "the displacement takes fewer than three distinct values: its motion is below the quantisation"
+    return None
+
+
+def parse_length(text: str, what: str) -> float:
+    """A length from the command line: a number in metres, or a number with a unit (``20nm``, ``5 um``)."""
+    m = re.fullmatch(r"\s*([-+0-9.eE]+)\s*([a-zµμ]*)\s*", str(text))
+    unit = m.group(2) if m else None
+    if m is None or (unit and unit not in _LENGTH_UNITS):
+        raise InputError(f"{what}: '{text}' is not a length (a number in metres, or with a unit: "
+                         f"{', '.join(k for k in _LENGTH_UNITS if k not in ('µm', 'μm'))})")
+    try:
+        value = float(m.group(1)) * _LENGTH_UNITS[unit or "m"]
+    except ValueError:
+        raise InputError(f"{what}: '{text}' is not a length") from None
+    if not math.isfinite(value) or value < 0:
+        raise InputError(f"{what}: must be a non-negative length, got '{text}'")
+    return value
+
+
+__all__ = ["kelvin_hint", "TEMPERATURE_RANGE", "MIN_DISPLACEMENT_SPAN", "temperature_problem", "check_temperature",
+           "displacement_problem", "parse_length"]
