@@ -1,0 +1,189 @@
+"""Identification on data it did not make: truths drawn away from the presets (masses, Model II break
+temperatures and slopes), noise and quantisation; fit adequacy against the noise estimated from the
+data alone; one RMSE in identify and validate; validation of every experiment; plausible data."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+import thermofriction as tf
+from thermofriction.identify.laws import fit_law
+from thermofriction.identify.quality import noise_level
+from thermofriction.models import ModelI, ModelII, PWL, Linear
+
+from conftest import run_cli
+
+SAW = tf.Sawtooth(amplitude=30, frequency=5, rise=0.999)
+
+
+def _base():
+    return tf.load_model("li2009-base")
+
+
+def model_ii_truth(break_T=36.5, mid=-0.12, top=-0.45, lo=30.0, hi=42.0):
+    return dataclasses.replace(_base(), thermal=ModelII(PWL([lo, break_T, hi], [0.0, mid, top], range=(lo, hi))),
+                               name="truth")
+
+
+# -- the noise, from the data alone -------------------------------------------------------------
+
+@pytest.mark.parametrize("sigma", [2e-9, 20e-9, 80e-9])
+def test_noise_level_recovers_known_white_noise_on_a_stick_slip_record(sigma):
+    """Second differences of a 10 kHz stick-slip record plus white noise of known sigma: the estimate
+    is within 10 % (the motion's own curvature and slips are a few samples per cycle)."""
+    res = tf.simulate(_base(), 1.0, input=SAW, sample_rate=10_000)
+    x = res.displacement + sigma * np.random.default_rng(1).standard_normal(res.time.size)
+    assert noise_level(x) == pytest.approx(sigma, rel=0.1)
+
+
+# -- adequacy -----------------------------------------------------------------------------------
+
+def test_a_fit_with_wrong_masses_is_flagged_not_adequate_and_the_right_masses_are_not():
+    """Truth: end-effector mass 4x and stage mass 0.5x the preset's. Fitting sigma0, sigma1, fc with the
+    preset's masses cannot reach the noise: flagged, first, in the report and the JSON; with the true
+    masses the same fit is adequate."""
+    base = _base()
+    truth = dataclasses.replace(base, plant=dataclasses.replace(base.plant, end_effector_mass=4 * base.plant.end_effector_mass,
+                                                                mass=0.5 * base.plant.mass))
+    data = tf.synthesize(truth, [35.0], duration=0.6, sample_rate=5000, noise=20e-9, quantization=1e-9, seed=2)
+    wrong = tf.identify(data, method="base", init=base, starts=4)
+    assert wrong.adequate is False
+    assert wrong.fit_quality["ratio"] > 2.0
+    assert wrong.warnings[0].startswith("the fit is not adequate")
+    assert "NOT ADEQUATE" in wrong.report().splitlines()[1]
+    d = json.loads(wrong.to_json())
+    assert d["fit_quality"]["adequate"] is False and d["experiments"][0]["fit_quality"]["adequate"] is False
+    right = tf.identify(data, method="base", init=dataclasses.replace(base, plant=truth.plant), starts=4)
+    assert right.adequate is True
+    assert right.fit_quality["ratio"] == pytest.approx(1.0, abs=0.15)
+
+
+# -- Model II that works ------------------------------------------------------------------------
+
+def test_model_ii_recovers_a_negative_thermal_friction_away_from_the_preset():
+    """Truth: dF falls to -0.45 N (half the friction level) with a break at 36.5 C, not the preset's
+    38.4 C. The direct procedure finds the sign and the size (relative to the reference temperature,
+    which is its definition of dF = 0) within its 95 % interval at the hottest temperature, the fit is
+    at the noise, and the fitted model predicts every experiment, held-out ones included."""
+    truth = model_ii_truth()
+    Ts = [30.5, 32.5, 34.5, 36.5, 38.5, 40.5, 41.8]
+    data = tf.synthesize(truth, Ts, validate=[35.0, 39.5], duration=0.6, sample_rate=5000, noise=20e-9,
+                         quantization=1e-9, seed=7)
+    fit = tf.identify(data, method="model-ii", init="li2009-base")
+    assert fit.success and fit.adequate
+    law = fit.model.thermal.dF
+    expected = truth.thermal.dF(41.8) - truth.thermal.dF(30.5)
+    top = fit.parameters[f"dF.values[{len(law.values) - 1}]"]
+    assert top.ci95[0] <= expected <= top.ci95[1]
+    assert abs(top.value - expected) < 0.05 * abs(expected)
+    assert fit.model.unphysical_over_range() is None
+    v = tf.validate(fit.model, data)
+    assert v.complete and len(v.predictions) == len(Ts) + 2
+    assert max(p.fit_quality["ratio"] for p in v.predictions) < 1.5
+
+
+def test_model_ii_paper_procedure_says_when_its_assumptions_fail():
+    """Data without a thermal effect: displacement against temperature is noise, not two straight
+    segments, and the paper's procedure says so instead of returning a confident law."""
+    base = _base()
+    data = tf.synthesize(base, [30.5, 33.0, 36.0, 39.0, 41.5], duration=0.4, sample_rate=5000, noise=20e-9,
+                         seed=3)
+    fit = tf.identify(data, method="model-ii", init=base, procedure="paper")
+    assert any("two-segment fit" in w and "poor" in w for w in fit.warnings)
+    assert fit.details["paper"]["segmented_r2"] < 0.9
+    fc = base.reference_force()
+    # and what it returns never reverses friction (else it is refused, success False)
+    assert fit.success is bool(np.all(np.abs(fit.model.thermal.dF.values) < fc))
+
+
+# -- physical laws ------------------------------------------------------------------------------
+
+def test_fit_law_never_returns_a_law_that_leaves_the_physical_domain_in_its_range():
+    """sigma1 falling convexly towards zero: the least-squares line goes negative inside the range, so
+    it is excluded and the exponential (positive everywhere) is chosen."""
+    T = np.linspace(30, 42, 7)
+    vals = 2.0 * np.exp(-0.45 * (T - 30))
+    law, table = fit_law(T, vals, parameter="sigma1")
+    assert "excluded" in table["linear"]
+    assert law.kind == "exp" and np.all(law(np.linspace(30, 42, 101)) > 0)
+
+
+def test_a_model_whose_law_turns_unphysical_within_its_range_is_named():
+    m = tf.load_model("li2009-model-i")
+    bad = dataclasses.replace(m, thermal=ModelI({**m.laws, "sigma1": Linear(-0.5, 20.0, range=(30.0, 45.0))}))
+    problem = bad.unphysical_over_range()
+    assert problem and "sigma1" in problem and "non-negative" in problem
+    assert m.unphysical_over_range() is None
+
+
+# -- one RMSE, every experiment -----------------------------------------------------------------
+
+def test_identify_and_validate_report_the_same_rmse_for_the_same_model():
+    truth = tf.load_model("li2009-model-i")
+    data = tf.synthesize(truth, [31.0, 36.0, 41.0], duration=0.6, sample_rate=5000, noise=20e-9, seed=4)
+    fit = tf.identify(data, method="model-i", init="li2009-base")
+    v = {p.file: p.rmse for p in tf.validate(fit.model, data).predictions}
+    for e in fit.experiments:
+        assert e["rmse_offset_removed"] == pytest.approx(v[e["file"]], rel=0.01)
+
+
+def test_validate_predicts_every_experiment_and_lists_the_ones_it_cannot(tmp_path):
+    """A Model II whose lambda turns negative above ~39 C: the 41.5 C experiment cannot be simulated;
+    it is listed with its reason, the others are still predicted, and the command line exits 1."""
+    base = _base()
+    data = tf.synthesize(base, [31.0, 41.5], duration=0.3, sample_rate=5000, noise=20e-9, seed=5)
+    fc = base.reference_force()
+    model = dataclasses.replace(base, thermal=ModelII(Linear(-fc / 9.0, 30.0 * fc / 9.0)))  # lambda(39) = 0
+    res = tf.validate(model, data)
+    assert [p.file for p in res.predictions] == [data.experiments[0].file]
+    assert len(res.failures) == 1 and res.failures[0].file == data.experiments[1].file
+    assert "lambda" in res.failures[0].reason
+    d = res.to_dict()
+    assert d["failed"][0]["file"] == data.experiments[1].file
+    tf.save_dataset(data, tmp_path / "ds")
+    model.save(tmp_path / "m.toml")
+    out = run_cli("validate", tmp_path / "m.toml", tmp_path / "ds", "--json", tmp_path / "v.json")
+    assert out.returncode == 1, out.stderr
+    assert "not predicted" in out.stderr and "Traceback" not in out.stderr
+    assert json.loads((tmp_path / "v.json").read_text())["failed"]
+
+
+# -- plausible data -----------------------------------------------------------------------------
+
+def test_temperatures_in_kelvin_are_refused_alike_in_simulate_and_in_data(tmp_path):
+    model = tf.load_model("li2009-model-i")
+    with pytest.raises(tf.InputError, match="kelvin"):
+        tf.simulate(model, 0.01, temperature=308.15)
+    data = tf.synthesize(model, [35.0], duration=0.05, sample_rate=2000, noise=20e-9)
+    tf.save_dataset(data, tmp_path / "ds")
+    manifest = tmp_path / "ds" / "dataset.toml"
+    manifest.write_text(manifest.read_text().replace("temperature = 35.0", "temperature = 308.15"))
+    with pytest.raises(tf.InputError, match="kelvin"):
+        tf.load_dataset(tmp_path / "ds")
+    out = run_cli("simulate", "li2009-model-i", "--temperature", "308.15", "--duration", "0.01", "-o",
+                  tmp_path / "x.csv")
+    assert out.returncode == 2 and "kelvin" in out.stderr and not (tmp_path / "x.csv").exists()
+
+
+def test_metre_values_under_a_micrometre_header_are_refused(tmp_path):
+    t = np.arange(200) / 1000.0
+    x = 1e-6 * np.sin(2 * np.pi * 5 * t)  # metres, but labelled um
+    rows = "\n".join(f"{a:.6f},{10 * a:.6f},{b:.9e}" for a, b in zip(t, x))
+    (tmp_path / "run.csv").write_text("time[s],voltage[V],displacement[um]\n" + rows + "\n")
+    with pytest.raises(tf.InputError, match=r"displacement\[um\].*metres under a \[um\] header"):
+        tf.data.read_experiment_csv(tmp_path / "run.csv")
+
+
+def test_synth_noise_takes_units_and_refuses_metres_meant_as_nanometres(tmp_path):
+    bad = run_cli("synth", "li2009-model-i", "--temperatures", "35", "--duration", "0.2", "--sample-rate", "5000",
+                  "--noise", "20", "-o", tmp_path / "bad")
+    assert bad.returncode == 2 and "give it with a unit" in bad.stderr and not (tmp_path / "bad").exists()
+    ok = run_cli("synth", "li2009-model-i", "--temperatures", "35", "--duration", "0.5", "--sample-rate", "5000",
+                 "--noise", "20nm", "-o", tmp_path / "ok")
+    assert ok.returncode == 0, ok.stderr
+    exp = tf.load_dataset(tmp_path / "ok").experiments[0]
+    assert noise_level(exp.displacement) == pytest.approx(20e-9, rel=0.15)
