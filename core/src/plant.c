@@ -299,6 +299,35 @@ int tf_model_jac(double t, const double *y, double *J, void *ctx)
     return 0;
 }
 
+/* d(rhs)/d(plant parameter) into column k of fp (stride np): only the mechanical rows depend on
+ * these directly (the friction force and its power are functions of the state). */
+static void plant_partials(const tf_model *m, double t, const double *y, const double *dy, int param,
+                           double *fp, int np, int k)
+{
+    if (m->plant == TF_PLANT_STICK_SLIP) {
+        double u = tf_waveform_value(&m->input, t);
+        double d_m = -dy[VP] / m->m, d_c = -y[VP] / m->m, d_k = -y[XP] / m->m, d_T = u / m->m;
+        double wn = sqrt(m->k / m->m), xi = m->c / (2.0 * wn * m->m), K = m->T_em / m->k;
+        double vp = 0.0;
+        switch (param) {
+        case TF_PLANT_P_M: vp = d_m; break;
+        case TF_PLANT_P_M_E: fp[VE * np + k] = -dy[VE] / m->m_e; return;
+        case TF_PLANT_P_C: vp = d_c; break;
+        case TF_PLANT_P_K: vp = d_k; break;
+        case TF_PLANT_P_T_EM: vp = d_T; break;
+        case TF_PLANT_P_XI: vp = d_c * 2.0 * wn * m->m; break;
+        case TF_PLANT_P_WN: vp = (d_c * xi + d_k * wn + d_T * K * wn) * 2.0 * m->m; break;
+        case TF_PLANT_P_GAIN: vp = d_T * m->k; break;
+        case TF_PLANT_P_M_MODAL: vp = d_m + d_c * 2.0 * xi * wn + (d_k + d_T * K) * wn * wn; break;
+        default: break;
+        }
+        fp[VP * np + k] = vp;
+    } else if (m->plant == TF_PLANT_MASS) {
+        if (param == TF_PLANT_P_M || param == TF_PLANT_P_M_MODAL) fp[V * np + k] = -dy[V] / m->m;
+        else if (param == TF_PLANT_P_K_S) fp[V * np + k] = (m->v_0 * t - y[X]) / m->m;
+    }
+}
+
 int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
                          const tf_target *targets, int np, double *fp)
 {
@@ -324,6 +353,10 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         double dF = 0.0, chain = 1.0; /* dF'/dtheta and d(param)/dtheta */
         int i = tg->param;
         for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
+        if (tg->kind == TF_TARGET_PLANT) {
+            plant_partials(m, t, y, dy, i, fp, np, k);
+            continue;
+        }
         if (tg->kind == TF_TARGET_HEAT) { /* only the heat balance depends on these */
             if (m->heat.on) fp[iT * np + k] = tf_heat_param_partial(&m->heat, i, y[iT], fabs(F * v), dy[iT]);
             continue;

@@ -49,6 +49,7 @@ METHOD_NAMES = {code: name for name, code in METHOD_CODES.items()}
 STATUS_NAMES = {code: name for name, code in _GROUPS["status"].items()}
 TARGET_CODES = dict(_GROUPS["target"])
 HEAT_PARAMETER_INDEX = dict(_GROUPS["heat_parameter"])
+PLANT_PARAMETER_INDEX = dict(_GROUPS["plant_parameter"])
 COMPENSATION_CODES = dict(_GROUPS["compensation"])
 #: Output channels, in column order; after them come the friction states, then the friction work.
 OUTPUTS = _ordered("output")

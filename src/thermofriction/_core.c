@@ -329,8 +329,10 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
         const tf_law *law = targets[k].kind == TF_TARGET_DF ? &m.dF
                             : targets[k].kind == TF_TARGET_LAW && targets[k].param >= 0 && targets[k].param < TF_NPARAM
                                 ? &m.law[targets[k].param] : NULL;
-        int bad = targets[k].kind < 0 || targets[k].kind > 3 || targets[k].param < 0 ||
-                  targets[k].param >= (targets[k].kind == TF_TARGET_HEAT ? TF_HEAT_NPARAM : TF_NPARAM);
+        int bad = targets[k].kind < 0 || targets[k].kind > TF_TARGET_PLANT || targets[k].param < 0 ||
+                  targets[k].param >= (targets[k].kind == TF_TARGET_HEAT    ? TF_HEAT_NPARAM
+                                       : targets[k].kind == TF_TARGET_PLANT ? TF_PLANT_NPARAM
+                                                                            : TF_NPARAM);
         if (!bad && law && (targets[k].coef < 0 || targets[k].coef >= tf_law_ncoef(law))) bad = 1;
         if (bad) { PyErr_Format(PyExc_ValueError, "target %d is not valid for this model", k); goto done; }
     }
@@ -674,7 +676,12 @@ static const tf_constant constants[] = {
     C("output", "relative_velocity", TF_OUT_RELATIVE_VELOCITY), C("output", "friction_force", TF_OUT_FRICTION_FORCE),
     C("output", "temperature", TF_OUT_TEMPERATURE),
     C("target", "param", TF_TARGET_PARAM), C("target", "law", TF_TARGET_LAW), C("target", "dF", TF_TARGET_DF),
-    C("target", "heat", TF_TARGET_HEAT),
+    C("target", "heat", TF_TARGET_HEAT), C("target", "plant", TF_TARGET_PLANT),
+    C("plant_parameter", "m", TF_PLANT_P_M), C("plant_parameter", "m_e", TF_PLANT_P_M_E),
+    C("plant_parameter", "c", TF_PLANT_P_C), C("plant_parameter", "k", TF_PLANT_P_K),
+    C("plant_parameter", "T_em", TF_PLANT_P_T_EM), C("plant_parameter", "xi", TF_PLANT_P_XI),
+    C("plant_parameter", "wn", TF_PLANT_P_WN), C("plant_parameter", "K", TF_PLANT_P_GAIN),
+    C("plant_parameter", "m (modal)", TF_PLANT_P_M_MODAL), C("plant_parameter", "k_s", TF_PLANT_P_K_S),
     C("heat_parameter", "C_th", TF_HEAT_C_TH), C("heat_parameter", "R_th", TF_HEAT_R_TH),
     C("heat_parameter", "eta", TF_HEAT_ETA), C("heat_parameter", "T_amb", TF_HEAT_T_AMB),
     C("heat_parameter", "T_0", TF_HEAT_T_0),
@@ -682,7 +689,7 @@ static const tf_constant constants[] = {
     C("compensation", "observer", TF_COMP_OBSERVER),
     /* counts and capacities */
     C("limit", "parameters", TF_NPARAM), C("limit", "fixed_outputs", TF_OUT_NFIXED),
-    C("limit", "heat_parameters", TF_HEAT_NPARAM), C("limit", "friction_states", TF_MAX_FRICTION_STATES),
+    C("limit", "heat_parameters", TF_HEAT_NPARAM), C("limit", "plant_parameters", TF_PLANT_NPARAM), C("limit", "friction_states", TF_MAX_FRICTION_STATES),
     C("limit", "states", TF_MAX_STATES), C("limit", "targets", TF_MAX_TARGETS),
 };
 #undef C

@@ -113,6 +113,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="initial model: file or preset (default: the paper's preset for the method)")
     i.add_argument("--parameters", metavar="NAMES",
                    help="comma-separated parameters to fit with --method base (default: sigma0,sigma1,fc)")
+    i.add_argument("--free", metavar="NAMES",
+                   help="plant parameters to fit too, one value shared by all experiments, comma-separated: m_e, m "
+                        "(the masses), xi, wn, K (c, k, T_em for a plant in physical form); e.g. --free m_e,m")
     i.add_argument("--procedure", choices=("direct", "paper", "both"), default="direct",
                    help="Model II procedure (default: direct; both: report the paper's too)")
     i.add_argument("--law", action="append", default=[], metavar="PARAM=KIND",
@@ -247,7 +250,8 @@ def cmd_identify(args) -> int:
         raise InputError("--parameters applies to --method base only")
     update, status = _progress(args.quiet)
     try:
-        fit = identify(data, args.method, init=args.init, parameters=params, procedure=args.procedure,
+        fit = identify(data, args.method, init=args.init, parameters=params, free=args.free or (),
+                       procedure=args.procedure,
                        laws=laws or None, refine=not args.no_refine,
                        reference_temperature=args.reference_temperature, rtol=args.rtol, starts=args.starts,
                        seed=args.seed, progress=update)

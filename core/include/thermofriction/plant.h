@@ -117,8 +117,26 @@ typedef enum {
     TF_TARGET_PARAM = 0, /* friction parameter `param` given as a number */
     TF_TARGET_LAW = 1,   /* coefficient `coef` of the Model I law of parameter `param` */
     TF_TARGET_DF = 2,    /* coefficient `coef` of Model II's dF law */
-    TF_TARGET_HEAT = 3   /* heat model parameter `param`: one of tf_heat_param (thermal.h) */
+    TF_TARGET_HEAT = 3,  /* heat model parameter `param`: one of tf_heat_param (thermal.h) */
+    TF_TARGET_PLANT = 4  /* plant parameter `param`: one of tf_plant_param */
 } tf_target_kind;
+
+/* Plant parameters a sensitivity can be taken with respect to. The stick-slip plant stores its physical
+ * form (m, c, k, T_em); its modal parameters xi, wn, K (k = m wn^2, c = 2 xi wn m, T_em = K k) move c, k
+ * and T_em together, and TF_PLANT_P_M_MODAL is the stage mass with xi, wn and K held. */
+typedef enum {
+    TF_PLANT_P_M = 0,       /* stage (or body) mass, c, k, T_em held */
+    TF_PLANT_P_M_E,         /* end-effector mass */
+    TF_PLANT_P_C,           /* stage damping */
+    TF_PLANT_P_K,           /* stage stiffness */
+    TF_PLANT_P_T_EM,        /* transducer ratio */
+    TF_PLANT_P_XI,          /* damping ratio */
+    TF_PLANT_P_WN,          /* natural frequency */
+    TF_PLANT_P_GAIN,        /* static gain K */
+    TF_PLANT_P_M_MODAL,     /* stage mass, xi, wn, K held */
+    TF_PLANT_P_K_S,         /* mass plant: pulling spring stiffness */
+    TF_PLANT_NPARAM
+} tf_plant_param;
 
 typedef struct {
     int kind, param, coef;

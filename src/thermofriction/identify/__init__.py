@@ -9,8 +9,8 @@ from __future__ import annotations
 from ..errors import InputError
 from ..models import Model, StickSlipPlant, load_model
 from .engine import fit, make_traces, uncertainty
-from .parameters import Parameter, Parameters
-from .procedures import (base_model, fit_friction, fit_law, identify_heat, identify_model_i, identify_model_ii,
+from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
+from .procedures import (DEFAULT_FRICTION_PARAMETERS, base_model, fit_friction, fit_law, identify_heat, identify_model_i, identify_model_ii,
                          segmented_fit)
 from .plant import PlantFit, fit_plant, step_response
 from .result import FitResult
@@ -18,8 +18,8 @@ from .result import FitResult
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
 
-def identify(data, method="model-i", init=None, *, parameters=None, procedure="direct", laws=None, refine=True,
-             reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None) -> FitResult:
+def identify(data, method="model-i", init=None, *, parameters=None, free=(), procedure="direct", laws=None,
+             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
@@ -28,6 +28,9 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
         name. Default: the paper's preset for the method.
     parameters: names (or a Parameters object) to fit for "base"; default sigma0, sigma1, fc.
     procedure: Model II's "direct" (default), "paper" or "both".
+    free: plant parameters fitted too, in any method but "plant", one value shared by all experiments:
+        "m_e", "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a
+        plant given in its physical form).
     laws: Model I law kinds per parameter, e.g. {"sigma0": "exp"}; default: chosen by AICc.
     rtol: the simulations' relative tolerance during the fit; starts: the multi-start size.
     """
@@ -48,19 +51,40 @@ def identify(data, method="model-i", init=None, *, parameters=None, procedure="d
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
+    free = _plant_parameters(init, free, method)
     if method == "plant":
         return _identify_plant(getattr(data, "experiments", data), init)
     if method == "heat":
-        return identify_heat(experiments, init, parameters, progress=progress, **opts)
+        return identify_heat(experiments, init, parameters, free=free, progress=progress, **opts)
     if method == "base":
         model = base_model(init)
+        if free:
+            if isinstance(parameters, Parameters):
+                raise InputError("free= adds plant parameters to the default ones; with a Parameters object, add "
+                                 "them to it instead")
+            parameters = list(parameters or DEFAULT_FRICTION_PARAMETERS) + free
         return fit_friction(experiments, model, parameters, method="base", progress=progress, **opts)
     if method == "model-i":
         if init.thermal is not None and not hasattr(init.thermal, "laws"):
             init = base_model(init)
-        return identify_model_i(experiments, init, laws=laws, refine=refine, progress=progress, **opts)
+        return identify_model_i(experiments, init, laws=laws, refine=refine, progress=progress, free=free, **opts)
     return identify_model_ii(experiments, init, procedure=procedure, reference_temperature=reference_temperature,
-                             refine=refine, progress=progress, **opts)
+                             refine=refine, progress=progress, free=free, **opts)
+
+
+def _plant_parameters(init, free, method) -> list:
+    """The plant parameters to free, checked against the initial model's plant."""
+    if isinstance(free, str):
+        free = [f.strip() for f in free.split(",") if f.strip()]
+    free = list(dict.fromkeys(free or ()))
+    if free and method == "plant":
+        raise InputError("free= applies to the friction methods; --method plant fits xi, wn and K itself")
+    for name in free:
+        if name not in PLANT_UNITS:
+            raise InputError(f"'{name}' is not a plant parameter that can be freed "
+                             f"(one of: {', '.join(PLANT_UNITS)})")
+        target_of(init, name)  # the plant's form: modal plants free xi, wn, K; physical ones c, k, T_em
+    return free
 
 
 def _identify_plant(experiments, init):

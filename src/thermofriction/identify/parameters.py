@@ -13,7 +13,12 @@ from .. import _bridge
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
 
-_TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT = (_bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat"))
+_TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT, _TARGET_PLANT = (
+    _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
+#: The plant's fittable parameters by their model-file symbols, with units: one value shared by all
+#: experiments (the masses above all, which the paper does not give).
+PLANT_UNITS = {"m": "kg", "m_e": "kg", "xi": "", "wn": "rad/s", "K": "m/V", "c": "N s/m", "k": "N/m", "T_em": "N/V",
+               "k_s": "N/m"}
 #: The lumped thermal model's fittable parameters (docs/models.md#self-heating): symbol -> (Heat
 #: field, unit, the C core's index)
 HEAT_PARAMETERS = {sym: (field, unit, _bridge.HEAT_PARAMETER_INDEX[sym]) for sym, field, unit in (
@@ -80,9 +85,31 @@ def _split(name):
     return m.group(1), m.group(2)
 
 
+def _plant_field(model: Model, base: str):
+    """The plant's dataclass field for a model-file symbol (m, m_e, xi, ...), or None."""
+    symbols = getattr(model.plant, "_SYMBOLS", {})
+    return {sym: f for f, sym in symbols.items()}.get(base)
+
+
+def _plant_target(model: Model, name: str):
+    field = _plant_field(model, name)
+    if field is None or name not in PLANT_UNITS:
+        return None
+    if getattr(model.plant, field) is None:
+        form = "modal (xi, wn, K)" if getattr(model.plant, "modal", False) else "physical (c, k, T_em)"
+        raise InputError(f"'{name}': the plant is given in its {form} form; free those parameters instead")
+    if name == "m" and getattr(model.plant, "modal", False):
+        return (_TARGET_PLANT, _bridge.PLANT_PARAMETER_INDEX["m (modal)"], 0)
+    return (_TARGET_PLANT, _bridge.PLANT_PARAMETER_INDEX[name], 0)
+
+
 def target_of(model: Model, name: str):
     """(kind, parameter index, coefficient index) of the C core's sensitivity target."""
     base, coef = _split(name)
+    if coef is None and base not in PARAMETERS:
+        plant = _plant_target(model, base)
+        if plant is not None:
+            return plant
     if base in HEAT_PARAMETERS and coef is None:
         if model.heat is None:
             raise InputError(f"'{name}': the model has no [heat] section")
@@ -114,6 +141,8 @@ def get_value(model: Model, name: str) -> float:
     kind, idx, coef = target_of(model, name)
     if kind == _TARGET_HEAT:
         return float(getattr(model.heat, HEAT_PARAMETERS[name][0]))
+    if kind == _TARGET_PLANT:
+        return float(getattr(model.plant, _plant_field(model, name)))
     if kind == _TARGET_DF:
         return float(model.thermal.dF.coefficients()[coef])
     if kind == _TARGET_LAW:
@@ -132,10 +161,12 @@ def with_values(model: Model, values: dict) -> Model:
     friction = {}
     laws = dict(model.laws)
     dF = model.thermal.dF if isinstance(model.thermal, ModelII) else None
-    heat = {}
+    heat, plant = {}, {}
     for name, v in values.items():
         kind, idx, coef = target_of(model, name)
-        if kind == _TARGET_HEAT:
+        if kind == _TARGET_PLANT:
+            plant[_plant_field(model, name)] = float(v)
+        elif kind == _TARGET_HEAT:
             heat[HEAT_PARAMETERS[name][0]] = float(v)
         elif kind == _TARGET_PARAM:
             friction[PARAMETERS[idx]] = float(v)
@@ -154,13 +185,16 @@ def with_values(model: Model, values: dict) -> Model:
     elif isinstance(thermal, ModelII):
         thermal = dataclasses.replace(thermal, dF=dF)
     return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **friction), thermal=thermal,
-                               heat=dataclasses.replace(model.heat, **heat) if heat else model.heat)
+                               heat=dataclasses.replace(model.heat, **heat) if heat else model.heat,
+                               plant=dataclasses.replace(model.plant, **plant) if plant else model.plant)
 
 
 def unit_of(model: Model, name: str) -> str:
     base, coef = _split(name)
     if base in HEAT_PARAMETERS:
         return HEAT_PARAMETERS[base][1]
+    if coef is None and base not in PARAMETERS and base in PLANT_UNITS:
+        return PLANT_UNITS[base]
     unit = "N" if base == "dF" else PARAMETER_UNITS.get(base, "")
     if coef is None:
         return unit
@@ -168,4 +202,4 @@ def unit_of(model: Model, name: str) -> str:
     return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]
+__all__ = ["PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]

@@ -93,7 +93,7 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", *
 DEFAULT_HEAT_PARAMETERS = ("C_th", "R_th", "eta")
 
 
-def identify_heat(experiments, init: Model, parameters=None, **opts) -> FitResult:
+def identify_heat(experiments, init: Model, parameters=None, free=(), **opts) -> FitResult:
     """Fits the lumped thermal model (docs/models.md#self-heating) -- by default C_th, R_th and eta; friction
     parameters named too are fitted jointly -- to the recorded temperatures and displacements.
 
@@ -107,7 +107,7 @@ def identify_heat(experiments, init: Model, parameters=None, **opts) -> FitResul
     t0 = time.perf_counter()
     traces = make_traces(experiments, init)
     starts = [tr.initial_temperature for tr in traces]
-    names = list(parameters or DEFAULT_HEAT_PARAMETERS)
+    names = list(parameters or DEFAULT_HEAT_PARAMETERS) + list(free)
     if parameters is None and max(starts) - min(starts) < 0.1:
         # every run starts at one temperature (thermal equilibrium): estimate it with the rest, the
         # displacement pins it far better than a thermometer's first samples (0.3 um/K per cycle)
@@ -163,9 +163,12 @@ def _fit_parameter_names(model):
     return list(DEFAULT_FRICTION_PARAMETERS)
 
 
-def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, **opts) -> FitResult:
+def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
-    ``laws`` names one), then a joint refinement of the law coefficients on all experiments."""
+    ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
+    ``free``: plant parameters (e.g. m_e) fitted too, one value shared by all experiments (per
+    temperature first; their median starts the joint refinement)."""
+    free = list(free)
     t0 = time.perf_counter()
     groups = _groups(experiments)
     if len(groups) < 2:
@@ -183,7 +186,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         first = dict(opts)
         if previous is not None:  # continuation from the neighbouring temperature
             first["starts"] = 1
-        res = fit_friction(group, base, _friction_parameters(base, names, fixed=held),
+        res = fit_friction(group, base, _friction_parameters(base, names + free, fixed=held),
                            method=f"base at {T:.4g} C", **first)
         if i == 0:
             undetermined = [n for n in names if not math.isfinite(res.parameters[n].stderr)
@@ -194,7 +197,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
                              f"at {T:.4g} C): held at the initial model's law")
                 res = fit_friction(group, base.with_friction(**{n: base_model(init, T).friction.values()[n]
                                                                 for n in held}),
-                                   _friction_parameters(base, names, fixed=held), method=f"base at {T:.4g} C", **opts)
+                                   _friction_parameters(base, names + free, fixed=held), method=f"base at {T:.4g} C",
+                                   **opts)
         previous = res.model
         per_T.append((T, res))
     details = {"per_temperature": [
@@ -219,6 +223,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     details["laws"] = law_tables
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in names})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
+    if free:  # one plant for all temperatures: the median of the per-temperature estimates
+        model = with_values(model, {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free})
     if not refine:
         params = Parameters()
         for n, law in new_laws.items():
@@ -237,6 +243,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
             name = f"{n}.{cname}"
             positive = law.kind == "exp" and cname == "a" and v > 0
             params.add(name, v, min=0.0 if positive else -math.inf, unit=unit_of(model, name), vary=n not in held)
+    for n in free:
+        params.add(n, get_value(model, n), min=0.0, unit=unit_of(model, n))
     traces = make_traces(experiments, model)
     ropts = dict(opts)
     ropts["starts"] = 1
@@ -256,7 +264,7 @@ def _final_displacement(exp):
     return float(np.mean(exp.displacement[-k:]) - np.mean(exp.displacement[:k]))
 
 
-def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True,
+def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True, free=(),
                       progress=None, **opts) -> FitResult:
     """Model II. ``procedure="paper"``: base model at the reference temperature; displacement
     against temperature by a segmented linear fit with an estimated breakpoint; displacement
@@ -277,7 +285,7 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     if progress:
         progress(f"Model II: base model at the reference temperature {T_ref:.4g} C")
     base_init = base_model(init, T_ref)
-    base_fit = fit_friction(ref_group, base_init, _fit_parameter_names(base_init),
+    base_fit = fit_friction(ref_group, base_init, _fit_parameter_names(base_init) + list(free),
                             method=f"base at {T_ref:.4g} C", **opts)
     base = base_fit.model
     details = {"reference_temperature": T_ref, "base": base_fit.to_dict()}
@@ -285,7 +293,8 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     if procedure in ("paper", "both"):
         results["paper"] = _model_ii_paper(groups, base, T_ref, details, t0, progress)
     if procedure in ("direct", "both"):
-        results["direct"] = _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts)
+        results["direct"] = _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts,
+                                             free)
     main = results["direct" if procedure != "paper" else "paper"]
     if procedure == "both":
         main.alternatives["paper"] = results["paper"]
@@ -357,7 +366,7 @@ def _dF_start(group, m, fc, previous, opts):
     return float(grid[int(np.argmin(costs))]), {"grid": grid, "cost": costs}
 
 
-def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts):
+def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=()):
     per_T = []
     popts = dict(opts)
     popts["starts"] = 1
@@ -421,7 +430,7 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
             [0.0 if j == k else v for j, v in enumerate(law.values)])))
         params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
         params[f"dF.values[{k}]"].vary = False
-        for name in _fit_parameter_names(base):
+        for name in _fit_parameter_names(base) + list(free):
             params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
     else:
         warns.append(f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters "
