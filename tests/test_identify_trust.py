@@ -234,3 +234,26 @@ def test_free_names_a_plant_parameter_of_the_plants_form():
         tf.identify(data, method="base", init="li2009-base", free=["sigma0"])
     with pytest.raises(tf.InputError, match="modal"):
         tf.identify(data, method="base", init="li2009-base", free=["c"])
+
+
+# -- starting values from the data --------------------------------------------------------------
+
+@pytest.mark.parametrize("m_e,fc,sigma0,sigma1", [(0.08, 2.0, 8e5, 20.0), (0.02, 0.25, 3e5, 4.0),
+                                                  (0.3, 6.0, 6e6, 150.0)])
+def test_a_model_file_with_only_a_plant_starts_from_the_data_and_recovers_the_truth(tmp_path, m_e, fc, sigma0,
+                                                                                     sigma1):
+    """Truths over decades of friction level and bristle stiffness, none near a preset: the initial
+    model file has only [plant] and [input]; the starting values come from the data and the fit
+    reaches the noise with sigma0 and fc within 3 standard errors (and 5 %)."""
+    import tomli_w
+    base = _base()
+    plant = dataclasses.replace(base.plant, end_effector_mass=m_e)
+    truth = tf.Model(plant, tf.LuGre(sigma0=sigma0, sigma1=sigma1, fc=fc), input=base.input)
+    data = tf.synthesize(truth, [35.0], duration=0.6, sample_rate=5000, noise=20e-9, quantization=1e-9, seed=1)
+    path = tmp_path / "plant.toml"
+    path.write_text(tomli_w.dumps({"plant": plant.to_dict(), "input": base.input.to_dict()}))
+    fit = tf.identify(data, method="base", init=path)
+    assert fit.adequate, fit.report()
+    for name, true in (("sigma0", sigma0), ("fc", fc)):
+        p = fit.parameters[name]
+        assert abs(p.value - true) < min(3 * p.stderr, 0.05 * true), (name, p)

@@ -14,6 +14,7 @@ from .procedures import (DEFAULT_FRICTION_PARAMETERS, base_model, fit_friction, 
                          segmented_fit)
 from .plant import PlantFit, fit_plant, step_response
 from .result import FitResult
+from .start import lugre_start
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
@@ -25,7 +26,8 @@ def identify(data, method="model-i", init=None, *, parameters=None, free=(), pro
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
         (one friction model for all experiments, no thermal model), "model-i" or "model-ii".
     init: the initial model (its plant, masses and input are kept); a model, a file or a preset
-        name. Default: the paper's preset for the method.
+        name. Default: the paper's preset for the method. A file with a [plant] and no [friction]
+        section starts LuGre from values taken from the data (identify/start.py).
     parameters: names (or a Parameters object) to fit for "base"; default sigma0, sigma1, fc.
     procedure: Model II's "direct" (default), "paper" or "both".
     free: plant parameters fitted too, in any method but "plant", one value shared by all experiments:
@@ -39,15 +41,16 @@ def identify(data, method="model-i", init=None, *, parameters=None, free=(), pro
     if init is None:
         init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii",
                 "heat": "li2009-self-heating"}[method]
+    experiments = getattr(data, "fit", data)
     if not isinstance(init, Model):
-        init = load_model(init)
+        # a file with only a [plant] (and [input]): a LuGre start taken from the data
+        init = load_model(init, friction_from=lambda plant, inp: lugre_start(plant, experiments, inp))
     if not isinstance(init.plant, StickSlipPlant):
         raise InputError(f"identification works on the stick-slip actuator (datasets record its voltage and "
                          f"displacement); a '{init.plant.type}' plant can be simulated but not identified yet")
     if method != "plant" and init.friction.model != "lugre":
         raise InputError(f"identification of '{init.friction.model}' friction is not available yet (LuGre only); "
                          f"every friction model can be simulated")
-    experiments = getattr(data, "fit", data)
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)

@@ -68,8 +68,8 @@ def pooled(qualities, sizes) -> dict:
 
 def advice(model) -> str:
     """What to try when a fit is not adequate."""
-    tips = ["check the displacement unit in the files' headers",
-            "check the plant's masses (m, m_e in the model file): identification holds them fixed",
+    tips = ["free the plant's masses (--free m_e,m; free=[\"m_e\", \"m\"] in Python), which the fit otherwise "
+            "holds at the initial model's", "check the displacement unit in the files' headers",
             "check that the friction model and its parameters held fixed (e.g. fs, vs) suit the contact"]
     if getattr(model, "thermal", None) is None:
         tips.append("fit a thermal model (--method model-i or model-ii) if the experiments span temperatures")

@@ -153,9 +153,14 @@ class Model:
 _TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "heat", "input"}
 
 
-def model_from_dict(d: dict, source: str = "<model>", base_dir=None) -> Model:
-    """Builds a model from a parsed model file; errors name the file and the key."""
+def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_from=None) -> Model:
+    """Builds a model from a parsed model file; errors name the file and the key. ``friction_from``:
+    for a file without a [friction] section, a function of the parsed plant and input that returns one
+    (identification's starting values from the data)."""
     try:
+        if friction_from is not None and "friction" not in d and isinstance(d.get("plant"), dict):
+            inp = waveform_from_dict(d["input"], "[input]", base_dir) if isinstance(d.get("input"), dict) else None
+            d = {**d, "friction": friction_from(plant_from_dict(d["plant"]), inp)}
         unknown = set(d) - _TOP_KEYS
         if unknown:
             raise InputError(unknown_keys(unknown, sorted(_TOP_KEYS), "a model file"))
@@ -222,8 +227,9 @@ def preset_path(name: str):
     return resources.files("thermofriction").joinpath("presets", f"{name}.toml")
 
 
-def load_model(source) -> Model:
-    """Loads a model file, or a shipped preset by name (see ``PRESETS``)."""
+def load_model(source, friction_from=None) -> Model:
+    """Loads a model file, or a shipped preset by name (see ``PRESETS``). ``friction_from``: see
+    :func:`model_from_dict`."""
     source = os.fspath(source)
     p = Path(source)
     try:
@@ -249,7 +255,7 @@ def load_model(source) -> Model:
         raise InputError(f"{source}: TOML syntax error: {e}") from None
     except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
         raise InputError(f"{source}: TOML nested too deeply") from None
-    return model_from_dict(data, source, base_dir)
+    return model_from_dict(data, source, base_dir, friction_from)
 
 
 
