@@ -23,7 +23,7 @@ import threading
 import time
 from pathlib import Path
 
-from .errors import ThermofrictionError
+from .errors import InputError
 
 #: marks the temporary files this package creates: ``.NAME`` + TMP_TAG + ``PID-XXXX.tmp``
 TMP_TAG = ".thermofriction-"
@@ -32,7 +32,7 @@ TMP_TAG = ".thermofriction-"
 STALE_AGE = 60.0
 
 
-class OutputError(ThermofrictionError):
+class OutputError(InputError):
     """An output that cannot be written. Exit status 2 when refused before any work (fix the
     path), 1 when the writing itself failed (a full disk, an I/O error)."""
 
@@ -240,8 +240,7 @@ class _Staged:
 
     def discard(self):
         for _, tmp in self.files:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
+            _discard(tmp)
         self.files.clear()
 
     def publish(self):
@@ -272,8 +271,7 @@ class _Staged:
     def discard_remaining(self, done):
         for target, tmp in self.files:
             if target not in done:
-                with contextlib.suppress(OSError):
-                    os.unlink(tmp)
+                _discard(tmp)
 
 
 def current_set():
@@ -349,8 +347,14 @@ def atomic_write(path, mode="w", **kwargs):
             raise OutputError(f"{target.label}: cannot write ({_why(e)})", exit_status=1) from None
         return
     remove_stale_temporaries(target.folder)
-    fd, tmp = target._mkstemp()
+    global _critical
+    _critical += 1  # a signal between creating the temporary file and the try below would leave it
     try:
+        fd, tmp = target._mkstemp()
+    finally:
+        _critical -= 1
+    try:
+        _raise_deferred()
         with os.fdopen(fd, mode, **kwargs) as fh:
             yield fh
             fh.flush()
@@ -367,7 +371,6 @@ def atomic_write(path, mode="w", **kwargs):
         if staged is not None:
             staged.files.append((target, tmp))
             return
-        global _critical
         _critical += 1
         try:
             os.replace(tmp, target.real)
@@ -376,14 +379,23 @@ def atomic_write(path, mode="w", **kwargs):
             _critical -= 1
         _fsync_folder(target.folder)
     except OSError as e:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
+        _discard(tmp)
         raise OutputError(f"{target.label}: cannot write ({_why(e)})", exit_status=1) from None
     except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
+        _discard(tmp)
         raise
     _raise_deferred()
+
+
+def _discard(tmp):
+    """Removes a temporary file; a second signal meanwhile waits (it would skip the removal)."""
+    global _critical
+    _critical += 1
+    try:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+    finally:
+        _critical -= 1
 
 
 def jsonable(obj):

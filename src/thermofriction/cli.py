@@ -196,7 +196,7 @@ def cmd_simulate(args) -> int:
         sys.stdout.flush()  # a write error (a full disk) is reported here, as one line (main)
         return 0
     if args.output:
-        res.to_csv(args.output)
+        res.to_csv(args.targets["output"])
     out = sys.stdout
     name = model.name or args.model
     if model.heat is not None:  # the temperature is a state: say where it went
@@ -262,9 +262,9 @@ def cmd_identify(args) -> int:
             status.stop()
     with _io.publish_together():  # the model and its JSON appear together, or neither
         if args.output:
-            fit.model.save(args.output)
+            fit.model.save(args.targets["output"])
         if args.json:
-            fit.to_json(args.json)
+            fit.to_json(args.targets["json"])
     if not args.quiet:
         print(fit.report())
         for name, alt in fit.alternatives.items():
@@ -285,7 +285,7 @@ def cmd_validate(args) -> int:
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
     res = validate(model, data)
     if args.json:
-        res.to_json(args.json)
+        res.to_json(args.targets["json"])
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)

@@ -138,7 +138,7 @@ def check_dataset_folder(folder, overwrite=False, hint="overwrite=True"):
     from .._io import OutputError, Target
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
-        raise OutputError(f"{folder}: not a folder (a dataset is a folder)")
+        raise OutputError(f"{folder}: cannot create the dataset folder (a file of that name exists)")
     if (folder / "dataset.toml").exists() or (folder / "dataset.toml").is_symlink():
         if not overwrite:
             raise OutputError(f"{folder}: already holds a dataset (dataset.toml); give {hint} to replace it")
