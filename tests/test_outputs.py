@@ -1,4 +1,5 @@
-"""Outputs never destroy anything and never leave debris (issue 17, docs/limits.md#outputs).
+"""Outputs never destroy anything and never leave debris (issue 17,
+docs/limits.md#outputs-never-destroy-never-leave-debris).
 
 Each reproduction of the issue is a test: special files written through, not replaced; symbolic
 links followed; modes kept; an output that is an input refused; every write failure one line with
@@ -252,6 +253,20 @@ def test_output_is_a_folder_or_a_name_too_long_or_in_a_missing_folder(tmp_path):
     assert "symbolic links" in one_line_error(run_cli(*SIM, "-o", "loop", cwd=tmp_path), 2)
     (tmp_path / "loop").unlink()
     assert snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("args, message", [
+    (("simulate", "li2009-model-i", "--temperature", "35", "-o", ""), "-o: an empty output path"),
+    (("synth", "li2009-model-i", "--temperatures", "31", "-o", "afile"), "afile: cannot create the dataset folder"),
+    (("synth", "li2009-model-i", "--temperatures", "31", "-o", "afile/ds"), "afile is not a folder"),
+    (("report", "li2009-model-i", "ds", "-o", "r.html", "--figures", "afile"), "--figures afile: not a folder"),
+    (("demo", "-o", "afile"), "-o afile: not a folder"),
+], ids=["empty path", "synth -o file", "synth -o under a file", "report --figures file", "demo -o file"])
+def test_unusable_output_folders_are_refused_before_the_work(args, message, work):
+    (work / "afile").write_text("keep\n")
+    before = snapshot(work)
+    assert message in one_line_error(run_cli(*args, cwd=work), 2)
+    assert snapshot(work) == before
 
 
 def test_identify_checks_every_output_before_the_work(work):

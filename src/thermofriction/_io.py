@@ -1,4 +1,5 @@
-"""Output files that never destroy anything and never leave debris (docs/limits.md#outputs).
+"""Output files that never destroy anything and never leave debris
+(docs/limits.md#outputs-never-destroy-never-leave-debris).
 
 - A regular file is written to a temporary file beside its target (``.NAME.thermofriction-PID-XXXX.tmp``),
   flushed to disk and renamed over the target only when complete; an existing target keeps its mode
@@ -54,14 +55,14 @@ class Target:
     "stream" (a character device or FIFO, written through); ``real`` is the path with symbolic
     links followed; ``st`` the existing file's status (None for a new file)."""
 
-    def __init__(self, path, option=None):
+    def __init__(self, path, option=None, label=None):
         self.path = path
-        self.label = f"{option} {path}" if option else f"{path}"
+        self.label = label or (f"{option} {path}" if option else f"{path}")
         p = os.fspath(path)
         if isinstance(p, bytes):
             p = os.fsdecode(p)
         if not p:
-            raise OutputError(f"{option + ': ' if option else ''}empty output path")
+            raise OutputError(f"{option + ': ' if option else ''}an empty output path")
         if "\0" in p:
             raise OutputError(f"{self.label!r}: a file name cannot contain a NUL character")
         self.real = os.path.realpath(p)  # a link's target; a dangling link's would-be target
@@ -115,6 +116,24 @@ class Target:
             return tempfile.mkstemp(prefix=f".{stem}{TMP_TAG}{os.getpid()}-", suffix=".tmp", dir=self.folder)
         except OSError as e:  # read-only file system, no permission, no space for a directory entry
             raise OutputError(f"{self.label}: cannot write in {self.folder} ({_why(e)})") from None
+
+
+def check_folder(path, label=None):
+    """Before any work: ``path`` is a folder, or one can be created there (a probe temporary file in
+    the nearest existing folder); OutputError (exit 2) otherwise."""
+    label = label or str(path)
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise OutputError(f"{label}: not a folder (a file of that name exists)")
+    existing, first_missing = path, None
+    while not existing.exists():  # the nearest folder that exists must take the new ones
+        first_missing = existing
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if not existing.is_dir():
+        raise OutputError(f"{label}: cannot create the folder ({existing} is not a folder)")
+    Target(first_missing if first_missing is not None else path / ".probe", label=label).check()
 
 
 def remove_stale_temporaries(folder) -> list[str]:

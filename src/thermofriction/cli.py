@@ -341,7 +341,8 @@ def cmd_demo(args) -> int:
 
     update, status = _progress(False)
     try:
-        out = run_demo(args.output, progress=update or (lambda m: print(f"  {m}", file=sys.stderr)))
+        with _io.publish_together():  # every file of the demo appears at the end, or none
+            out = run_demo(args.output, progress=update or (lambda m: print(f"  {m}", file=sys.stderr)))
     finally:
         if status is not None:
             status.stop()
@@ -368,12 +369,13 @@ def _check_outputs(args):
     args.targets = {}
     for dest, option in _OUTPUT_FILES.get(args.command, {}).items():
         path = getattr(args, dest, None)
-        if path and path != "-":
+        if path is not None and path != "-":  # (an empty path is refused, not taken for none)
             args.targets[dest] = _io.Target(path, option).check()
     _io.refuse_inputs(args.targets.values(), ())  # two outputs that are one file
-    figures = getattr(args, "figures", None)
-    if figures and os.path.exists(figures) and not os.path.isdir(figures):
-        raise InputError(f"--figures {figures}: not a folder")
+    for option, folder in (("--figures", getattr(args, "figures", None)),
+                           ("-o", args.output if args.command == "demo" else None)):
+        if folder:
+            _io.check_folder(folder, f"{option} {folder}")
 
 
 def _refuse_inputs(args, *inputs):

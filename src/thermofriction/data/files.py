@@ -135,22 +135,14 @@ def load_dataset(path) -> Dataset:
 def check_dataset_folder(folder, overwrite=False, hint="overwrite=True"):
     """Before any work: refuses (exit 2) a path that is not a folder, a folder that already holds a
     dataset (unless ``overwrite``) and a place where no file can be created."""
-    from .._io import OutputError, Target
+    from .._io import OutputError, check_folder
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{folder}: cannot create the dataset folder (a file of that name exists)")
     if (folder / "dataset.toml").exists() or (folder / "dataset.toml").is_symlink():
         if not overwrite:
             raise OutputError(f"{folder}: already holds a dataset (dataset.toml); give {hint} to replace it")
-    existing, first_missing = folder, None
-    while not existing.exists():  # the nearest folder that exists must take the new ones
-        first_missing = existing
-        if existing.parent == existing:
-            break
-        existing = existing.parent
-    if not existing.is_dir():
-        raise OutputError(f"{folder}: cannot create the dataset folder ({existing} is not a folder)")
-    Target(first_missing if first_missing is not None else folder / "dataset.toml").check()
+    check_folder(folder)
 
 
 def _listed_files(folder: Path) -> list[Path]:
