@@ -46,10 +46,6 @@ def _why(err: OSError) -> str:
     return err.strerror or str(err)
 
 
-def _stdout_name(path) -> bool:
-    return os.fspath(path) == "-"
-
-
 class Target:
     """Where one output goes, resolved and checked: ``kind`` is "file" (written by a rename) or
     "stream" (a character device or FIFO, written through); ``real`` is the path with symbolic

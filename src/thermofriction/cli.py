@@ -196,7 +196,7 @@ def cmd_simulate(args) -> int:
         sys.stdout.flush()  # a write error (a full disk) is reported here, as one line (main)
         return 0
     if args.output:
-        res.to_csv(args.targets["output"])
+        res.to_csv(_target(args, "output"))
     out = sys.stdout
     name = model.name or args.model
     if model.heat is not None:  # the temperature is a state: say where it went
@@ -262,9 +262,9 @@ def cmd_identify(args) -> int:
             status.stop()
     with _io.publish_together():  # the model and its JSON appear together, or neither
         if args.output:
-            fit.model.save(args.targets["output"])
+            fit.model.save(_target(args, "output"))
         if args.json:
-            fit.to_json(args.targets["json"])
+            fit.to_json(_target(args, "json"))
     if not args.quiet:
         print(fit.report())
         for name, alt in fit.alternatives.items():
@@ -285,7 +285,7 @@ def cmd_validate(args) -> int:
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
     res = validate(model, data)
     if args.json:
-        res.to_json(args.targets["json"])
+        res.to_json(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)
@@ -376,6 +376,11 @@ def _check_outputs(args):
                            ("-o", args.output if args.command == "demo" else None)):
         if folder:
             _io.check_folder(folder, f"{option} {folder}")
+
+
+def _target(args, dest):
+    """The checked Target of an output (main() made it), or the path when a command runs on its own."""
+    return getattr(args, "targets", {}).get(dest) or getattr(args, dest)
 
 
 def _refuse_inputs(args, *inputs):
