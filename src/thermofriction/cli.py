@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 import warnings
 
 import numpy as np
 
+from . import _io
 from ._version import __version__
 from .errors import InputError, ThermofrictionError
 from .models import PRESETS, MassPlant, load_model
@@ -182,6 +184,7 @@ def cmd_simulate(args) -> int:
     if args.rtol >= 1:
         raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
     controller = StepSizeController(rtol=args.rtol, atol=args.atol, max_steps=args.max_steps)
+    _refuse_inputs(args, _model_inputs(args.model, model), args.temperature_file, _waveform_inputs(waveform))
     t0 = time.perf_counter()
     res = simulate(model, args.duration, temperature=temperature, input=waveform, sample_rate=args.sample_rate,
                    solver=SOLVERS[args.method](), controller=controller, max_samples=args.max_samples)
@@ -193,9 +196,10 @@ def cmd_simulate(args) -> int:
         buf.write(",".join(cols) + "\n")
         np.savetxt(buf, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12g")
         sys.stdout.write(buf.getvalue())
+        sys.stdout.flush()  # a write error (a full disk) is reported here, as one line (main)
         return 0
     if args.output:
-        res.to_csv(args.output)
+        res.to_csv(_target(args, "output"))
     out = sys.stdout
     name = model.name or args.model
     if model.heat is not None:  # the temperature is a state: say where it went
@@ -248,6 +252,8 @@ def cmd_identify(args) -> int:
     params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
     if params and args.method != "base":
         raise InputError("--parameters applies to --method base only")
+    init = args.init if args.init and args.init not in PRESETS else None
+    _refuse_inputs(args, _dataset_inputs(data), init, *_model_inputs(init, None))
     update, status = _progress(args.quiet)
     try:
         fit = identify(data, args.method, init=args.init, parameters=params, free=args.free or (),
@@ -258,10 +264,11 @@ def cmd_identify(args) -> int:
     finally:
         if status is not None:
             status.stop()
-    if args.output:
-        fit.model.save(args.output)
-    if args.json:
-        fit.to_json(args.json)
+    with _io.publish_together():  # the model and its JSON appear together, or neither
+        if args.output:
+            fit.model.save(_target(args, "output"))
+        if args.json:
+            fit.to_json(_target(args, "json"))
     if not args.quiet:
         print(fit.report())
         for name, alt in fit.alternatives.items():
@@ -279,9 +286,10 @@ def cmd_validate(args) -> int:
 
     model = load_model(args.model)
     data = load_dataset(args.dataset)
+    _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
     res = validate(model, data)
     if args.json:
-        res.to_json(args.json)
+        res.to_json(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)
@@ -304,21 +312,32 @@ def cmd_report(args) -> int:
     *model_paths, dataset = args.paths
     data = load_dataset(dataset)
     entries = []
+    inputs = list(_dataset_inputs(data))
     for mp in model_paths:
         model = load_model(mp)
+        inputs += _model_inputs(mp, model)
         fit = None
         side = Path(mp).with_suffix(".json")
         if Path(mp).exists() and side.exists():
+            inputs.append(str(side))
             try:
                 fit = json.loads(side.read_text())
             except (OSError, ValueError) as e:
                 raise InputError(f"{side}: not readable JSON ({e})") from None
+            if isinstance(fit, dict) and "model" in fit and fit["model"] != _io.jsonable(model.to_dict()):
+                # a model and its results are written together; a mismatch is an interrupted or
+                # partly repeated identify, or an edit: its numbers would be wrong for this model
+                print(f"thermofriction: warning: {side} describes another model than {mp} (an interrupted "
+                      f"identify, or one of them was edited); its results are not used", file=sys.stderr)
+                fit = None
         label = entry_label(model, fit)
         if any(e.label == label for e in entries):
             label = f"{label} ({Path(mp).stem})"
         entries.append(Entry(label, model, fit))
-    report(entries, data, args.output, figures_dir=args.figures, title=args.title,
-           command="thermofriction " + " ".join(sys.argv[1:]))
+    _refuse_inputs(args, *inputs)
+    with _io.publish_together(inputs=inputs):  # the page and its figures appear together, or none
+        report(entries, data, args.output, figures_dir=args.figures, title=args.title,
+               command="thermofriction " + " ".join(sys.argv[1:]))
     print(f"wrote {args.output}" + (f" and the figures in {args.figures}" if args.figures else ""))
     return 0
 
@@ -328,7 +347,8 @@ def cmd_demo(args) -> int:
 
     update, status = _progress(False)
     try:
-        out = run_demo(args.output, progress=update or (lambda m: print(f"  {m}", file=sys.stderr)))
+        with _io.publish_together():  # every file of the demo appears at the end, or none
+            out = run_demo(args.output, progress=update or (lambda m: print(f"  {m}", file=sys.stderr)))
     finally:
         if status is not None:
             status.stop()
@@ -343,19 +363,59 @@ def cmd_demo(args) -> int:
     return 0
 
 
-#: each command's output files (argparse dests); their folders must exist before any work starts,
-#: so that a long run does not fail at the end, or write one output and not the next
-_OUTPUT_FILES = {"simulate": ("output",), "identify": ("output", "json"), "validate": ("json",), "report": ("output",)}
+#: each command's output files (argparse dest: option); they are checked before any work starts
+#: (folder, name, writability, not a folder), so that a long run does not fail at the end, or write
+#: one output and not the next
+_OUTPUT_FILES = {"simulate": {"output": "-o"}, "identify": {"output": "-o", "json": "--json"},
+                 "validate": {"json": "--json"}, "report": {"output": "-o"}}
 
 
-def _check_output_folders(args):
-    from pathlib import Path
-    for dest in _OUTPUT_FILES.get(args.command, ()):
+def _check_outputs(args):
+    """Resolves and checks every output file of the command (args.targets: dest -> Target)."""
+    args.targets = {}
+    for dest, option in _OUTPUT_FILES.get(args.command, {}).items():
         path = getattr(args, dest, None)
-        if path and path != "-":
-            folder = Path(path).parent
-            if not folder.is_dir():
-                raise InputError(f"{path}: folder {folder} does not exist")
+        if path is not None and path != "-":  # (an empty path is refused, not taken for none)
+            args.targets[dest] = _io.Target(path, option).check()
+    _io.refuse_inputs(args.targets.values(), ())  # two outputs that are one file
+    for option, folder in (("--figures", getattr(args, "figures", None)),
+                           ("-o", args.output if args.command == "demo" else None)):
+        if folder:
+            _io.check_folder(folder, f"{option} {folder}")
+
+
+def _target(args, dest):
+    """The checked Target of an output (main() made it), or the path when a command runs on its own."""
+    return getattr(args, "targets", {}).get(dest) or getattr(args, dest)
+
+
+def _refuse_inputs(args, *inputs):
+    """Exit 2 before any work when an output is one of the run's input files."""
+    flat = []
+    for i in inputs:
+        flat.extend(i if isinstance(i, (list, tuple)) else [i])
+    _io.refuse_inputs(getattr(args, "targets", {}).values(), [os.fspath(i) for i in flat if i])
+
+
+def _waveform_inputs(waveform):
+    f = getattr(waveform, "file", None) if isinstance(waveform, Sampled) else None
+    return [f] if f else []
+
+
+def _model_inputs(path, model):
+    """The files a model argument reads: the model file (not a preset) and a sampled input's file."""
+    if not path or path in PRESETS:
+        return []
+    files = [path]
+    inp = getattr(model, "input", None)
+    for f in _waveform_inputs(inp):
+        files += [f, os.path.join(os.path.dirname(os.fspath(path)), f)]
+    return files
+
+
+def _dataset_inputs(data):
+    """A dataset's manifest and experiment files."""
+    return [os.path.join(data.path, "dataset.toml")] + [os.path.join(data.path, e.file) for e in data.experiments]
 
 
 def main(argv=None) -> int:
@@ -368,20 +428,52 @@ def main(argv=None) -> int:
         print(f"thermofriction: warning: {message}", file=sys.stderr)
 
     warnings.showwarning = show
+    handlers = _io.install_signal_handlers()  # SIGTERM/SIGHUP remove temporary files too
+    _io.published.clear()
     try:
-        _check_output_folders(args)
-        return args.run(args)
+        _check_outputs(args)
+        status = args.run(args)
+        sys.stdout.flush()
+        return status
     except ThermofrictionError as e:
         print(f"thermofriction: error: {e}", file=sys.stderr)
         return e.exit_status
     except KeyboardInterrupt:
-        print("thermofriction: interrupted; no output was written", file=sys.stderr)
+        print(f"thermofriction: interrupted; {_after_signal()}", file=sys.stderr)
         return 130
+    except _io.Terminated as e:
+        import signal
+        print(f"thermofriction: terminated by {signal.Signals(e.signum).name}; {_after_signal()}", file=sys.stderr)
+        return 128 + e.signum
     except MemoryError:
         print("thermofriction: error: out of memory (lower --duration or --sample-rate)", file=sys.stderr)
         return 1
-    except BrokenPipeError:
+    except BrokenPipeError:  # a reader that stopped early (| head): not an error worth a message
+        _silence_stdout()
         return 1
+    except OSError as e:  # writing standard output or the terminal: a full disk, a closed terminal
+        print(f"thermofriction: error: {e.filename or 'standard output'}: cannot write ({e.strerror or e})",
+              file=sys.stderr)
+        _silence_stdout()
+        return 1
+    finally:
+        _io.restore_signal_handlers(handlers)
+
+
+def _after_signal():
+    if not _io.published:
+        return "no output was written"
+    return "outputs completed before it: " + ", ".join(map(str, _io.published))
+
+
+def _silence_stdout():
+    """Points standard output at /dev/null so that Python's final flush of what could not be
+    written raises nothing more (the error was reported once)."""
+    import contextlib
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -33,7 +33,7 @@ def run_demo(folder="thermofriction-demo", progress=None, command=None) -> dict:
     truth = load_model("li2009-model-i")
     data = synthesize(truth, FIT_TEMPERATURES, validate=HELD_OUT, duration=2.0, sample_rate=10_000.0,
                       noise=20e-9, quantization=5e-9, temperature_noise=0.05, seed=2009, name="li2009-synthetic")
-    save_dataset(data, folder / "data")
+    save_dataset(data, folder / "data", overwrite=True)  # the demo's own folder
     timings["synthesise"] = time.perf_counter() - t0
     start = load_model("li2009-base")  # a user's starting point: LuGre at 30 C, no thermal model
     fits = {}

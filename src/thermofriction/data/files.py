@@ -53,6 +53,12 @@ def load_dataset(path) -> Dataset:
     else:
         raise InputError(f"{path}: no such dataset folder")
     if not manifest.is_file():
+        from .._io import stale_temporaries
+        left = stale_temporaries(folder)
+        if left:  # save_dataset removes the manifest first and renames the new one last
+            raise InputError(f"{folder}: no dataset.toml, and temporary files of an interrupted write "
+                             f"({', '.join(left[:3])}{', ...' if len(left) > 3 else ''}): the dataset was not "
+                             f"completely written; write it again")
         raise InputError(f"{folder}: no dataset.toml in this folder")
     try:
         meta = tomllib.loads(manifest.read_text(encoding="utf-8"))
@@ -128,11 +134,52 @@ def load_dataset(path) -> Dataset:
     return Dataset(path=folder, name=name, description=description, experiments=exps)
 
 
-def save_dataset(dataset: Dataset, folder) -> Path:
+def check_dataset_folder(folder, overwrite=False, hint="overwrite=True"):
+    """Before any work: refuses (exit 2) a path that is not a folder, a folder that already holds a
+    dataset (unless ``overwrite``) and a place where no file can be created."""
+    from .._io import OutputError, check_folder
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"{folder}: cannot create the dataset folder (a file of that name exists)")
+    if (folder / "dataset.toml").exists() or (folder / "dataset.toml").is_symlink():
+        if not overwrite:
+            raise OutputError(f"{folder}: already holds a dataset (dataset.toml); give {hint} to replace it")
+    check_folder(folder)
+
+
+def _listed_files(folder: Path) -> list[Path]:
+    """The files an existing manifest lists (inside the folder), or [] when it cannot be read."""
+    try:
+        meta = tomllib.loads((folder / "dataset.toml").read_text(encoding="utf-8"))
+        entries = meta.get("experiment", [])
+        files = [e.get("file") for e in entries if isinstance(e, dict)]
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError, AttributeError, TypeError):
+        return []
+    root = folder.resolve()
+    out = []
+    for f in files:
+        if isinstance(f, str) and f.strip() and _is_inside(f):
+            try:
+                target = (folder / f).resolve()
+            except (OSError, ValueError, RuntimeError):
+                continue
+            if root in target.parents:
+                out.append(folder / f)
+    return out
+
+
+def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     """Writes ``folder`` (created if needed): one CSV per experiment (``time[s],voltage[V],
     displacement[um]``, and ``temperature[C]`` and ``stage_displacement[um]`` where present, ten
-    significant digits) and ``dataset.toml``, each file atomically. Returns the folder and sets
-    ``dataset.path`` to it."""
+    significant digits) and ``dataset.toml``. Returns the folder and sets ``dataset.path`` to it.
+
+    A folder that already holds a dataset is refused unless ``overwrite``; then the files its old
+    manifest lists and the new one does not are removed. The files are published as a set: every
+    file is written to a temporary one first; then the old manifest is removed, the CSV files are
+    renamed into place and the manifest comes last. A write interrupted between those renames
+    leaves a folder without ``dataset.toml``, which :func:`load_dataset` refuses, naming the
+    temporary files left; on an error nothing is changed and folders created for it are removed."""
+    from .._io import publish_together
     folder = Path(folder)
     files = [e.file for e in dataset.experiments]
     if not files:
@@ -143,42 +190,68 @@ def save_dataset(dataset: Dataset, folder) -> Path:
     dup = sorted({f for f in files if files.count(f) > 1})
     if dup:
         raise InputError(f"two experiments would be written to the same file: {', '.join(dup)}")
+    if any(PurePosixPath(f.replace("\\", "/")) == PurePosixPath("dataset.toml") for f in files):
+        raise InputError("an experiment file cannot be named dataset.toml (the manifest)")
+    check_dataset_folder(folder, overwrite)
+    created = []  # folders made here, removed again if the writing fails
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-        for f in files:
-            (folder / f).parent.mkdir(parents=True, exist_ok=True)
+        for d in [folder] + [(folder / f).parent for f in files]:
+            missing = []
+            while not d.exists():
+                missing.append(d)
+                d = d.parent
+            for m in reversed(missing):
+                m.mkdir()
+                created.append(m)
     except OSError as err:
+        _remove_folders(created)
         raise InputError(f"{folder}: cannot create the dataset folder ({err.strerror or err})") from None
-    entries = []
-    for e in dataset.experiments:
-        cols = {"time[s]": e.time, "voltage[V]": e.voltage, "displacement[um]": np.asarray(e.displacement) * 1e6}
-        if e.temperature_signal is not None:
-            cols["temperature[C]"] = e.temperature_signal
-        if e.stage_displacement is not None:
-            cols["stage_displacement[um]"] = np.asarray(e.stage_displacement) * 1e6
-        try:
-            with atomic_write(folder / e.file, "w", newline="") as fh:
-                fh.write(",".join(cols) + "\n")
-                np.savetxt(fh, np.column_stack([np.asarray(v, float) for v in cols.values()]), delimiter=",",
-                           fmt="%.10g")
-        except OSError as err:
-            raise InputError(f"{folder / e.file}: cannot write ({err.strerror or err})") from None
-        entry = {"file": e.file, "temperature": float(e.temperature), "role": e.role}
-        if e.description:
-            entry["description"] = e.description
-        if e.input is not None:
-            entry["input"] = e.input.spec()
-        entries.append(entry)
-    meta = {}
-    if dataset.name:
-        meta["name"] = dataset.name
-    if dataset.description:
-        meta["description"] = dataset.description
-    meta["experiment"] = entries
+    manifest = folder / "dataset.toml"
     try:
-        with atomic_write(folder / "dataset.toml", "w") as fh:
-            fh.write(tomli_w.dumps(meta))
-    except OSError as err:
-        raise InputError(f"{folder / 'dataset.toml'}: cannot write ({err.strerror or err})") from None
+        with publish_together() as staged:
+            entries = []
+            for e in dataset.experiments:
+                cols = {"time[s]": e.time, "voltage[V]": e.voltage,
+                        "displacement[um]": np.asarray(e.displacement) * 1e6}
+                if e.temperature_signal is not None:
+                    cols["temperature[C]"] = e.temperature_signal
+                if e.stage_displacement is not None:
+                    cols["stage_displacement[um]"] = np.asarray(e.stage_displacement) * 1e6
+                with atomic_write(folder / e.file, "w", newline="") as fh:
+                    fh.write(",".join(cols) + "\n")
+                    np.savetxt(fh, np.column_stack([np.asarray(v, float) for v in cols.values()]), delimiter=",",
+                               fmt="%.10g")
+                entry = {"file": e.file, "temperature": float(e.temperature), "role": e.role}
+                if e.description:
+                    entry["description"] = e.description
+                if e.input is not None:
+                    entry["input"] = e.input.spec()
+                entries.append(entry)
+            meta = {}
+            if dataset.name:
+                meta["name"] = dataset.name
+            if dataset.description:
+                meta["description"] = dataset.description
+            meta["experiment"] = entries
+            if manifest.exists() or manifest.is_symlink():
+                new = {(folder / f).resolve() for f in files}
+                old = [p for p in _listed_files(folder) if p.resolve() not in new]
+                from .._io import refuse_inputs, Target
+                refuse_inputs([Target(p) for p in old if p.is_file()], staged.inputs)
+                staged.remove_before.append(manifest)  # no manifest while the files change
+                staged.remove_after.extend(old)        # the old dataset's files the new one does not list
+            with atomic_write(manifest, "w") as fh:  # staged last: renamed last
+                fh.write(tomli_w.dumps(meta))
+    except BaseException:
+        _remove_folders(created)
+        raise
     dataset.path = folder
     return folder
+
+
+def _remove_folders(created):
+    for d in reversed(created):
+        try:
+            d.rmdir()  # only if still empty
+        except OSError:
+            pass

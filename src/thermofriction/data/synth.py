@@ -4,16 +4,18 @@ noise), and the ``thermofriction synth`` command."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
-from ..models import Model, load_model, require_actuator
+from ..models import PRESETS, Model, load_model, require_actuator
 from ..plausible import parse_length
 from ..simulate import StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
-from .files import _check_temperature, save_dataset
+from .._io import publish_together
+from .files import _check_temperature, check_dataset_folder, save_dataset
 
 def _nonneg(label, v):
     try:
@@ -185,7 +187,11 @@ def add_synth_command(subparsers):
                         "for identifying the plant")
     s.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default: 0)")
     s.add_argument("-o", "--output", required=True, metavar="DIR",
-                   help="dataset folder to write (created if needed; files in it are replaced)")
+                   help="dataset folder to write (created if needed); a folder that already holds a dataset "
+                        "is refused unless --force")
+    s.add_argument("--force", action="store_true",
+                   help="replace the dataset in the output folder (its files that the new one does not list "
+                        "are removed)")
     s.set_defaults(run=cmd_synth)
     return s
 
@@ -207,6 +213,7 @@ def cmd_synth(args) -> int:
     if not fit_T:
         raise InputError("--temperatures: give at least one temperature, e.g. --temperatures 30.8,35.7,41.5")
     val_T = _float_list(args.validate or "", "--validate")
+    check_dataset_folder(args.output, args.force, hint="--force")  # before the work, not after it
     model = load_model(args.model)
     waveform = parse_waveform(args.input) if args.input else None
     if waveform is None and model.input is None:
@@ -220,7 +227,12 @@ def cmd_synth(args) -> int:
                           seed=args.seed)
     except InputError as e:
         raise InputError(f"synth: {e}") from None
-    folder = save_dataset(data, args.output)
+    inputs = [] if args.model in PRESETS else [args.model]
+    for w in (waveform, model.input):
+        if isinstance(w, Sampled) and w.file:
+            inputs += [w.file, str(Path(args.model).parent / w.file)]
+    with publish_together(inputs=inputs):  # refuses to replace or remove an input file
+        folder = save_dataset(data, args.output, overwrite=args.force)
     for e in data.experiments:
         print(f"wrote {folder / e.file} ({e.role}, {e.temperature:g} C, {e.time.size} samples)")
     print(f"wrote {folder / 'dataset.toml'} ({len(data.fit)} fit, {len(data.validate)} validate)")
