@@ -145,7 +145,7 @@ int tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, do
     double h = L->dt / L->substeps;
     for (long i = 0; i < n; i++) {
         double e = x_ref[i] - x, u, Fc = 0.0;
-        if ((status = tf_pid_step_status(&L->pid, e, L->dt, &u))) return stop(L, status, "pid", "u", i);
+        if ((status = tf_pid_step_status(&L->pid, e, L->dt, &u))) return stop(L, status, "pid", "u (not finite: the loop is unstable)", i);
         if (L->compensation == TF_COMP_FEEDFORWARD) status = tf_rt_step_status(L->comp, v_ref[i], L->T_comp, L->dt, &Fc);
         else if (L->compensation == TF_COMP_OBSERVER)
             status = tf_observer_step_status(L->comp, v, -e, L->observer_gain, L->T_comp, L->dt, &Fc);

@@ -25,7 +25,7 @@ static const char *rt_check(const tf_rt_friction *f, int T_known, double T)
 
 static int valid_kind(int kind, const tf_gms_elements *gms)
 {
-    if (tf_friction_nstate(kind, 0) < 0) return 0;
+    if (tf_friction_nstate(kind, 1) < 0) return 0;
     return kind != TF_FRICTION_GMS || (gms && gms->n >= 1 && gms->n <= TF_MAX_FRICTION_STATES);
 }
 
@@ -34,7 +34,7 @@ int tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_elemen
     if (!f) return TF_ERR_BAD_ARGUMENT;
     memset(f, 0, sizeof *f);
     if (!p) return rt_done(f, TF_ERR_BAD_ARGUMENT, "p (NULL)");
-    if (tf_friction_nstate(kind, 0) < 0) return rt_done(f, TF_ERR_BAD_ARGUMENT, "kind");
+    if (tf_friction_nstate(kind, 1) < 0) return rt_done(f, TF_ERR_BAD_ARGUMENT, "kind");
     if (kind == TF_FRICTION_GMS && !gms) return rt_done(f, TF_ERR_BAD_ARGUMENT, "gms (NULL)");
     tf_model *m = &f->model;
     m->plant = TF_PLANT_PRESCRIBED;
@@ -58,6 +58,19 @@ static int last_T(const tf_rt_friction *f, double *T)
     return f->model.cache_valid && f->model.thermal != TF_THERMAL_NONE;
 }
 
+/* After a setter: a refusal restored the model (the cache still holds); an accepted change
+ * refills the cache at the last temperature, where it was checked, so the next change is checked
+ * there too. */
+static int set_done(tf_rt_friction *f, const char *bad, int known, double T)
+{
+    if (!bad) {
+        double l, d;
+        tf_model_prepare(&f->model);
+        if (known) tf_model_params_cached(&f->model, T, &l, &d);
+    }
+    return rt_done(f, bad ? TF_ERR_BAD_ARGUMENT : TF_OK, bad);
+}
+
 int tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law)
 {
     if (!f) return TF_ERR_BAD_ARGUMENT;
@@ -73,8 +86,7 @@ int tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law)
     m->law[param] = *law;
     const char *bad = rt_check(f, known, T);
     if (bad) m->thermal = thermal, m->law[param] = old;
-    tf_model_prepare(m);
-    return rt_done(f, bad ? TF_ERR_BAD_ARGUMENT : TF_OK, bad);
+    return set_done(f, bad, known, T);
 }
 
 int tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form)
@@ -92,8 +104,7 @@ int tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form)
     m->dF_form = form;
     const char *bad = rt_check(f, known, T);
     if (bad) m->thermal = thermal, m->dF = old, m->dF_form = old_form;
-    tf_model_prepare(m);
-    return rt_done(f, bad ? TF_ERR_BAD_ARGUMENT : TF_OK, bad);
+    return set_done(f, bad, known, T);
 }
 
 int tf_rt_set_param(tf_rt_friction *f, int param, double value)
@@ -111,8 +122,7 @@ int tf_rt_set_param(tf_rt_friction *f, int param, double value)
     if (param == TF_P_FS) m->fs_follows_fc = !isfinite(value);
     const char *bad = rt_check(f, known, T);
     if (bad) m->p[param] = old, m->law[param] = old_law, m->fs_follows_fc = old_follows;
-    tf_model_prepare(m);
-    return rt_done(f, bad ? TF_ERR_BAD_ARGUMENT : TF_OK, bad);
+    return set_done(f, bad, known, T);
 }
 
 int tf_rt_reset(tf_rt_friction *f)
