@@ -151,6 +151,7 @@ int tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, do
             status = tf_observer_step_status(L->comp, v, -e, L->observer_gain, L->T_comp, L->dt, &Fc);
         if (status) return stop(L, status, "compensation", L->comp->what, i);
         u += Fc;
+        if (!isfinite(u)) return stop(L, TF_ERR_NONFINITE, "loop", "u (not finite: the loop is unstable)", i);
         if (x_out) x_out[i] = x;
         if (u_out) u_out[i] = u;
         if (F_out) F_out[i] = Fc;
@@ -160,9 +161,10 @@ int tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, do
                 return stop(L, status, "plant", L->plant->what, i);
             v += (u - F) / L->mass * h;
             x += v * h;
+            /* here, not after the period: the next substep would refuse a non-finite v as an argument */
+            if (!isfinite(x) || !isfinite(v))
+                return stop(L, TF_ERR_NONFINITE, "loop", "position or velocity not finite (the loop is unstable)", i);
         }
-        if (!isfinite(x) || !isfinite(v))
-            return stop(L, TF_ERR_NONFINITE, "loop", "position or velocity not finite (the loop is unstable)", i);
     }
     return stop(L, TF_OK, 0, 0, -1);
 }
