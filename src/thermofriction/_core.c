@@ -581,8 +581,10 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     status = tf_loop_run(&loop, (long)n, x_ref, v_ref, out[0], out[1], out[2]);
     Py_END_ALLOW_THREADS
     /* a refusal (ValueError) names the part, the argument and the period; other statuses are returned */
-    if (status == TF_ERR_BAD_ARGUMENT)
+    if (status == TF_ERR_BAD_ARGUMENT && loop.period >= 0)
         PyErr_Format(PyExc_ValueError, "%s: %s (period %ld)", loop.where, loop.what, loop.period);
+    else if (status == TF_ERR_BAD_ARGUMENT)
+        PyErr_Format(PyExc_ValueError, "%s: %s", loop.where, loop.what);
     else
         result = PyLong_FromLong(status);
 done:

@@ -229,7 +229,8 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
     comp_spec, T_comp, kind, gain = None, math.nan, "none", 0.0
     if compensation is not None:
         T_comp = temperature if compensation.temperature is None else compensation.temperature
-        _check_at(f"{where}: the {compensation.kind} model", compensation.model, T_comp)
+        name = {"feedforward": "feed-forward"}.get(compensation.kind, compensation.kind)
+        _check_at(f"{where}: the {name} compensation's model", compensation.model, T_comp)
         comp_spec = model_spec(compensation.model, T_comp)
         kind = compensation.kind
         gain = float(getattr(compensation, "gain", 0.0))
