@@ -179,10 +179,9 @@ double tf_rt_thermal_force(double F_base, double v, const double *p, double lamb
     return tf_thermal_force(F_base, v, p[TF_P_VSMOOTH], lambda, dF_offset, 0, 0);
 }
 
-static double advance(int kind, const double *p, tf_gms_elements *gms, double *z, double v, double dt,
+static double advance(int kind, int nz, const double *p, tf_gms_elements *gms, double *z, double v, double dt,
                       const double *extra, double *dz)
 {
-    int nz = tf_friction_nstate(kind, gms ? gms->n : 0);
     if (nz > 0 && dt > 0.0) {
         tf_friction_partials d;
         tf_friction_eval(kind, p, gms, v, z, dz, &d, 0);
@@ -205,34 +204,52 @@ double tf_rt_advance(int kind, const double *p, tf_gms_elements *gms, double *z,
                      const double *extra, double *dz)
 {
     if (!p || !z || !dz || !valid_kind(kind, gms)) return NAN;
-    return advance(kind, p, gms, z, v, dt, extra, dz);
+    return advance(kind, tf_friction_nstate(kind, gms ? gms->n : 0), p, gms, z, v, dt, extra, dz);
 }
 
-/* One checked step: the states advance on a copy, committed only when the force F' and every
- * state are finite. */
+/* Internal states of a checked model (tf_friction_nstate without the call: it is on every step). */
+static inline int nstate(const tf_model *m)
+{
+    switch (m->friction) {
+    case TF_FRICTION_COULOMB: case TF_FRICTION_STRIBECK: return 0;
+    case TF_FRICTION_GMS: return m->gms.n;
+    default: return 1;
+    }
+}
+
+/* One checked step: the states advance in place from a backup, restored unless the force F' (and
+ * so every state) is finite. The per-step cost of the checks: three isfinite, the cache test (a
+ * model without a thermal extension skips even that) and the backup of the states. */
 static int rt_step(tf_rt_friction *f, double v, double T, double dt, double *F_out)
 {
     if (!isfinite(v)) return rt_done(f, TF_ERR_BAD_ARGUMENT, "v (not finite)");
     if (!isfinite(dt)) return rt_done(f, TF_ERR_BAD_ARGUMENT, "dt (not finite)");
-    double lambda, dF, dz[TF_MAX_FRICTION_STATES], z[TF_MAX_FRICTION_STATES];
-    int mode[TF_MAX_FRICTION_STATES];
-    const double *p = rt_params(f, T, &lambda, &dF);
-    if (!p) return f->status;
     tf_model *m = &f->model;
-    int gms = m->friction == TF_FRICTION_GMS, nz = tf_friction_nstate(m->friction, m->gms.n);
-    memcpy(z, f->z, sizeof(double) * nz);
-    if (gms) memcpy(mode, m->gms.mode, sizeof(int) * nz);
-    double F = advance(m->friction, p, &m->gms, z, v, dt, 0, dz);
+    double lambda, dF, dz[TF_MAX_FRICTION_STATES], z0[TF_MAX_FRICTION_STATES];
+    int mode0[TF_MAX_FRICTION_STATES];
+    const double *p;
+    if (m->thermal == TF_THERMAL_NONE && m->cache_valid) {
+        p = m->cache_p, lambda = m->cache_lambda, dF = m->cache_dF;
+    } else if (!(p = rt_params(f, T, &lambda, &dF))) {
+        return f->status;
+    }
+    int nz = nstate(m), gms = m->friction == TF_FRICTION_GMS;
+    for (int j = 0; j < nz; j++) z0[j] = f->z[j];
+    if (gms)
+        for (int j = 0; j < nz; j++) mode0[j] = m->gms.mode[j];
+    double F = advance(m->friction, nz, p, &m->gms, f->z, v, dt, 0, dz);
     F = tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 0, 0);
-    int finite = isfinite(F);
-    for (int j = 0; j < nz; j++) finite &= isfinite(z[j]);
-    if (!finite) {
-        if (gms) memcpy(m->gms.mode, mode, sizeof(int) * nz);
+    /* F' is finite only if every state is: each model's force sums its states with positive
+       weights (sigma0 z, the GMS element forces), and lambda > 0 */
+    if (!isfinite(F)) {
+        for (int j = 0; j < nz; j++) f->z[j] = z0[j];
+        if (gms)
+            for (int j = 0; j < nz; j++) m->gms.mode[j] = mode0[j];
         return rt_done(f, TF_ERR_NONFINITE, "force or state not finite (v or dt too large)");
     }
-    memcpy(f->z, z, sizeof(double) * nz);
     *F_out = F;
-    return rt_done(f, TF_OK, 0);
+    f->status = TF_OK, f->what = 0;
+    return TF_OK;
 }
 
 int tf_rt_step_status(tf_rt_friction *f, double v, double T, double dt, double *F)
