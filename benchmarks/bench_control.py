@@ -39,7 +39,8 @@ def models():
     yield "stribeck", tf.Stribeck(fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4, v_smooth=1e-4)
     yield "dahl", tf.Dahl(sigma0=1e5, fc=1.0)
     yield "lugre", tf.LuGre(**CANUDAS)
-    yield "elastoplastic", tf.ElastoPlastic(**CANUDAS, z_ba=3e-6)
+    # z_ba < fc/sigma0 at every temperature of the sweep (fc falls to 0.16 N at 41.5 C)
+    yield "elastoplastic", tf.ElastoPlastic(**CANUDAS, z_ba=1e-6)
     yield "gms (4)", tf.GMS(k=[k * 1e5 / sum(k4) for k in k4], w=[0.25] * 4, C=20.0, fc=1.0, fs=1.5, vs=1e-3)
     yield "gms (50)", tf.GMS(k=k50, w=[0.02] * 50, C=20.0, fc=1.0, fs=1.5, vs=1e-3)
 

@@ -32,6 +32,7 @@ def test_c_library_builds_standalone_and_its_tests_pass(tmp_path):
 # ---------------------------------------------------------------------------------------------
 
 CORPUS = CORE / "fuzz" / "corpus"
+CORPUS_REALTIME = CORE / "fuzz" / "corpus_realtime"  # fuzz_realtime.c: the real-time and control APIs
 
 
 def need(tool):
@@ -47,8 +48,8 @@ def build_core(build, *cmake_args):
     subprocess.run(["cmake", "--build", str(build), "-j", "2"], check=True, capture_output=True)
 
 
-def corpus():
-    files = sorted(CORPUS.iterdir())
+def corpus(folder=CORPUS):
+    files = sorted(folder.iterdir())
     assert len(files) > 100  # the seed corpus is there (a replay of nothing proves nothing)
     return [str(f) for f in files]
 
@@ -63,9 +64,10 @@ def test_c_tests_and_fuzz_corpus_are_clean_under_address_and_undefined_behaviour
     env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=1", UBSAN_OPTIONS="print_stacktrace=1")
     out = subprocess.run([str(build / "test_core")], capture_output=True, text=True, env=env)
     assert out.returncode == 0 and "0 failed" in out.stdout, out.stdout + out.stderr
-    files = corpus()
-    rep = subprocess.run([str(build / "fuzz_replay"), *files], capture_output=True, text=True, env=env)
-    assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
+    for replay, folder in (("fuzz_replay", CORPUS), ("fuzz_replay_realtime", CORPUS_REALTIME)):
+        files = corpus(folder)
+        rep = subprocess.run([str(build / replay), *files], capture_output=True, text=True, env=env)
+        assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
 
 
 def test_c_tests_and_fuzz_corpus_are_valgrind_clean(tmp_path):
@@ -80,6 +82,9 @@ def test_c_tests_and_fuzz_corpus_are_valgrind_clean(tmp_path):
     files = corpus()[::4]  # valgrind is ~50x slower: a quarter of the corpus
     rep = subprocess.run([*vg, str(build / "fuzz_replay"), *files], capture_output=True, text=True)
     assert rep.returncode == 0, rep.stdout + rep.stderr[-3000:]
+    files = corpus(CORPUS_REALTIME)  # the real-time programs are short: all of them (~2 s)
+    rep = subprocess.run([*vg, str(build / "fuzz_replay_realtime"), *files], capture_output=True, text=True)
+    assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
 
 
 def test_fuzz_target_runs_30_seconds_without_a_finding(tmp_path):
@@ -96,6 +101,28 @@ def test_fuzz_target_runs_30_seconds_without_a_finding(tmp_path):
     shutil.copytree(CORPUS, work)
     seconds = int(os.environ.get("TF_FUZZ_SECONDS", "30"))
     out = subprocess.run([str(build / "fuzz_simulate"), f"-max_total_time={seconds}", "-timeout=10",
+                          "-rss_limit_mb=2048", f"-artifact_prefix={tmp_path}/", str(work)],
+                         capture_output=True, text=True, timeout=seconds + 300)
+    assert out.returncode == 0 and "Done" in out.stderr, out.stderr[-4000:]
+    assert not list(tmp_path.glob("crash-*")) and not list(tmp_path.glob("timeout-*"))
+
+
+def test_realtime_fuzz_target_runs_20_seconds_without_a_finding(tmp_path):
+    """Coverage-guided fuzzing (libFuzzer, ASan, UBSan) of the real-time and control APIs
+    (core/fuzz/fuzz_realtime.c): programs of up to 64 calls -- init, from_model, set_model_i / _ii,
+    set_param, reset, params_at, steps, observer steps, advance, PID, loop -- with NULLs, unknown
+    kinds, unordered or duplicate breakpoints, NaN, inf and huge values. A crash, sanitiser report,
+    hang (10 s) or broken contract (an unknown status; a refused call that changed the object, the
+    PID or a loop output; TF_OK with a non-finite force, state or output; a NaN force that does not
+    match the status) fails the run. 20 s on CI (TF_FUZZ_SECONDS changes it, as for the other)."""
+    need("clang")
+    build = tmp_path / "fuzz"
+    build_core(build, "-DCMAKE_C_COMPILER=clang", "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DTF_BUILD_FUZZERS=ON",
+               "-DTF_SANITIZE=address,undefined", "-DTF_BUILD_TESTS=OFF")
+    work = tmp_path / "corpus"
+    shutil.copytree(CORPUS_REALTIME, work)
+    seconds = int(os.environ.get("TF_FUZZ_SECONDS", "20"))
+    out = subprocess.run([str(build / "fuzz_realtime"), f"-max_total_time={seconds}", "-timeout=10",
                           "-rss_limit_mb=2048", f"-artifact_prefix={tmp_path}/", str(work)],
                          capture_output=True, text=True, timeout=seconds + 300)
     assert out.returncode == 0 and "Done" in out.stderr, out.stderr[-4000:]

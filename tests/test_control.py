@@ -118,3 +118,155 @@ def test_closed_loop_matches_the_plain_python_reference():
     res = C.simulate_loop(stage, ref, temperature=41.5, compensation=C.Observer(stage, 100.0))
     xs = R.reference_closed_loop(stage, ref, 41.5, C.DEFAULT_PID, gain=100.0)
     assert np.max(np.abs(res.position - xs)) < 1e-15
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 17: the real-time API and the compensation layer check their inputs. Oracle: the
+# documented refusal (the package's error naming the argument), never a crash or a wrong number.
+# ---------------------------------------------------------------------------------------------
+
+def mass_stage(kind):
+    return tf.Model(tf.MassPlant(mass=1.0), MODELS[kind])
+
+
+@pytest.mark.parametrize("kind", ["gms", "coulomb", "stribeck"])
+def test_observer_refuses_a_model_without_one_bristle_state(kind):
+    """The issue's reproduction: simulate_loop(gms_model, ref, temperature=35,
+    compensation=Observer(gms_model)) read past a one-double buffer in C (one `extra` for every GMS
+    element). The observer estimates a bristle deflection: LuGre, Dahl and elasto-plastic have one;
+    the others are refused with a message that says what to use instead."""
+    stage = mass_stage(kind)
+    ref = C.sine_reference(1e-3, 0.5, 0.1)
+    with pytest.raises(tf.InputError, match=f"bristle state.*{kind} model.*FeedForward"):
+        C.simulate_loop(stage, ref, temperature=35, compensation=C.Observer(stage))
+
+
+def test_the_core_refuses_the_observer_on_gms_even_past_the_python_check():
+    """Defence in depth: an Observer whose model was swapped after construction reaches the C core,
+    which refuses it (tf_observer_step_status / tf_loop_run) instead of overflowing its stack."""
+    obs = C.Observer(mass_stage("lugre"))
+    object.__setattr__(obs, "model", mass_stage("gms"))
+    with pytest.raises(tf.InputError, match="C core refused.*compensation.*LuGre, Dahl or elasto-plastic"):
+        C.simulate_loop(mass_stage("lugre"), C.sine_reference(1e-3, 0.5, 0.1), temperature=35, compensation=obs)
+
+
+@pytest.mark.parametrize("kind", C.OBSERVED_MODELS)
+def test_observer_runs_on_every_bristle_model(kind):
+    """Oracle: the observer's estimate of a perfect model follows the plant's friction (as for
+    the preset above), here for each model it accepts: after 0.2 s within 5 % of fc = 1 N."""
+    stage = mass_stage(kind)
+    ref = C.sine_reference(1e-3, 0.5, 1.0)
+    res = C.simulate_loop(stage, ref, temperature=35, compensation=C.Observer(stage, 100.0))
+    F_true, _ = C.friction_steps(stage, np.gradient(res.position, res.time), ref.time[1] - ref.time[0])
+    late = res.time > 0.2
+    assert np.all(np.isfinite(res.compensation))
+    assert np.max(np.abs(res.compensation[late] - F_true[late])) < 0.05
+
+
+def law_i_model():
+    """fc = fs = 2.5 - 0.05 T: positive below 50 C, negative above (the issue's F = -1.6e17 N at 60 C)."""
+    friction = dataclasses.replace(MODELS["lugre"], fc=None, fs=None)
+    law = tf.Linear(a=-0.05, b=2.5)
+    return tf.Model(tf.PrescribedMotion(), friction, tf.ModelI({"fc": law, "fs": law}))
+
+
+def test_friction_steps_refuses_a_model_i_law_out_of_its_domain():
+    model = law_i_model()
+    v = np.full(4, 1e-3)
+    F, _ = C.friction_steps(model, v, 1e-4, temperature=35.0)
+    assert np.all(np.isfinite(F)) and np.all(F > 0)
+    with pytest.raises(tf.InputError, match="fc.*positive"):
+        C.friction_steps(model, v, 1e-4, temperature=60.0)
+    # one temperature per step: the core checks the model at each new one and names the step
+    with pytest.raises(tf.InputError, match=r"invalid at step 2 \(T = 60 C\): 'fc' is out of its domain"):
+        C.friction_steps(model, v, 1e-4, temperature=np.array([35.0, 40.0, 60.0, 35.0]))
+
+
+def test_friction_steps_refuses_a_model_ii_that_reverses_friction():
+    """Model II's lambda = 1 + dF/fc <= 0 reverses friction: refused (it gave negative forces)."""
+    model = tf.Model(tf.PrescribedMotion(), MODELS["lugre"], tf.ModelII(tf.Linear(a=-0.1, b=0.6)))
+    v = np.full(3, 1e-3)
+    assert np.all(C.friction_steps(model, v, 1e-4, temperature=5.0)[0] > 0)
+    with pytest.raises(tf.InputError, match="lambda.*reverse friction"):
+        C.friction_steps(model, v, 1e-4, temperature=35.0)
+    with pytest.raises(tf.InputError, match=r"step 1 \(T = 35 C\): 'dF' is out of its domain"):
+        C.friction_steps(model, v, 1e-4, temperature=np.array([5.0, 35.0, 5.0]))
+
+
+@pytest.mark.parametrize("velocity, dt, temperature, match", [
+    ([1e-3, math.nan, 1e-3], 1e-4, None, r"velocity\[1\] is nan"),
+    ([1e-3, math.inf], 1e-4, None, r"velocity\[1\] is inf"),
+    ([1e-3], 0.0, None, "dt must be > 0"),
+    ([1e-3], math.nan, None, "dt must be finite"),
+    ([1e-3], "1e-4", None, "dt must be a number"),
+    ([1e-3], 1e-4, math.nan, "temperature must be finite"),
+    ([1e-3, 1e-3], 1e-4, [35.0, math.inf], r"temperature\[1\] is inf"),
+    ([1e-3, 1e-3], 1e-4, [35.0], "temperature must be one-dimensional with 2 values"),
+    ("fast", 1e-4, None, "velocity must be an array of numbers"),
+])
+def test_friction_steps_refuses_bad_arguments(velocity, dt, temperature, match):
+    with pytest.raises(tf.InputError, match=f"friction_steps: {match}"):
+        C.friction_steps(prescribed("lugre"), velocity, dt, temperature=temperature)
+
+
+def test_friction_steps_needs_a_temperature_for_a_thermal_model_and_a_model():
+    with pytest.raises(tf.InputError, match="depends on temperature"):
+        C.friction_steps(law_i_model(), [1e-3], 1e-4)
+    with pytest.raises(tf.InputError, match="model must be a thermofriction Model"):
+        C.friction_steps("li2009-model-i", [1e-3], 1e-4)
+
+
+def test_an_overflowing_step_is_a_solver_error():
+    """v = 1e308: sigma1 z' overflows. The core refuses the step (TF_ERR_NONFINITE) and keeps the
+    state; the package reports it as a SolverError naming the step."""
+    with pytest.raises(tf.SolverError, match="step 1: force or state not finite"):
+        C.friction_steps(prescribed("lugre"), [1e-3, 1e308], 1e-4)
+
+
+def test_simulate_loop_refuses_bad_arguments():
+    stage = tf.load_model("stage-model-i")
+    ref = C.sine_reference(1e-3, 0.5, 0.1)
+    bad_ref = C.Reference("bad", ref.time, ref.position.copy(), ref.velocity)
+    bad_ref.position[7] = math.nan
+    cases = [
+        (dict(stage="stage-model-i"), "stage must be a thermofriction Model"),
+        (dict(reference="sine"), "reference must be a Reference"),
+        (dict(reference=bad_ref), r"reference.position\[7\] is nan"),
+        (dict(reference=C.Reference("one", ref.time[:1], ref.position[:1], ref.velocity[:1])), "two samples"),
+        (dict(temperature=math.nan), "temperature must be finite"),
+        (dict(temperature="35"), "temperature must be a number"),
+        (dict(substeps=0), "substeps must be an integer >= 1"),
+        (dict(substeps=1.5), "substeps must be an integer >= 1"),
+        (dict(pid=(1, 2, 3)), "pid must be a PID"),
+        (dict(compensation="observer"), "compensation must be FeedForward, Observer or None"),
+        (dict(temperature=80.0), "the stage.*Model I at 80 C"),
+    ]
+    for change, match in cases:
+        kw = dict(stage=stage, reference=ref, temperature=41.5)
+        kw.update(change)
+        with pytest.raises(tf.InputError, match=match):
+            C.simulate_loop(kw.pop("stage"), kw.pop("reference"), **kw)
+
+
+def test_compensation_and_pid_check_their_arguments():
+    stage = tf.load_model("stage-model-i")
+    for make, match in [
+        (lambda: C.PID(kp=math.nan, ki=0, kd=0), "PID: kp must be finite"),
+        (lambda: C.PID(kp=1, ki=0, kd=0, tau_d=-1e-3), "PID: tau_d must be >= 0"),
+        (lambda: C.Observer(stage, gain=-1.0), "Observer: gain must be >= 0"),
+        (lambda: C.Observer(stage, temperature=math.inf), "Observer: temperature must be finite"),
+        (lambda: C.FeedForward("stage-model-i"), "FeedForward: model must be a thermofriction Model"),
+    ]:
+        with pytest.raises(tf.InputError, match=match):
+            make()
+    # a compensation told a temperature where its model is invalid
+    with pytest.raises(tf.InputError, match="feed-forward compensation's model: Model I at 80 C"):
+        C.simulate_loop(stage, C.sine_reference(1e-3, 0.5, 0.1), temperature=41.5,
+                        compensation=C.FeedForward(stage, temperature=80.0))
+
+
+def test_an_unstable_loop_is_a_solver_error():
+    """Positive feedback (kp < 0) diverges: the core stops at the first non-finite state."""
+    with pytest.raises(tf.SolverError, match="unstable"):
+        C.simulate_loop(tf.load_model("stage-model-i"), C.sine_reference(1e-3, 0.5, 0.2), temperature=41.5,
+                        pid=C.PID(kp=-1e12, ki=0.0, kd=0.0))

@@ -485,20 +485,25 @@ static const char *check_friction_params(const tf_model *m, const double *p, int
     return 0;
 }
 
+int tf_model_check_params(const tf_model *m, const double *p, double lambda, double dF_offset, const char **what)
+{
+    int offset = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET;
+    const char *bad = check_friction_params(m, p, offset);
+    if (!bad && m->thermal == TF_THERMAL_MODEL_II) {
+        if (offset ? !isfinite(dF_offset) : !isfinite(lambda)) bad = "dF";
+        else if (!offset && !(lambda > 0.0)) bad = "dF (lambda <= 0 or not finite)";
+    }
+    if (what) *what = bad;
+    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
+}
+
 static const char *check_at(const tf_model *m, double T)
 {
     double p[TF_NPARAM];
+    const char *bad;
     tf_model_params_at(m, T, p);
-    int offset = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET;
-    const char *bad = check_friction_params(m, p, offset);
-    if (bad) return bad;
-    if (m->thermal == TF_THERMAL_MODEL_II) {
-        double dF = tf_law_eval(&m->dF, T, 0);
-        if (!isfinite(dF)) return "dF";
-        double lambda = tf_model_lambda(m, T);
-        if (m->dF_form == TF_DF_SCALE && !(isfinite(lambda) && lambda > 0.0)) return "dF (lambda <= 0 or not finite)";
-    }
-    return 0;
+    tf_model_check_params(m, p, tf_model_lambda(m, T), tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T), &bad);
+    return bad;
 }
 
 /* n >= 2 points with finite values and strictly increasing finite times (knots). */
@@ -565,6 +570,40 @@ static const char *check_waveform(const tf_waveform *w, int prescribed)
     }
 }
 
+/* The friction model and its thermal extension, apart from the parameters' values. */
+static const char *check_friction_structure(const tf_model *m)
+{
+    const char *bad = 0;
+    if (m->friction < TF_FRICTION_LUGRE || m->friction > TF_FRICTION_GMS) bad = "friction";
+    if (!bad && m->friction == TF_FRICTION_GMS) {
+        double sum = 0.0;
+        if (m->gms.n < 1 || m->gms.n > TF_MAX_FRICTION_STATES) bad = "gms.n (1 to 64 elements)";
+        for (int i = 0; !bad && i < m->gms.n; i++) {
+            if (!pos(m->gms.k[i])) bad = "gms.k";
+            else if (!pos(m->gms.w[i])) bad = "gms.w";
+            sum += m->gms.w[i];
+        }
+        if (!bad && !(fabs(sum - 1.0) <= 1e-9)) bad = "gms.w (must sum to one)";
+    }
+    if (!bad && (m->thermal < TF_THERMAL_NONE || m->thermal > TF_THERMAL_MODEL_II)) bad = "thermal";
+    if (!bad && m->thermal == TF_THERMAL_MODEL_I)
+        for (int i = 0; !bad && i < TF_NPARAM; i++)
+            if (!law_ok(&m->law[i])) bad = "law";
+    if (!bad && m->thermal == TF_THERMAL_MODEL_II) {
+        if (m->dF.kind == TF_LAW_NONE || !law_ok(&m->dF)) bad = "dF";
+        else if (m->dF_form != TF_DF_SCALE && m->dF_form != TF_DF_OFFSET) bad = "dF form";
+    }
+    return bad;
+}
+
+int tf_model_check_friction(const tf_model *m, double T, const char **what)
+{
+    const char *bad = check_friction_structure(m);
+    if (!bad && (m->thermal == TF_THERMAL_NONE || isfinite(T))) bad = check_at(m, m->thermal ? T : NAN);
+    if (what) *what = bad;
+    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
+}
+
 int tf_model_check(const tf_model *m, const char **what)
 {
     const char *bad = 0;
@@ -587,25 +626,7 @@ int tf_model_check(const tf_model *m, const char **what)
     default:
         bad = "plant";
     }
-    if (!bad && (m->friction < TF_FRICTION_LUGRE || m->friction > TF_FRICTION_GMS)) bad = "friction";
-    if (!bad && m->friction == TF_FRICTION_GMS) {
-        double sum = 0.0;
-        if (m->gms.n < 1 || m->gms.n > TF_MAX_FRICTION_STATES) bad = "gms.n (1 to 64 elements)";
-        for (int i = 0; !bad && i < m->gms.n; i++) {
-            if (!pos(m->gms.k[i])) bad = "gms.k";
-            else if (!pos(m->gms.w[i])) bad = "gms.w";
-            sum += m->gms.w[i];
-        }
-        if (!bad && !(fabs(sum - 1.0) <= 1e-9)) bad = "gms.w (must sum to one)";
-    }
-    if (!bad && (m->thermal < TF_THERMAL_NONE || m->thermal > TF_THERMAL_MODEL_II)) bad = "thermal";
-    if (!bad && m->thermal == TF_THERMAL_MODEL_I)
-        for (int i = 0; !bad && i < TF_NPARAM; i++)
-            if (!law_ok(&m->law[i])) bad = "law";
-    if (!bad && m->thermal == TF_THERMAL_MODEL_II) {
-        if (m->dF.kind == TF_LAW_NONE || !law_ok(&m->dF)) bad = "dF";
-        else if (m->dF_form != TF_DF_SCALE && m->dF_form != TF_DF_OFFSET) bad = "dF form";
-    }
+    if (!bad) bad = check_friction_structure(m);
     if (!bad) bad = check_waveform(&m->input, m->plant == TF_PLANT_PRESCRIBED);
     if (!bad && m->heat.on) {
         const tf_heat *h = &m->heat;

@@ -530,8 +530,253 @@ static void test_sigma1_thermal_force_and_heat_rate_partials(void)
     CHECK(tf_heat_param_partial(&heat, TF_HEAT_T_0, T, P, rate) == 0.0, "T_0 enters through the initial state");
 }
 
+/* ---- Checks of the real-time and control APIs (issue 17): every refusal leaves the object as it
+ * was, so the oracle of "as it was" is a twin that never saw the bad call. ---- */
+
+#define B TF_ERR_BAD_ARGUMENT
+
+static void rt_gms(tf_rt_friction *f)
+{
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5, p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0;
+    p[TF_P_C] = 20.0;
+    static tf_gms_elements g = {3, {5e4, 3e4, 2e4}, {0.3, 0.3, 0.4}, {0}};
+    CHECK(tf_rt_init(f, TF_FRICTION_GMS, p, &g) == TF_OK, "tf_rt_init GMS: %s", f->what);
+}
+
+static void test_rt_init_and_setters_refuse_bad_arguments(void)
+{
+    static tf_rt_friction f;
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
+    p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_VSMOOTH] = 1e-6;
+    CHECK(tf_rt_init(NULL, TF_FRICTION_LUGRE, p, NULL) == B, "init: NULL f");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, NULL, NULL) == B && f.status == B && !strcmp(f.what, "p (NULL)"),
+          "init: NULL p");
+    CHECK(tf_rt_init(&f, 99, p, NULL) == B, "init: unknown kind");
+    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, NULL) == B, "init: GMS without elements");
+    tf_gms_elements g = {0};
+    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, &g) == B, "init: GMS with 0 elements");
+    g.n = TF_MAX_FRICTION_STATES + 1;
+    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, &g) == B, "init: GMS with 65 elements");
+    p[TF_P_SIGMA0] = -1e5; /* the simulator's rules: sigma0 > 0 */
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL) == B && !strcmp(f.what, "sigma0"), "init: sigma0 < 0");
+    CHECK(isnan(tf_rt_step(&f, 1e-3, NAN, 1e-4)), "a refused init leaves a model that every step refuses");
+    p[TF_P_SIGMA0] = 1e5;
+    p[TF_P_FS] = 0.5;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL) == B && !strcmp(f.what, "fs"), "init: fs < fc");
+    p[TF_P_FS] = 1.5;
+
+    rt_lugre(&f);
+    double x2[2] = {20.0, 20.0}, y2[2] = {1.0, 2.0};
+    tf_law pwl0 = {TF_LAW_PWL, 0, 0, 0, x2, y2, 0};
+    tf_law table_null = {TF_LAW_TABLE, 0, 0, 2, NULL, NULL, NULL};
+    tf_law duplicate = {TF_LAW_PWL, 0, 0, 2, x2, y2, 0};
+    tf_law table_no_slopes = {TF_LAW_TABLE, 0, 0, 2, x2, y2, NULL};
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &pwl0) == B, "PWL law with n = 0");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &table_null) == B, "TABLE law with NULL data");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &duplicate) == B, "duplicate breakpoints");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &table_no_slopes) == B, "TABLE law without slopes");
+    CHECK(tf_rt_set_model_i(&f, -1, &pwl0) == B && tf_rt_set_model_i(&f, TF_NPARAM, &pwl0) == B,
+          "Model I: bad index");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, NULL) == B && tf_rt_set_model_i(NULL, TF_P_FC, &pwl0) == B,
+          "Model I: NULL law or model");
+    CHECK(f.model.thermal == TF_THERMAL_NONE && f.model.law[TF_P_FC].kind == TF_LAW_NONE,
+          "a refused law leaves the model without it");
+    CHECK(tf_rt_set_model_ii(&f, NULL, TF_DF_SCALE) == B && tf_rt_set_model_ii(NULL, &pwl0, TF_DF_SCALE) == B,
+          "Model II: NULL");
+    tf_law lin = {TF_LAW_LINEAR, -0.02, 0.6, 0, 0, 0, 0};
+    CHECK(tf_rt_set_model_ii(&f, &lin, 7) == B && f.model.thermal == TF_THERMAL_NONE, "Model II: bad form");
+    CHECK(tf_rt_set_param(NULL, TF_P_FC, 1.0) == B, "set_param: NULL");
+    CHECK(tf_rt_set_param(&f, TF_P_SIGMA0, -1.0) == B && f.model.p[TF_P_SIGMA0] == 1e5 && !strcmp(f.what, "sigma0"),
+          "set_param: sigma0 < 0 refused, the old value kept");
+    CHECK(tf_rt_set_param(&f, TF_P_FC, NAN) == B && f.model.p[TF_P_FC] == 1.0, "set_param: NaN fc");
+    CHECK(tf_rt_set_param(&f, TF_P_FS, NAN) == TF_OK && f.model.fs_follows_fc, "set_param: NaN fs = no Stribeck");
+    CHECK(tf_rt_reset(NULL) == B && tf_rt_params_at(NULL, 30.0, p, 0, 0) == B, "reset, params_at: NULL");
+    CHECK(tf_rt_from_model(NULL, &f.model) == B && tf_rt_from_model(&f, NULL) == B, "from_model: NULL");
+    tf_model bad = f.model;
+    bad.p[TF_P_SIGMA0] = -1.0;
+    CHECK(tf_rt_from_model(&f, &bad) == B && f.model.p[TF_P_SIGMA0] == 1e5, "from_model: sigma0 < 0");
+    double z[1] = {0}, dz[1];
+    CHECK(isnan(tf_rt_advance(TF_FRICTION_LUGRE, NULL, NULL, z, 1e-3, 1e-4, 0, dz)) &&
+              isnan(tf_rt_advance(TF_FRICTION_GMS, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz)) &&
+              isnan(tf_rt_advance(42, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz)) && z[0] == 0.0,
+          "advance: NULL p, GMS without elements, unknown kind");
+    p[TF_P_FS] = 1.5;
+    CHECK(isfinite(tf_rt_advance(TF_FRICTION_LUGRE, p, NULL, z, 1e-3, 1e-4, 0, dz)),
+          "advance: LuGre needs no GMS elements");
+    CHECK(isnan(tf_rt_thermal_force(1.0, 1e-3, NULL, 1.0, 0.0)), "thermal_force: NULL p");
+}
+
+static void test_rt_step_refuses_bad_samples_and_keeps_its_state(void)
+{
+    static tf_rt_friction f, twin;
+    double F;
+    CHECK(isnan(tf_rt_step(NULL, 1e-3, NAN, 1e-4)), "step(NULL) is NaN");
+    CHECK(tf_rt_step_status(NULL, 1e-3, NAN, 1e-4, &F) == B && isnan(F), "step_status(NULL)");
+    rt_lugre(&f);
+    CHECK(tf_rt_step_status(&f, 1e-3, NAN, 1e-4, NULL) == B, "step_status: NULL F");
+    rt_lugre(&twin);
+    for (int i = 0; i < 10; i++) tf_rt_step(&f, 1e-3, NAN, 1e-4), tf_rt_step(&twin, 1e-3, NAN, 1e-4);
+    const double bad[] = {NAN, INFINITY, -INFINITY};
+    for (int k = 0; k < 3; k++) {
+        CHECK(isnan(tf_rt_step(&f, bad[k], NAN, 1e-4)) && f.status == B && !strcmp(f.what, "v (not finite)"),
+              "v = %g refused", bad[k]);
+        CHECK(tf_rt_step_status(&f, 1e-3, NAN, bad[k], &F) == B && isnan(F), "dt = %g refused", bad[k]);
+    }
+    CHECK(tf_rt_step(&f, 1e-3, INFINITY, 1e-4) == tf_rt_step(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
+          "without a thermal model T is ignored (NaN, inf), and the refused samples left the state as it was");
+    /* an overflow: sigma1 |v| at v = 1e308 is infinite; the step is refused, the state kept */
+    CHECK(tf_rt_step_status(&f, 1e308, NAN, 1e-4, &F) == TF_ERR_NONFINITE && isnan(F) && f.z[0] == twin.z[0],
+          "overflowing step: status %d, z %g vs %g", f.status, f.z[0], twin.z[0]);
+    CHECK(tf_rt_step(&f, 1e-3, NAN, 1e-4) == tf_rt_step(&twin, 1e-3, NAN, 1e-4) && f.status == TF_OK && !f.what,
+          "the next good sample continues as if the bad ones had not come");
+
+    /* Model I: fc = 2.5 - 0.05 T turns negative above 50 C (the issue: F = -1.6e17 N at 60 C) */
+    rt_lugre(&f);
+    rt_lugre(&twin);
+    tf_law fc = {TF_LAW_LINEAR, -0.05, 2.5, 0, 0, 0, 0};
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &fc) == TF_OK && tf_rt_set_model_i(&twin, TF_P_FC, &fc) == TF_OK, "law");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FS, &fc) == TF_OK && tf_rt_set_model_i(&twin, TF_P_FS, &fc) == TF_OK, "law");
+    for (int i = 0; i < 10; i++) tf_rt_step(&f, 1e-3, 35.0, 1e-4), tf_rt_step(&twin, 1e-3, 35.0, 1e-4);
+    CHECK(isnan(tf_rt_step(&f, 1e-3, 60.0, 1e-4)) && f.status == B && !strcmp(f.what, "fc"),
+          "Model I: fc < 0 at 60 C refused (%s)", f.what ? f.what : "accepted");
+    CHECK(isnan(tf_rt_step(&f, 1e-3, 60.0, 1e-4)), "and refused again at the same temperature");
+    CHECK(tf_rt_params_at(&f, 60.0, 0, 0, 0) == B, "params_at 60 C refused");
+    CHECK(isnan(tf_rt_step(&f, 1e-3, NAN, 1e-4)) && !strcmp(f.what, "T (not finite)"), "NaN T with a thermal model");
+    CHECK(isnan(tf_rt_step(&f, 1e-3, INFINITY, 1e-4)) && !strcmp(f.what, "T (not finite)"), "inf T refused");
+    CHECK(tf_rt_step(&f, 1e-3, 35.0, 1e-4) == tf_rt_step(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
+          "back at 35 C as if 60 C had not come");
+    CHECK(tf_rt_set_param(&f, TF_P_SIGMA0, -5.0) == B && !strcmp(f.what, "sigma0"),
+          "set_param with Model I: checked at the last temperature");
+    tf_law neg = {TF_LAW_CONST, -1.0, 0, 0, 0, 0, 0};
+    CHECK(tf_rt_set_model_i(&f, TF_P_SIGMA0, &neg) == B && f.model.law[TF_P_SIGMA0].kind == TF_LAW_NONE,
+          "a law negative at the last temperature refused");
+
+    /* Model II: lambda = 1 + dF / fc <= 0 reverses friction: refused at that step */
+    rt_lugre(&f);
+    tf_law dF = {TF_LAW_LINEAR, -0.1, 0.6, 0, 0, 0, 0}; /* lambda = 1.6 - 0.1 T <= 0 from 16 C */
+    CHECK(tf_rt_set_model_ii(&f, &dF, TF_DF_SCALE) == TF_OK, "Model II");
+    CHECK(isfinite(tf_rt_step(&f, 1e-3, 5.0, 1e-4)) && tf_rt_step(&f, 1e-3, 5.0, 1e-4) > 0.0, "lambda > 0 at 5 C");
+    CHECK(isnan(tf_rt_step(&f, 1e-3, 35.0, 1e-4)) && f.status == B && !strncmp(f.what, "dF", 2),
+          "Model II: lambda < 0 at 35 C refused");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &fc) == B, "Model I on a Model II model refused");
+}
+
+static void test_observer_pid_and_loop_refuse_bad_arguments(void)
+{
+    static tf_rt_friction f, twin, plant, comp;
+    double F;
+    /* the issue's stack buffer overflow: one `extra` for every GMS element; now a clear refusal */
+    rt_gms(&f);
+    double z0[3] = {f.z[0], f.z[1], f.z[2]};
+    CHECK(isnan(tf_observer_step(&f, 1e-3, 1e-6, 100.0, NAN, 1e-4)) && f.status == B &&
+              f.z[0] == z0[0] && f.z[1] == z0[1] && f.z[2] == z0[2],
+          "observer on GMS refused");
+    double p[TF_NPARAM] = {0};
+    p[TF_P_FC] = 1.0, p[TF_P_SIGMA2] = 0.4, p[TF_P_VSMOOTH] = 1e-4;
+    CHECK(tf_rt_init(&f, TF_FRICTION_COULOMB, p, NULL) == TF_OK &&
+              tf_observer_step_status(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, &F) == B,
+          "observer on Coulomb refused (no state)");
+    CHECK(isnan(tf_observer_step(NULL, 1e-3, 0, 100, NAN, 1e-4)), "observer(NULL)");
+    rt_lugre(&f);
+    rt_lugre(&twin);
+    CHECK(tf_observer_step_status(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, NULL) == B, "observer: NULL F");
+    const double bad[] = {NAN, INFINITY};
+    for (int k = 0; k < 2; k++) {
+        CHECK(tf_observer_step_status(&f, bad[k], 0.0, 100.0, NAN, 1e-4, &F) == B && isnan(F), "observer v");
+        CHECK(tf_observer_step_status(&f, 1e-3, bad[k], 100.0, NAN, 1e-4, &F) == B, "observer e");
+        CHECK(tf_observer_step_status(&f, 1e-3, 0.0, bad[k], NAN, 1e-4, &F) == B, "observer k");
+        CHECK(tf_observer_step_status(&f, 1e-3, 0.0, 100.0, NAN, bad[k], &F) == B, "observer dt");
+    }
+    CHECK(tf_observer_step_status(&f, 1e-3, 0.0, -1.0, NAN, 1e-4, &F) == B, "observer: negative gain");
+    CHECK(tf_observer_step(&f, 1e-3, 1e-7, 100.0, NAN, 1e-4) == tf_observer_step(&twin, 1e-3, 1e-7, 100.0, NAN, 1e-4) &&
+              f.z[0] == twin.z[0],
+          "observer state untouched by the refusals");
+
+    tf_pid c, ctwin;
+    CHECK(tf_pid_init(NULL, 1, 1, 1, 0) == B && tf_pid_init(&c, NAN, 1, 1, 0) == B &&
+              tf_pid_init(&c, 1, INFINITY, 1, 0) == B && tf_pid_init(&c, 1, 1, 1, -1e-3) == B,
+          "pid_init: NULL, non-finite gains, tau_d < 0");
+    CHECK(tf_pid_init(&c, 4e4, 4e5, 280.0, 2e-4) == TF_OK && tf_pid_init(&ctwin, 4e4, 4e5, 280.0, 2e-4) == TF_OK,
+          "pid_init");
+    double u;
+    tf_pid_step(&c, 1e-6, 1e-4), tf_pid_step(&ctwin, 1e-6, 1e-4);
+    CHECK(isnan(tf_pid_step(&c, 2e-6, 0.0)) && tf_pid_step_status(&c, 2e-6, 0.0, &u) == B && isnan(u),
+          "pid: dt = 0 refused (it gave NaN forever)");
+    CHECK(tf_pid_step_status(&c, 2e-6, -1e-4, &u) == B && tf_pid_step_status(&c, NAN, 1e-4, &u) == B &&
+              tf_pid_step_status(&c, 2e-6, NAN, &u) == B && tf_pid_step_status(NULL, 0, 1e-4, &u) == B &&
+              tf_pid_step_status(&c, 0, 1e-4, NULL) == B,
+          "pid: negative or NaN dt, NaN e, NULL");
+    CHECK(tf_pid_step_status(&c, 1e305, 1e-4, &u) == TF_ERR_NONFINITE, "pid: an overflowing u");
+    CHECK(tf_pid_step(&c, 2e-6, 1e-4) == tf_pid_step(&ctwin, 2e-6, 1e-4), "pid state untouched by the refusals");
+
+    enum { N = 200 };
+    static double x_ref[N], v_ref[N], x[N];
+    for (int i = 0; i < N; i++) x_ref[i] = 1e-6 * i, v_ref[i] = 1e-2, x[i] = -7.0;
+    rt_lugre(&plant);
+    rt_lugre(&comp);
+    tf_loop L = {1.0, &plant, 30.0, {0}, TF_COMP_FEEDFORWARD, &comp, 30.0, 100.0, 1e-4, 10};
+    tf_pid_init(&L.pid, 4e4, 4e5, 280.0, 2e-4);
+    CHECK(tf_loop_run(NULL, N, x_ref, v_ref, x, 0, 0) == B, "loop(NULL)");
+    CHECK(tf_loop_run(&L, 0, NULL, v_ref, x, 0, 0) == B && !strcmp(L.where, "loop"), "loop: n = 0, x_ref NULL");
+    CHECK(tf_loop_run(&L, N, NULL, v_ref, x, 0, 0) == B && !strcmp(L.what, "x_ref (NULL)"), "loop: x_ref NULL");
+    CHECK(tf_loop_run(&L, N, x_ref, NULL, x, 0, 0) == B && !strcmp(L.what, "v_ref (NULL)"),
+          "loop: feed-forward without v_ref");
+    x_ref[150] = NAN;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && L.period == 150 && x[0] == -7.0,
+          "loop: a NaN reference sample refused before anything is written");
+    x_ref[150] = 150e-6;
+    double *fields[] = {&L.mass, &L.dt};
+    for (int k = 0; k < 2; k++) {
+        double keep = *fields[k];
+        *fields[k] = 0.0;
+        CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: %s = 0", k ? "dt" : "mass");
+        *fields[k] = NAN;
+        CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: %s = NaN", k ? "dt" : "mass");
+        *fields[k] = keep;
+    }
+    L.substeps = 0;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: substeps = 0");
+    L.substeps = 10, L.compensation = 9;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: unknown compensation");
+    L.compensation = TF_COMP_OBSERVER, L.comp = NULL;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: compensation NULL");
+    rt_gms(&comp);
+    L.comp = &comp;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "compensation"),
+          "loop: observer on GMS (the issue's overflow, through the loop)");
+    rt_lugre(&comp);
+    L.observer_gain = -1.0;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: negative observer gain");
+    L.observer_gain = 100.0, L.pid.kd = NAN;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "pid"), "loop: NaN gain");
+    L.pid.kd = 280.0, L.plant = NULL;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: plant NULL");
+    L.plant = &plant;
+    tf_law fc = {TF_LAW_LINEAR, -0.05, 2.5, 0, 0, 0, 0};
+    tf_rt_set_model_i(&plant, TF_P_FC, &fc);
+    tf_rt_set_model_i(&plant, TF_P_FS, &fc);
+    L.T_plant = 60.0;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "plant") && !strcmp(L.what, "fc") &&
+              x[0] == -7.0,
+          "loop: the plant's Model I invalid at 60 C, refused before the first period");
+    L.T_plant = NAN;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: NaN plant temperature");
+    L.T_plant = 35.0;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == TF_OK && isfinite(x[N - 1]) && x[0] == 0.0, "loop runs");
+    L.pid.kp = -1e12; /* positive feedback */
+    tf_rt_reset(&plant), tf_rt_reset(&comp);
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == TF_ERR_NONFINITE && L.period >= 0,
+          "loop: unstable gains stop the run (at period %ld: %s)", L.period, L.what);
+}
+#undef B
+
 int main(void)
 {
+    test_rt_init_and_setters_refuse_bad_arguments();
+    test_rt_step_refuses_bad_samples_and_keeps_its_state();
+    test_observer_pid_and_loop_refuse_bad_arguments();
     test_sigma1_thermal_force_and_heat_rate_partials();
     test_rt_parameter_update_and_reset();
     test_rt_exact_for_constant_velocity_and_stable_at_large_steps();

@@ -24,13 +24,14 @@ static const tf_law FS = {TF_LAW_EXP, 176.8788629, -0.159, 0, 0, 0, 0};
 
 static void stage_friction(tf_rt_friction *f)
 {
+    /* the 30 C values (tf_rt_init checks them: a model must be valid before laws are added) */
     double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
     p[TF_P_SIGMA2] = 0.4, p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_VSMOOTH] = 1e-6;
     if (tf_rt_init(f, TF_FRICTION_LUGRE, p, NULL) != 0) exit(1);
-    tf_rt_set_model_i(f, TF_P_SIGMA0, &SIGMA0);
-    tf_rt_set_model_i(f, TF_P_SIGMA1, &SIGMA1);
-    tf_rt_set_model_i(f, TF_P_FC, &FC);
-    tf_rt_set_model_i(f, TF_P_FS, &FS);
+    if (tf_rt_set_model_i(f, TF_P_SIGMA0, &SIGMA0) || tf_rt_set_model_i(f, TF_P_SIGMA1, &SIGMA1) ||
+        tf_rt_set_model_i(f, TF_P_FC, &FC) || tf_rt_set_model_i(f, TF_P_FS, &FS))
+        exit(1);
 }
 
 int main(void)
@@ -59,7 +60,7 @@ int main(void)
                             cases[c].aware ? temps[k] : 30.0, 100.0, DT, 10};
             tf_pid_init(&loop.pid, 4e4, 4e5, 280.0, 2e-4);
             if (tf_loop_run(&loop, N, x_ref, v_ref, x, NULL, NULL) != 0) {
-                fprintf(stderr, "the loop went unstable\n");
+                fprintf(stderr, "the loop stopped at period %ld: %s: %s\n", loop.period, loop.where, loop.what);
                 return 1;
             }
             double ss = 0.0, mx = 0.0;

@@ -572,17 +572,24 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
         out[k] = (double *)views[k].buf;
     }
     if (tf_rt_from_model(&rt[0], &pm) || (comp_spec != Py_None && tf_rt_from_model(&rt[1], &cm))) {
-        PyErr_SetString(PyExc_ValueError, "bad friction model");
+        PyErr_Format(PyExc_ValueError, "%s friction model: %s", rt[0].status ? "plant" : "compensation",
+                     rt[0].status ? rt[0].what : rt[1].what);
         goto done;
     }
-    tf_loop loop = {mass, &rt[0], T_plant, {0}, comp_spec == Py_None ? TF_COMP_NONE : compensation,
+    /* the PID at rest, as tf_pid_init leaves it (bad gains: tf_loop_run refuses them) */
+    tf_loop loop = {mass, &rt[0], T_plant, {kp, ki, kd, tau_d}, comp_spec == Py_None ? TF_COMP_NONE : compensation,
                     &rt[1], T_comp, gain, dt, substeps};
-    tf_pid_init(&loop.pid, kp, ki, kd, tau_d);
     int status;
     Py_BEGIN_ALLOW_THREADS
     status = tf_loop_run(&loop, (long)n, x_ref, v_ref, out[0], out[1], out[2]);
     Py_END_ALLOW_THREADS
-    result = PyLong_FromLong(status);
+    /* a refusal (ValueError) names the part, the argument and the period; other statuses are returned */
+    if (status == TF_ERR_BAD_ARGUMENT && loop.period >= 0)
+        PyErr_Format(PyExc_ValueError, "%s: %s (period %ld)", loop.where, loop.what, loop.period);
+    else if (status == TF_ERR_BAD_ARGUMENT)
+        PyErr_Format(PyExc_ValueError, "%s: %s", loop.where, loop.what);
+    else
+        result = PyLong_FromLong(status);
 done:
     for (int k = 0; k < nviews; k++) PyBuffer_Release(&views[k]);
     PyMem_Free(rt);
@@ -622,15 +629,22 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
         if (PyErr_Occurred()) goto done;
         if (nT != n) { PyErr_SetString(PyExc_ValueError, "T: a number or one per velocity"); goto done; }
     }
-    if (tf_rt_from_model(f, &m)) { PyErr_SetString(PyExc_ValueError, "bad friction model"); goto done; }
+    if (tf_rt_from_model(f, &m)) { PyErr_Format(PyExc_ValueError, "friction model: %s", f->what); goto done; }
     double *F = (double *)Fv.buf;
     struct timespec t0, t1;
+    Py_ssize_t i = 0;
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (Py_ssize_t i = 0; i < n; i++) F[i] = tf_rt_step(f, v[i], T ? T[i] : T_const, dt);
+    for (; i < n; i++)
+        if (tf_rt_step_status(f, v[i], T ? T[i] : T_const, dt, &F[i])) break;
     clock_gettime(CLOCK_MONOTONIC, &t1);
     Py_END_ALLOW_THREADS
-    result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+    /* a refused step: ValueError (an argument or parameter), FloatingPointError (an overflow) */
+    if (i < n)
+        PyErr_Format(f->status == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "step %zd: %s",
+                     i, f->what);
+    else
+        result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
 done:
     if (have_F) PyBuffer_Release(&Fv);
     PyMem_Free(f);

@@ -14,6 +14,9 @@ observer of Canudas de Wit et al. 1995), each told a temperature: the measured o
 from __future__ import annotations
 
 import math
+import numbers
+import re
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +25,60 @@ from . import _bridge
 from ._bridge import model_spec
 from .errors import InputError, SolverError
 from .models import MassPlant, Model
+
+
+# -- argument checks: the package's InputError naming the argument, before the C core sees it -----
+
+def _number(where: str, name: str, value, *, minimum=None, positive=False) -> float:
+    """A finite real number (not a string, not a bool), optionally > 0 or >= minimum."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InputError(f"{where}: {name} must be a number, got {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise InputError(f"{where}: {name} must be finite, got {value!r}")
+    if positive and not x > 0:
+        raise InputError(f"{where}: {name} must be > 0, got {value!r}")
+    if minimum is not None and x < minimum:
+        raise InputError(f"{where}: {name} must be >= {minimum:g}, got {value!r}")
+    return x
+
+
+def _model(where: str, name: str, model) -> Model:
+    if not isinstance(model, Model):
+        raise InputError(f"{where}: {name} must be a thermofriction Model (e.g. tf.load_model(...)), "
+                         f"got {type(model).__name__}")
+    return model
+
+
+def _samples(where: str, name: str, values, n=None) -> np.ndarray:
+    """A 1-D array of finite floats (n of them when given)."""
+    try:
+        a = np.ascontiguousarray(values, float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: {name} must be an array of numbers") from None
+    if a.ndim != 1 or (n is not None and a.size != n):
+        raise InputError(f"{where}: {name} must be one-dimensional" + (f" with {n} values" if n is not None else "")
+                         + f", got shape {a.shape}")
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise InputError(f"{where}: {name}[{bad[0]}] is {float(a[bad[0]])!r}: every value must be finite")
+    return a
+
+
+def _check_at(where: str, model: Model, temperature: float):
+    """The model's domain at one temperature (Model I parameters, Model II's lambda), with the
+    simulator's messages; its warnings (calibrated range, passivity) are the simulator's business."""
+    from .simulate.checks import check_temperatures
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            check_temperatures(model, temperature)
+    except InputError as e:
+        raise InputError(f"{where}: {e}") from None
+
+
+#: The friction models with a bristle state for the observer to estimate.
+OBSERVED_MODELS = ("lugre", "dahl", "elastoplastic")
 
 
 @dataclass(frozen=True)
@@ -33,6 +90,15 @@ class PID:
     kd: float
     tau_d: float = 0.0
 
+    def __post_init__(self):
+        for name in ("kp", "ki", "kd"):
+            _number("PID", name, getattr(self, name))
+        _number("PID", "tau_d", self.tau_d, minimum=0.0)
+
+
+def _temperature(where: str, temperature):
+    return None if temperature is None else _number(where, "temperature", temperature)
+
 
 @dataclass(frozen=True)
 class FeedForward:
@@ -42,16 +108,33 @@ class FeedForward:
     temperature: float | None = None
     kind = "feedforward"
 
+    def __post_init__(self):
+        _model("FeedForward", "model", self.model)
+        _temperature("FeedForward", self.temperature)
+
 
 @dataclass(frozen=True)
 class Observer:
     """Canudas de Wit et al. (1995): z^' = v - sigma0 |v| z^/g(v) - gain (x - x_ref),
-    u_c = sigma0 z^ + sigma1 z^' + sigma2 v, from ``model`` told ``temperature`` (None: measured)."""
+    u_c = sigma0 z^ + sigma1 z^' + sigma2 v, from ``model`` told ``temperature`` (None: measured).
+
+    The observer estimates a bristle deflection, so ``model`` must have one: LuGre, Dahl or
+    elasto-plastic. Coulomb and Stribeck have no state to observe (use ``FeedForward``); GMS has one
+    per element and no published observer. ``gain`` [1/s] >= 0 (0: no correction)."""
 
     model: Model
     gain: float = 100.0
     temperature: float | None = None
     kind = "observer"
+
+    def __post_init__(self):
+        _model("Observer", "model", self.model)
+        kind = self.model.friction.model
+        if kind not in OBSERVED_MODELS:
+            raise InputError(f"Observer: the observer estimates a bristle state, which a {kind} model does not have "
+                             f"(it needs a LuGre, Dahl or elasto-plastic model; use FeedForward for {kind})")
+        _number("Observer", "gain", self.gain, minimum=0.0)
+        _temperature("Observer", self.temperature)
 
 
 @dataclass(frozen=True)
@@ -118,39 +201,88 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
                   compensation: FeedForward | Observer | None = None, substeps: int = 10) -> LoopResult:
     """The closed loop of control.h: the C core runs every control period (fixed step, ``reference``'s
     sampling) and ``substeps`` plant steps within it."""
+    where = "simulate_loop"
+    _model(where, "stage", stage)
     if not isinstance(stage.plant, MassPlant):
         raise InputError("the closed loop drives a single-mass stage: the model's plant must be 'mass'")
-    dt = float(reference.time[1] - reference.time[0])
-    x_ref = np.ascontiguousarray(reference.position, float)
-    v_ref = np.ascontiguousarray(reference.velocity, float)
+    if not isinstance(reference, Reference):
+        raise InputError(f"{where}: reference must be a Reference (sine_reference, point_to_point), "
+                         f"got {type(reference).__name__}")
+    t = _samples(where, "reference.time", reference.time)
+    if t.size < 2:
+        raise InputError(f"{where}: reference needs two samples or more, got {t.size}")
+    x_ref = _samples(where, "reference.position", reference.position, t.size)
+    v_ref = _samples(where, "reference.velocity", reference.velocity, t.size)
+    dt = float(t[1] - t[0])
+    if not (math.isfinite(dt) and dt > 0):
+        raise InputError(f"{where}: reference.time must increase (control period {dt!r})")
+    temperature = _number(where, "temperature", temperature)
+    if not isinstance(pid, PID):
+        raise InputError(f"{where}: pid must be a PID, got {type(pid).__name__}")
+    if compensation is not None and not isinstance(compensation, (FeedForward, Observer)):
+        raise InputError(f"{where}: compensation must be FeedForward, Observer or None, "
+                         f"got {type(compensation).__name__}")
+    if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral) or substeps < 1:
+        raise InputError(f"{where}: substeps must be an integer >= 1, got {substeps!r}")
+    _check_at(f"{where}: the stage", stage, temperature)
     outs = [np.empty_like(x_ref) for _ in range(3)]
     comp_spec, T_comp, kind, gain = None, math.nan, "none", 0.0
     if compensation is not None:
         T_comp = temperature if compensation.temperature is None else compensation.temperature
+        name = {"feedforward": "feed-forward"}.get(compensation.kind, compensation.kind)
+        _check_at(f"{where}: the {name} compensation's model", compensation.model, T_comp)
         comp_spec = model_spec(compensation.model, T_comp)
         kind = compensation.kind
         gain = float(getattr(compensation, "gain", 0.0))
-    status = _bridge.loop(model_spec(stage, temperature), temperature, comp_spec, T_comp, kind, gain,
-                          stage.plant.mass, (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, substeps, x_ref, v_ref, *outs)
+    try:
+        status = _bridge.loop(model_spec(stage, temperature), temperature, comp_spec, T_comp, kind, gain,
+                              stage.plant.mass, (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps), x_ref, v_ref,
+                              *outs)
+    except ValueError as e:  # the core's own checks (a backstop for the ones above)
+        raise InputError(f"{where}: the C core refused the loop: {e}") from None
     if status != "ok":
         raise SolverError("the closed loop went unstable (non-finite position): lower the gains or the control period")
-    return LoopResult(reference.time, x_ref, outs[0], outs[1], outs[2])
+    return LoopResult(t, x_ref, outs[0], outs[1], outs[2])
 
 
 def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None):
     """The real-time model (realtime.h: tf_rt_step) stepped at ``dt`` through the sliding velocities
     ``velocity`` (one per step, held over it) at ``temperature`` (a number, or one per step):
     returns (forces, seconds spent in C)."""
-    v = np.ascontiguousarray(velocity, float)
+    where = "friction_steps"
+    _model(where, "model", model)
+    v = _samples(where, "velocity", velocity)
+    dt = _number(where, "dt", dt, positive=True)
     F = np.empty_like(v)
     if temperature is None or np.ndim(temperature) == 0:
-        T = math.nan if temperature is None else float(temperature)
-        spec_T = temperature
-    else:  # one temperature per step
-        T = np.ascontiguousarray(temperature, float)
-        spec_T = float(T[0])
-    seconds = _bridge.rt_steps(model_spec(model, spec_T), T, v, dt, F)
+        T = math.nan if temperature is None else _number(where, "temperature", temperature)
+        if model.thermal is not None or temperature is not None:  # (the former: "give a temperature")
+            _check_at(where, model, None if temperature is None else T)
+        spec_T = None if temperature is None else T
+    else:  # one temperature per step: the core checks the model at each new one
+        T = _samples(where, "temperature", temperature, v.size)
+        spec_T = float(T[0]) if T.size else None
+    try:
+        seconds = _bridge.rt_steps(model_spec(model, spec_T), T, v, dt, F)
+    except FloatingPointError as e:
+        raise SolverError(f"{where}: {_step_message(e, T)}") from None
+    except ValueError as e:  # the core refused a step: the model at that step's temperature
+        raise InputError(f"{where}: {_step_message(e, T)}") from None
     return F, seconds
+
+
+def _step_message(error, T) -> str:
+    """The core's "step N: what" with the step's temperature and a sentence for a parameter name."""
+    m = re.fullmatch(r"step (\d+): (.*)", str(error))
+    if not m:
+        return str(error)
+    i, what = int(m.group(1)), m.group(2)
+    Ti = float(T[i]) if np.ndim(T) else float(T)
+    at = f" (T = {Ti:g} C)" if math.isfinite(Ti) else ""
+    name = what.split(" ")[0]
+    if name in _bridge.PARAMETERS or name == "dF":
+        return f"the model is invalid at step {i}{at}: '{name}' is out of its domain{what[len(name):]}"
+    return f"step {i}{at}: {what}"
 
 
 def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), calibration: float = 30.0,
@@ -173,5 +305,5 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
     return rows
 
 
-__all__ = ["PID", "FeedForward", "Observer", "Reference", "sine_reference", "point_to_point", "LoopResult",
+__all__ = ["OBSERVED_MODELS", "PID", "FeedForward", "Observer", "Reference", "sine_reference", "point_to_point", "LoopResult",
            "simulate_loop", "compare_compensation", "friction_steps", "DEFAULT_PID"]

@@ -92,6 +92,15 @@ void tf_model_prepare(tf_model *model);
  * tf_solve does not call it: callers that build models from user data must (the Python package
  * checks the same rules, with messages). */
 int tf_model_check(const tf_model *model, const char **what);
+/* The same rules for the friction model and its thermal extension alone (the plant, input and
+ * temperature signal are not looked at: the real-time API, realtime.h, holds no more): the kind,
+ * GMS elements, the laws' structure, and the parameters -- always for a model without a thermal
+ * extension, at temperature T for one with it (not at all when T is not finite). */
+int tf_model_check_friction(const tf_model *model, double T, const char **what);
+/* The same rules for parameters already evaluated at one temperature: p (TF_NPARAM values), Model
+ * II's lambda and offset there (as tf_model_params_cached gives them). */
+int tf_model_check_params(const tf_model *model, const double *p, double lambda, double dF_offset,
+                          const char **what);
 
 int tf_model_nstate(const tf_model *model);
 int tf_model_noutput(const tf_model *model);

@@ -5,7 +5,7 @@
  *     tf_rt_friction f;
  *     tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL);          // parameters p[TF_NPARAM]
  *     tf_rt_set_model_i(&f, TF_P_FC, &fc_law);             // optional: a law of temperature
- *     double F = tf_rt_step(&f, v, T, dt);                 // every control period
+ *     double F = tf_rt_step(&f, v, T, dt);                 // every control period (NaN: refused)
  *     tf_rt_set_param(&f, TF_P_SIGMA1, 3.0);               // at run time
  *     tf_rt_reset(&f);                                     // internal states to rest
  *
@@ -40,38 +40,63 @@ typedef struct {
        plant fields are unused), with its per-temperature parameter cache */
     tf_model model;
     double z[TF_MAX_FRICTION_STATES]; /* internal states */
+    /* The outcome of the last call on this object: TF_OK, or a tf_status (integrator.h) with `what`
+       naming the argument or parameter refused (a static string; NULL on TF_OK). */
+    int status;
+    const char *what;
 } tf_rt_friction;
 
+/* Checks. Every function validates its arguments and returns a status (TF_OK = 0), or reports a
+ * failure as documented for the three that return a number. A refused call changes nothing: the
+ * internal states, the parameters and the laws stay as they were, so that a controller can skip a
+ * bad sample and go on. The model is checked with the simulator's rules (tf_model_check_friction,
+ * plant.h: sigma0, fc > 0, fs >= fc, ...; 1..64 GMS elements; laws with n >= 2 strictly increasing
+ * finite breakpoints, TABLE slopes given); a model with a thermal extension has its parameters
+ * (and Model II's lambda > 0) checked at each new temperature it is stepped at, which costs
+ * nothing at a constant temperature. TF_ERR_BAD_ARGUMENT: a NULL pointer, an unknown kind or
+ * index, a parameter out of its domain (at that temperature), a non-finite v, T (with a thermal
+ * extension; without one T is ignored, NaN included) or dt. TF_ERR_NONFINITE: a step whose force
+ * or state would not be finite (a velocity or step so large that the equations overflow). */
+
 /* Sets up a model at rest. p: TF_NPARAM values (unused ones ignored); gms: the elements for
- * TF_FRICTION_GMS (else NULL). fs = fc when p[TF_P_FS] is not finite (no Stribeck effect). Returns
- * TF_OK (0) or TF_ERR_BAD_ARGUMENT (4) for an unknown kind or a bad GMS element count. */
+ * TF_FRICTION_GMS (else NULL). fs = fc when p[TF_P_FS] is not finite (no Stribeck effect). The
+ * parameters must be valid as given (they are the model's while no law is set): give a
+ * parameter that will follow a law its value at some temperature, not 0. */
 int tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_elements *gms);
-/* Model I: parameter `param` follows `law` (copied; its arrays must outlive f). */
+/* Model I: parameter `param` follows `law` (copied; its arrays must outlive f). Not with Model II. */
 int tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law);
-/* Model II: dF(T) [N] applied in `form` (TF_DF_SCALE: F (1 + dF / fc); TF_DF_OFFSET: + dF tanh(v / v_smooth)). */
+/* Model II: dF(T) [N] applied in `form` (TF_DF_SCALE: F (1 + dF / fc); TF_DF_OFFSET: + dF tanh(v / v_smooth)).
+ * Not with Model I. */
 int tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form);
-/* Changes parameter `param` at run time (its law, if any, is dropped). */
+/* Changes parameter `param` at run time (its law, if any, is dropped). With a thermal extension
+ * the new value is checked at the last temperature stepped at (if any), else at the next step. */
 int tf_rt_set_param(tf_rt_friction *f, int param, double value);
 /* Internal states to rest (z = 0, GMS elements stuck). */
-void tf_rt_reset(tf_rt_friction *f);
-/* Parameters at temperature T [degC] into p[TF_NPARAM]; *lambda, *dF_offset (may be NULL). */
-void tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset);
+int tf_rt_reset(tf_rt_friction *f);
+/* Parameters at temperature T [degC] into p[TF_NPARAM]; *lambda, *dF_offset (may be NULL).
+ * Nothing is written if T or the parameters there are refused. */
+int tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset);
 /* Advances the internal states by dt [s] at sliding velocity v [m/s] and temperature T [degC]
- * (ignored without a thermal model) and returns the friction force F [N] (the sign convention of
- * docs/models.md#conventions: the force resisting sliding, with v's sign in steady sliding).
- * dt <= 0 returns the force without advancing. */
+ * (ignored without a thermal model) and writes the friction force F [N] to *F (the sign convention
+ * of docs/models.md#conventions: the force resisting sliding, with v's sign in steady sliding).
+ * dt <= 0 gives the force without advancing. On a refusal *F is NaN and the state is unchanged. */
+int tf_rt_step_status(tf_rt_friction *f, double v, double T, double dt, double *F);
+/* The same, returning F: NaN when the step is refused (f->status says why; NULL f: NaN only). */
 double tf_rt_step(tf_rt_friction *f, double v, double T, double dt);
 
 /* The friction model and thermal extension of a simulation model (plant.h's tf_model), for
  * callers that already configure one; its laws' arrays must outlive f. */
 int tf_rt_from_model(tf_rt_friction *f, const tf_model *model);
 /* F' from the base model's force: Model II's scale factor and offset (docs/models.md#model-ii) as
- * tf_rt_params_at gives them, at sliding velocity v with parameters p (tf_thermal_force, thermal.h). */
+ * tf_rt_params_at gives them, at sliding velocity v with parameters p (tf_thermal_force, thermal.h).
+ * NaN when p is NULL. */
 double tf_rt_thermal_force(double F_base, double v, const double *p, double lambda, double dF_offset);
 
 /* The core of tf_rt_step for callers that add terms to the state equation (observers): advances
- * z by one exponential-Euler step of z' = f(v, z) + extra[j] (extra may be NULL) with parameters
- * p, writes the rates at the new state to dz (with extra added) and returns the base force. */
+ * z by one exponential-Euler step of z' = f(v, z) + extra[j] (extra: NULL, or one value per
+ * internal state) with parameters p (already checked), writes the rates at the new state to dz
+ * (with extra added) and returns the base force. gms: the elements for TF_FRICTION_GMS (else may
+ * be NULL). Returns NaN, changing nothing, for NULL p, z or dz, an unknown kind or bad GMS elements. */
 double tf_rt_advance(int kind, const double *p, tf_gms_elements *gms, double *z, double v, double dt,
                      const double *extra, double *dz);
 
