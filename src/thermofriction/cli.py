@@ -381,6 +381,9 @@ def _check_output_folders(args):
 
 
 def main(argv=None) -> int:
+    # NumPy's "overflow encountered in ..." says nothing a user can act on: results are checked
+    # (non-finite outputs and values are refused with a message of their own)
+    warnings.filterwarnings("ignore", message=".* encountered in ", category=RuntimeWarning)
     parser = build_parser()
     args = parser.parse_args(argv)
     caught = []
