@@ -388,7 +388,9 @@ API_CASES = {
     "LuGre(fc=nan)": (lambda m: tf.LuGre(sigma0=1e5, sigma1=1.0, fc=math.nan), "'fc' must be finite"),
     "GMS(k=('a',))": (lambda m: tf.GMS(k=("a",), w=(1.0,), C=1.0, fc=1.0), r"'k\[0\]' must be a number"),
     "Exp(a='1')": (lambda m: tf.Exp("1", 0.1), "'a' must be a number"),
-    "PWL one point": (lambda m: tf.PWL([30.0], [1.0]), "at least two points"),
+    "one-point PWL in a model": (lambda m: tf.Model(m.plant, tf.LuGre(sigma0=1e5, sigma1=1.0, fc=1.0),
+                                                        tf.ModelII(tf.PWL([30.0], [0.1]))),
+                                 "dF: law 'pwl' needs at least two points"),
     "Poly 200": (lambda m: tf.Poly([1.0] * 200), "200 coefficients"),
     "Sawtooth(amplitude='30')": (lambda m: tf.Sawtooth("30", 5), "'amplitude' must be a number"),
     "parse_waveform(5)": (lambda m: tf.parse_waveform(5), "spec must be a string"),
@@ -492,3 +494,19 @@ def test_cli_max_starts_is_identify_max_starts():
     from thermofriction.identify import MAX_STARTS
 
     assert cli.MAX_STARTS == MAX_STARTS
+
+
+def test_out_of_memory_advice_names_only_options_the_command_has(monkeypatch, capsys, tmp_path):
+    """identify ran out of memory with advice about --duration and --sample-rate, which it lacks."""
+    from thermofriction import cli
+
+    def exhausted(args):
+        raise MemoryError
+
+    monkeypatch.setattr(cli, "cmd_identify", exhausted)
+    monkeypatch.setattr(cli, "cmd_simulate", exhausted)
+    assert cli.main(["identify", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert "out of memory" in err and "--starts" in err and "--duration" not in err
+    assert cli.main(["simulate", "li2009-model-i"]) == 1
+    assert "--duration" in capsys.readouterr().err

@@ -403,7 +403,10 @@ def main(argv=None) -> int:
         print("thermofriction: interrupted; no output was written", file=sys.stderr)
         return 130
     except MemoryError:
-        print("thermofriction: error: out of memory (lower --duration or --sample-rate)", file=sys.stderr)
+        # advice only where the options exist (identify has neither)
+        hint = {"simulate": " (lower --duration or --sample-rate)", "synth": " (lower --duration or --sample-rate)",
+                "identify": " (use fewer or shorter experiments, or fewer --starts)"}.get(args.command, "")
+        print(f"thermofriction: error: out of memory{hint}", file=sys.stderr)
         return 1
     except BrokenPipeError:
         return 1

@@ -214,8 +214,6 @@ class PWL(Law):
         where = f"law '{self.kind}'"
         T = num_array(self.T, where, "T")
         values = num_array(self.values, where, "values")
-        if len(T) < 2:
-            raise InputError(f"{where}: needs at least two points (T and values of length 2 or more), got {len(T)}")
         if len(T) != len(values):
             raise InputError(f"{where}: 'T' and 'values' must have the same length ({len(T)} != {len(values)})")
         if np.any(np.diff(T) <= 0):
@@ -236,12 +234,21 @@ class PWL(Law):
     def with_coefficients(self, coefficients):
         return dataclasses.replace(self, values=np.array([float(c) for c in coefficients]))
 
+    def check_points(self, where):
+        """A law in a model needs two points or more (the C core's model check: a one-point law is
+        a constant, which 'const' says plainly)."""
+        if len(self.T) < 2:
+            raise InputError(f"{where}: law '{self.kind}' needs at least two points (T and values of length 2 "
+                             f"or more), got {len(self.T)}; for one value use law = \"const\"")
+
     @classmethod
     def from_table(cls, d, where, rng):
         try:
-            return cls(d["T"], d["values"], range=rng)
+            law = cls(d["T"], d["values"], range=rng)
         except InputError as e:
             raise InputError(f"{where}: {str(e).partition(': ')[2]}") from None
+        law.check_points(where)
+        return law
 
 
 @dataclass(frozen=True, eq=False, repr=False)

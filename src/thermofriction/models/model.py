@@ -19,7 +19,7 @@ from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
 from .friction import (FRICTION_MODELS, GMS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre, Stribeck,
                        check_friction_values)
-from .laws import Law, law_from_dict
+from .laws import PWL, Law, law_from_dict
 from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
 
@@ -59,6 +59,8 @@ class Model:
                                  f"[thermal]; give it once")
             if not isinstance(law, Law):
                 raise InputError(f"[thermal]: '{pname}' must be a law")
+            if isinstance(law, PWL):
+                law.check_points(f"[thermal] {pname}")
         for pname in self.friction.required:
             if pname not in given and pname not in laws:
                 raise InputError(f"[friction]: missing '{pname}' (a number here, or a law in [thermal])")
@@ -66,6 +68,8 @@ class Model:
         if isinstance(self.thermal, ModelII):
             if not isinstance(self.thermal.dF, Law):
                 raise InputError("[thermal]: 'dF' must be a law")
+            if isinstance(self.thermal.dF, PWL):
+                self.thermal.dF.check_points("[thermal] dF")
         if self.heat is not None and not isinstance(self.heat, Heat):
             raise InputError("'heat' must be a Heat model (the [heat] section)")
 
