@@ -16,8 +16,9 @@ import warnings
 import numpy as np
 
 from . import _io
+from ._reading import strict_float
 from ._version import __version__
-from .errors import InputError, ThermofrictionError
+from .errors import InputError, ThermofrictionError, shorten
 from .models import PRESETS, MassPlant, load_model
 from .simulate import MAX_SAMPLES, SOLVERS, StepSizeController, simulate
 from .waveforms import Sampled, parse_waveform
@@ -27,9 +28,9 @@ def _number(positive):
     """An argparse type: a finite float, positive when asked."""
     def parse(text):
         try:
-            v = float(text)
+            v = strict_float(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+            raise argparse.ArgumentTypeError(f"not a number: {shorten(text)}") from None
         if not math.isfinite(v) or (positive and v <= 0):
             raise argparse.ArgumentTypeError(f"must be a {'positive' if positive else 'finite'} number, got {text!r}")
         return v
@@ -40,13 +41,35 @@ _positive_float = _number(positive=True)
 _finite_float = _number(positive=False)
 
 
-def _positive_int(text):
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {text!r}")
+def _int_in(low, high=None):
+    """An argparse type: a whole number in [low, high] (high None: no upper bound)."""
+    def parse(text):
+        try:
+            if "_" in text:  # int() takes 1_000; no option value means that
+                raise ValueError
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a whole number: {shorten(text)}") from None
+        if v < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low}, got {shorten(text)}")
+        if high is not None and v > high:
+            raise argparse.ArgumentTypeError(f"must be at most {high}, got {shorten(text)}")
+        return v
+    return parse
+
+
+_positive_int = _int_in(1)
+#: identify.MAX_STARTS, not imported from there (identify loads SciPy); a test keeps them equal
+MAX_STARTS = 10_000
+
+
+def _temperature(text):
+    """An argparse type: a plausible temperature [C] (the range of dataset temperatures)."""
+    from .data.experiments import TEMPERATURE_RANGE
+    v = _finite_float(text)
+    lo, hi = TEMPERATURE_RANGE
+    if not lo <= v <= hi:
+        raise argparse.ArgumentTypeError(f"{v:g} C is not a plausible temperature (expected {lo:g} to {hi:g} C)")
     return v
 
 
@@ -124,12 +147,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="Model I law kind for a parameter, e.g. sigma0=exp (default: chosen by AICc)")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the joint refinement of the laws on all experiments")
-    i.add_argument("--reference-temperature", type=_finite_float, metavar="C",
-                   help="Model II base temperature (default: the lowest fit temperature)")
-    i.add_argument("--starts", type=_positive_int, default=8, help="multi-start size (default: 8)")
+    i.add_argument("--reference-temperature", type=_temperature, metavar="C",
+                   help="Model II base temperature, with --method model-ii (default: the lowest fit temperature)")
+    i.add_argument("--starts", type=_int_in(1, MAX_STARTS), default=8,
+                   help=f"multi-start size, 1 to {MAX_STARTS} (default: 8)")
     i.add_argument("--rtol", type=_positive_float, default=1e-8,
                    help="simulation tolerance during the fit (default: 1e-8)")
-    i.add_argument("--seed", type=int, default=0, help="seed of the multi-start sample (default: 0)")
+    i.add_argument("--seed", type=_int_in(0), default=0, help="seed of the multi-start sample, 0 or more (default: 0)")
     i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
     i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
@@ -254,6 +278,10 @@ def cmd_identify(args) -> int:
         raise InputError("--parameters applies to --method base only")
     init = args.init if args.init and args.init not in PRESETS else None
     _refuse_inputs(args, _dataset_inputs(data), init, *_model_inputs(init, None))
+    if args.reference_temperature is not None and args.method != "model-ii":
+        raise InputError("--reference-temperature applies to --method model-ii only")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
     update, status = _progress(args.quiet)
     try:
         fit = identify(data, args.method, init=args.init, parameters=params, free=args.free or (),
@@ -419,6 +447,9 @@ def _dataset_inputs(data):
 
 
 def main(argv=None) -> int:
+    # NumPy's "overflow encountered in ..." says nothing a user can act on: results are checked
+    # (non-finite outputs and values are refused with a message of their own)
+    warnings.filterwarnings("ignore", message=".* encountered in ", category=RuntimeWarning)
     parser = build_parser()
     args = parser.parse_args(argv)
     caught = []
@@ -446,7 +477,10 @@ def main(argv=None) -> int:
         print(f"thermofriction: terminated by {signal.Signals(e.signum).name}; {_after_signal()}", file=sys.stderr)
         return 128 + e.signum
     except MemoryError:
-        print("thermofriction: error: out of memory (lower --duration or --sample-rate)", file=sys.stderr)
+        # advice only where the options exist (identify has neither)
+        hint = {"simulate": " (lower --duration or --sample-rate)", "synth": " (lower --duration or --sample-rate)",
+                "identify": " (use fewer or shorter experiments, or fewer --starts)"}.get(args.command, "")
+        print(f"thermofriction: error: out of memory{hint}", file=sys.stderr)
         return 1
     except BrokenPipeError:  # a reader that stopped early (| head): not an error worth a message
         _silence_stdout()

@@ -40,9 +40,22 @@ class ConditioningWarning(UserWarning):
     """The model is ill-conditioned where it will be simulated (default tolerances may not be enough)."""
 
 
+def shorten(value, limit: int = 60) -> str:
+    """``repr(value)``, cut to about ``limit`` characters: a message quotes what it refuses, but a
+    1 MB key or value is not echoed back whole."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit - 20]}...{text[-10:]} ({len(text)} characters)"
+
+
 def unknown_keys(keys, allowed, what="") -> str:
     """``unknown key 'x' for lugre (allowed: a, b)`` -- one wording for every unknown-key error."""
     keys = sorted(keys)
-    names = ", ".join(repr(k) for k in keys)  # repr: a key with a line break stays on one line
+    if len(keys) > 5:
+        keys = keys[:5] + [f"and {len(keys) - 5} more"]
+        names = ", ".join(shorten(k) for k in keys[:5]) + f", {keys[5]}"
+    else:
+        names = ", ".join(shorten(k) for k in keys)  # repr: a key with a line break stays on one line
     head = f"unknown key {names}" if len(keys) == 1 else f"unknown keys {names}"
     return f"{head}{f' for {what}' if what else ''} (allowed: {', '.join(allowed)})"

@@ -17,6 +17,11 @@ from .models import Model, require_actuator
 from .simulate import StepSizeController, simulate
 
 
+class MetricWarning(UserWarning):
+    """A validation metric is undefined for this experiment (NaN), e.g. a percentage of a measured
+    displacement that does not move."""
+
+
 def _zero(measured, predicted):
     """The measurement's zero (a sensor's zero is arbitrary): the offset that makes the first 1 % of
     the run agree with the prediction on average -- exact for a perfect model, robust to noise,
@@ -87,21 +92,31 @@ def predict(model: Model, exp, rtol=1e-8) -> Prediction:
     meas = np.asarray(exp.displacement, float)
     meas = meas - _zero(meas, pred)
     err = pred - meas
-    span = float(np.max(meas) - np.min(meas)) or 1e-300
+    span = float(np.max(meas) - np.min(meas))
     # RMSE as identification measures it: about the mean offset (the sensor's zero is arbitrary)
     quality = fit_quality(err - err.mean(), meas)
     rmse = quality["rmse"]
-    net = meas[-1] - meas[0]
+    net = float(meas[-1] - meas[0])
     ms = step_sizes(exp.time, meas, waveform.period)
     ps = step_sizes(exp.time, pred, waveform.period)
-    if ms.size:
-        step_err = float(np.mean(np.abs(ps - ms)))
-        step_pct = 100 * step_err / (abs(float(np.mean(ms))) or 1e-300)
-    else:
-        step_err = step_pct = math.nan
+    step_err = float(np.mean(np.abs(ps - ms))) if ms.size else math.nan
+    mean_step = abs(float(np.mean(ms))) if ms.size else math.nan
+
+    # a percentage of nothing is not a number: a measurement that does not move (a constant
+    # displacement, a sensor that was off) has no span; dividing by a stand-in such as 1e-300
+    # gave 1e297 % with no word of why
+    def pct(value, scale, what):
+        if scale > 0:
+            return 100 * value / scale
+        warnings.warn(f"{exp.file}: the measured {what} is zero: percentage errors relative to it are "
+                      f"undefined (NaN)", MetricWarning, stacklevel=3)
+        return math.nan
+
+    max_pct = pct(float(np.max(np.abs(err))), span, "displacement's span (it is constant)")
     return Prediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time), meas, pred,
-                      100 * float(np.max(np.abs(err))) / span, rmse, rmse / span,
-                      100 * float(err[-1]) / (abs(net) or 1e-300), step_pct, step_err, ms, ps, quality)
+                      max_pct, rmse, rmse / span if span > 0 else math.nan,
+                      pct(float(err[-1]), abs(net), "net displacement (it ends where it starts)") if span > 0 else math.nan,
+                      pct(step_err, mean_step, "mean step per cycle") if ms.size and span > 0 else math.nan, step_err, ms, ps, quality)
 
 
 @dataclasses.dataclass
@@ -126,8 +141,10 @@ class ValidationResult:
         for role in ("fit", "validate"):
             ps = [p for p in self.predictions if p.role == role]
             if ps:
-                out[role] = {"max_error_pct": max(p.max_error_pct for p in ps),
-                             "mean_max_error_pct": float(np.mean([p.max_error_pct for p in ps])),
+                # an undefined (NaN) percentage, warned about, does not hide the others
+                pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
+                out[role] = {"max_error_pct": max(pcts) if pcts else math.nan,
+                             "mean_max_error_pct": float(np.mean(pcts)) if pcts else math.nan,
                              "rmse_offset_removed": float(np.sqrt(np.mean([p.rmse ** 2 for p in ps]))),
                              "n": len(ps)}
         return out
@@ -185,12 +202,14 @@ def validate(model: Model, data, experiments=None) -> ValidationResult:
     for exp in exps:
         with warnings.catch_warnings(record=True) as w:
             warnings.simplefilter("always", TemperatureRangeWarning)
+            warnings.simplefilter("always", MetricWarning)
             try:
                 preds.append(predict(model, exp))
             except ThermofrictionError as e:  # one experiment the model cannot run: say why, go on
                 failures.append(Failure(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
         caught += [f"{exp.file}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
+        caught += [str(x.message) for x in w if issubclass(x.category, MetricWarning)]
     return ValidationResult(model, preds, caught, failures)
 
 
-__all__ = ["validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]
+__all__ = ["MetricWarning", "validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]

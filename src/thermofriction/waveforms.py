@@ -7,6 +7,7 @@ and exposes its corner times (where it or its slope jumps); the integrator stops
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
@@ -14,13 +15,16 @@ from pathlib import Path
 import numpy as np
 
 from . import _bridge
-from .errors import InputError, unknown_keys
+from ._reading import read_bytes, strict_float
+from .errors import InputError, shorten, unknown_keys
 
 def _finite(name, value, where):
+    if isinstance(value, (str, bytes, bool)):  # float("1e5") would pass: a number is asked for
+        raise InputError(f"{where}: '{name}' must be a number, got {shorten(value)}")
     try:
         value = float(value)
     except (TypeError, ValueError):
-        raise InputError(f"{where}: '{name}' must be a number, got {value!r}") from None
+        raise InputError(f"{where}: '{name}' must be a number, got {shorten(value)}") from None
     except OverflowError:  # an integer beyond the float range, e.g. 10**400
         raise InputError(f"{where}: '{name}' must be finite, got an integer too large for a number") from None
     if not math.isfinite(value):
@@ -238,9 +242,9 @@ class Sampled(Waveform):
 def read_two_column_csv(path: Path, first: str):
     """A CSV with a header ``first[unit]`` and one value column; time units s or ms."""
     try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            reader = csv.reader(fh)
-            numbered = [(reader.line_num, r) for r in reader]  # line_num: the file's line where the row ends
+        text = read_bytes(path, "CSV file").decode("utf-8-sig")
+        reader = csv.reader(io.StringIO(text, newline=""))
+        numbered = [(reader.line_num, r) for r in reader]  # line_num: the file's line where the row ends
     except OSError as e:
         raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
     except UnicodeDecodeError as e:
@@ -270,12 +274,16 @@ def read_two_column_csv(path: Path, first: str):
             raise InputError(f"{path}: line {i}: expected 2 values, got {len(row)}")
         for j, cell in enumerate(row):
             try:
-                data[k - 2, j] = float(cell)
+                data[k - 2, j] = strict_float(cell)
             except ValueError:
-                raise InputError(f"{path}: line {i}, column '{header[j]}': not a number: {cell.strip()!r}") from None
+                raise InputError(f"{path}: line {i}, column '{header[j]}': not a number: "
+                                 f"{shorten(cell.strip())}") from None
             if not math.isfinite(data[k - 2, j]):
-                raise InputError(f"{path}: line {i}, column '{header[j]}': not finite: {cell.strip()!r}")
+                raise InputError(f"{path}: line {i}, column '{header[j]}': not finite: {shorten(cell.strip())}")
     t = data[:, 0] * scale
+    far = np.nonzero(np.abs(t) > 1e12)[0]  # the C core's time limit (simulate.MAX_TIME)
+    if far.size:
+        raise InputError(f"{path}: line {lines[far[0] + 1]}: time {t[far[0]]:g} s is beyond the limit of 1e12 s")
     bad = np.nonzero(np.diff(t) <= 0)[0]  # after scaling: ms to s can merge neighbouring values
     if bad.size:
         raise InputError(f"{path}: line {lines[bad[0] + 2]}: time must increase strictly")
@@ -312,7 +320,7 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
             raise InputError(f"{where}: sampled 'time' and 'value' must be arrays of numbers") from None
     cls = _KINDS.get(kind) if isinstance(kind, str) else None
     if cls is None:
-        raise InputError(f"{where}: unknown waveform '{kind}' (one of: {', '.join([*_KINDS, 'sampled'])})")
+        raise InputError(f"{where}: unknown waveform {shorten(kind)} (one of: {', '.join([*_KINDS, 'sampled'])})")
     names = [f.name for f in fields(cls)]
     unknown = set(d) - set(names)
     if unknown:
@@ -329,7 +337,10 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
 def parse_waveform(spec: str) -> Waveform:
     """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
     ``sampled:file=u.csv``."""
-    where = f"--input {spec!r}"
+    if not isinstance(spec, str):
+        raise InputError(f"a waveform spec must be a string such as 'sawtooth:amplitude=30,frequency=5', "
+                         f"got {shorten(spec)}")
+    where = f"--input {shorten(spec, 100)}"
     if not spec.isprintable():  # so that every message below, which quotes parts of it, is one line
         raise InputError(f"{where}: contains a control character (a line break, tab or NUL)")
     kind, sep, rest = spec.strip().partition(":")
@@ -339,16 +350,16 @@ def parse_waveform(spec: str) -> Waveform:
             key, eq, value = item.partition("=")
             key = key.strip()
             if not eq or not key:
-                raise InputError(f"{where}: expected key=value, got '{item.strip()}'")
+                raise InputError(f"{where}: expected key=value, got {shorten(item.strip())}")
             if key in d:
-                raise InputError(f"{where}: '{key}' given twice")
+                raise InputError(f"{where}: {shorten(key)} given twice")
             if key == "file":
                 d[key] = value.strip()
                 continue
             try:
-                num = float(value)
+                num = strict_float(value)
             except ValueError:
-                raise InputError(f"{where}: '{key}' must be a number, got '{value.strip()}'") from None
+                raise InputError(f"{where}: {shorten(key)} must be a number, got {shorten(value.strip())}") from None
             d[key] = int(num) if key == "direction" and num.is_integer() else num
     return waveform_from_dict(d, where)
 

@@ -9,9 +9,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from .._reading import read_bytes, strict_float
+from ..errors import InputError, shorten
 from ..plausible import displacement_problem, kelvin_hint
 from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
+
+#: Magnitude limits on an experiment's values in SI units: time within the simulator's +-1e12 s
+#: (simulate.MAX_TIME); other values within 1e100, so that squares and sums of squares over ten
+#: million rows (metrics, least squares) stay finite.
+TIME_LIMIT = 1e12
+VALUE_LIMIT = 1e100
+
 
 def _parse_header(path, header):
     """[(name, scale to SI, the header cell)] for the header row, or one InputError."""
@@ -60,10 +68,10 @@ def _scan(path, body, cols):
         row = []
         for j, cell in enumerate(cells):
             try:
-                v = float(cell)
+                v = strict_float(cell)
             except ValueError:
                 raise InputError(f"{path}: line {i}, column {j + 1} ({cols[j][2]}): not a number: "
-                                 f"{cell.strip()!r}") from None
+                                 f"{shorten(cell.strip())}") from None
             row.append(v)
         data.append(row)
     return np.array(data, dtype=float).reshape(-1, ncol)
@@ -88,7 +96,7 @@ def read_experiment_csv(path) -> dict:
     line (the header is line 1) and the column."""
     path = Path(path)
     try:
-        raw = path.read_bytes()
+        raw = read_bytes(path, "experiment CSV file")
     except FileNotFoundError:
         raise InputError(f"{path}: no such file") from None
     except IsADirectoryError:
@@ -148,6 +156,15 @@ def read_experiment_csv(path) -> dict:
         raise InputError(f"{path}: {n} data row{'s' if n != 1 else ''}; an experiment needs at least "
                          f"{MIN_SAMPLES} samples")
     out = {name: arr[:, j] * scale for j, (name, scale, _) in enumerate(cols)}
+    for j, (name, _, cell) in enumerate(cols):
+        limit = TIME_LIMIT if name == "time" else VALUE_LIMIT
+        big = np.abs(out[name]) > limit
+        if big.any():
+            r = int(np.argmax(big))
+            raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cell}): {float(out[name][r]):g} "
+                             f"{_SI[name]} is beyond the limit of {limit:g} {_SI[name]} in magnitude"
+                             + (" (the simulator's time limit)" if name == "time" else
+                                " (the metrics and the fit square the values: they would overflow)"))
     jt = [c[0] for c in cols].index("time")
     t = out["time"]
     dt = np.diff(t)

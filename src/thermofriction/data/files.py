@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from pathlib import Path, PurePosixPath
@@ -11,6 +12,7 @@ import numpy as np
 import tomli_w
 
 from .._io import atomic_write
+from .._reading import read_text
 from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
@@ -39,6 +41,27 @@ def _check_temperature(T, where):
     return float(T)
 
 
+def _from_zero(time, inp):
+    """An experiment logged with a clock's time (it starts later than it lasts, e.g. at 1e6 s or an
+    epoch time) is moved to start at zero: the simulation starts there at rest, and far from zero a
+    double resolves time too coarsely for the solver (2e-10 s at 1e6 s). The manifest's input moves
+    with it when that is exact (a periodic input by a whole number of periods, a step by its
+    time); otherwise the time is kept."""
+    t0 = float(time[0])
+    if not t0 > float(time[-1]) - t0:
+        return time, inp
+    if inp is not None:
+        if inp.period is not None:
+            k = round(t0 / inp.period)
+            if abs(k * inp.period - t0) > 1e-9 * inp.period:
+                return time, inp
+        elif inp.kind == "step":
+            inp = dataclasses.replace(inp, time=inp.time - t0)
+        else:
+            return time, inp
+    return time - t0, inp
+
+
 def load_dataset(path) -> Dataset:
     """Reads a dataset folder (docs/formats.md): ``dataset.toml`` and the experiment files it lists,
     all checked; any problem is one InputError naming the file (and its line, column or
@@ -46,13 +69,13 @@ def load_dataset(path) -> Dataset:
     folder = Path(path)
     if folder.is_dir():
         manifest = folder / "dataset.toml"
-    elif folder.name == "dataset.toml" and folder.is_file():
+    elif folder.name == "dataset.toml" and folder.exists():
         manifest, folder = folder, folder.parent
     elif folder.exists():
         raise InputError(f"{path}: not a dataset folder (a folder with a dataset.toml)")
     else:
         raise InputError(f"{path}: no such dataset folder")
-    if not manifest.is_file():
+    if not manifest.exists():  # (a FIFO or a device named dataset.toml is refused by the reader)
         from .._io import stale_temporaries
         left = stale_temporaries(folder)
         if left:  # save_dataset removes the manifest first and renames the new one last
@@ -61,11 +84,13 @@ def load_dataset(path) -> Dataset:
                              f"completely written; write it again")
         raise InputError(f"{folder}: no dataset.toml in this folder")
     try:
-        meta = tomllib.loads(manifest.read_text(encoding="utf-8"))
+        meta = tomllib.loads(read_text(manifest, "dataset manifest (dataset.toml)"))
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{manifest}: TOML syntax error: {e}") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"{manifest}: cannot read ({e})") from None
+    except OSError as e:
+        raise InputError(f"{manifest}: cannot read ({e.strerror or e})") from None
+    except UnicodeDecodeError as e:
+        raise InputError(f"{manifest}: not UTF-8 text ({e.reason} at byte {e.start})") from None
     except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
         raise InputError(f"{manifest}: TOML nested too deeply") from None
     unknown = set(meta) - set(_MANIFEST_KEYS)
@@ -122,6 +147,7 @@ def load_dataset(path) -> Dataset:
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
         cols = read_experiment_csv(folder / f)
+        cols["time"], inp = _from_zero(cols["time"], inp)
         sig = cols.get("temperature")
         if T is None:
             if sig is None:

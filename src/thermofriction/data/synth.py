@@ -4,6 +4,7 @@ noise), and the ``thermofriction synth`` command."""
 from __future__ import annotations
 
 import math
+import numbers
 from pathlib import Path
 
 import numpy as np
@@ -78,6 +79,8 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
         raise InputError(f"sample_rate must be positive [Hz], got {sample_rate!r}")
     if duration * sample_rate + 1 < MIN_SAMPLES:
         raise InputError(f"duration x sample_rate gives fewer than {MIN_SAMPLES} samples")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise InputError(f"seed must be a whole number, 0 or more, got {seed!r}"[:200])
     if record_temperature is None:  # a self-heating model's temperature is an output: always recorded
         record_temperature = temperature_noise > 0 or model.heat is not None
     runs = [(T, "fit", [int(seed), i]) for i, T in enumerate(fit_T)]

@@ -6,7 +6,9 @@
 
 from __future__ import annotations
 
-from ..errors import InputError
+import numbers
+
+from ..errors import InputError, shorten
 from ..models import Model, StickSlipPlant, load_model
 from .engine import fit, make_traces, uncertainty
 from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
@@ -17,6 +19,32 @@ from .result import FitResult
 from .start import lugre_start
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
+
+
+#: The most starting points of the multi-start phase: each one simulates every fit experiment
+MAX_STARTS = 10_000
+
+
+def _check_arguments(method, reference_temperature, rtol, starts, seed):
+    from ..data.experiments import TEMPERATURE_RANGE
+
+    def whole(v):
+        return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+    if not whole(starts) or not 1 <= starts <= MAX_STARTS:
+        raise InputError(f"starts must be a whole number from 1 to {MAX_STARTS}, got {shorten(starts)}")
+    if not whole(seed) or seed < 0:
+        raise InputError(f"seed must be a whole number, 0 or more, got {shorten(seed)}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not 0 < rtol < 1:
+        raise InputError(f"rtol must be between 0 and 1, got {shorten(rtol)}")
+    if reference_temperature is not None:
+        if method != "model-ii":
+            raise InputError("reference_temperature applies to method 'model-ii' only")
+        lo, hi = TEMPERATURE_RANGE
+        if (isinstance(reference_temperature, bool) or not isinstance(reference_temperature, numbers.Real)
+                or not lo <= reference_temperature <= hi):
+            raise InputError(f"reference_temperature must be a temperature from {lo:g} to {hi:g} C, "
+                             f"got {shorten(reference_temperature)}")
 
 
 def identify(data, method="model-i", init=None, *, parameters=None, free=(), procedure="direct", laws=None,
@@ -37,7 +65,8 @@ def identify(data, method="model-i", init=None, *, parameters=None, free=(), pro
     rtol: the simulations' relative tolerance during the fit; starts: the multi-start size.
     """
     if method not in METHODS:
-        raise InputError(f"unknown method '{method}' (one of: {', '.join(METHODS)})")
+        raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
+    _check_arguments(method, reference_temperature, rtol, starts, seed)
     if init is None:
         init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii",
                 "heat": "li2009-self-heating"}[method]
@@ -117,4 +146,4 @@ def _identify_plant(experiments, init):
 
 
 __all__ = ["fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter", "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit",
-           "identify_model_i", "identify_model_ii", "identify_heat", "base_model", "make_traces", "uncertainty", "METHODS"]
+           "identify_model_i", "identify_model_ii", "identify_heat", "base_model", "make_traces", "uncertainty", "METHODS", "MAX_STARTS"]

@@ -3,21 +3,23 @@
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
-from ..errors import InputError, unknown_keys
+from ..errors import InputError, shorten, unknown_keys
 
 
 def num(value, where, key):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(f"{where}: '{key}' must be a number, got {value!r}")
+    # numbers.Real: NumPy's integer and float scalars too (an array's elements); not bool, not a string
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InputError(f"{where}: '{key}' must be a number, got {shorten(value)}")
     try:
         value = float(value)
     except OverflowError:  # an integer beyond the float range, e.g. 10**400
         raise InputError(f"{where}: '{key}' must be finite, got an integer too large for a number") from None
     if not math.isfinite(value):
-        raise InputError(f"{where}: '{key}' must be finite, got {value!r}")
+        raise InputError(f"{where}: '{key}' must be finite, got {shorten(value)}")
     return value
 
 

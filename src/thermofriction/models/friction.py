@@ -9,7 +9,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from .._bridge import PARAMETER_UNITS, PARAMETERS
-from ..errors import InputError, unknown_keys
+from ..errors import InputError, shorten, unknown_keys
 from ._parse import num, num_array
 
 # PARAMETERS and PARAMETER_UNITS (the one table of units: files, reports and fit results use it) come
@@ -27,6 +27,16 @@ class _Friction:
     state_units: tuple = ()
     #: parameters that are arrays, not numbers (never a law of temperature)
     arrays: tuple = ()
+
+    def __post_init__(self):
+        # checked at construction, so that LuGre(sigma0="1e5") fails here, naming the parameter,
+        # not later inside a simulation (the physical checks need the whole model: Model does them)
+        for f in fields(self):
+            if f.name in self.arrays:
+                continue
+            v = getattr(self, f.name)
+            if v is not None:
+                object.__setattr__(self, f.name, num(v, f"{self.model} friction", f.name))
 
     def values(self) -> dict:
         """Parameters given as numbers (None-valued ones omitted)."""
@@ -187,7 +197,8 @@ class GMS(_Friction):
     _MAX_ELEMENTS = 64
 
     def __post_init__(self):
-        k, w = tuple(float(x) for x in self.k), tuple(float(x) for x in self.w)
+        super().__post_init__()
+        k, w = (tuple(float(x) for x in num_array(a, "[friction]", name)) for name, a in (("k", self.k), ("w", self.w)))
         if len(k) != len(w) or not 1 <= len(k) <= self._MAX_ELEMENTS:
             raise InputError(f"[friction]: 'k' and 'w' must have the same length, 1 to {self._MAX_ELEMENTS} "
                              f"elements (got {len(k)} and {len(w)})")
@@ -237,13 +248,18 @@ def check_friction_values(values: dict, where: str):
     """Physical checks on a full set of parameter values (numbers and laws evaluated)."""
     for name, domain in PARAMETER_DOMAIN.items():
         v = values.get(name)
-        if v is not None and not in_domain(name, v):
-            raise InputError(f"{where}: '{name}' must be {domain}, got {v!r}")
+        # finite first: a law that overflows (a exp(b T) with b = 100) gives inf, which is "positive"
+        if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and in_domain(name, v)):
+            raise InputError(f"{where}: '{name}' must be {domain} and finite, got {shorten(v)}")
     z_ba, sigma0, fc = values.get("z_ba"), values.get("sigma0"), values.get("fc")
     if z_ba is not None and sigma0 and fc and not z_ba < fc / sigma0:
         raise InputError(f"{where}: 'z_ba' ({z_ba!r} m) must be below the steady deflection fc/sigma0 "
                          f"({fc / sigma0:.6g} m): the elasto-plastic model breaks away before it")
     fs = values.get("fs")
+    for name in ("fs", "vs"):  # no domain of their own (fs relative to fc, below), but finite
+        v = values.get(name)
+        if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
+            raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
     if fs is not None and fc is not None and fs < fc:
         raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r})")
     if fs is not None and fc is not None and fs != fc:
@@ -276,6 +292,13 @@ def dissipativity_violation(model_name: str, values: dict):
     lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
     if model_name not in ("lugre", "elastoplastic"):
         return None
+    # extreme but finite values (sigma0 = 1e300) overflow the products below; the condition is
+    # then decided by the terms that remain finite, and NumPy's warnings are not the user's business
+    with np.errstate(over="ignore", invalid="ignore", under="ignore", divide="ignore"):
+        return _dissipativity_violation(values)
+
+
+def _dissipativity_violation(values: dict):
     s0, s1, s2, fc = values["sigma0"], values["sigma1"], values.get("sigma2", 0.0) or 0.0, values["fc"]
     fs = values.get("fs") if values.get("fs") is not None else fc
     v = np.logspace(-9, 2, 1101)

@@ -27,6 +27,12 @@ class Law:
     #: the keys of the law's inline table in a model file, besides ``law`` and ``range``
     keys = ()
 
+    def __post_init__(self):
+        # checked at construction (Exp(a="1") or a NaN coefficient fail here, naming the coefficient)
+        for k in self.keys:
+            object.__setattr__(self, k, num(getattr(self, k), f"law '{self.kind}'", k))
+        object.__setattr__(self, "range", _check_range(self.range, f"law '{self.kind}'"))
+
     def core_fields(self) -> dict:
         """The numbers the C core's tf_law takes (a, b, x, y)."""
         raise NotImplementedError
@@ -158,8 +164,18 @@ class Poly(Law):
     kind = "poly"
     keys = ("c",)
 
+    #: a polynomial of temperature with more terms is ill-conditioned (35^20 ~ 1e31) and overflows
+    #: easily; a table or pwl law follows any shape instead
+    MAX_COEFFICIENTS = 16
+
     def __post_init__(self):
-        object.__setattr__(self, "c", np.ascontiguousarray(self.c, dtype=float))
+        where = "law 'poly'"
+        c = num_array(self.c, where, "c")
+        if c.ndim != 1 or len(c) > self.MAX_COEFFICIENTS:
+            raise InputError(f"{where}: 'c' has {len(c)} coefficients, more than {self.MAX_COEFFICIENTS} (degree "
+                             f"{self.MAX_COEFFICIENTS - 1}); use a 'table' or 'pwl' law for a detailed shape")
+        object.__setattr__(self, "c", np.ascontiguousarray(c, dtype=float))
+        object.__setattr__(self, "range", _check_range(self.range, where))
 
     def core_fields(self):
         return {"y": self.c}
@@ -178,7 +194,10 @@ class Poly(Law):
 
     @classmethod
     def from_table(cls, d, where, rng):
-        return cls(num_array(d["c"], where, "c"), range=rng)
+        try:
+            return cls(d["c"], range=rng)
+        except InputError as e:
+            raise InputError(f"{where}: {str(e).partition(': ')[2]}") from None
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -192,8 +211,16 @@ class PWL(Law):
     keys = ("T", "values")
 
     def __post_init__(self):
-        object.__setattr__(self, "T", np.ascontiguousarray(self.T, dtype=float))
-        object.__setattr__(self, "values", np.ascontiguousarray(self.values, dtype=float))
+        where = f"law '{self.kind}'"
+        T = num_array(self.T, where, "T")
+        values = num_array(self.values, where, "values")
+        if len(T) != len(values):
+            raise InputError(f"{where}: 'T' and 'values' must have the same length ({len(T)} != {len(values)})")
+        if np.any(np.diff(T) <= 0):
+            raise InputError(f"{where}: 'T' must increase strictly")
+        object.__setattr__(self, "T", np.ascontiguousarray(T, dtype=float))
+        object.__setattr__(self, "values", np.ascontiguousarray(values, dtype=float))
+        object.__setattr__(self, "range", _check_range(self.range, where))
 
     def core_fields(self):
         return {"x": self.T, "y": self.values}
@@ -207,15 +234,21 @@ class PWL(Law):
     def with_coefficients(self, coefficients):
         return dataclasses.replace(self, values=np.array([float(c) for c in coefficients]))
 
+    def check_points(self, where):
+        """A law in a model needs two points or more (the C core's model check: a one-point law is
+        a constant, which 'const' says plainly)."""
+        if len(self.T) < 2:
+            raise InputError(f"{where}: law '{self.kind}' needs at least two points (T and values of length 2 "
+                             f"or more), got {len(self.T)}; for one value use law = \"const\"")
+
     @classmethod
     def from_table(cls, d, where, rng):
-        T = num_array(d["T"], where, "T")
-        values = num_array(d["values"], where, "values")
-        if len(T) != len(values):
-            raise InputError(f"{where}: 'T' and 'values' must have the same length ({len(T)} != {len(values)})")
-        if np.any(np.diff(T) <= 0):
-            raise InputError(f"{where}: 'T' must increase strictly")
-        return cls(T, values, range=rng)
+        try:
+            law = cls(d["T"], d["values"], range=rng)
+        except InputError as e:
+            raise InputError(f"{where}: {str(e).partition(': ')[2]}") from None
+        law.check_points(where)
+        return law
 
 
 @dataclass(frozen=True, eq=False, repr=False)

@@ -14,11 +14,12 @@ import numpy as np
 import tomli_w
 
 from .._io import atomic_write
-from ..errors import InputError, unknown_keys
+from .._reading import read_text
+from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
 from .friction import (FRICTION_MODELS, GMS, PARAMETER_DOMAIN, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,
                        Stribeck, check_friction_values, in_domain)
-from .laws import Law, law_from_dict
+from .laws import PWL, Law, law_from_dict
 from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
 
@@ -37,6 +38,17 @@ class Model:
     heat: Heat | None = None
 
     def __post_init__(self):
+        # the parts' types first, so that Model(None, None) names the argument
+        for name, ok, what in (("plant", (StickSlipPlant, MassPlant, PrescribedMotion),
+                                "StickSlipPlant, MassPlant or PrescribedMotion"),
+                               ("friction", tuple(FRICTION_MODELS.values()), "friction model (LuGre, Coulomb, ...)"),
+                               ("thermal", (ModelI, ModelII, type(None)), "ModelI, ModelII or None"),
+                               ("input", (Waveform, type(None)), "Waveform or None")):
+            if not isinstance(getattr(self, name), ok):
+                raise InputError(f"Model: '{name}' must be a {what}, got {shorten(getattr(self, name))}")
+        for name in ("name", "description"):
+            if getattr(self, name) is not None and not isinstance(getattr(self, name), str):
+                raise InputError(f"Model: '{name}' must be a string, got {shorten(getattr(self, name))}")
         laws = self.thermal.laws if isinstance(self.thermal, ModelI) else {}
         given = self.friction.values()
         for pname, law in laws.items():
@@ -47,6 +59,8 @@ class Model:
                                  f"[thermal]; give it once")
             if not isinstance(law, Law):
                 raise InputError(f"[thermal]: '{pname}' must be a law")
+            if isinstance(law, PWL):
+                law.check_points(f"[thermal] {pname}")
         for pname in self.friction.required:
             if pname not in given and pname not in laws:
                 raise InputError(f"[friction]: missing '{pname}' (a number here, or a law in [thermal])")
@@ -54,6 +68,8 @@ class Model:
         if isinstance(self.thermal, ModelII):
             if not isinstance(self.thermal.dF, Law):
                 raise InputError("[thermal]: 'dF' must be a law")
+            if isinstance(self.thermal.dF, PWL):
+                self.thermal.dF.check_points("[thermal] dF")
         if self.heat is not None and not isinstance(self.heat, Heat):
             raise InputError("'heat' must be a Heat model (the [heat] section)")
 
@@ -143,8 +159,17 @@ class Model:
     def save(self, path):
         """Writes the model file atomically (temporary file, then rename)."""
         text = self.to_toml()
-        with atomic_write(path, "w") as fh:
-            fh.write(text)
+        try:
+            target = Path(os.fspath(path))
+        except TypeError:
+            raise InputError(f"save: path must be a file name, got {shorten(path)}") from None
+        if target.is_dir():
+            raise InputError(f"{target}: is a folder; give a file name for the model (e.g. {target / 'model.toml'})")
+        try:
+            with atomic_write(target, "w") as fh:
+                fh.write(text)
+        except OSError as e:
+            raise InputError(f"{target}: cannot write ({e.strerror or e})") from None
 
     def with_friction(self, **values) -> "Model":
         return replace(self, friction=self.friction.with_values(**values))
@@ -245,9 +270,11 @@ def load_model(source, friction_from=None) -> Model:
             hint = f" (presets: {', '.join(PRESETS)})" if os.sep not in source and not source.endswith(".toml") else ""
             raise InputError(f"{source}: no such file{hint}")
         try:
-            text = p.read_text()
-        except (OSError, UnicodeDecodeError) as e:
-            raise InputError(f"{source}: cannot read ({e})") from None
+            text = read_text(p, "model file (TOML)")
+        except OSError as e:
+            raise InputError(f"{source}: cannot read ({e.strerror or e})") from None
+        except UnicodeDecodeError as e:
+            raise InputError(f"{source}: not UTF-8 text ({e.reason} at byte {e.start})") from None
         base_dir = p.parent
     try:
         data = tomllib.loads(text)

@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import InputError, unknown_keys
 from ._parse import by_symbol, num
 
@@ -50,6 +52,24 @@ class StickSlipPlant:
             if name in ("damping_ratio", "damping") and v < 0:
                 raise InputError(f"{where}: '{sym}' must not be negative, got {v!r}")
             object.__setattr__(self, name, v)
+        # the derived form must exist too: m = 1e308 or wn = 1e200 overflow k = m wn^2 (and the
+        # solver could not resolve such a time scale anyway)
+        with np.errstate(over="ignore", invalid="ignore"):
+            m = np.float64(self.mass)
+            if all(modal):
+                xi, wn, K = (np.float64(getattr(self, n)) for n in self._MODAL)
+                k = m * wn * wn
+                c, T_em = 2 * xi * wn * m, K * k
+            else:
+                c, k, T_em = (np.float64(getattr(self, n)) for n in self._PHYSICAL)
+                wn = np.sqrt(k / m)
+        derived = {"c": c, "k": k, "T_em": T_em, "wn": wn}
+        for sym, v in derived.items():
+            if not np.isfinite(v):
+                given = ", ".join(f"{self._SYMBOLS[n]} = {getattr(self, n)!r}" for n in
+                                  ("mass", "end_effector_mass", *(self._MODAL if self.modal else self._PHYSICAL)))
+                raise InputError(f"{where}: the derived '{sym}' overflows ({given}): the values are beyond "
+                                 f"what can be computed")
 
     @property
     def modal(self) -> bool:

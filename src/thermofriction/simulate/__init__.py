@@ -11,16 +11,18 @@ core, the explanation of a failed run, and the packing of the outputs into a res
 from __future__ import annotations
 
 import math
+import numbers
+import os
 
 import numpy as np
 
 from .. import _bridge
 from ..drive import input_of
-from ..errors import InputError, SolverError
+from ..errors import InputError, SolverError, shorten
 from ..models import Model, PrescribedMotion, StickSlipPlant
 from ..waveforms import Sampled, Waveform
 from .checks import (as_temperature, check_heated_temperatures, check_passivity, check_prescribed_motion,
-                     check_temperatures)
+                     check_temperature_coverage, check_temperatures)
 from .result import SimulationResult
 from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 
@@ -29,11 +31,26 @@ from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 MAX_SAMPLES = 10_000_000
 
 
-def _check_samples(n, max_samples, what):
+#: Output times must lie within +-MAX_TIME s: the C core refuses others (integrator.c, tf_solve),
+#: as beyond it a double resolves time only to ~1e-4 s and periodic inputs lose their phase.
+MAX_TIME = 1e12
+
+
+def _count(n) -> str:
+    return f"{n}" if n < 1e15 else f"{float(n):.3g}"
+
+
+def _check_samples(n, max_samples, what, at_least=""):
     if max_samples is not None and n > max_samples:
-        raise InputError(f"{n} output samples requested ({what}), above the limit of {max_samples} "
+        raise InputError(f"{at_least}{_count(n)} output samples requested ({what}), above the limit of {max_samples} "
                          f"(~{n * 184 / 1e9:.3g} GB of memory): lower the duration or the sample rate, or raise "
                          f"the limit (--max-samples N; max_samples=N in Python, None for no limit)")
+
+
+def _check_span(t0, t1, what):
+    if not (abs(t0) <= MAX_TIME and abs(t1) <= MAX_TIME):
+        raise InputError(f"{what} reaches t = {max(abs(t0), abs(t1)):g} s, beyond the limit of {MAX_TIME:g} s (there "
+                         f"a double resolves time only to ~1e-4 s): shorten the duration")
 
 
 def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
@@ -41,6 +58,7 @@ def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
         raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
     if not (sample_rate > 0 and math.isfinite(sample_rate)):
         raise InputError(f"sample rate must be positive, got {sample_rate!r}")
+    _check_span(0.0, duration, f"duration {duration:g} s")
     x = duration * sample_rate * (1 + 1e-12)
     if not math.isfinite(x) or x >= 2.0 ** 62:
         raise InputError(f"duration {duration:g} s x sample rate {sample_rate:g} Hz is too many output samples: lower the duration or the sample rate")
@@ -53,32 +71,57 @@ def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
 def output_grid(duration, sample_rate, t_eval, max_samples) -> np.ndarray:
     """The requested output times: ``t_eval``, or a uniform grid from 0 to ``duration``."""
     if t_eval is not None:
-        t_grid = np.ascontiguousarray(t_eval, dtype=float)
+        try:
+            t_grid = np.ascontiguousarray(t_eval, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("t_eval must be an array of times [s]") from None
         if t_grid.ndim != 1 or t_grid.size < 1 or np.any(np.diff(t_grid) < 0) or not np.all(np.isfinite(t_grid)):
             raise InputError("t_eval must be a non-empty, non-decreasing array of finite times")
+        _check_span(float(t_grid[0]), float(t_grid[-1]), "t_eval")
         _check_samples(t_grid.size, max_samples, "t_eval")
         return t_grid
     if duration is None:
         raise InputError("give a duration (seconds) or t_eval")
-    return _grid(float(duration), float(sample_rate), max_samples)
+    try:
+        duration, sample_rate = float(duration), float(sample_rate)
+    except (TypeError, ValueError):
+        raise InputError(f"duration and sample_rate must be numbers, got {duration!r} and {sample_rate!r}") from None
+    return _grid(duration, sample_rate, max_samples)
 
 
 class _Grid:
     """The output grid with the input's period starts joined to it, so that per-cycle step sizes
-    are exact, not interpolated; ``unjoin`` removes the joined rows again."""
+    are exact, not interpolated; ``unjoin`` removes the joined rows again.
 
-    def __init__(self, t_grid: np.ndarray, period: float | None):
+    Every joined row is stored too: their number is counted against ``max_samples`` before
+    anything is allocated (a 1 MHz input on a 1 Hz grid joins a million rows per second)."""
+
+    def __init__(self, t_grid: np.ndarray, period: float | None, max_samples=MAX_SAMPLES):
         self.requested = t_grid
         t0, t1 = float(t_grid[0]), float(t_grid[-1])
         self.cycle_times = np.empty(0)
         if period is not None:
             k0 = math.ceil(t0 / period - 1e-9)
-            self.cycle_times = np.arange(k0, math.floor(t1 / period + 1e-9) + 1) * period
+            k1 = math.floor(t1 / period + 1e-9)
+            n_cycles = max(k1 - k0 + 1, 0)
+            what = f"{t_grid.size} requested + {{}} period starts of the {1 / period:g} Hz input joined to them"
+            if n_cycles >= 2 ** 40:  # beyond any memory, with or without a limit
+                raise InputError(f"{_count(t_grid.size + n_cycles)} output samples requested "
+                                 f"({what.format(_count(n_cycles))}): shorten the duration or lower the input's "
+                                 f"frequency")
+            # each requested time can absorb at most one period start: more starts than the limit
+            # exceed it whatever the grid (refused before they are allocated)
+            if max_samples is not None and n_cycles > max_samples:
+                _check_samples(n_cycles, max_samples, what.format(f"at least {_count(n_cycles - t_grid.size)}"),
+                               at_least="at least ")
+            self.cycle_times = np.arange(k0, k1 + 1) * period
         # cycle starts usually fall on the grid already; only the others are inserted (O(n), no sort)
         self.tol = 1e-12 * max(1.0, abs(t1))
         on_grid_at = np.minimum(np.searchsorted(t_grid, self.cycle_times - self.tol), t_grid.size - 1)
         hit = np.abs(t_grid[on_grid_at] - self.cycle_times) <= self.tol
         self.extra = self.cycle_times[~hit]
+        if period is not None:
+            _check_samples(t_grid.size + self.extra.size, max_samples, what.format(self.extra.size))
         self.times = (np.insert(t_grid, np.searchsorted(t_grid, self.extra), self.extra) if self.extra.size
                       else t_grid)
 
@@ -114,6 +157,9 @@ def _explain(e: _bridge.CoreFailure, model: Model, solver, controller, waveform,
     elif e.status == "step_underflow":
         hint = ("likely cause: extreme parameter or input values, or a solution that blows up or "
                 "jumps faster than the time resolution; check them")
+        if abs(e.time) >= 1e3:  # far from t = 0 a double's spacing, not the model, may be the limit
+            hint += (f"; or a late start: at t = {e.time:.3g} s a double resolves time only to "
+                     f"{np.spacing(abs(e.time)):.2g} s, so start the time at 0")
         if e.stiff and explicit:
             hint = f"{stiff_hint}; or {hint}"
     elif e.status == "no_memory":
@@ -122,6 +168,22 @@ def _explain(e: _bridge.CoreFailure, model: Model, solver, controller, waveform,
         hint = "this is a bug if the inputs were checked; please report it"
     return SolverError(f"integration failed at t = {e.time:.9g} s (step {e.step:.3g} s, {solver.name}): "
                        f"{e.core_message}; state {where}; {hint}", time=e.time, state=e.state)
+
+
+def _check_arguments(model, input, controller, max_samples):
+    """The public arguments' types, so that a wrong one is an InputError naming it (not an
+    AttributeError deep inside)."""
+    if not isinstance(model, Model):
+        hint = " (tf.load_model(path) reads a model file or preset)" if isinstance(model, (str, os.PathLike)) else ""
+        raise InputError(f"model must be a Model{hint}, got {shorten(model)}")
+    if input is not None and not isinstance(input, Waveform):
+        hint = f" (tf.parse_waveform({shorten(input)}) makes one from a spec)" if isinstance(input, str) else ""
+        raise InputError(f"input must be a Waveform{hint}, got {shorten(input)}")
+    if controller is not None and not isinstance(controller, StepSizeController):
+        raise InputError(f"controller must be a StepSizeController, got {shorten(controller)}")
+    if max_samples is not None and (isinstance(max_samples, bool) or not isinstance(max_samples, numbers.Integral)
+                                    or max_samples < 1):
+        raise InputError(f"max_samples must be a positive whole number or None, got {shorten(max_samples)}")
 
 
 def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
@@ -142,11 +204,14 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     friction_work: also integrate the friction work W = integral |F v_r| dt (always done with a
         heat model), returned as ``friction_work``.
     """
+    _check_arguments(model, input, controller, max_samples)
     solver = solver or AutoSwitch()
     if isinstance(solver, str):
         if solver not in SOLVERS:
-            raise InputError(f"unknown solver '{solver}' (one of: {', '.join(SOLVERS)})")
+            raise InputError(f"unknown solver {shorten(solver)} (one of: {', '.join(SOLVERS)})")
         solver = SOLVERS[solver]()
+    if not isinstance(solver, tuple(SOLVERS.values())):
+        raise InputError(f"solver must be Dopri5(), Rodas4(), AutoSwitch() or one of their names, got {shorten(solver)}")
     controller = controller or StepSizeController()
     temperature = as_temperature(temperature)
     heat = None
@@ -162,7 +227,9 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         check_temperatures(model, temperature)
     friction_work = bool(friction_work) or heat is not None
     waveform = input_of(model, input)
-    grid = _Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period)
+    grid = _Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period, max_samples)
+    if model.thermal is not None and heat is None:
+        check_temperature_coverage(temperature, float(grid.requested[0]), float(grid.requested[-1]))
     if isinstance(model.plant, PrescribedMotion):
         check_prescribed_motion(waveform)
 
@@ -171,9 +238,11 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
                    + ("T",) * (heat is not None) + ("W",) * friction_work)
     atol = controller.atol
     if atol is not None:
-        atol = np.broadcast_to(np.asarray(atol, float), (len(state_names),)).copy()
-        if np.any(atol <= 0):
-            raise InputError("atol must be positive")
+        try:
+            atol = np.broadcast_to(np.asarray(atol, float), (len(state_names),)).copy()
+        except ValueError:
+            raise InputError(f"atol must be one number or one per state ({len(state_names)}: "
+                             f"{', '.join(state_names)}), got {shorten(controller.atol)}") from None
     out = np.empty((grid.times.size, _bridge.n_outputs(model, friction_work)))
     try:
         stats = _bridge.run(_bridge.model_spec(model, temperature, waveform, friction_work), grid.times, out,

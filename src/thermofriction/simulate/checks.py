@@ -58,6 +58,20 @@ def check_passivity(model: Model, temperatures=(math.nan,)):
             return
 
 
+def check_temperature_coverage(temperature, t0: float, t1: float):
+    """Warns when a temperature signal does not cover the run [t0, t1]: beyond its ends it is
+    held constant, which is rarely what a file starting at t = 5 s for a 0-0.1 s run meant."""
+    if not isinstance(temperature, Sampled):
+        return
+    a, b = float(temperature.time[0]), float(temperature.time[-1])
+    tol = 1e-9 * max(1.0, abs(t0), abs(t1))
+    if a > t0 + tol or b < t1 - tol:
+        where = f" ({temperature.file})" if temperature.file else ""
+        warnings.warn(f"the temperature signal{where} covers {a:g}..{b:g} s, the run {t0:g}..{t1:g} s: outside "
+                      f"it the temperature is held at its first or last value", TemperatureRangeWarning,
+                      stacklevel=3)
+
+
 def check_temperatures(model: Model, temperature):
     """Warns for temperatures outside a law's calibrated range; raises where the model is
     invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
@@ -75,6 +89,12 @@ def check_temperatures(model: Model, temperature):
     laws = dict(model.laws)
     if isinstance(model.thermal, ModelII):
         laws["dF"] = model.thermal.dF
+    for name, law in laws.items():  # an overflow (a exp(b T) with b = 100) is named as one
+        vals = np.atleast_1d(law(Ts))
+        if not np.all(np.isfinite(vals)):
+            T_bad = Ts[np.argmax(~np.isfinite(vals))]
+            raise InputError(f"[thermal] {name}: the '{law.kind}' law gives {vals[~np.isfinite(vals)][0]} at "
+                             f"{T_bad:g} C (an overflow): its coefficients are beyond what can be computed there")
     outside = [f"'{name}' ({law.range[0]:g}..{law.range[1]:g} C)" for name, law in laws.items()
                if not law.in_range(Ts)]
     if outside:
@@ -131,5 +151,5 @@ def check_heated_temperatures(model: Model, time, temperature):
                           f"invalid: {e}") from None
 
 
-__all__ = ["as_temperature", "check_prescribed_motion", "check_passivity", "check_temperatures",
+__all__ = ["as_temperature", "check_temperature_coverage", "check_prescribed_motion", "check_passivity", "check_temperatures",
            "check_heated_temperatures"]

@@ -6,9 +6,13 @@ limits. They are separate so that either can change without the other.
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass
 
-from ..errors import InputError
+import numpy as np
+
+from ..errors import InputError, shorten
 
 
 
@@ -54,10 +58,23 @@ class StepSizeController:
     max_steps: int = 10_000_000
 
     def __post_init__(self):
-        if not (isinstance(self.rtol, (int, float)) and 0 < self.rtol < 1):
-            raise InputError(f"rtol must be between 0 and 1, got {self.rtol!r}")
-        if self.max_steps < 1:
-            raise InputError(f"max_steps must be positive, got {self.max_steps!r}")
+        if isinstance(self.rtol, bool) or not (isinstance(self.rtol, numbers.Real) and 0 < self.rtol < 1):
+            raise InputError(f"rtol must be between 0 and 1, got {shorten(self.rtol)}")
+        if (isinstance(self.max_steps, bool) or not isinstance(self.max_steps, numbers.Integral)
+                or self.max_steps < 1):
+            raise InputError(f"max_steps must be a positive whole number, got {shorten(self.max_steps)}")
+        if self.atol is not None:
+            try:
+                atol = np.asarray(self.atol, dtype=float)
+            except (TypeError, ValueError):
+                atol = None
+            if atol is None or atol.ndim > 1 or atol.size < 1 or not np.all(np.isfinite(atol) & (atol > 0)):
+                raise InputError(f"atol must be a positive finite number (or one per state), got {shorten(self.atol)}")
+        for name in ("first_step", "max_step"):
+            v = getattr(self, name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v)
+                                  or v <= 0):
+                raise InputError(f"{name} must be a positive finite number of seconds or None, got {shorten(v)}")
 
 
 # ---------------------------------------------------------------------------------------------

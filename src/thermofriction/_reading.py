@@ -1,0 +1,62 @@
+"""Reading input files and numbers strictly.
+
+Only regular files are read: a device such as /dev/zero never ends and a FIFO may block forever,
+so either is refused with one line before anything is read. Numbers in CSV cells and option values
+are read by ``strict_float``: Python's ``float()`` also takes ``1_0`` (as 10), which no data file
+means.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+
+from .errors import InputError
+
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+          (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"))
+
+
+def _kind(mode) -> str:
+    for test, name in _KINDS:
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def read_bytes(path, what: str = "file") -> bytes:
+    """The bytes of the regular file ``path``; InputError for anything else (a folder, a device, a
+    FIFO). OSError (a missing file, no permission) is left to the caller, which names it."""
+    # O_NONBLOCK: opening a FIFO for reading must not wait for a writer; cleared before reading
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = _kind(mode)
+            if kind == "a folder":
+                raise InputError(f"{path}: is a folder, not a {what}")
+            raise InputError(f"{path}: is {kind}, not a regular file: give a regular {what} (input from a device "
+                             f"or a pipe may never end)")
+        os.set_blocking(fd, True)
+        with os.fdopen(fd, "rb") as fh:
+            fd = None
+            return fh.read()
+    finally:
+        if fd is not None:
+            os.close(fd)
+
+
+def read_text(path, what: str = "file", encoding: str = "utf-8") -> str:
+    """``read_bytes`` decoded (UnicodeDecodeError is left to the caller)."""
+    return read_bytes(path, what).decode(encoding)
+
+
+def strict_float(text: str) -> float:
+    """``float(text)`` without the underscores Python allows between digits (``1_0`` is 10 there);
+    ValueError otherwise."""
+    if "_" in text:
+        raise ValueError(f"could not convert string to float: {text!r}")
+    return float(text)
+
+
+__all__ = ["read_bytes", "read_text", "strict_float"]
