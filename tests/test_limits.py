@@ -322,7 +322,7 @@ def test_a_record_starting_at_1e6_s_gives_the_metrics_of_one_starting_at_zero(da
     assert tf.load_dataset(shifted).experiments[0].time[0] == 0.0
     for x, y in zip(a.experiments, b.experiments):
         assert y["max_error_pct"] == pytest.approx(x["max_error_pct"], rel=1e-3)
-        assert y["rmse"] == pytest.approx(x["rmse"], rel=1e-3)
+        assert y["rmse_offset_removed"] == pytest.approx(x["rmse_offset_removed"], rel=1e-3)
 
 
 def test_a_late_start_that_cannot_move_is_kept_and_explained(dataset, tmp_path):
@@ -439,7 +439,7 @@ def test_a_constant_measurement_gives_nan_percentages_and_a_warning(dataset, mod
     res = tf.validate(model_i, data)
     m = res.experiments[0]
     assert math.isnan(m["max_error_pct"]) and math.isnan(m["nrmse"]) and math.isnan(m["final_error_pct"])
-    assert m["rmse"] > 0  # the absolute error is still defined
+    assert m["rmse_offset_removed"] > 0  # the absolute error is still defined
     assert any("undefined (NaN)" in w for w in res.warnings)
     # the summary of the others is not hidden by the NaN
     assert res.summary()["fit"]["max_error_pct"] == res.experiments[1]["max_error_pct"]

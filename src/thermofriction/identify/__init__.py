@@ -12,8 +12,9 @@ from ..errors import InputError, shorten
 from ..models import Model, StickSlipPlant, load_model
 from .engine import fit, make_traces, uncertainty
 from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
-from .procedures import (DEFAULT_FRICTION_PARAMETERS, base_model, fit_friction, fit_law, identify_heat, identify_model_i, identify_model_ii,
-                         segmented_fit)
+from .laws import fit_law, segmented_fit
+from .model_ii import identify_model_ii
+from .procedures import DEFAULT_FRICTION_PARAMETERS, base_model, fit_friction, identify_heat, identify_model_i
 from .plant import PlantFit, fit_plant, step_response
 from .result import FitResult
 from .start import lugre_start

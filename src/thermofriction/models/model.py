@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import tomli_w
 
-from .._io import atomic_write
+from .._io import Target, atomic_write
 from .._reading import read_text
 from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
@@ -159,6 +159,10 @@ class Model:
     def save(self, path):
         """Writes the model file atomically (temporary file, then rename)."""
         text = self.to_toml()
+        if isinstance(path, Target):  # the command line's checked output (a device, a link, a set member)
+            with atomic_write(path, "w") as fh:
+                fh.write(text)
+            return
         try:
             target = Path(os.fspath(path))
         except TypeError:

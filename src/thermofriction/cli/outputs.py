@@ -1,0 +1,62 @@
+"""The command line's outputs: checked before any work, never one of the run's inputs."""
+
+from __future__ import annotations
+
+import os
+
+from .. import _io
+from ..models import PRESETS
+from ..waveforms import Sampled
+
+
+_OUTPUT_FILES = {"simulate": {"output": "-o"}, "identify": {"output": "-o", "json": "--json"},
+                 "validate": {"json": "--json"}, "report": {"output": "-o"}}
+
+
+def _check_outputs(args):
+    """Resolves and checks every output file of the command (args.targets: dest -> Target)."""
+    args.targets = {}
+    for dest, option in _OUTPUT_FILES.get(args.command, {}).items():
+        path = getattr(args, dest, None)
+        if path is not None and path != "-":  # (an empty path is refused, not taken for none)
+            args.targets[dest] = _io.Target(path, option).check()
+    _io.refuse_inputs(args.targets.values(), ())  # two outputs that are one file
+    for option, folder in (("--figures", getattr(args, "figures", None)),
+                           ("-o", args.output if args.command == "demo" else None)):
+        if folder:
+            _io.check_folder(folder, f"{option} {folder}")
+
+
+def _target(args, dest):
+    """The checked Target of an output (main() made it), or the path when a command runs on its own."""
+    return getattr(args, "targets", {}).get(dest) or getattr(args, dest)
+
+
+def _refuse_inputs(args, *inputs):
+    """Exit 2 before any work when an output is one of the run's input files."""
+    flat = []
+    for i in inputs:
+        flat.extend(i if isinstance(i, (list, tuple)) else [i])
+    _io.refuse_inputs(getattr(args, "targets", {}).values(), [os.fspath(i) for i in flat if i])
+
+
+def _waveform_inputs(waveform):
+    f = getattr(waveform, "file", None) if isinstance(waveform, Sampled) else None
+    return [f] if f else []
+
+
+def _model_inputs(path, model):
+    """The files a model argument reads: the model file (not a preset) and a sampled input's file."""
+    if not path or path in PRESETS:
+        return []
+    files = [path]
+    inp = getattr(model, "input", None)
+    for f in _waveform_inputs(inp):
+        files += [f, os.path.join(os.path.dirname(os.fspath(path)), f)]
+    return files
+
+
+def _dataset_inputs(data):
+    """A dataset's manifest and experiment files."""
+    return [os.path.join(data.path, "dataset.toml")] + [os.path.join(data.path, e.file) for e in data.experiments]
+

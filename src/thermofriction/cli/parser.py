@@ -1,0 +1,183 @@
+"""The command line's arguments: every subcommand, option and its checks (docs/cli.md)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from .._reading import strict_float
+from .._version import __version__
+from ..errors import shorten
+from ..models import PRESETS
+from ..simulate import MAX_SAMPLES, SOLVERS
+from .commands import cmd_demo, cmd_identify, cmd_report, cmd_simulate, cmd_validate
+
+
+def _number(positive):
+    """An argparse type: a finite float, positive when asked."""
+    def parse(text):
+        try:
+            v = strict_float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a number: {shorten(text)}") from None
+        if not math.isfinite(v) or (positive and v <= 0):
+            raise argparse.ArgumentTypeError(f"must be a {'positive' if positive else 'finite'} number, got {text!r}")
+        return v
+    return parse
+
+
+_positive_float = _number(positive=True)
+_finite_float = _number(positive=False)
+
+
+def _int_in(low, high=None):
+    """An argparse type: a whole number in [low, high] (high None: no upper bound)."""
+    def parse(text):
+        try:
+            if "_" in text:  # int() takes 1_000; no option value means that
+                raise ValueError
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a whole number: {shorten(text)}") from None
+        if v < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low}, got {shorten(text)}")
+        if high is not None and v > high:
+            raise argparse.ArgumentTypeError(f"must be at most {high}, got {shorten(text)}")
+        return v
+    return parse
+
+
+_positive_int = _int_in(1)
+#: identify.MAX_STARTS, not imported from there (identify loads SciPy); a test keeps them equal
+MAX_STARTS = 10_000
+
+
+def _temperature(text):
+    """An argparse type: a plausible temperature [C] (the range of dataset temperatures)."""
+    from ..data.experiments import TEMPERATURE_RANGE
+    v = _finite_float(text)
+    lo, hi = TEMPERATURE_RANGE
+    if not lo <= v <= hi:
+        raise argparse.ArgumentTypeError(f"{v:g} C is not a plausible temperature (expected {lo:g} to {hi:g} C)")
+    return v
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="thermofriction",
+        description="Temperature-aware friction models for precision motion systems "
+                    "(Li et al., Rev. Sci. Instrum. 80, 045104, 2009, and beyond).",
+        epilog="Exit status: 0 success, 1 a computation failed, 2 bad usage or data.")
+    p.add_argument("--version", action="version", version=f"thermofriction {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    s = sub.add_parser(
+        "simulate", help="simulate a model file (or a preset) and write the simulation CSV (docs/formats.md#simulation-output)",
+        description="Simulate a model from rest -- a stick-slip actuator, a single mass (force-driven or "
+                    "spring-pulled) or prescribed motion, with any friction model (lugre, coulomb, stribeck, "
+                    "dahl, elastoplastic, gms) -- and write time, input, displacements, velocity, friction "
+                    "force, temperature and internal states (SI units, temperature in C) on a uniform grid. "
+                    "Without -o, prints a summary.",
+        epilog=f"MODEL is a model file (TOML) or a preset name: {', '.join(PRESETS)}. "
+               "Input specs: sawtooth:amplitude=A,frequency=F[,rise=0.99,offset=0,direction=1] | "
+               "sine:amplitude=A,frequency=F[,offset=0] | square:amplitude=A,frequency=F,slew=S[,offset=0,duty=0.5] | "
+               "step:amplitude=A[,time=0,slew=0,offset=0] | sampled:file=PATH (CSV with time[s] and one value column). "
+               "The input is a voltage [V] for the stick-slip plant, a force [N] for the mass, the displacement [m] "
+               "for prescribed motion.")
+    s.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
+    temp = s.add_mutually_exclusive_group()
+    temp.add_argument("--temperature", type=_finite_float, metavar="C",
+                      help="constant interface temperature [C] (required for thermal models)")
+    temp.add_argument("--temperature-file", metavar="F.csv",
+                      help="temperature signal: CSV with time[s] and temperature[C], linearly interpolated")
+    s.add_argument("--input", metavar="WAVEFORM", help="input waveform, overriding the model's [input]")
+    s.add_argument("--duration", type=_positive_float, default=2.0, metavar="S",
+                   help="simulated time [s] (default: 2)")
+    s.add_argument("--sample-rate", type=_positive_float, default=10_000.0, metavar="HZ",
+                   help="output sample rate [Hz] (default: 10000)")
+    s.add_argument("-o", "--output", metavar="OUT.csv", help="CSV output file ('-' for standard output)")
+    s.add_argument("--method", choices=sorted(SOLVERS), default="auto",
+                   help="integrator: dopri5 (explicit), rodas4 (stiff), auto (default: dopri5, trying rodas4 "
+                        "when it detects stiffness and keeping it only where it is cheaper)")
+    s.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
+    s.add_argument("--atol", type=_positive_float, default=None,
+                   help="absolute tolerance for every state (default: rtol times each state's scale)")
+    s.add_argument("--max-steps", type=_positive_int, default=10_000_000, metavar="N",
+                   help="step limit (default: 10000000)")
+    s.add_argument("--max-samples", type=_positive_int, default=MAX_SAMPLES, metavar="N",
+                   help=f"limit on output samples, duration x sample rate + 1, each ~184 bytes in memory "
+                        f"(default: {MAX_SAMPLES})")
+    s.set_defaults(run=cmd_simulate)
+
+    i = sub.add_parser(
+        "identify", help="identify a model from a dataset (docs/formats.md#datasets) and write the fitted model and results",
+        description="Fit a friction model (base), Model I or Model II to the 'fit' experiments of a dataset: "
+                    "trust-region least squares with exact sensitivities from the C core, a multi-start "
+                    "global phase, and standard errors, 95 % intervals and correlations at the optimum.",
+        epilog="Writes FITTED.toml (loadable by simulate) and, with --json, the results JSON (docs/formats.md#results-json). "
+               "The initial model provides the plant (masses, xi, wn, K) and the input waveform.")
+    i.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
+    i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
+                   help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
+                        "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
+                        "[heat] section's C_th, R_th, eta from recorded temperature[C] columns)")
+    i.add_argument("--friction", choices=("lugre",), default="lugre", help="base friction model (default: lugre)")
+    i.add_argument("--init", metavar="MODEL.toml",
+                   help="initial model: file or preset (default: the paper's preset for the method)")
+    i.add_argument("--parameters", metavar="NAMES",
+                   help="comma-separated parameters to fit with --method base (default: sigma0,sigma1,fc)")
+    i.add_argument("--free", metavar="NAMES",
+                   help="plant parameters to fit too, one value shared by all experiments, comma-separated: m_e, m "
+                        "(the masses), xi, wn, K (c, k, T_em for a plant in physical form); e.g. --free m_e,m")
+    i.add_argument("--procedure", choices=("direct", "paper", "both"), default="direct",
+                   help="Model II procedure (default: direct; both: report the paper's too)")
+    i.add_argument("--law", action="append", default=[], metavar="PARAM=KIND",
+                   help="Model I law kind for a parameter, e.g. sigma0=exp (default: chosen by AICc)")
+    i.add_argument("--no-refine", action="store_true",
+                   help="skip the joint refinement of the laws on all experiments")
+    i.add_argument("--reference-temperature", type=_temperature, metavar="C",
+                   help="Model II base temperature, with --method model-ii (default: the lowest fit temperature)")
+    i.add_argument("--starts", type=_int_in(1, MAX_STARTS), default=8,
+                   help=f"multi-start size, 1 to {MAX_STARTS} (default: 8)")
+    i.add_argument("--rtol", type=_positive_float, default=1e-8,
+                   help="simulation tolerance during the fit (default: 1e-8)")
+    i.add_argument("--seed", type=_int_in(0), default=0, help="seed of the multi-start sample, 0 or more (default: 0)")
+    i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
+    i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
+    i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
+    i.set_defaults(run=cmd_identify)
+
+    v = sub.add_parser("validate", help="predict every experiment of a dataset with a model: the metrics of docs/formats.md#validation-metrics",
+                       description="Simulate each experiment of DATASET with MODEL and report the paper's maximum "
+                                   "prediction error, RMSE, NRMSE, final-displacement error and per-cycle step-size "
+                                   "error, as a table and (with --json) as JSON.")
+    v.add_argument("model", metavar="MODEL.toml", help="model file or preset")
+    v.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
+    v.add_argument("--json", metavar="METRICS.json", help="metrics as JSON (docs/formats.md#validation-metrics)")
+    v.set_defaults(run=cmd_validate)
+
+    r = sub.add_parser("report", help="an HTML report comparing models on a dataset",
+                       description="Compare one or more models on a dataset in one self-contained HTML file "
+                                   "(figures inlined as SVG; it opens offline). Identification results are read "
+                                   "from a JSON file beside each model file (same name, .json), when there is one.")
+    r.add_argument("paths", nargs="+", metavar="MODEL.toml... DATASET",
+                   help="one or more model files (or presets), then the dataset folder")
+    r.add_argument("-o", "--output", required=True, metavar="REPORT.html", help="the report")
+    r.add_argument("--figures", metavar="DIR", help="also write every figure as SVG and PNG into DIR")
+    r.add_argument("--title", help="the report's title")
+    r.set_defaults(run=cmd_report)
+
+    d = sub.add_parser("demo", help="the main job: synthesise the example dataset, identify, validate, report",
+                       description="Synthesise the bundled example dataset from the paper's preset (seeded, with "
+                                   "sensor noise, quantisation and temperature-sensor noise; two temperatures held "
+                                   "out), identify Model I, Model II and a model without thermal effects, validate "
+                                   "them and write report.html with the models and JSON results.")
+    d.add_argument("-o", "--output", default="thermofriction-demo", metavar="DIR",
+                   help="output folder (default: thermofriction-demo)")
+    d.set_defaults(run=cmd_demo)
+
+    from ..data import add_synth_command  # dataset tools (synth) live with the data module
+    add_synth_command(sub)
+    return p
+

@@ -1,0 +1,208 @@
+"""Model II (docs/models.md#model-ii): the paper's procedure (displacement against temperature and
+against dF, composed) and the direct one (dF per temperature on the trajectories, a law, a joint
+refinement with the base parameters)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from ..drive import experiment_waveform
+from ..errors import InputError
+from ..models import PWL, Const, Model, ModelII
+from ..simulate import simulate
+from .engine import Problem, fit, make_traces
+from .laws import _aicc, segmented_fit
+from .parameters import Parameters, get_value, unit_of
+from .procedures import _fit_parameter_names, _groups, _result, base_model, fit_friction
+from .result import FitResult
+
+
+def _final_displacement(exp):
+    """Net displacement of a run: mean of its last 1 % minus mean of its first 1 % (robust to noise)."""
+    k = max(len(exp.displacement) // 100, 1)
+    return float(np.mean(exp.displacement[-k:]) - np.mean(exp.displacement[:k]))
+
+
+def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True, free=(),
+                      progress=None, **opts) -> FitResult:
+    """Model II. ``procedure="paper"``: base model at the reference temperature; displacement
+    against temperature by a segmented linear fit with an estimated breakpoint; displacement
+    against dF by simulation; composed dF(T). ``"direct"``: dF fitted per temperature on the
+    trajectories, then a law (linear or two segments by AICc) and a joint refinement.
+    ``"both"``: the direct result, with the paper's in ``alternatives["paper"]``."""
+    if procedure not in ("direct", "paper", "both"):
+        raise InputError(f"Model II procedure must be 'direct', 'paper' or 'both', got {procedure!r}")
+    t0 = time.perf_counter()
+    groups = _groups(experiments)
+    if len(groups) < 2:
+        raise InputError("Model II needs fit experiments at two or more temperatures")
+    if reference_temperature is None:
+        ref_group = groups[0]
+    else:
+        ref_group = min(groups, key=lambda g: abs(g[0].temperature - reference_temperature))
+    T_ref = float(np.mean([e.temperature for e in ref_group]))
+    if progress:
+        progress(f"Model II: base model at the reference temperature {T_ref:.4g} C")
+    base_init = base_model(init, T_ref)
+    base_fit = fit_friction(ref_group, base_init, _fit_parameter_names(base_init) + list(free),
+                            method=f"base at {T_ref:.4g} C", **opts)
+    base = base_fit.model
+    details = {"reference_temperature": T_ref, "base": base_fit.to_dict()}
+    results = {}
+    if procedure in ("paper", "both"):
+        results["paper"] = _model_ii_paper(groups, base, T_ref, details, t0, progress)
+    if procedure in ("direct", "both"):
+        results["direct"] = _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts,
+                                             free)
+    main = results["direct" if procedure != "paper" else "paper"]
+    if procedure == "both":
+        main.alternatives["paper"] = results["paper"]
+    main.wall_time = time.perf_counter() - t0
+    return main
+
+
+def _model_ii_paper(groups, base, T_ref, details, t0, progress):
+    if progress:
+        progress("Model II (paper): displacement against temperature and against dF")
+    Ts = np.array([np.mean([e.temperature for e in g]) for g in groups])
+    D = np.array([np.mean([_final_displacement(e) for e in g]) for g in groups])
+    tb, D_law, ssr_seg = segmented_fit(Ts, D)
+    sst = float(np.sum((D - D.mean()) ** 2))
+    r2_seg = 1.0 - ssr_seg / sst if sst > 0 else math.nan
+    # displacement against dF, by simulating the base model with a constant dF
+    ref = groups[0][0]
+    fc = base.reference_force()
+    dFs = np.linspace(-0.5 * fc, 0.2 * fc, 8)
+    waveform = experiment_waveform(ref, base)
+    D_sim = []
+    for dF in dFs:
+        m = dataclasses.replace(base, thermal=ModelII(Const(float(dF))))
+        res = simulate(m, t_eval=ref.time, temperature=T_ref, input=waveform)
+        D_sim.append(res.displacement[-1] - res.displacement[0])
+    D_sim = np.array(D_sim)
+    beta, alpha = np.polyfit(dFs, D_sim, 1)
+    r2 = 1 - np.sum((alpha + beta * dFs - D_sim) ** 2) / np.sum((D_sim - D_sim.mean()) ** 2)
+    knots = D_law.T
+    dF_knots = (D_law.values - alpha) / beta
+    law = PWL(knots, dF_knots, range=(float(Ts.min()), float(Ts.max())))
+    model = dataclasses.replace(base, thermal=ModelII(law))
+    details["paper"] = {"temperatures": Ts, "displacement": D, "breakpoint": tb,
+                        "displacement_law": D_law.to_dict(), "dF_grid": dFs, "displacement_vs_dF": D_sim,
+                        "linear_fit": {"slope": beta, "intercept": alpha, "r2": r2}, "dF_law": law.to_dict()}
+    params = Parameters()
+    for i, v in enumerate(dF_knots):
+        params.add(f"dF.values[{i}]", float(v), unit="N")
+    warns = [] if r2 > 0.98 else [f"displacement is not linear in dF (R^2 = {r2:.3f}): the paper's procedure "
+                                  f"assumes it is"]
+    if not (r2_seg >= 0.9):
+        warns.append(f"the two-segment fit of displacement against temperature is poor (R^2 = {r2_seg:.3f}): the "
+                     f"paper's procedure assumes two straight segments")
+    success, message = True, "paper's procedure (no trajectory fit, no intervals)"
+    worst = float(np.max(np.abs(dF_knots)))
+    if not np.all(np.isfinite(dF_knots)) or worst >= fc or np.any(1.0 + dF_knots / fc <= 0):
+        # beyond the friction level the scale form reverses friction: not a model of these data
+        success = False
+        message = (f"refused: the paper's procedure gives |dF| up to {worst:.4g} N, beyond the friction level "
+                   f"fc = {fc:.4g} N (the displacement hardly depends on dF here; use --procedure direct)")
+        warns.insert(0, message)
+    details["paper"]["segmented_r2"] = r2_seg
+    return FitResult("model-ii (paper)", model, params, np.full((len(params), len(params)), np.nan), math.nan,
+                     math.nan, 0, len(dFs), 0, 0, time.perf_counter() - t0, success, message, warnings=warns,
+                     details=details)
+
+
+def _dF_start(group, m, fc, previous, opts):
+    """Where to start dF at one temperature: the cost in dF can have two minima (a stick-slip step
+    grows and then shrinks as friction falls), so scan it across the friction level, and keep the
+    neighbouring temperature's value (continuation) in the scan."""
+    grid = sorted(set(np.round(np.linspace(-0.9, 0.9, 13) * fc, 12)) | {0.0, float(previous)})
+    traces = make_traces(group, m)
+    problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), 1e-6))
+    costs = []
+    for v in grid:
+        r, _ = problem.evaluate(np.array([v]))
+        costs.append(math.inf if r is None else float(r @ r))
+    return float(grid[int(np.argmin(costs))]), {"grid": grid, "cost": costs}
+
+
+def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=()):
+    per_T = []
+    popts = dict(opts)
+    popts["starts"] = 1
+    fc = base.reference_force()
+    # continuation outward from the reference temperature, where dF is smallest
+    order = sorted(range(len(groups)), key=lambda i: abs(float(np.mean([e.temperature for e in groups[i]])) - T_ref))
+    previous, fits, scans = 0.0, {}, {}
+    for i in order:
+        g = groups[i]
+        T = float(np.mean([e.temperature for e in g]))
+        if progress:
+            progress(f"Model II (direct): dF at {T:.4g} C")
+        m = dataclasses.replace(base, thermal=ModelII(Const(0.0)))
+        start, scans[T] = _dF_start(g, m, fc, previous, popts)
+        params = Parameters()
+        # lambda = 1 + dF/fc stays positive: friction never reverses
+        params.add("dF.value", start, min=-0.95 * fc, max=10.0 * fc, unit="N")
+        r = fit_friction(g, dataclasses.replace(m, thermal=ModelII(Const(start))), params,
+                         method=f"dF at {T:.4g} C", **popts)
+        fits[i] = (T, r)
+        previous = r.parameters["dF.value"].value
+    per_T = [fits[i] for i in range(len(groups))]
+    Ts = np.array([T for T, _ in per_T])
+    vals = np.array([r.parameters["dF.value"].value for _, r in per_T])
+    ses = np.array([r.parameters["dF.value"].stderr for _, r in per_T])
+    w = 1.0 / ses if np.all(np.isfinite(ses) & (ses > 0)) else np.ones_like(ses)
+    w = w / w.mean()
+    candidates = {}
+    A = np.column_stack([Ts, np.ones_like(Ts)]) * w[:, None]
+    coef, *_ = np.linalg.lstsq(A, vals * w, rcond=None)
+    lin = PWL([Ts.min(), Ts.max()], [coef[0] * Ts.min() + coef[1], coef[0] * Ts.max() + coef[1]],
+              range=(float(Ts.min()), float(Ts.max())))
+    candidates["linear"] = (lin, _aicc(float(np.sum(((lin(Ts) - vals) * w) ** 2)), len(Ts), 2))
+    if len(Ts) >= 4:
+        tb, seg, ssr = segmented_fit(Ts, vals, w)
+        candidates["two segments"] = (seg, _aicc(ssr, len(Ts), 4))
+    chosen = min(candidates, key=lambda k: candidates[k][1])
+    law = candidates[chosen][0]
+    details["direct"] = {"temperatures": Ts, "dF": vals, "stderr": ses, "chosen": chosen,
+                         "candidates": {k: {"aicc": a, "law": l.to_dict()} for k, (l, a) in candidates.items()}}
+    model = dataclasses.replace(base, thermal=ModelII(law))
+    details["direct"]["scans"] = [{"temperature": T, **scans[T]} for T in sorted(scans)]
+    params = Parameters()
+    for i, v in enumerate(law.values):
+        params.add(f"dF.values[{i}]", float(v), unit="N")
+    if not refine:
+        return FitResult("model-ii (direct)", model, params, np.full((len(params),) * 2, np.nan), math.nan,
+                         math.nan, 0, sum(r.nfev for _, r in per_T), 0, 0, time.perf_counter() - t0, True,
+                         "per-temperature dF and law (no joint refinement)", details=details)
+    if progress:
+        progress("Model II (direct): joint refinement of dF(T) and the base parameters on all experiments")
+    # The base parameters are refined with dF, so that dF's intervals carry their uncertainty. Scaling
+    # sigma0, sigma1, fc by 1/c and shifting dF by fc (1 - 1/c) leaves the scale form unchanged, so
+    # dF is pinned to zero at the reference temperature (its definition: the base model holds there).
+    knots = np.asarray(law.T)
+    at_ref = np.flatnonzero(np.abs(knots - T_ref) <= 0.05)
+    warns = []
+    if at_ref.size:
+        k = int(at_ref[0])
+        model = dataclasses.replace(model, thermal=ModelII(law.with_coefficients(
+            [0.0 if j == k else v for j, v in enumerate(law.values)])))
+        params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
+        params[f"dF.values[{k}]"].vary = False
+        for name in _fit_parameter_names(base) + list(free):
+            params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
+    else:
+        warns.append(f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters "
+                     f"are held at their fit there, so dF's intervals do not include their uncertainty")
+    traces = make_traces(experiments, model)
+    outcome = fit(model, params, traces, **popts)
+    res = _result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
+    res.nfev += sum(r.nfev for _, r in per_T)
+    return res
+
+
+__all__ = ["identify_model_ii"]
