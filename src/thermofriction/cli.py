@@ -108,11 +108,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
                         "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
                         "[heat] section's C_th, R_th, eta from recorded temperature[C] columns)")
-    i.add_argument("--friction", choices=("lugre",), default="lugre", help="base friction model (default: lugre)")
+    i.add_argument("--friction", choices=("lugre", "dahl", "elastoplastic", "gms", "stribeck", "coulomb"),
+                   help="friction model to identify (default: the initial model's); built from the initial model's "
+                        "values where they share a parameter (docs/identification.md#friction-models)")
     i.add_argument("--init", metavar="MODEL.toml",
                    help="initial model: file or preset (default: the paper's preset for the method)")
     i.add_argument("--parameters", metavar="NAMES",
-                   help="comma-separated parameters to fit with --method base (default: sigma0,sigma1,fc)")
+                   help="comma-separated parameters to fit with --method base (default: the friction model's, "
+                        "LuGre's sigma0,sigma1,fc)")
     i.add_argument("--procedure", choices=("direct", "paper", "both"), default="direct",
                    help="Model II procedure (default: direct; both: report the paper's too)")
     i.add_argument("--law", action="append", default=[], metavar="PARAM=KIND",
@@ -247,7 +250,7 @@ def cmd_identify(args) -> int:
         raise InputError("--parameters applies to --method base only")
     update, status = _progress(args.quiet)
     try:
-        fit = identify(data, args.method, init=args.init, parameters=params, procedure=args.procedure,
+        fit = identify(data, args.method, init=args.init, friction=args.friction, parameters=params, procedure=args.procedure,
                        laws=laws or None, refine=not args.no_refine,
                        reference_temperature=args.reference_temperature, rtol=args.rtol, starts=args.starts,
                        seed=args.seed, progress=update)
