@@ -549,3 +549,80 @@ def test_gms_breaks_loose_after_reversing_at_capacity(solver):
     assert res.friction_force[500] == pytest.approx(fc, abs=1e-6)
     assert res.friction_force.min() >= -fc * (1 + 1e-6)
     assert res.friction_force[-1] == pytest.approx(-fc, abs=1e-6)
+
+
+# ---------------------------------------------------------------------------------------------
+# Forward sensitivities of every friction model (the identification's Jacobian) against central
+# differences of whole simulations, on the actuator (the plant identification runs on)
+# ---------------------------------------------------------------------------------------------
+
+#: every parameter of the list each model reads (the actuator's levels, sigma2 > 0 so that it counts)
+SENSITIVITY_PARAMETERS = {
+    "coulomb": ("fc", "sigma2", "v_smooth"),
+    "stribeck": ("fc", "fs", "vs", "delta", "sigma2", "v_smooth"),
+    "dahl": ("sigma0", "fc"),
+    "lugre": ("sigma0", "sigma1", "fc", "fs", "vs", "delta", "vd", "sigma2"),
+    "elastoplastic": ("sigma0", "sigma1", "fc", "fs", "vs", "delta", "vd", "z_ba", "sigma2"),
+    "gms": ("C", "fc", "fs", "vs", "delta", "sigma2"),
+}
+
+
+def sensitivity_model(kind):
+    m = actuator_model(kind)
+    extra = {"lugre": dict(fs=1.3 * m.friction.fc, vs=1e-3, vd=5e-3),
+             "elastoplastic": dict(fs=1.3 * m.friction.fc, vs=1e-3, vd=5e-3)}.get(kind, {})
+    if "sigma2" in SENSITIVITY_PARAMETERS[kind]:
+        extra["sigma2"] = 20.0
+    return m.with_friction(**extra)
+
+
+def x_e_and_sensitivities(model, names, t, rtol=1e-10):
+    """x_e(t) and dx_e/dtheta by the core's forward sensitivities (as identify/engine.py runs them)."""
+    from thermofriction.identify.parameters import target_of
+    spec = _bridge.model_spec(model, 30.0, model.input)
+    theta = np.array([model.friction.values()[n] for n in names], float)
+    targets = np.array([target_of(model, n) for n in names], dtype=np.int32).reshape(-1, 3)
+    atol_y = rtol * _bridge.state_scale(spec)
+    atol_s = atol_y[:, None] / np.abs(theta)[None, :]
+    out = np.empty((len(t), _bridge.n_outputs(model, False)))
+    sens = np.empty((len(t), len(atol_y), len(names)))
+    stats = _bridge.run_sensitivities(spec, targets, t, out, sens, rtol=rtol,
+                                      atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=10_000_000)
+    i = _bridge.state_index(model, "x_e")
+    return out[:, _bridge.OUTPUT_COLUMN["displacement"]], sens[:, i, :], stats
+
+
+def x_e(model, t, rtol=1e-12):
+    spec = _bridge.model_spec(model, 30.0, model.input)
+    out = np.empty((len(t), _bridge.n_outputs(model, False)))
+    stats = _bridge.run(spec, t, out, method="dopri5", rtol=rtol)
+    return out[:, _bridge.OUTPUT_COLUMN["displacement"]], stats
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_sensitivities_match_finite_differences_of_simulations(kind):
+    """Oracle: central differences (relative step 1e-3) of x_e(t) simulated at rtol 1e-12. The
+    forward sensitivities of every parameter each model reads agree to 1e-3 of the largest
+    sensitivity times the parameter (the displacement a 100 % change would make, to first order).
+    For GMS the record holds stick-slip cycles, so elements break loose and re-stick (events):
+    the sensitivities' jump at each switch is part of what is checked."""
+    model = sensitivity_model(kind)
+    names = SENSITIVITY_PARAMETERS[kind]
+    t = np.linspace(0.0, 0.21, 1051)  # through the sawtooth's first flyback (0.1998 s), where it slips
+    x, S, _ = x_e_and_sensitivities(model, names, t)
+    x_ref, stats = x_e(model, t)
+    # the same trajectory as a simulation (a sensitivity run that missed GMS's mode switches would not be)
+    np.testing.assert_allclose(x, x_ref, atol=1e-6 * np.ptp(x_ref))
+    if kind == "gms":
+        assert stats["events"] >= 4, stats  # elements switched modes within the record
+    for j, name in enumerate(names):
+        v = model.friction.values()[name]
+        h = 1e-3 * v  # (smaller steps drown the weakest sensitivities, sigma1's, in the solver's noise)
+        xp, _ = x_e(model.with_friction(**{name: v + h}), t)
+        xm, _ = x_e(model.with_friction(**{name: v - h}), t)
+        fd = (xp - xm) / (2 * h)
+        scale = np.max(np.abs(S[:, j])) + np.max(np.abs(fd))
+        err = np.max(np.abs(S[:, j] - fd)) / scale
+        print(f"{kind} {name}: |S| max {np.max(np.abs(S[:, j])) * v:.3g} m per 100 %, worst {err:.2e}")
+        assert scale * v > 1e-6 * np.ptp(x_ref), f"{name} moves nothing here: the test would not see an error"
+        assert err < 1e-3, f"{kind} {name}: sensitivity off by {err:.3g} of its scale"

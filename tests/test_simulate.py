@@ -255,13 +255,11 @@ def test_lugre_passivity_condition_warns_for_large_sigma1_and_not_with_vd_or_the
 
 
 def test_identification_and_datasets_refuse_what_they_cannot_do_with_a_clear_message():
-    """Identification is implemented for LuGre on the stick-slip actuator; datasets record that
-    actuator. Other models and plants simulate, and say so when asked for more."""
+    """Identification is implemented on the stick-slip actuator (any friction model: see
+    tests/test_identify_friction.py); datasets record that actuator. Other plants simulate, and say
+    so when asked for more."""
     base = tf.load_model("li2009-base")
     synthetic_experiments = tf.synthesize(base, [30.0], duration=0.2, sample_rate=2000)
-    dahl = tf.Model(base.plant, tf.Dahl(sigma0=2e6, fc=0.9), input=base.input)
-    with pytest.raises(tf.InputError, match="'dahl' friction is not available yet"):
-        tf.identify(synthetic_experiments, method="base", init=dahl)
     mass = tf.Model(tf.MassPlant(1.0, 2.0, 0.1), tf.LuGre(**CANUDAS))
     with pytest.raises(tf.InputError, match="'mass' plant"):
         tf.identify(synthetic_experiments, method="base", init=mass)

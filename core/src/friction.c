@@ -45,8 +45,7 @@ double tf_stribeck(const double *p, double v, double *dg)
 
 /* LuGre (Canudas de Wit et al. 1995):
  *   z' = v - sigma0 |v| z / g(v),  F = sigma0 z + sigma1(v) z' + sigma2 v  (sigma1(v): tf_sigma1). */
-/* Partial derivatives of g(v) with respect to fc, fs, vs, delta. */
-static void stribeck_param_partials(const double *p, double v, double *dg)
+void tf_stribeck_param_partials(const double *p, double v, double *dg)
 {
     double fc = p[TF_P_FC], fs = p[TF_P_FS], vs = p[TF_P_VS], delta = p[TF_P_DELTA];
     memset(dg, 0, sizeof(double) * TF_NPARAM);
@@ -81,7 +80,7 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
     }
     if (dp) {
         double dg[TF_NPARAM];
-        stribeck_param_partials(p, v, dg);
+        tf_stribeck_param_partials(p, v, dg);
         double dzd_dg = s0 * fabs(v) * z[0] / (g * g); /* z' = v - sigma0 |v| z / g */
         for (int i = 0; i < TF_NPARAM; i++) dp->ddz_dp[0][i] = dzd_dg * dg[i];
         dp->ddz_dp[0][TF_P_SIGMA0] = -fabs(v) * z[0] / g;
@@ -96,18 +95,31 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
 
 /* Static maps: F = G(v) s(v) + sigma2 v with the sign smoothed over v_smooth, s = tanh(v / v_smooth),
  * G = fc (Coulomb) or g(v) (Stribeck). */
-static double static_map(int stribeck, const double *p, double v, tf_friction_partials *jac)
+static double static_map(int stribeck, const double *p, double v, tf_friction_partials *jac,
+                         tf_friction_param_partials *dp)
 {
     double vsm = p[TF_P_VSMOOTH], s2 = p[TF_P_SIGMA2];
     double dG = 0.0;
     double G = stribeck ? tf_stribeck(p, v, jac ? &dG : 0) : p[TF_P_FC];
     double s = tanh(v / vsm);
     if (jac) jac->dF_dv = G * (1.0 - s * s) / vsm + dG * s + s2;
+    if (dp) {
+        if (stribeck) {
+            double dg[TF_NPARAM];
+            tf_stribeck_param_partials(p, v, dg);
+            for (int i = 0; i < TF_NPARAM; i++) dp->dF_dp[i] = dg[i] * s;
+        } else {
+            dp->dF_dp[TF_P_FC] = s;
+        }
+        dp->dF_dp[TF_P_SIGMA2] = v;
+        dp->dF_dp[TF_P_VSMOOTH] = -G * (1.0 - s * s) * v / (vsm * vsm);
+    }
     return G * s + s2 * v;
 }
 
 /* Dahl (1968): z' = v - sigma0 |v| z / fc, F = sigma0 z. */
-static double dahl(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac)
+static double dahl(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac,
+                   tf_friction_param_partials *dp)
 {
     double s0 = p[TF_P_SIGMA0], fc = p[TF_P_FC];
     dz[0] = v - s0 * fabs(v) * z[0] / fc;
@@ -117,19 +129,25 @@ static double dahl(const double *p, double v, const double *z, double *dz, tf_fr
         jac->dF_dz[0] = s0;
         jac->dF_dv = 0.0;
     }
+    if (dp) {
+        dp->ddz_dp[0][TF_P_SIGMA0] = -fabs(v) * z[0] / fc;
+        dp->ddz_dp[0][TF_P_FC] = s0 * fabs(v) * z[0] / (fc * fc);
+        dp->dF_dp[TF_P_SIGMA0] = z[0];
+    }
     return s0 * z[0];
 }
 
 /* Elasto-plastic (Dupont et al. 2002): z' = v - alpha(z, v) sigma0 |v| z / g(v). alpha is zero
  * below the break-away deflection z_ba and when z opposes v (purely elastic: no drift under
  * small forces), one from the steady deflection z_ss = g(v)/sigma0 on, and a half sine between. */
-static double elastoplastic(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac)
+static double elastoplastic(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac,
+                            tf_friction_param_partials *dp)
 {
     double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2], zba = p[TF_P_ZBA];
     double dg = 0.0;
     double g = tf_stribeck(p, v, jac ? &dg : 0);
     double zss = g / s0, az = fabs(z[0]);
-    double alpha = 0.0, da_dz = 0.0, da_dzss = 0.0;
+    double alpha = 0.0, da_dz = 0.0, da_dzss = 0.0, da_dzba = 0.0;
     if (z[0] * v > 0.0 && az > zba) {
         if (az >= zss) {
             alpha = 1.0;
@@ -137,16 +155,18 @@ static double elastoplastic(const double *p, double v, const double *z, double *
             double width = zss - zba;
             double u = (az - 0.5 * (zss + zba)) / width;
             double du_dz = sgn(z[0]) / width, du_dzss = (zba - az) / (width * width);
+            double du_dzba = (az - zss) / (width * width);
             alpha = 0.5 * sin(M_PI * u) + 0.5;
             double da_du = 0.5 * M_PI * cos(M_PI * u);
             da_dz = da_du * du_dz;
             da_dzss = da_du * du_dzss;
+            da_dzba = da_du * du_dzba;
         }
     }
     double r = s0 * fabs(v) / g;
     double zd = v - alpha * r * z[0];
-    double ds1;
-    double s1 = tf_sigma1(p, v, &ds1, 0, 0);
+    double ds1, ds1_dsigma1 = 0.0, ds1_dvd = 0.0;
+    double s1 = tf_sigma1(p, v, &ds1, dp ? &ds1_dsigma1 : 0, dp ? &ds1_dvd : 0);
     dz[0] = zd;
     if (jac) {
         double dr = s0 * (sgn(v) * g - fabs(v) * dg) / (g * g);
@@ -156,24 +176,47 @@ static double elastoplastic(const double *p, double v, const double *z, double *
         jac->dF_dz[0] = s0 + s1 * jac->ddz_dz[0];
         jac->dF_dv = ds1 * zd + s1 * jac->ddz_dv[0] + s2;
     }
+    if (dp) {
+        /* g enters through r = sigma0 |v| / g and z_ss = g / sigma0; sigma0 through both as well */
+        double dg_p[TF_NPARAM];
+        tf_stribeck_param_partials(p, v, dg_p);
+        double dzd_dg = -z[0] * (da_dzss * r / s0 - alpha * r / g);
+        for (int i = 0; i < TF_NPARAM; i++) dp->ddz_dp[0][i] = dzd_dg * dg_p[i];
+        dp->ddz_dp[0][TF_P_SIGMA0] = -z[0] * (-da_dzss * zss / s0 * r + alpha * r / s0);
+        dp->ddz_dp[0][TF_P_ZBA] = -z[0] * r * da_dzba;
+        for (int i = 0; i < TF_NPARAM; i++) dp->dF_dp[i] = s1 * dp->ddz_dp[0][i];
+        dp->dF_dp[TF_P_SIGMA0] += z[0];
+        dp->dF_dp[TF_P_SIGMA1] = ds1_dsigma1 * zd;
+        dp->dF_dp[TF_P_SIGMA2] = v;
+        dp->dF_dp[TF_P_VD] = ds1_dvd * zd;
+    }
     return s0 * z[0] + s1 * zd + s2 * v;
 }
 
 /* Generalized Maxwell-slip (Al-Bender, Lampaert and Swevers 2005): F = sum F_i + sigma2 v. */
 static double gms(const double *p, const tf_gms_elements *el, double v, const double *z, double *dz,
-                  tf_friction_partials *jac)
+                  tf_friction_partials *jac, tf_friction_param_partials *dp)
 {
     double C = p[TF_P_C], dg = 0.0;
     double g = tf_stribeck(p, v, jac ? &dg : 0);
     double F = p[TF_P_SIGMA2] * v;
+    double dg_p[TF_NPARAM];
+    if (dp) {
+        tf_stribeck_param_partials(p, v, dg_p);
+        dp->dF_dp[TF_P_SIGMA2] = v;
+    }
     for (int i = 0; i < el->n; i++) {
         F += z[i];
         if (el->mode[i] == 0) {
-            dz[i] = el->k[i] * v;
+            dz[i] = el->k[i] * v; /* stuck: no parameter of the list enters (k_i are arrays) */
             if (jac) { jac->ddz_dz[i] = 0.0; jac->ddz_dv[i] = el->k[i]; }
         } else {
             dz[i] = C * (el->mode[i] * el->w[i] - z[i] / g);
             if (jac) { jac->ddz_dz[i] = -C / g; jac->ddz_dv[i] = C * z[i] * dg / (g * g); }
+            if (dp) {
+                for (int j = 0; j < TF_NPARAM; j++) dp->ddz_dp[i][j] = C * z[i] / (g * g) * dg_p[j];
+                dp->ddz_dp[i][TF_P_C] = el->mode[i] * el->w[i] - z[i] / g;
+            }
         }
         if (jac) jac->dF_dz[i] = 1.0;
     }
@@ -185,13 +228,17 @@ double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, do
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
 {
     if (kind == TF_FRICTION_LUGRE) return lugre(p, v, z, dz, jac, dp);
-    if (dp) memset(dp, 0, sizeof *dp);
+    if (dp) { /* each model writes the entries its equations have; the rest stay zero */
+        int nz = kind == TF_FRICTION_GMS && el ? el->n : 1;
+        memset(dp->dF_dp, 0, sizeof dp->dF_dp);
+        memset(dp->ddz_dp, 0, sizeof(dp->ddz_dp[0]) * (size_t)(nz > 0 ? nz : 1));
+    }
     switch (kind) {
-    case TF_FRICTION_COULOMB: return static_map(0, p, v, jac);
-    case TF_FRICTION_STRIBECK: return static_map(1, p, v, jac);
-    case TF_FRICTION_DAHL: return dahl(p, v, z, dz, jac);
-    case TF_FRICTION_ELASTOPLASTIC: return elastoplastic(p, v, z, dz, jac);
-    case TF_FRICTION_GMS: return gms(p, el, v, z, dz, jac);
+    case TF_FRICTION_COULOMB: return static_map(0, p, v, jac, dp);
+    case TF_FRICTION_STRIBECK: return static_map(1, p, v, jac, dp);
+    case TF_FRICTION_DAHL: return dahl(p, v, z, dz, jac, dp);
+    case TF_FRICTION_ELASTOPLASTIC: return elastoplastic(p, v, z, dz, jac, dp);
+    case TF_FRICTION_GMS: return gms(p, el, v, z, dz, jac, dp);
     default: return NAN;
     }
 }

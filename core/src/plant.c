@@ -420,10 +420,73 @@ void tf_model_on_restart(double t, const double *y, void *ctx)
     tf_friction_update_modes(m->friction, p, &m->gms, v, y + nmech(m));
 }
 
+/* dv/dy . w: the relative velocity is linear in the state (zero under prescribed motion). */
+static double velocity_along(const tf_model *m, const double *w)
+{
+    switch (m->plant) {
+    case TF_PLANT_STICK_SLIP: return w[VE] - w[VP];
+    case TF_PLANT_MASS: return w[V];
+    default: return 0.0;
+    }
+}
+
+void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_target *targets, int np)
+{
+    if (m->friction != TF_FRICTION_GMS) return;
+    int n = tf_model_nstate(m), nm = nmech(m), ne = m->gms.n;
+    int old[TF_MAX_FRICTION_STATES];
+    double fm[TF_MAX_STATES], fpl[TF_MAX_STATES];
+    memcpy(old, m->gms.mode, sizeof(int) * (size_t)ne);
+    tf_model_rhs(t, Y, fm, m);
+    tf_model_on_restart(t, Y, m);
+    int changed = 0;
+    for (int i = 0; i < ne; i++) changed |= old[i] != m->gms.mode[i];
+    if (!changed || !np) return;
+    tf_model_rhs(t, Y, fpl, m);
+    double lambda, dF;
+    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, Y), &lambda, &dF);
+    double v = relative_velocity(m, t, Y), dg_dv, dg_p[TF_NPARAM];
+    tf_stribeck(p, v, &dg_dv);
+    tf_stribeck_param_partials(p, v, dg_p);
+    if (m->fs_follows_fc) dg_p[TF_P_FC] += dg_p[TF_P_FS];
+    /* dv/dt along the trajectory before the switch; under prescribed motion v(t) is the input's
+       slope, whose change is left out (it moves an event only through the Stribeck curve's slope) */
+    double vdot = velocity_along(m, fm);
+    double *S = Y + n;
+    for (int i = 0; i < ne; i++) {
+        int a = old[i], b = m->gms.mode[i], row = nm + i;
+        if (a == b) continue;
+        double jump = fm[row] - fpl[row], w = m->gms.w[i];
+        /* the event function that fired: a stuck element reaching its capacity, b z_i - w_i g(v);
+           a slipping one whose motion reversed, -a v */
+        double rate = a == 0 ? b * fm[row] - w * dg_dv * vdot : -a * vdot;
+        if (!(fabs(rate) > 0.0) || jump == 0.0) continue;
+        for (int k = 0; k < np; k++) {
+            const tf_target *tg = &targets[k];
+            double col[TF_MAX_STATES], num; /* column k of S (row-major n x np) */
+            for (int r = 0; r < n; r++) col[r] = S[r * np + k];
+            double dv = velocity_along(m, col);
+            if (a == 0) {
+                double dcap = 0.0; /* d(capacity g)/dtheta, directly */
+                if (tg->kind == TF_TARGET_PARAM) dcap = dg_p[tg->param];
+                else if (tg->kind == TF_TARGET_LAW) dcap = tf_law_coef_derivative(&m->law[tg->param], tg->coef,
+                                                                                  tf_model_temperature(m, t, Y)) *
+                                                           dg_p[tg->param];
+                num = b * col[row] - w * (dcap + dg_dv * dv);
+            } else {
+                num = -a * dv;
+            }
+            S[row * np + k] -= jump * num / rate;
+        }
+    }
+}
+
+static void model_restart(double t, double *y, void *ctx) { tf_model_on_restart(t, y, ctx); }
+
 tf_ode tf_model_ode(tf_model *model)
 {
     tf_ode ode = {tf_model_nstate(model), model, tf_model_rhs, tf_model_jac, tf_model_next_corner,
-                  tf_model_nevent(model), tf_model_events, tf_model_on_restart};
+                  tf_model_nevent(model), tf_model_events, model_restart};
     if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
     return ode;
 }

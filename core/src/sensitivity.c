@@ -27,9 +27,23 @@ double tf_sensitivity_next_corner(double t, void *ctx)
     return tf_model_next_corner(t, ((tf_sensitivity_system *)ctx)->model);
 }
 
+/* Discrete modes (GMS): the model's events on the state part, and at each restart its modes set
+ * and the sensitivities' jump applied where a mode switched (tf_model_sensitivity_restart). */
+static void sensitivity_events(double t, const double *Y, double *g, void *ctx)
+{
+    tf_model_events(t, Y, g, ((tf_sensitivity_system *)ctx)->model);
+}
+
+static void sensitivity_restart(double t, double *Y, void *ctx)
+{
+    tf_sensitivity_system *s = (tf_sensitivity_system *)ctx;
+    tf_model_sensitivity_restart(s->model, t, Y, s->targets, s->np);
+}
+
 tf_ode tf_sensitivity_ode(tf_sensitivity_system *s)
 {
     tf_ode ode = {.n = tf_model_nstate(s->model) * (1 + s->np), .ctx = s, .rhs = tf_sensitivity_rhs,
-                  .next_corner = tf_sensitivity_next_corner};
+                  .next_corner = tf_sensitivity_next_corner, .nevent = tf_model_nevent(s->model)};
+    if (ode.nevent) ode.events = sensitivity_events, ode.on_restart = sensitivity_restart;
     return ode;
 }

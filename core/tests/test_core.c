@@ -772,6 +772,73 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
 }
 #undef B
 
+/* Parameter partials of every friction model (tf_friction_eval's dp) against central differences
+ * of tf_friction_eval itself, at states and velocities that visit each branch: both signs of v,
+ * the elasto-plastic transition band (alpha between 0 and 1) and full sliding, GMS elements stuck
+ * and slipping either way, velocities inside and beyond the Stribeck band. */
+static void test_friction_parameter_partials_vs_finite_differences(void)
+{
+    const int kinds[6] = {TF_FRICTION_LUGRE, TF_FRICTION_COULOMB, TF_FRICTION_STRIBECK, TF_FRICTION_DAHL,
+                          TF_FRICTION_ELASTOPLASTIC, TF_FRICTION_GMS};
+    const char *names[6] = {"lugre", "coulomb", "stribeck", "dahl", "elastoplastic", "gms"};
+    /* which parameters each model reads (the ones whose partials must be nonzero somewhere) */
+    const int reads[6][TF_NPARAM] = {
+        [0] = {[TF_P_SIGMA0] = 1, [TF_P_SIGMA1] = 1, [TF_P_SIGMA2] = 1, [TF_P_FC] = 1, [TF_P_FS] = 1, [TF_P_VS] = 1,
+               [TF_P_DELTA] = 1, [TF_P_VD] = 1},
+        [1] = {[TF_P_FC] = 1, [TF_P_SIGMA2] = 1, [TF_P_VSMOOTH] = 1},
+        [2] = {[TF_P_FC] = 1, [TF_P_FS] = 1, [TF_P_VS] = 1, [TF_P_DELTA] = 1, [TF_P_SIGMA2] = 1, [TF_P_VSMOOTH] = 1},
+        [3] = {[TF_P_SIGMA0] = 1, [TF_P_FC] = 1},
+        [4] = {[TF_P_SIGMA0] = 1, [TF_P_SIGMA1] = 1, [TF_P_SIGMA2] = 1, [TF_P_FC] = 1, [TF_P_FS] = 1, [TF_P_VS] = 1,
+               [TF_P_DELTA] = 1, [TF_P_VD] = 1, [TF_P_ZBA] = 1},
+        [5] = {[TF_P_C] = 1, [TF_P_FC] = 1, [TF_P_FS] = 1, [TF_P_VS] = 1, [TF_P_DELTA] = 1, [TF_P_SIGMA2] = 1}};
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5; p[TF_P_SIGMA1] = 300.0; p[TF_P_SIGMA2] = 0.4; p[TF_P_FC] = 1.0; p[TF_P_FS] = 1.5;
+    p[TF_P_VS] = 1e-3; p[TF_P_DELTA] = 1.7; p[TF_P_VD] = 2e-3; p[TF_P_VSMOOTH] = 2e-4; p[TF_P_ZBA] = 4e-6;
+    p[TF_P_C] = 50.0;
+    tf_gms_elements el = {3, {1e4, 3e4, 6e4}, {0.3, 0.3, 0.4}, {0, 1, -1}};
+    /* (v, z): z in the elasto-plastic band [z_ba, g/sigma0] = [4, ~10..15] um, beyond it, opposing v */
+    const double vz[][2] = {{7e-4, 8e-6}, {-1.3e-3, -9e-6}, {2.5e-3, 1.2e-5}, {5e-3, 2e-5}, {4e-4, -3e-6},
+                            {-3e-4, -5e-6}, {1e-4, 2e-6}};
+    const int nvz = (int)(sizeof vz / sizeof vz[0]);
+    for (int m = 0; m < 6; m++) {
+        int seen[TF_NPARAM] = {0};
+        double worst = 0.0;
+        for (int c = 0; c < nvz; c++) {
+            double v = vz[c][0], z[3] = {vz[c][1], 0.25 * v / fabs(v), -0.3}, dz[3], dz1[3], dz2[3];
+            if (kinds[m] == TF_FRICTION_GMS) z[0] = 0.1, z[1] = 0.2 * (v > 0 ? 1 : -1) , z[2] = -0.35;
+            tf_friction_param_partials dp;
+            tf_friction_eval(kinds[m], p, &el, v, z, dz, 0, &dp);
+            int nz = tf_friction_nstate(kinds[m], el.n);
+            for (int i = 0; i < TF_NPARAM; i++) {
+                double q[TF_NPARAM];
+                memcpy(q, p, sizeof q);
+                double h = 1e-6 * fabs(p[i]);
+                q[i] = p[i] + h; double F1 = tf_friction_eval(kinds[m], q, &el, v, z, dz1, 0, 0);
+                q[i] = p[i] - h; double F2 = tf_friction_eval(kinds[m], q, &el, v, z, dz2, 0, 0);
+                double fd = (F1 - F2) / (2 * h), an = dp.dF_dp[i];
+                double err = fabs(fd - an) / (1e-3 * fabs(p[TF_P_FC] / p[i]) + fabs(fd));
+                if (an != 0.0) seen[i] = 1;
+                if (!reads[m][i] && an != 0.0) err = 1.0;
+                worst = fmax(worst, err);
+                if (err > 1e-5) printf("  %s dF/dp[%d] at v=%g: fd %g analytic %g\n", names[m], i, v, fd, an);
+                for (int j = 0; j < nz; j++) {
+                    double fdz = (dz1[j] - dz2[j]) / (2 * h), anz = dp.ddz_dp[j][i];
+                    double scale = kinds[m] == TF_FRICTION_GMS ? p[TF_P_C] : fabs(v); /* of z' */
+                    double e = fabs(fdz - anz) / (1e-3 * scale / p[i] + fabs(fdz));
+                    if (anz != 0.0) seen[i] = 1;
+                    if (!reads[m][i] && anz != 0.0) e = 1.0;
+                    worst = fmax(worst, e);
+                    if (e > 1e-5) printf("  %s dz%d'/dp[%d] at v=%g: fd %g analytic %g\n", names[m], j, i, v, fdz, anz);
+                }
+            }
+        }
+        int missing = 0;
+        for (int i = 0; i < TF_NPARAM; i++) missing += reads[m][i] && !seen[i];
+        CHECK(worst < 1e-5 && !missing, "%s parameter partials: worst relative error %g, %d read parameters never "
+              "moved", names[m], worst, missing);
+    }
+}
+
 int main(void)
 {
     test_rt_init_and_setters_refuse_bad_arguments();
@@ -783,6 +850,7 @@ int main(void)
     test_rt_observer_converges();
     test_lu_solves_systems_that_need_pivoting_in_later_columns();
     test_parameter_derivatives_vs_finite_differences();
+    test_friction_parameter_partials_vs_finite_differences();
     test_grid_end_one_ulp_past_a_corner();
     test_oscillator_dense_output(TF_METHOD_DOPRI5);
     test_oscillator_dense_output(TF_METHOD_RODAS4);

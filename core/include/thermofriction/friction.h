@@ -76,6 +76,8 @@ int tf_friction_nstate(int kind, int n_elements);
 double tf_friction_reference_force(int kind, const double *p);
 /* Stribeck curve g(v) = fc + (fs - fc) exp(-|v/vs|^delta), and dg/dv in *dg when not NULL. */
 double tf_stribeck(const double *p, double v, double *dg);
+/* Partial derivatives of g(v) with respect to the parameters (fc, fs, vs, delta; zeros elsewhere). */
+void tf_stribeck_param_partials(const double *p, double v, double *dg);
 /* LuGre's velocity-dependent damping (the bristle models: LuGre, elasto-plastic, the observer):
  * sigma1(v) = sigma1 exp(-(v/vd)^2) when vd > 0, else sigma1. Its derivatives with respect to v, to
  * the parameter sigma1 and to vd go where the pointers are not NULL. Inline: it is on every step. */
@@ -96,7 +98,9 @@ static inline double tf_sigma1(const double *p, double v, double *d_dv, double *
     return s1;
 }
 /* Force and state rates; state partials when jac is not NULL, parameter partials when dp
- * is not NULL (LuGre only: others report zeros). gms is read for TF_FRICTION_GMS only. */
+ * is not NULL (every model, every parameter of the list it reads; dp->ddz_dp is written for
+ * the model's states only). gms is read for TF_FRICTION_GMS only. GMS: the partials hold within
+ * the current modes; where a mode switches, the sensitivities jump (tf_model_sensitivity_jump). */
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
 

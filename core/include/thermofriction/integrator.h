@@ -17,10 +17,11 @@ typedef struct {
     /* Discrete modes (may be 0/NULL): nevent event functions g(t, y) that cross zero upwards
      * where a mode must change. After every accepted step the driver locates the earliest
      * crossing on the dense output, ends the step there and restarts; on_restart(t, y) is
-     * called at every restart (start, corners, events) to set the modes for what follows. */
+     * called at every restart (start, corners, events) to set the modes for what follows; it
+     * may change y there (a sensitivity system's jump where a mode switches). */
     int nevent;
     void (*events)(double t, const double *y, double *g, void *ctx);
-    void (*on_restart)(double t, const double *y, void *ctx);
+    void (*on_restart)(double t, double *y, void *ctx);
 } tf_ode;
 
 typedef enum {

@@ -168,6 +168,11 @@ double tf_model_next_corner(double t, void *model);
 int tf_model_nevent(const tf_model *model);
 void tf_model_events(double t, const double *y, double *g, void *model);
 void tf_model_on_restart(double t, const double *y, void *model);
+/* The same for a sensitivity run, Y = [y, S (n x np, row-major)]: sets the modes and, for each
+ * GMS element whose mode changed at an event of the state, applies the sensitivities' jump
+ * S+ = S- + (f- - f+) dtau/dtheta, dtau/dtheta = -(dg/dy S + dg/dtheta) / (dg/dt), g the
+ * element's event function (docs/identification.md#friction-models). */
+void tf_model_sensitivity_restart(tf_model *model, double t, double *Y, const tf_target *targets, int np);
 /* The model as an ODE system for tf_solve (right-hand side, Jacobian, corners, events). */
 tf_ode tf_model_ode(tf_model *model);
 /* Writes the output channels at (t, y). */

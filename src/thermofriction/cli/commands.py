@@ -103,7 +103,8 @@ def cmd_identify(args) -> int:
         raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
     update, status = _progress(args.quiet)
     try:
-        fit = identify(data, args.method, init=args.init, parameters=params, free=args.free or (),
+        fit = identify(data, args.method, init=args.init, friction=args.friction, parameters=params,
+                       free=args.free or (),
                        procedure=args.procedure,
                        laws=laws or None, refine=not args.no_refine,
                        reference_temperature=args.reference_temperature, rtol=args.rtol, starts=args.starts,

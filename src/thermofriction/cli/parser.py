@@ -122,11 +122,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
                         "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
                         "[heat] section's C_th, R_th, eta from recorded temperature[C] columns)")
-    i.add_argument("--friction", choices=("lugre",), default="lugre", help="base friction model (default: lugre)")
+    i.add_argument("--friction", choices=("lugre", "dahl", "elastoplastic", "gms", "stribeck", "coulomb"),
+                   help="friction model to identify (default: the initial model's); built from the initial model's "
+                        "values where they share a parameter (docs/identification.md#friction-models)")
     i.add_argument("--init", metavar="MODEL.toml",
                    help="initial model: file or preset (default: the paper's preset for the method)")
     i.add_argument("--parameters", metavar="NAMES",
-                   help="comma-separated parameters to fit with --method base (default: sigma0,sigma1,fc)")
+                   help="comma-separated parameters to fit with --method base (default: the friction model's, "
+                        "LuGre's sigma0,sigma1,fc)")
     i.add_argument("--free", metavar="NAMES",
                    help="plant parameters to fit too, one value shared by all experiments, comma-separated: m_e, m "
                         "(the masses), xi, wn, K (c, k, T_em for a plant in physical form); e.g. --free m_e,m")

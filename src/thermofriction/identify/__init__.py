@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import numbers
 
 from ..errors import InputError, shorten
@@ -14,7 +15,7 @@ from .engine import fit, make_traces, uncertainty
 from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
 from .laws import fit_law, segmented_fit
 from .model_ii import identify_model_ii
-from .procedures import DEFAULT_FRICTION_PARAMETERS, base_model, fit_friction, identify_heat, identify_model_i
+from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat, identify_model_i
 from .plant import PlantFit, fit_plant, step_response
 from .result import FitResult
 from .start import lugre_start
@@ -48,7 +49,42 @@ def _check_arguments(method, reference_temperature, rtol, starts, seed):
                              f"got {shorten(reference_temperature)}")
 
 
-def identify(data, method="model-i", init=None, *, parameters=None, free=(), procedure="direct", laws=None,
+def with_friction_model(model: Model, kind: str) -> Model:
+    """``model`` with a ``kind`` friction model (docs/identification.md#friction-models), built from
+    its own friction's values where the two share a parameter (a Model I law goes with its
+    parameter; laws of parameters the new model lacks are dropped). What the new model requires
+    and the old one lacks is derived from the level fc and the presliding stiffness sigma0 (a GMS
+    model's sum of k_i; else fc over 1 um): sigma1 = 1e-6 s x sigma0, z_ba = fc / (2 sigma0),
+    C = 1e4 /s x fc, and GMS elements k_i proportional to 1/i summing to sigma0, w_i = 1/4 (four
+    elements breaking loose one after the other)."""
+    from ..models import FRICTION_MODELS, ModelI
+
+    if kind not in FRICTION_MODELS:
+        raise InputError(f"unknown friction model '{kind}' (one of: {', '.join(FRICTION_MODELS)})")
+    if model.friction.model == kind:
+        return model
+    cls = FRICTION_MODELS[kind]
+    names = {f.name for f in dataclasses.fields(cls)} - set(cls.arrays)
+    laws = {k: v for k, v in model.laws.items() if k in names}
+    kw = {k: v for k, v in model.friction.values().items() if k in names}
+    kw.update({k: None for k in laws})
+    at = base_model(model).friction.values()  # numbers (laws at mid-range), to derive the rest from
+    fc = at["fc"]
+    sigma0 = at.get("sigma0") or (sum(at["k"]) if "k" in at else fc / 1e-6)
+    derived = {"sigma0": sigma0, "sigma1": 1e-6 * sigma0, "z_ba": 0.5 * fc / sigma0, "C": 1e4 * fc}
+    if kind == "gms":
+        h = sum(1.0 / i for i in range(1, 5))
+        derived.update(k=tuple(sigma0 / (i * h) for i in range(1, 5)), w=(0.25,) * 4)
+    for name in cls.required:
+        if name not in kw:
+            kw[name] = derived[name]
+    thermal = model.thermal
+    if isinstance(thermal, ModelI):
+        thermal = ModelI(laws) if laws else None
+    return dataclasses.replace(model, friction=cls(**kw), thermal=thermal)
+
+
+def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
              refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
@@ -57,7 +93,11 @@ def identify(data, method="model-i", init=None, *, parameters=None, free=(), pro
     init: the initial model (its plant, masses and input are kept); a model, a file or a preset
         name. Default: the paper's preset for the method. A file with a [plant] and no [friction]
         section starts LuGre from values taken from the data (identify/start.py).
-    parameters: names (or a Parameters object) to fit for "base"; default sigma0, sigma1, fc.
+    friction: the friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb);
+        default the initial model's. When it differs, the initial friction model is built from the
+        initial model's values (:func:`with_friction_model`).
+    parameters: names (or a Parameters object) to fit for "base"; default the friction model's
+        (procedures.FRICTION_FIT_PARAMETERS; LuGre: sigma0, sigma1, fc).
     procedure: Model II's "direct" (default), "paper" or "both".
     free: plant parameters fitted too, in any method but "plant", one value shared by all experiments:
         "m_e", "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a
@@ -78,9 +118,8 @@ def identify(data, method="model-i", init=None, *, parameters=None, free=(), pro
     if not isinstance(init.plant, StickSlipPlant):
         raise InputError(f"identification works on the stick-slip actuator (datasets record its voltage and "
                          f"displacement); a '{init.plant.type}' plant can be simulated but not identified yet")
-    if method != "plant" and init.friction.model != "lugre":
-        raise InputError(f"identification of '{init.friction.model}' friction is not available yet (LuGre only); "
-                         f"every friction model can be simulated")
+    if friction is not None and method != "plant":
+        init = with_friction_model(init, friction)
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
@@ -95,7 +134,7 @@ def identify(data, method="model-i", init=None, *, parameters=None, free=(), pro
             if isinstance(parameters, Parameters):
                 raise InputError("free= adds plant parameters to the default ones; with a Parameters object, add "
                                  "them to it instead")
-            parameters = list(parameters or DEFAULT_FRICTION_PARAMETERS) + free
+            parameters = list(parameters or default_fit_parameters(model)) + free
         return fit_friction(experiments, model, parameters, method="base", progress=progress, **opts)
     if method == "model-i":
         if init.thermal is not None and not hasattr(init.thermal, "laws"):
@@ -121,7 +160,6 @@ def _plant_parameters(init, free, method) -> list:
 
 
 def _identify_plant(experiments, init):
-    import dataclasses
     import math
 
     import numpy as np
@@ -146,5 +184,6 @@ def _identify_plant(experiments, init):
                      details={"note": "the equivalent masses m and m_e are kept from the initial model"})
 
 
-__all__ = ["fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter", "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit",
-           "identify_model_i", "identify_model_ii", "identify_heat", "base_model", "make_traces", "uncertainty", "METHODS", "MAX_STARTS"]
+__all__ = ["with_friction_model", "fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter",
+           "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit", "identify_model_i", "identify_model_ii",
+           "identify_heat", "base_model", "make_traces", "uncertainty", "METHODS", "MAX_STARTS"]

@@ -17,7 +17,36 @@ from .parameters import Parameters, get_value, unit_of, with_values
 from .quality import advice, fit_quality, pooled
 from .result import FitResult
 
-DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")
+DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")  # LuGre's (the paper's)
+#: The parameters fitted by default for each friction model (docs/identification.md#friction-models):
+#: what sets the level and the presliding stiffness, which displacement data determine; the shape
+#: parameters (delta, vd, v_smooth, GMS's element stiffnesses k and capacities w) are kept. A
+#: parameter the initial model leaves unset or at zero (vs, sigma2) is kept too: fitted in log
+#: space it needs a positive start, and zero means "not in the model". fs and z_ba are bound to
+#: other parameters (fs >= fc, z_ba < fc/sigma0), which a step of the fit may break, and the engine
+#: does not yet treat such a step as unphysical (it stops): they are kept unless named.
+FRICTION_FIT_PARAMETERS = {
+    "lugre": DEFAULT_FRICTION_PARAMETERS,
+    "elastoplastic": ("sigma0", "sigma1", "fc"),
+    "dahl": ("sigma0", "fc"),
+    "coulomb": ("fc", "sigma2"),
+    "stribeck": ("fc", "vs", "sigma2"),
+    "gms": ("C", "fc"),
+}
+
+
+def default_fit_parameters(model: Model) -> list:
+    """The default fitted parameters of ``model``'s friction model (FRICTION_FIT_PARAMETERS), less
+    those it leaves unset or at zero; under Model I, those with a law (if any has one)."""
+    names = FRICTION_FIT_PARAMETERS.get(model.friction.model, DEFAULT_FRICTION_PARAMETERS)
+    laws = model.laws if isinstance(model.thermal, ModelI) else {}
+    values = model.friction.values()
+    if model.friction.model in ("stribeck", "gms", "lugre", "elastoplastic") and \
+            values.get("fs") in (None, values.get("fc")) and "fs" not in laws:
+        values = {k: v for k, v in values.items() if k not in ("fs", "vs")}  # no Stribeck effect to fit
+    names = [n for n in names if n in laws or (values.get(n) or 0.0) > 0.0]
+    with_law = [n for n in names if n in laws]
+    return with_law or names
 
 
 def _result(method, model, params, outcome, traces, t0, extra_warnings=(), details=None):
@@ -83,7 +112,7 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", *
     if isinstance(parameters, Parameters):
         params = parameters
     else:
-        params = _friction_parameters(model, parameters or DEFAULT_FRICTION_PARAMETERS)
+        params = _friction_parameters(model, parameters or default_fit_parameters(model))
     outcome = fit(model, params, traces, **opts)
     return _result(method, model, params, outcome, traces, t0)
 
@@ -156,9 +185,7 @@ def _groups(experiments):
 
 
 def _fit_parameter_names(model):
-    if isinstance(model.thermal, ModelI) and model.laws:
-        return [n for n in DEFAULT_FRICTION_PARAMETERS if n in model.laws] or list(DEFAULT_FRICTION_PARAMETERS)
-    return list(DEFAULT_FRICTION_PARAMETERS)
+    return default_fit_parameters(model)
 
 
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), **opts) -> FitResult:

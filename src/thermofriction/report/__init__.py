@@ -53,15 +53,39 @@ def data_hash(experiments) -> str:
 
 
 
+def akaike(entries):
+    """AICc difference to the best and Akaike weight of each entry's fit, or None: only between fits
+    of the same data (the same experiments and points), where AICc is comparable; the weights sum to
+    one over such a group."""
+    groups = {}
+    for i, e in enumerate(entries):
+        f = e.fit or {}
+        a = f.get("aicc")
+        if a is None or not math.isfinite(float(a)):
+            continue
+        key = (f.get("n_points"), tuple(sorted(str(x.get("file")) for x in f.get("experiments") or [])))
+        groups.setdefault(key, []).append((i, float(a)))
+    out = [None] * len(entries)
+    for members in groups.values():
+        best = min(a for _, a in members)
+        w = {i: math.exp(-0.5 * (a - best)) for i, a in members}
+        total = sum(w.values())
+        for i, a in members:
+            out[i] = (a - best, w[i] / total)
+    return out, len(groups)
+
+
 def comparison_rows(entries):
     rows = []
-    for e in entries:
+    aic, _ = akaike(entries)
+    for e, a in zip(entries, aic):
         s = e.validation.summary()
         v = s.get("validate", s.get("fit", {}))
         f = e.fit or {}
-        rows.append([e.label, _fmt(v.get("max_error_pct")), _fmt(v.get("mean_max_error_pct")),
+        rows.append([e.label, e.model.friction.model, _fmt(v.get("max_error_pct")), _fmt(v.get("mean_max_error_pct")),
                      _fmt(v.get("rmse_offset_removed", math.nan) * 1e9, "{:.4g}"), _fmt(s.get("fit", {}).get("max_error_pct")),
-                     _fmt(f.get("aicc"), "{:.1f}"), _fmt(f.get("wall_time"), "{:.2f} s")])
+                     _fmt(a[0] if a else None, "{:.1f}"), _fmt(a[1] if a else None, "{:.3f}"),
+                     _fmt(f.get("wall_time"), "{:.2f} s")])
     return rows
 
 
@@ -104,10 +128,15 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
     parts.append("<section><h2>Model comparison</h2>" + _table(
-        ["model", "max error, held out [%]", "mean max error, held out [%]", "RMSE, held out [nm] (offset removed)",
-         "max error, fit [%]", "AICc", "identification time"], comparison_rows(entries)) +
+        ["model", "friction", "max error, held out [%]", "mean max error, held out [%]",
+         "RMSE, held out [nm] (offset removed)", "max error, fit [%]", "ΔAICc", "Akaike weight",
+         "identification time"], comparison_rows(entries)) +
         "<p style='font-size:13px;color:#4a5266'>Max error is the paper's maximum prediction error, "
-        "max |x_sim − x_meas| / (max x_meas − min x_meas).</p></section>")
+        "max |x_sim − x_meas| / (max x_meas − min x_meas). ΔAICc is each fit's AICc minus the lowest, and "
+        "the Akaike weight exp(−ΔAICc/2) normalised to one: the weight of evidence for each model among "
+        "those fitted to the same data" + ("" if akaike(entries)[1] <= 1 else
+                                           " (fits of different data are compared within their own group)") +
+        "; held-out errors compare them on temperatures none was fitted to.</p></section>")
     parts.append("<section><h2>Displacement</h2>" + fig_displacement(figs, entries) + fig_steps(figs, entries) +
                  "</section>")
     mi = [e for e in entries if isinstance(e.model.thermal, ModelI)]
