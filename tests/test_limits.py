@@ -48,26 +48,7 @@ def _run(argv, cwd):
                           cwd=cwd, timeout=TIMEOUT, preexec_fn=_limit_memory)
 
 
-GOOD = """[plant]
-type = "stick-slip"
-xi = 0.2488
-wn = 6685.5
-K = 0.096e-6
-m = 0.05
-m_e = 0.02
-
-[friction]
-model = "lugre"
-sigma0 = 1.9e6
-sigma1 = 2.3
-fc = 0.9
-
-[input]
-waveform = "sawtooth"
-amplitude = 30.0
-frequency = 5.0
-rise = 0.999
-"""
+from test_bad_input import GOOD  # noqa: E402  (the same valid model file)
 NO_FC = GOOD.replace("fc = 0.9\n", "")
 NO_SIGMA0 = GOOD.replace("sigma0 = 1.9e6\n", "")
 

@@ -264,10 +264,10 @@ def read_two_column_csv(path: Path, first: str):
     name, _, unit = header[0].partition("[")
     unit = unit.rstrip("]") or "s"
     if name.strip() != first:
-        raise InputError(f"{path}: line {lines[0]}: the first column must be '{first}[s]', got '{header[0]}'")
+        raise InputError(f"{path}: line {lines[0]}: the first column must be '{first}[s]', got {shorten(header[0])}")
     scale = {"s": 1.0, "ms": 1e-3}.get(unit)
     if scale is None:
-        raise InputError(f"{path}: line {lines[0]}: unknown time unit '{unit}' (use s or ms)")
+        raise InputError(f"{path}: line {lines[0]}: unknown time unit {shorten(unit)} (use s or ms)")
     data = np.empty((len(rows) - 1, 2))
     for k, (i, row) in enumerate(zip(lines[1:], rows[1:]), start=2):
         if len(row) != 2:

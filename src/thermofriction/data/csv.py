@@ -31,16 +31,16 @@ def _parse_header(path, header):
         name = name.strip()
         if br:
             if not unit.endswith("]"):
-                raise InputError(f"{where}: '{cell}' must be name[unit], e.g. displacement[um]")
+                raise InputError(f"{where}: {shorten(cell)} must be name[unit], e.g. displacement[um]")
             unit = unit[:-1].strip()
         else:
             unit = _SI.get(name, "")
         if not name:
             raise InputError(f"{where}: empty column name (columns: {', '.join(_UNITS)})")
         if name not in _UNITS:
-            raise InputError(f"{where}: unknown column '{name}' (columns: {', '.join(_UNITS)})")
+            raise InputError(f"{where}: unknown column {shorten(name)} (columns: {', '.join(_UNITS)})")
         if unit not in _UNITS[name]:
-            raise InputError(f"{where} ('{cell}'): unknown unit '{unit}' for {name} "
+            raise InputError(f"{where} ({shorten(cell)}): unknown unit {shorten(unit)} for {name} "
                              f"(one of: {', '.join(u for u in _UNITS[name] if u != 'μm')})")
         for k, c in enumerate(cols):
             if c[0] == name:

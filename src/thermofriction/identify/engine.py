@@ -89,7 +89,10 @@ class Problem:
         self.njev = 0
 
     def _run(self, trace: Trace, theta, jac):
-        model = with_values(self.model, dict(zip(self.names, theta)))
+        try:
+            model = with_values(self.model, dict(zip(self.names, theta)))
+        except InputError:  # a step that breaks a rule between parameters (fs >= fc, z_ba < fc/sigma0)
+            return None, None
         if model.unphysical_over_range():  # never step where the fitted model would not load or run
             return None, None
         heated = model.heat is not None
