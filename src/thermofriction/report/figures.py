@@ -79,9 +79,16 @@ def fig_model_i(figs, entry):
         ci = np.array([r["parameters"][n]["ci95"] or [np.nan, np.nan] for r in per_T], dtype=object)
         lo = np.array([float(c[0]) if c[0] not in ("inf", "-inf", None) else np.nan for c in ci])
         hi = np.array([float(c[1]) if c[1] not in ("inf", "-inf", None) else np.nan for c in ci])
+        # an interval that spans decades (a parameter the data do not determine) would flatten the
+        # panel: it is drawn to the panel's edge instead (arrow) and named in the warnings
+        span = np.nanmax(np.abs(vals)) if np.any(np.isfinite(vals)) else 1.0
+        open_hi = ~np.isfinite(hi) | (hi > vals + 3 * span)
+        hi = np.where(open_hi, np.nan, hi)
         yerr = np.vstack([np.clip(vals - lo, 0, None), np.clip(hi - vals, 0, None)])
         yerr = np.where(np.isfinite(yerr), yerr, 0)
         ax.errorbar(T, vals, yerr=yerr, fmt="o", ms=4, capsize=2, color="k", label="per temperature (95 %)")
+        if open_hi.any():
+            ax.plot(T[open_hi], vals[open_hi], "^", ms=6, color="C1", label="interval open upwards")
         law = entry.model.laws.get(n)
         if law is not None:
             ax.plot(grid, law(grid), "-", color="C0", label=f"fitted law ({law.kind})")
@@ -92,7 +99,8 @@ def fig_model_i(figs, entry):
         ax.set_title(f"{n}: {laws[n].get('chosen', '')}", fontsize=9)
     axes[0][0].legend(fontsize=7, frameon=False)
     return figs.render(fig, "model-i-parameters", "Model I: each identified parameter against temperature with its "
-                       "95 % interval, the law fitted through them (refined on all experiments), and the paper's "
+                       "95 % interval (an orange triangle where it is open upwards: the data do not bound the parameter "
+                       "there), the law fitted through them (refined on all experiments), and the paper's "
                        "Eqs. (9)-(11) (Figs. 3-5).")
 
 
