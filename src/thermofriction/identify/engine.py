@@ -206,8 +206,10 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
     # along directions the data do not determine
     # (tight: down to the solver's own floor, for checks against noise-free data)
     tol = 1e-15 if tight else max(1e-10, 10 * problem.rtol)
+    # on residuals of unit noise, the scaled gradient is the residuals' projection on each parameter's
+    # direction: below 1e-4 a further step would move the parameters by ~1e-4 of their standard errors
     return optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
-                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-15 if tight else 1e-10,
+                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-15 if tight else 1e-4,
                                   max_nfev=max_nfev)
 
 

@@ -224,7 +224,14 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
                                                                 for n in held}),
                                    _friction_parameters(base, names + free, fixed=held), method=f"base at {T:.4g} C",
                                    **opts)
-        previous = res.model
+        # continuation carries only what this temperature determined: a parameter the data leave open
+        # (standard error above its value, e.g. sigma1 run to its bound) restarts from the initial model,
+        # or the next fit spends most of its evaluations walking back from a bound
+        open_ = [n for n in names if n in res.parameters and n not in held
+                 and not (res.parameters[n].stderr is not None and math.isfinite(res.parameters[n].stderr)
+                          and res.parameters[n].stderr < abs(res.parameters[n].value))]
+        previous = res.model.with_friction(**{n: base_model(init, T).friction.values()[n] for n in open_
+                                              if n in base_model(init, T).friction.values()}) if open_ else res.model
         per_T.append((T, res))
     details = {"per_temperature": [
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
