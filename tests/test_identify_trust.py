@@ -257,3 +257,13 @@ def test_a_model_file_with_only_a_plant_starts_from_the_data_and_recovers_the_tr
     for name, true in (("sigma0", sigma0), ("fc", fc)):
         p = fit.parameters[name]
         assert abs(p.value - true) < min(3 * p.stderr, 0.05 * true), (name, p)
+
+
+def test_fit_law_falls_back_to_a_constant_when_every_shape_leaves_the_domain():
+    """sigma1 estimated at zero (its bound) at all but the first temperature: the line goes negative
+    and no exponential passes through zeros, so the law is the constant the data support, inside the
+    domain, and the table says why (before: no law at all, and Model I failed)."""
+    T = np.linspace(30, 42, 6)
+    law, table = fit_law(T, [2.0, 0, 0, 0, 0, 0], parameter="sigma1")
+    assert "excluded" in table["linear"] and "exp" not in table
+    assert law.kind == "const" and law.value == pytest.approx(2.0 / 6) and "fallback" in table["const"]["note"]

@@ -61,6 +61,19 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
             continue
         if best is None or table[kind]["aicc"] < table[best[0]]["aicc"]:
             best = (kind, law)
+    if best is None and parameter is not None and "const" not in table:
+        # every shape left the physical domain (e.g. sigma1 estimates at zero and above): a constant,
+        # the weighted mean kept inside the domain, is the law the data support without leaving it
+        value = float(np.average(values, weights=w ** 2))
+        positive = values[values > 0]
+        if not in_domain(parameter, value):
+            value = float(positive.min()) if positive.size else 0.0
+        if in_domain(parameter, value):
+            law = Const(value, range=rng)
+            ssr = float(np.sum(((law(T) - values) * w) ** 2))
+            table["const"] = {"aicc": _aicc(ssr, len(T), 1), "law": law.to_dict(),
+                              "note": "the fallback: every other kind left the physical domain"}
+            best = ("const", law)
     if best is None:
         raise InputError("no law could be fitted" + (f" that keeps {parameter} physical over "
                                                        f"{rng[0]:g}..{rng[1]:g} C" if parameter else ""))
