@@ -11,7 +11,7 @@ import numpy as np
 
 from .._reading import read_bytes, strict_float
 from ..errors import InputError, shorten
-from ..plausible import displacement_problem, kelvin_hint
+from ..plausible import kelvin_hint
 from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
 
 #: Magnitude limits on an experiment's values in SI units: time within the simulator's +-1e12 s
@@ -88,7 +88,7 @@ def _line_of(body, row):
     return row + 2
 
 
-def read_experiment_csv(path) -> dict:
+def read_experiment_csv(path, with_headers: bool = False) -> dict:
     """Reads one experiment CSV (docs/formats.md) into SI arrays: a dict with ``time``, ``voltage``,
     ``displacement`` and, where the file has them, ``temperature`` and ``stage_displacement``.
 
@@ -189,11 +189,6 @@ def read_experiment_csv(path) -> dict:
             i = int(np.argmax(bad))
             raise InputError(f"{path}: line {_line_of(body, i)}, column {jT + 1} ({cols[jT][2]}): {float(T[i]):g} C "
                              f"is not a plausible temperature (expected {lo:g} to {hi:g} C{kelvin_hint(float(T[i]))})")
-    names = [c[0] for c in cols]
-    for name in ("displacement", "stage_displacement"):
-        if name in out:
-            j = names.index(name)
-            problem = displacement_problem(out[name], cols[j][2].partition("[")[2].rstrip("]"))
-            if problem:
-                raise InputError(f"{path}: column {j + 1} ({cols[j][2]}): {problem}")
+    if with_headers:  # the header cells, for a dataset's plausibility checks
+        return out, {c[0]: c[2] for c in cols}
     return out

@@ -16,7 +16,7 @@ from .._reading import read_text
 from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
-from ..plausible import kelvin_hint
+from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "experiment")
@@ -146,7 +146,12 @@ def load_dataset(path) -> Dataset:
                 inp = parse_waveform(e["input"])
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
-        cols = read_experiment_csv(folder / f)
+        cols, headers = read_experiment_csv(folder / f, with_headers=True)
+        for column in ("displacement", "stage_displacement"):  # a parser reads any numbers; a dataset is physics
+            if column in cols:
+                problem = displacement_problem(cols[column], headers[column].partition("[")[2].rstrip("]"))
+                if problem:
+                    raise InputError(f"{folder / f}: column {headers[column]}: {problem}")
         cols["time"], inp = _from_zero(cols["time"], inp)
         sig = cols.get("temperature")
         if T is None:
