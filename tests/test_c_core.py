@@ -87,24 +87,30 @@ def test_c_tests_and_fuzz_corpus_are_valgrind_clean(tmp_path):
     assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
 
 
+def run_fuzzer(tmp_path, target, corpus, default_seconds):
+    """Builds the libFuzzer targets with ASan and UBSan, fuzzes ``target`` from a copy of ``corpus``
+    for TF_FUZZ_SECONDS (else ``default_seconds``) and fails on any finding (crash or timeout file)."""
+    need("clang")
+    build = tmp_path / "fuzz"
+    build_core(build, "-DCMAKE_C_COMPILER=clang", "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DTF_BUILD_FUZZERS=ON",
+               "-DTF_SANITIZE=address,undefined", "-DTF_BUILD_TESTS=OFF")
+    work = tmp_path / "corpus"
+    shutil.copytree(corpus, work)
+    seconds = int(os.environ.get("TF_FUZZ_SECONDS", str(default_seconds)))
+    out = subprocess.run([str(build / target), f"-max_total_time={seconds}", "-timeout=10",
+                          "-rss_limit_mb=2048", f"-artifact_prefix={tmp_path}/", str(work)],
+                         capture_output=True, text=True, timeout=seconds + 300)
+    assert out.returncode == 0 and "Done" in out.stderr, out.stderr[-4000:]
+    assert not list(tmp_path.glob("crash-*")) and not list(tmp_path.glob("timeout-*"))
+
+
 def test_fuzz_target_runs_30_seconds_without_a_finding(tmp_path):
     """Coverage-guided fuzzing (libFuzzer, with ASan and UBSan) of the C entry points that take
     user data: a model decoded from bytes is checked (tf_model_check) and, if accepted, solved by
     each method. A crash, sanitiser report, hang (10 s) or broken contract (unknown status, a
     sample emitted twice or skipped, a non-finite state on TF_OK, a corner not after t, a refusal
     that names no field) fails the run. CI runs 30 s; docs/hardening.md says how to run longer."""
-    need("clang")
-    build = tmp_path / "fuzz"
-    build_core(build, "-DCMAKE_C_COMPILER=clang", "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DTF_BUILD_FUZZERS=ON",
-               "-DTF_SANITIZE=address,undefined", "-DTF_BUILD_TESTS=OFF")
-    work = tmp_path / "corpus"
-    shutil.copytree(CORPUS, work)
-    seconds = int(os.environ.get("TF_FUZZ_SECONDS", "30"))
-    out = subprocess.run([str(build / "fuzz_simulate"), f"-max_total_time={seconds}", "-timeout=10",
-                          "-rss_limit_mb=2048", f"-artifact_prefix={tmp_path}/", str(work)],
-                         capture_output=True, text=True, timeout=seconds + 300)
-    assert out.returncode == 0 and "Done" in out.stderr, out.stderr[-4000:]
-    assert not list(tmp_path.glob("crash-*")) and not list(tmp_path.glob("timeout-*"))
+    run_fuzzer(tmp_path, "fuzz_simulate", CORPUS, default_seconds=30)
 
 
 def test_realtime_fuzz_target_runs_20_seconds_without_a_finding(tmp_path):
@@ -115,18 +121,7 @@ def test_realtime_fuzz_target_runs_20_seconds_without_a_finding(tmp_path):
     hang (10 s) or broken contract (an unknown status; a refused call that changed the object, the
     PID or a loop output; TF_OK with a non-finite force, state or output; a NaN force that does not
     match the status) fails the run. 20 s on CI (TF_FUZZ_SECONDS changes it, as for the other)."""
-    need("clang")
-    build = tmp_path / "fuzz"
-    build_core(build, "-DCMAKE_C_COMPILER=clang", "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DTF_BUILD_FUZZERS=ON",
-               "-DTF_SANITIZE=address,undefined", "-DTF_BUILD_TESTS=OFF")
-    work = tmp_path / "corpus"
-    shutil.copytree(CORPUS_REALTIME, work)
-    seconds = int(os.environ.get("TF_FUZZ_SECONDS", "20"))
-    out = subprocess.run([str(build / "fuzz_realtime"), f"-max_total_time={seconds}", "-timeout=10",
-                          "-rss_limit_mb=2048", f"-artifact_prefix={tmp_path}/", str(work)],
-                         capture_output=True, text=True, timeout=seconds + 300)
-    assert out.returncode == 0 and "Done" in out.stderr, out.stderr[-4000:]
-    assert not list(tmp_path.glob("crash-*")) and not list(tmp_path.glob("timeout-*"))
+    run_fuzzer(tmp_path, "fuzz_realtime", CORPUS_REALTIME, default_seconds=20)
 
 
 # ---------------------------------------------------------------------------------------------

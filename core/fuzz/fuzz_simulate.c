@@ -259,19 +259,5 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 }
 
 #ifdef TF_FUZZ_REPLAY
-/* Without libFuzzer (e.g. gcc): run the target once on each file named on the command line. */
-#include <stdio.h>
-int main(int argc, char **argv)
-{
-    for (int i = 1; i < argc; i++) {
-        FILE *f = fopen(argv[i], "rb");
-        if (!f) { fprintf(stderr, "cannot open %s\n", argv[i]); return 2; }
-        static uint8_t buf[1 << 16];
-        size_t len = fread(buf, 1, sizeof buf, f);
-        fclose(f);
-        LLVMFuzzerTestOneInput(buf, len);
-    }
-    printf("replayed %d inputs\n", argc - 1);
-    return 0;
-}
+#include "replay_main.h"
 #endif

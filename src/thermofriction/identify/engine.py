@@ -88,13 +88,18 @@ class Problem:
         self.nfev = 0
         self.njev = 0
 
-    def _run(self, trace: Trace, theta, jac):
+    def _model(self, theta):
+        """The model at theta, or None where it must not be simulated: built and checked once per
+        evaluation, not once per trace."""
         try:
             model = with_values(self.model, dict(zip(self.names, theta)))
         except InputError:  # a step that breaks a rule between parameters (fs >= fc, z_ba < fc/sigma0)
-            return None, None
+            return None
         if model.unphysical_over_range():  # never step where the fitted model would not load or run
-            return None, None
+            return None
+        return model
+
+    def _run(self, model: Model, trace: Trace, theta, jac):
         heated = model.heat is not None
         if heated:  # each run from its own start, unless the fit estimates one start for all (T_0)
             T0 = model.heat.initial_temperature if "T_0" in self.names else trace.initial_temperature
@@ -133,12 +138,15 @@ class Problem:
     def evaluate(self, theta, jac=False):
         """(r, J) at theta; r is None when a simulation failed (the parameters are implausible)."""
         theta = np.asarray(theta, float)
-        if self.parallel and len(self.traces) > 1:
-            results = list(pool().map(lambda tr: self._run(tr, theta, jac), self.traces))
-        else:
-            results = [self._run(tr, theta, jac) for tr in self.traces]
+        model = self._model(theta)
         self.nfev += 1
         self.njev += int(jac)
+        if model is None:
+            return None, None
+        if self.parallel and len(self.traces) > 1:
+            results = list(pool().map(lambda tr: self._run(model, tr, theta, jac), self.traces))
+        else:
+            results = [self._run(model, tr, theta, jac) for tr in self.traces]
         if any(r is None for r, _ in results):
             return None, None
         r = np.concatenate([r for r, _ in results])
@@ -146,8 +154,11 @@ class Problem:
         return r, J
 
     def per_trace(self, theta):
-        results = [self._run(tr, np.asarray(theta, float), False) for tr in self.traces]
-        return [r for r, _ in results]
+        theta = np.asarray(theta, float)
+        model = self._model(theta)
+        if model is None:
+            return [None] * len(self.traces)
+        return [self._run(model, tr, theta, False)[0] for tr in self.traces]
 
 
 @dataclasses.dataclass
