@@ -100,6 +100,47 @@ def test_model_ii_paper_procedure_says_when_its_assumptions_fail():
     assert fit.success is bool(np.all(np.abs(fit.model.thermal.dF.values) < fc))
 
 
+@pytest.mark.parametrize("temperatures", [[33.5], [37.5], [30.5, 35.0, 41.5]])
+def test_breakpoint_sensitivity_matches_finite_differences__independent_derivative(temperatures):
+    """The breakpoint's Jacobian column (the chain rule on the knot values' exact sensitivities)
+    against central differences of whole simulations, on either side of the break."""
+    from thermofriction.identify.engine import Problem, make_traces
+    from thermofriction.identify.parameters import get_value
+
+    from conftest import synthetic_experiments
+    truth = model_ii_truth(break_T=36.0, mid=-0.2, top=-0.45)
+    exps = synthetic_experiments(truth, temperatures, duration=0.4, noise=20e-9)
+    names = ["dF.T[1]", "dF.values[1]"]
+    problem = Problem(truth, names, make_traces(exps, truth), rtol=1e-11, parallel=False)
+    theta = np.array([get_value(truth, n) for n in names])
+    r, J = problem.evaluate(theta, jac=True)
+    problem.rtol = 1e-13
+    h = 1e-4 * theta[0]
+    fd = (problem.evaluate(theta + [h, 0])[0] - problem.evaluate(theta - [h, 0])[0]) / (2 * h)
+    assert np.linalg.norm(fd) > 0
+    assert np.linalg.norm(J[:, 0] - fd) < 1e-3 * np.linalg.norm(fd)
+
+
+def test_model_ii_fits_the_breakpoint_and_its_interval_covers_the_truth():
+    """Truth: a break at 37.2 C, between two measured temperatures and away from where the
+    per-temperature estimates alone would put a grid point. The joint refinement moves the
+    breakpoint off its start, and its 95 % interval and the dF intervals at the measured
+    temperatures cover the truth (relative to the reference temperature, dF's definition)."""
+    truth = model_ii_truth(break_T=37.2, mid=-0.25, top=-0.05)
+    Ts = [30.5, 33.5, 36.0, 38.5, 41.5]
+    data = tf.synthesize(truth, Ts, duration=0.4, sample_rate=5000, noise=20e-9, quantization=1e-9, seed=11)
+    fit = tf.identify(data, method="model-ii", init="li2009-base")
+    assert fit.success and fit.adequate
+    tb = fit.parameters["dF.T[1]"]
+    assert tb.vary and tb.value != tb.init_value
+    assert tb.ci95[0] <= 37.2 <= tb.ci95[1]
+    assert tb.ci95[1] - tb.ci95[0] < 0.25 * (Ts[-1] - Ts[0])
+    value, lo, hi = fit.law_interval("dF", Ts[1:])
+    truth_rel = np.array([truth.thermal.dF(T) - truth.thermal.dF(Ts[0]) for T in Ts[1:]])
+    assert np.all((lo <= truth_rel) & (truth_rel <= hi)), (lo, truth_rel, hi)
+    assert np.all(hi - lo < 0.1 * truth.reference_force())
+
+
 # -- physical laws ------------------------------------------------------------------------------
 
 def test_fit_law_never_returns_a_law_that_leaves_the_physical_domain_in_its_range():

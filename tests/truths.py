@@ -58,25 +58,9 @@ def plant_only_file(model, folder) -> Path:
 
 
 def law_value_interval(fit, name, law, T):
-    """The 95 % interval of a fitted law's value at T, by the delta method on the fit's covariance of
-    the law's coefficients (the t quantile replaced by 1.96: thousands of points)."""
-    names = [p.name for p in fit.parameters.varying]
-    coefs = [f"{name}.{c}" for c in law.coefficient_names()]
-    cov = np.zeros((len(coefs), len(coefs)))  # a fixed coefficient (dF pinned at the reference) has none
-    vary = [k for k, c in enumerate(coefs) if c in names]
-    idx = [names.index(coefs[k]) for k in vary]
-    se = np.array([fit.parameters[coefs[k]].stderr for k in vary])
-    cov[np.ix_(vary, vary)] = fit.correlation[np.ix_(idx, idx)] * np.outer(se, se)
-    h = 1e-6
-    grad = []
-    for k, c in enumerate(law.coefficients()):
-        step = h * max(abs(c), 1e-12)
-        up = law.with_coefficients([v + (step if j == k else 0.0) for j, v in enumerate(law.coefficients())])
-        grad.append((up(T) - law(T)) / step)
-    grad = np.array(grad)
-    sd = math.sqrt(max(float(grad @ cov @ grad), 0.0))
-    v = law(T)
-    return v - 1.96 * sd, v + 1.96 * sd
+    """The 95 % interval of a fitted law's value at T (the fit's own delta method)."""
+    _, lo, hi = fit.law_interval(name, [T])
+    return float(lo[0]), float(hi[0])
 
 
 @dataclasses.dataclass

@@ -18,7 +18,7 @@ from ..drive import drive
 from ..errors import ComputationError, InputError
 from ..models import Model
 from ..waveforms import Sampled, Waveform
-from .parameters import Parameters, target_of, unit_of, with_values
+from .parameters import KNOT, Parameters, get_value, target_of, unit_of, with_values
 from .quality import ADEQUATE_RATIO, noise_level
 
 _MAX_STEPS = 2_000_000
@@ -80,7 +80,21 @@ class Problem:
     def __init__(self, model: Model, names, traces, rtol=1e-8, parallel=True):
         self.model = model
         self.names = list(names)
-        self.targets = np.array([target_of(model, n) for n in self.names], dtype=np.int32).reshape(-1, 3)
+        kinds = [target_of(model, n)[0] for n in self.names]
+        self.knots = {j: target_of(model, n)[2] for j, n in enumerate(self.names) if kinds[j] == KNOT}
+        self.core_names = [n for n, k in zip(self.names, kinds) if k != KNOT]
+        if self.knots:
+            # a breakpoint's column is dx/d(dF at the run's temperature) times d(dF)/d(breakpoint); the
+            # first is the sum of the knot values' columns (their weights sum to one), so every knot
+            # value is a core target, fitted or not
+            if model.heat is not None or any(not isinstance(t.temperature, (int, float)) for t in traces):
+                raise InputError("dF's breakpoints can be fitted only on runs at constant temperature "
+                                 "(no temperature signal, no self-heating)")
+            values = [f"dF.{c}" for c in model.thermal.dF.coefficient_names()]
+            self.core_names += [n for n in values if n not in self.core_names]
+            self.value_columns = [self.core_names.index(n) for n in values]
+            self.core_columns = {j: self.core_names.index(n) for j, n in enumerate(self.names) if j not in self.knots}
+        self.targets = np.array([target_of(model, n) for n in self.core_names], dtype=np.int32).reshape(-1, 3)
         self.traces = traces
         self.rtol = rtol
         self.parallel = parallel
@@ -113,6 +127,10 @@ class Problem:
                 _bridge.run(spec, trace.time, out, method="dopri5", rtol=self.rtol, max_steps=_MAX_STEPS)
                 S = None
             else:
+                if self.knots:  # the tolerance of a knot value pinned at zero in the units of dF's scale
+                    theta = np.array([get_value(model, n) for n in self.core_names])
+                    dF_scale = max(float(np.max(np.abs(model.thermal.dF.values))), 1e-300)
+                    theta[self.value_columns] = np.maximum(np.abs(theta[self.value_columns]), dF_scale)
                 scale = _bridge.state_scale(spec)
                 atol_y = self.rtol * scale
                 atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
@@ -121,6 +139,11 @@ class Problem:
                 _bridge.run_sensitivities(spec, self.targets, trace.time, out, sens, rtol=self.rtol,
                                           atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=_MAX_STEPS)
                 S = sens[:, _bridge.state_index(model, "x_e"), :]
+                if self.knots:
+                    S_dF = S[:, self.value_columns].sum(axis=1)
+                    S = np.column_stack([S_dF * knot_derivative(model.thermal.dF, self.knots[j], trace.temperature)
+                                         if j in self.knots else S[:, self.core_columns[j]]
+                                         for j in range(len(self.names))])
                 S_T = sens[:, _bridge.state_index(model, "T"), :] if heated else None
         except _bridge.CoreFailure:
             return None, None
@@ -159,6 +182,19 @@ class Problem:
         if model is None:
             return [None] * len(self.traces)
         return [self._run(model, tr, theta, False)[0] for tr in self.traces]
+
+
+def knot_derivative(law, k, T) -> float:
+    """d law(T) / d T[k] of a piecewise-linear law (extrapolated with its end segments)."""
+    knots, values = law.T, law.values
+    i = int(np.clip(np.searchsorted(knots, T, side="right") - 1, 0, len(knots) - 2))
+    a, b = knots[i], knots[i + 1]
+    slope_term = (values[i + 1] - values[i]) / (b - a) ** 2
+    if k == i + 1:
+        return float(-slope_term * (T - a))
+    if k == i:
+        return float(-slope_term * (b - T))
+    return 0.0
 
 
 @dataclasses.dataclass

@@ -195,10 +195,18 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         params[f"dF.values[{k}]"].vary = False
         for name in _fit_parameter_names(base) + list(free):
             params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
+        # the breakpoint is fitted with the values: held where the per-temperature estimates put it,
+        # its error would bias dF between the measured temperatures and leave it out of the intervals
+        traces = make_traces(experiments, model)
+        if len(knots) > 2 and all(isinstance(t.temperature, (int, float)) for t in traces) and base.heat is None:
+            margin = 0.02 * (knots[-1] - knots[0])
+            for k in range(1, len(knots) - 1):
+                params.add(f"dF.T[{k}]", float(knots[k]), min=float(knots[k - 1] + margin),
+                           max=float(knots[k + 1] - margin), unit="C")
     else:
         warns.append(f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters "
                      f"are held at their fit there, so dF's intervals do not include their uncertainty")
-    traces = make_traces(experiments, model)
+        traces = make_traces(experiments, model)
     outcome = fit(model, params, traces, **popts)
     res = _result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
     res.nfev += sum(r.nfev for _, r in per_T)

@@ -1,6 +1,7 @@
 """Fit parameters as objects (value, bounds, ``vary``, and after a fit ``stderr`` and ``ci95``),
 and their mapping onto a model: a friction parameter given as a number (``sigma0``), a
-coefficient of a Model I law (``sigma0.a``, ``fc.values[2]``) or of Model II's ``dF`` (``dF.values[1]``)."""
+coefficient of a Model I law (``sigma0.a``, ``fc.values[2]``) or of Model II's ``dF`` (``dF.values[1]``),
+or the temperature of one of dF's inner breakpoints (``dF.T[1]``)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,9 @@ from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
 
 _TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT, _TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
+#: Not a C core target: a breakpoint temperature of a piecewise-linear dF. Its sensitivity is the chain
+#: rule on the knot values' sensitivities (identify/engine.py), exact on constant-temperature runs.
+KNOT = -1
 #: The plant's fittable parameters by their model-file symbols, with units: one value shared by all
 #: experiments (the masses above all, which the paper does not give).
 PLANT_UNITS = {"m": "kg", "m_e": "kg", "xi": "", "wn": "rad/s", "K": "m/V", "c": "N s/m", "k": "N/m", "T_em": "N/V",
@@ -117,6 +121,15 @@ def target_of(model: Model, name: str):
     if base == "dF":
         if not isinstance(model.thermal, ModelII):
             raise InputError(f"'{name}': the model has no Model II dF law")
+        knot = re.fullmatch(r"T\[(\d+)\]", coef or "")
+        if knot:
+            law = model.thermal.dF
+            k = int(knot.group(1))
+            if law.kind != "pwl" or not 0 < k < len(law.T) - 1:
+                raise InputError(f"'{name}': only an inner breakpoint of a 'pwl' dF law can be fitted"
+                                 + (f" (dF.T[1] .. dF.T[{len(law.T) - 2}])" if law.kind == "pwl" and len(law.T) > 2
+                                    else ""))
+            return (KNOT, 0, k)
         names = model.thermal.dF.coefficient_names()
         if coef not in names:
             raise InputError(f"'{name}': dF ({model.thermal.dF.kind}) has coefficients {', '.join(names) or 'none'}")
@@ -145,6 +158,8 @@ def get_value(model: Model, name: str) -> float:
         return float(getattr(model.plant, _plant_field(model, name)))
     if kind == _TARGET_DF:
         return float(model.thermal.dF.coefficients()[coef])
+    if kind == KNOT:
+        return float(model.thermal.dF.T[coef])
     if kind == _TARGET_LAW:
         return float(model.laws[PARAMETERS[idx]].coefficients()[coef])
     values = model.friction.values()
@@ -161,10 +176,12 @@ def with_values(model: Model, values: dict) -> Model:
     friction = {}
     laws = dict(model.laws)
     dF = model.thermal.dF if isinstance(model.thermal, ModelII) else None
-    heat, plant = {}, {}
+    heat, plant, knots = {}, {}, {}
     for name, v in values.items():
         kind, idx, coef = target_of(model, name)
-        if kind == _TARGET_PLANT:
+        if kind == KNOT:
+            knots[coef] = float(v)
+        elif kind == _TARGET_PLANT:
             plant[_plant_field(model, name)] = float(v)
         elif kind == _TARGET_HEAT:
             heat[HEAT_PARAMETERS[name][0]] = float(v)
@@ -179,6 +196,11 @@ def with_values(model: Model, values: dict) -> Model:
             c = dF.coefficients()
             c[coef] = v
             dF = dF.with_coefficients(c)
+    if knots:  # PWL refuses knots out of order: the step is then refused, like any rule-breaking step
+        T = dF.T.copy()
+        for k, v in knots.items():
+            T[k] = v
+        dF = dataclasses.replace(dF, T=T)
     thermal = model.thermal
     if isinstance(thermal, ModelI):
         thermal = ModelI(laws)
@@ -196,10 +218,12 @@ def unit_of(model: Model, name: str) -> str:
     if coef is None and base not in PARAMETERS and base in PLANT_UNITS:
         return PLANT_UNITS[base]
     unit = "N" if base == "dF" else PARAMETER_UNITS.get(base, "")
+    if base == "dF" and coef and coef.startswith("T["):
+        return "C"
     if coef is None:
         return unit
     law = model.thermal.dF if base == "dF" else model.laws.get(base)
     return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]
+__all__ = ["KNOT", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]

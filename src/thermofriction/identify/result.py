@@ -50,6 +50,34 @@ class FitResult:
             return math.nan
         return n * math.log(self.cost / n) + 2 * k + 2 * k * (k + 1) / (n - k - 1)
 
+    def law_interval(self, name: str, temperatures, level: float = 0.95):
+        """The fitted law of ``name`` (a Model I parameter, or ``"dF"``) at ``temperatures`` with its
+        ``level`` interval, by the delta method on the covariance of every fitted coefficient and
+        breakpoint of that law. Returns (value, lower, upper) arrays."""
+        from scipy import stats
+
+        from .parameters import with_values
+        T = np.atleast_1d(np.asarray(temperatures, float))
+        law_of = (lambda m: m.thermal.dF) if name == "dF" else (lambda m: m.laws[name])
+        value = np.asarray(law_of(self.model)(T), float)
+        names = [p.name for p in self.parameters.varying]
+        own = [i for i, n in enumerate(names) if n.startswith(name + ".")]
+        if not own:
+            return value, value.copy(), value.copy()
+        theta = np.array([self.parameters[names[i]].value for i in own])
+        se = np.array([self.parameters[names[i]].stderr for i in own], float)
+        if not np.all(np.isfinite(se)):
+            return value, np.full_like(value, -math.inf), np.full_like(value, math.inf)
+        cov = self.correlation[np.ix_(own, own)] * np.outer(se, se)
+        grad = np.empty((len(own), len(T)))
+        for j in range(len(own)):
+            h = 1e-6 * max(abs(theta[j]), se[j], 1e-12)
+            up = with_values(self.model, {names[own[j]]: theta[j] + h})
+            grad[j] = (np.asarray(law_of(up)(T), float) - value) / h
+        sd = np.sqrt(np.maximum(np.einsum("it,ij,jt->t", grad, np.nan_to_num(cov), grad), 0.0))
+        z = stats.norm.ppf(0.5 + level / 2)
+        return value, value - z * sd, value + z * sd
+
     def to_dict(self) -> dict:
         names = [p.name for p in self.parameters.varying]
         d = {

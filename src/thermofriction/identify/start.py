@@ -4,9 +4,11 @@
 A stick-slip actuator slips when the stage's acceleration times the end-effector mass exceeds the
 friction level, so the friction level is of the order of ``m_e`` times the stage's acceleration. That
 scale comes from the plant alone (the stage driven by the recorded input, nothing on it); a scan of the
-friction level over four decades around it, each with bristles whose steady deflection is a tenth of the
-stage's stroke and lightly damped, picks the start with the lowest misfit. The fit then starts from
-there with its multi-start spanning a decade either way of each parameter.
+friction level over four decades around it, each with bristles whose steady deflection is from 3 % to
+3 times the stage's stroke (their stiffness is otherwise unknown to two decades) and lightly damped,
+keeps the three starts with the lowest misfit. A short fit of the friction level, the stiffness and the
+damping from each (on the shortest run) picks the start; the fit then starts from there with its
+multi-start spanning a decade either way of each parameter.
 """
 
 from __future__ import annotations
@@ -16,14 +18,15 @@ import math
 import numpy as np
 
 from ..drive import experiment_waveform
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..models import Coulomb, LuGre, Model
 from ..simulate import simulate
-from .engine import Problem, make_traces
+from .engine import Problem, fit, make_traces
+from .parameters import Parameters
 
 #: the scan, in units of m_e times the stage's acceleration scale
 SCAN = np.logspace(-3, 1, 13)
-DEFLECTION = 0.1   # steady bristle deflection fc/sigma0, as a fraction of the stage's stroke
+DEFLECTIONS = (0.03, 0.1, 0.3, 1.0, 3.0)   # steady bristle deflection fc/sigma0, in units of the stage's stroke
 DAMPING = 0.01     # sigma1 as a fraction of 2 sqrt(sigma0 m_e) (critical damping of the stuck end effector)
 
 
@@ -44,22 +47,37 @@ def lugre_start(plant, experiments, input=None) -> dict:
     if not (a_scale > 0 and stroke > 0):
         raise InputError(f"{exp.file}: the input does not move the stage: no starting values can be taken from it")
     m_e = plant.end_effector_mass
-    best, scan = None, []
-    for f in SCAN:
+    scan = []
+    for f, deflection in ((f, d) for f in SCAN for d in DEFLECTIONS):
         fc = float(f * m_e * a_scale)
-        sigma0 = fc / (DEFLECTION * stroke)
+        sigma0 = fc / (deflection * stroke)
         sigma1 = DAMPING * 2.0 * math.sqrt(sigma0 * m_e)
         model = Model(plant, LuGre(sigma0=sigma0, sigma1=sigma1, fc=fc), input=input)
         problem = Problem(model, ["fc"], make_traces([exp], model), rtol=1e-6, parallel=False)
         r, _ = problem.evaluate(np.array([fc]))
         cost = math.inf if r is None else float(r @ r)
-        scan.append((fc, cost))
-        if best is None or cost < best[0]:
-            best = (cost, {"model": "lugre", "sigma0": sigma0, "sigma1": sigma1, "fc": fc})
-    if not math.isfinite(best[0]):
+        scan.append((cost, {"sigma0": sigma0, "sigma1": sigma1, "fc": fc}))
+    scan = sorted((c for c in scan if math.isfinite(c[0])), key=lambda c: c[0])
+    if not scan:
         raise InputError(f"{exp.file}: no friction level between {SCAN[0]:g} and {SCAN[-1]:g} x m_e x the stage's "
                          f"acceleration could be simulated: check the plant")
-    return best[1]
+    # a scan point's misfit says little about where a fit from it ends (stiffness and friction level
+    # trade off): a few steps of the fit from each of the best three decide
+    best = None
+    for _, start in scan[:3]:
+        model = Model(plant, LuGre(**start), input=input)
+        params = Parameters()
+        for name, value in start.items():
+            params.add(name, value, min=0.0)
+        try:
+            outcome = fit(model, params, make_traces([exp], model), rtol=1e-6, starts=1, max_nfev=15)
+        except (ComputationError, InputError):  # a start whose fit cannot run is simply not chosen
+            continue
+        cost = float(outcome.r @ outcome.r)
+        if best is None or cost < best[0]:
+            best = (cost, dict(zip(start, (float(v) for v in outcome.theta))))
+    values = best[1] if best is not None else scan[0][1]
+    return {"model": "lugre", **values}
 
 
 __all__ = ["lugre_start"]
