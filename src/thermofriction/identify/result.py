@@ -78,6 +78,31 @@ class FitResult:
         z = stats.norm.ppf(0.5 + level / 2)
         return value, value - z * sd, value + z * sd
 
+    def recovery(self, truth: Model, temperatures, level: float = 0.95) -> list:
+        """For data made from a known ``truth`` (a study, the demo): each temperature-dependent
+        parameter of the truth against the fit, with the fit's ``level`` interval, and whether it
+        covers the truth. Model I laws compare directly; Model II's dF relative to the fit's
+        reference temperature (its definition: dF = 0 there). Empty where the fit and the truth are
+        not the same kind of model."""
+        from ..models import ModelI, ModelII
+        rows = []
+        T = np.atleast_1d(np.asarray(temperatures, float))
+        if isinstance(truth.thermal, ModelI) and isinstance(self.model.thermal, ModelI):
+            pairs = [(name, truth.laws[name](T)) for name in truth.laws if name in self.model.laws]
+        elif isinstance(truth.thermal, ModelII) and isinstance(self.model.thermal, ModelII):
+            law = self.model.thermal.dF
+            ref = float(law.T[int(np.argmin(np.abs(law.values)))]) if law.kind == "pwl" else float(T.min())
+            pairs = [("dF", truth.thermal.dF(T) - truth.thermal.dF(ref))]
+        else:
+            return rows
+        for name, true in pairs:
+            value, lo, hi = self.law_interval(name, T, level)
+            for k, t in enumerate(T):
+                rows.append({"parameter": name, "temperature": float(t), "truth": float(true[k]),
+                             "value": float(value[k]), "lower": float(lo[k]), "upper": float(hi[k]),
+                             "covered": bool(lo[k] <= true[k] <= hi[k])})
+        return rows
+
     def to_dict(self) -> dict:
         names = [p.name for p in self.parameters.varying]
         d = {
