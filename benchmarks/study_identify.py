@@ -33,9 +33,15 @@ def summarise(label, outcomes):
               f"{np.median(errs[ok]) if ok.any() else float('nan'):.2g}")
     print(f"  95 % intervals of the law values covering the truth: {covered} of {points} "
           f"({100 * covered / max(points, 1):.0f} %)")
+    for name in outcomes[0].errors:
+        base = name.split("/")[0]
+        n_missed = sum(1 for o in outcomes for m in o.missed if m[0] == base)
+        print(f"    {base}: {n_missed} points not covered")
     for o in outcomes:
         if not o.adequate:
             print(f"    seed {o.seed}: not adequate ({o.wall_time:.1f} s)")
+        if o.missed:
+            print(f"    seed {o.seed}: not covered at " + ", ".join(f"{n} {T:g} C" for n, T in o.missed))
 
 
 def main():

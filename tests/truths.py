@@ -71,6 +71,7 @@ class Outcome:
     errors: dict        # parameter -> max relative error of the law over the fit temperatures
     covered: int        # (parameter, temperature) points whose 95 % interval covers the truth
     points: int
+    missed: list = dataclasses.field(default_factory=list)   # (parameter, temperature) not covered
 
 
 def study_model_i(seed, duration=0.4, sample_rate=5000):
@@ -82,7 +83,7 @@ def study_model_i(seed, duration=0.4, sample_rate=5000):
         t0 = time.perf_counter()
         fit = tf.identify(data, method="model-i", init=plant_only_file(truth, d))
         wall = time.perf_counter() - t0
-    errors, covered, points = {}, 0, 0
+    errors, covered, points, missed = {}, 0, 0, []
     for name in ("sigma0", "sigma1", "fc"):
         law, true = fit.model.laws[name], truth.laws[name]
         errs = []
@@ -91,8 +92,10 @@ def study_model_i(seed, duration=0.4, sample_rate=5000):
             lo, hi = law_value_interval(fit, name, law, T)
             covered += lo <= true(T) <= hi
             points += 1
+            if not lo <= true(T) <= hi:
+                missed.append((name, T))
         errors[name] = max(errs)
-    return Outcome(seed, wall, bool(fit.adequate), errors, covered, points)
+    return Outcome(seed, wall, bool(fit.adequate), errors, covered, points, missed)
 
 
 def study_model_ii(seed, duration=0.4, sample_rate=5000):
@@ -109,7 +112,7 @@ def study_model_ii(seed, duration=0.4, sample_rate=5000):
     law = fit.model.thermal.dF
     fc = truth.friction.fc
     ref = truth.thermal.dF(FIT_T[0])
-    errs, covered, points = [], 0, 0
+    errs, covered, points, missed = [], 0, 0, []
     for T in FIT_T:
         true = truth.thermal.dF(T) - ref
         errs.append(abs(law(T) - true) / fc)
@@ -117,7 +120,9 @@ def study_model_ii(seed, duration=0.4, sample_rate=5000):
             lo, hi = law_value_interval(fit, "dF", law, T)
             covered += lo <= true <= hi
             points += 1
-    return Outcome(seed, wall, bool(fit.adequate), {"dF/fc": max(errs)}, covered, points)
+            if not lo <= true <= hi:
+                missed.append(("dF", T))
+    return Outcome(seed, wall, bool(fit.adequate), {"dF/fc": max(errs)}, covered, points, missed)
 
 
 __all__ = ["study_model_i", "study_model_ii", "model_i_truth", "model_ii_truth", "law_value_interval", "Outcome"]
