@@ -63,6 +63,12 @@ def test_demo_runs_the_main_job(tmp_path):
     held = {k: v[k]["summary"]["validate"]["max_error_pct"] for k in v}
     assert held["model-i"] < held["base"] and held["model-ii"] < held["base"]
     assert "report:" in out.stdout
+    # the demo knows its truth (the Model I preset): Model I's intervals cover it, Model II says why it
+    # cannot be compared
+    rec = json.loads((tmp_path / "demo" / "recovery.json").read_text())
+    assert rec["model-i"]["points"] == 24 and rec["model-i"]["covered"] >= 0.9 * 24, rec["model-i"]["missed"]
+    assert rec["model-ii"]["covered"] is None and "not comparable" in rec["model-ii"]["summary"]
+    assert "against the truth" in out.stdout
 
 
 def test_identify_plant_from_a_recorded_stage(tmp_path):

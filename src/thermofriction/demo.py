@@ -55,9 +55,29 @@ def run_demo(folder="thermofriction-demo", progress=None, command=None) -> dict:
         entries.append(Entry(label, fits[key].model, fits[key].to_dict(), v))
     from ._io import dump_json
     dump_json(validation, folder / "validation.json")
+    recovery = truth_recovery(fits, truth)
+    dump_json(recovery, folder / "recovery.json")
     report(entries, data, folder / "report.html", command=command or "thermofriction demo",
            title="thermofriction demo — the paper's actuator at 30.8-41.5 °C")
     timings["validate and report"] = time.perf_counter() - t1
     timings["total"] = time.perf_counter() - t0
     return {"folder": folder, "report": folder / "report.html", "fits": fits, "validation": validation,
-            "timings": timings}
+            "recovery": recovery, "timings": timings}
+
+
+def truth_recovery(fits, truth) -> dict:
+    """Whether each fit recovers the truth the demo's data were made from, or why it cannot say."""
+    out = {}
+    for key, fit in fits.items():
+        rows = fit.recovery(truth, FIT_TEMPERATURES)
+        if rows:
+            missed = [f"{r['parameter']} at {r['temperature']:g} C" for r in rows if not r["covered"]]
+            out[key] = {"covered": len(rows) - len(missed), "points": len(rows), "missed": missed, "rows": rows,
+                        "summary": f"the 95 % intervals of the fitted laws cover the truth at {len(rows) - len(missed)} "
+                                   f"of {len(rows)} (parameter, temperature) points"
+                                   + (f"; not at {', '.join(missed)}" if missed else "")}
+        else:
+            out[key] = {"covered": None, "points": 0, "missed": [], "rows": [],
+                        "summary": f"not comparable: the data are made from {type(truth.thermal).__name__} "
+                                   f"({truth.name}); a {fit.method} fit has no law that corresponds to the truth's"}
+    return out

@@ -207,6 +207,7 @@ def cmd_demo(args) -> int:
         s = out["validation"][key]["summary"].get("validate", {})
         print(f"  {label:17s} identified in {fits[key].wall_time:5.1f} s; held-out max error "
               f"{s.get('max_error_pct', float('nan')):.3g} %, RMSE {s.get('rmse_offset_removed', float('nan')) * 1e9:.4g} nm")
+    print(f"  Model I against the truth the data were made from: {out['recovery']['model-i']['summary']}")
     print(f"  report: {out['report']}")
     return 0
 
