@@ -248,7 +248,7 @@ def _points(ax, T, v, held, color, label, line=True):
     if line:
         ax.plot(T[ok], v[ok], "-", color=color, lw=1.3, label=label, zorder=2)
     ax.plot(T[~held & ok], v[~held & ok], "o", ms=6, color=color, zorder=3, label=None if line else label)
-    ax.plot(T[held & ok], v[held & ok], "D", ms=7, mfc="white", mec=color, mew=1.8, zorder=4)
+    ax.plot(T[held & ok], v[held & ok], "D", ms=7, color=color, mfc="white", mec=color, mew=1.8, zorder=4)
 
 
 METRIC_LABELS = {"max_error_pct": "max error [%]", "final_error_pct": "final error [%]",
@@ -258,6 +258,8 @@ METRIC_LABELS = {"max_error_pct": "max error [%]", "final_error_pct": "final err
 def draw_errors(ax, entries, metric="max_error_pct", paper=True):
     """One line per model of ``metric`` against temperature; fit temperatures filled circles,
     held-out ones open diamonds on a pale red band; the paper's 7-8 % as a grey band."""
+    if metric not in METRIC_LABELS:
+        raise ValueError(f"unknown metric {metric!r}: choose from {', '.join(METRIC_LABELS)}")
     values = []
     held_T = set()
     for i, (label, v) in enumerate(entries):
