@@ -21,6 +21,7 @@ from ..validate import ValidationResult, validate
 from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
                       fig_steps)
 from .page import _CSS, Figures, _fmt, _table, _versions
+from .plots import _float
 from .studies import control_report, heating_report
 
 @dataclasses.dataclass
@@ -122,8 +123,7 @@ def _covariance(fit: dict, names):
         p = params.get(n)
         if p is None:
             return None
-        x = p.get("stderr")
-        x = float(x) if isinstance(x, (int, float)) or (isinstance(x, str) and x not in ("", "nan")) else math.nan
+        x = _float(p.get("stderr"))  # None, "inf" (JSON), a number
         se.append(x if n in idx else 0.0)
     if not all(math.isfinite(x) for x in se):
         return None
@@ -310,7 +310,8 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
     groups = akaike(entries)[1]
-    parts.append("<section><h2>Model comparison</h2>" + _table(COMPARISON_COLUMNS, comparison_rows(entries), text=(1,)) +
+    parts.append("<section><h2>Model comparison</h2>" +
+                 _table(COMPARISON_COLUMNS, comparison_rows(entries), text=(1,)) +
                  definitions(*COMPARISON_COLUMNS[2:8]) +
                  ("" if groups <= 1 else "<p class='note'>Fits of different data are compared within their own "
                   "group.</p>") +

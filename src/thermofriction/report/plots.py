@@ -162,7 +162,8 @@ def window_rms(time, residual, windows=50):
 def noise_level(predictions):
     """The measurement noise estimated from the data (median over the experiments), or None."""
     vals = [float(p.fit_quality["noise"]) for p in predictions
-            if p.fit_quality and p.fit_quality.get("noise") is not None and math.isfinite(float(p.fit_quality["noise"]))]
+            if p.fit_quality and p.fit_quality.get("noise") is not None
+            and math.isfinite(float(p.fit_quality["noise"]))]
     return float(np.median(vals)) if vals else None
 
 
@@ -501,7 +502,8 @@ def model_ii_figure(fit, model, held_out=(), paper=True):
         ax.plot(T, D * 1e6, "ko", ms=5, label="measured")
         knots = np.array(procedure["displacement_law"]["T"], float)
         vals = np.array(procedure["displacement_law"]["values"], float)
-        ax.plot(knots, vals * 1e6, "-", color=MODEL_COLOURS[1], label=f"two segments,\nbreak at {procedure['breakpoint']:.1f} °C")
+        ax.plot(knots, vals * 1e6, "-", color=MODEL_COLOURS[1],
+                label=f"two segments,\nbreak at {procedure['breakpoint']:.1f} °C")
         mark_held_out(ax, held_out, label=False)
         ax.set_xlabel("temperature [°C]")
         ax.set_ylabel("net displacement [µm]")
