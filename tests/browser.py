@@ -84,6 +84,7 @@ class Browser:
                 return msg
 
     def open(self, url, expression, screenshot=None, height=None):
+        self.events = []  # a second page must wait for its own load event, and report its own errors
         target = self.call("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = self.call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
         for domain in ("Page", "Runtime", "Log"):

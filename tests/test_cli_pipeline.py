@@ -59,6 +59,7 @@ def test_demo_runs_the_main_job(tmp_path):
     for name in ("report.html", "model-i.toml", "model-i.json", "model-ii.toml", "model-ii.json", "validation.json",
                  "data/dataset.toml"):
         assert (tmp_path / "demo" / name).exists(), name
+    assert (tmp_path / "demo" / "report.html").stat().st_size < 1_000_000  # issue 19: the whole report under 1 MB
     v = json.loads((tmp_path / "demo" / "validation.json").read_text())
     held = {k: v[k]["summary"]["validate"]["max_error_pct"] for k in v}
     assert held["model-i"] < held["base"] and held["model-ii"] < held["base"]

@@ -185,6 +185,13 @@ class ValidationResult:
             t.add_row(*r)
         Console().print(t)
 
+    def plot(self, metric="max_error_pct", ax=None, label=None):
+        """A matplotlib figure of ``metric`` (max_error_pct, final_error_pct, step_error_pct, nrmse,
+        rmse) against temperature: fit temperatures filled, held-out ones open on pale red bands,
+        and for the max error the 7-8 % of Li et al. (2009). Draws into ``ax`` when given."""
+        from .report.plots import error_figure
+        return error_figure([(label or self.model.name or "model", self)], metric, ax=ax)
+
     def _repr_html_(self):
         head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.rows())

@@ -185,6 +185,18 @@ class FitResult:
     def __str__(self):
         return self.report()
 
+    def plot(self, data=None, paper=False):
+        """A matplotlib figure of the fit: with ``data`` (the dataset, or a ValidationResult of
+        this model on it) measured against predicted displacement and the residuals' RMS; for Model
+        I and II the laws with the per-temperature estimates and their 95 % intervals (``paper``:
+        the paper's Eqs. (9)-(11) and (13) beside them)."""
+        from ..report.plots import fit_figure
+        validation = data
+        if data is not None and not hasattr(data, "predictions"):
+            from ..validate import validate
+            validation = validate(self.model, data)
+        return fit_figure(self, validation, paper=paper)
+
     def _repr_html_(self):
         head = "".join(f"<th>{h}</th>" for h in ("name", "value", "stderr", "rel", "95 % interval", "unit"))
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self._rows())

@@ -1,166 +1,107 @@
-"""The figures of the main report: the paper's Figs. 3-7 and 9-10, residuals, step sizes, and
-the identified laws against the paper's."""
+"""The figures of the main report, as HTML: each figure of plots.py (the one implementation, shared
+with the results' ``.plot()``) rendered with a caption that says how to read it, and the
+definitions of the metrics the report shows."""
 
 from __future__ import annotations
 
-import numpy as np
+from ..models import ModelII
+from . import plots
 
-from ..models import PARAMETER_UNITS, ModelII, load_model
-from .page import _colors, _plt, _thin
+#: every metric the report shows, defined where it is shown (docs/formats.md#validation-metrics);
+#: e = x_sim − x_meas at each sample, x_meas zeroed so that the first 1 % of the run agrees on average
+DEFINITIONS = {
+    "max error [%]": "100 · max|e| / span, with e = x_sim − x_meas at each sample and span = max x_meas − "
+                     "min x_meas: the paper's maximum prediction error (Li et al. 2009 report 7–8 %).",
+    "RMSE [nm]": "the root mean square of e − mean(e): the error with the sensor's arbitrary zero removed, "
+                 "as identification measures it.",
+    "NRMSE": "RMSE / span: a fraction of the measured displacement's range, not a percentage.",
+    "final error [%]": "100 · e_last / |x_meas,last − x_meas,first|: the error of the net displacement at the "
+                       "end of the run, signed (positive: the model predicts too far).",
+    "step error [%]": "100 · mean over whole input periods k of |s_sim,k − s_meas,k| / |mean s_meas,k|, where "
+                      "s_k is the displacement over period k.",
+    "max error, held out [%]": "the largest max error over the held-out experiments.",
+    "mean max error, held out [%]": "the mean of the held-out experiments' max errors.",
+    "RMSE, held out [nm]": "the root mean square of the held-out experiments' RMSEs.",
+    "max error, fit [%]": "the largest max error over the experiments the model was fitted to.",
+    "ΔAICc": "the fit's corrected Akaike information criterion minus the lowest among the fits of the same "
+             "data: n ln(SSR/n) + 2k + 2k(k+1)/(n−k−1), n data points, k fitted parameters; below 2 the data "
+             "hardly prefer the better fit, above 10 they rule the other out.",
+    "Akaike weight": "exp(−ΔAICc/2), normalised to one over the fits of the same data: the weight of evidence "
+                     "for each model among them.",
+}
 
-def fig_displacement(figs, entries):
-    plt = _plt()
-    n = len(entries)
-    fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.4), squeeze=False, sharey=True)
-    temps = sorted({p.temperature for p in entries[0].validation.predictions})
-    col = _colors(temps)
-    for ax, e in zip(axes[0], entries):
-        for p in e.validation.predictions:
-            stride = max(len(p.time) // 60, 1)
-            ax.plot(p.time[::stride], p.measured[::stride] * 1e6, "o", ms=3, mfc="none", color=col[p.temperature],
-                    alpha=0.8)
-            ax.plot(*_thin(p.time, p.predicted * 1e6), "-", lw=1.2, color=col[p.temperature],
-                    label=f"{p.temperature:.1f} °C" + (" (held out)" if p.role == "validate" else ""))
-        ax.set_title(e.label)
-        ax.set_xlabel("time [s]")
-    axes[0][0].set_ylabel("displacement [µm]")
-    axes[0][-1].legend(fontsize=7, loc="upper left", frameon=False)
-    return figs.render(fig, "displacement", "Measured (markers) and predicted (lines) end-effector displacement at "
-                       "each temperature, as in the paper's Figs. 9-10. Held-out temperatures were not used "
-                       "for identification.")
+
+def definitions(*names) -> str:
+    """The definitions of ``names`` as a definition list."""
+    import html
+    return ('<dl class="defs">' + "".join(f"<dt>{html.escape(n)}</dt><dd>{html.escape(DEFINITIONS[n])}</dd>"
+                                          for n in names) + "</dl>")
 
 
-def fig_residuals(figs, entries):
-    plt = _plt()
-    n = len(entries)
-    fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 2.8), squeeze=False)
-    temps = sorted({p.temperature for p in entries[0].validation.predictions})
-    col = _colors(temps)
-    for ax, e in zip(axes[0], entries):
-        for p in e.validation.predictions:
-            ax.plot(*_thin(p.time, (p.predicted - p.measured) * 1e9), lw=0.6, color=col[p.temperature])
-        ax.set_title(e.label)
-        ax.set_xlabel("time [s]")
-    axes[0][0].set_ylabel("predicted − measured [nm]")
-    return figs.render(fig, "residuals", "Residuals of each model at each temperature.")
+def _pairs(entries):
+    return [(e.label, e.validation) for e in entries]
+
+
+def _held_out(entries):
+    return sorted({p.temperature for e in entries for p in e.validation.predictions if p.role == "validate"})
+
+
+def fig_errors(figs, entries):
+    return figs.render(plots.error_figure(_pairs(entries)), "error-vs-temperature",
+                       "Max error against temperature for each model: filled circles at the temperatures it was "
+                       "fitted to, open diamonds on pale red bands at the held-out ones (never used in "
+                       "identification). Max error = 100 · max|x_sim − x_meas| / (max x_meas − min x_meas), the "
+                       "paper's maximum prediction error; the grey band is the 7–8 % Li et al. (2009) report. "
+                       "A logarithmic axis where the models differ by decades.")
 
 
 def fig_steps(figs, entries):
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(5.5, 3.4))
-    preds = entries[0].validation.predictions
-    T = np.array([p.temperature for p in preds])
-    meas = np.array([np.mean(p.measured_steps) if p.measured_steps.size else np.nan for p in preds]) * 1e6
-    order = np.argsort(T)
-    ax.plot(T[order], meas[order], "ko", label="measured", zorder=5)
-    for e, marker in zip(entries, "s^dv<>"):
-        pr = np.array([np.mean(p.predicted_steps) if p.predicted_steps.size else np.nan
-                       for p in e.validation.predictions]) * 1e6
-        ax.plot(T[order], pr[order], marker + "-", ms=4, lw=1, label=e.label)
-    ax.set_xlabel("temperature [°C]")
-    ax.set_ylabel("step per cycle [µm]")
-    ax.legend(frameon=False, fontsize=8)
-    return figs.render(fig, "steps", "Mean step per cycle against temperature: measured and predicted.")
+    return figs.render(plots.steps_figure(_pairs(entries)), "steps",
+                       "Mean displacement per input period against temperature: measured (black) and predicted by "
+                       "each model; open diamonds and pale red bands at the held-out temperatures.")
 
 
-def fig_model_i(figs, entry):
-    det = (entry.fit or {}).get("details", {})
-    per_T, laws = det.get("per_temperature"), det.get("laws")
-    if not per_T or not laws:
+def fig_displacement(figs, entries):
+    return figs.render(plots.displacement_figure(_pairs(entries)), "displacement",
+                       "Measured (markers, a few dozen per run) and predicted (lines) end-effector displacement "
+                       "at each temperature, as in the paper's Figs. 9–10. Temperatures the models were fitted to "
+                       "in viridis colours, solid; held-out temperatures in reds, dashed, with open squares.")
+
+
+def fig_residuals(figs, entries):
+    return figs.render(plots.residual_figure(_pairs(entries)), "residuals",
+                       "Residuals: the root mean square of predicted − measured displacement over each 2 % of the "
+                       "run (measurement zeroed on the first 1 %), one line per experiment, coloured as above. "
+                       "A model at the measurement noise lies on the dotted line; an error that builds up over the "
+                       "run rises above it. (20 000 overlaid samples per trace would hide this; the RMS keeps it "
+                       "legible per temperature.)")
+
+
+def fig_model_i(figs, entry, held_out=()):
+    if not entry.model.laws or not ((entry.fit or {}).get("details") or {}).get("per_temperature"):
         return ""
-    plt = _plt()
-    names = list(laws)
-    fig, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.0), squeeze=False)
-    T = np.array([r["temperature"] for r in per_T])
-    grid = np.linspace(T.min() - 0.5, T.max() + 0.5, 200)
-    paper = load_model("li2009-model-i").laws  # the paper's Eqs. (9)-(11)
-    for ax, n in zip(axes[0], names):
-        vals = np.array([r["parameters"][n]["value"] for r in per_T], dtype=float)
-        ci = np.array([r["parameters"][n]["ci95"] or [np.nan, np.nan] for r in per_T], dtype=object)
-        lo = np.array([float(c[0]) if c[0] not in ("inf", "-inf", None) else np.nan for c in ci])
-        hi = np.array([float(c[1]) if c[1] not in ("inf", "-inf", None) else np.nan for c in ci])
-        # an interval that spans decades (a parameter the data do not determine) would flatten the
-        # panel: it is drawn to the panel's edge instead (arrow) and named in the warnings
-        span = np.nanmax(np.abs(vals)) if np.any(np.isfinite(vals)) else 1.0
-        open_hi = ~np.isfinite(hi) | (hi > vals + 3 * span)
-        hi = np.where(open_hi, np.nan, hi)
-        yerr = np.vstack([np.clip(vals - lo, 0, None), np.clip(hi - vals, 0, None)])
-        yerr = np.where(np.isfinite(yerr), yerr, 0)
-        ax.errorbar(T, vals, yerr=yerr, fmt="o", ms=4, capsize=2, color="k", label="per temperature (95 %)")
-        if open_hi.any():
-            ax.plot(T[open_hi], vals[open_hi], "^", ms=6, color="C1", label="interval open upwards")
-        law = entry.model.laws.get(n)
-        if law is not None:
-            ax.plot(grid, law(grid), "-", color="C0", label=f"fitted law ({law.kind})")
-        if n in paper:
-            ax.plot(grid, paper[n](grid), "--", color="C3", lw=1, label="paper, Eqs. (9)-(11)")
-        ax.set_xlabel("temperature [°C]")
-        ax.set_ylabel(f"{n} [{PARAMETER_UNITS.get(n, '')}]")
-        ax.set_title(f"{n}: {laws[n].get('chosen', '')}", fontsize=9)
-    axes[0][0].legend(fontsize=7, frameon=False)
-    return figs.render(fig, "model-i-parameters", "Model I: each identified parameter against temperature with its "
-                       "95 % interval (an orange triangle where it is open upwards: the data do not bound the parameter "
-                       "there), the law fitted through them (refined on all experiments), and the paper's "
-                       "Eqs. (9)-(11) (Figs. 3-5).")
+    fig = plots.laws_figure(entry.fit, entry.model, held_out)
+    return figs.render(fig, "model-i-parameters",
+                       f"{entry.label}: each parameter identified per temperature with its 95 % interval (an "
+                       "orange triangle where the interval is open upwards: the data do not bound the parameter "
+                       "there), the law fitted through those estimates (dotted), the law refined on all "
+                       "experiments at once (solid; red rings where it leaves an interval), and the paper's "
+                       "Eqs. (9)–(11) (grey, Figs. 3–5). Pale red bands: held-out temperatures.")
 
 
-def fig_model_ii(figs, entry):
+def fig_model_ii(figs, entry, held_out=()):
     fit = entry.fit or {}
-    det = fit.get("details", {})
-    alt = (fit.get("alternatives") or {}).get("paper", {}).get("details", {})
-    paper = det.get("paper") or alt.get("paper")
-    direct = det.get("direct")
-    if not paper and not direct:
+    det = fit.get("details") or {}
+    alt = ((fit.get("alternatives") or {}).get("paper") or {}).get("details") or {}
+    if not (det.get("paper") or alt.get("paper") or det.get("direct")) or not isinstance(entry.model.thermal, ModelII):
         return ""
-    plt = _plt()
-    panels = (2 if paper else 0) + 1
-    fig, axes = plt.subplots(1, panels, figsize=(3.9 * panels, 3.1), squeeze=False)
-    ax_list = list(axes[0])
-    if paper:
-        ax = ax_list.pop(0)
-        T = np.array(paper["temperatures"], float)
-        D = np.array(paper["displacement"], float)
-        ax.plot(T, D * 1e6, "ko", ms=4, label="measured")
-        knots = np.array(paper["displacement_law"]["T"], float)
-        vals = np.array(paper["displacement_law"]["values"], float)
-        ax.plot(knots, vals * 1e6, "-", color="C0", label=f"two segments, break {paper['breakpoint']:.1f} °C")
-        ax.set_xlabel("temperature [°C]")
-        ax.set_ylabel("net displacement [µm]")
-        ax.set_title("displacement vs temperature (Fig. 6)", fontsize=9)
-        ax.legend(fontsize=7, frameon=False)
-        ax = ax_list.pop(0)
-        dF = np.array(paper["dF_grid"], float)
-        Ds = np.array(paper["displacement_vs_dF"], float)
-        lf = paper["linear_fit"]
-        ax.plot(dF, Ds * 1e6, "ko", ms=4, label="simulated")
-        ax.plot(dF, (lf["intercept"] + lf["slope"] * dF) * 1e6, "-", color="C0", label=f"linear, R² = {lf['r2']:.4f}")
-        ax.set_xlabel("thermal-induced friction dF [N]")
-        ax.set_ylabel("net displacement [µm]")
-        ax.set_title("displacement vs dF (Fig. 7)", fontsize=9)
-        ax.legend(fontsize=7, frameon=False)
-    ax = ax_list.pop(0)
-    lo_hi = [30.0, 41.5]
-    if direct:
-        T = np.array(direct["temperatures"], float)
-        v = np.array(direct["dF"], float)
-        se = np.array([float(x) if x not in ("inf", None) else np.nan for x in direct["stderr"]])
-        ax.errorbar(T, v, yerr=np.where(np.isfinite(se), 1.96 * se, 0), fmt="o", ms=4, capsize=2, color="k",
-                    label="per temperature (direct, 95 %)")
-        lo_hi = [T.min(), T.max()]
-    grid = np.linspace(lo_hi[0] - 0.5, lo_hi[1] + 0.5, 200)
-    if isinstance(entry.model.thermal, ModelII):
-        ax.plot(grid, entry.model.thermal.dF(grid), "-", color="C0", label=f"{entry.label}")
-    if paper:
-        law = paper["dF_law"]
-        ax.plot(law["T"], law["values"], "-", color="C2", label="paper's procedure")
-    eq13 = load_model("li2009-model-ii").thermal.dF(grid)  # the paper's Eq. (13)
-    ax.plot(grid, eq13, "--", color="C3", lw=1, label="paper, Eq. (13)")
-    ax.set_xlabel("temperature [°C]")
-    ax.set_ylabel("dF [N]")
-    ax.set_title("thermal-induced friction (Eq. 13)", fontsize=9)
-    ax.legend(fontsize=7, frameon=False)
-    return figs.render(fig, "model-ii", "Model II: the paper's procedure (displacement against temperature with "
-                       "an estimated breakpoint, displacement against dF by simulation) and the direct one "
-                       "(dF fitted per temperature on the trajectories), with the paper's Eq. (13).")
+    fig = plots.model_ii_figure(fit, entry.model, held_out)
+    return figs.render(fig, "model-ii",
+                       f"{entry.label}: the paper's procedure (net displacement against temperature with an "
+                       "estimated breakpoint, Fig. 6; net displacement against dF by simulation, Fig. 7) where it "
+                       "ran, and dF(T): fitted per temperature on the trajectories (direct, 95 % intervals), the "
+                       "fitted piecewise-linear law with its breakpoints, and the paper's Eq. (13) (grey).")
 
 
+__all__ = ["DEFINITIONS", "definitions", "fig_errors", "fig_steps", "fig_displacement", "fig_residuals",
+           "fig_model_i", "fig_model_ii"]

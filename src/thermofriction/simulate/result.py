@@ -80,6 +80,13 @@ class SimulationResult:
             fh.write(",".join(cols) + "\n")
             np.savetxt(fh, table, delimiter=",", fmt="%.12g")
 
+    def plot(self, what=None):
+        """A matplotlib figure against time: the input, displacement, friction force and (when it
+        changes) the temperature; ``what`` names other fields, e.g. ``("velocity", "temperature")``.
+        The figure is not pyplot's: a notebook shows it once, ``fig.savefig(path)`` writes it."""
+        from ..report.plots import simulation_figure
+        return simulation_figure(self, what)
+
     def _repr_html_(self):
         rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
                 ("final displacement", f"{self.displacement[-1] * 1e6:.6g} µm"),

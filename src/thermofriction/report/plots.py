@@ -1,0 +1,615 @@
+"""Figures as matplotlib ``Figure`` objects: one implementation for the HTML report and for the
+``.plot()`` methods of simulation, identification and validation results.
+
+Figures are made without pyplot (``matplotlib.figure.Figure``): making one never opens a window
+or changes the user's backend, a notebook shows a returned figure once, and ``fig.savefig(...)``
+writes it. Every figure uses one visual language:
+
+- temperatures the model was fitted to: a sequential colour scale (viridis), solid lines, filled markers;
+- held-out temperatures: their own colours (reds), dashed lines, open markers, and on temperature
+  axes a pale red band;
+- models: one colour each (blue, green, purple, ...), the same in every figure;
+- the paper's values: grey, dashed.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from ..models import PARAMETER_UNITS, ModelII, load_model
+
+#: font sizes in points; the report draws figures 11 in wide at the card's full width (~1070 px), so
+#: a point renders at ~1.35 px: 9 pt legend text is ~12 px on the page
+STYLE = {"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10.5, "xtick.labelsize": 9.5,
+         "ytick.labelsize": 9.5, "legend.fontsize": 9, "legend.title_fontsize": 9.5, "axes.grid": True,
+         "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
+         "svg.fonttype": "none", "figure.dpi": 100}
+WIDE = 11.0                      # a full-width figure [in]
+HALF = 5.6                       # one of two side by side [in]
+MODEL_COLOURS = ("#1f77b4", "#2ca02c", "#9467bd", "#8c6d31", "#17becf", "#7f7f7f")
+HELD_OUT_COLOURS = ("#d62728", "#ff7f0e", "#e377c2", "#8c564b")
+HELD_OUT_BAND = "#f7c6c5"
+PAPER = dict(color="#555555", ls="--", lw=1.2)
+#: Li et al. (2009) report maximum prediction errors of 7-8 % for their models on the real actuator
+PAPER_ERROR_PCT = (7.0, 8.0)
+
+
+def styled(fn):
+    """Runs a figure function inside the report's style (rcParams are read as artists are made)."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        import matplotlib
+        with matplotlib.rc_context(STYLE):
+            return fn(*args, **kwargs)
+    return wrapper
+
+
+def new_figure(width, height, **subplots):
+    """A pyplot-free figure with constrained layout and its axes (``squeeze=False``)."""
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(width, height), layout="constrained")
+    if subplots.pop("none", False):
+        return fig, None
+    return fig, fig.subplots(squeeze=False, **subplots)
+
+
+def thin(t, y, n=600):
+    """At most ~2n points that keep each bucket's minimum and maximum: a 20 000-sample curve draws
+    the same in a panel a few hundred pixels wide, in a fraction of the file size."""
+    t, y = np.asarray(t), np.asarray(y)
+    if len(t) <= 2 * n:
+        return t, y
+    edges = np.linspace(0, len(t), n + 1).astype(int)
+    idx = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = y[a:b]
+        i, j = a + int(np.argmin(seg)), a + int(np.argmax(seg))
+        idx.extend(sorted({i, j}))
+    idx = np.array(idx)
+    return t[idx], y[idx]
+
+
+# -- the visual language -----------------------------------------------------------------------
+
+def is_held_out(role) -> bool:
+    return role == "validate"
+
+
+def temperature_styles(pairs):
+    """(temperature, role) -> line and marker style: fit temperatures on viridis by value, held-out
+    ones in reds, dashed, with open markers."""
+    import matplotlib
+    fit = sorted({float(T) for T, r in pairs if not is_held_out(r)})
+    held = sorted({float(T) for T, r in pairs if is_held_out(r)})
+    cmap = matplotlib.colormaps["viridis"]
+    lo, hi = (min(fit), max(fit)) if fit else (0.0, 1.0)
+    out = {}
+    for T in fit:
+        c = cmap(0.05 + 0.8 * ((T - lo) / (hi - lo) if hi > lo else 0.5))
+        out[(T, "fit")] = dict(color=c, ls="-", lw=1.3, marker="o", mfc=c, ms=3.2, label=f"{T:.1f} °C", held=False)
+    for i, T in enumerate(held):
+        c = HELD_OUT_COLOURS[i % len(HELD_OUT_COLOURS)]
+        out[(T, "validate")] = dict(color=c, ls="--", lw=2.0, marker="s", mfc="none", ms=4.5,
+                                    label=f"{T:.1f} °C, held out", held=True)
+    return out
+
+
+def style_of(styles, T, role):
+    return styles[(float(T), "validate" if is_held_out(role) else "fit")]
+
+
+def temperature_key(fig, styles, title="temperature", extra=()):
+    """One legend for the figure, outside on the right: fit temperatures, then held-out ones."""
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color=s["color"], ls=s["ls"], lw=s["lw"], marker=s["marker"], mfc=s["mfc"],
+                      ms=s["ms"] + 1, label=s["label"])
+               for _, s in sorted(styles.items(), key=lambda kv: (kv[1]["held"], kv[0][0]))]
+    fig.legend(handles=list(handles) + list(extra), title=title, loc="outside right upper")
+
+
+def mark_held_out(ax, temperatures, label=True):
+    """Pale red bands at held-out temperatures on a temperature axis."""
+    for i, T in enumerate(sorted(set(temperatures))):
+        ax.axvspan(T - 0.15, T + 0.15, color=HELD_OUT_BAND, alpha=0.6, lw=0, zorder=0,
+                   label="held-out temperature" if (label and i == 0) else None)
+
+
+def _grid(n, per_row=3):
+    cols = min(n, per_row)
+    return math.ceil(n / cols), cols
+
+
+def _hide_unused(axes, n):
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+
+
+# -- measured against predicted --------------------------------------------------------------
+
+def _predictions(entries):
+    """[(label, [Prediction])] from [(label, ValidationResult)]."""
+    return [(label, list(v.predictions)) for label, v in entries]
+
+
+def draw_displacement(ax, predictions, styles, markers=None, points=400):
+    """Measured displacement (markers, ~``markers`` per trace: by default 60, fewer when there are
+    many traces, ~600 in a panel) and predicted (lines) per experiment."""
+    markers = markers or int(np.clip(600 // max(len(predictions), 1), 20, 60))
+    order = sorted(predictions, key=lambda p: (is_held_out(p.role), p.temperature))
+    for p in order:
+        s = style_of(styles, p.temperature, p.role)
+        stride = max(len(p.time) // markers, 1)
+        z = 3 if s["held"] else 2
+        ax.plot(p.time[::stride], p.measured[::stride] * 1e6, ls="none", marker=s["marker"], ms=s["ms"],
+                mfc=s["mfc"], mec=s["color"], mew=0.9, zorder=z)
+        ax.plot(*thin(p.time, p.predicted * 1e6, points), ls=s["ls"], lw=s["lw"], color=s["color"], zorder=z + 0.5)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("displacement [µm]")
+
+
+def window_rms(time, residual, windows=50):
+    """(window centres, RMS of the residual in each of ``windows`` equal windows of the run)."""
+    time, residual = np.asarray(time), np.asarray(residual)
+    edges = np.linspace(0, len(time), min(windows, len(time)) + 1).astype(int)
+    centres = np.array([0.5 * (time[a] + time[b - 1]) for a, b in zip(edges[:-1], edges[1:])])
+    rms = np.array([math.sqrt(float(np.mean(residual[a:b] ** 2))) for a, b in zip(edges[:-1], edges[1:])])
+    return centres, rms
+
+
+def noise_level(predictions):
+    """The measurement noise estimated from the data (median over the experiments), or None."""
+    vals = [float(p.fit_quality["noise"]) for p in predictions
+            if p.fit_quality and p.fit_quality.get("noise") is not None
+            and math.isfinite(float(p.fit_quality["noise"]))]
+    return float(np.median(vals)) if vals else None
+
+
+def draw_residuals(ax, predictions, styles, windows=50):
+    """RMS of predicted - measured in short windows, one line per experiment, with the noise level."""
+    for p in sorted(predictions, key=lambda p: (is_held_out(p.role), p.temperature)):
+        s = style_of(styles, p.temperature, p.role)
+        t, r = window_rms(p.time, p.predicted - p.measured, windows)
+        ax.plot(t, r * 1e9, ls=s["ls"], lw=s["lw"], color=s["color"], zorder=3 if s["held"] else 2)
+    noise = noise_level(predictions)
+    if noise:
+        ax.axhline(noise * 1e9, color="k", ls=":", lw=1.2, zorder=4)
+        ax.annotate("noise", (1.0, noise * 1e9), xycoords=("axes fraction", "data"), xytext=(-2, 3),
+                    textcoords="offset points", ha="right", va="bottom", fontsize=9)
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("RMS(predicted − measured) [nm]")
+
+
+def _noise_handle():
+    from matplotlib.lines import Line2D
+    return Line2D([], [], color="k", ls=":", lw=1.2, label="measurement noise\n(estimated from the data)")
+
+
+def _style_handles():
+    from matplotlib.lines import Line2D
+    return [Line2D([], [], color="0.3", ls="none", marker="o", ms=4, label="markers: measured"),
+            Line2D([], [], color="0.3", ls="-", lw=1.3, label="lines: predicted")]
+
+
+@styled
+def displacement_figure(entries):
+    """Measured and predicted displacement, one panel per model: [(label, ValidationResult)]."""
+    preds = _predictions(entries)
+    styles = temperature_styles([(p.temperature, p.role) for _, ps in preds for p in ps])
+    rows, cols = _grid(len(preds))
+    fig, axes = new_figure(WIDE, 3.5 * rows + 0.4, nrows=rows, ncols=cols, sharey=True)
+    for ax, (label, ps) in zip(axes.flat, preds):
+        draw_displacement(ax, ps, styles)
+        ax.set_title(label)
+    for ax in axes[:, 1:].flat:
+        ax.set_ylabel("")
+    _hide_unused(axes, len(preds))
+    temperature_key(fig, styles, extra=_style_handles())
+    return fig
+
+
+@styled
+def residual_figure(entries):
+    """Windowed RMS residuals, one panel per model: [(label, ValidationResult)]."""
+    preds = _predictions(entries)
+    styles = temperature_styles([(p.temperature, p.role) for _, ps in preds for p in ps])
+    rows, cols = _grid(len(preds))
+    fig, axes = new_figure(WIDE, 3.2 * rows + 0.4, nrows=rows, ncols=cols)
+    for ax, (label, ps) in zip(axes.flat, preds):
+        draw_residuals(ax, ps, styles)
+        ax.set_title(label)
+    for ax in axes[:, 1:].flat:
+        ax.set_ylabel("")
+    _hide_unused(axes, len(preds))
+    temperature_key(fig, styles, extra=[_noise_handle()])
+    return fig
+
+
+# -- against temperature ---------------------------------------------------------------------
+
+def _by_temperature(predictions, value):
+    T = np.array([p.temperature for p in predictions], float)
+    v = np.array([value(p) for p in predictions], float)
+    held = np.array([is_held_out(p.role) for p in predictions])
+    order = np.argsort(T, kind="stable")
+    return T[order], v[order], held[order]
+
+
+def _fit_held_handles(color="0.3"):
+    from matplotlib.lines import Line2D
+    return [Line2D([], [], color=color, ls="none", marker="o", ms=6, label="fit temperature"),
+            Line2D([], [], color=color, ls="none", marker="D", mfc="none", mew=1.6, ms=7, label="held out")]
+
+
+def _points(ax, T, v, held, color, label, line=True):
+    ok = np.isfinite(v)
+    if line:
+        ax.plot(T[ok], v[ok], "-", color=color, lw=1.3, label=label, zorder=2)
+    ax.plot(T[~held & ok], v[~held & ok], "o", ms=6, color=color, zorder=3, label=None if line else label)
+    ax.plot(T[held & ok], v[held & ok], "D", ms=7, color=color, mfc="white", mec=color, mew=1.8, zorder=4)
+
+
+METRIC_LABELS = {"max_error_pct": "max error [%]", "final_error_pct": "final error [%]",
+                 "step_error_pct": "step error [%]", "nrmse": "NRMSE", "rmse": "RMSE [nm]"}
+
+
+def draw_errors(ax, entries, metric="max_error_pct", paper=True):
+    """One line per model of ``metric`` against temperature; fit temperatures filled circles,
+    held-out ones open diamonds on a pale red band; the paper's 7-8 % as a grey band."""
+    if metric not in METRIC_LABELS:
+        raise ValueError(f"unknown metric {metric!r}: choose from {', '.join(METRIC_LABELS)}")
+    values = []
+    held_T = set()
+    for i, (label, v) in enumerate(entries):
+        T, e, held = _by_temperature(v.predictions, lambda p: p.rmse * 1e9 if metric == "rmse" else getattr(p, metric))
+        if metric == "final_error_pct":
+            e = np.abs(e)
+        held_T |= set(T[held])
+        values.extend(e[np.isfinite(e)])
+        _points(ax, T, e, held, MODEL_COLOURS[i % len(MODEL_COLOURS)], label)
+    mark_held_out(ax, held_T)
+    if paper and metric == "max_error_pct":
+        ax.axhspan(*PAPER_ERROR_PCT, color="0.6", alpha=0.35, lw=0, zorder=1,
+                   label="Li et al. (2009): 7–8 %")
+        values.extend(PAPER_ERROR_PCT)
+    pos = [x for x in values if x > 0]
+    if pos and max(pos) / min(pos) > 30:  # models that differ by decades: each stays readable
+        from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+        ax.set_yscale("log")
+        ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+    else:
+        ax.set_ylim(bottom=0)
+    ax.set_xlabel("temperature [°C]")
+    ax.set_ylabel(("|final error| [%]" if metric == "final_error_pct" else METRIC_LABELS.get(metric, metric)))
+    handles, labels = ax.get_legend_handles_labels()
+    below(ax, handles + _fit_held_handles())
+
+
+def below(ax, handles):
+    """The panel's legend under its x axis, in columns: nothing of the data hidden."""
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2 if len(handles) > 4 else 1)
+
+
+@styled
+def error_figure(entries, metric="max_error_pct", ax=None, width=HALF):
+    """Error against temperature for each model: [(label, ValidationResult)]. Draws into ``ax`` when
+    given (and returns its figure)."""
+    if ax is not None:
+        draw_errors(ax, entries, metric)
+        return ax.figure
+    fig, axes = new_figure(width, 5.6)
+    draw_errors(axes[0, 0], entries, metric)
+    return fig
+
+
+@styled
+def steps_figure(entries, width=HALF):
+    """Mean step per cycle against temperature, measured and predicted by each model."""
+    from matplotlib.lines import Line2D
+    fig, axes = new_figure(width, 5.6)
+    ax = axes[0, 0]
+    preds = entries[0][1].predictions
+
+    def mean_step(which):
+        return lambda p: np.mean(getattr(p, which)) * 1e6 if getattr(p, which).size else np.nan
+    T, meas, held = _by_temperature(preds, mean_step("measured_steps"))
+    for i, (label, v) in enumerate(entries):
+        Tm, pr, hm = _by_temperature(v.predictions, mean_step("predicted_steps"))
+        _points(ax, Tm, pr, hm, MODEL_COLOURS[i % len(MODEL_COLOURS)], label)
+    ax.plot(T[~held], meas[~held], "o", ms=7, color="k", mfc="none", mew=1.6, zorder=5)
+    ax.plot(T[held], meas[held], "D", ms=8, color="k", mfc="none", mew=1.6, zorder=5)
+    mark_held_out(ax, T[held])
+    ax.set_xlabel("temperature [°C]")
+    ax.set_ylabel("mean step per cycle [µm]")
+    handles, _ = ax.get_legend_handles_labels()
+    handles.insert(0, Line2D([], [], color="k", mfc="none", mew=1.6, ls="none", marker="o", ms=7, label="measured"))
+    below(ax, handles + _fit_held_handles())
+    return fig
+
+
+# -- thermal laws ------------------------------------------------------------------------------
+
+def _float(x):
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return math.nan
+    return x
+
+
+def per_temperature_estimates(fit: dict, name: str):
+    """(T, value, lower, upper) arrays of a Model I parameter's per-temperature estimates and their
+    95 % intervals (NaN where open), from a fit's results (FitResult.to_dict())."""
+    per_T = ((fit or {}).get("details") or {}).get("per_temperature") or []
+    rows = [(r["temperature"], r["parameters"][name]) for r in per_T if name in r.get("parameters", {})]
+    T = np.array([t for t, _ in rows], float)
+    v = np.array([_float(p.get("value")) for _, p in rows])
+    ci = [p.get("ci95") or [None, None] for _, p in rows]
+    lo = np.array([_float(c[0]) for c in ci])
+    hi = np.array([_float(c[1]) for c in ci])
+    return T, v, lo, hi
+
+
+def law_outside_intervals(fit: dict, model) -> dict:
+    """parameter -> temperatures where the (refined) law lies outside the per-temperature 95 % interval."""
+    out = {}
+    for name, law in model.laws.items():
+        T, v, lo, hi = per_temperature_estimates(fit, name)
+        if not T.size:
+            continue
+        at = np.asarray(law(T), float)
+        bad = (np.isfinite(lo) & (at < lo)) | (np.isfinite(hi) & (at > hi))
+        if bad.any():
+            out[name] = [float(x) for x in T[bad]]
+    return out
+
+
+def draw_law(ax, fit, model, name, held_out=(), paper=True):
+    """A Model I parameter against temperature: per-temperature estimates with 95 % intervals,
+    the law through them before refinement, the refined law, the paper's, held-out temperatures."""
+    T, vals, lo, hi = per_temperature_estimates(fit, name)
+    unit = PARAMETER_UNITS.get(name, "")
+    lims = [x for x in vals if math.isfinite(x)]
+    if T.size:
+        # an interval that spans decades (a parameter the data do not determine) would flatten the
+        # panel: it is drawn to the panel's edge instead (an upward triangle)
+        span = np.nanmax(np.abs(vals)) if np.any(np.isfinite(vals)) else 1.0
+        open_hi = ~np.isfinite(hi) | (hi > vals + 3 * span)
+        hi_d = np.where(open_hi, np.nan, hi)
+        yerr = np.vstack([np.clip(vals - lo, 0, None), np.clip(hi_d - vals, 0, None)])
+        yerr = np.where(np.isfinite(yerr), yerr, 0)
+        ax.errorbar(T, vals, yerr=yerr, fmt="o", ms=5, capsize=3, color="k", zorder=4,
+                    label="per temperature, 95 % interval")
+        if open_hi.any():
+            ax.plot(T[open_hi], vals[open_hi], "^", ms=8, color="#ff7f0e", zorder=5, label="interval open upwards")
+        lims += [x for x in np.concatenate([lo, hi_d]) if math.isfinite(x)]
+    lo_T, hi_T = (float(T.min()), float(T.max())) if T.size else (model.laws[name].range or (30.0, 40.0))
+    allT = list(held_out) + ([lo_T, hi_T])
+    grid = np.linspace(min(allT) - 0.5, max(allT) + 0.5, 200)
+    chosen = (((fit or {}).get("details") or {}).get("laws") or {}).get(name, {})
+    first = (chosen.get("candidates") or {}).get(chosen.get("chosen"), {}).get("law")
+    if first:
+        from ..models.laws import law_from_dict
+        try:
+            before = law_from_dict(first, name)
+            ax.plot(grid, before(grid), ":", color=MODEL_COLOURS[0], lw=1.4, label="law through the estimates")
+        except Exception:  # a law the reader does not know: the refined one is still drawn
+            pass
+    law = model.laws.get(name)
+    if law is not None:
+        y = law(grid)
+        ax.plot(grid, y, "-", color=MODEL_COLOURS[0], lw=2, label=f"refined law ({law.kind})", zorder=3)
+        lims += list(y)
+        if T.size:
+            at = np.asarray(law(T), float)
+            bad = (np.isfinite(lo) & (at < lo)) | (np.isfinite(hi) & (at > hi))
+            if bad.any():
+                ax.plot(T[bad], vals[bad], "o", ms=12, mfc="none", mec="#d62728", mew=1.6, zorder=6,
+                        label="law outside the interval")
+    if paper:
+        ref = load_model("li2009-model-i").laws  # the paper's Eqs. (9)-(11)
+        if name in ref:
+            ax.plot(grid, ref[name](grid), label="paper, Eqs. (9)–(11)", **PAPER)
+    mark_held_out(ax, held_out)
+    if lims:  # the paper's law may leave the panel; the data and the fitted law may not
+        a, b = min(lims), max(lims)
+        pad = 0.08 * (b - a if b > a else abs(a) or 1.0)
+        ax.set_ylim(a - pad, b + pad)
+    ax.set_xlabel("temperature [°C]")
+    ax.set_ylabel(f"{name} [{unit}]" if unit else name)
+    ax.set_title(name)
+
+
+@styled
+def laws_figure(fit, model, held_out=(), paper=True):
+    """Model I: every parameter with a law, one panel each (a fit's results dict and its model)."""
+    names = list(model.laws)
+    if not names:
+        return None
+    rows, cols = _grid(len(names))
+    fig, axes = new_figure(WIDE, 3.6 * rows + 0.3, nrows=rows, ncols=cols)
+    for ax, n in zip(axes.flat, names):
+        draw_law(ax, fit, model, n, held_out, paper)
+    _hide_unused(axes, len(names))
+    handles, labels = {}, []
+    for ax in axes.flat[:len(names)]:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    fig.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
+    return fig
+
+
+def draw_dF(ax, fit, model, label="fitted dF(T)", held_out=(), paper=True):
+    """Model II's dF(T): per-temperature (direct) estimates, the fitted law with its breakpoints,
+    the paper's procedure's law and Eq. (13)."""
+    det = (fit or {}).get("details") or {}
+    alt = (((fit or {}).get("alternatives") or {}).get("paper") or {}).get("details") or {}
+    procedure = det.get("paper") or alt.get("paper")
+    direct = det.get("direct")
+    Ts = list(held_out)
+    if direct:
+        T = np.array(direct["temperatures"], float)
+        v = np.array(direct["dF"], float)
+        se = np.array([_float(x) for x in direct["stderr"]])
+        ax.errorbar(T, v, yerr=np.where(np.isfinite(se), 1.96 * se, 0), fmt="o", ms=5, capsize=3, color="k",
+                    zorder=4, label="per temperature (direct), 95 % interval")
+        Ts += list(T)
+    dF = model.thermal.dF if isinstance(model.thermal, ModelII) else None
+    if dF is not None and getattr(dF, "range", None):
+        Ts += list(dF.range)
+    if not Ts:
+        Ts = [30.0, 41.5]
+    grid = np.linspace(min(Ts) - 0.5, max(Ts) + 0.5, 200)
+    if dF is not None:
+        ax.plot(grid, dF(grid), "-", color=MODEL_COLOURS[0], lw=2, label=label, zorder=3)
+        if dF.kind in ("pwl", "table"):
+            ax.plot(dF.T, dF.values, "s", ms=7, color=MODEL_COLOURS[0], zorder=5, label="breakpoints")
+            for t, y in zip(dF.T, dF.values):
+                ax.annotate(f"{t:.1f} °C", (t, y), xytext=(4, 6), textcoords="offset points", fontsize=9,
+                            color=MODEL_COLOURS[0])
+    if procedure:
+        law = procedure["dF_law"]
+        ax.plot(law["T"], law["values"], "-", color=MODEL_COLOURS[1], lw=1.4, label="the paper's procedure")
+    if paper:
+        ax.plot(grid, load_model("li2009-model-ii").thermal.dF(grid), label="paper, Eq. (13)", **PAPER)
+    mark_held_out(ax, held_out)
+    ax.set_xlabel("temperature [°C]")
+    ax.set_ylabel("dF [N]")
+    ax.set_title("thermal-induced friction dF(T)")
+
+
+@styled
+def model_ii_figure(fit, model, held_out=(), paper=True):
+    """Model II: the paper's procedure (displacement against temperature, against dF) when it ran,
+    and dF(T)."""
+    det = (fit or {}).get("details") or {}
+    alt = (((fit or {}).get("alternatives") or {}).get("paper") or {}).get("details") or {}
+    procedure = det.get("paper") or alt.get("paper")
+    if not procedure and not det.get("direct") and not isinstance(model.thermal, ModelII):
+        return None
+    panels = 3 if procedure else 1
+    fig, axes = new_figure(WIDE if procedure else HALF + 1.5, 3.9, nrows=1, ncols=panels)
+    axl = list(axes[0])
+    if procedure:
+        ax = axl.pop(0)
+        T = np.array(procedure["temperatures"], float)
+        D = np.array(procedure["displacement"], float)
+        ax.plot(T, D * 1e6, "ko", ms=5, label="measured")
+        knots = np.array(procedure["displacement_law"]["T"], float)
+        vals = np.array(procedure["displacement_law"]["values"], float)
+        ax.plot(knots, vals * 1e6, "-", color=MODEL_COLOURS[1],
+                label=f"two segments,\nbreak at {procedure['breakpoint']:.1f} °C")
+        mark_held_out(ax, held_out, label=False)
+        ax.set_xlabel("temperature [°C]")
+        ax.set_ylabel("net displacement [µm]")
+        ax.set_title("displacement vs temperature (Fig. 6)")
+        ax.legend(loc="best")
+        ax = axl.pop(0)
+        dFg = np.array(procedure["dF_grid"], float)
+        Ds = np.array(procedure["displacement_vs_dF"], float)
+        lf = procedure["linear_fit"]
+        ax.plot(dFg, Ds * 1e6, "ko", ms=5, label="simulated")
+        ax.plot(dFg, (lf["intercept"] + lf["slope"] * dFg) * 1e6, "-", color=MODEL_COLOURS[1],
+                label=f"linear, R² = {lf['r2']:.4f}")
+        ax.set_xlabel("dF [N]")
+        ax.set_ylabel("net displacement [µm]")
+        ax.set_title("displacement vs dF (Fig. 7)")
+        ax.legend(loc="best")
+    ax = axl.pop(0)
+    draw_dF(ax, fit, model, held_out=held_out, paper=paper)
+    fig.legend(handles=ax.get_legend_handles_labels()[0], loc="outside right upper")
+    return fig
+
+
+# -- the result objects' .plot() ---------------------------------------------------------------
+
+def _held_out_temperatures(predictions):
+    return sorted({p.temperature for p in predictions if is_held_out(p.role)})
+
+
+@styled
+def fit_figure(fit, validation=None, paper=False):
+    """An identification result (FitResult or its dict with ``model``): measured vs predicted and
+    residual RMS (when ``validation`` of its model on the data is given), and its thermal law(s)
+    with the per-temperature estimates and intervals."""
+    from ..models import Model
+    from ..models.model import model_from_dict
+    d = fit.to_dict() if hasattr(fit, "to_dict") else fit
+    model = fit.model if isinstance(getattr(fit, "model", None), Model) else model_from_dict(d["model"])
+    laws = list(model.laws)
+    model_ii = isinstance(model.thermal, ModelII)
+    law_panels = len(laws) + (1 if model_ii else 0)
+    rows = (1 if validation is not None else 0) + (1 if law_panels else 0)
+    if rows == 0:
+        raise ValueError("nothing to plot: this fit has no thermal law; give its validation on the data "
+                         "(fit.plot(data)) to see measured against predicted")
+    fig, _ = new_figure(WIDE, 3.7 * rows + 0.3, none=True)
+    subs = fig.subfigures(rows, 1, squeeze=False)[:, 0] if rows > 1 else [fig]
+    held = []
+    k = 0
+    if validation is not None:
+        preds = list(validation.predictions)
+        held = _held_out_temperatures(preds)
+        styles = temperature_styles([(p.temperature, p.role) for p in preds])
+        sub = subs[k]
+        k += 1
+        a = sub.subplots(1, 2)
+        draw_displacement(a[0], preds, styles)
+        a[0].set_title("measured (markers) and predicted (lines)")
+        draw_residuals(a[1], preds, styles)
+        a[1].set_title("residual RMS over 2 % windows of the run")
+        temperature_key(sub, styles, extra=[_noise_handle()])
+    if law_panels:
+        sub = subs[k]
+        a = sub.subplots(1, max(law_panels, 2) if rows > 1 else law_panels, squeeze=False)[0]
+        for ax, n in zip(a, laws):
+            draw_law(ax, d, model, n, held, paper)
+        if model_ii:
+            draw_dF(a[len(laws)], d, model, held_out=held, paper=paper)
+        for ax in a[law_panels:]:
+            ax.set_visible(False)
+        handles = {}
+        for ax in a[:law_panels]:
+            for h, lab in zip(*ax.get_legend_handles_labels()):
+                handles.setdefault(lab, h)
+        sub.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
+    return fig
+
+
+@styled
+def simulation_figure(result, what=None):
+    """A simulation result against time: input, displacement, friction force, and the temperature
+    when it changes (``what`` picks the panels by field name)."""
+    panels = list(what) if what else ["input", "displacement", "friction_force"]
+    if what is None and np.ptp(result.temperature) > 1e-9:
+        panels.append("temperature")
+    scales = {"input": (1.0, f"input [{result.input_unit}]"), "displacement": (1e6, "displacement [µm]"),
+              "velocity": (1e3, "velocity [mm/s]"), "friction_force": (1.0, "friction force [N]"),
+              "temperature": (1.0, "temperature [°C]"), "relative_displacement": (1e6, "x_e − x_p [µm]"),
+              "stage_displacement": (1e6, "stage displacement [µm]")}
+    for p in panels:
+        if p not in scales or getattr(result, p, None) is None:
+            raise ValueError(f"cannot plot {p!r}: choose from "
+                             f"{', '.join(k for k in scales if getattr(result, k, None) is not None)}")
+    fig, axes = new_figure(9.0, 1.9 * len(panels) + 0.5, nrows=len(panels), ncols=1, sharex=True)
+    for ax, p in zip(axes[:, 0], panels):
+        scale, label = scales[p]
+        ax.plot(*thin(result.time, getattr(result, p) * scale, 1500), lw=1.1, color=MODEL_COLOURS[0])
+        if p == "displacement" and result.stage_displacement is not None:
+            ax.plot(*thin(result.time, result.stage_displacement * 1e6, 1500), lw=0.9, color="0.55",
+                    label="stage")
+            ax.lines[0].set_label("end effector")
+            ax.legend(loc="best")
+        ax.set_ylabel(label)
+    axes[-1, 0].set_xlabel("time [s]")
+    return fig
+
+
+__all__ = ["STYLE", "displacement_figure", "residual_figure", "error_figure", "steps_figure", "laws_figure",
+           "model_ii_figure", "fit_figure", "simulation_figure", "law_outside_intervals", "temperature_styles",
+           "window_rms"]
