@@ -270,7 +270,7 @@ def parameter_section(entries, fit_T) -> str:
     return ("<section><h2>Identified parameters</h2>" + "".join(out) + "</section>") if out else ""
 
 
-def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
+def render(entries, data, *, figures_dir=None, command=None, title=None, truth=None) -> str:
     exps = list(getattr(data, "experiments", data))
     if not any(getattr(e, "role", "fit") == "validate" for e in exps):
         raise InputError("the dataset has no experiment with role 'validate': a report compares predictions at "
@@ -339,6 +339,8 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
                  "<p class='note'>e = x_sim − x_meas at each sample: the predicted minus the measured end-effector "
                  "displacement, both starting from zero (the measurement's arbitrary zero matched on the first 1 % "
                  "of the run). Held-out rows are shaded.</p>" + definitions(*EXPERIMENT_COLUMNS[4:]) + "</section>")
+    if truth:
+        parts.append(truth_section(truth))
     fit_T = float(np.mean([e.temperature for e in exps if getattr(e, "role", "fit") != "validate"] or
                           [e.temperature for e in exps]))
     parts.append(parameter_section(entries, fit_T))
@@ -355,9 +357,28 @@ def render(entries, data, *, figures_dir=None, command=None, title=None) -> str:
             f"{len(exps)} experiments</p></header><main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
 
 
-def report(models, data, path, *, figures_dir=None, command=None, title=None) -> str:
+def truth_section(truth: dict) -> str:
+    """Data made from a known model (the demo, a study): whether each fit's 95 % intervals cover it, or
+    why a fit cannot be compared with it. ``truth``: label -> FitResult.recovery summary."""
+    parts = []
+    for label, rec in truth.items():
+        parts.append(f"<p><b>{html.escape(label)}</b>: {html.escape(rec['summary'])}.</p>")
+        rows = [[r["parameter"], _fmt(r["temperature"], "{:.4g}"), _fmt(r["truth"], "{:.5g}"),
+                 _fmt(r["value"], "{:.5g}"), f"[{r['lower']:.5g}, {r['upper']:.5g}]",
+                 "yes" if r["covered"] else "NO"] for r in rec.get("rows", [])]
+        if rows:
+            parts.append(_table(["parameter", "temperature [°C]", "truth", "fitted", "95 % interval", "covered"],
+                                rows, text=(0, 5)))
+    return ("<section><h2>Against the truth</h2><p class='note'>These data were made by simulation from a known "
+            "model: each fitted law at the fit temperatures, with its 95 % interval (delta method over the fitted "
+            "coefficients and breakpoints), against the truth. About 1 point in 20 outside its interval is what a "
+            "95 % interval means.</p>" + "".join(parts) + "</section>")
+
+
+def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None) -> str:
     """Writes the HTML report comparing ``models`` (Model, FitResult, or (label, Model, fit dict)
-    entries) on ``data``; returns the HTML."""
+    entries) on ``data``; returns the HTML. ``truth`` (label -> FitResult.recovery summary, for data
+    made from a known model) adds a section saying whether the fits recover it."""
     entries = []
     for m in models:
         if isinstance(m, Entry):
@@ -372,7 +393,8 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None) ->
             entries.append(Entry(label, model, fit))
     if not entries:
         raise InputError("give at least one model")
-    text = render(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title)
+    text = render(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title,
+                  truth=truth)
     with atomic_write(path, "w", encoding="utf-8") as fh:
         fh.write(text)
     return text
