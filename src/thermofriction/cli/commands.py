@@ -42,7 +42,11 @@ def cmd_simulate(args) -> int:
         sys.stdout.flush()  # a write error (a full disk) is reported here, as one line (main)
         return 0
     if args.output:
-        res.to_csv(_target(args, "output"))
+        from ..data.matlab import is_matlab, simulation_to_mat
+        if is_matlab(args.output):  # docs/formats.md#matlab-files
+            simulation_to_mat(res, _target(args, "output"))
+        else:
+            res.to_csv(_target(args, "output"))
     out = sys.stdout
     name = model.name or args.model
     if model.heat is not None:  # the temperature is a state: say where it went
