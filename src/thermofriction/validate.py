@@ -158,7 +158,7 @@ class ValidationResult:
         return dump_json(self.to_dict(), path)
 
     _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
-                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm], offset removed", "rmse_offset_removed", "{:.4g}"),
+                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm]", "rmse_offset_removed", "{:.4g}"),
                 ("NRMSE", "nrmse", "{:.3g}"), ("final error [%]", "final_error_pct", "{:+.3g}"),
                 ("step error [%]", "step_error_pct", "{:.3g}"))
 
@@ -177,13 +177,23 @@ class ValidationResult:
     def print_table(self, title=None):
         """A rich table on the terminal."""
         from rich.console import Console
+        from rich.markup import escape
+        from rich.measure import Measurement
         from rich.table import Table
-        t = Table(title=title or f"Validation of {self.model.name or 'the model'}")
+        # (escaped: rich would take "[nm]" in a header, or brackets in a file name, for markup)
+        t = Table(title=escape(title or f"Validation of {self.model.name or 'the model'}"),
+                  caption="RMSE: each experiment's constant offset removed; NRMSE = RMSE / measured span; "
+                          "definitions: docs/formats.md#validation-metrics")
         for name, _, _ in self._COLUMNS:
-            t.add_column(name, justify="left" if name in ("file", "role") else "right")
+            t.add_column(escape(name), justify="left" if name in ("file", "role") else "right", no_wrap=True)
         for r in self.rows():
-            t.add_row(*r)
-        Console().print(t)
+            t.add_row(*map(escape, r))
+        console = Console()
+        # never cut a file name to fit 80 columns (a pipe, a CI log): the table as wide as it needs
+        width = Measurement.get(console, console.options.update_width(10_000), t).maximum
+        if width > console.width:
+            console = Console(width=width)
+        console.print(t)
 
     def _repr_html_(self):
         head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)

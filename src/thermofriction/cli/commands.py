@@ -116,6 +116,8 @@ def cmd_identify(args) -> int:
     finally:
         if status is not None:
             status.stop()
+    import shlex
+    fit = fit.with_command("thermofriction " + shlex.join(sys.argv[1:]))  # in the model's [provenance]
     with _io.publish_together():  # the model and its JSON appear together, or neither
         if args.output:
             fit.model.save(_target(args, "output"))
