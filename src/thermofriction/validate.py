@@ -198,7 +198,16 @@ class ValidationResult:
     def _repr_html_(self):
         head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.rows())
-        return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+        summary = "; ".join(f"{role}: max error {s['max_error_pct']:.3g} %, RMSE {s['rmse_offset_removed'] * 1e9:.4g} nm "
+                            f"({s['n']} run{'s' if s['n'] != 1 else ''})" for role, s in self.summary().items())
+        notes = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
+        notes += "".join(f"<li>{html.escape(f.file)}: not predicted: {html.escape(f.reason)}</li>" for f in self.failures)
+        return (f"<div><b>Validation of {html.escape(self.model.name or 'the model')}</b> — {html.escape(summary)}"
+                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+                f"<small>RMSE: each experiment's constant offset removed; NRMSE = RMSE / measured span; max error: "
+                f"100 max|error| / measured span; final error: of the net displacement; step error: mean per input "
+                f"period (docs/formats.md#validation-metrics)</small>"
+                + (f"<ul>{notes}</ul>" if notes else "") + "</div>")
 
 
 def validate(model: Model, data, experiments=None) -> ValidationResult:

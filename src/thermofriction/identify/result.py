@@ -166,8 +166,16 @@ class FitResult:
         head = "".join(f"<th>{h}</th>" for h in ("name", "value", "stderr", "rel", "95 % interval", "unit"))
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self._rows())
         warn = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
-        return (f"<div><b>Fit: {html.escape(self.method)}</b> — {'converged' if self.success else 'not converged'}, "
-                f"rmse {self.rmse * 1e9:.4g} nm, {self.wall_time:.3g} s"
+        q = self.fit_quality
+        quality = "" if q is None else (f", noise {q['noise'] * 1e9:.4g} nm: rmse/noise {q['ratio']:.3g}, "
+                                        f"{'adequate' if q['adequate'] else '<b>NOT adequate</b>'}")
+        rmse = "" if self.n_points == 0 else f", rmse {self.rmse * 1e9:.4g} nm"
+        prov = self.model.provenance or {}
+        origin = (f"<br><small>{html.escape(self.model.name or '')}: data sha256 {html.escape(prov['data_sha256'][:12])}…, "
+                  f"{html.escape(prov.get('date', ''))}, thermofriction {html.escape(prov.get('thermofriction', ''))}"
+                  f"</small>") if prov.get("data_sha256") else ""
+        return (f"<div><b>Fit: {html.escape(self.method)}</b> — {'converged' if self.success else 'not converged'}"
+                f"{rmse}{quality}, {self.wall_time:.3g} s{origin}"
                 f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
                 + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
 
