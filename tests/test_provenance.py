@@ -103,7 +103,7 @@ def test_changing_a_data_file_changes_the_hash(tmp_path):
     ('method = "base"\ncolour = "red"', ["[provenance]", "colour"]),
     ("method = 3", ["[provenance]", "'method' must be a string"]),
     ('fit_files = "a.csv"', ["'fit_files' must be a list"]),
-    ("options = { starts = { a = 1 } }", ["options 'starts'"]),
+    ("options = { starts = { a = [1] } }", ["options 'starts'"]),
 ])
 def test_malformed_provenance_is_refused_by_name(tmp_path, table, words):
     text = tf.load_model("li2009-base").to_toml() + "\n[provenance]\n" + table + "\n"
@@ -112,3 +112,17 @@ def test_malformed_provenance_is_refused_by_name(tmp_path, table, words):
         tf.load_model(tmp_path / "m.toml")
     for w in words:
         assert w in str(info.value), str(info.value)
+
+
+def test_every_identify_option_fits_in_the_model_file(tmp_path):
+    """Options of every shape (a table of law kinds, a list of plant parameters) go into [provenance]
+    and the file loads again."""
+    ds = tf.synthesize(tf.load_model("li2009-model-i"), [31.0, 40.5], duration=0.2, sample_rate=2000, noise=20e-9,
+                       seed=9)
+    fit = tf.identify(ds, method="model-i", starts=1, laws={"sigma0": "exp", "fc": "linear"}, free=["m_e"],
+                      refine=False)
+    opts = fit.model.provenance["options"]
+    assert opts["laws"] == {"sigma0": "exp", "fc": "linear"} and opts["free"] == ["m_e"]
+    assert fit.model.provenance["data"] == "experiments in memory"
+    fit.model.save(tmp_path / "m.toml")
+    assert tf.load_model(tmp_path / "m.toml").provenance == fit.model.provenance

@@ -253,6 +253,11 @@ def stamp(fit, data, method: str, init, options: dict):
     label = _label(data)
     temps = ", ".join(f"{e.temperature:.4g}" for e in fit_runs)
     opts = {k: _option(v) for k, v in options.items() if v is not None and v != () and v != []}
+
+    def plain(x):  # what the model file's [provenance] holds; anything else as its text (never fail a fit here)
+        items = list(x.values()) if isinstance(x, dict) else x if isinstance(x, list) else [x]
+        return x if all(isinstance(i, (str, bool, int, float)) for i in items) else str(x)
+    opts = {k: plain(v) for k, v in opts.items()}
     date = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
     init_name = init.name or "a Model object" if isinstance(init, Model) else str(init)
 

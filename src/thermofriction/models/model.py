@@ -220,11 +220,11 @@ def check_provenance(p, where="[provenance]") -> dict:
         elif key == "options":
             if not isinstance(value, dict):
                 raise InputError(f"{where}: 'options' must be a table, got {shorten(value)}")
-            for k, x in value.items():
-                items = x if isinstance(x, (list, tuple)) else [x]
+            for k, x in value.items():  # e.g. starts = 8, free = ["m_e"], laws = { fc = "linear" }
+                items = list(x.values()) if isinstance(x, dict) else x if isinstance(x, (list, tuple)) else [x]
                 if not all(isinstance(i, (str, bool, int, float)) for i in items):
-                    raise InputError(f"{where}: options '{k}' must be a string, number, true/false or a list of "
-                                     f"them, got {shorten(x)}")
+                    raise InputError(f"{where}: options '{k}' must be a string, number, true/false, or a list or "
+                                     f"table of them, got {shorten(x)}")
         elif not isinstance(value, str):
             raise InputError(f"{where}: '{key}' must be a string, got {shorten(value)}")
     return p
