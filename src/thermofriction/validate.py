@@ -158,7 +158,7 @@ class ValidationResult:
         return dump_json(self.to_dict(), path)
 
     _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
-                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm], offset removed", "rmse_offset_removed", "{:.4g}"),
+                ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm]", "rmse_offset_removed", "{:.4g}"),
                 ("NRMSE", "nrmse", "{:.3g}"), ("final error [%]", "final_error_pct", "{:+.3g}"),
                 ("step error [%]", "step_error_pct", "{:.3g}"))
 
@@ -177,13 +177,23 @@ class ValidationResult:
     def print_table(self, title=None):
         """A rich table on the terminal."""
         from rich.console import Console
+        from rich.markup import escape
+        from rich.measure import Measurement
         from rich.table import Table
-        t = Table(title=title or f"Validation of {self.model.name or 'the model'}")
+        # (escaped: rich would take "[nm]" in a header, or brackets in a file name, for markup)
+        t = Table(title=escape(title or f"Validation of {self.model.name or 'the model'}"),
+                  caption="RMSE: each experiment's constant offset removed; NRMSE = RMSE / measured span; "
+                          "definitions: docs/formats.md#validation-metrics")
         for name, _, _ in self._COLUMNS:
-            t.add_column(name, justify="left" if name in ("file", "role") else "right")
+            t.add_column(escape(name), justify="left" if name in ("file", "role") else "right", no_wrap=True)
         for r in self.rows():
-            t.add_row(*r)
-        Console().print(t)
+            t.add_row(*map(escape, r))
+        console = Console()
+        # never cut a file name to fit 80 columns (a pipe, a CI log): the table as wide as it needs
+        width = Measurement.get(console, console.options.update_width(10_000), t).maximum
+        if width > console.width:
+            console = Console(width=width)
+        console.print(t)
 
     def plot(self, metric="max_error_pct", ax=None, label=None):
         """A matplotlib figure of ``metric`` (max_error_pct, final_error_pct, step_error_pct, nrmse,
@@ -195,7 +205,16 @@ class ValidationResult:
     def _repr_html_(self):
         head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.rows())
-        return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+        summary = "; ".join(f"{role}: max error {s['max_error_pct']:.3g} %, RMSE {s['rmse_offset_removed'] * 1e9:.4g} nm "
+                            f"({s['n']} run{'s' if s['n'] != 1 else ''})" for role, s in self.summary().items())
+        notes = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
+        notes += "".join(f"<li>{html.escape(f.file)}: not predicted: {html.escape(f.reason)}</li>" for f in self.failures)
+        return (f"<div><b>Validation of {html.escape(self.model.name or 'the model')}</b> — {html.escape(summary)}"
+                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+                f"<small>RMSE: each experiment's constant offset removed; NRMSE = RMSE / measured span; max error: "
+                f"100 max|error| / measured span; final error: of the net displacement; step error: mean per input "
+                f"period (docs/formats.md#validation-metrics)</small>"
+                + (f"<ul>{notes}</ul>" if notes else "") + "</div>")
 
 
 def validate(model: Model, data, experiments=None) -> ValidationResult:

@@ -42,7 +42,11 @@ def cmd_simulate(args) -> int:
         sys.stdout.flush()  # a write error (a full disk) is reported here, as one line (main)
         return 0
     if args.output:
-        res.to_csv(_target(args, "output"))
+        from ..data.matlab import is_matlab, simulation_to_mat
+        if is_matlab(args.output):  # docs/formats.md#matlab-files
+            simulation_to_mat(res, _target(args, "output"))
+        else:
+            res.to_csv(_target(args, "output"))
     out = sys.stdout
     name = model.name or args.model
     if model.heat is not None:  # the temperature is a state: say where it went
@@ -112,6 +116,8 @@ def cmd_identify(args) -> int:
     finally:
         if status is not None:
             status.stop()
+    import shlex
+    fit = fit.with_command("thermofriction " + shlex.join(sys.argv[1:]))  # in the model's [provenance]
     with _io.publish_together():  # the model and its JSON appear together, or neither
         if args.output:
             fit.model.save(_target(args, "output"))

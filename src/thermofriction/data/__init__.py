@@ -11,8 +11,9 @@ from .csv import read_experiment_csv
 from .experiments import (MAX_ROWS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, ROLES, SAMPLING_TOLERANCE, TEMPERATURE_RANGE,
                           TEMPERATURE_VARIES, Dataset, Experiment, max_rows)
 from .files import load_dataset, save_dataset
+from .matlab import read_experiment_mat
 from .synth import add_synth_command, cmd_synth, synthesize
 
-__all__ = ["Experiment", "Dataset", "read_experiment_csv", "load_dataset", "save_dataset", "synthesize",
+__all__ = ["Experiment", "Dataset", "read_experiment_csv", "read_experiment_mat", "load_dataset", "save_dataset", "synthesize",
            "add_synth_command", "cmd_synth", "max_rows", "MAX_ROWS", "MAX_ROWS_ENV", "MIN_SAMPLES", "REQUIRED", "ROLES",
            "SAMPLING_TOLERANCE", "TEMPERATURE_RANGE", "TEMPERATURE_VARIES"]

@@ -147,48 +147,70 @@ def read_experiment_csv(path, with_headers: bool = False) -> dict:
         arr = _scan(path, body, cols)
     n = arr.shape[0]
 
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        r, j = (int(v) for v in np.argwhere(bad)[0])
-        raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cols[j][2]}): "
-                         f"not a finite number ({float(arr[r, j])})")
     if n < MIN_SAMPLES:
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            r, j = (int(v) for v in np.argwhere(bad)[0])
+            raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cols[j][2]}): "
+                             f"not a finite number ({float(arr[r, j])})")
         raise InputError(f"{path}: {n} data row{'s' if n != 1 else ''}; an experiment needs at least "
                          f"{MIN_SAMPLES} samples")
-    out = {name: arr[:, j] * scale for j, (name, scale, _) in enumerate(cols)}
-    for j, (name, _, cell) in enumerate(cols):
+    index = {name: j for j, (name, _, _) in enumerate(cols)}
+
+    def where(name, row, short=False):
+        if short:
+            return f"line {_line_of(body, row)}"
+        j = index[name]
+        return f"line {_line_of(body, row)}, column {j + 1} ({cols[j][2]})"
+
+    out = check_columns(path, {name: arr[:, j] for j, (name, _, _) in enumerate(cols)},
+                        {name: scale for name, scale, _ in cols}, where)
+    if with_headers:  # the header cells, for a dataset's plausibility checks
+        return out, {c[0]: c[2] for c in cols}
+    return out
+
+
+def check_columns(path, raw: dict, scale: dict, where) -> dict:
+    """The rules every experiment file obeys (docs/formats.md#experiment-files), on its columns in
+    the file's units (``raw``: name -> array; ``scale``: name -> factor to SI): every value finite
+    and within the limits, time strictly increasing and uniformly sampled, plausible temperatures.
+    Returns the columns in SI units. ``where(name, row)`` says where a value is (``short=True``:
+    the row alone), for the one InputError."""
+    names = list(raw)
+    first = [(int(np.argmax(~np.isfinite(raw[c]))), k) for k, c in enumerate(names) if not np.isfinite(raw[c]).all()]
+    if first:  # the first bad value row by row, as a reader meets it
+        r, k = min(first)
+        raise InputError(f"{path}: {where(names[k], r)}: not a finite number ({float(raw[names[k]][r])})")
+    out = {name: np.asarray(raw[name], float) * scale[name] for name in names}
+    for name in names:
         limit = TIME_LIMIT if name == "time" else VALUE_LIMIT
         big = np.abs(out[name]) > limit
         if big.any():
             r = int(np.argmax(big))
-            raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cell}): {float(out[name][r]):g} "
+            raise InputError(f"{path}: {where(name, r)}: {float(out[name][r]):g} "
                              f"{_SI[name]} is beyond the limit of {limit:g} {_SI[name]} in magnitude"
                              + (" (the simulator's time limit)" if name == "time" else
                                 " (the metrics and the fit square the values: they would overflow)"))
-    jt = [c[0] for c in cols].index("time")
     t = out["time"]
     dt = np.diff(t)
     if np.any(dt <= 0):
         i = int(np.argmax(dt <= 0))
-        raise InputError(f"{path}: line {_line_of(body, i + 1)}, column {jt + 1} ({cols[jt][2]}): time must "
-                         f"increase strictly ({float(arr[i + 1, jt]):.10g} after {float(arr[i, jt]):.10g} "
-                         f"on line {_line_of(body, i)})")
+        raise InputError(f"{path}: {where('time', i + 1)}: time must increase strictly "
+                         f"({float(raw['time'][i + 1]):.10g} after {float(raw['time'][i]):.10g} "
+                         f"on {where('time', i, short=True)})")
     med = float(np.median(dt))
     irregular = np.abs(dt - med) > SAMPLING_TOLERANCE * med
     if np.any(irregular):
         i = int(np.argmax(irregular))
-        raise InputError(f"{path}: line {_line_of(body, i + 1)}, column {jt + 1} ({cols[jt][2]}): irregular "
+        raise InputError(f"{path}: {where('time', i + 1)}: irregular "
                          f"sampling: interval {dt[i]:.6g} s, median {med:.6g} s (the intervals may differ "
                          f"by at most {100 * SAMPLING_TOLERANCE:g} %)")
     if "temperature" in out:
-        jT = [c[0] for c in cols].index("temperature")
         T = out["temperature"]
         lo, hi = TEMPERATURE_RANGE
         bad = (T < lo) | (T > hi)
         if np.any(bad):
             i = int(np.argmax(bad))
-            raise InputError(f"{path}: line {_line_of(body, i)}, column {jT + 1} ({cols[jT][2]}): {float(T[i]):g} C "
+            raise InputError(f"{path}: {where('temperature', i)}: {float(T[i]):g} C "
                              f"is not a plausible temperature (expected {lo:g} to {hi:g} C{kelvin_hint(float(T[i]))})")
-    if with_headers:  # the header cells, for a dataset's plausibility checks
-        return out, {c[0]: c[2] for c in cols}
     return out

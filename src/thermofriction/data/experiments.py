@@ -58,6 +58,8 @@ class Experiment:
     role: str = "fit"
     description: str = ""
     input: Waveform | None = None
+    #: in a MATLAB file holding several runs, the struct holding this one (docs/formats.md#matlab-files)
+    struct: str | None = None
 
     @property
     def sample_rate(self) -> float:

@@ -20,7 +20,7 @@ from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "experiment")
-_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input")
+_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units")
 
 
 def _is_inside(f: str) -> bool:
@@ -146,12 +146,13 @@ def load_dataset(path) -> Dataset:
                 inp = parse_waveform(e["input"])
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
-        cols, headers = read_experiment_csv(folder / f, with_headers=True)
+        cols, headers = _read_experiment(folder / f, e, where)
         for column in ("displacement", "stage_displacement"):  # a parser reads any numbers; a dataset is physics
             if column in cols:
-                problem = displacement_problem(cols[column], headers[column].partition("[")[2].rstrip("]"))
+                label, unit = headers[column]
+                problem = displacement_problem(cols[column], unit)
                 if problem:
-                    raise InputError(f"{folder / f}: column {headers[column]}: {problem}")
+                    raise InputError(f"{folder / f}: {label}: {problem}")
         cols["time"], inp = _from_zero(cols["time"], inp)
         sig = cols.get("temperature")
         if T is None:
@@ -161,8 +162,32 @@ def load_dataset(path) -> Dataset:
         exps.append(Experiment(file=f, time=cols["time"], voltage=cols["voltage"], displacement=cols["displacement"],
                                temperature=T, temperature_signal=sig,
                                stage_displacement=cols.get("stage_displacement"), role=role, description=desc,
-                               input=inp))
+                               input=inp, struct=e.get("struct")))
     return Dataset(path=folder, name=name, description=description, experiments=exps)
+
+
+def _read_experiment(path: Path, entry: dict, where: str):
+    """An experiment file's columns (SI) and, per column, (where it is, its unit): a CSV file, or a
+    MATLAB file (docs/formats.md#matlab-files) with the entry's optional 'struct' and 'units'."""
+    from .matlab import is_matlab, read_experiment_mat
+    if not is_matlab(path):
+        for key in ("struct", "units"):
+            if key in entry:
+                raise InputError(f"{where}: '{key}' applies to MATLAB files (.mat) only; a CSV file declares its "
+                                 f"units in its header")
+        cols, headers = read_experiment_csv(path, with_headers=True)
+        return cols, {k: (f"column {h}", h.partition("[")[2].rstrip("]")) for k, h in headers.items()}
+    struct, units = entry.get("struct"), entry.get("units")
+    if struct is not None and (not isinstance(struct, str) or not struct.isidentifier()):
+        raise InputError(f"{where}: 'struct' must be the name of a struct variable in {entry['file']}, got {struct!r}")
+    if units is not None and not isinstance(units, dict):
+        raise InputError(f"{where}: 'units' must be a table such as {{ displacement = \"um\" }}, got {units!r}")
+    try:
+        return read_experiment_mat(path, struct=struct, units=units, with_headers=True)
+    except InputError as err:
+        if str(err).startswith(f"{path}: units:"):  # the manifest's table: say where it is
+            raise InputError(f"{where}: {str(err)[len(str(path)) + 2:]}") from None
+        raise
 
 
 def check_dataset_folder(folder, overwrite=False, hint="overwrite=True"):
@@ -218,7 +243,8 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     for f in files:
         if not isinstance(f, str) or not _is_inside(f):
             raise InputError(f"experiment file '{f}' must be a relative path inside the dataset folder")
-    dup = sorted({f for f in files if files.count(f) > 1})
+    # several runs may share one MATLAB file, each in its own struct
+    dup = sorted({f for f in files if files.count(f) > 1 and not _structs_apart(dataset.experiments, f)})
     if dup:
         raise InputError(f"two experiments would be written to the same file: {', '.join(dup)}")
     if any(PurePosixPath(f.replace("\\", "/")) == PurePosixPath("dataset.toml") for f in files):
@@ -241,7 +267,16 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     try:
         with publish_together() as staged:
             entries = []
+            mat = {}  # MATLAB file -> its variables, written once all its runs are in
             for e in dataset.experiments:
+                if _is_mat(e.file):
+                    run = _mat_variables(e)
+                    if e.struct:
+                        mat.setdefault(e.file, {})[e.struct] = run
+                    else:
+                        mat[e.file] = run
+                    entries.append(_entry(e))
+                    continue
                 cols = {"time[s]": e.time, "voltage[V]": e.voltage,
                         "displacement[um]": np.asarray(e.displacement) * 1e6}
                 if e.temperature_signal is not None:
@@ -252,12 +287,10 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
                     fh.write(",".join(cols) + "\n")
                     np.savetxt(fh, np.column_stack([np.asarray(v, float) for v in cols.values()]), delimiter=",",
                                fmt="%.10g")
-                entry = {"file": e.file, "temperature": float(e.temperature), "role": e.role}
-                if e.description:
-                    entry["description"] = e.description
-                if e.input is not None:
-                    entry["input"] = e.input.spec()
-                entries.append(entry)
+                entries.append(_entry(e))
+            for f, variables in mat.items():
+                from .matlab import save_mat
+                save_mat(folder / f, variables)
             meta = {}
             if dataset.name:
                 meta["name"] = dataset.name
@@ -278,6 +311,40 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
         raise
     dataset.path = folder
     return folder
+
+
+def _is_mat(f):
+    from .matlab import is_matlab
+    return is_matlab(f)
+
+
+def _structs_apart(experiments, f):
+    """Whether the experiments written to file ``f`` can share it: a MATLAB file, each run in its own struct."""
+    structs = [e.struct for e in experiments if e.file == f]
+    return _is_mat(f) and all(structs) and len(set(structs)) == len(structs)
+
+
+def _mat_variables(e) -> dict:
+    """An experiment as MATLAB variables (docs/formats.md#matlab-files), lengths in um as in the CSV files."""
+    out = {"time": np.asarray(e.time, float), "voltage": np.asarray(e.voltage, float),
+           "displacement_um": np.asarray(e.displacement, float) * 1e6}
+    if e.temperature_signal is not None:
+        out["temperature"] = np.asarray(e.temperature_signal, float)
+    if e.stage_displacement is not None:
+        out["stage_displacement_um"] = np.asarray(e.stage_displacement, float) * 1e6
+    return out
+
+
+def _entry(e) -> dict:
+    """An experiment's [[experiment]] table."""
+    entry = {"file": e.file, "temperature": float(e.temperature), "role": e.role}
+    if getattr(e, "struct", None):
+        entry["struct"] = e.struct
+    if e.description:
+        entry["description"] = e.description
+    if e.input is not None:
+        entry["input"] = e.input.spec()
+    return entry
 
 
 def _remove_folders(created):

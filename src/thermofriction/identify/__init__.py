@@ -17,7 +17,7 @@ from .laws import fit_law, segmented_fit
 from .model_ii import identify_model_ii
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat, identify_model_i
 from .plant import PlantFit, fit_plant, step_response
-from .result import FitResult
+from .result import FitResult, stamped
 from .start import lugre_start
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
@@ -84,6 +84,7 @@ def with_friction_model(model: Model, kind: str) -> Model:
     return dataclasses.replace(model, friction=cls(**kw), thermal=thermal)
 
 
+@stamped  # the fitted model's name and provenance (result.py)
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
              refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.

@@ -126,9 +126,20 @@ class FitResult:
             "details": self.details,
             "model": self.model.to_dict(),
         }
+        if self.model.provenance:
+            d["provenance"] = self.model.provenance
         if self.alternatives:
             d["alternatives"] = {k: v.to_dict() for k, v in self.alternatives.items()}
         return jsonable(d)
+
+    def with_command(self, command: str) -> "FitResult":
+        """This result with the command line that made it in the fitted models' provenance."""
+        def add(fit):
+            if not fit.model.provenance:
+                return fit
+            model = dataclasses.replace(fit.model, provenance={**fit.model.provenance, "command": command})
+            return dataclasses.replace(fit, model=model, alternatives={k: add(v) for k, v in fit.alternatives.items()})
+        return add(self)
 
     def to_json(self, path=None) -> str:
         """The results as JSON (docs/formats.md#results-json), written atomically to ``path`` when given."""
@@ -150,9 +161,12 @@ class FitResult:
         if self.adequate is False:  # first, in plain words
             lines.append(f"    NOT ADEQUATE: residuals {self.fit_quality['ratio']:.3g} x the measurement noise "
                          f"(see the first warning)")
-        lines += [f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
-                 f"    data points      = {self.n_points}",
-                 f"    rmse             = {self.rmse * 1e9:.4g} nm (each experiment's offset removed)"]
+        if self.n_points == 0 and "paper" in self.details:  # no trajectory fit: say what was done instead
+            lines += [f"    {'done' if self.success else 'REFUSED'}: {self.message}"] + self._paper_lines()
+        else:
+            lines += [f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
+                      f"    data points      = {self.n_points}",
+                      f"    rmse             = {self.rmse * 1e9:.4g} nm (each experiment's offset removed)"]
         if self.fit_quality is not None:
             q = self.fit_quality
             lines.append(f"    noise (data)     = {q['noise'] * 1e9:.4g} nm; rmse/noise = {q['ratio']:.3g}, "
@@ -182,6 +196,22 @@ class FitResult:
             lines.extend(f"    {w}" for w in self.warnings)
         return "\n".join(lines)
 
+    def _paper_lines(self) -> list:
+        """What the paper's procedure of Model II did, step by step, with its numbers."""
+        p = self.details["paper"]
+        lin = p.get("linear_fit", {})
+        Ts = ", ".join(f"{t:.4g}" for t in np.atleast_1d(p.get("temperatures", [])))
+        law = p.get("dF_law", {})
+        knots = ", ".join(f"{v:+.4g} N at {t:.4g} C" for t, v in zip(law.get("T", []), law.get("values", [])))
+        return [f"    1. base model fitted at the reference temperature "
+                f"{self.details.get('reference_temperature', math.nan):.4g} C",
+                f"    2. final displacement against temperature ({Ts} C): two straight segments, breakpoint "
+                f"{p.get('breakpoint', math.nan):.4g} C, R^2 = {p.get('segmented_r2', math.nan):.3f}",
+                f"    3. final displacement against a constant dF, simulated: linear, slope "
+                f"{lin.get('slope', math.nan) * 1e6:.4g} um/N, R^2 = {lin.get('r2', math.nan):.3f}",
+                f"    4. dF(T) read through that line: {knots}",
+                "    no trajectory fit: no RMSE and no intervals here; `validate` gives this model's errors"]
+
     def __str__(self):
         return self.report()
 
@@ -201,7 +231,132 @@ class FitResult:
         head = "".join(f"<th>{h}</th>" for h in ("name", "value", "stderr", "rel", "95 % interval", "unit"))
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self._rows())
         warn = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
-        return (f"<div><b>Fit: {html.escape(self.method)}</b> — {'converged' if self.success else 'not converged'}, "
-                f"rmse {self.rmse * 1e9:.4g} nm, {self.wall_time:.3g} s"
+        q = self.fit_quality
+        quality = "" if q is None else (f", noise {q['noise'] * 1e9:.4g} nm: rmse/noise {q['ratio']:.3g}, "
+                                        f"{'adequate' if q['adequate'] else '<b>NOT adequate</b>'}")
+        rmse = "" if self.n_points == 0 else f", rmse {self.rmse * 1e9:.4g} nm"
+        prov = self.model.provenance or {}
+        origin = (f"<br><small>{html.escape(self.model.name or '')}: data sha256 {html.escape(prov['data_sha256'][:12])}…, "
+                  f"{html.escape(prov.get('date', ''))}, thermofriction {html.escape(prov.get('thermofriction', ''))}"
+                  f"</small>") if prov.get("data_sha256") else ""
+        return (f"<div><b>Fit: {html.escape(self.method)}</b> — {'converged' if self.success else 'not converged'}"
+                f"{rmse}{quality}, {self.wall_time:.3g} s{origin}"
                 f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
                 + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
+
+
+# -- provenance (docs/formats.md#provenance) -------------------------------------------------------
+
+METHOD_NAMES = {"plant": "the plant (xi, wn, K)", "base": "a friction model without thermal effects",
+                "model-i": "Model I (temperature-dependent parameters)", "model-ii": "Model II (a thermal friction term)",
+                "heat": "the self-heating model"}
+
+
+def data_sha256(data) -> tuple[str, str]:
+    """(what was hashed, its SHA-256): for a dataset read from a folder, its files -- the manifest
+    and every experiment file, sorted by path -- hashed as ``sha256sum`` lists them and that list
+    hashed again (``sha256sum FILES | sha256sum`` in the folder gives the same); otherwise the
+    experiments' numbers (time, voltage, displacement as float64, in order)."""
+    import hashlib
+    import os
+
+    folder = getattr(data, "path", None)
+    experiments = list(getattr(data, "experiments", data))
+    if folder is not None:
+        files = sorted({"dataset.toml", *(e.file for e in experiments)})
+        if all(os.path.isfile(os.path.join(folder, f)) for f in files):
+            listing = hashlib.sha256()
+            for f in files:
+                h = hashlib.sha256()
+                with open(os.path.join(folder, f), "rb") as fh:
+                    for block in iter(lambda: fh.read(1 << 20), b""):
+                        h.update(block)
+                listing.update(f"{h.hexdigest()}  {f}\n".encode())
+            return str(folder), listing.hexdigest()
+    h = hashlib.sha256()
+    for e in experiments:
+        for a in (e.time, e.voltage, e.displacement):
+            h.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
+    return "experiments in memory", h.hexdigest()
+
+
+def _label(data) -> str:
+    import os
+    name = getattr(data, "name", None)
+    path = getattr(data, "path", None)
+    return name or (os.path.basename(os.path.normpath(str(path))) if path is not None else "data")
+
+
+def _option(v):
+    if isinstance(v, Parameters):
+        return [p.name for p in v.varying]
+    if isinstance(v, Model):
+        return v.name or "a Model object"
+    if isinstance(v, dict):
+        return {str(k): _option(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_option(x) for x in v]
+    if isinstance(v, (str, bool, int, float)) or v is None:
+        return v
+    if isinstance(v, np.generic):
+        return v.item()
+    return repr(v)
+
+
+def stamp(fit, data, method: str, init, options: dict):
+    """``fit`` with its model named for the data and the method, described, and its provenance
+    (the data's hash, the method, the date, the version, the options); the same for its alternatives."""
+    import datetime
+
+    from .._version import __version__
+    if not isinstance(getattr(fit, "model", None), Model):
+        return fit
+    where, digest = data_sha256(data)
+    experiments = list(getattr(data, "experiments", data))
+    fit_runs = [e for e in experiments if getattr(e, "role", "fit") == "fit"]
+    held = [e for e in experiments if getattr(e, "role", "fit") != "fit"]
+    label = _label(data)
+    temps = ", ".join(f"{e.temperature:.4g}" for e in fit_runs)
+    opts = {k: _option(v) for k, v in options.items() if v is not None and v != () and v != []}
+
+    def plain(x):  # what the model file's [provenance] holds; anything else as its text (never fail a fit here)
+        items = list(x.values()) if isinstance(x, dict) else x if isinstance(x, list) else [x]
+        return x if all(isinstance(i, (str, bool, int, float)) for i in items) else str(x)
+    opts = {k: plain(v) for k, v in opts.items()}
+    date = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+    init_name = init.name or "a Model object" if isinstance(init, Model) else str(init)
+
+    def one(f, how):
+        prov = {"method": f.method, "data": where, "data_sha256": digest,
+                "fit_files": [e.file for e in fit_runs], "held_out_files": [e.file for e in held],
+                "date": date, "thermofriction": __version__, "initial_model": init_name,
+                "options": {**opts, **how}}
+        description = (f"{METHOD_NAMES.get(f.method, f.method)} identified by thermofriction {__version__} on {date} "
+                       f"from {len(fit_runs)} experiment{'s' if len(fit_runs) != 1 else ''} of {label} "
+                       f"at {temps} C" + (f" ({len(held)} held out)" if held else "")
+                       + f", starting from {init_name}")
+        model = dataclasses.replace(f.model, name=f"{f.method} fit to {label}", description=description, provenance=prov)
+        alternatives = {k: one(v, {"procedure": k}) for k, v in f.alternatives.items()}
+        return dataclasses.replace(f, model=model, alternatives=alternatives)
+    return one(fit, {})
+
+
+def stamped(identify):
+    """Decorates ``identify`` so that every fitted model it returns carries its name and provenance."""
+    import functools
+    import inspect
+
+    signature = inspect.signature(identify)
+
+    @functools.wraps(identify)
+    def wrapper(*args, **kwargs):
+        fit = identify(*args, **kwargs)
+        bound = signature.bind(*args, **kwargs)
+        bound.apply_defaults()
+        a = dict(bound.arguments)
+        data, method, init = a.pop("data"), a.pop("method"), a.pop("init")
+        a.pop("progress", None)
+        if init is None:  # the method's default start, a preset, whose name the fitted model still has
+            init = getattr(getattr(fit, "model", None), "name", None) or "the method's preset"
+        return stamp(fit, data, method, init, a)
+    return wrapper

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import os
 import tomllib
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
 
@@ -36,6 +36,10 @@ class Model:
     name: str | None = None
     description: str | None = None
     heat: Heat | None = None
+    #: where a fitted model came from (the [provenance] table, docs/formats.md#provenance): the data's
+    #: hash, the method, the date, the version, the options; None for a model written by hand. Not
+    #: part of the model's physics: two models that differ only here compare equal.
+    provenance: dict | None = field(default=None, compare=False)
 
     def __post_init__(self):
         # the parts' types first, so that Model(None, None) names the argument
@@ -72,6 +76,8 @@ class Model:
                 self.thermal.dF.check_points("[thermal] dF")
         if self.heat is not None and not isinstance(self.heat, Heat):
             raise InputError("'heat' must be a Heat model (the [heat] section)")
+        if self.provenance is not None:
+            check_provenance(self.provenance, "[provenance]")
 
     def _number_values(self):
         v = self.friction.values()
@@ -151,6 +157,8 @@ class Model:
             d["heat"] = self.heat.to_dict()
         if self.input is not None:
             d["input"] = self.input.to_dict()
+        if self.provenance:
+            d["provenance"] = _toml_plain(self.provenance)
         return d
 
     def to_toml(self) -> str:
@@ -179,7 +187,47 @@ class Model:
         return replace(self, friction=self.friction.with_values(**values))
 
 
-_TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "heat", "input"}
+_TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "heat", "input", "provenance"}
+
+#: the [provenance] table's keys (docs/formats.md#provenance): strings, but for the lists and the options table
+PROVENANCE_KEYS = ("method", "data", "data_sha256", "fit_files", "held_out_files", "date", "thermofriction",
+                   "initial_model", "command", "options")
+
+
+def _toml_plain(v):
+    """Values TOML can hold: None dropped, tuples as lists, NumPy scalars as Python numbers."""
+    if isinstance(v, dict):
+        return {str(k): _toml_plain(x) for k, x in v.items() if x is not None}
+    if isinstance(v, (list, tuple)):
+        return [_toml_plain(x) for x in v if x is not None]
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+def check_provenance(p, where="[provenance]") -> dict:
+    """The [provenance] table, checked: known keys; strings, lists of strings (the file lists) and a
+    table of plain values (options)."""
+    if not isinstance(p, dict):
+        raise InputError(f"{where} must be a table")
+    unknown = set(p) - set(PROVENANCE_KEYS)
+    if unknown:
+        raise InputError(f"{where}: {unknown_keys(unknown, PROVENANCE_KEYS)}")
+    for key, value in p.items():
+        if key in ("fit_files", "held_out_files"):
+            if not isinstance(value, (list, tuple)) or not all(isinstance(x, str) for x in value):
+                raise InputError(f"{where}: '{key}' must be a list of file names, got {shorten(value)}")
+        elif key == "options":
+            if not isinstance(value, dict):
+                raise InputError(f"{where}: 'options' must be a table, got {shorten(value)}")
+            for k, x in value.items():  # e.g. starts = 8, free = ["m_e"], laws = { fc = "linear" }
+                items = list(x.values()) if isinstance(x, dict) else x if isinstance(x, (list, tuple)) else [x]
+                if not all(isinstance(i, (str, bool, int, float)) for i in items):
+                    raise InputError(f"{where}: options '{k}' must be a string, number, true/false, or a list or "
+                                     f"table of them, got {shorten(x)}")
+        elif not isinstance(value, str):
+            raise InputError(f"{where}: '{key}' must be a string, got {shorten(value)}")
+    return p
 
 
 def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_from=None) -> Model:
@@ -237,7 +285,8 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_fr
         for key in ("name", "description"):
             if key in d and not isinstance(d[key], str):
                 raise InputError(f"'{key}' must be a string")
-        return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"), heat)
+        provenance = check_provenance(d["provenance"]) if "provenance" in d else None
+        return Model(plant, friction, thermal, inp, d.get("name"), d.get("description"), heat, provenance)
     except InputError as e:
         raise InputError(f"{source}: {e}") from None
 

@@ -1,0 +1,200 @@
+"""MATLAB files (docs/formats.md#matlab-files): experiments read from ``.mat`` files, simulation results
+written to them.
+
+An experiment is a set of vectors named like the CSV columns, the unit a suffix of the name
+(``time``, ``voltage``, ``displacement_um``, ``temperature_C``: the CSV header ``displacement[um]``
+becomes ``displacement_um``; no suffix means the SI unit). They are the file's variables, or the
+fields of one struct in it (the manifest's ``struct = "run1"``), so that one file can hold several
+runs. Other variables are ignored: a MATLAB workspace saved whole carries more than the run.
+SciPy reads MATLAB's formats up to v7; a v7.3 file (HDF5) gets a message saying how to save it
+instead."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, shorten
+from .experiments import _SI, _UNITS, MIN_SAMPLES, REQUIRED, max_rows, MAX_ROWS_ENV
+
+#: longest first, so that stage_displacement_um is not read as a "displacement" with unit "stage..."
+_COLUMNS = sorted(_UNITS, key=len, reverse=True)
+_HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
+
+
+def is_matlab(path) -> bool:
+    return str(path).lower().endswith(".mat")
+
+
+def column_of(variable: str):
+    """(column, unit) that a variable's name declares (the unit possibly unknown), or None for a
+    variable that is not a column."""
+    for name in _COLUMNS:
+        if variable == name:
+            return name, _SI[name]
+        if variable.startswith(name + "_"):
+            return name, variable[len(name) + 1:]
+    return None
+
+
+def _units_of(name):
+    return ", ".join(name + "_" + u for u in _UNITS[name] if u.isascii())
+
+
+def _load(path: Path) -> dict:
+    """The file's variables (scipy.io.loadmat), or one InputError naming the file."""
+    import scipy.io
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(512 + len(_HDF5_MAGIC))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{path}: is a folder, not a MATLAB file") from None
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    if head[512:].startswith(_HDF5_MAGIC) or head.startswith(_HDF5_MAGIC):
+        raise InputError(f"{path}: a MATLAB v7.3 (HDF5) file, which thermofriction does not read: save it with "
+                         f"save('{path.name}', ..., '-v7') in MATLAB, or write the run as CSV "
+                         f"(docs/formats.md#experiment-files)")
+    try:
+        return scipy.io.loadmat(path, squeeze_me=False, struct_as_record=True, mat_dtype=False)
+    except NotImplementedError as e:  # SciPy's word for v7.3
+        raise InputError(f"{path}: not readable as a MATLAB file up to v7 ({e}); save it with '-v7' in MATLAB "
+                         f"or write the run as CSV") from None
+    except (ValueError, TypeError, OSError, EOFError, IndexError, KeyError, UnicodeDecodeError, OverflowError,
+            MemoryError, AssertionError) as e:
+        raise InputError(f"{path}: not a readable MATLAB file ({shorten(str(e) or type(e).__name__)})") from None
+
+
+def _vector(path, label, value) -> np.ndarray:
+    """A real numeric vector (1xN or Nx1) as float64, or one InputError naming the variable."""
+    a = value
+    if not isinstance(a, np.ndarray):
+        raise InputError(f"{path}: {label}: must be a numeric vector, got {shorten(a)}")
+    if a.dtype.kind not in "iuf":
+        what = {"b": "logical", "c": "complex", "U": "text (char)", "S": "text (char)", "O": "a cell array or struct",
+                "V": "a struct"}.get(a.dtype.kind, a.dtype.name)
+        raise InputError(f"{path}: {label}: must be a real numeric vector (double), got {what}")
+    if a.ndim > 2 or (a.ndim == 2 and min(a.shape) > 1):
+        raise InputError(f"{path}: {label}: must be a vector (1xN or Nx1), got a {'x'.join(map(str, a.shape))} array")
+    return a.reshape(-1).astype(float)
+
+
+def read_experiment_mat(path, struct: str | None = None, units: dict | None = None, with_headers: bool = False):
+    """Reads one experiment from a MATLAB file into SI arrays, as :func:`read_experiment_csv` does
+    from a CSV file: a dict with ``time``, ``voltage``, ``displacement`` and, where present,
+    ``temperature`` and ``stage_displacement``.
+
+    struct: the name of a struct variable whose fields hold the run (default: the file's variables).
+    units: units of columns whose variable has no unit suffix (the manifest's ``units`` table,
+        e.g. ``{"displacement": "um"}``); a suffix that disagrees with it is an error.
+    with_headers: also return, per column, (where it is, its unit) for a dataset's checks."""
+    from .csv import check_columns
+
+    path = Path(path)
+    variables = {k: v for k, v in _load(path).items() if not k.startswith("__")}
+    origin = "variable"
+    if struct is not None:
+        if struct not in variables:
+            found = ", ".join(sorted(variables)) or "none"
+            raise InputError(f"{path}: no variable '{struct}' (the manifest's 'struct'; variables: {found})")
+        s = variables[struct]
+        if not (isinstance(s, np.ndarray) and s.dtype.names):
+            raise InputError(f"{path}: variable '{struct}': must be a struct (the manifest's 'struct' names one), "
+                             f"got {'a ' + s.dtype.name + ' array' if isinstance(s, np.ndarray) else shorten(s)}")
+        if s.size != 1:
+            raise InputError(f"{path}: variable '{struct}': must be one struct, got a "
+                             f"{'x'.join(map(str, s.shape))} struct array (give each run its own struct)")
+        rec = s.reshape(-1)[0]
+        variables = {name: rec[name] for name in s.dtype.names}
+        origin = f"struct '{struct}', field"
+    units = dict(units or {})
+    for name, unit in units.items():
+        if name not in _UNITS:
+            raise InputError(f"{path}: units: unknown column '{shorten(name)}' (columns: {', '.join(_UNITS)})")
+        if not isinstance(unit, str) or unit not in _UNITS[name]:
+            raise InputError(f"{path}: units: unknown unit {shorten(unit)} for {name} "
+                             f"(one of: {', '.join(u for u in _UNITS[name] if u.isascii())})")
+    found, odd = {}, {}  # column -> (variable, unit); column -> why a variable of its name is not it
+    for var in variables:
+        col = column_of(var)
+        if col is None:
+            continue
+        name, unit = col
+        if unit not in _UNITS[name]:  # e.g. displacement_inch, time_offset: an error only if nothing else is the column
+            odd.setdefault(name, f"'{var}': unknown unit {shorten(unit)} for {name} (one of: {_units_of(name)})")
+            continue
+        if name in found:
+            raise InputError(f"{path}: {origin} '{var}' and '{found[name][0]}' are both the {name} (give one)")
+        if var == name and name in units:
+            unit = units[name]
+        elif name in units and units[name] != unit:
+            raise InputError(f"{path}: {origin} '{var}' declares {unit}, the manifest's units {units[name]}: "
+                             f"give the unit once")
+        found[name] = (var, unit)
+    for name, why in odd.items():
+        if name not in found:
+            raise InputError(f"{path}: {origin} {why}")
+    missing = [r for r in REQUIRED if r not in found]
+    if missing:
+        names = ", ".join(sorted(variables)) or "none"
+        raise InputError(f"{path}: {'struct ' + repr(struct) + ': ' if struct else ''}missing "
+                         f"{', '.join(missing)} (an experiment needs vectors time, voltage and displacement, "
+                         f"a unit suffix where not SI, e.g. displacement_um; found: {shorten(names)})")
+    raw = {}
+    for name, (var, unit) in found.items():
+        raw[name] = _vector(path, f"{origin} '{var}'", variables[var])
+    n = len(raw["time"])
+    for name, a in raw.items():
+        if len(a) != n:
+            raise InputError(f"{path}: {origin} '{found[name][0]}' has {len(a)} values, '{found['time'][0]}' "
+                             f"{n}: the vectors of a run must have one value per sample")
+    limit = max_rows()
+    if n > limit:
+        raise InputError(f"{path}: {n} samples, more than the limit of {limit}: downsample the run, or raise the "
+                         f"limit with the environment variable {MAX_ROWS_ENV}=N")
+    if n < MIN_SAMPLES:
+        raise InputError(f"{path}: {n} sample{'s' if n != 1 else ''}; an experiment needs at least "
+                         f"{MIN_SAMPLES} samples")
+
+    def where(name, row, short=False):
+        return f"element {row + 1}" if short else f"{origin} '{found[name][0]}', element {row + 1}"
+
+    out = check_columns(path, raw, {name: _UNITS[name][unit] for name, (_, unit) in found.items()}, where)
+    if with_headers:
+        return out, {name: (f"{origin} '{var}'", unit) for name, (var, unit) in found.items()}
+    return out
+
+
+def matlab_name(header: str) -> str:
+    """A CSV header such as ``velocity[m/s]`` as a MATLAB variable name: ``velocity_m_per_s``."""
+    name, _, unit = header.partition("[")
+    unit = unit.rstrip("]").replace("/", "_per_").replace(" ", "_")
+    return re.sub(r"\W", "_", f"{name}_{unit}" if unit else name)
+
+
+def save_mat(path, variables: dict):
+    """Writes MATLAB variables (v5 format, readable by MATLAB and Octave) atomically."""
+    import scipy.io
+
+    from .._io import atomic_write
+    with atomic_write(path, "wb") as fh:
+        scipy.io.savemat(fh, variables, do_compression=True, oned_as="column")
+
+
+def simulation_to_mat(result, path):
+    """A simulation result as a MATLAB file: one column vector per CSV column
+    (docs/formats.md#simulation-output), named as the header with its unit as a suffix
+    (``time_s``, ``displacement_m``, ``velocity_m_per_s``); per-cycle ``step_sizes_m`` and
+    ``cycle_times_s`` for periodic inputs."""
+    variables = {matlab_name(h): np.asarray(v, float) for h, v in result.columns().items()}
+    if getattr(result, "step_sizes", None) is not None and np.size(result.step_sizes):
+        variables["step_sizes_m"] = np.asarray(result.step_sizes, float)
+        variables["cycle_times_s"] = np.asarray(result.cycle_times, float)
+    save_mat(path, variables)
+
+
+__all__ = ["read_experiment_mat", "is_matlab", "simulation_to_mat", "save_mat", "matlab_name"]
