@@ -286,3 +286,16 @@ def test_report_in_chromium_is_legible_and_uses_the_card_width(demo_like):
     keep = Path(__file__).resolve().parents[1] / "build"
     keep.mkdir(exist_ok=True)
     (keep / "report-screenshot.png").write_bytes((demo_like.folder / "report.png").read_bytes())
+
+
+def test_truth_section_counts_covered_points_per_parameter_and_says_why_a_fit_cannot_be_compared():
+    """A hand-made recovery (what FitResult.recovery returns): the section counts covered points per
+    parameter, gives the largest error relative to the truth, and carries the reason verbatim."""
+    from thermofriction.report import truth_section
+    rows = [{"parameter": "fc", "temperature": T, "truth": 1.0, "value": v, "lower": v - 0.01, "upper": v + 0.01,
+             "covered": abs(v - 1.0) <= 0.01} for T, v in ((30.0, 1.005), (35.0, 1.02), (40.0, 0.995))]
+    page = truth_section({"Model I": {"summary": "2 of 3 covered", "rows": rows},
+                          "Model II": {"summary": "not comparable with the truth: a reason", "rows": []}})
+    assert "2 of 3" in page and ">2<" in page  # largest error 2 % of the truth
+    assert "not comparable with the truth: a reason" in page
+    assert page.count("<tr>") >= 1 + 3 + 1 + 1

@@ -80,6 +80,17 @@ def truth_recovery(fits, truth) -> dict:
                                    + (f"; not at {', '.join(missed)}" if missed else "")}
         else:
             out[key] = {"covered": None, "points": 0, "missed": [], "rows": [],
-                        "summary": f"not comparable: the data are made from {type(truth.thermal).__name__} "
-                                   f"({truth.name}); a {fit.method} fit has no law that corresponds to the truth's"}
+                        "summary": "not comparable with the truth: " + _why_not_comparable(fit, truth)}
     return out
+
+
+def _why_not_comparable(fit, truth) -> str:
+    from .models import ModelI, ModelII
+    kind = {ModelI: "Model I", ModelII: "Model II"}
+    made = f"the data are made from {kind.get(type(truth.thermal), 'a model without a thermal part')} ({truth.name})"
+    if isinstance(truth.thermal, ModelI) and isinstance(fit.model.thermal, ModelII):
+        return (f"{made}, whose sigma0, sigma1 and fc change with temperature at different rates; Model II scales "
+                f"them all by one factor lambda(T), so it has no law to compare and is not expected to reach the noise")
+    if fit.model.thermal is None:
+        return f"{made}; a model without a thermal part has no temperature law to compare"
+    return f"{made}; a {kind.get(type(fit.model.thermal), 'different')} fit has no law that corresponds to the truth's"

@@ -363,12 +363,23 @@ def truth_section(truth: dict) -> str:
     parts = []
     for label, rec in truth.items():
         parts.append(f"<p><b>{html.escape(label)}</b>: {html.escape(rec['summary'])}.</p>")
-        rows = [[r["parameter"], _fmt(r["temperature"], "{:.4g}"), _fmt(r["truth"], "{:.5g}"),
-                 _fmt(r["value"], "{:.5g}"), f"[{r['lower']:.5g}, {r['upper']:.5g}]",
-                 "yes" if r["covered"] else "NO"] for r in rec.get("rows", [])]
+        rows = rec.get("rows", [])
         if rows:
-            parts.append(_table(["parameter", "temperature [°C]", "truth", "fitted", "95 % interval", "covered"],
-                                rows, text=(0, 5)))
+            summary = []
+            for name in dict.fromkeys(r["parameter"] for r in rows):
+                mine = [r for r in rows if r["parameter"] == name]
+                scale = max(abs(r["truth"]) for r in mine) or 1.0
+                summary.append([name, f"{sum(r['covered'] for r in mine)} of {len(mine)}",
+                                _fmt(100 * max(abs(r["value"] - r["truth"]) for r in mine) / scale, "{:.2g}"),
+                                _fmt(100 * max((r["upper"] - r["lower"]) / 2 for r in mine) / scale, "{:.2g}")])
+            parts.append(_table(["parameter", "covered", "largest error [% of the truth's largest value]",
+                                 "largest interval half-width [%]"], summary, text=(0,)))
+            detail = [[r["parameter"], _fmt(r["temperature"], "{:.4g}"), _fmt(r["truth"], "{:.5g}"),
+                       _fmt(r["value"], "{:.5g}"), f"[{r['lower']:.5g}, {r['upper']:.5g}]",
+                       "yes" if r["covered"] else "NO"] for r in rows]
+            parts.append("<details><summary>every (parameter, temperature) point</summary>" +
+                         _table(["parameter", "temperature [°C]", "truth", "fitted", "95 % interval", "covered"],
+                                detail, text=(0, 5)) + "</details>")
     return ("<section><h2>Against the truth</h2><p class='note'>These data were made by simulation from a known "
             "model: each fitted law at the fit temperatures, with its 95 % interval (delta method over the fitted "
             "coefficients and breakpoints), against the truth. About 1 point in 20 outside its interval is what a "
