@@ -37,7 +37,7 @@ def test_notebook_runs_and_shows_tables_and_figures(executed):
     assert "<table>" in fit_html and "fc.b" in fit_html and "adequate" in fit_html and "sha256" in fit_html
     metrics_html = next(v for k, v in html.items() if k.strip().endswith("\nmetrics"))
     assert "max error [%]" in metrics_html and "validate" in metrics_html and "NRMSE = RMSE" in metrics_html
-    assert len(list(outputs(executed, "image/png"))) >= 2  # the simulation and the held-out prediction
+    assert len(list(outputs(executed, "image/png"))) >= 3  # sim.plot(), fit.plot(data), metrics.plot()
 
 
 def test_notebook_results_say_what_the_text_claims(executed):
