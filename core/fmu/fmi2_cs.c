@@ -82,6 +82,7 @@ typedef struct {
     double du, dT;           /* input derivatives for the next step (0: held) */
     int du_set;              /* du given for the next step */
     double u_prev;           /* prescribed motion: where the last step left the motion */
+    double last_du;          /* prescribed motion: its slope over the last step (the velocity reported after it) */
 
     /* the model and its state */
     tf_model model;
@@ -97,10 +98,17 @@ static void logv(instance *c, fmi2Status status, const char *category, const cha
 {
     if (!c || !c->cb.logger) return;
     if (status == fmi2OK && !c->logging) return;
-    char msg[512];
+    char msg[512], esc[1024];
     vsnprintf(msg, sizeof msg, fmt, ap);
-    /* the logger formats its message like printf: pass ours as an argument, never as the format */
-    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "thermofriction", status, category, "%s", msg);
+    /* The logger takes a printf format; many importers (fmpy among them) show the format without
+     * formatting it. So the message itself is the format, its '%' doubled. */
+    size_t k = 0;
+    for (const char *s = msg; *s && k + 2 < sizeof esc; s++) {
+        if (*s == '%') esc[k++] = '%';
+        esc[k++] = *s;
+    }
+    esc[k] = 0;
+    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "thermofriction", status, category, esc);
 }
 
 #if defined(__GNUC__)
@@ -326,9 +334,17 @@ static void set_signals(instance *c, tf_model *m, double t, double h)
         u = c->u_prev;
     }
     double dT = c->dT;
-    if (!(h > 0)) h = 1.0, du = 0.0, dT = 0.0; /* two points a second apart, both the value at t */
+    if (!(h > 0)) { /* at a communication point: the values at t; a prescribed motion's velocity that of the last step */
+        h = 1.0, dT = 0.0;
+        du = c->plant == TF_PLANT_PRESCRIBED ? c->last_du : 0.0;
+        u = c->plant == TF_PLANT_PRESCRIBED ? c->u_prev : c->r[VR_DRIVE];
+        c->wave_t[0] = t - h, c->wave_t[1] = t + h; /* a segment through (t, u) with slope du */
+        c->wave_v[0] = u - du * h, c->wave_v[1] = u + du * h;
+        goto temperature;
+    }
     c->wave_t[0] = t, c->wave_t[1] = t + h;
     c->wave_v[0] = u, c->wave_v[1] = u + du * h;
+temperature:
     m->input.kind = TF_WAVE_SAMPLED;
     m->input.n = 2;
     m->input.t = c->wave_t;
@@ -634,6 +650,7 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     memcpy(c->y, y, sizeof(double) * n);
     c->t = t_out[1];
     c->u_prev = c->wave_v[1];
+    c->last_du = (c->wave_v[1] - c->wave_v[0]) / h;
     if (c->temperature_input && !c->heat) c->r[VR_TEMPERATURE] += c->dT * h;
     if (c->du_set || c->plant != TF_PLANT_PRESCRIBED) c->r[VR_DRIVE] = c->wave_v[1];
     c->du = c->dT = 0.0; /* derivatives hold for one step */

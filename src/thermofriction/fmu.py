@@ -276,12 +276,13 @@ def _xml(model: Model, variables, identifier: str, guid: str, source: str | None
     return "\n".join(out)
 
 
-def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None) -> Path | Target:
+def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
+               source: str | None = None) -> Path | Target:
     """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 co-simulation FMU to
     ``path`` (docs/fmu.md). ``temperature``: the start value of the temperature input [degC] (with a
     heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
-    ``model_identifier``: the binary's name inside the FMU (default: from the model's name)."""
-    source = None
+    ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
+    ``source``: where the model came from (a file or preset name), for the FMU's description."""
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)
         model = load_model(model)
