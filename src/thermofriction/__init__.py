@@ -38,3 +38,11 @@ __all__ = [
     "FitResult", "Parameter", "Parameters", "identify",
     "Dataset", "Experiment", "load_dataset", "save_dataset", "synthesize", "validate", "report",
 ]
+
+
+def __getattr__(name):
+    # export_fmu loads on first use: `import thermofriction` stays light
+    if name == "export_fmu":
+        from .fmu import export_fmu
+        return export_fmu
+    raise AttributeError(f"module 'thermofriction' has no attribute {name!r}")

@@ -220,3 +220,15 @@ def cmd_demo(args) -> int:
 
 #: each command's output files (argparse dest: option); they are checked before any work starts
 #: (folder, name, writability, not a folder), so that a long run does not fail at the end, or write
+
+
+def cmd_fmu(args) -> int:
+    """Export a model as an FMI 2.0 co-simulation FMU (docs/fmu.md)."""
+    from ..fmu import export_fmu  # zipfile and the binary only when asked for
+
+    model = load_model(args.model)
+    _refuse_inputs(args, _model_inputs(args.model, model))
+    export_fmu(model, _target(args, "output"), temperature=args.temperature, model_identifier=args.model_identifier,
+               source=args.model)
+    print(f"{model.name or args.model}: wrote {args.output} (FMI 2.0 co-simulation, linux64)")
+    return 0

@@ -180,7 +180,29 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output folder (default: thermofriction-demo)")
     d.set_defaults(run=cmd_demo)
 
+    _add_fmu_command(sub)
+
     from ..data import add_synth_command  # dataset tools (synth) live with the data module
     add_synth_command(sub)
     return p
 
+
+def _add_fmu_command(sub):
+    """`thermofriction fmu`: export a model as an FMI 2.0 co-simulation FMU (docs/fmu.md)."""
+    f = sub.add_parser(
+        "fmu", help="export a model as an FMI 2.0 co-simulation FMU for Simulink, OpenModelica, fmpy, ... (docs/fmu.md)",
+        description="Write MODEL as an FMI 2.0 co-simulation FMU for Linux x86-64 (the C core inside, libc and libm "
+                    "its only dependencies). Inputs: the plant's drive (voltage, force or motion) and, for Model I "
+                    "and II, the temperature [C] (with a [heat] section, the ambient temperature). Outputs: "
+                    "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
+                    "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
+                    "The model's [input] is not part of the FMU: the importer drives it.",
+        epilog="Example: thermofriction fmu li2009-model-i -o li2009-model-i.fmu")
+    f.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
+    f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help="the FMU file to write")
+    f.add_argument("--temperature", type=_finite_float, metavar="C",
+                   help="start value of the temperature input [C] (with [heat]: of the ambient temperature)")
+    f.add_argument("--model-identifier", metavar="NAME",
+                   help="the FMU's model identifier, letters, digits and _ (default: from the model's name)")
+    from .commands import cmd_fmu
+    f.set_defaults(run=cmd_fmu)

@@ -1,0 +1,335 @@
+"""FMI 2.0 co-simulation FMUs of any model (docs/fmu.md): ``export_fmu(model, path)``.
+
+One prebuilt binary serves every model: the C core with an FMI wrapper (core/fmu/fmi2_cs.c), built
+when the package is installed. Exporting a model zips that binary as
+``binaries/linux64/<modelIdentifier>.so`` with a generated ``modelDescription.xml`` and
+``resources/model.tfm``, the model description the binary reads when it is instantiated (its plant,
+friction model, thermal extension, laws and every tunable parameter with its value reference). So an
+export needs no compiler.
+
+The FMU has the plant's drive as input (a voltage for the stick-slip actuator, a force for a mass, the
+displacement for prescribed motion), the temperature [degC] for Model I and II (the ambient temperature
+with a ``[heat]`` section), and every plant, friction, law and heat parameter as a tunable parameter.
+The model file's own ``[input]`` is not part of the FMU: the importer drives it.
+"""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import os
+import platform
+import re
+import uuid
+import zipfile
+from importlib import resources
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from . import _bridge
+from ._io import Target, atomic_write
+from ._version import __version__
+from .errors import InputError, shorten
+from .models import MassPlant, Model, PrescribedMotion, StickSlipPlant, load_model
+
+#: The resource file's format version (core/fmu/fmi2_cs.c, FMU_FORMAT).
+FORMAT = 1
+#: The binary's limits (fmi2_cs.c: MAX_VR value references, MAX_POINTS points of one law).
+MAX_VALUE_REFERENCE = 2048
+MAX_POINTS = 256
+FIRST_PARAMETER = 16
+
+#: Fixed value references of the inputs and outputs (fmi2_cs.c).
+VR_DRIVE, VR_TEMPERATURE, VR_DISPLACEMENT, VR_VELOCITY, VR_FRICTION_FORCE, VR_TEMPERATURE_OUT, VR_STAGE = range(7)
+
+_BINARY = "thermofriction_fmi2.so"
+
+# SI base units of the units the FMU declares (FMI 2.0 UnitDefinitions); others are declared by name.
+_BASE_UNITS = {
+    "m": {"m": 1}, "m/s": {"m": 1, "s": -1}, "N": {"kg": 1, "m": 1, "s": -2}, "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
+    "kg": {"kg": 1}, "N/m": {"kg": 1, "s": -2}, "N s/m": {"kg": 1, "s": -1}, "N/s": {"kg": 1, "m": 1, "s": -3},
+    "rad/s": {"rad": 1, "s": -1}, "m/V": {"kg": -1, "m": -1, "s": 3, "A": 1}, "N/V": {"m": -1, "s": 1, "A": 1},
+    "J/K": {"kg": 1, "m": 2, "s": -2, "K": -1}, "K/W": {"kg": -1, "m": -2, "s": 3, "K": 1},
+}
+
+
+class _Variable:
+    def __init__(self, name, vr, unit, description, start=None, causality="parameter", variability="tunable",
+                 role=None, i=0, j=0):
+        self.name, self.vr, self.unit, self.description, self.start = name, vr, unit, description, start
+        self.causality, self.variability, self.role, self.i, self.j = causality, variability, role, i, j
+
+
+def binary_path() -> Path:
+    """The installed FMI binary (built with the package on Linux)."""
+    return Path(str(resources.files("thermofriction"))) / "_fmu" / _BINARY
+
+
+def _identifier(text: str) -> str:
+    ident = re.sub(r"[^A-Za-z0-9_]", "_", text).strip("_") or "thermofriction_model"
+    return ident if not ident[0].isdigit() else f"tf_{ident}"
+
+
+def _check_exportable(model: Model):
+    """Refuses, naming the part and what to do, what the FMU cannot carry."""
+    if model.heat is not None and model.heat.external_heat is not None and model.heat.external_heat.kind == "sampled":
+        raise InputError("[heat] P_ext: a sampled external heat (a file of samples) cannot be baked into an FMU: give "
+                         "P_ext as a step, square, sine or sawtooth waveform, or leave it out")
+    laws = dict(model.laws)
+    if getattr(model.thermal, "model", None) == "II":
+        laws["dF"] = model.thermal.dF
+    for name, law in laws.items():
+        y = law.core_fields().get("y")
+        n = 0 if y is None else len(y)
+        if n > MAX_POINTS:
+            raise InputError(f"[thermal] {name}: a law of {n} points or coefficients; an FMU takes at most {MAX_POINTS}")
+
+
+def _variables(model: Model, spec: dict, temperature: float | None):
+    """The FMU's variables: inputs, outputs, then every parameter with its role in the binary."""
+    plant = model.plant
+    drive = {StickSlipPlant: ("voltage", "V", "drive voltage of the actuator"),
+             MassPlant: ("force", "N", "force applied to the mass"),
+             PrescribedMotion: ("motion", "m", "the prescribed displacement of the body (its slope is the sliding "
+                                "velocity: give input derivatives, else the motion reaches each value one "
+                                "communication step later)")}[type(plant)]
+    variables = [_Variable(drive[0], VR_DRIVE, drive[1], drive[2], 0.0, "input", "continuous")]
+    thermal = model.thermal is not None
+    heat = model.heat
+    if heat is not None:
+        T_amb = heat.resolved(temperature).ambient_temperature if (heat.ambient_temperature is not None
+                                                                    or temperature is not None) else 20.0
+        variables.append(_Variable("ambient_temperature", VR_TEMPERATURE, "degC",
+                                   "ambient temperature of the heat balance", T_amb, "input", "continuous"))
+    elif thermal:
+        rng = model.temperature_range()
+        T0 = temperature if temperature is not None else (rng[0] if rng else 20.0)
+        variables.append(_Variable("temperature", VR_TEMPERATURE, "degC",
+                                   "temperature of the friction interface", float(T0), "input", "continuous"))
+    variables += [
+        _Variable("displacement", VR_DISPLACEMENT, "m", "displacement of the driven body (end effector, mass, or "
+                  "the prescribed motion)", causality="output", variability="continuous"),
+        _Variable("velocity", VR_VELOCITY, "m/s", "velocity of the driven body", causality="output",
+                  variability="continuous"),
+        _Variable("friction_force", VR_FRICTION_FORCE, "N", "friction force resisting sliding (thermal extension "
+                  "included)", causality="output", variability="continuous"),
+    ]
+    if heat is not None:
+        variables.append(_Variable("temperature", VR_TEMPERATURE_OUT, "degC", "interface temperature (the heat "
+                                   "balance's state)", causality="output", variability="continuous"))
+    if isinstance(plant, StickSlipPlant):
+        variables.append(_Variable("stage_displacement", VR_STAGE, "m", "displacement of the driving stage",
+                                   causality="output", variability="continuous"))
+
+    vr = FIRST_PARAMETER
+
+    def add(name, unit, description, start, role, i=0, j=0, variability="tunable"):
+        nonlocal vr
+        variables.append(_Variable(name, vr, unit, description, float(start), role=role, i=i, j=j,
+                                   variability=variability))
+        vr += 1
+
+    # the plant, in the model file's own form
+    if isinstance(plant, StickSlipPlant):
+        add("plant.m", "kg", "equivalent stage mass", plant.mass, "m")
+        add("plant.m_e", "kg", "end-effector mass", plant.end_effector_mass, "m_e")
+        if plant.modal:
+            xi, wn, K = plant.modal_parameters()
+            add("plant.xi", "", "damping ratio", xi, "xi")
+            add("plant.wn", "rad/s", "natural frequency", wn, "wn")
+            add("plant.K", "m/V", "static gain", K, "K")
+        else:
+            c, k, T_em = plant.physical()
+            add("plant.c", "N s/m", "stage damping", c, "c")
+            add("plant.k", "N/m", "stage stiffness", k, "k")
+            add("plant.T_em", "N/V", "transducer ratio", T_em, "T_em")
+    elif isinstance(plant, MassPlant):
+        add("plant.m", "kg", "mass", plant.mass, "m")
+        add("plant.k_s", "N/m", "stiffness of the pulling spring", plant.spring_stiffness, "k_s")
+        add("plant.v_0", "m/s", "pull velocity of the spring's end", plant.pull_velocity, "v_0")
+
+    # the friction parameters given as numbers (those following a law are the laws' coefficients)
+    friction = model.friction
+    numbers = {k: v for k, v in friction.values().items() if k not in friction.arrays}
+    for name in _bridge.PARAMETERS:
+        if name in numbers:
+            add(f"friction.{name}", _bridge.PARAMETER_UNITS[name], f"{friction.model} parameter {name}",
+                spec["params"][_bridge.PARAMETERS.index(name)], "p", _bridge.PARAMETERS.index(name))
+    if friction.model == "gms":
+        for e, (k, w) in enumerate(zip(friction.k, friction.w)):
+            add(f"friction.k[{e + 1}]", "N/m", f"stiffness of GMS element {e + 1}", k, "gms_k", e)
+            add(f"friction.w[{e + 1}]", "", f"capacity fraction of GMS element {e + 1} (the fractions sum to 1)", w,
+                "gms_w", e)
+
+    # the laws' coefficients (breakpoints fixed: settable before initialisation only)
+    laws = [(name, _bridge.PARAMETERS.index(name), law, _bridge.PARAMETER_UNITS[name])
+            for name, law in model.laws.items()]
+    if getattr(model.thermal, "model", None) == "II":
+        laws.append(("dF", len(_bridge.PARAMETERS), model.thermal.dF, "N"))
+    for name, index, law, unit in laws:
+        where = f"thermal.{name}"
+        what = f"{law.kind} law of {name}"
+        if law.kind == "const":
+            add(f"{where}.value", unit, f"value of the {what}", law.value, "law_a", index)
+        elif law.kind in ("linear", "exp"):
+            add(f"{where}.a", law.coefficient_unit("a", unit), f"a of the {what}", law.a, "law_a", index)
+            add(f"{where}.b", law.coefficient_unit("b", unit), f"b of the {what}", law.b, "law_b", index)
+        elif law.kind == "poly":
+            for j, c in enumerate(law.c):
+                add(f"{where}.c[{j + 1}]", law.coefficient_unit(f"c[{j}]", unit), f"coefficient of T^{j} of the {what}",
+                    c, "law_y", index, j)
+        else:  # pwl, table
+            for j, (T, v) in enumerate(zip(law.T, law.values)):
+                add(f"{where}.T[{j + 1}]", "degC", f"breakpoint {j + 1} of the {what}", T, "law_x", index, j,
+                    variability="fixed")
+                add(f"{where}.values[{j + 1}]", unit, f"value at breakpoint {j + 1} of the {what}", v, "law_y",
+                    index, j)
+
+    if heat is not None:
+        h = heat.resolved(variables[1].start)
+        add("heat.C_th", "J/K", "heat capacity of the interface", h.heat_capacity, "C_th")
+        add("heat.R_th", "K/W", "thermal resistance to ambient", h.thermal_resistance, "R_th")
+        add("heat.eta", "", "fraction of the friction power that heats the interface", h.heat_fraction, "eta")
+        add("heat.T_0", "degC", "start temperature", h.initial_temperature, "T_0", variability="fixed")
+    if vr > MAX_VALUE_REFERENCE:
+        raise InputError(f"the model has {vr - FIRST_PARAMETER} parameters; an FMU takes at most "
+                         f"{MAX_VALUE_REFERENCE - FIRST_PARAMETER}")
+    return variables
+
+
+def _resource_text(model: Model, spec: dict, variables) -> str:
+    """resources/model.tfm: the structure and the parameters' roles (read by fmi2_cs.c)."""
+    lines = [f"thermofriction-fmu {FORMAT}",
+             f"# {model.name or 'model'}: written by thermofriction {__version__}",
+             f"plant {spec['plant']} {int(isinstance(model.plant, StickSlipPlant) and model.plant.modal)}",
+             f"friction {spec['friction']} {0 if spec['gms_k'] is None else len(spec['gms_k'])}",
+             f"thermal {spec['thermal']} {spec['dF_form']} {spec['fs_follows_fc']}",
+             f"heat {int(model.heat is not None)}",
+             f"temperature_input {int(model.thermal is not None and model.heat is None)}"]
+    rng = model.temperature_range()
+    if rng is not None:
+        lines.append(f"range {rng[0]!r} {rng[1]!r}")
+    if model.heat is not None and model.heat.external_heat is not None:
+        w = _bridge.waveform_tuple(model.heat.external_heat)
+        lines.append("p_ext " + " ".join([str(w[0])] + [repr(float(x)) for x in w[1:8]]))
+    laws = spec["laws"] or [None] * len(_bridge.PARAMETERS)
+    for i, law in enumerate([*laws, spec["dF"]]):
+        if law is not None:
+            n = 0 if law[4] is None else len(law[4])
+            lines.append(f"law {i} {law[0]} {n}")
+    temperature_start = next((v.start for v in variables if v.vr == VR_TEMPERATURE), float("nan"))
+    lines.append(f"input 0.0 {temperature_start!r}" if temperature_start == temperature_start else "input 0.0 0.0")
+    for v in variables:
+        if v.role:
+            lines.append(f"var {v.vr} {v.role} {v.i} {v.j} {int(v.variability == 'fixed')} {v.start!r}")
+    return "\n".join(lines) + "\n"
+
+
+def _xml(model: Model, variables, identifier: str, guid: str, source: str | None) -> str:
+    name = model.name or identifier
+    provenance = f"exported by thermofriction {__version__}" + (f" from {source}" if source else "")
+    description = ((model.description + " -- ") if model.description else "") + provenance
+    units = sorted({v.unit for v in variables if v.unit})
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(name)} guid="{guid}"',
+           f'  description={quoteattr(description)} generationTool="thermofriction {__version__}"',
+           f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"',
+           '  variableNamingConvention="structured" numberOfEventIndicators="0">',
+           f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
+           '    canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"',
+           '    canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+           '  <UnitDefinitions>']
+    for u in units:
+        if u == "degC":
+            out.append('    <Unit name="degC"><BaseUnit K="1" offset="273.15"/></Unit>')
+        elif u in _BASE_UNITS:
+            attrs = " ".join(f'{k}="{e}"' for k, e in _BASE_UNITS[u].items())
+            out.append(f'    <Unit name={quoteattr(u)}><BaseUnit {attrs}/></Unit>')
+        else:
+            out.append(f'    <Unit name={quoteattr(u)}/>')
+    out += ['  </UnitDefinitions>',
+            '  <LogCategories>',
+            '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
+            '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
+            '  </LogCategories>',
+            '  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.0001" tolerance="1e-06"/>',
+            '  <ModelVariables>']
+    outputs = []
+    for index, v in enumerate(variables, start=1):
+        attrs = [f"name={quoteattr(v.name)}", f'valueReference="{v.vr}"', f"description={quoteattr(v.description)}",
+                 f'causality="{v.causality}"', f'variability="{v.variability}"']
+        real = [f"unit={quoteattr(v.unit)}"] if v.unit else []
+        if v.causality == "parameter":
+            attrs.append('initial="exact"')
+            real.append(f'start="{v.start!r}"')
+        elif v.causality == "input":
+            real.append(f'start="{v.start!r}"')
+        else:
+            outputs.append(index)
+        out.append(f'    <ScalarVariable {" ".join(attrs)}><Real {" ".join(real)}/></ScalarVariable>')
+        out[-1] = out[-1].replace(" >", ">")
+    out += ['  </ModelVariables>', '  <ModelStructure>', '    <Outputs>']
+    out += [f'      <Unknown index="{i}"/>' for i in outputs]
+    out += ['    </Outputs>', '    <InitialUnknowns>']
+    out += [f'      <Unknown index="{i}"/>' for i in outputs]
+    out += ['    </InitialUnknowns>', '  </ModelStructure>', '</fmiModelDescription>', '']
+    return "\n".join(out)
+
+
+def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
+               source: str | None = None) -> Path | Target:
+    """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 co-simulation FMU to
+    ``path`` (docs/fmu.md). ``temperature``: the start value of the temperature input [degC] (with a
+    heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
+    ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
+    ``source``: where the model came from (a file or preset name), for the FMU's description."""
+    if isinstance(model, (str, os.PathLike)):
+        source = os.fspath(model)
+        model = load_model(model)
+    if not isinstance(model, Model):
+        raise InputError(f"export_fmu: model must be a Model, a model file or a preset name, got {shorten(model)}")
+    if temperature is not None:
+        temperature = float(temperature)
+        if temperature != temperature or abs(temperature) == float("inf"):
+            raise InputError(f"export_fmu: temperature must be a finite number of degrees C, got {temperature!r}")
+    if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
+        raise InputError(f"FMUs are exported for Linux x86-64 only; this is {platform.system()} {platform.machine()}")
+    binary = binary_path()
+    if not binary.is_file():
+        raise InputError(f"this installation has no FMU binary ({binary}): reinstall thermofriction on Linux x86-64 "
+                         "(the package builds it with CMake)")
+    _check_exportable(model)
+    identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
+    if model_identifier is not None and identifier != model_identifier:
+        raise InputError(f"model identifier {model_identifier!r}: letters, digits and '_' only, not starting with a "
+                         f"digit (e.g. {identifier!r})")
+    heat_temperature = temperature if model.heat is None else (
+        temperature if temperature is not None else (model.heat.ambient_temperature or 20.0))
+    spec = _bridge.model_spec(model, temperature=heat_temperature if model.heat is not None else None)
+    variables = _variables(model, spec, temperature)
+    tfm = _resource_text(model, spec, variables)
+    guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
+    xml = _xml(model, variables, identifier, guid, source)
+    so = binary.read_bytes()
+    target = path if isinstance(path, Target) else Path(os.fspath(path))
+    if isinstance(target, Path) and target.is_dir():
+        raise InputError(f"{target}: is a folder; give a file name for the FMU (e.g. {target / (identifier + '.fmu')})")
+    with atomic_write(target, "wb") as fh:
+        with zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr("modelDescription.xml", xml)
+            info = zipfile.ZipInfo(f"binaries/linux64/{identifier}.so", date_time=(2020, 1, 1, 0, 0, 0))
+            info.external_attr = 0o755 << 16
+            info.compress_type = zipfile.ZIP_DEFLATED
+            z.writestr(info, so)
+            z.writestr("resources/model.tfm", tfm)
+            z.writestr("resources/model.toml", model.to_toml())
+            z.writestr("documentation/licenses/fmi2-headers.txt", _headers_licence())
+    return target
+
+
+def _headers_licence() -> str:
+    return ("The binary was built with the official FMI 2.0.1 headers, (C) 2008-2011 MODELISAR consortium, "
+            "2012-2019 Modelica Association Project \"FMI\", under the 2-Clause BSD License.\n")
+
+
+__all__ = ["export_fmu", "binary_path"]
