@@ -16,6 +16,9 @@
 (iii) Peak memory of a 100 s run at 10 kHz (in a fresh interpreter): tracemalloc peak of Python
       allocations (NumPy arrays included) and the increase of the peak resident set size
       (VmHWM; ru_maxrss where /proc is missing), against the size of the output arrays.
+(iv)  Start-up, as whole processes (interleaved, medians): the interpreter alone, `import numpy`
+      (the floor: the package needs NumPy), `import thermofriction`, `thermofriction simulate
+      --help`, and a whole `thermofriction simulate` of 0.1 s writing a CSV (target 0.3 s).
 """
 
 from __future__ import annotations
@@ -289,9 +292,33 @@ def part_iii():
     print(f"    {'peak RSS increase (VmHWM, whole process)':44s}  {rss_mb:8.1f}  {rss_mb / out_mb:8.2f}")
 
 
+def part_iv(rounds=9):
+    print(f"\n(iv) start-up as whole processes (medians of {rounds} interleaved rounds)")
+    exe = Path(sys.executable).with_name("thermofriction")
+    with tempfile.TemporaryDirectory() as tmp:
+        cmds = {"python -c pass": [sys.executable, "-c", "pass"],
+                "python -c 'import numpy'": [sys.executable, "-c", "import numpy"],
+                "python -c 'import thermofriction'": [sys.executable, "-c", "import thermofriction"],
+                "thermofriction simulate --help": [str(exe), "simulate", "--help"],
+                "thermofriction simulate (0.1 s, -o CSV)": [str(exe), "simulate", "li2009-model-i", "--temperature",
+                                                            "35.7", "--duration", "0.1", "-o",
+                                                            str(Path(tmp) / "run.csv")]}
+        times = {k: [] for k in cmds}
+        for _ in range(rounds):
+            for k, c in cmds.items():
+                t0 = time.perf_counter()
+                subprocess.run(c, stdout=subprocess.DEVNULL, check=True)
+                times[k].append(time.perf_counter() - t0)
+    floor = float(np.median(times["python -c 'import numpy'"]))
+    for k, v in times.items():
+        t = float(np.median(v))
+        print(f"    {k:42s}  {t:6.3f} s  ({t - floor:+.3f} s over importing NumPy)")
+    print("    target: the whole simulate process <= 0.3 s")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--parts", default="i,ii,iii", help="which parts to run (comma-separated; default all)")
+    ap.add_argument("--parts", default="i,ii,iii,iv", help="which parts to run (comma-separated; default all)")
     ap.add_argument("--rounds", type=int, default=15, help="interleaved rounds of part (i) (default 15)")
     args = ap.parse_args()
     parts = set(args.parts.split(","))
@@ -303,6 +330,8 @@ def main():
         part_ii()
     if "iii" in parts:
         part_iii()
+    if "iv" in parts:
+        part_iv()
 
 
 if __name__ == "__main__":
