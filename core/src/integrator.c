@@ -69,6 +69,12 @@ typedef struct {
     int n;
     double *k[7], *ytmp, *y1, *ysti, *ft, *cont[5], *J, *W;
     int *piv;
+    /* Rodas4's linear solves, reduced by the kinematic rows (structure_of_jacobian): the rows p whose
+     * Jacobian row is a unit vector e_q (x' = v) are eliminated, k_p = gamma h (b_p + k_q); the other
+     * nred rows (red[]) form the reduced matrix, LU-factored in W with reciprocal pivots in dinv, and
+     * Jpos (nred x npos) holds gamma h J[r][pos[j]], what the eliminated unknowns add to row r */
+    int npos, nred, *pos, *partner, *red;
+    double gh, *dinv, *Jpos, *xr;
     double t_clamp; /* stages never look past the corner that ends the segment */
     double *block; /* one allocation for all of the above */
 } work;
@@ -140,6 +146,94 @@ void tf_lu_solve(const double *A, int n, const int *piv, double *b)
     }
 }
 
+/* ---- Rodas4's linear systems (I/(gamma h) - J) k = b, reduced by the kinematic rows ----
+ * A mechanical system's position rows x' = v have a unit vector for their Jacobian row: their
+ * unknowns follow from their velocity's, k_x = gamma h (b_x + k_v), and need no elimination. The
+ * rest is a smaller dense system (3 x 3 instead of 5 x 5 for LuGre on the stick-slip actuator),
+ * factored with partial pivoting and reciprocal pivots (no division in the six solves per step). */
+
+/* Finds the kinematic rows of the current Jacobian (called after every Jacobian evaluation). */
+static void structure_of_jacobian(work *w)
+{
+    int n = w->n;
+    const double *J = w->J;
+    for (int i = 0; i < n; i++) {
+        int q = -1, nz = 0;
+        for (int j = 0; j < n; j++)
+            if (J[i * n + j] != 0.0) { nz++; q = j; }
+        w->partner[i] = (nz == 1 && q != i && J[i * n + q] == 1.0) ? q : -1;
+    }
+    /* a partner must itself stay in the reduced system */
+    for (int i = 0; i < n; i++)
+        if (w->partner[i] >= 0 && w->partner[w->partner[i]] >= 0) w->partner[i] = -1;
+    w->npos = w->nred = 0;
+    for (int i = 0; i < n; i++) {
+        if (w->partner[i] >= 0) w->pos[w->npos++] = i;
+        else w->red[w->nred++] = i;
+    }
+}
+
+static int reduced_factor(work *w, double h)
+{
+    int n = w->n, nr = w->nred, np = w->npos;
+    const double *J = w->J;
+    double *A = w->W, gh = ro_gamma * h, c = 1.0 / gh;
+    w->gh = gh;
+    for (int a = 0; a < nr; a++) {
+        int r = w->red[a];
+        for (int b = 0; b < nr; b++) A[a * nr + b] = -J[r * n + w->red[b]];
+        A[a * nr + a] += c;
+        for (int j = 0; j < np; j++) {
+            double Jrp = gh * J[r * n + w->pos[j]];
+            w->Jpos[a * np + j] = Jrp;
+            /* -J[r][p] k_p = -J[r][p] gh (b_p + k_q): the k_q part moves into column q */
+            int q = w->partner[w->pos[j]];
+            for (int b = 0; b < nr; b++)
+                if (w->red[b] == q) { A[a * nr + b] -= Jrp; break; }
+        }
+    }
+    for (int k = 0; k < nr; k++) {
+        int p = k;
+        double big = fabs(A[k * nr + k]);
+        for (int i = k + 1; i < nr; i++)
+            if (fabs(A[i * nr + k]) > big) { big = fabs(A[i * nr + k]); p = i; }
+        w->piv[k] = p;
+        if (big == 0.0 || !isfinite(big)) return 1;
+        if (p != k)
+            for (int j = k; j < nr; j++) { double tmp = A[k * nr + j]; A[k * nr + j] = A[p * nr + j]; A[p * nr + j] = tmp; }
+        double inv = w->dinv[k] = 1.0 / A[k * nr + k];
+        for (int i = k + 1; i < nr; i++) {
+            double l = A[i * nr + k] *= inv;
+            if (l != 0.0)
+                for (int j = k + 1; j < nr; j++) A[i * nr + j] -= l * A[k * nr + j];
+        }
+    }
+    return 0;
+}
+
+static void reduced_solve(const work *w, double *b)
+{
+    int nr = w->nred, np = w->npos;
+    const double *A = w->W;
+    double *xr = w->xr;
+    for (int a = 0; a < nr; a++) {
+        double s = b[w->red[a]];
+        for (int j = 0; j < np; j++) s += w->Jpos[a * np + j] * b[w->pos[j]];
+        xr[a] = s;
+    }
+    for (int k = 0; k < nr; k++) {
+        if (w->piv[k] != k) { double tmp = xr[k]; xr[k] = xr[w->piv[k]]; xr[w->piv[k]] = tmp; }
+        for (int i = k + 1; i < nr; i++) xr[i] -= A[i * nr + k] * xr[k];
+    }
+    for (int i = nr - 1; i >= 0; i--) {
+        double s = xr[i];
+        for (int j = i + 1; j < nr; j++) s -= A[i * nr + j] * xr[j];
+        xr[i] = s * w->dinv[i];
+    }
+    for (int a = 0; a < nr; a++) b[w->red[a]] = xr[a];
+    for (int j = 0; j < np; j++) b[w->pos[j]] = w->gh * (b[w->pos[j]] + b[w->partner[w->pos[j]]]);
+}
+
 /* ---- one attempted step of each method: y1, dense coefficients; returns the error norm,
  *      or a negative value when the step produced non-finite numbers ---- */
 static double dopri5_step(work *w, double t, double h, const double *y, const double *f0)
@@ -204,44 +298,41 @@ static double rodas4_step(work *w, double t, double h, const double *y, const do
 {
     int n = w->n, i;
     double **k = w->k, *yt = w->ytmp, *fs = w->k[6], *ft = w->ft;
-    double *W = w->W;
-    for (i = 0; i < n * n; i++) W[i] = -w->J[i];
-    for (i = 0; i < n; i++) W[i * n + i] += 1.0 / (ro_gamma * h);
     w->st->decompositions++;
-    if (tf_lu_factor(W, n, w->piv)) return -2;
+    if (reduced_factor(w, h)) return -2;
 
     for (i = 0; i < n; i++) k[0][i] = f0[i] + h * ro_g1 * ft[i];
-    tf_lu_solve(W, n, w->piv, k[0]);
+    reduced_solve(w, k[0]);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a21 * k[0][i];
     if (rhs(w, t + ro_c2 * h, yt, fs)) return -1;
     for (i = 0; i < n; i++) k[1][i] = fs[i] + h * ro_g2 * ft[i] + ro_c21 * k[0][i] / h;
-    tf_lu_solve(W, n, w->piv, k[1]);
+    reduced_solve(w, k[1]);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a31 * k[0][i] + ro_a32 * k[1][i];
     if (rhs(w, t + ro_c3 * h, yt, fs)) return -1;
     for (i = 0; i < n; i++) k[2][i] = fs[i] + h * ro_g3 * ft[i] + (ro_c31 * k[0][i] + ro_c32 * k[1][i]) / h;
-    tf_lu_solve(W, n, w->piv, k[2]);
+    reduced_solve(w, k[2]);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a41 * k[0][i] + ro_a42 * k[1][i] + ro_a43 * k[2][i];
     if (rhs(w, t + ro_c4 * h, yt, fs)) return -1;
     for (i = 0; i < n; i++)
         k[3][i] = fs[i] + h * ro_g4 * ft[i] + (ro_c41 * k[0][i] + ro_c42 * k[1][i] + ro_c43 * k[2][i]) / h;
-    tf_lu_solve(W, n, w->piv, k[3]);
+    reduced_solve(w, k[3]);
 
     for (i = 0; i < n; i++)
         yt[i] = y[i] + ro_a51 * k[0][i] + ro_a52 * k[1][i] + ro_a53 * k[2][i] + ro_a54 * k[3][i];
     if (rhs(w, t + h, yt, fs)) return -1;
     for (i = 0; i < n; i++)
         k[4][i] = fs[i] + (ro_c51 * k[0][i] + ro_c52 * k[1][i] + ro_c53 * k[2][i] + ro_c54 * k[3][i]) / h;
-    tf_lu_solve(W, n, w->piv, k[4]);
+    reduced_solve(w, k[4]);
 
     for (i = 0; i < n; i++) yt[i] += k[4][i];
     if (rhs(w, t + h, yt, fs)) return -1;
     for (i = 0; i < n; i++)
         k[5][i] = fs[i] + (ro_c61 * k[0][i] + ro_c62 * k[1][i] + ro_c63 * k[2][i] + ro_c64 * k[3][i] +
                            ro_c65 * k[4][i]) / h;
-    tf_lu_solve(W, n, w->piv, k[5]);
+    reduced_solve(w, k[5]);
 
     for (i = 0; i < n; i++) w->y1[i] = yt[i] + k[5][i];
     double err = wnorm(w, k[5], y, w->y1);
@@ -319,8 +410,8 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     memset(w, 0, sizeof *w);
     w->t_clamp = INFINITY;
     w->ode = ode; w->opt = opt; w->st = st; w->n = n;
-    size_t nvec = 7 + 4 + 5;
-    w->block = (double *)malloc(sizeof(double) * (nvec * n + 2 * (size_t)n * n) + sizeof(int) * n);
+    size_t nvec = 7 + 4 + 5 + 2;
+    w->block = (double *)malloc(sizeof(double) * (nvec * n + 3 * (size_t)n * n) + sizeof(int) * 4 * n);
     if (!w->block) return 1;
     double *p = w->block;
     for (int i = 0; i < 7; i++, p += n) w->k[i] = p;
@@ -331,7 +422,13 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     for (int i = 0; i < 5; i++, p += n) w->cont[i] = p;
     w->J = p; p += n * n;
     w->W = p; p += n * n;
+    w->Jpos = p; p += n * n;
+    w->dinv = p; p += n;
+    w->xr = p; p += n;
     w->piv = (int *)p;
+    w->pos = w->piv + n;
+    w->partner = w->pos + n;
+    w->red = w->partner + n;
     return 0;
 }
 
@@ -460,6 +557,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                         status = fail(&w, TF_ERR_NONFINITE, t, h);
                         goto done;
                     }
+                    structure_of_jacobian(&w);
                     jac_current = 1;
                 }
                 err = rodas4_step(&w, t, h, y, f0);

@@ -209,8 +209,8 @@ def _failure(e) -> CoreFailure:
 def run(spec: dict, t: np.ndarray, out: np.ndarray, *, method: str = "auto", rtol: float = 1e-6, atol=None,
         first_step: float = 0.0, max_step: float = 0.0, max_steps: int = 10_000_000) -> dict:
     """Integrates the model ``spec`` from rest, writing its outputs at times ``t`` into ``out``
-    (shape (len(t), n_outputs)). Returns the solver's statistics, ``method`` the one that finished
-    the run. Raises CoreFailure."""
+    (shape (len(t), n_outputs), in C or Fortran order). Returns the solver's statistics, ``method`` the
+    one that finished the run. Raises CoreFailure."""
     try:
         stats = _core.simulate(spec, t, out, METHOD_CODES[method], float(rtol), atol, float(first_step),
                                float(max_step), int(max_steps))

@@ -213,12 +213,19 @@ typedef struct {
     const tf_model *model;
     double *out;
     int nch;
+    long n_out; /* > 0: out is column-major (Fortran order), a column per output channel */
 } emit_ctx;
 
 static void emit_outputs(long i, double t, const double *y, void *ctx)
 {
     emit_ctx *e = (emit_ctx *)ctx;
-    tf_model_outputs(e->model, t, y, e->out + (size_t)i * e->nch);
+    if (!e->n_out) {
+        tf_model_outputs(e->model, t, y, e->out + (size_t)i * e->nch);
+        return;
+    }
+    double row[TF_OUT_NFIXED + TF_MAX_FRICTION_STATES + 1];
+    tf_model_outputs(e->model, t, y, row);
+    for (int j = 0; j < e->nch; j++) e->out[(size_t)j * e->n_out + i] = row[j];
 }
 
 /* simulate(spec, t_out, out, method, rtol, atol|None, h0, hmax, max_steps) -> stats dict */
@@ -242,10 +249,14 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     if (PyErr_Occurred()) goto done;
     if (n_out < 1) { PyErr_SetString(PyExc_ValueError, "t_out is empty"); goto done; }
     int n = tf_model_nstate(&m), nch = tf_model_noutput(&m);
-    if (PyObject_GetBuffer(out_obj, &outv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
+    /* out: (n_out, nch), C order (a row per sample) or Fortran order (a contiguous column per channel,
+     * which the package reads as views without copying) */
+    if (PyObject_GetBuffer(out_obj, &outv, PyBUF_STRIDES | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
     have_out = 1;
-    if (outv.itemsize != 8 || strcmp(outv.format, "d") != 0 || outv.len != (Py_ssize_t)(8 * n_out * nch)) {
-        PyErr_Format(PyExc_ValueError, "out must be a float64 array of shape (%zd, %d)", n_out, nch);
+    int rows = PyBuffer_IsContiguous(&outv, 'C'), columns = !rows && PyBuffer_IsContiguous(&outv, 'F');
+    if (outv.itemsize != 8 || strcmp(outv.format, "d") != 0 || outv.ndim != 2 || outv.shape[0] != n_out ||
+        outv.shape[1] != nch || !(rows || columns)) {
+        PyErr_Format(PyExc_ValueError, "out must be a contiguous float64 array of shape (%zd, %d)", n_out, nch);
         goto done;
     }
     double atol[TF_MAX_STATES];
@@ -264,7 +275,7 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     tf_ode ode = tf_model_ode(&m);
     tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps};
     tf_solver_stats st;
-    emit_ctx ec = {&m, (double *)outv.buf, nch};
+    emit_ctx ec = {&m, (double *)outv.buf, nch, columns ? (long)n_out : 0};
     int status;
     Py_BEGIN_ALLOW_THREADS
     status = tf_solve(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st);

@@ -25,14 +25,15 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.interpolate import PchipInterpolator
 
+from ._lazy import lazy
 from .errors import InputError, SolverError, TemperatureRangeWarning
 from .models import Model
 from .drive import input_of
 from .simulate import StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
+
+integrate, interpolate = lazy("scipy.integrate"), lazy("scipy.interpolate")
 
 
 @dataclass(frozen=True)
@@ -72,8 +73,8 @@ class CycleTable:
     startup: np.ndarray | None = None  # displacement of the warm-up from rest beyond its periodic steps [m]
 
     def interpolants(self):
-        return (PchipInterpolator(self.temperature, self.step_size, extrapolate=False),
-                PchipInterpolator(self.temperature, self.cycle_work, extrapolate=False))
+        return (interpolate.PchipInterpolator(self.temperature, self.step_size, extrapolate=False),
+                interpolate.PchipInterpolator(self.temperature, self.cycle_work, extrapolate=False))
 
 
 @dataclass(eq=False)
@@ -218,7 +219,7 @@ def _two_time_scale(model, heat, waveform, t_samples, method: TwoTimeScale) -> H
         for a, b in zip(bounds[:-1], bounds[1:]):
             if b <= a:
                 continue
-            sol = solve_ivp(rates, (a, b), y, method="LSODA", rtol=method.rtol, atol=[1e-9, 1e-15, 1e-15],
+            sol = integrate.solve_ivp(rates, (a, b), y, method="LSODA", rtol=method.rtol, atol=[1e-9, 1e-15, 1e-15],
                             events=leaves, dense_output=True)
             if sol.status < 0:
                 raise SolverError(f"two-time-scale: the slow heat balance failed at t = {sol.t[-1]:.6g} s: "

@@ -11,15 +11,17 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from scipy import optimize, stats
 
 from .. import _bridge
+from .._lazy import lazy
 from ..drive import drive
 from ..errors import ComputationError, InputError
 from ..models import Model
 from ..waveforms import Sampled, Waveform
 from .parameters import KNOT, Parameters, get_value, target_of, unit_of, with_values
 from .quality import ADEQUATE_RATIO, noise_level
+
+optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
 
 _MAX_STEPS = 2_000_000
 

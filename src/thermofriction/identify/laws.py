@@ -6,11 +6,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import optimize
 
+from .._lazy import lazy
 from ..errors import InputError
 from ..models import PWL, Const, Exp, Linear
 from ..models.friction import in_domain
+
+optimize = lazy("scipy.optimize")
 
 def _aicc(ssr, n, k):
     if ssr <= 0:

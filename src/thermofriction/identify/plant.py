@@ -25,10 +25,12 @@ import math
 import time as _time
 
 import numpy as np
-from scipy import linalg, optimize, signal, stats
 
+from .._lazy import lazy
 from ..errors import InputError
 from .parameters import Parameters
+
+linalg, optimize, signal, stats = (lazy(f"scipy.{name}") for name in ("linalg", "optimize", "signal", "stats"))
 
 NAMES = ("damping_ratio", "natural_frequency", "gain")
 UNITS = {"damping_ratio": "", "natural_frequency": "rad/s", "gain": "m/V"}

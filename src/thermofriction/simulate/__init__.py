@@ -26,8 +26,8 @@ from .checks import (as_temperature, check_heated_temperatures, check_passivity,
 from .result import SimulationResult
 from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 
-#: Default limit on output samples: each takes ~8 x (8 + internal states) bytes of outputs and about
-#: twice that at the peak (README "Speed": 184 MB for 1,000,001 samples), so 10 million need ~2 GB.
+#: Default limit on output samples: each takes ~8 x (10 + internal states) bytes of outputs, ~1.1 times
+#: that at the peak (README "Speed": 97 MB for 1,000,001 samples), so 10 million need ~1 GB.
 MAX_SAMPLES = 10_000_000
 
 
@@ -43,7 +43,7 @@ def _count(n) -> str:
 def _check_samples(n, max_samples, what, at_least=""):
     if max_samples is not None and n > max_samples:
         raise InputError(f"{at_least}{_count(n)} output samples requested ({what}), above the limit of {max_samples} "
-                         f"(~{n * 184 / 1e9:.3g} GB of memory): lower the duration or the sample rate, or raise "
+                         f"(~{n * 100 / 1e9:.3g} GB of memory): lower the duration or the sample rate, or raise "
                          f"the limit (--max-samples N; max_samples=N in Python, None for no limit)")
 
 
@@ -129,10 +129,15 @@ class _Grid:
         return column[np.searchsorted(self.times, self.cycle_times - self.tol)] if self.cycle_times.size else np.empty(0)
 
     def unjoin(self, out: np.ndarray) -> np.ndarray:
+        """``out`` (a row per time) without the joined rows, in Fortran order (a contiguous column per
+        output): one copy, and none when nothing was joined."""
         if not self.extra.size:
             return out
-        inserted = np.searchsorted(self.requested, self.extra) + np.arange(self.extra.size)
-        return np.delete(out, inserted, axis=0)
+        keep = np.ones(out.shape[0], bool)
+        keep[np.searchsorted(self.requested, self.extra) + np.arange(self.extra.size)] = False
+        kept = np.empty((out.shape[1], self.requested.size))
+        np.compress(keep, out.T, axis=1, out=kept)
+        return kept.T
 
 
 def _explain(e: _bridge.CoreFailure, model: Model, solver, controller, waveform, state_names) -> SolverError:
@@ -200,7 +205,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         non-decreasing grid starting at the initial time.
     solver: ``AutoSwitch()`` (default), ``Dopri5()`` or ``Rodas4()``.
     controller: ``StepSizeController`` (tolerances, step limits).
-    max_samples: the most output samples allowed (default 10 million, ~2 GB); None for no limit.
+    max_samples: the most output samples allowed (default 10 million, ~1 GB); None for no limit.
     friction_work: also integrate the friction work W = integral |F v_r| dt (always done with a
         heat model), returned as ``friction_work``.
     """
@@ -243,7 +248,8 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         except ValueError:
             raise InputError(f"atol must be one number or one per state ({len(state_names)}: "
                              f"{', '.join(state_names)}), got {shorten(controller.atol)}") from None
-    out = np.empty((grid.times.size, _bridge.n_outputs(model, friction_work)))
+    # one block in Fortran order: each output is a contiguous column, which the result holds as a view
+    out = np.empty((_bridge.n_outputs(model, friction_work), grid.times.size)).T
     try:
         stats = _bridge.run(_bridge.model_spec(model, temperature, waveform, friction_work), grid.times, out,
                             method=solver.name, rtol=controller.rtol, atol=atol,
@@ -261,17 +267,20 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
     # the C core keeps the states finite; an output computed from finite but extreme values
     # (e.g. a 1e165 m amplitude) may still overflow: refuse it rather than return it
     outputs = _bridge.OUTPUTS
-    finite = np.isfinite(out)
-    finite[:, _bridge.OUTPUT_COLUMN["temperature"]] = True  # NaN by design without a thermal part
-    if not finite.all():
-        row, col = np.argwhere(~finite)[0]
+    finite, bad = np.empty(out.shape[0], bool), None  # column by column: no temporary of the block's size
+    for col in range(out.shape[1]):
+        if col != _bridge.OUTPUT_COLUMN["temperature"]:  # NaN by design without a thermal part
+            if not np.isfinite(out[:, col], out=finite).all():
+                bad = min(bad or (math.inf, 0), (int(np.argmin(finite)), col))  # the earliest, as time goes
+    if bad:
+        row, col = bad
         raise SolverError(f"the output '{(outputs + tuple(model.friction.state_names) + ('friction_work',))[col]}' "
                           f"is not finite at "
                           f"t = {grid.times[row]:.9g} s ({out[row, col]}): likely cause: extreme parameter or input "
                           f"values (an overflow); check them", time=float(grid.times[row]))
     steps = np.diff(grid.at_cycles(out[:, _bridge.OUTPUT_COLUMN["displacement"]]))
     out = grid.unjoin(out)
-    cols = {name: np.ascontiguousarray(out[:, i]) for i, name in enumerate(outputs)}
+    cols = {name: out[:, i] for i, name in enumerate(outputs)}  # views of the block's contiguous columns
     if not isinstance(model.plant, StickSlipPlant):  # no stage: the driving surface is fixed (or the motion given)
         cols["stage_displacement"] = cols["stage_velocity"] = None
     if temperature is None and heat is None:
@@ -281,7 +290,7 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
     nfric = model.friction.nstate
     return SimulationResult(
         **cols,
-        friction_work=np.ascontiguousarray(out[:, len(outputs) + nfric]) if friction_work else None,
+        friction_work=out[:, len(outputs) + nfric] if friction_work else None,
         states=np.ascontiguousarray(out[:, len(outputs):len(outputs) + nfric]),
         state_names=model.friction.state_names,
         state_units=model.friction.state_units,
