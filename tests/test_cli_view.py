@@ -54,3 +54,16 @@ def test_identify_both_procedures_says_what_the_paper_procedure_did(model_ii_dat
     # the direct fit above it still reports its points and RMSE
     direct = out[:out.index("[[Fit: model-ii (paper)]]")]
     assert re.search(r"data points\s*=\s*[1-9]\d*", direct) and re.search(r"rmse\s*=\s*[\d.]+ nm", direct)
+
+
+def test_identify_in_a_pipe_prints_a_line_per_stage_and_quiet_prints_none(model_ii_data):
+    """stderr is a pipe here, as in a CI log: each stage says what it does (not nothing, and not a
+    terminal status line's control codes); --quiet silences it."""
+    r = run_cli("identify", model_ii_data, "--method", "model-i", "--starts", "1")
+    assert r.returncode == 0, r.stderr
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert len(lines) >= 3, r.stderr
+    assert "\x1b[" not in r.stderr
+    assert any("31" in line for line in lines)  # a per-temperature stage names its temperature
+    q = run_cli("identify", model_ii_data, "--method", "model-i", "--starts", "1", "--quiet")
+    assert q.returncode == 0 and q.stderr.strip() == "", q.stderr

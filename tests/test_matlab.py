@@ -200,3 +200,46 @@ def test_struct_and_units_keys_refused_for_csv_files(csv_folder, tmp_path):
     (tmp_path / "dataset.toml").write_text(text)
     with pytest.raises(tf.InputError, match=r"\[\[experiment\]\] 1: 'struct' applies to MATLAB files"):
         tf.load_dataset(tmp_path)
+
+
+def test_identify_and_validate_results_round_trip_through_mat_files(csv_folder, tmp_path):
+    """identify --json r.mat and validate --json m.mat (real CLI runs), loaded back with scipy.io:
+    every fitted parameter's name, value, error and unit, and every experiment's RMSE, equal the JSON
+    written by the same run to the last bit (numbers) and character (text)."""
+    import json
+    out = run_cli("identify", csv_folder, "--method", "base", "--starts", "1", "--json", tmp_path / "r.json")
+    assert out.returncode == 0, out.stderr
+    out = run_cli("identify", csv_folder, "--method", "base", "--starts", "1", "--json", tmp_path / "r.mat")
+    assert out.returncode == 0, out.stderr
+    ref = json.loads((tmp_path / "r.json").read_text())
+    mat = scipy.io.loadmat(tmp_path / "r.mat", simplify_cells=True)
+    params = mat["parameters"]
+    assert list(params["name"]) == list(ref["parameters"])
+    for k, name in enumerate(params["name"]):
+        assert params["value"][k] == ref["parameters"][name]["value"]
+        assert params["unit"][k] == ref["parameters"][name]["unit"]
+    exps = mat["experiments"]
+    assert list(np.atleast_1d(exps["file"])) == [e["file"] for e in ref["experiments"]]
+    np.testing.assert_array_equal(np.atleast_1d(exps["rmse_offset_removed"]),
+                                  [e["rmse_offset_removed"] for e in ref["experiments"]])
+    assert mat["fit_quality"]["ratio"] == ref["fit_quality"]["ratio"]
+    assert mat["method"] == ref["method"]
+    assert np.shape(mat["correlation"]["matrix"]) == (len(params["name"]),) * 2
+
+    assert run_cli("validate", "li2009-base", csv_folder, "--json", tmp_path / "m.mat").returncode in (0, 1)
+    assert run_cli("validate", "li2009-base", csv_folder, "--json", tmp_path / "m.json").returncode in (0, 1)
+    vm = scipy.io.loadmat(tmp_path / "m.mat", simplify_cells=True)
+    vj = json.loads((tmp_path / "m.json").read_text())
+    np.testing.assert_array_equal(np.atleast_1d(vm["experiments"]["max_error_pct"]),
+                                  [e["max_error_pct"] for e in vj["experiments"]])
+
+
+def test_results_to_mat_turns_json_shapes_into_matlab_shapes():
+    """Independent of any fit: the documented mapping on a hand-made document."""
+    from thermofriction.data.matlab import results_to_mat
+    m = results_to_mat({"a.b": {"value": 1.0, "unit": "N"}, "c": {"value": "nan", "unit": ""}})
+    assert list(m["name"]) == ["a.b", "c"] and np.isnan(m["value"][1]) and m["value"][0] == 1.0
+    t = results_to_mat([{"file": "x.csv", "T": 30.0}, {"file": "y.csv", "T": "inf"}])
+    assert list(t["file"]) == ["x.csv", "y.csv"] and np.isinf(t["T"][1])
+    assert results_to_mat([[1, 0.5], [0.5, 1]]).shape == (2, 2)
+    assert results_to_mat(None).size == 0

@@ -157,6 +157,11 @@ class ValidationResult:
         """The metrics (docs/formats.md#validation-metrics) as JSON, written atomically to ``path`` when given."""
         return dump_json(self.to_dict(), path)
 
+    def to_mat(self, path):
+        """The same metrics as a MATLAB file (docs/formats.md#results-in-matlab-files)."""
+        from .data.matlab import save_results_mat
+        save_results_mat(jsonable(self.to_dict()), path)
+
     _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
                 ("max error [%]", "max_error_pct", "{:.3g}"), ("RMSE [nm]", "rmse_offset_removed", "{:.4g}"),
                 ("NRMSE", "nrmse", "{:.3g}"), ("final error [%]", "final_error_pct", "{:+.3g}"),

@@ -72,9 +72,14 @@ def cmd_simulate(args) -> int:
 
 
 def _progress(quiet):
-    """A status line on a terminal; nothing otherwise (or with --quiet)."""
-    if quiet or not sys.stderr.isatty():
+    """A status line on a terminal; a line per stage when stderr is a file or a pipe (a CI log);
+    nothing with --quiet."""
+    if quiet:
         return None, None
+    if not sys.stderr.isatty():
+        def line(message):
+            print(f"  {message}", file=sys.stderr, flush=True)
+        return line, None
     from rich.console import Console
     console = Console(stderr=True)
     status = console.status("identifying")
@@ -121,8 +126,8 @@ def cmd_identify(args) -> int:
     with _io.publish_together():  # the model and its JSON appear together, or neither
         if args.output:
             fit.model.save(_target(args, "output"))
-        if args.json:
-            fit.to_json(_target(args, "json"))
+        if args.json:  # a .mat name writes the same results for MATLAB
+            (fit.to_mat if str(args.json).lower().endswith(".mat") else fit.to_json)(_target(args, "json"))
     if not args.quiet:
         print(fit.report())
         for name, alt in fit.alternatives.items():
@@ -142,8 +147,8 @@ def cmd_validate(args) -> int:
     data = load_dataset(args.dataset)
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
     res = validate(model, data)
-    if args.json:
-        res.to_json(_target(args, "json"))
+    if args.json:  # a .mat name writes the same metrics for MATLAB
+        (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)
@@ -202,7 +207,7 @@ def cmd_demo(args) -> int:
     update, status = _progress(False)
     try:
         with _io.publish_together():  # every file of the demo appears at the end, or none
-            out = run_demo(args.output, progress=update or (lambda m: print(f"  {m}", file=sys.stderr)))
+            out = run_demo(args.output, progress=update)
     finally:
         if status is not None:
             status.stop()

@@ -145,6 +145,11 @@ class FitResult:
         """The results as JSON (docs/formats.md#results-json), written atomically to ``path`` when given."""
         return dump_json(self.to_dict(), path)
 
+    def to_mat(self, path):
+        """The same results as a MATLAB file (docs/formats.md#results-in-matlab-files)."""
+        from ..data.matlab import save_results_mat
+        save_results_mat(self.to_dict(), path)
+
     def _rows(self):
         for p in self.parameters.values():
             if p.stderr is None or not p.vary:
