@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -209,6 +210,50 @@ def cmd_demo(args) -> int:
               f"{s.get('max_error_pct', float('nan')):.3g} %, RMSE {s.get('rmse_offset_removed', float('nan')) * 1e9:.4g} nm")
     print(f"  report: {out['report']}")
     return 0
+
+
+def cmd_sweep(args) -> int:
+    """``thermofriction sweep``: the table is written once every point has run (nothing on Ctrl-C)."""
+    from ..scale.cluster import progress_bar
+    from ..scale.sweep import sweep
+
+    model = load_model(args.model)
+    waveform = parse_waveform(args.input) if args.input else None
+    if waveform is None and model.input is None:
+        raise InputError(f"{args.model}: the model has no [input]: give --input")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    if str(args.output).lower().endswith(".parquet"):
+        import importlib.util
+        if importlib.util.find_spec("pyarrow") is None:
+            raise InputError(f"-o {args.output}: writing Parquet needs pyarrow (pip install pyarrow); "
+                             f"or give a .csv name")
+    _refuse_inputs(args, _model_inputs(args.model, model), _waveform_inputs(waveform))
+    from ..scale.sweep import _grid  # the grid's size for the progress bar, checked before any work
+    _, n_points = _grid(args.grid)
+    update, stop = progress_bar(n_points, "sweep", enabled=not args.quiet)
+    try:
+        res = sweep(model, args.grid, input=waveform, duration=args.duration, temperature=args.temperature,
+                    metrics=args.metrics, sample_rate=args.sample_rate, solver=SOLVERS[args.method](),
+                    controller=StepSizeController(rtol=args.rtol), scheduler=args.scheduler, workers=args.workers,
+                    batch_size=args.batch_size, progress=update)
+    finally:
+        stop()
+    res.save(_target(args, "output"))
+    for w in res.warnings:
+        print(f"thermofriction: warning: {w}", file=sys.stderr)
+    for i, reason in list(res.errors.items())[:5]:
+        point = ", ".join(f"{n} = {res[n][i]:g}" for n in res.coordinates)
+        print(f"thermofriction: point {i} ({point}) failed: {reason}", file=sys.stderr)
+    if res.failed > 5:
+        print(f"thermofriction: ... {res.failed - 5} more failed points (the error column of {args.output})",
+              file=sys.stderr)
+    if not args.quiet:
+        rate = len(res) / res.wall_time if res.wall_time > 0 else math.nan
+        print(f"{len(res)} points ({res.failed} failed) in {res.wall_time:.3g} s, {rate:.3g} simulations/s, "
+              f"on {res.where}")
+        print(f"wrote {args.output}")
+    return 1 if res.failed else 0
 
 
 #: each command's output files (argparse dest: option); they are checked before any work starts

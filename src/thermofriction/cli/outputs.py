@@ -10,7 +10,8 @@ from ..waveforms import Sampled
 
 
 _OUTPUT_FILES = {"simulate": {"output": "-o"}, "identify": {"output": "-o", "json": "--json"},
-                 "validate": {"json": "--json"}, "report": {"output": "-o"}}
+                 "validate": {"json": "--json"}, "report": {"output": "-o"},
+                 "sweep": {"output": "-o"}}
 
 
 def _check_outputs(args):
