@@ -86,6 +86,10 @@ def cmd_identify(args) -> int:
     from ..data import load_dataset
     from ..identify import identify
 
+    if _fleet_paths(args) is not None:  # many datasets: the fleet path (scale/fleet.py)
+        return cmd_identify_fleet(args)
+    if isinstance(args.dataset, list):
+        args.dataset = args.dataset[0]
     data = load_dataset(args.dataset)
     laws = {}
     for item in args.law:
@@ -127,6 +131,55 @@ def cmd_identify(args) -> int:
             if path:
                 print(f"wrote {path}")
     return 0
+
+
+def _fleet_paths(args):
+    from ..scale.fleet import fleet_datasets
+    return fleet_datasets(args.dataset)
+
+
+def cmd_identify_fleet(args) -> int:
+    """``thermofriction identify DATASET DATASET ...``: every dataset identified on the cluster; the
+    fitted models, their results and the fleet summary are written together at the end."""
+    from ..scale.cluster import progress_bar
+    from ..scale.fleet import identify_fleet
+
+    paths = _fleet_paths(args)
+    if not args.output:
+        raise InputError("identifying several datasets writes a folder: give -o DIR (NAME.toml and NAME.json per "
+                         "dataset, fleet.json and fleet.csv)")
+    if args.json:
+        raise InputError("--json applies to one dataset; with several, each dataset's results JSON goes into -o DIR")
+    laws = {}
+    for item in args.law:
+        name, eq, kind = item.partition("=")
+        if not eq or kind not in ("linear", "exp", "const"):
+            raise InputError(f"--law '{item}': expected PARAM=linear|exp|const")
+        laws[name.strip()] = kind
+    params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
+    if params and args.method != "base":
+        raise InputError("--parameters applies to --method base only")
+    if args.reference_temperature is not None and args.method != "model-ii":
+        raise InputError("--reference-temperature applies to --method model-ii only")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    update, stop = progress_bar(len(paths), "identify", enabled=not args.quiet)
+    try:
+        fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,
+                               free=args.free or (), procedure=args.procedure, laws=laws or None,
+                               refine=not args.no_refine, reference_temperature=args.reference_temperature,
+                               rtol=args.rtol, starts=args.starts, seed=args.seed, scheduler=args.scheduler,
+                               workers=args.workers, progress=update)
+    finally:
+        stop()
+    fleet.write(args.output)
+    if not args.quiet:
+        print(fleet.report())
+        print(f"{len(fleet.names)} datasets in {fleet.wall_time:.3g} s on {fleet.where}")
+        print(f"wrote {len(fleet.fits)} fitted models and results, fleet.json and fleet.csv in {args.output}")
+    for name, reason in fleet.failures.items():
+        print(f"thermofriction: {name}: not identified: {reason}", file=sys.stderr)
+    return 1 if fleet.failures else 0
 
 
 def cmd_validate(args) -> int:

@@ -117,7 +117,10 @@ def build_parser() -> argparse.ArgumentParser:
                     "global phase, and standard errors, 95 % intervals and correlations at the optimum.",
         epilog="Writes FITTED.toml (loadable by simulate) and, with --json, the results JSON (docs/formats.md#results-json). "
                "The initial model provides the plant (masses, xi, wn, K) and the input waveform.")
-    i.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
+    i.add_argument("dataset", metavar="DATASET", nargs="+",
+                   help="dataset folder (with dataset.toml); several, or one folder of dataset folders, identify "
+                        "a fleet: each dataset on the Dask cluster, -o DIR gets NAME.toml and NAME.json per "
+                        "dataset and the fleet summary fleet.json and fleet.csv (docs/scale-out.md)")
     i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
                         "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
@@ -149,6 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
     i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
+    _scheduler_options(i)  # fleet identification only
     i.set_defaults(run=cmd_identify)
 
     v = sub.add_parser("validate", help="predict every experiment of a dataset with a model: the metrics of docs/formats.md#validation-metrics",

@@ -13,6 +13,8 @@ process, in order. Dask is imported only when a cluster is used.
 from __future__ import annotations
 
 from .cluster import SEQUENTIAL, Runner
+from .fleet import FleetResult, fleet_datasets, identify_fleet
 from .sweep import METRICS, SweepResult, parse_axis, sweep
 
-__all__ = ["sweep", "SweepResult", "METRICS", "parse_axis", "Runner", "SEQUENTIAL"]
+__all__ = ["sweep", "SweepResult", "METRICS", "parse_axis", "identify_fleet", "FleetResult", "fleet_datasets",
+           "Runner", "SEQUENTIAL"]
