@@ -14,6 +14,7 @@ import contextlib
 import logging
 import math
 import os
+import pickle
 import sys
 import uuid
 
@@ -137,14 +138,15 @@ class Runner:
         # one unique key per task: pure=False would also do, but named keys read well in the dashboard
         tag = uuid.uuid4().hex[:12]
         name = getattr(fn, "__name__", "task").lstrip("_")
-        futures = [self.client.submit(fn, *args, key=f"thermofriction-{name}-{tag}-{i}", pure=False)
+        futures = [self.client.submit(_call, fn, pickle.dumps(args, protocol=pickle.HIGHEST_PROTOCOL),
+                                      key=f"thermofriction-{name}-{tag}-{i}", pure=False)
                    for i, args in enumerate(arg_tuples)]
         index = {f.key: i for i, f in enumerate(futures)}
         results = [None] * len(futures)
         try:
             for fut in distributed.as_completed(futures):
                 i = index[fut.key]
-                results[i] = fut.result()
+                results[i] = pickle.loads(fut.result())
                 fut.release()
                 done += weights[i]
                 if progress:
@@ -154,6 +156,13 @@ class Runner:
                 self.client.cancel(futures)
             raise
         return results
+
+
+def _call(fn, payload: bytes) -> bytes:
+    """A task as the workers run it: arguments and result travel as pickles of our own, because
+    Dask hands NumPy arrays over as read-only views of its network buffers, which the C core's
+    binding refuses as outputs (and a model or dataset must come out as it went in)."""
+    return pickle.dumps(fn(*pickle.loads(payload)), protocol=pickle.HIGHEST_PROTOCOL)
 
 
 def batches(n: int, size: int):
