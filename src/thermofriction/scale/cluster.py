@@ -20,8 +20,6 @@ import uuid
 
 from ..errors import InputError, shorten
 
-#: seconds to wait for an existing scheduler to answer
-CONNECT_TIMEOUT = 30.0
 SEQUENTIAL = "sequential"
 
 
@@ -96,7 +94,8 @@ class Runner:
         address = self.scheduler
         kw = {"scheduler_file": address} if os.path.isfile(address) else {"address": address}
         try:
-            self.client = self._stack.enter_context(distributed.Client(timeout=CONNECT_TIMEOUT, **kw))
+            # the wait is Dask's own (distributed.comm.timeouts.connect, 30 s unless configured)
+            self.client = self._stack.enter_context(distributed.Client(**kw))
         except (OSError, TimeoutError, ValueError) as e:
             raise InputError(f"scheduler {address}: cannot connect ({e}); start one with 'dask scheduler' and "
                              f"'dask worker ADDRESS' (docs/scale-out.md)") from None
