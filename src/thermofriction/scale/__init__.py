@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from .cluster import SEQUENTIAL, Runner
 from .fleet import FleetResult, fleet_datasets, identify_fleet
+from .propagate import PropagationResult, draw_parameters, propagate
 from .sweep import METRICS, SweepResult, parse_axis, sweep
 
 __all__ = ["sweep", "SweepResult", "METRICS", "parse_axis", "identify_fleet", "FleetResult", "fleet_datasets",
-           "Runner", "SEQUENTIAL"]
+           "propagate", "PropagationResult", "draw_parameters", "Runner", "SEQUENTIAL"]
