@@ -86,9 +86,10 @@ class Runner:
             # processes, one thread each: the C core releases the GIL, but a crash or a leak in one
             # worker must not take the others (or this process) with it
             n = self.workers or os.cpu_count() or 1
+            # the workers ignore Ctrl-C (scale/_worker.py): this process stops them
             self._cluster = self._stack.enter_context(distributed.LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=logging.ERROR))
+                silence_logs=logging.ERROR, preload=["thermofriction.scale._worker"]))
             self.client = self._stack.enter_context(distributed.Client(self._cluster))
             return
         address = self.scheduler
