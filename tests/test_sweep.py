@@ -212,6 +212,25 @@ def test_ctrl_c_stops_the_local_cluster_and_writes_nothing(tmp_path):
     assert not alive
 
 
+def _exit_on_one(i):
+    if i == 1:
+        os._exit(3)  # a crash of the worker process, every time it runs this task
+    return 2 * i
+
+
+def test_a_task_that_kills_its_workers_is_recorded_and_the_rest_go_on():
+    import dask
+
+    from thermofriction.scale.cluster import Runner
+    # Dask retries a task whose worker died on other workers, by default up to 3 times: once here
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), Runner(None, workers=2) as runner:
+        out = runner.map(_exit_on_one, [(i,) for i in range(6)], on_error=lambda i, why: ("lost", why))
+    assert out[1] == ("lost", "its worker died each time it ran (a crash or out of memory?)")
+    # Dask also gives up on a task that shared a dying worker with it too often; all others ran
+    assert sum(o == 2 * i for i, o in enumerate(out)) >= 3 and all(o == 2 * i or o[0] == "lost"
+                                                                    for i, o in enumerate(out))
+
+
 def test_import_does_not_load_dask():
     code = ("import sys, thermofriction as tf; tf.sweep; tf.identify_fleet; tf.propagate; "
             "print(any(m.split('.')[0] in ('dask', 'distributed') for m in sys.modules))")

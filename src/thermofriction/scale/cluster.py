@@ -10,6 +10,7 @@ results are put back in task order, so they equal a sequential run's.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import math
@@ -18,7 +19,7 @@ import pickle
 import sys
 import uuid
 
-from ..errors import InputError, shorten
+from ..errors import ComputationError, InputError, shorten
 
 SEQUENTIAL = "sequential"
 
@@ -89,7 +90,7 @@ class Runner:
             # the workers ignore Ctrl-C (scale/_worker.py): this process stops them
             self._cluster = self._stack.enter_context(distributed.LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=logging.ERROR, preload=["thermofriction.scale._worker"]))
+                silence_logs=logging.CRITICAL, preload=["thermofriction.scale._worker"]))
             self.client = self._stack.enter_context(distributed.Client(self._cluster))
             return
         address = self.scheduler
@@ -122,7 +123,9 @@ class Runner:
         where = "a local Dask cluster" if self._cluster is not None else f"Dask scheduler {self.client.scheduler.address}"
         return f"{where} ({self.n_workers()} workers)"
 
-    def map(self, fn, arg_tuples, weights=None, progress=None) -> list:
+    def map(self, fn, arg_tuples, weights=None, progress=None, on_error=None) -> list:
+        """``on_error(i, reason)``: the result of task i when the cluster could not run it (its
+        worker died every time it ran it, e.g. a crash); without it such a task stops the run."""
         arg_tuples = list(arg_tuples)
         weights = list(weights) if weights is not None else [1] * len(arg_tuples)
         done = 0
@@ -146,7 +149,15 @@ class Runner:
         try:
             for fut in distributed.as_completed(futures):
                 i = index[fut.key]
-                results[i] = pickle.loads(fut.result())
+                try:
+                    results[i] = pickle.loads(fut.result())
+                except (Exception, asyncio.CancelledError) as e:  # a killed worker, a lost scheduler
+                    reason = ("its worker died each time it ran (a crash or out of memory?)"
+                              if type(e).__name__ == "KilledWorker" else
+                              f"the cluster could not run it ({type(e).__name__}: {e})")
+                    if on_error is None or isinstance(e, asyncio.CancelledError):
+                        raise ComputationError(reason) from None
+                    results[i] = on_error(i, reason)
                 fut.release()
                 done += weights[i]
                 if progress:

@@ -189,7 +189,8 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
         size = batch_size or auto_batch_size(int(draws), runner.n_workers(), largest=100)
         spans = batches(int(draws), size)
         outs = runner.map(_run_draws, [(model, names, thetas[a:b], temps, waveform, sim) for a, b in spans],
-                          weights=[b - a for a, b in spans], progress=progress)
+                          weights=[b - a for a, b in spans], progress=progress,
+                          on_error=lambda i, reason: (None, None, {k: reason for k in range(spans[i][1] - spans[i][0])}))
         where = runner.describe()
     n_t = nominal[0].time.size
     disp = np.full((int(draws), temps.size, n_t), np.nan)

@@ -315,7 +315,10 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
         size = batch_size or auto_batch_size(n, runner.n_workers())
         spans = batches(n, size)
         args = [(model, waveform, temperature, names, kinds, coords[a:b], metrics, sim) for a, b in spans]
-        outs = runner.map(_run_batch, args, weights=[b - a for a, b in spans], progress=progress)
+        def lost(i, reason):  # every point of a batch the cluster could not run
+            a, b = spans[i]
+            return np.full((b - a, len(metrics)), np.nan), {k: reason for k in range(b - a)}, []
+        outs = runner.map(_run_batch, args, weights=[b - a for a, b in spans], progress=progress, on_error=lost)
         where = runner.describe()
     values = np.vstack([o[0] for o in outs]) if outs else np.empty((0, len(metrics)))
     errors, seen = {}, {}
