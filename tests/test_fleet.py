@@ -95,22 +95,21 @@ def test_write_publishes_every_model_result_and_the_summary(fleet, tmp_path):
     assert all(0.8 * NOISE < x < 1.25 * NOISE for x in rmse)
 
 
-def test_cli_fleet_and_its_usage_errors(fleet_dir, tmp_path):
-    def run(*args):
-        return subprocess.run([sys.executable, "-m", "thermofriction", "identify", *map(str, args)], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=240)
-
-    r = run(fleet_dir / "unit-0", fleet_dir / "unit-9", "--method", "base", "--starts", "2", "--scheduler",
-            "sequential", "-o", "out")
+def test_cli_fleet_and_its_usage_errors(fleet_dir, tmp_path, monkeypatch, capsys):
+    r = subprocess.run([sys.executable, "-m", "thermofriction", "identify", fleet_dir / "unit-0", fleet_dir / "unit-9",
+                        "--method", "base", "--starts", "2", "--scheduler", "sequential", "-o", "out"], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=240)
     assert r.returncode == 1 and "unit-9: not identified" in r.stderr and "Traceback" not in r.stderr
     assert sorted(os.listdir(tmp_path / "out")) == ["fleet.csv", "fleet.json", "unit-0.json", "unit-0.toml"]
-    for args, words in ((["--scheduler", "sequential"], "give -o DIR"),
-                        (["-o", "x", "--json", "r.json"], "--json applies to one dataset")):
-        r = run(fleet_dir / "unit-0", fleet_dir / "unit-1", *args)
-        assert r.returncode == 2 and words in r.stderr, r.stderr
+    from thermofriction.cli import main
+    monkeypatch.chdir(tmp_path)
     (tmp_path / "afile").write_text("")
-    r = run(fleet_dir, "-o", "afile")
-    assert r.returncode == 2 and "not a folder" in r.stderr
+    for args, words in ((["--scheduler", "sequential"], "give -o DIR"),
+                        (["-o", "x", "--json", "r.json"], "--json applies to one dataset"),
+                        (["-o", "afile"], "not a folder")):
+        assert main(["identify", str(fleet_dir / "unit-0"), str(fleet_dir / "unit-1"), *args]) == 2
+        assert words in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["afile", "out"]
 
 
 # -- uncertainty propagation ------------------------------------------------------------------
@@ -125,11 +124,11 @@ def fit_two():
 def test_monte_carlo_spread_equals_the_delta_method(fit_two):
     """For small uncertainties the Monte Carlo standard deviation of a prediction equals the first-order
     (delta-method) one, sqrt(g' C g), g the prediction's gradient by central differences: an
-    independent computation. Tolerance: the Monte Carlo error of a standard deviation from 400 draws
-    (1/sqrt(2 x 400) = 3.5 %), times 3."""
+    independent computation. Tolerance: the Monte Carlo error of a standard deviation from 300 draws
+    (1/sqrt(2 x 300) = 4.1 %), times 3."""
     from thermofriction.identify.parameters import with_values
 
-    T, draws = 38.0, 400
+    T, draws = 38.0, 300
     tight = tf.StepSizeController(rtol=1e-10)  # the differences below must not see the integration error
     res = tf.propagate(fit_two, [T], draws=draws, seed=5, duration=0.6, controller=tight, scheduler="sequential")
     assert res.failures == {} and res.parameters.shape == (draws, 2)
@@ -151,7 +150,7 @@ def test_monte_carlo_spread_equals_the_delta_method(fit_two):
     delta = np.sqrt(g @ cov @ g)
     mc = np.std(res.final_displacement[:, 0], ddof=1)
     print(f"Monte Carlo {mc:.4g} m, delta method {delta:.4g} m")
-    assert mc == pytest.approx(delta, rel=3 * 0.035)
+    assert mc == pytest.approx(delta, rel=3 * 0.041)
     # the band holds the nominal prediction and is about 2 x 1.96 standard deviations wide
     assert res.lower[0, -1] < res.nominal[0, -1] < res.upper[0, -1]
     assert res.upper[0, -1] - res.lower[0, -1] == pytest.approx(2 * 1.96 * delta, rel=0.2)
