@@ -178,6 +178,15 @@ def test_propagation_writes_bands_and_refuses_what_it_cannot_draw(fit_two, tmp_p
     assert table.size == 2 * res.time.size
     assert set(np.unique(table[table.dtype.names[0]])) == {33.0, 40.0}
     assert "40 C: step per cycle" in res.report()
+    from xml.etree import ElementTree
+
+    from thermofriction.scale.figures import save_bands_figure
+    save_bands_figure(res, tmp_path / "bands.svg")
+    save_bands_figure(res, tmp_path / "bands.png")
+    svg = (tmp_path / "bands.svg").read_text()
+    ElementTree.fromstring(svg)  # well-formed
+    assert "33 °C" in svg and "mean step per cycle" in svg
+    assert (tmp_path / "bands.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     params = tf.Parameters({name: dataclasses.replace(p) for name, p in fit_two.parameters.items()})
     broken = dataclasses.replace(fit_two, parameters=params)
     broken.parameters["fc"].stderr = float("inf")

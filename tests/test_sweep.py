@@ -58,7 +58,7 @@ def test_points_are_the_product_with_the_last_axis_fastest():
 
 def test_unknown_names_and_metrics_are_refused_before_any_work():
     m = tf.load_model("li2009-model-i")
-    with pytest.raises(InputError, match="grid 'sigma0'.*follows a law"):
+    with pytest.raises(InputError, match=r"grid 'sigma0': it follows a law .* coefficients \(sigma0.a, sigma0.b\)"):
         tf.sweep(m, {"sigma0": [1e6]}, temperature=35, scheduler="sequential")
     with pytest.raises(InputError, match="grid 'bogus'"):
         tf.sweep(m, {"bogus": [1]}, temperature=35, scheduler="sequential")

@@ -207,9 +207,12 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
     q = [50 * (1 - level), 50, 50 * (1 + level)]
     lo, med, hi = np.percentile(disp[ok], q, axis=0)
     noise = float((getattr(result, "fit_quality", None) or {}).get("noise") or 0.0)
-    # a new measurement = a drawn model's prediction + the sensor noise (seeded: its own stream)
-    noisy = disp[ok] + noise * np.random.default_rng([int(seed), 22]).standard_normal(disp[ok].shape)
-    plo, phi = np.percentile(noisy, [q[0], q[2]], axis=0)
+    # a new measurement = a drawn model's prediction + independent Gaussian sensor noise: each side of
+    # the band and the noise's quantile add in quadrature (exact for a Gaussian band; sampling the noise
+    # per output sample would make a ragged band from a few hundred draws)
+    from scipy.stats import norm
+    zn = float(norm.ppf(0.5 * (1 + level))) * noise
+    plo, phi = med - np.hypot(med - lo, zn), med + np.hypot(hi - med, zn)
     slo, shi = np.percentile(steps[ok], [q[0], q[2]], axis=0)
     return PropagationResult(
         temperatures=temps, time=nominal[0].time, level=float(level),

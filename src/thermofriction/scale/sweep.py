@@ -116,6 +116,10 @@ def _kinds(model: Model, waveform, names):
             try:
                 target_of(model, name)
             except InputError as e:
+                if name in model.laws:  # a Model I parameter: its law's coefficients are the knobs
+                    raise InputError(f"grid '{name}': it follows a law of temperature in this model: sweep its "
+                                     f"coefficients ({', '.join(name + '.' + c for c in model.laws[name].coefficient_names())}) "
+                                     f"or use a model without the law") from None
                 what = f"the input's fields ({', '.join(sorted(fields))}), " if fields else ""
                 raise InputError(f"grid '{name}': not temperature, {what}or a parameter of the model: {e}") from None
             kinds[name], units[name] = "parameter", unit_of(model, name)
