@@ -90,6 +90,9 @@ def cmd_identify(args) -> int:
         return cmd_identify_fleet(args)
     if isinstance(args.dataset, list):
         args.dataset = args.dataset[0]
+    if getattr(args, "scheduler", None) or getattr(args, "workers", None):
+        raise InputError("--scheduler and --workers apply to fleet identification (several datasets, or a folder "
+                         "of datasets); one dataset is identified in this process")
     data = load_dataset(args.dataset)
     laws = {}
     for item in args.law:

@@ -152,7 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
     i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
-    _scheduler_options(i)  # fleet identification only
+    _scheduler_options(i, " (several datasets only)")
     i.set_defaults(run=cmd_identify)
 
     v = sub.add_parser("validate", help="predict every experiment of a dataset with a model: the metrics of docs/formats.md#validation-metrics",
@@ -190,13 +190,13 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _scheduler_options(parser):
+def _scheduler_options(parser, only=""):
     """Where the work runs (docs/scale-out.md): shared by sweep and fleet identification."""
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="an existing Dask cluster: tcp://HOST:8786 or a scheduler file; 'sequential' runs in "
-                             "this process, in order (default: a local Dask cluster on this machine's cores)")
+                             f"this process, in order (default: a local Dask cluster on this machine's cores){only}")
     parser.add_argument("--workers", type=_positive_int, metavar="N",
-                        help="workers of the local cluster (default: one per core)")
+                        help=f"workers of the local cluster (default: one per core){only}")
 
 
 def _add_sweep_command(sub):
