@@ -145,6 +145,17 @@ def test_cli_sweep_on_the_local_cluster_equals_the_sequential_run(tmp_path):
     assert (tmp_path / "local.csv").read_text() == (tmp_path / "seq.csv").read_text()
 
 
+def test_cli_table_on_standard_output(tmp_path, monkeypatch, capsys):
+    from thermofriction.cli import main
+    monkeypatch.chdir(tmp_path)
+    assert main(["sweep", "li2009-base", "--grid", "fc=0.7,0.9", "--duration", "0.2", "--scheduler", "sequential",
+                 "-o", "-"]) == 0
+    out, err = capsys.readouterr()
+    lines = out.splitlines()
+    assert lines[0].startswith("fc[N],mean_step[m],") and len(lines) == 3 and "2 points (0 failed)" in err
+    assert os.listdir(tmp_path) == []
+
+
 def test_cli_failed_points_exit_1_and_are_named(tmp_path):
     r = run("sweep", "li2009-base", "--grid", "fc=0.8,-1,1.1", "--duration", "0.3", "--scheduler", "sequential",
             "-o", "s.csv", cwd=tmp_path)

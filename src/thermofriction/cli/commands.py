@@ -279,7 +279,7 @@ def cmd_sweep(args) -> int:
         raise InputError(f"{args.model}: the model has no [input]: give --input")
     if args.rtol >= 1:
         raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
-    if str(args.output).lower().endswith(".parquet"):
+    if args.output != "-" and str(args.output).lower().endswith(".parquet"):
         import importlib.util
         if importlib.util.find_spec("pyarrow") is None:
             raise InputError(f"-o {args.output}: writing Parquet needs pyarrow (pip install pyarrow); "
@@ -295,7 +295,12 @@ def cmd_sweep(args) -> int:
                     batch_size=args.batch_size, progress=update)
     finally:
         stop()
-    res.save(_target(args, "output"))
+    if args.output == "-":  # the table on standard output, the summary on standard error
+        res.write_csv(sys.stdout)
+        sys.stdout.flush()
+    else:
+        res.save(_target(args, "output"))
+    summary = sys.stderr if args.output == "-" else sys.stdout
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)
     for i, reason in list(res.errors.items())[:5]:
@@ -307,8 +312,9 @@ def cmd_sweep(args) -> int:
     if not args.quiet:
         rate = len(res) / res.wall_time if res.wall_time > 0 else math.nan
         print(f"{len(res)} points ({res.failed} failed) in {res.wall_time:.3g} s, {rate:.3g} simulations/s, "
-              f"on {res.where}")
-        print(f"wrote {args.output}")
+              f"on {res.where}", file=summary)
+        if args.output != "-":
+            print(f"wrote {args.output}")
     return 1 if res.failed else 0
 
 

@@ -232,7 +232,8 @@ def _add_sweep_command(sub):
     w.add_argument("--batch-size", type=_positive_int, metavar="N",
                    help="points per task (default: about 8 tasks per worker, at most 500 points each)")
     w.add_argument("-o", "--output", required=True, metavar="SWEEP.csv",
-                   help="the table: CSV, or Parquet when the name ends .parquet (needs pyarrow)")
+                   help="the table: CSV ('-' for standard output), or Parquet when the name ends .parquet "
+                        "(needs pyarrow)")
     w.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     w.set_defaults(run=cmd_sweep)
 

@@ -217,13 +217,17 @@ class SweepResult:
     def to_csv(self, path):
         """Writes the table atomically: a header with units, numbers exact to the last bit (repr),
         an ``error`` column (empty where the point ran)."""
+        with _io.atomic_write(path, "w", newline="") as fh:
+            self.write_csv(fh)
+
+    def write_csv(self, fh):
+        """The CSV table into an open text file (``to_csv`` writes a file atomically)."""
         names = list(self.coordinates) + list(self.metrics)
         cols = [self.columns[n] for n in names]
-        with _io.atomic_write(path, "w", newline="") as fh:
-            w = csv.writer(fh, lineterminator="\n")
-            w.writerow([self.header(n) for n in names] + ["error"])
-            for i in range(len(self)):
-                w.writerow([repr(float(c[i])) for c in cols] + [self.errors.get(i, "")])
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow([self.header(n) for n in names] + ["error"])
+        for i in range(len(self)):
+            w.writerow([repr(float(c[i])) for c in cols] + [self.errors.get(i, "")])
 
     def to_parquet(self, path):
         try:
