@@ -25,6 +25,16 @@ from .validate import validate
 from . import control, heating
 from .report import report
 
+#: scale-out (scale/, docs/scale-out.md): loaded on first use, so that Dask loads only when it is needed
+_SCALE = ("sweep", "SweepResult", "identify_fleet", "FleetResult", "propagate", "PropagationResult")
+
+
+def __getattr__(name):
+    if name in _SCALE:
+        from . import scale
+        return getattr(scale, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "ComputationError", "ConditioningWarning", "InputError", "PassivityWarning", "SolverError", "TemperatureRangeWarning",
@@ -37,6 +47,7 @@ __all__ = [
     "Sampled", "Sawtooth", "Sine", "Square", "Step", "Waveform", "parse_waveform",
     "FitResult", "Parameter", "Parameters", "identify",
     "Dataset", "Experiment", "load_dataset", "save_dataset", "synthesize", "validate", "report",
+    *_SCALE,
 ]
 
 

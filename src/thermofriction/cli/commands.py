@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -94,6 +95,13 @@ def cmd_identify(args) -> int:
     from ..data import load_dataset
     from ..identify import identify
 
+    if _fleet_paths(args) is not None:  # many datasets: the fleet path (scale/fleet.py)
+        return cmd_identify_fleet(args)
+    if isinstance(args.dataset, list):
+        args.dataset = args.dataset[0]
+    if getattr(args, "scheduler", None) or getattr(args, "workers", None):
+        raise InputError("--scheduler and --workers apply to fleet identification (several datasets, or a folder "
+                         "of datasets); one dataset is identified in this process")
     data = load_dataset(args.dataset)
     laws = {}
     for item in args.law:
@@ -137,6 +145,55 @@ def cmd_identify(args) -> int:
             if path:
                 print(f"wrote {path}")
     return 0
+
+
+def _fleet_paths(args):
+    from ..scale.fleet import fleet_datasets
+    return fleet_datasets(args.dataset)
+
+
+def cmd_identify_fleet(args) -> int:
+    """``thermofriction identify DATASET DATASET ...``: every dataset identified on the cluster; the
+    fitted models, their results and the fleet summary are written together at the end."""
+    from ..scale.cluster import progress_bar
+    from ..scale.fleet import identify_fleet
+
+    paths = _fleet_paths(args)
+    if not args.output:
+        raise InputError("identifying several datasets writes a folder: give -o DIR (NAME.toml and NAME.json per "
+                         "dataset, fleet.json and fleet.csv)")
+    if args.json:
+        raise InputError("--json applies to one dataset; with several, each dataset's results JSON goes into -o DIR")
+    laws = {}
+    for item in args.law:
+        name, eq, kind = item.partition("=")
+        if not eq or kind not in ("linear", "exp", "const"):
+            raise InputError(f"--law '{item}': expected PARAM=linear|exp|const")
+        laws[name.strip()] = kind
+    params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
+    if params and args.method != "base":
+        raise InputError("--parameters applies to --method base only")
+    if args.reference_temperature is not None and args.method != "model-ii":
+        raise InputError("--reference-temperature applies to --method model-ii only")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    update, stop = progress_bar(len(paths), "identify", enabled=not args.quiet)
+    try:
+        fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,
+                               free=args.free or (), procedure=args.procedure, laws=laws or None,
+                               refine=not args.no_refine, reference_temperature=args.reference_temperature,
+                               rtol=args.rtol, starts=args.starts, seed=args.seed, scheduler=args.scheduler,
+                               workers=args.workers, progress=update)
+    finally:
+        stop()
+    fleet.write(args.output)
+    if not args.quiet:
+        print(fleet.report())
+        print(f"{len(fleet.names)} datasets in {fleet.wall_time:.3g} s on {fleet.where}")
+        print(f"wrote {len(fleet.fits)} fitted models and results, fleet.json and fleet.csv in {args.output}")
+    for name, reason in fleet.failures.items():
+        print(f"thermofriction: {name}: not identified: {reason}", file=sys.stderr)
+    return 1 if fleet.failures else 0
 
 
 def cmd_validate(args) -> int:
@@ -221,6 +278,56 @@ def cmd_demo(args) -> int:
     print(f"  Model I against the truth the data were made from: {out['recovery']['model-i']['summary']}")
     print(f"  report: {out['report']}")
     return 0
+
+
+def cmd_sweep(args) -> int:
+    """``thermofriction sweep``: the table is written once every point has run (nothing on Ctrl-C)."""
+    from ..scale.cluster import progress_bar
+    from ..scale.sweep import sweep
+
+    model = load_model(args.model)
+    waveform = parse_waveform(args.input) if args.input else None
+    if waveform is None and model.input is None:
+        raise InputError(f"{args.model}: the model has no [input]: give --input")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    if args.output != "-" and str(args.output).lower().endswith(".parquet"):
+        import importlib.util
+        if importlib.util.find_spec("pyarrow") is None:
+            raise InputError(f"-o {args.output}: writing Parquet needs pyarrow (pip install pyarrow); "
+                             f"or give a .csv name")
+    _refuse_inputs(args, _model_inputs(args.model, model), _waveform_inputs(waveform))
+    from ..scale.sweep import _grid  # the grid's size for the progress bar, checked before any work
+    _, n_points = _grid(args.grid)
+    update, stop = progress_bar(n_points, "sweep", enabled=not args.quiet)
+    try:
+        res = sweep(model, args.grid, input=waveform, duration=args.duration, temperature=args.temperature,
+                    metrics=args.metrics, sample_rate=args.sample_rate, solver=SOLVERS[args.method](),
+                    controller=StepSizeController(rtol=args.rtol), scheduler=args.scheduler, workers=args.workers,
+                    batch_size=args.batch_size, progress=update)
+    finally:
+        stop()
+    if args.output == "-":  # the table on standard output, the summary on standard error
+        res.write_csv(sys.stdout)
+        sys.stdout.flush()
+    else:
+        res.save(_target(args, "output"))
+    summary = sys.stderr if args.output == "-" else sys.stdout
+    for w in res.warnings:
+        print(f"thermofriction: warning: {w}", file=sys.stderr)
+    for i, reason in list(res.errors.items())[:5]:
+        point = ", ".join(f"{n} = {res[n][i]:g}" for n in res.coordinates)
+        print(f"thermofriction: point {i} ({point}) failed: {reason}", file=sys.stderr)
+    if res.failed > 5:
+        print(f"thermofriction: ... {res.failed - 5} more failed points (the error column of {args.output})",
+              file=sys.stderr)
+    if not args.quiet:
+        rate = len(res) / res.wall_time if res.wall_time > 0 else math.nan
+        print(f"{len(res)} points ({res.failed} failed) in {res.wall_time:.3g} s, {rate:.3g} simulations/s, "
+              f"on {res.where}", file=summary)
+        if args.output != "-":
+            print(f"wrote {args.output}")
+    return 1 if res.failed else 0
 
 
 #: each command's output files (argparse dest: option); they are checked before any work starts

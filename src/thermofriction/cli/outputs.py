@@ -11,12 +11,15 @@ from ..waveforms import Sampled
 
 _OUTPUT_FILES = {"simulate": {"output": "-o"}, "identify": {"output": "-o", "json": "--json"},
                  "validate": {"json": "--json"}, "report": {"output": "-o"},
-                 "fmu": {"output": "-o"}}
+                 "fmu": {"output": "-o"},
+                 "sweep": {"output": "-o"}}
 
 
 def _check_outputs(args):
     """Resolves and checks every output file of the command (args.targets: dest -> Target)."""
     args.targets = {}
+    if _fleet_output(args):
+        return
     for dest, option in _OUTPUT_FILES.get(args.command, {}).items():
         path = getattr(args, dest, None)
         if path is not None and path != "-":  # (an empty path is refused, not taken for none)
@@ -26,6 +29,18 @@ def _check_outputs(args):
                            ("-o", args.output if args.command == "demo" else None)):
         if folder:
             _io.check_folder(folder, f"{option} {folder}")
+
+
+def _fleet_output(args) -> bool:
+    """identify with several datasets writes into the folder -o DIR (scale/fleet.py): checked as one."""
+    if args.command != "identify":
+        return False
+    from ..scale.fleet import fleet_datasets
+    if fleet_datasets(args.dataset) is None:
+        return False
+    if args.output:
+        _io.check_folder(args.output, f"-o {args.output}")
+    return True
 
 
 def _target(args, dest):

@@ -117,7 +117,10 @@ def build_parser() -> argparse.ArgumentParser:
                     "global phase, and standard errors, 95 % intervals and correlations at the optimum.",
         epilog="Writes FITTED.toml (loadable by simulate) and, with --json, the results JSON (docs/formats.md#results-json). "
                "The initial model provides the plant (masses, xi, wn, K) and the input waveform.")
-    i.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
+    i.add_argument("dataset", metavar="DATASET", nargs="+",
+                   help="dataset folder (with dataset.toml); several, or one folder of dataset folders, identify "
+                        "a fleet: each dataset on the Dask cluster, -o DIR gets NAME.toml and NAME.json per "
+                        "dataset and the fleet summary fleet.json and fleet.csv (docs/scale-out.md)")
     i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
                         "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
@@ -149,6 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
     i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
+    _scheduler_options(i, " (several datasets only)")
     i.set_defaults(run=cmd_identify)
 
     v = sub.add_parser("validate", help="predict every experiment of a dataset with a model: the metrics of docs/formats.md#validation-metrics",
@@ -184,6 +188,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     from ..data import add_synth_command  # dataset tools (synth) live with the data module
     add_synth_command(sub)
+    _add_sweep_command(sub)
     return p
 
 
@@ -206,3 +211,52 @@ def _add_fmu_command(sub):
                    help="the FMU's model identifier, letters, digits and _ (default: from the model's name)")
     from .commands import cmd_fmu
     f.set_defaults(run=cmd_fmu)
+
+
+def _scheduler_options(parser, only=""):
+    """Where the work runs (docs/scale-out.md): shared by sweep and fleet identification."""
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="an existing Dask cluster: tcp://HOST:8786 or a scheduler file; 'sequential' runs in "
+                             f"this process, in order (default: a local Dask cluster on this machine's cores){only}")
+    parser.add_argument("--workers", type=_positive_int, metavar="N",
+                        help=f"workers of the local cluster (default: one per core){only}")
+
+
+def _add_sweep_command(sub):
+    from ..scale.sweep import DEFAULT_METRICS, METRICS
+    from .commands import cmd_sweep
+
+    w = sub.add_parser(
+        "sweep", help="a design map: simulate a model at every point of a grid, one row of metrics per point",
+        description="Simulate MODEL at every point of the grid given by the --grid options (their Cartesian "
+                    "product, the last varying fastest) and write one row per point: the point's coordinates, "
+                    "then the metrics. Runs on Dask: a local cluster on this machine's cores, or an existing "
+                    "cluster (--scheduler). A point that fails is written with empty metrics and its reason "
+                    "in the error column; the others go on (exit status 1 when any failed).",
+        epilog="Grid names: temperature [C]; a field of the input waveform (amplitude, frequency, rise, offset, "
+               "duty, slew); a model parameter (sigma0, sigma1, fc, fs, vs, sigma2, a law coefficient such as "
+               "sigma0.b, dF.values[1], a plant parameter such as m_e). Metrics: "
+               + "; ".join(f"{k} [{u}] {what}" for k, (u, what, _) in METRICS.items()) + ".")
+    w.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
+    w.add_argument("--grid", action="append", required=True, metavar="NAME=VALUES",
+                   help="an axis: NAME=START:STOP:STEP (STOP included) or NAME=V1,V2,...; repeat for more axes")
+    w.add_argument("--input", metavar="WAVEFORM", help="input waveform, overriding the model's [input]")
+    w.add_argument("--temperature", type=_finite_float, metavar="C",
+                   help="temperature [C] of every point, when the grid has no temperature axis")
+    w.add_argument("--duration", type=_positive_float, default=1.0, metavar="S",
+                   help="simulated time per point [s] (default: 1)")
+    w.add_argument("--sample-rate", type=_positive_float, default=10_000.0, metavar="HZ",
+                   help="output sample rate [Hz] the metrics are taken from (default: 10000)")
+    w.add_argument("--metrics", default=",".join(DEFAULT_METRICS), metavar="NAMES",
+                   help=f"comma-separated metrics (default: {','.join(DEFAULT_METRICS)})")
+    w.add_argument("--method", choices=sorted(SOLVERS), default="auto", help="integrator (default: auto)")
+    w.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
+    _scheduler_options(w)
+    w.add_argument("--batch-size", type=_positive_int, metavar="N",
+                   help="points per task (default: about 8 tasks per worker, at most 500 points each)")
+    w.add_argument("-o", "--output", required=True, metavar="SWEEP.csv",
+                   help="the table: CSV ('-' for standard output), or Parquet when the name ends .parquet "
+                        "(needs pyarrow)")
+    w.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
+    w.set_defaults(run=cmd_sweep)
+

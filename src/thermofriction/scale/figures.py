@@ -1,0 +1,89 @@
+"""The figure of an uncertainty propagation (tf.propagate): the predicted displacement at each new
+temperature with its bands, and the mean step per cycle against temperature with its band.
+
+    fig = bands_figure(bands)              # a matplotlib Figure
+    save_bands_figure(bands, "bands.svg")  # or .png; written atomically
+
+Kept apart from the report module, which may embed it (``fig.savefig`` to SVG)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .._io import atomic_write
+
+
+def bands_figure(result):
+    """The bands drawn around the fitted model's prediction (their width is nanometres on
+    micrometres of motion). Left: per temperature, the parameters' band minus the fitted model's
+    displacement [nm], over time (the band with the measurement noise is given in words). Right: the mean
+    step per cycle's band minus the fitted model's step [nm] against temperature, each point labelled
+    with the fitted model's step [um]."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    temps = np.asarray(result.temperatures, float)
+    cmap = plt.get_cmap("plasma")
+    span = float(np.ptp(temps)) or 1.0
+    colors = [cmap(0.1 + 0.75 * (T - temps.min()) / span) for T in temps]
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 3.8), gridspec_kw={"width_ratios": [1.6, 1]})
+    t = result.time
+    level = f"{100 * result.level:g} %"
+    for j, T in enumerate(temps):
+        c, nom = colors[j], result.nominal[j]
+        ax.fill_between(t, (result.lower[j] - nom) * 1e9, (result.upper[j] - nom) * 1e9, color=c, alpha=0.45,
+                        linewidth=0.6, edgecolor=c, label=f"{T:g} °C")
+    ax.axhline(0, color="#1d2433", linewidth=0.8)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("displacement − fitted model's [nm]")
+    ax.set_title(f"{level} band of the prediction from the parameters' uncertainty", fontsize=9)
+    if result.noise:  # far wider than the parameters' band as a rule: said, not drawn
+        extra = float(np.max(result.prediction_upper - result.nominal)) * 1e9
+        ax.text(0.01, 0.02, f"a new measurement adds the {result.noise * 1e9:.3g} nm sensor noise: "
+                f"up to ±{extra:.3g} nm (prediction_lower/upper)", transform=ax.transAxes, fontsize=7,
+                color="#4a5266")
+    ax.legend(fontsize=8, frameon=False, ncol=min(len(temps), 4))
+    ok = np.isfinite(result.nominal_step)
+    if ok.any():
+        order = np.argsort(temps)
+        T, nom = temps[order], result.nominal_step[order]
+        lo, hi = (result.step_lower[order] - nom) * 1e9, (result.step_upper[order] - nom) * 1e9
+        bx.fill_between(T, lo, hi, color="#f0a500", alpha=0.35, linewidth=0, label=f"{level} band")
+        bx.plot(T, lo, T, hi, color="#f0a500", linewidth=0.8)
+        bx.plot(T, np.zeros_like(T), "o-", color="#1d2433", markersize=4, linewidth=0.8, label="fitted model")
+        for x, step in zip(T, nom):
+            bx.annotate(f"{step * 1e6:.4g} µm", (x, 0), textcoords="offset points", xytext=(0, 6), ha="center",
+                        fontsize=7, color="#4a5266")
+        bx.set_ylabel("step per cycle − fitted model's [nm]")
+        bx.legend(fontsize=8, frameon=False, loc="lower right")
+    else:
+        bx.text(0.5, 0.5, "no periodic input: no steps per cycle", ha="center", va="center",
+                transform=bx.transAxes)
+    bx.set_xlabel("temperature [°C]")
+    bx.set_title(f"mean step per cycle, {result.draws - len(result.failures)} of {result.draws} draws", fontsize=9)
+    for a in (ax, bx):
+        a.grid(alpha=0.3)
+        a.spines["top"].set_visible(False)
+        a.spines["right"].set_visible(False)
+    fig.tight_layout()
+    return fig
+
+
+def save_bands_figure(result, path):
+    """Writes :func:`bands_figure` as SVG (or PNG when the name ends .png), atomically."""
+    import matplotlib.pyplot as plt
+
+    fig = bands_figure(result)
+    fmt = "png" if str(path).lower().endswith(".png") else "svg"
+    try:
+        with atomic_write(Path(path), "wb") as fh:
+            fig.savefig(fh, format=fmt, dpi=150, bbox_inches="tight")
+    finally:
+        plt.close(fig)
+    return path
+
+
+__all__ = ["bands_figure", "save_bands_figure"]

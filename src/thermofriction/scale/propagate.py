@@ -1,0 +1,227 @@
+"""Uncertainty propagation: a fit's parameter uncertainty carried into predictions at new
+temperatures, by Monte Carlo on Dask.
+
+    fit = tf.identify(data, method="model-i")
+    bands = tf.propagate(fit, temperatures=[33, 37, 40], draws=400, seed=1)
+    bands.time, bands.nominal, bands.lower, bands.upper        # (temperatures, samples) [m]
+    bands.step_lower, bands.step_upper                          # the mean step per cycle's band [m]
+
+Parameter sets are drawn from the fit's covariance (its standard errors and correlations): a
+positive parameter (fitted in log space, its interval multiplicative) is drawn log-normally, the
+others normally; the draws are made here from ``seed`` before any task runs, so the bands do not
+depend on where the simulations ran. ``lower``/``upper`` hold the parameters' band (the model's
+prediction); ``prediction_lower``/``prediction_upper`` add the measurement noise the fit
+estimated, for where a new measurement would fall.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+
+import numpy as np
+
+from .. import _io
+from ..errors import InputError, ThermofrictionError, shorten
+from .cluster import Runner, auto_batch_size, batches
+
+MAX_DRAWS = 1_000_000
+
+
+def _covariance(result):
+    """(names, centre in the drawing space, covariance there, which are drawn in log space)."""
+    varying = [p for p in result.parameters.values() if p.vary]
+    if not varying:
+        raise InputError("the fit has no fitted parameters: nothing to propagate")
+    names = [p.name for p in varying]
+    theta = np.array([p.value for p in varying], float)
+    se = np.array([math.nan if p.stderr is None else p.stderr for p in varying], float)
+    bad = [n for n, s in zip(names, se) if not math.isfinite(s)]
+    if bad:
+        raise InputError(f"'{bad[0]}' has no finite standard error (not identifiable from the fit's data): its "
+                         f"uncertainty cannot be propagated; fix it or fit it on more informative data")
+    corr = np.array(result.correlation, float)[:len(names), :len(names)]
+    if corr.shape != (len(names), len(names)) or not np.all(np.isfinite(corr)):
+        raise InputError("the fit's correlation matrix is missing or not finite: its uncertainty cannot be propagated")
+    log = np.array([p.positive for p in varying])
+    centre = np.where(log, np.log(np.where(log, theta, 1.0)), theta)
+    sd = np.where(log, se / np.where(log, theta, 1.0), se)  # log space: the relative error, to first order
+    return names, centre, corr * np.outer(sd, sd), log
+
+
+def draw_parameters(result, draws: int, seed: int = 0):
+    """(names, array (draws, parameters)): seeded draws from the fit's covariance."""
+    names, centre, cov, log = _covariance(result)
+    w, V = np.linalg.eigh((cov + cov.T) / 2)
+    root = V * np.sqrt(np.clip(w, 0.0, None))  # a covariance that is singular to rounding stays usable
+    z = np.random.default_rng([int(seed), 21]).standard_normal((draws, len(names)))
+    phi = centre + z @ root.T
+    return names, np.where(log, np.exp(phi), phi)
+
+
+def _run_draws(model, names, thetas, temperatures, waveform, sim):
+    """Runs on a worker: displacement (draws, temperatures, samples), mean steps (draws,
+    temperatures), and {row: reason} for draws that could not be simulated (all NaN)."""
+    from ..identify.parameters import with_values
+    from ..simulate import simulate
+
+    disp = steps = None
+    errors = {}
+    for i, theta in enumerate(thetas):
+        try:
+            m = with_values(model, dict(zip(names, (float(v) for v in theta))))
+            why = m.unphysical_over_range()
+            if why:
+                raise InputError(f"drawn model leaves its physical domain: {why}")
+            for j, T in enumerate(temperatures):
+                res = simulate(m, temperature=float(T), input=waveform, **sim)
+                if disp is None:
+                    disp = np.full((len(thetas), len(temperatures), res.time.size), np.nan)
+                    steps = np.full((len(thetas), len(temperatures)), np.nan)
+                disp[i, j] = res.displacement
+                steps[i, j] = res.step_sizes.mean() if res.step_sizes.size else np.nan
+        except ThermofrictionError as e:
+            errors[i] = str(e)
+            if disp is not None:
+                disp[i] = np.nan
+                steps[i] = np.nan
+        except Exception as e:  # noqa: BLE001 - one draw's surprise must not stop the others
+            errors[i] = f"{type(e).__name__}: {e}"
+            if disp is not None:
+                disp[i] = np.nan
+                steps[i] = np.nan
+    return disp, steps, errors
+
+
+@dataclasses.dataclass(eq=False)
+class PropagationResult:
+    """Bands over draws, per temperature (rows) and output time (columns), SI units."""
+
+    temperatures: np.ndarray
+    time: np.ndarray
+    level: float
+    nominal: np.ndarray            # the fitted model's displacement
+    median: np.ndarray
+    lower: np.ndarray              # the parameters' band
+    upper: np.ndarray
+    prediction_lower: np.ndarray   # with the measurement noise the fit estimated
+    prediction_upper: np.ndarray
+    noise: float                   # [m], the fit's noise estimate (0 when it had none)
+    nominal_step: np.ndarray       # mean step per cycle [m], per temperature
+    step_lower: np.ndarray
+    step_upper: np.ndarray
+    names: list
+    parameters: np.ndarray         # the draws (draws x parameters)
+    steps: np.ndarray              # each draw's mean step per temperature (NaN where it failed)
+    final_displacement: np.ndarray  # each draw's final displacement per temperature
+    failures: dict                 # draw index -> reason
+    wall_time: float = math.nan
+    where: str = ""
+
+    @property
+    def draws(self) -> int:
+        return self.parameters.shape[0]
+
+    def to_csv(self, path):
+        """One row per temperature and output time: the nominal prediction, the median and both bands."""
+        level = f"{100 * self.level:g}"
+        head = ["temperature[C]", "time[s]", "nominal[m]", "median[m]", f"lower_{level}[m]", f"upper_{level}[m]",
+                f"prediction_lower_{level}[m]", f"prediction_upper_{level}[m]"]
+        n_t = self.time.size
+        cols = [np.repeat(self.temperatures, n_t), np.tile(self.time, self.temperatures.size)]
+        cols += [a.ravel() for a in (self.nominal, self.median, self.lower, self.upper, self.prediction_lower,
+                                     self.prediction_upper)]
+        with _io.atomic_write(path, "w", newline="") as fh:
+            fh.write(",".join(head) + "\n")
+            np.savetxt(fh, np.column_stack(cols), delimiter=",", fmt="%.12g")
+
+    def report(self) -> str:
+        lines = [f"[[Propagation]] {self.draws} draws ({len(self.failures)} failed), {100 * self.level:g} % bands"]
+        for j, T in enumerate(self.temperatures):
+            lines.append(f"    {T:g} C: step per cycle {self.nominal_step[j] * 1e6:.5g} um "
+                         f"[{self.step_lower[j] * 1e6:.5g}, {self.step_upper[j] * 1e6:.5g}]; final displacement "
+                         f"{self.nominal[j, -1] * 1e6:.5g} um [{self.lower[j, -1] * 1e6:.5g}, "
+                         f"{self.upper[j, -1] * 1e6:.5g}]")
+        return "\n".join(lines)
+
+    def __repr__(self):
+        return (f"PropagationResult({self.draws} draws at {', '.join(f'{T:g}' for T in self.temperatures)} C, "
+                f"{100 * self.level:g} % bands)")
+
+
+def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=None, duration: float = 1.0,
+              sample_rate: float = 1000.0, level: float = 0.95, solver=None, controller=None, scheduler=None,
+              workers=None, batch_size=None, progress=None) -> PropagationResult:
+    """Draws ``draws`` parameter sets from ``result``'s covariance (a ``FitResult``), simulates each
+    at every temperature [C] (``duration`` s of ``input``, default the model's), and returns the
+    central ``level`` bands of the displacement and of the mean step per cycle.
+
+    scheduler, workers: as for :func:`thermofriction.sweep` (None: a local Dask cluster).
+    batch_size: draws per task. progress: called with the number of draws done."""
+    import time
+
+    from ..simulate import simulate
+
+    model = getattr(result, "model", None)
+    if model is None or not hasattr(result, "parameters"):
+        raise InputError(f"result must be a fit (tf.identify's FitResult), got {shorten(result)}")
+    if isinstance(draws, bool) or not isinstance(draws, numbers.Integral) or not 2 <= draws <= MAX_DRAWS:
+        raise InputError(f"draws must be a whole number from 2 to {MAX_DRAWS}, got {shorten(draws)}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise InputError(f"seed must be a whole number, 0 or more, got {shorten(seed)}")
+    if isinstance(level, bool) or not isinstance(level, numbers.Real) or not 0 < level < 1:
+        raise InputError(f"level must be between 0 and 1, got {shorten(level)}")
+    try:
+        temps = np.atleast_1d(np.asarray(temperatures, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"temperatures must be numbers [C], got {shorten(temperatures)}") from None
+    if temps.ndim != 1 or temps.size == 0 or not np.all(np.isfinite(temps)):
+        raise InputError(f"temperatures must be a non-empty list of finite numbers [C], got {shorten(temperatures)}")
+    waveform = input if input is not None else model.input
+    if waveform is None:
+        raise InputError("the fitted model has no [input]: give input= (e.g. tf.Sawtooth(amplitude=30, frequency=5))")
+    sim = dict(duration=duration, sample_rate=sample_rate, solver=solver, controller=controller)
+    t0 = time.perf_counter()
+    nominal = [simulate(model, temperature=float(T), input=waveform, **sim) for T in temps]  # checks the arguments
+    names, thetas = draw_parameters(result, int(draws), int(seed))
+    with Runner(scheduler, workers) as runner:
+        size = batch_size or auto_batch_size(int(draws), runner.n_workers(), largest=100)
+        spans = batches(int(draws), size)
+        outs = runner.map(_run_draws, [(model, names, thetas[a:b], temps, waveform, sim) for a, b in spans],
+                          weights=[b - a for a, b in spans], progress=progress,
+                          on_error=lambda i, reason: (None, None, {k: reason for k in range(spans[i][1] - spans[i][0])}))
+        where = runner.describe()
+    n_t = nominal[0].time.size
+    disp = np.full((int(draws), temps.size, n_t), np.nan)
+    steps = np.full((int(draws), temps.size), np.nan)
+    failures = {}
+    for (a, b), (d, s, errs) in zip(spans, outs):
+        if d is not None:
+            disp[a:b], steps[a:b] = d, s
+        failures.update({a + i: r for i, r in errs.items()})
+    ok = np.array([i not in failures for i in range(int(draws))])
+    if ok.sum() < 2:
+        first = next(iter(failures.values()), "")
+        raise ThermofrictionError(f"fewer than two of {draws} drawn models could be simulated: {first}")
+    q = [50 * (1 - level), 50, 50 * (1 + level)]
+    lo, med, hi = np.percentile(disp[ok], q, axis=0)
+    noise = float((getattr(result, "fit_quality", None) or {}).get("noise") or 0.0)
+    # a new measurement = a drawn model's prediction + independent Gaussian sensor noise: each side of
+    # the band and the noise's quantile add in quadrature (exact for a Gaussian band; sampling the noise
+    # per output sample would make a ragged band from a few hundred draws)
+    from scipy.stats import norm
+    zn = float(norm.ppf(0.5 * (1 + level))) * noise
+    plo, phi = med - np.hypot(med - lo, zn), med + np.hypot(hi - med, zn)
+    slo, shi = np.percentile(steps[ok], [q[0], q[2]], axis=0)
+    return PropagationResult(
+        temperatures=temps, time=nominal[0].time, level=float(level),
+        nominal=np.array([r.displacement for r in nominal]), median=med, lower=lo, upper=hi,
+        prediction_lower=plo, prediction_upper=phi, noise=noise,
+        nominal_step=np.array([r.step_sizes.mean() if r.step_sizes.size else np.nan for r in nominal]),
+        step_lower=slo, step_upper=shi, names=list(names), parameters=thetas, steps=steps,
+        final_displacement=disp[:, :, -1], failures=dict(sorted(failures.items())),
+        wall_time=time.perf_counter() - t0, where=where)
+
+
+__all__ = ["propagate", "PropagationResult", "draw_parameters"]

@@ -1,0 +1,344 @@
+"""Design sweeps: one simulation per point of a grid (temperature x input x model parameters),
+reduced to a few summary metrics per point, batched many points per Dask task.
+
+    res = tf.sweep(model, grid={"temperature": np.arange(30, 42.25, 0.25), "amplitude": [10, 20, 30]},
+                   duration=0.4, metrics=["mean_step", "final_displacement"])
+    res["temperature"], res["mean_step"], res.failed          # arrays, one entry per point
+    res.to_csv("sweep.csv")                                    # or .to_parquet(...), .to_dataframe()
+
+The points are the Cartesian product of the grid's axes in the order given, the last varying
+fastest. Every point is simulated on its own from the same arguments, so the result does not depend
+on where or in which order the points ran: a cluster's run equals ``scheduler="sequential"``'s.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+import numbers
+import warnings
+
+import numpy as np
+
+from .. import _io
+from .._reading import strict_float
+from ..errors import InputError, ThermofrictionError, shorten
+from ..models import Model, load_model
+from ..waveforms import Sampled, Waveform
+from .cluster import Runner, auto_batch_size, batches
+
+#: the most points of one sweep (their coordinates and metrics are held in memory: ~100 bytes each)
+MAX_POINTS = 50_000_000
+
+
+def _mean_step(res):
+    return float(res.step_sizes.mean()) if res.step_sizes.size else math.nan
+
+
+def _last_step(res):
+    return float(res.step_sizes[-1]) if res.step_sizes.size else math.nan
+
+
+#: name -> (unit, what it is, function of a SimulationResult)
+METRICS = {
+    "mean_step": ("m", "mean displacement per input cycle", _mean_step),
+    "last_step": ("m", "displacement over the last full input cycle", _last_step),
+    "mean_velocity": ("m/s", "mean step per cycle times the input frequency", lambda r: float(r.mean_velocity)),
+    "final_displacement": ("m", "displacement at the end of the run", lambda r: float(r.displacement[-1])),
+    "displacement_range": ("m", "largest minus smallest displacement", lambda r: float(np.ptp(r.displacement))),
+    "peak_friction_force": ("N", "largest |friction force|", lambda r: float(np.max(np.abs(r.friction_force)))),
+}
+DEFAULT_METRICS = ("mean_step", "final_displacement", "peak_friction_force")
+_INPUT_UNITS = {"stick-slip": "V", "mass": "N", "prescribed": "m"}
+_WAVEFORM_UNITS = {"frequency": "Hz", "rise": "", "duty": "", "slew": "s", "time": "s", "direction": ""}
+
+
+# -- the grid ---------------------------------------------------------------------------------
+
+def parse_axis(text: str):
+    """``NAME=START:STOP:STEP`` (STOP included when the steps reach it), ``NAME=V1,V2,...`` or
+    ``NAME=V``: (name, values)."""
+    name, eq, spec = text.partition("=")
+    name, spec = name.strip(), spec.strip()
+    where = f"--grid {shorten(text)}"
+    if not eq or not name or not spec:
+        raise InputError(f"{where}: expected NAME=START:STOP:STEP or NAME=V1,V2,... "
+                         f"(e.g. temperature=30:42:0.25, amplitude=10,20,30)")
+
+    def number(s):
+        try:
+            v = strict_float(s.strip())
+        except ValueError:
+            raise InputError(f"{where}: not a number: {shorten(s.strip())}") from None
+        if not math.isfinite(v):
+            raise InputError(f"{where}: values must be finite, got {shorten(s.strip())}")
+        return v
+
+    if ":" in spec:
+        parts = spec.split(":")
+        if len(parts) != 3:
+            raise InputError(f"{where}: a range is START:STOP:STEP, e.g. 30:42:0.25")
+        start, stop, step = (number(p) for p in parts)
+        if step <= 0 or stop < start:
+            raise InputError(f"{where}: a range needs START <= STOP and a positive STEP")
+        count = (stop - start) / step
+        if count >= MAX_POINTS:
+            raise InputError(f"{where}: {count:.3g} values, above the limit of {MAX_POINTS} points")
+        n = int(math.floor(count + 1e-9)) + 1  # STOP itself when it is (to rounding) a whole number of steps
+        return name, start + step * np.arange(n)
+    return name, np.array([number(v) for v in spec.split(",")])
+
+
+def _as_axis(name, values):
+    try:
+        arr = np.atleast_1d(np.asarray(values, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"grid '{name}': values must be numbers, got {shorten(values)}") from None
+    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
+        raise InputError(f"grid '{name}': give a non-empty list of finite numbers, got {shorten(values)}")
+    return arr
+
+
+def _kinds(model: Model, waveform, names):
+    """Each grid name's kind ("temperature", "input", "parameter") and unit, checked against the model."""
+    from ..identify.parameters import target_of, unit_of  # loads SciPy: only when a sweep runs
+
+    fields = {f.name for f in dataclasses.fields(waveform)} if dataclasses.is_dataclass(waveform) else set()
+    kinds, units = {}, {}
+    for name in names:
+        if name == "temperature":
+            kinds[name], units[name] = "temperature", "C"
+        elif name in fields and not isinstance(waveform, Sampled):
+            kinds[name] = "input"
+            units[name] = _WAVEFORM_UNITS.get(name, _INPUT_UNITS.get(model.plant.type, ""))
+        else:
+            try:
+                target_of(model, name)
+            except InputError as e:
+                if name in model.laws:  # a Model I parameter: its law's coefficients are the knobs
+                    raise InputError(f"grid '{name}': it follows a law of temperature in this model: sweep its "
+                                     f"coefficients ({', '.join(name + '.' + c for c in model.laws[name].coefficient_names())}) "
+                                     f"or use a model without the law") from None
+                what = f"the input's fields ({', '.join(sorted(fields))}), " if fields else ""
+                raise InputError(f"grid '{name}': not temperature, {what}or a parameter of the model: {e}") from None
+            kinds[name], units[name] = "parameter", unit_of(model, name)
+    return kinds, units
+
+
+# -- one batch of points (runs on a worker) ---------------------------------------------------
+
+def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim):
+    """Simulates each row of ``coords``; returns (values (n, len(metrics)), errors {row: reason},
+    warnings). A point that fails is NaN with its reason; the others go on."""
+    from ..identify.parameters import with_values
+    from ..simulate import simulate
+
+    values = np.full((coords.shape[0], len(metrics)), np.nan)
+    errors, seen = {}, {}
+    for i, row in enumerate(coords):
+        point = dict(zip(names, (float(v) for v in row)))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                T = point.get("temperature", temperature)
+                inp = {n: v for n, v in point.items() if kinds[n] == "input"}
+                if "direction" in inp:
+                    inp["direction"] = int(inp["direction"])
+                params = {n: v for n, v in point.items() if kinds[n] == "parameter"}
+                m = with_values(model, params) if params else model
+                w = dataclasses.replace(waveform, **inp) if inp else waveform
+                res = simulate(m, temperature=T, input=w, **sim)
+                values[i] = [METRICS[k][2](res) for k in metrics]
+            except ThermofrictionError as e:
+                errors[i] = str(e)
+            except Exception as e:  # noqa: BLE001 - one point's surprise must not stop the sweep
+                errors[i] = f"{type(e).__name__}: {e}"
+        for w in caught:
+            seen.setdefault(f"{w.category.__name__}: {w.message}", None)
+    return values, errors, list(seen)
+
+
+# -- the result -------------------------------------------------------------------------------
+
+@dataclasses.dataclass(eq=False)
+class SweepResult:
+    """One row per point: the coordinates, then the metrics (NaN where the point failed).
+
+    ``res[name]`` is a column (coordinates and metrics by name), ``units[name]`` its unit;
+    ``errors`` maps a failed row's index to its reason; ``ok`` is a boolean column."""
+
+    coordinates: tuple
+    metrics: tuple
+    columns: dict
+    units: dict
+    errors: dict
+    warnings: list
+    wall_time: float = math.nan
+    where: str = ""
+
+    def __getitem__(self, name):
+        return self.columns[name]
+
+    def __len__(self):
+        return len(next(iter(self.columns.values()))) if self.columns else 0
+
+    @property
+    def ok(self) -> np.ndarray:
+        ok = np.ones(len(self), bool)
+        ok[list(self.errors)] = False
+        return ok
+
+    @property
+    def failed(self) -> int:
+        return len(self.errors)
+
+    def header(self, name) -> str:
+        return f"{name}[{self.units[name]}]" if self.units.get(name) else name
+
+    def to_records(self) -> np.ndarray:
+        """A NumPy structured array (named fields)."""
+        names = list(self.coordinates) + list(self.metrics)
+        rec = np.empty(len(self), dtype=[(n, float) for n in names] + [("error", object)])
+        for n in names:
+            rec[n] = self.columns[n]
+        rec["error"] = [self.errors.get(i, "") for i in range(len(self))]
+        return rec
+
+    def to_dataframe(self):
+        try:
+            import pandas as pd
+        except ImportError:  # pragma: no cover - depends on the environment
+            raise ImportError("to_dataframe() needs pandas: pip install 'thermofriction[dataframe]'") from None
+        data = {self.header(n): self.columns[n] for n in self.coordinates + self.metrics}
+        data["error"] = [self.errors.get(i, "") for i in range(len(self))]
+        return pd.DataFrame(data)
+
+    def to_csv(self, path):
+        """Writes the table atomically: a header with units, numbers exact to the last bit (repr),
+        an ``error`` column (empty where the point ran)."""
+        with _io.atomic_write(path, "w", newline="") as fh:
+            self.write_csv(fh)
+
+    def write_csv(self, fh):
+        """The CSV table into an open text file (``to_csv`` writes a file atomically)."""
+        names = list(self.coordinates) + list(self.metrics)
+        cols = [self.columns[n] for n in names]
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow([self.header(n) for n in names] + ["error"])
+        for i in range(len(self)):
+            w.writerow([repr(float(c[i])) for c in cols] + [self.errors.get(i, "")])
+
+    def to_parquet(self, path):
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError:
+            raise InputError(f"{path}: writing Parquet needs pyarrow (pip install pyarrow); or write a .csv") from None
+        names = list(self.coordinates) + list(self.metrics)
+        table = pa.table({**{self.header(n): self.columns[n] for n in names},
+                          "error": [self.errors.get(i, "") for i in range(len(self))]})
+        with _io.atomic_write(path, "wb") as fh:
+            pq.write_table(table, fh)
+
+    def save(self, path):
+        """``.parquet`` as Parquet (needs pyarrow), anything else as CSV."""
+        name = str(getattr(path, "path", path))
+        return self.to_parquet(path) if name.lower().endswith(".parquet") else self.to_csv(path)
+
+    def __repr__(self):
+        return (f"SweepResult({len(self)} points over {', '.join(self.coordinates)}; metrics "
+                f"{', '.join(self.metrics)}; {self.failed} failed)")
+
+
+# -- the sweep --------------------------------------------------------------------------------
+
+def _grid(grid):
+    if isinstance(grid, (list, tuple)):  # ["temperature=30:42:0.25", ...] as on the command line
+        grid = dict(parse_axis(g) for g in grid)
+    if not isinstance(grid, dict) or not grid:
+        raise InputError(f"grid must be a non-empty dict of name -> values, got {shorten(grid)}")
+    axes = {str(k): _as_axis(k, v) for k, v in grid.items()}
+    n = math.prod(a.size for a in axes.values())
+    if n > MAX_POINTS:
+        raise InputError(f"the grid has {n:.3g} points, above the limit of {MAX_POINTS}")
+    return axes, n
+
+
+def points(axes: dict) -> np.ndarray:
+    """The grid's points, one row each: the Cartesian product, the last axis varying fastest."""
+    mesh = np.meshgrid(*axes.values(), indexing="ij")
+    return np.column_stack([m.ravel() for m in mesh]) if mesh else np.empty((1, 0))
+
+
+def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, temperature=None,
+          metrics=DEFAULT_METRICS, sample_rate: float = 10_000.0, solver=None, controller=None,
+          scheduler=None, workers=None, batch_size=None, progress=None) -> SweepResult:
+    """Simulates ``model`` at every point of ``grid`` and returns one row of ``metrics`` per point.
+
+    grid: name -> values. Names are ``temperature`` [C], a field of the input waveform
+        (``amplitude``, ``frequency``, ``rise``, ...), or any parameter the model can be given by name
+        (``sigma0``, ``fc``, a law coefficient ``sigma0.b``, ``dF.values[1]``, a plant's ``m_e``).
+    input: the waveform (default: the model's ``[input]``); temperature: the temperature [C] of
+        the points when the grid has no ``temperature`` axis.
+    metrics: names from ``METRICS`` (default: mean step per cycle, final displacement, peak
+        friction force).
+    scheduler: None (a local Dask cluster on this machine's cores; ``workers`` of them),
+        "sequential" (in this process, in order), an address (``tcp://HOST:8786``, a scheduler
+        file) or a ``distributed.Client``.
+    batch_size: points per task (default: about 8 tasks per worker, at most 500 points each).
+    progress: called with the number of points done.
+    """
+    import time
+
+    if isinstance(model, str):
+        model = load_model(model)
+    if not isinstance(model, Model):
+        raise InputError(f"model must be a Model (or a model file / preset name), got {shorten(model)}")
+    waveform = input if input is not None else model.input
+    if waveform is None:
+        raise InputError("the model has no [input]: give input= (e.g. tf.Sawtooth(amplitude=30, frequency=5))")
+    if not isinstance(waveform, Waveform):
+        raise InputError(f"input must be a Waveform, got {shorten(waveform)}")
+    if isinstance(metrics, str):
+        metrics = [m.strip() for m in metrics.split(",") if m.strip()]
+    metrics = tuple(dict.fromkeys(metrics))
+    unknown = [m for m in metrics if m not in METRICS]
+    if unknown or not metrics:
+        raise InputError(f"unknown metric {shorten(unknown[0]) if unknown else '(none given)'} "
+                         f"(one of: {', '.join(METRICS)})")
+    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, numbers.Integral)
+                                   or batch_size < 1):
+        raise InputError(f"batch_size must be a positive whole number, got {shorten(batch_size)}")
+    axes, n = _grid(grid)
+    names = tuple(axes)
+    kinds, units = _kinds(model, waveform, names)
+    if model.thermal is not None and "temperature" not in axes and temperature is None and model.heat is None:
+        raise InputError("the model depends on temperature: give a temperature axis in the grid "
+                         "(temperature=30:42:0.25) or temperature=C for every point")
+    coords = points(axes)
+    sim = dict(duration=duration, sample_rate=sample_rate, solver=solver, controller=controller)
+    t0 = time.perf_counter()
+    with Runner(scheduler, workers) as runner:
+        size = batch_size or auto_batch_size(n, runner.n_workers())
+        spans = batches(n, size)
+        args = [(model, waveform, temperature, names, kinds, coords[a:b], metrics, sim) for a, b in spans]
+        def lost(i, reason):  # every point of a batch the cluster could not run
+            a, b = spans[i]
+            return np.full((b - a, len(metrics)), np.nan), {k: reason for k in range(b - a)}, []
+        outs = runner.map(_run_batch, args, weights=[b - a for a, b in spans], progress=progress, on_error=lost)
+        where = runner.describe()
+    values = np.vstack([o[0] for o in outs]) if outs else np.empty((0, len(metrics)))
+    errors, seen = {}, {}
+    for (a, _), (_, errs, warns) in zip(spans, outs):
+        errors.update({a + i: reason for i, reason in errs.items()})
+        for w in warns:
+            seen.setdefault(w, None)
+    columns = {name: coords[:, j] for j, name in enumerate(names)}
+    columns.update({m: values[:, j] for j, m in enumerate(metrics)})
+    units.update({m: METRICS[m][0] for m in metrics})
+    return SweepResult(names, metrics, columns, units, dict(sorted(errors.items())), list(seen),
+                       time.perf_counter() - t0, where)
+
+
+__all__ = ["sweep", "SweepResult", "METRICS", "DEFAULT_METRICS", "parse_axis", "points", "MAX_POINTS"]
