@@ -25,7 +25,7 @@ from .validate import validate
 from . import control, heating
 from .report import report
 
-#: scale-out (scale/, docs/scale-out.md): loaded on first use, so that Dask loads only when it is needed
+#: scale-out (scale/, docs/scale.md): loaded on first use, so that Dask loads only when it is needed
 _SCALE = ("sweep", "SweepResult", "identify_fleet", "FleetResult", "propagate", "PropagationResult")
 
 

@@ -120,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("dataset", metavar="DATASET", nargs="+",
                    help="dataset folder (with dataset.toml); several, or one folder of dataset folders, identify "
                         "a fleet: each dataset on the Dask cluster, -o DIR gets NAME.toml and NAME.json per "
-                        "dataset and the fleet summary fleet.json and fleet.csv (docs/scale-out.md)")
+                        "dataset and the fleet summary fleet.json and fleet.csv (docs/scale.md)")
     i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
                         "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
@@ -214,7 +214,7 @@ def _add_fmu_command(sub):
 
 
 def _scheduler_options(parser, only=""):
-    """Where the work runs (docs/scale-out.md): shared by sweep and fleet identification."""
+    """Where the work runs (docs/scale.md): shared by sweep and fleet identification."""
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="an existing Dask cluster: tcp://HOST:8786 or a scheduler file; 'sequential' runs in "
                              f"this process, in order (default: a local Dask cluster on this machine's cores){only}")

@@ -1,5 +1,5 @@
 """Scale-out: many simulations and identifications on Dask's distributed scheduler
-(docs/scale-out.md).
+(docs/scale.md).
 
 - :func:`sweep`: a design map, one simulation per grid point, summary metrics per point;
 - :func:`identify_fleet`: one identification per dataset of a production batch, with a fleet summary;

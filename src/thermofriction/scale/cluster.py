@@ -100,7 +100,7 @@ class Runner:
             self.client = self._stack.enter_context(distributed.Client(**kw))
         except (OSError, TimeoutError, ValueError) as e:
             raise InputError(f"scheduler {address}: cannot connect ({e}); start one with 'dask scheduler' and "
-                             f"'dask worker ADDRESS' (docs/scale-out.md)") from None
+                             f"'dask worker ADDRESS' (docs/scale.md)") from None
 
     def __exit__(self, *exc):
         self._stack.close()
