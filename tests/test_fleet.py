@@ -187,6 +187,14 @@ def test_propagation_writes_bands_and_refuses_what_it_cannot_draw(fit_two, tmp_p
     ElementTree.fromstring(svg)  # well-formed
     assert "33 °C" in svg and "mean step per cycle" in svg
     assert (tmp_path / "bands.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the report shows the same bands (one figure implementation)
+    fig = res.plot()
+    assert len(fig.axes) == 2 and fig.axes[0].collections  # a filled band per temperature
+    data = tf.synthesize(tf.load_model("li2009-base"), [35.0], validate=[36.0], duration=0.2, sample_rate=2000,
+                         noise=NOISE, seed=1)
+    page = tf.report([fit_two], data, tmp_path / "report.html", bands=res)
+    section = page[page.index("<h2>Prediction bands</h2>"):]
+    assert "<svg" in section[:section.index("</section>")] and "20 parameter sets" in section
     params = tf.Parameters({name: dataclasses.replace(p) for name, p in fit_two.parameters.items()})
     broken = dataclasses.replace(fit_two, parameters=params)
     broken.parameters["fc"].stderr = float("inf")

@@ -44,3 +44,16 @@ def test_heavy_module_loads_when_first_used():
             "assert abs(engine.stats.norm.cdf(0.0) - 0.5) < 1e-15\n"
             "assert 'scipy.stats' in sys.modules")
     assert "scipy.stats" in loaded_after(code)
+
+
+def test_every_lazy_name_of_the_package_resolves_and_loads_its_module_only_then():
+    """The package's lazily loaded names (scale-out and FMU export) each resolve to the real thing on first
+    use; Dask and the FMU module are not loaded before."""
+    code = ("import sys, thermofriction as tf\n"
+            "assert 'distributed' not in sys.modules and 'thermofriction.fmu' not in sys.modules\n"
+            "missing = [n for n in tf.__all__ if not callable(getattr(tf, n, None)) and not isinstance(getattr(tf, n), "
+            "(tuple, list, dict))]\n"
+            "assert not missing, missing\n"
+            "from thermofriction.scale import propagate\nfrom thermofriction.fmu import export_fmu\n"
+            "assert tf.propagate is propagate and tf.export_fmu is export_fmu")
+    loaded_after(code)

@@ -33,6 +33,9 @@ def __getattr__(name):
     if name in _SCALE:
         from . import scale
         return getattr(scale, name)
+    if name == "export_fmu":  # the FMU export likewise
+        from .fmu import export_fmu
+        return export_fmu
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -47,13 +50,6 @@ __all__ = [
     "Sampled", "Sawtooth", "Sine", "Square", "Step", "Waveform", "parse_waveform",
     "FitResult", "Parameter", "Parameters", "identify",
     "Dataset", "Experiment", "load_dataset", "save_dataset", "synthesize", "validate", "report",
-    *_SCALE,
+    *_SCALE, "export_fmu",
 ]
 
-
-def __getattr__(name):
-    # export_fmu loads on first use: `import thermofriction` stays light
-    if name == "export_fmu":
-        from .fmu import export_fmu
-        return export_fmu
-    raise AttributeError(f"module 'thermofriction' has no attribute {name!r}")

@@ -270,7 +270,7 @@ def parameter_section(entries, fit_T) -> str:
     return ("<section><h2>Identified parameters</h2>" + "".join(out) + "</section>") if out else ""
 
 
-def render(entries, data, *, figures_dir=None, command=None, title=None, truth=None) -> str:
+def render(entries, data, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
     exps = list(getattr(data, "experiments", data))
     if not any(getattr(e, "role", "fit") == "validate" for e in exps):
         raise InputError("the dataset has no experiment with role 'validate': a report compares predictions at "
@@ -339,6 +339,14 @@ def render(entries, data, *, figures_dir=None, command=None, title=None, truth=N
                  "<p class='note'>e = x_sim − x_meas at each sample: the predicted minus the measured end-effector "
                  "displacement, both starting from zero (the measurement's arbitrary zero matched on the first 1 % "
                  "of the run). Held-out rows are shaded.</p>" + definitions(*EXPERIMENT_COLUMNS[4:]) + "</section>")
+    if bands is not None:
+        parts.append("<section><h2>Prediction bands</h2>" + figs.render(
+            bands.plot(), "prediction-bands",
+            f"The fitted model's prediction with its {100 * bands.level:g} % band from the parameters' uncertainty "
+            f"(Monte Carlo: {bands.draws} parameter sets drawn from the fit's covariance, "
+            f"{bands.draws - len(bands.failures)} of them simulated), shown as the difference from the fitted "
+            f"model: per temperature over time (left) and the mean step per cycle against temperature (right).")
+            + "</section>")
     if truth:
         parts.append(truth_section(truth))
     fit_T = float(np.mean([e.temperature for e in exps if getattr(e, "role", "fit") != "validate"] or
@@ -386,10 +394,11 @@ def truth_section(truth: dict) -> str:
             "95 % interval means.</p>" + "".join(parts) + "</section>")
 
 
-def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None) -> str:
+def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
     """Writes the HTML report comparing ``models`` (Model, FitResult, or (label, Model, fit dict)
     entries) on ``data``; returns the HTML. ``truth`` (label -> FitResult.recovery summary, for data
-    made from a known model) adds a section saying whether the fits recover it."""
+    made from a known model) adds a section saying whether the fits recover it; ``bands`` (what
+    ``tf.propagate`` returns) a section with the prediction bands."""
     entries = []
     for m in models:
         if isinstance(m, Entry):
@@ -405,7 +414,7 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
     if not entries:
         raise InputError("give at least one model")
     text = render(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title,
-                  truth=truth)
+                  truth=truth, bands=bands)
     with atomic_write(path, "w", encoding="utf-8") as fh:
         fh.write(text)
     return text

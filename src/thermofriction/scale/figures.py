@@ -22,14 +22,14 @@ def bands_figure(result):
     step per cycle's band minus the fitted model's step [nm] against temperature, each point labelled
     with the fitted model's step [um]."""
     import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
 
     temps = np.asarray(result.temperatures, float)
-    cmap = plt.get_cmap("plasma")
+    cmap = matplotlib.colormaps["plasma"]
     span = float(np.ptp(temps)) or 1.0
     colors = [cmap(0.1 + 0.75 * (T - temps.min()) / span) for T in temps]
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 3.8), gridspec_kw={"width_ratios": [1.6, 1]})
+    fig = Figure(figsize=(10, 3.8))
+    ax, bx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.6, 1]})
     t = result.time
     level = f"{100 * result.level:g} %"
     for j, T in enumerate(temps):
@@ -74,15 +74,10 @@ def bands_figure(result):
 
 def save_bands_figure(result, path):
     """Writes :func:`bands_figure` as SVG (or PNG when the name ends .png), atomically."""
-    import matplotlib.pyplot as plt
-
     fig = bands_figure(result)
     fmt = "png" if str(path).lower().endswith(".png") else "svg"
-    try:
-        with atomic_write(Path(path), "wb") as fh:
-            fig.savefig(fh, format=fmt, dpi=150, bbox_inches="tight")
-    finally:
-        plt.close(fig)
+    with atomic_write(Path(path), "wb") as fh:
+        fig.savefig(fh, format=fmt, dpi=150, bbox_inches="tight")
     return path
 
 

@@ -150,6 +150,11 @@ class PropagationResult:
                 f"{100 * self.level:g} % bands)")
 
 
+    def plot(self):
+        """The bands as a matplotlib figure (the report's prediction-band figure)."""
+        from .figures import bands_figure
+        return bands_figure(self)
+
 def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=None, duration: float = 1.0,
               sample_rate: float = 1000.0, level: float = 0.95, solver=None, controller=None, scheduler=None,
               workers=None, batch_size=None, progress=None) -> PropagationResult:
