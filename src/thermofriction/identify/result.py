@@ -336,7 +336,7 @@ def stamp(fit, data, method: str, init, options: dict):
                 "fit_files": [e.file for e in fit_runs], "held_out_files": [e.file for e in held],
                 "date": date, "thermofriction": __version__, "initial_model": init_name,
                 "options": {**opts, **how}}
-        description = (f"{METHOD_NAMES.get(f.method, f.method)} identified by thermofriction {__version__} on {date} "
+        description = (f"{METHOD_NAMES.get(f.method, f.method)} identified by thermofriction {__version__} "
                        f"from {len(fit_runs)} experiment{'s' if len(fit_runs) != 1 else ''} of {label} "
                        f"at {temps} C" + (f" ({len(held)} held out)" if held else "")
                        + f", starting from {init_name}")
