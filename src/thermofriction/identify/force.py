@@ -205,7 +205,7 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
     if not top > 0:
         raise InputError(f"{exps[0].file}: the motion does not move: no friction can be taken from it")
-    sliding = speed > 0.05 * top
+    sliding = speed > 0.02 * top
     fast = sliding & (speed >= np.median(speed[sliding]))
     both_ways = np.any(v[fast] > 0) and np.any(v[fast] < 0)
     cols = [np.sign(v[fast]), v[fast]] + ([np.ones(int(fast.sum()))] if both_ways else [])
@@ -238,7 +238,7 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     excess = np.sign(v[steady]) * (F[steady] - b) - fc - sigma2 * speed[steady]
     s = speed[steady]
     order = np.argsort(s)
-    n_bin = max(len(order) // 20, 1)
+    n_bin = max(len(order) // 40, 5)
     bins = [order[i:i + n_bin] for i in range(0, len(order), n_bin)]
     levels = np.array([np.median(excess[i]) for i in bins])
     speeds = np.array([np.median(s[i]) for i in bins])

@@ -193,7 +193,11 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None) ->
             entries.append(Entry(label, model, fit))
     if not entries:
         raise InputError("give at least one model")
-    text = render(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title)
+    from ..data.force import is_force_data
+    draw = render
+    if is_force_data(getattr(data, "experiments", data)):  # measured force under measured motion: report/force.py
+        from .force import render_force as draw
+    text = draw(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title)
     with atomic_write(path, "w", encoding="utf-8") as fh:
         fh.write(text)
     return text
