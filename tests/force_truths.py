@@ -57,9 +57,11 @@ def write_experiment(path, t, x, v, F, T=None, units=("rad", "rad/s", "N*m"), ve
 
 
 def make_dataset(folder, model, *, temperatures=(35.0,), validate=(), n=1200, duration=4.0, amplitude=0.5,
-                 frequency=0.5, noise=0.01, offset=0.05, seed=0, units=("rad", "rad/s", "N*m"), velocity=True):
+                 frequency=0.5, noise=0.01, offset=0.05, seed=0, units=("rad", "rad/s", "N*m"), velocity=True,
+                 validate_offset=None):
     """A dataset folder of ``model``'s friction under sine motions (one run per temperature; ``validate``
     temperatures held out), with jitter, noise (a fraction of the force's range) and a sensor offset.
+    ``validate_offset``: the held-out runs' sensor offset, when it differs (a sensor re-zeroed between runs).
     Returns the folder and the noise's standard deviation in SI units."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -70,7 +72,8 @@ def make_dataset(folder, model, *, temperatures=(35.0,), validate=(), n=1200, du
         t = jittered_times(n, duration, rng)
         x, v, F = reference_run(model, t, amplitude * (1 + 0.1 * k), frequency * (1 + 0.07 * k), T)
         sd = noise * float(np.ptp(F)) if sd is None else sd
-        F = F + offset + rng.normal(0.0, sd, F.size)
+        bias = validate_offset if role == "validate" and validate_offset is not None else offset
+        F = F + bias + rng.normal(0.0, sd, F.size)
         name = f"run{k}-T{T:g}C{'-validate' if role == 'validate' else ''}.csv"
         write_experiment(folder / name, t, x, v, F, T, units, velocity)
         entries.append({"file": name, "temperature": float(T), "role": role})

@@ -75,10 +75,9 @@ def make_force_trace(exp, model: Model) -> ForceTrace:
 def _steps(model, names, theta):
     """The forward-difference step of each parameter: FD_STEP of its magnitude, of the friction level for a
     Model II value that starts at zero."""
-    ref = abs(model.reference_force()) if hasattr(model, "reference_force") else 1.0
     out = []
     for name, v in zip(names, theta):
-        scale = abs(v) if v != 0 else (ref if name.startswith("dF") else 1.0)
+        scale = abs(v) if v != 0 else (abs(model.reference_force()) if name.startswith("dF") else 1.0)
         out.append(FD_STEP * max(scale, 1e-300))
     return np.array(out)
 
