@@ -69,9 +69,11 @@ def predict_force(model, exp, rtol=1e-8) -> ForcePrediction:
 class ForceValidationResult(ValidationResult):
     """As :class:`~thermofriction.validate.ValidationResult`, in force units (``rmse`` in N or N m)."""
 
-    _COLUMNS = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
-                ("RMSE", "rmse", "{:.4g}"), ("NRMSE", "nrmse", "{:.3g}"), ("max error [%]", "max_error_pct", "{:.3g}"),
-                ("mean error", "bias", "{:+.3g}"))
+    @property
+    def _COLUMNS(self):  # noqa: N802 - the base class's table layout, with the unit in the headers
+        return (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
+                (f"RMSE [{self.unit}]", "rmse", "{:.4g}"), ("NRMSE", "nrmse", "{:.3g}"),
+                ("max error [%]", "max_error_pct", "{:.3g}"), (f"mean error [{self.unit}]", "bias", "{:+.3g}"))
 
     @property
     def unit(self) -> str:
@@ -79,8 +81,7 @@ class ForceValidationResult(ValidationResult):
 
     def rows(self):
         for m in self.experiments:
-            yield [fmt.format(m[key]) + (f" {m['unit']}" if key in ("rmse", "bias") else "")
-                   for _, key, fmt in self._COLUMNS]
+            yield [fmt.format(m[key]) for _, key, fmt in self._COLUMNS]
 
     def summary(self) -> dict:
         out = {}

@@ -116,10 +116,13 @@ def motion_waveform(time, velocity) -> Sampled:
     v = np.asarray(velocity, float)
     dt = np.diff(t)
     x = np.concatenate([[0.0], np.cumsum(0.5 * dt * (v[:-1] + v[1:]))])
-    knots = np.empty(2 * len(t) - 1)
+    knots = np.empty(2 * len(t))
     values = np.empty_like(knots)
     knots[0::2], values[0::2] = t, x
-    knots[1::2], values[1::2] = t[:-1] + 0.5 * dt, x[:-1] + 0.5 * dt * v[:-1]
+    knots[1:-1:2], values[1:-1:2] = t[:-1] + 0.5 * dt, x[:-1] + 0.5 * dt * v[:-1]
+    # half an interval beyond the last sample, so that the velocity there is the last sample's too (a
+    # sampled waveform is held constant after its last knot)
+    knots[-1], values[-1] = t[-1] + 0.5 * dt[-1], x[-1] + 0.5 * dt[-1] * v[-1]
     return Sampled(knots, values)
 
 

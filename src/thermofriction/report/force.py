@@ -51,7 +51,8 @@ def fig_force_time(figs, entries, unit, what):
     plt = _plt()
     preds0 = entries[0].validation.predictions
     shown = sorted(preds0, key=lambda p: (p.role != "validate", p.temperature))[:MAX_PANELS]
-    fig, axes = plt.subplots(len(shown), 1, figsize=(8.5, 2.3 * len(shown)), squeeze=False, sharex=False)
+    fig, axes = plt.subplots(len(shown), 1, figsize=(8.5, 2.4 * len(shown) + 0.5), squeeze=False,
+                             constrained_layout=True)
     for ax, p0 in zip(axes[:, 0], shown):
         stride = max(len(p0.time) // 400, 1)
         ax.plot(p0.time[::stride], p0.measured[::stride], "o", ms=2.5, mfc="none", color="0.35", label="measured")
@@ -62,7 +63,8 @@ def fig_force_time(figs, entries, unit, what):
                      fontsize=9)
         ax.set_ylabel(f"{what} [{unit}]")
     axes[-1, 0].set_xlabel("time [s]")
-    axes[0, 0].legend(fontsize=7, frameon=False, loc="upper right")
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, frameon=False, loc="outside lower center",
+               ncol=len(entries) + 1)
     return figs.render(fig, "force-time", f"Measured (markers) and predicted (lines) friction {what} over time, "
                        f"the model's sensor offset included; held-out experiments first.")
 
@@ -73,9 +75,10 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
     temps = sorted({e.temperature for e in exps})
     col = _colors(temps)
     top = max(float(np.max(np.abs(e.drive_velocity))) for e in exps)
-    for e in exps:
+    for k, e in enumerate(exps):
         stride = max(len(e.time) // 1500, 1)
-        ax.plot(e.drive_velocity[::stride], e.force[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature])
+        ax.plot(e.drive_velocity[::stride], e.force[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature],
+                label="measured" if k == 0 else None)
     v = np.concatenate([-np.geomspace(top, top * 1e-3, 40), np.geomspace(top * 1e-3, top, 40)])
     from ..validate_force import steady_state_curve
     T_mid = float(np.median(temps))
