@@ -208,3 +208,24 @@ def test_friction_models_compared_by_aicc_and_held_out_error(tmp_path):
     assert out["coulomb"]["delta_aicc"] > 10 and out["stribeck"]["delta_aicc"] > 10
     assert out["lugre"]["heldout_rmse"] < min(out["coulomb"]["heldout_rmse"], out["stribeck"]["heldout_rmse"])
     assert out["lugre"]["heldout_rmse"] < 1.3 * sd
+
+
+LINEAR = {  # a stage in mm and mN: fc = 3 N, fs = 4 N, vs = 5 mm/s, sigma2 = 100 N s/m, sigma0 = 2e5 N/m
+    "stribeck": (lambda: tf.Stribeck(fc=3.0, fs=4.0, vs=5e-3, sigma2=100.0), True),
+    "coulomb": (lambda: tf.Coulomb(fc=3.0, sigma2=100.0), True),
+    "dahl": (lambda: tf.Dahl(sigma0=2e5, fc=3.0), False),
+}
+
+
+@pytest.mark.parametrize("kind", list(LINEAR))
+def test_cheap_friction_models_in_linear_units(kind, tmp_path):
+    """The static maps and Dahl on a linear stage (mm, mm/s, mN), with and without a velocity column."""
+    make, velocity = LINEAR[kind]
+    truth = tf.Model(STAGE, make())
+    folder, _ = make_dataset(tmp_path, truth, amplitude=5e-3, offset=0.2, units=("mm", "mm/s", "mN"),
+                             velocity=velocity, **DATA)
+    fit = tf.identify(tf.load_dataset(folder), "base", friction=kind)
+    assert fit.adequate, fit.fit_quality
+    assert fit.unit == "N" and fit.parameters["fc"].unit == "N"
+    check_recovered(fit, truth.friction.values())
+    check_offset(fit, 0.2)

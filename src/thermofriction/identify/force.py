@@ -36,6 +36,11 @@ FIT_OFFSET = contextvars.ContextVar("thermofriction_fit_offset", default=True)
 #: error over the step (1e-9 / 1e-5) and the truncation error (~1e-5) make the Jacobian good to ~1e-4, ample
 #: for Gauss-Newton steps and for the intervals (1e-10 costs half as much again for nothing visible).
 FD_STEP = 1e-5
+#: What to try when a fit to force data is not adequate.
+FORCE_ADVICE = ("check the units in the files' headers; check that the sampling resolves the force's swing after "
+                "each reversal (a few samples at least); try another friction model (--friction) or fit the "
+                "parameters held fixed (--parameters); fit a thermal model (--method model-i or model-ii) if the "
+                "experiments span temperatures")
 FD_RTOL = 1e-9
 
 

@@ -84,7 +84,7 @@ def _result(method, model, params, outcome, traces, t0, extra_warnings=(), detai
         first.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
                         f"noise estimated from the data ({_amount(overall['rmse'], traces)} against "
                         f"{_amount(overall['noise'], traces)}; not adequate in {len(bad)} of {len(per)} experiments): "
-                        f"the model misses what the data show. Try: {advice(model)}")
+                        f"the model misses what the data show. Try: {_advice(model, traces)}")
     cost = float(outcome.r @ outcome.r)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
                      rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
@@ -98,6 +98,14 @@ def _amount(value, traces) -> str:
     """A residual in the traces' unit: nm for displacements, N or N m for forces (identify/force.py)."""
     unit = getattr(traces[0], "unit", None)
     return f"{value:.4g} {unit}" if unit else f"{value * 1e9:.4g} nm"
+
+
+def _advice(model, traces) -> str:
+    """What to try when a fit is not adequate (force data: identify/force.py)."""
+    if getattr(traces[0], "unit", None):
+        from .force import FORCE_ADVICE
+        return FORCE_ADVICE
+    return advice(model)
 
 
 def _friction_parameters(model: Model, names, fixed=()):

@@ -154,7 +154,9 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None) -
     for e in entries:
         if e.validation is None:
             e.validation = validate(e.model, data)
-        if e.label in ("no thermal model", "Model I", "Model II") or e.label.startswith("base"):
+        # the default labels name the thermal model only (and the command line adds the file's stem to tell
+        # them apart): here the friction model is what differs
+        if e.label.startswith(("no thermal model", "Model I", "base")):
             e.label = _label(e.model)
     seen = {}
     for e in entries:  # one label per entry
