@@ -96,7 +96,9 @@ class ForceProblem(Problem):
         spec = _bridge.model_spec(model, trace.temperature, trace.waveform)
         out = np.empty((len(trace.time), _bridge.n_outputs(model, False)))
         try:
-            _bridge.run(spec, trace.time, out, method="dopri5", rtol=rtol, max_steps=_MAX_STEPS)
+            # no sensitivities here: the solver may switch to Rodas4 where stiff bristles would hold Dormand-Prince
+            # to tiny steps (a start far above the data's stiffness)
+            _bridge.run(spec, trace.time, out, method="auto", rtol=rtol, max_steps=_MAX_STEPS)
         except _bridge.CoreFailure:
             return None
         return out[:, _bridge.OUTPUT_COLUMN["friction_force"]]
@@ -235,6 +237,11 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
         travelled.append(np.abs(xe - xe[np.maximum.accumulate(start)]))
     stroke = max(float(np.ptp(np.concatenate(x))), 1e-300)
     sigma0 = math.log(2.0) * float(np.median(secants)) if secants else fc / (1e-3 * stroke)
+    # a swing within one sample gives no stiffness, only a bound: start where the presliding spans a tenth of a
+    # typical sample's motion (stiffer bristles change nothing the data can show, and make the runs stiff)
+    step = float(np.median(np.concatenate([np.abs(np.diff(xe)) for xe in x])))
+    if step > 0:
+        sigma0 = min(sigma0, 2.0 * fc / (0.1 * step))
     typical = float(np.median(speed[sliding]))
     section = {"model": "lugre", "fc": fc, "sigma2": sigma2, "sigma0": sigma0, "sigma1": 0.1 * fc / typical}
     # Stribeck: the excess over the Coulomb-viscous line at the slowest speeds of steady sliding (five
