@@ -225,10 +225,14 @@ class ValidationResult:
 def validate(model: Model, data, experiments=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics). Temperatures outside a law's calibrated range are reported as warnings."""
-    require_actuator(model, "validate")
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")
+    from .data.force import is_force_data
+    if is_force_data(exps):  # measured force under measured motion: validate_force.py
+        from .validate_force import validate_force
+        return validate_force(model, exps)
+    require_actuator(model, "validate")
     caught, preds, failures = [], [], []
     for exp in exps:
         with warnings.catch_warnings(record=True) as w:

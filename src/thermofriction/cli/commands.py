@@ -125,7 +125,7 @@ def cmd_identify(args) -> int:
                        procedure=args.procedure,
                        laws=laws or None, refine=not args.no_refine,
                        reference_temperature=args.reference_temperature, rtol=args.rtol, starts=args.starts,
-                       seed=args.seed, progress=update)
+                       seed=args.seed, progress=update, offset=not getattr(args, "no_offset", False))
     finally:
         if status is not None:
             status.stop()

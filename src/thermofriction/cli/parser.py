@@ -149,6 +149,10 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--rtol", type=_positive_float, default=1e-8,
                    help="simulation tolerance during the fit (default: 1e-8)")
     i.add_argument("--seed", type=_int_in(0), default=0, help="seed of the multi-start sample, 0 or more (default: 0)")
+    # force (torque) data (docs/force-data.md)
+    i.add_argument("--no-offset", action="store_true",
+                   help="force data: do not fit the force sensor's offset (one for all experiments, fitted by "
+                        "default); hold it at the initial model's [plant] sensor_offset (default 0)")
     i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
     i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")

@@ -16,6 +16,7 @@ from .._reading import read_text
 from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
+from .force import force_experiment, is_force_data, is_force_file, units_of
 from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
@@ -146,6 +147,12 @@ def load_dataset(path) -> Dataset:
                 inp = parse_waveform(e["input"])
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
+        if is_force_file(folder / f):  # measured motion and friction force (torque): data/force.py
+            if inp is not None:
+                raise InputError(f"{where}: 'input' does not apply to a force experiment (its motion is measured)")
+            exps.append(force_experiment(folder / f, f, temperature=T, role=role, description=desc,
+                                         from_zero=_from_zero))
+            continue
         cols, headers = _read_experiment(folder / f, e, where)
         for column in ("displacement", "stage_displacement"):  # a parser reads any numbers; a dataset is physics
             if column in cols:
@@ -163,6 +170,11 @@ def load_dataset(path) -> Dataset:
                                temperature=T, temperature_signal=sig,
                                stage_displacement=cols.get("stage_displacement"), role=role, description=desc,
                                input=inp, struct=e.get("struct")))
+    try:  # one kind of experiment per dataset, and force data in one kind of units (data/force.py)
+        if is_force_data(exps):
+            units_of(exps)
+    except InputError as err:
+        raise InputError(f"{manifest}: {err}") from None
     return Dataset(path=folder, name=name, description=description, experiments=exps)
 
 

@@ -86,7 +86,7 @@ def with_friction_model(model: Model, kind: str) -> Model:
 
 @stamped  # the fitted model's name and provenance (result.py)
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
-             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None) -> FitResult:
+             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None, offset=True) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
@@ -105,17 +105,30 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         plant given in its physical form).
     laws: Model I law kinds per parameter, e.g. {"sigma0": "exp"}; default: chosen by AICc.
     rtol: the simulations' relative tolerance during the fit; starts: the multi-start size.
+    offset: force data only (docs/force-data.md): fit the force sensor's offset, one for all experiments
+        (default), or hold it at the initial model's ``[plant] sensor_offset``.
     """
     if method not in METHODS:
         raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
     _check_arguments(method, reference_temperature, rtol, starts, seed)
+    from ..data.force import is_force_data
+    if is_force_data(getattr(data, "experiments", data)):  # measured force under measured motion
+        from .force import identify_force
+        return identify_force(data, method, init, friction=friction,
+                              parameters=parameters, free=free, procedure=procedure, laws=laws, refine=refine,
+                              reference_temperature=reference_temperature, offset=offset, rtol=rtol, starts=starts,
+                              seed=seed, progress=progress)
+    if not offset:
+        raise InputError("offset=False (--no-offset) applies to force data; displacement data remove each "
+                         "experiment's zero")
     if init is None:
         init = {"plant": "li2009-base", "base": "li2009-base", "model-i": "li2009-model-i", "model-ii": "li2009-model-ii",
                 "heat": "li2009-self-heating"}[method]
     experiments = getattr(data, "fit", data)
     if not isinstance(init, Model):
         # a file with only a [plant] (and [input]): a LuGre start taken from the data
-        init = load_model(init, friction_from=lambda plant, inp: lugre_start(plant, experiments, inp))
+        init = load_model(init, friction_from=lambda plant, inp, model="lugre": _start_of(
+            model, plant, lugre_start(plant, experiments, inp)))
     if not isinstance(init.plant, StickSlipPlant):
         raise InputError(f"identification works on the stick-slip actuator (datasets record its voltage and "
                          f"displacement); a '{init.plant.type}' plant can be simulated but not identified yet")
@@ -143,6 +156,14 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         return identify_model_i(experiments, init, laws=laws, refine=refine, progress=progress, free=free, **opts)
     return identify_model_ii(experiments, init, procedure=procedure, reference_temperature=reference_temperature,
                              refine=refine, progress=progress, free=free, **opts)
+
+
+def _start_of(kind, plant, lugre_section) -> dict:
+    """A [friction] section of ``kind`` from LuGre starting values (a file naming only its friction model)."""
+    from ..models import LuGre
+    if kind == "lugre":
+        return lugre_section
+    return with_friction_model(Model(plant, LuGre.from_dict(lugre_section)), kind).friction.to_dict()
 
 
 def _plant_parameters(init, free, method) -> list:

@@ -49,12 +49,26 @@ class Trace:
     def n_residuals(self) -> int:
         return len(self.time) * (1 if self.measured_temperature is None else 2)
 
+    @property
+    def measured(self) -> np.ndarray:
+        """The record the residuals are taken against (a force trace's is its force: identify/force.py)."""
+        return self.displacement
+
+    @staticmethod
+    def offsets_in(traces) -> int:
+        """Offsets fitted besides the parameters: one per trace (each record's zero)."""
+        return len(traces)
+
 
 def make_traces(experiments, model: Model):
     """One trace per experiment, driven as :func:`thermofriction.drive.drive` says (a self-heating run
     from where its record starts)."""
     traces = []
     for exp in experiments:
+        if getattr(exp, "force", None) is not None:  # measured force under measured motion
+            from .force import make_force_trace
+            traces.append(make_force_trace(exp, model))
+            continue
         d = drive(exp, model, start="record")
         trace = Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.displacement, float),
                       d.temperature, d.waveform, getattr(exp, "role", "fit"), float(exp.temperature))
@@ -78,6 +92,11 @@ def pool() -> ThreadPoolExecutor:
 
 class Problem:
     """Residuals r(theta) (offset of each trace profiled out) and their Jacobian dr/dtheta."""
+
+    def __new__(cls, model=None, names=(), traces=(), *args, **kwargs):
+        # traces of another kind of measurement bring their own residuals (force: identify/force.py)
+        kind = getattr(traces[0], "problem_class", None) if cls is Problem and traces else None
+        return super().__new__(kind or cls)
 
     def __init__(self, model: Model, names, traces, rtol=1e-8, parallel=True):
         self.model = model
@@ -263,16 +282,16 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
 
 
 def _y_scale(problem):
-    return max(float(np.ptp(t.displacement)) for t in problem.traces)
+    return max(float(np.ptp(t.measured)) for t in problem.traces)
 
 
 def residual_scale(traces) -> float:
     """The scale residuals are measured in: the displacement noise estimated from the data (pooled
     over the traces), at least 1e-6 of the largest displacement range (noise-free data)."""
-    noise = [noise_level(t.displacement) for t in traces]
+    noise = [noise_level(t.measured) for t in traces]
     noise = [s for s in noise if math.isfinite(s)]
     pooled = math.sqrt(sum(s * s for s in noise) / len(noise)) if noise else 0.0
-    span = max(float(np.ptp(t.displacement)) for t in traces)
+    span = max(float(np.ptp(t.measured)) for t in traces)
     return max(pooled, 1e-6 * span, 1e-300)
 
 
@@ -375,7 +394,7 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
     varying = params.varying
     theta, r, J = outcome.theta, outcome.r, outcome.J
     n, p = J.shape
-    dof = max(n - p - len(traces), 1)
+    dof = max(n - p - traces[0].offsets_in(traces), 1)
     s2 = float(r @ r) / dof
     rhos, start = [], 0
     for tr in traces:

@@ -34,11 +34,23 @@ FRICTION_FIT_PARAMETERS = {
     "gms": ("C", "fc"),
 }
 
+#: Force data see the whole friction-velocity map: the Stribeck and viscous parameters are fitted too.
+FORCE_FIT_PARAMETERS = {
+    "lugre": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
+    "elastoplastic": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
+    "dahl": ("sigma0", "fc"),
+    "coulomb": ("fc", "sigma2"),
+    "stribeck": ("fc", "fs", "vs", "sigma2"),
+    "gms": ("C", "fc", "fs", "vs", "sigma2"),
+}
+
 
 def default_fit_parameters(model: Model) -> list:
-    """The default fitted parameters of ``model``'s friction model (FRICTION_FIT_PARAMETERS), less
-    those it leaves unset or at zero; under Model I, those with a law (if any has one)."""
-    names = FRICTION_FIT_PARAMETERS.get(model.friction.model, DEFAULT_FRICTION_PARAMETERS)
+    """The default fitted parameters of ``model``'s friction model (FRICTION_FIT_PARAMETERS; for prescribed
+    motion, fitted to force data, FORCE_FIT_PARAMETERS), less those it leaves unset or at zero; under Model I,
+    those with a law (if any has one)."""
+    table = FORCE_FIT_PARAMETERS if model.plant.type == "prescribed" else FRICTION_FIT_PARAMETERS
+    names = table.get(model.friction.model, DEFAULT_FRICTION_PARAMETERS)
     laws = model.laws if isinstance(model.thermal, ModelI) else {}
     values = model.friction.values()
     if model.friction.model in ("stribeck", "gms", "lugre", "elastoplastic") and \
@@ -59,7 +71,7 @@ def _result(method, model, params, outcome, traces, t0, extra_warnings=(), detai
         seg = outcome.r[start:start + tr.n_residuals]
         start += tr.n_residuals
         # the displacement residuals of a trace have their mean (the sensor's zero) removed
-        quality = fit_quality(seg[:n], tr.displacement)
+        quality = fit_quality(seg[:n], tr.measured)
         qualities.append(quality)
         per.append({"file": tr.name, "temperature": tr.nominal_temperature, "role": tr.role,
                     "rmse_offset_removed": quality["rmse"], "fit_quality": quality})
@@ -70,9 +82,9 @@ def _result(method, model, params, outcome, traces, t0, extra_warnings=(), detai
     if not overall["adequate"]:
         bad = [p["file"] for p, q in zip(per, qualities) if not q["adequate"]]
         first.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
-                        f"noise estimated from the data ({overall['rmse'] * 1e9:.4g} nm against "
-                        f"{overall['noise'] * 1e9:.3g} nm; not adequate in {len(bad)} of {len(per)} experiments): "
-                        f"the model misses what the data show. Try: {advice(model)}")
+                        f"noise estimated from the data ({_amount(overall['rmse'], traces)} against "
+                        f"{_amount(overall['noise'], traces)}; not adequate in {len(bad)} of {len(per)} experiments): "
+                        f"the model misses what the data show. Try: {_advice(model, traces)}")
     cost = float(outcome.r @ outcome.r)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
                      rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
@@ -80,6 +92,20 @@ def _result(method, model, params, outcome, traces, t0, extra_warnings=(), detai
                      success=outcome.success, message=str(outcome.message), experiments=per,
                      warnings=first + list(extra_warnings) + warns, statistics=stats, details=details or {},
                      fit_quality=overall)
+
+
+def _amount(value, traces) -> str:
+    """A residual in the traces' unit: nm for displacements, N or N m for forces (identify/force.py)."""
+    unit = getattr(traces[0], "unit", None)
+    return f"{value:.4g} {unit}" if unit else f"{value * 1e9:.4g} nm"
+
+
+def _advice(model, traces) -> str:
+    """What to try when a fit is not adequate (force data: identify/force.py)."""
+    if getattr(traces[0], "unit", None):
+        from .force import FORCE_ADVICE
+        return FORCE_ADVICE
+    return advice(model)
 
 
 def _friction_parameters(model: Model, names, fixed=()):

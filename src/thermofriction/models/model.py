@@ -235,9 +235,12 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_fr
     for a file without a [friction] section, a function of the parsed plant and input that returns one
     (identification's starting values from the data)."""
     try:
-        if friction_from is not None and "friction" not in d and isinstance(d.get("plant"), dict):
+        fr = d.get("friction")
+        bare = isinstance(fr, dict) and set(fr) == {"model"}  # a friction model named, no values: from the data
+        if friction_from is not None and ("friction" not in d or bare) and isinstance(d.get("plant"), dict):
             inp = waveform_from_dict(d["input"], "[input]", base_dir) if isinstance(d.get("input"), dict) else None
-            d = {**d, "friction": friction_from(plant_from_dict(d["plant"]), inp)}
+            kind = {"model": fr["model"]} if bare else {}
+            d = {**d, "friction": friction_from(plant_from_dict(d["plant"]), inp, **kind)}
         unknown = set(d) - _TOP_KEYS
         if unknown:
             raise InputError(unknown_keys(unknown, sorted(_TOP_KEYS), "a model file"))

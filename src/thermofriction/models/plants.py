@@ -152,19 +152,69 @@ class MassPlant:
 class PrescribedMotion:
     """Prescribed motion (docs/models.md#prescribed-motion): the relative displacement x_r(t) is the input waveform [m]
     and v_r its slope; the friction model is driven by it (hysteresis loops, Stribeck curves,
-    break-away tests). The waveform must be continuous (a step needs a slew time)."""
+    break-away tests). The waveform must be continuous (a step needs a slew time).
+
+    ``motion = "rotary"``: a joint, the same equations read in angles: the input is an angle [rad], the
+    friction a torque [N m], and the parameters' units follow (N m/rad, N m s/rad, N m, rad/s;
+    :func:`rotary_unit`). ``sensor_offset`` [N or N m]: the constant bias of the force (torque) sensor, fitted
+    with the friction from measured force (docs/force-data.md) and added to the predicted measurement; it is
+    not part of the friction."""
+
+    motion: str = "linear"
+    sensor_offset: float = 0.0
 
     type = "prescribed"
+    MOTIONS = ("linear", "rotary")
+
+    def __post_init__(self):
+        if self.motion not in self.MOTIONS:
+            raise InputError(f"[plant]: 'motion' must be \"linear\" or \"rotary\", got {self.motion!r}")
+        object.__setattr__(self, "sensor_offset", num(self.sensor_offset, "[plant]", "sensor_offset"))
+
+    @property
+    def rotary(self) -> bool:
+        return self.motion == "rotary"
+
+    def unit(self, unit: str) -> str:
+        """A linear unit as this motion reads it (unchanged for linear motion)."""
+        return rotary_unit(unit) if self.rotary else unit
 
     def to_dict(self) -> dict:
-        return {"type": self.type}
+        d = {"type": self.type}
+        if self.rotary:
+            d["motion"] = self.motion
+        if self.sensor_offset:
+            d["sensor_offset"] = self.sensor_offset
+        return d
 
     @classmethod
     def from_dict(cls, d: dict, where="[plant]"):
-        unknown = set(d) - {"type"}
+        keys = ["type", "motion", "sensor_offset"]
+        unknown = set(d) - set(keys)
         if unknown:
-            raise InputError(f"{where}: {unknown_keys(unknown, ['type'], 'prescribed motion')}")
-        return cls()
+            raise InputError(f"{where}: {unknown_keys(unknown, keys, 'prescribed motion')}")
+        return cls(**{k: d[k] for k in ("motion", "sensor_offset") if k in d})
+
+
+def rotary_unit(unit: str) -> str:
+    """A unit of linear motion read for a rotary joint: a force N becomes a torque N m, a length m an angle
+    rad (``N/m`` -> ``N m/rad``, ``N s/m`` -> ``N m s/rad``, ``m/s`` -> ``rad/s``, ``N/m/C`` -> ``N m/rad/C``).
+    The equations are the same; only what the numbers mean changes."""
+    if not unit:
+        return unit
+    parts = unit.split("/")
+    out = []
+    for i, part in enumerate(parts):
+        words = []
+        for w in part.split(" "):
+            if w == "N" and i == 0:
+                words += ["N", "m"]
+            elif w == "m":
+                words.append("rad")
+            else:
+                words.append(w)
+        out.append(" ".join(words))
+    return "/".join(out)
 
 
 PLANTS = {"stick-slip": StickSlipPlant, "mass": MassPlant, "prescribed": PrescribedMotion}
@@ -177,4 +227,4 @@ def plant_from_dict(d: dict, where="[plant]"):
     return PLANTS[kind].from_dict(d, where)
 
 
-__all__ = ["StickSlipPlant", "MassPlant", "PrescribedMotion", "PLANTS", "plant_from_dict"]
+__all__ = ["StickSlipPlant", "MassPlant", "PrescribedMotion", "PLANTS", "plant_from_dict", "rotary_unit"]

@@ -413,8 +413,13 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
             entries.append(Entry(label, model, fit))
     if not entries:
         raise InputError("give at least one model")
-    text = render(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title,
-                  truth=truth, bands=bands)
+    from ..data.force import is_force_data
+    if is_force_data(getattr(data, "experiments", data)):  # measured force under measured motion: report/force.py
+        from .force import render_force
+        text = render_force(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title)
+    else:
+        text = render(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title,
+                      truth=truth, bands=bands)
     with atomic_write(path, "w", encoding="utf-8") as fh:
         fh.write(text)
     return text

@@ -1,0 +1,246 @@
+"""The report on force (torque) data (docs/force-data.md#report): a comparison of the friction models (AICc
+differences among fits of the same data, errors on held-out experiments), measured against predicted force over
+time, the friction-velocity map with the measured points and each model's steady-sliding curve, presliding
+hysteresis loops where the motion reverses, errors per experiment and the identified parameters."""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import html
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from ..models import ModelI, ModelII
+from .page import _CSS, _colors, _fmt, _plt, _table, _thin, _versions
+
+_NAMES = {"lugre": "LuGre", "stribeck": "Stribeck", "coulomb": "Coulomb", "dahl": "Dahl",
+          "elastoplastic": "elasto-plastic", "gms": "GMS"}
+#: At most this many experiments get their own panel of force over time, and this many reversals a loop.
+MAX_PANELS = 4
+MAX_LOOPS = 4
+
+
+def _label(model) -> str:
+    name = _NAMES.get(model.friction.model, model.friction.model)
+    if isinstance(model.thermal, ModelI):
+        return f"{name}, Model I"
+    if isinstance(model.thermal, ModelII):
+        return f"{name}, Model II"
+    return name
+
+
+def _units(exps):
+    rotary = bool(exps[0].rotary)
+    return ("N m", "rad/s", "rad", "torque") if rotary else ("N", "m/s", "m", "force")
+
+
+def data_hash(experiments) -> str:
+    """SHA-256 over every experiment's time, position, force and temperature, in order."""
+    h = hashlib.sha256()
+    for e in experiments:
+        for arr in (e.time, e.displacement, e.force):
+            h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
+        h.update(repr(float(e.temperature)).encode())
+    return h.hexdigest()
+
+
+def fig_force_time(figs, entries, unit, what):
+    plt = _plt()
+    preds0 = entries[0].validation.predictions
+    shown = sorted(preds0, key=lambda p: (p.role != "validate", p.temperature))[:MAX_PANELS]
+    fig, axes = plt.subplots(len(shown), 1, figsize=(8.5, 2.4 * len(shown) + 0.5), squeeze=False,
+                             constrained_layout=True)
+    for ax, p0 in zip(axes[:, 0], shown):
+        stride = max(len(p0.time) // 400, 1)
+        ax.plot(p0.time[::stride], p0.measured[::stride], "o", ms=2.5, mfc="none", color="0.35", label="measured")
+        for e in entries:
+            p = next(q for q in e.validation.predictions if q.file == p0.file)
+            ax.plot(*_thin(p.time, p.predicted), lw=1.1, label=e.label)
+        ax.set_title(f"{p0.file}, {p0.temperature:.1f} °C" + (" (held out)" if p0.role == "validate" else ""),
+                     fontsize=9)
+        ax.set_ylabel(f"{what} [{unit}]")
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, frameon=False, loc="outside lower center",
+               ncol=len(entries) + 1)
+    return figs.render(fig, "force-time", f"Measured (markers) and predicted (lines) friction {what} over time, "
+                       f"the model's sensor offset included; held-out experiments first.")
+
+
+def fig_velocity_map(figs, entries, exps, unit, vunit, what):
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    temps = sorted({e.temperature for e in exps})
+    col = _colors(temps)
+    top = max(float(np.max(np.abs(e.drive_velocity))) for e in exps)
+    for k, e in enumerate(exps):
+        stride = max(len(e.time) // 1500, 1)
+        ax.plot(e.drive_velocity[::stride], e.force[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature],
+                label="measured" if k == 0 else None)
+    v = np.concatenate([-np.geomspace(top, top * 1e-3, 40), np.geomspace(top * 1e-3, top, 40)])
+    from ..validate_force import steady_state_curve
+    T_mid = float(np.median(temps))
+    for k, e in enumerate(entries):
+        try:
+            F = steady_state_curve(e.model, v, T_mid) + e.model.plant.sensor_offset
+        except Exception:  # noqa: BLE001 - a model that cannot run at this temperature: no curve, the rest stays
+            continue
+        ax.plot(v, F, "-", lw=1.4, label=f"{e.label}, steady sliding at {T_mid:.1f} °C")
+    ax.set_xlabel(f"velocity [{vunit}]")
+    ax.set_ylabel(f"friction {what} [{unit}]")
+    ax.legend(fontsize=7, frameon=False, loc="lower right")
+    return figs.render(fig, "velocity-map", f"The friction-velocity map: measured points (dots, coloured by "
+                       f"temperature, {min(temps):.1f}–{max(temps):.1f} °C) and each model's steady-sliding "
+                       f"{what} (simulated at constant velocity; sensor offset included).")
+
+
+def _reversals(p, n):
+    """Up to ``n`` reversals of the motion of prediction ``p`` with enough samples either side."""
+    v = p.velocity
+    flips = np.flatnonzero(np.sign(v[1:]) * np.sign(v[:-1]) < 0) + 1
+    return [int(i) for i in flips if 5 <= i < len(v) - 5][:n]
+
+
+def fig_loops(figs, entries, unit, xunit, what):
+    """Force against position after each reversal: the presliding hysteresis, measured and predicted."""
+    plt = _plt()
+    loops = []
+    for p in entries[0].validation.predictions:
+        for i in _reversals(p, MAX_LOOPS - len(loops)):
+            loops.append((p.file, i))
+        if len(loops) >= MAX_LOOPS:
+            break
+    if not loops:
+        return ""
+    fig, axes = plt.subplots(1, len(loops), figsize=(3.2 * len(loops), 3.0), squeeze=False)
+    for ax, (file, i) in zip(axes[0], loops):
+        p0 = next(q for q in entries[0].validation.predictions if q.file == file)
+        swing = abs(float(np.median(p0.measured[max(i - 20, 0):i])) - float(np.median(p0.measured[i + 1:i + 40])))
+        # the window: from a little before the reversal to where the force has swung to its new level
+        j = i
+        while j < len(p0.measured) - 1 and abs(p0.measured[j] - p0.measured[i]) < 0.95 * swing and j - i < 400:
+            j += 1
+        a, b = max(i - (j - i) // 2 - 2, 0), min(j + (j - i) // 2 + 2, len(p0.time))
+        x = p0.position[a:b] - p0.position[i]
+        ax.plot(x, p0.measured[a:b], "o", ms=3, mfc="none", color="0.35", label="measured")
+        for e in entries:
+            p = next(q for q in e.validation.predictions if q.file == file)
+            ax.plot(x, p.predicted[a:b], "-", lw=1.2, label=e.label)
+        ax.set_title(f"{file}, t = {p0.time[i]:.3g} s", fontsize=8)
+        ax.set_xlabel(f"position from the reversal [{xunit}]")
+    axes[0][0].set_ylabel(f"friction {what} [{unit}]")
+    axes[0][0].legend(fontsize=7, frameon=False)
+    return figs.render(fig, "presliding", f"Presliding: the {what} against the position around reversals of the "
+                       f"motion, measured (markers) and predicted (lines); the loop's slope at the reversal is the "
+                       f"bristle stiffness.")
+
+
+def _akaike(entries):
+    from . import akaike
+    return akaike(entries)[0]
+
+
+def render_force(entries, data, *, figures_dir=None, command=None, title=None) -> str:
+    from ..validate import validate
+    from .page import Figures
+
+    exps = list(getattr(data, "experiments", data))
+    if not any(getattr(e, "role", "fit") == "validate" for e in exps):
+        raise InputError("the dataset has no experiment with role 'validate': a report compares predictions on "
+                         "experiments the models were not identified on")
+    unit, vunit, xunit, what = _units(exps)
+    for e in entries:
+        if e.validation is None:
+            e.validation = validate(e.model, data)
+        # the default labels name the thermal model only (and the command line adds the file's stem to tell
+        # them apart): here the friction model is what differs
+        if e.label.startswith(("no thermal model", "Model I", "base")):
+            e.label = _label(e.model)
+    seen = {}
+    for e in entries:  # one label per entry
+        seen[e.label] = seen.get(e.label, 0) + 1
+        if seen[e.label] > 1:
+            e.label = f"{e.label} ({seen[e.label]})"
+    figs = Figures(figures_dir)
+    parts = []
+    held = {e.label: e.validation.summary().get("validate", {}).get("rmse", math.inf) for e in entries}
+    best = min(entries, key=lambda e: held[e.label])
+    cards = [("best on held-out experiments", best.label, f"RMSE {held[best.label]:.3g} {unit}"),
+             ("experiments", f"{len(exps)}", f"{sum(getattr(e, 'role', 'fit') == 'validate' for e in exps)} held out"),
+             ("temperatures", f"{min(e.temperature for e in exps):.1f}–{max(e.temperature for e in exps):.1f} °C", ""),
+             ("units", "rotary" if unit == "N m" else "linear", f"{xunit}, {vunit}, {unit}")]
+    parts.append('<div class="cards">' + "".join(
+        f'<div class="card"><div class="k">{html.escape(k)}</div><div class="v">{html.escape(v)}</div>'
+        f'<div class="s">{html.escape(s)}</div></div>' for k, v, s in cards) + "</div>")
+    warns = []
+    for e in entries:
+        f = e.fit or {}
+        warns += [f"{e.label}: {w}" for w in f.get("warnings", [])]
+        if f.get("success") is False:
+            warns.append(f"{e.label}: the fit did not converge: {f.get('message', '')}")
+        warns += [f"{e.label}: {x.file} could not be predicted: {x.reason}" for x in e.validation.failures]
+        warns += [f"{e.label}: {w}" for w in e.validation.warnings]
+    if warns:
+        parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
+                                                           for w in dict.fromkeys(warns)) + "</section>")
+    rows = []
+    for e, a in zip(entries, _akaike(entries)):
+        s = e.validation.summary()
+        f = e.fit or {}
+        k = sum(1 for p in (f.get("parameters") or {}).values() if p.get("vary"))
+        rows.append([e.label, _fmt(k if f else None, "{:.0f}"), _fmt(a[0] if a else None, "{:.1f}"),
+                     _fmt(a[1] if a else None, "{:.3f}"), _fmt(s.get("fit", {}).get("rmse"), "{:.4g}"),
+                     _fmt(s.get("validate", {}).get("rmse"), "{:.4g}"), _fmt(s.get("validate", {}).get("max_error_pct")),
+                     _fmt(e.model.plant.sensor_offset, "{:.4g}")])
+    parts.append("<section><h2>Friction models compared</h2>" + _table(
+        ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
+         "max error, held out [%]", f"sensor offset [{unit}]"], rows) +
+        "<p style='font-size:13px;color:#4a5266'>ΔAICc is each fit's AICc minus the lowest among fits of the same "
+        "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
+        "to one. The held-out RMSE compares the models on experiments none was fitted to; the sensor offset was "
+        "fitted once, on the fit experiments, and is used there as it is. Max error is "
+        "max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
+    parts.append(f"<section><h2>Measured and predicted {what}</h2>" + fig_force_time(figs, entries, unit, what)
+                 + "</section>")
+    parts.append("<section><h2>Friction–velocity map</h2>" + fig_velocity_map(figs, entries, exps, unit, vunit, what)
+                 + "</section>")
+    loops = fig_loops(figs, entries, unit, xunit, what)
+    if loops:
+        parts.append("<section><h2>Presliding hysteresis</h2>" + loops + "</section>")
+    err_rows = [[e.label, m["file"], _fmt(m["temperature"], "{:.4g}"), m["role"], _fmt(m["rmse"], "{:.4g}"),
+                 _fmt(m["nrmse"]), _fmt(m["max_error_pct"]), _fmt(m["bias"], "{:+.3g}")]
+                for e in entries for m in e.validation.experiments]
+    parts.append("<section><h2>Errors per experiment</h2>" + _table(
+        ["model", "file", "T [°C]", "role", f"RMSE [{unit}]", "NRMSE", "max error [%]", f"mean error [{unit}]"],
+        err_rows) + "</section>")
+    param_rows = []
+    for e in entries:
+        f = e.fit or {}
+        for name, p in (f.get("parameters") or {}).items():
+            ci = p.get("ci95") or ["", ""]
+            param_rows.append([e.label, name, _fmt(p.get("value"), "{:.6g}"), _fmt(p.get("stderr"), "{:.3g}"),
+                               f"[{_fmt(ci[0], '{:.5g}')}, {_fmt(ci[1], '{:.5g}')}]", p.get("unit", "")])
+        o = f.get("sensor_offset")
+        if o:
+            ci = o.get("ci95") or ["", ""]
+            param_rows.append([e.label, "sensor offset" + ("" if o.get("fitted") else " (held)"),
+                               _fmt(o.get("value"), "{:.6g}"), _fmt(o.get("stderr"), "{:.3g}"),
+                               f"[{_fmt(ci[0], '{:.5g}')}, {_fmt(ci[1], '{:.5g}')}]", o.get("unit", unit)])
+    if param_rows:
+        parts.append("<section><h2>Identified parameters</h2>" + _table(
+            ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
+    versions = _versions()
+    footer = (" · ".join(f"{k} {v}" for k, v in versions.items()) + f" · data SHA-256 <code>{data_hash(exps)}</code>"
+              f" · written {datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}"
+              + (f"<br>command: <code>{html.escape(command)}</code>" if command else ""))
+    name = html.escape(title or f"thermofriction report — {getattr(data, 'name', None) or 'force data'}")
+    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
+            f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
+            f"<body><header><h1>{name}</h1><p>{', '.join(html.escape(e.label) for e in entries)} on "
+            f"{len(exps)} {what} experiments</p></header><main>{''.join(parts)}</main><footer>{footer}</footer>"
+            f"</body></html>")
+
+
+__all__ = ["render_force", "data_hash"]
