@@ -14,7 +14,16 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import ModelI, ModelII
-from .page import _CSS, _colors, _fmt, _plt, _table, _thin, _versions
+from .page import _CSS, _fmt, _plt, _table, _versions
+from .plots import thin as _thin
+
+
+def _colors(temps):
+    """Temperature -> colour on the report's scale for temperatures (viridis, by value)."""
+    import matplotlib
+    lo, hi = min(temps), max(temps)
+    cmap = matplotlib.colormaps["viridis"]
+    return {T: cmap(0.05 + 0.8 * ((T - lo) / (hi - lo) if hi > lo else 0.5)) for T in temps}
 
 _NAMES = {"lugre": "LuGre", "stribeck": "Stribeck", "coulomb": "Coulomb", "dahl": "Dahl",
           "elastoplastic": "elasto-plastic", "gms": "GMS"}
