@@ -24,6 +24,8 @@ from .quality import ADEQUATE_RATIO, noise_level
 optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
 
 _MAX_STEPS = 2_000_000
+#: RMSE within this factor of the noise: a fit at the noise, where the multi-start stops
+AT_NOISE = 1.1
 
 
 @dataclasses.dataclass
@@ -323,32 +325,6 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     phi0 = np.clip(transform.to_phi(theta0), lo, hi)
     one_trace = len(traces) == 1
 
-    # global phase: screen a Latin hypercube around the initial guess (a decade either way for
-    # log parameters, +-100 % for the others) by cost alone, then refine the best few
-    candidates = [phi0]
-    if starts > 1:
-        width = np.where(transform.log, math.log(10.0), 1.0)
-        sample = stats.qmc.LatinHypercube(d=len(phi0), seed=seed).random(starts - 1)
-        for u in sample:
-            candidates.append(np.clip(phi0 + (2 * u - 1) * width, lo + 1e-9, hi - 1e-9))
-    screen = Problem(model, names, traces, rtol=max(rtol, 1e-6), parallel=not one_trace)
-
-    def cost(phi):
-        r, _ = screen.evaluate(transform.to_theta(phi))
-        return math.inf if r is None else float(r @ r)
-
-    if len(candidates) > 1:
-        costs = list(pool().map(cost, candidates)) if one_trace else [cost(c) for c in candidates]
-        order = np.argsort(costs)
-        n_refine = min(max(os.cpu_count() or 1, 2), 3) if one_trace else 1  # one per core
-        chosen = [candidates[i] for i in order[:n_refine] if math.isfinite(costs[i])]
-        if not any(np.array_equal(c, phi0) for c in chosen):
-            chosen.append(phi0)
-    else:
-        chosen = [phi0]
-    if progress:
-        progress(f"{len(candidates)} starts screened; refining {len(chosen)}")
-
     scale = residual_scale(traces)
 
     def run(phi_start):
@@ -365,10 +341,37 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         res.moved = bool(np.any(res.x != phi_first))
         return res, problem
 
-    if one_trace and len(chosen) > 1:
-        runs = list(pool().map(run, chosen))
-    else:
-        runs = [run(c) for c in chosen]
+    def at_noise(res):  # residuals at the data's noise: another start cannot do meaningfully better
+        return math.sqrt(2.0 * res.cost / max(res.fun.size, 1)) <= AT_NOISE
+
+    # The initial guess first. Only if it does not reach the noise, the global phase: screen a Latin
+    # hypercube around it (a decade either way for log parameters, +-100 % for the others) by cost
+    # alone, then refine the best few. (A start off in a direction the data hardly determine, sigma1,
+    # can screen best and yet take ten times longer to converge to the same optimum.)
+    runs = [run(phi0)]
+    screen = Problem(model, names, traces, rtol=max(rtol, 1e-6), parallel=not one_trace)
+    n_candidates = 1
+    if starts > 1 and not at_noise(runs[0][0]):
+        width = np.where(transform.log, math.log(10.0), 1.0)
+        sample = stats.qmc.LatinHypercube(d=len(phi0), seed=seed).random(starts - 1)
+        candidates = [np.clip(phi0 + (2 * u - 1) * width, lo + 1e-9, hi - 1e-9) for u in sample]
+        n_candidates += len(candidates)
+
+        def cost(phi):
+            r, _ = screen.evaluate(transform.to_theta(phi))
+            return math.inf if r is None else float(r @ r)
+
+        costs = list(pool().map(cost, candidates)) if one_trace else [cost(c) for c in candidates]
+        order = np.argsort(costs)
+        n_refine = min(max(os.cpu_count() or 1, 2), 3) if one_trace else 1  # one per core
+        chosen = [candidates[i] for i in order[:n_refine] if math.isfinite(costs[i])]
+        if progress:
+            progress(f"the initial guess is not at the noise: {len(candidates)} more starts screened; refining "
+                     f"{len(chosen)}")
+        if one_trace and len(chosen) > 1:
+            runs += list(pool().map(run, chosen))
+        else:
+            runs += [run(c) for c in chosen]
     best, best_problem = min(runs, key=lambda rp: rp[0].cost)
     theta = transform.to_theta(best.x)
     r, J = best_problem.evaluate(theta, jac=True)
@@ -380,7 +383,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     if not best.moved and math.sqrt(float(r @ r) / r.size) > ADEQUATE_RATIO * scale:
         # a small gradient at a start that does not fit the data is not convergence
         success, message = False, f"stopped at its starting point ({message})"
-    return FitOutcome(theta, r, J, nfev, njev, success, message, len(candidates), time.perf_counter() - t_start)
+    return FitOutcome(theta, r, J, nfev, njev, success, message, n_candidates, time.perf_counter() - t_start)
 
 
 def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
