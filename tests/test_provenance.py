@@ -49,6 +49,10 @@ def test_data_hash_is_sha256sum_of_the_sorted_files(fitted):
     listing = subprocess.run(["sha256sum", *files], cwd=data, capture_output=True, check=True).stdout
     expected = subprocess.run(["sha256sum"], input=listing, capture_output=True, check=True).stdout.split()[0].decode()
     assert tf.load_model(path).provenance["data_sha256"] == expected
+    # the report on the same folder names the same hash: a page can be traced to the model's data
+    r = run_cli("report", path, data, "-o", path.parent / "report.html")
+    assert r.returncode == 0, r.stderr
+    assert f"data SHA-256 <code>{expected}</code>" in (path.parent / "report.html").read_text()
 
 
 def test_provenance_records_method_date_version_options_and_command(fitted):

@@ -91,6 +91,24 @@ def _progress(quiet):
     return update, status
 
 
+def _identify_options(args):
+    """(laws, parameters) from identify's options, checked: one dataset or a fleet alike."""
+    laws = {}
+    for item in args.law:
+        name, eq, kind = item.partition("=")
+        if not eq or kind not in ("linear", "exp", "const"):
+            raise InputError(f"--law '{item}': expected PARAM=linear|exp|const")
+        laws[name.strip()] = kind
+    params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
+    if params and args.method != "base":
+        raise InputError("--parameters applies to --method base only")
+    if args.reference_temperature is not None and args.method != "model-ii":
+        raise InputError("--reference-temperature applies to --method model-ii only")
+    if args.rtol >= 1:
+        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    return laws, params
+
+
 def cmd_identify(args) -> int:
     from ..data import load_dataset
     from ..identify import identify
@@ -103,21 +121,9 @@ def cmd_identify(args) -> int:
         raise InputError("--scheduler and --workers apply to fleet identification (several datasets, or a folder "
                          "of datasets); one dataset is identified in this process")
     data = load_dataset(args.dataset)
-    laws = {}
-    for item in args.law:
-        name, eq, kind = item.partition("=")
-        if not eq or kind not in ("linear", "exp", "const"):
-            raise InputError(f"--law '{item}': expected PARAM=linear|exp|const")
-        laws[name.strip()] = kind
-    params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
-    if params and args.method != "base":
-        raise InputError("--parameters applies to --method base only")
+    laws, params = _identify_options(args)
     init = args.init if args.init and args.init not in PRESETS else None
     _refuse_inputs(args, _dataset_inputs(data), init, *_model_inputs(init, None))
-    if args.reference_temperature is not None and args.method != "model-ii":
-        raise InputError("--reference-temperature applies to --method model-ii only")
-    if args.rtol >= 1:
-        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
     update, status = _progress(args.quiet)
     try:
         fit = identify(data, args.method, init=args.init, friction=args.friction, parameters=params,
@@ -164,19 +170,7 @@ def cmd_identify_fleet(args) -> int:
                          "dataset, fleet.json and fleet.csv)")
     if args.json:
         raise InputError("--json applies to one dataset; with several, each dataset's results JSON goes into -o DIR")
-    laws = {}
-    for item in args.law:
-        name, eq, kind = item.partition("=")
-        if not eq or kind not in ("linear", "exp", "const"):
-            raise InputError(f"--law '{item}': expected PARAM=linear|exp|const")
-        laws[name.strip()] = kind
-    params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
-    if params and args.method != "base":
-        raise InputError("--parameters applies to --method base only")
-    if args.reference_temperature is not None and args.method != "model-ii":
-        raise InputError("--reference-temperature applies to --method model-ii only")
-    if args.rtol >= 1:
-        raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
+    laws, params = _identify_options(args)
     update, stop = progress_bar(len(paths), "identify", enabled=not args.quiet)
     try:
         fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,

@@ -365,3 +365,34 @@ def _remove_folders(created):
             d.rmdir()  # only if still empty
         except OSError:
             pass
+
+
+def dataset_sha256(data) -> tuple[str, str]:
+    """(what was hashed, its SHA-256): for a dataset read from a folder, its files -- the manifest
+    and every experiment file, sorted by path -- hashed as ``sha256sum`` lists them and that list
+    hashed again (``sha256sum FILES | sha256sum`` in the folder gives the same); otherwise the
+    experiments' numbers (time and each recorded signal -- voltage, displacement, force -- as little-endian
+    float64, in order). The one definition: fitted models' provenance and the reports' footers."""
+    import hashlib
+    import os
+
+    folder = getattr(data, "path", None)
+    experiments = list(getattr(data, "experiments", data))
+    if folder is not None:
+        files = sorted({"dataset.toml", *(e.file for e in experiments)})
+        if all(os.path.isfile(os.path.join(folder, f)) for f in files):
+            listing = hashlib.sha256()
+            for f in files:
+                h = hashlib.sha256()
+                with open(os.path.join(folder, f), "rb") as fh:
+                    for block in iter(lambda: fh.read(1 << 20), b""):
+                        h.update(block)
+                listing.update(f"{h.hexdigest()}  {f}\n".encode())
+            return str(folder), listing.hexdigest()
+    h = hashlib.sha256()
+    for e in experiments:
+        for name in ("time", "voltage", "displacement", "force"):
+            a = getattr(e, name, None)
+            if a is not None:
+                h.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
+    return "experiments in memory", h.hexdigest()

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._io import dump_json, jsonable
 from ..models import Model
+from ..data.files import dataset_sha256 as data_sha256
 from .parameters import Parameters
 
 
@@ -255,34 +256,6 @@ class FitResult:
 METHOD_NAMES = {"plant": "the plant (xi, wn, K)", "base": "a friction model without thermal effects",
                 "model-i": "Model I (temperature-dependent parameters)", "model-ii": "Model II (a thermal friction term)",
                 "heat": "the self-heating model"}
-
-
-def data_sha256(data) -> tuple[str, str]:
-    """(what was hashed, its SHA-256): for a dataset read from a folder, its files -- the manifest
-    and every experiment file, sorted by path -- hashed as ``sha256sum`` lists them and that list
-    hashed again (``sha256sum FILES | sha256sum`` in the folder gives the same); otherwise the
-    experiments' numbers (time, voltage, displacement as float64, in order)."""
-    import hashlib
-    import os
-
-    folder = getattr(data, "path", None)
-    experiments = list(getattr(data, "experiments", data))
-    if folder is not None:
-        files = sorted({"dataset.toml", *(e.file for e in experiments)})
-        if all(os.path.isfile(os.path.join(folder, f)) for f in files):
-            listing = hashlib.sha256()
-            for f in files:
-                h = hashlib.sha256()
-                with open(os.path.join(folder, f), "rb") as fh:
-                    for block in iter(lambda: fh.read(1 << 20), b""):
-                        h.update(block)
-                listing.update(f"{h.hexdigest()}  {f}\n".encode())
-            return str(folder), listing.hexdigest()
-    h = hashlib.sha256()
-    for e in experiments:
-        for a in (e.time, e.voltage, e.displacement):
-            h.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
-    return "experiments in memory", h.hexdigest()
 
 
 def _label(data) -> str:

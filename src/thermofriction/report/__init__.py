@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import datetime
-import hashlib
 import html
 import math
 import re
@@ -14,6 +13,7 @@ import sys
 
 import numpy as np
 
+from ..data.files import dataset_sha256
 from .._io import atomic_write
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
@@ -43,16 +43,6 @@ def entry_label(model: Model, fit: dict | None = None) -> str:
     if isinstance(model.thermal, ModelII):
         return "Model II"
     return "no thermal model"
-
-
-def data_hash(experiments) -> str:
-    """SHA-256 over the numbers of every experiment (time, voltage, displacement), in order."""
-    h = hashlib.sha256()
-    for e in experiments:
-        for arr in (e.time, e.voltage, e.displacement):
-            h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
-        h.update(repr(float(e.temperature)).encode())
-    return h.hexdigest()
 
 
 
@@ -355,7 +345,7 @@ def render(entries, data, *, figures_dir=None, command=None, title=None, truth=N
     versions = _versions()
     footer = (f"thermofriction {versions['thermofriction']} · Python {versions['python']} · NumPy "
               f"{versions['numpy']} · SciPy {versions['scipy']} · matplotlib {versions['matplotlib']} · "
-              f"data SHA-256 <code>{data_hash(exps)}</code> · written "
+              f"data SHA-256 <code>{dataset_sha256(data)[1]}</code> · written "
               f"{datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}"
               + (f"<br>command: <code>{html.escape(command)}</code>" if command else ""))
     name = html.escape(title or f"thermofriction report — {getattr(data, 'name', None) or 'dataset'}")
@@ -426,4 +416,4 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
 
 
 
-__all__ = ["report", "render", "Entry", "data_hash", "heating_report", "control_report"]
+__all__ = ["report", "render", "Entry", "heating_report", "control_report"]

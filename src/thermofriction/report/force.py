@@ -6,12 +6,12 @@ hysteresis loops where the motion reverses, errors per experiment and the identi
 from __future__ import annotations
 
 import datetime
-import hashlib
 import html
 import math
 
 import numpy as np
 
+from ..data.files import dataset_sha256
 from ..errors import InputError
 from ..models import ModelI, ModelII
 from .page import _CSS, _fmt, _plt, _table, _versions
@@ -44,16 +44,6 @@ def _label(model) -> str:
 def _units(exps):
     rotary = bool(exps[0].rotary)
     return ("N m", "rad/s", "rad", "torque") if rotary else ("N", "m/s", "m", "force")
-
-
-def data_hash(experiments) -> str:
-    """SHA-256 over every experiment's time, position, force and temperature, in order."""
-    h = hashlib.sha256()
-    for e in experiments:
-        for arr in (e.time, e.displacement, e.force):
-            h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
-        h.update(repr(float(e.temperature)).encode())
-    return h.hexdigest()
 
 
 def fig_force_time(figs, entries, unit, what):
@@ -241,7 +231,7 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None) -
         parts.append("<section><h2>Identified parameters</h2>" + _table(
             ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
     versions = _versions()
-    footer = (" · ".join(f"{k} {v}" for k, v in versions.items()) + f" · data SHA-256 <code>{data_hash(exps)}</code>"
+    footer = (" · ".join(f"{k} {v}" for k, v in versions.items()) + f" · data SHA-256 <code>{dataset_sha256(data)[1]}</code>"
               f" · written {datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}"
               + (f"<br>command: <code>{html.escape(command)}</code>" if command else ""))
     name = html.escape(title or f"thermofriction report — {getattr(data, 'name', None) or 'force data'}")
@@ -252,4 +242,4 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None) -
             f"</body></html>")
 
 
-__all__ = ["render_force", "data_hash"]
+__all__ = ["render_force"]

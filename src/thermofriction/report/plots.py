@@ -436,7 +436,7 @@ def laws_figure(fit, model, held_out=(), paper=True):
     for ax, n in zip(axes.flat, names):
         draw_law(ax, fit, model, n, held_out, paper)
     _hide_unused(axes, len(names))
-    handles, labels = {}, []
+    handles = {}
     for ax in axes.flat[:len(names)]:
         for h, lab in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lab, h)
