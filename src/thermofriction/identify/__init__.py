@@ -182,8 +182,6 @@ def _plant_parameters(init, free, method) -> list:
 
 
 def _identify_plant(experiments, init):
-    import math
-
     import numpy as np
 
     staged = [e for e in experiments if getattr(e, "stage_displacement", None) is not None]
