@@ -208,3 +208,28 @@ def test_steady_sliding_matches_the_analytic_lugre_curve(rotary):
         simulated = steady_state_curve(m, v)
     np.testing.assert_allclose(simulated, analytic, rtol=0, atol=1e-6 * p["fs"])
     assert math.isclose(steady_state_curve(m, [0.0])[0], 0.0)
+
+
+@pytest.mark.parametrize("rotary", [False, True])
+def test_save_dataset_writes_force_experiments_that_load_back_exactly(tmp_path, rotary):
+    """A force dataset read from files in mm, deg and mN (converted to SI), saved by save_dataset and loaded
+    again: the same experiments to the last bit, in SI columns with their units in the headers, and no
+    'input' in the manifest (a force run's motion is its record)."""
+    t, x, v, F = _sine_rows(rotary=rotary)
+    header = ("time[ms],position[deg],velocity[deg/s],friction_torque[mN*m]" if rotary
+              else "time[ms],position[mm],velocity[mm/s],friction_force[mN]")
+    scale = np.degrees(1.0) if rotary else 1e3
+    (tmp_path / "in").mkdir()
+    _write(tmp_path / "in" / "r.csv", header, np.column_stack([t * 1e3, x * scale, v * scale, F * 1e3]))
+    _dataset(tmp_path / "in", ["r.csv"])
+    data = tf.load_dataset(tmp_path / "in")
+    tf.save_dataset(data, tmp_path / "out")
+    again = tf.load_dataset(tmp_path / "out")
+    a, b = data.experiments[0], again.experiments[0]
+    for name in ("time", "displacement", "velocity", "force"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert b.rotary is rotary
+    head = (tmp_path / "out" / "r.csv").read_text().splitlines()[0]
+    assert head == ("time[s],position[rad],velocity[rad/s],friction_torque[N*m]" if rotary
+                    else "time[s],position[m],velocity[m/s],friction_force[N]")
+    assert "input" not in (tmp_path / "out" / "dataset.toml").read_text()

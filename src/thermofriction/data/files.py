@@ -16,7 +16,7 @@ from .._reading import read_text
 from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
-from .force import force_experiment, is_force_data, is_force_file, units_of
+from .force import ForceExperiment, force_experiment, is_force_data, is_force_file, units_of
 from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
@@ -281,6 +281,22 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
             entries = []
             mat = {}  # MATLAB file -> its variables, written once all its runs are in
             for e in dataset.experiments:
+                if isinstance(e, ForceExperiment):  # measured motion and friction: its own columns
+                    if _is_mat(e.file):
+                        raise InputError(f"{e.file}: force experiments are written as CSV files only; name it .csv")
+                    unit = ("rad", "rad/s", "friction_torque[N*m]") if e.rotary else ("m", "m/s", "friction_force[N]")
+                    cols = {"time[s]": e.time, f"position[{unit[0]}]": e.displacement}
+                    if e.velocity is not None:
+                        cols[f"velocity[{unit[1]}]"] = e.velocity
+                    cols[unit[2]] = e.force
+                    if e.temperature_signal is not None:
+                        cols["temperature[C]"] = e.temperature_signal
+                    with atomic_write(folder / e.file, "w", newline="") as fh:
+                        fh.write(",".join(cols) + "\n")
+                        np.savetxt(fh, np.column_stack([np.asarray(v, float) for v in cols.values()]), delimiter=",",
+                                   fmt="%.17g")  # every digit: a measured record read back is the same record
+                    entries.append(_entry(e))
+                    continue
                 if _is_mat(e.file):
                     run = _mat_variables(e)
                     if e.struct:
@@ -354,7 +370,7 @@ def _entry(e) -> dict:
         entry["struct"] = e.struct
     if e.description:
         entry["description"] = e.description
-    if e.input is not None:
+    if e.input is not None and not isinstance(e, ForceExperiment):  # a force run's motion is its record
         entry["input"] = e.input.spec()
     return entry
 
