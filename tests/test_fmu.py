@@ -303,3 +303,180 @@ def test_cli_exports_a_valid_fmu(tmp_path):
     causality = {v.name: v.causality for v in md.modelVariables}
     assert causality["ambient_temperature"] == "input" and causality["temperature"] == "output"
     assert causality["heat.C_th"] == "parameter"
+
+
+# ---- the fixed-step real-time integrator (export_fmu(..., integrator="realtime", step=...)) ----
+#
+# Its tolerance: the method is first order (the friction's exponential Euler step with the sliding
+# velocity held over a step, the plant's semi-implicit Euler, the drive held at each step's start), so
+# its global error is proportional to omega * step, omega the model's fastest mode: the larger of the
+# plant's natural frequency and the bristle frequency sqrt(sigma0 / m) of the driven mass. The tests
+# ask for an error below omega * step of each output's range (about 0.7 of that is seen for the friction
+# force, the output that moves fastest), and that halving the step halves the error (first order,
+# converging to tf.simulate's adaptive solution).
+
+
+def _realtime(model, tmp_path, name, step):
+    path = tmp_path / f"{name}.fmu"
+    export_fmu(model, path, integrator="realtime", step=step)
+    return path
+
+
+def _relative_errors(got, ref):
+    return {name: np.max(np.abs(got[name] - getattr(ref, name))) / np.ptp(getattr(ref, name)) for name in got}
+
+
+def test_realtime_stick_slip_converges_to_simulate(tmp_path):
+    """Independent client and reference: fmpy drives the real-time FMU (Model I stick-slip, 35 C) over two
+    sawtooth cycles; every output is within omega * step of its range from tf.simulate's adaptive
+    solution, omega = max(wn, sqrt(sigma0(T) / m_e)), and at half the step the error halves (first order)."""
+    model = tf.load_model("li2009-model-i")
+    T = 35.0
+    t = np.arange(4001) * 1e-4
+    u = tf.Sawtooth(amplitude=30.0, frequency=5.0, rise=0.999)(t)
+    ref = tf.simulate(model, input=tf.Sampled(t, u), t_eval=t, temperature=T)
+    sigma0 = model.laws["sigma0"](T)
+    omega = max(model.plant.modal_parameters()[1], np.sqrt(sigma0 / model.plant.end_effector_mass))
+    names = ["displacement", "velocity", "friction_force", "stage_displacement"]
+    errors = {}
+    for step in (1e-5, 5e-6):
+        path = _realtime(model, tmp_path, f"rt{step:g}", step)
+        assert validate_fmu(str(path)) == []
+        run = Run(path, tmp_path, {"temperature": T})
+        errors[step] = _relative_errors(run.drive(t, {"voltage": u}, names), ref)
+        run.close()
+        for name, err in errors[step].items():
+            assert err <= omega * step, f"step {step:g} s, {name}: {err:.3g} of range > omega step = {omega * step:.3g}"
+    for name in names:
+        ratio = errors[1e-5][name] / errors[5e-6][name]
+        assert 1.6 < ratio < 2.5, f"{name}: halving the step divided the error by {ratio:.2f}, not about 2"
+
+
+def test_realtime_mass_lugre_matches_simulate(tmp_path):
+    """Independent reference: a mass with LuGre under a sine force through the real-time FMU, within
+    omega * step of range of tf.simulate (omega = sqrt(sigma0 / m), the bristle frequency)."""
+    model = _mass_lugre()
+    step = 1e-4
+    t = np.arange(1001) * 1e-3
+    u = 2.2 * np.sin(2 * np.pi * 2.0 * t)
+    run = Run(_realtime(model, tmp_path, "rt-mass", step), tmp_path)
+    got = run.drive(t, {"force": u}, ["displacement", "velocity", "friction_force"])
+    run.close()
+    ref = tf.simulate(model, input=tf.Sampled(t, u), t_eval=t)
+    omega = np.sqrt(model.friction.sigma0 / model.plant.mass)
+    for name, err in _relative_errors(got, ref).items():
+        assert err <= omega * step, f"{name}: {err:.3g} of range > omega step = {omega * step:.3g}"
+
+
+def test_realtime_matches_the_cores_realtime_api(tmp_path):
+    """Independent path: a prescribed sine motion with GMS through the real-time FMU (ten fixed steps per
+    communication step) gives the friction force that the core's real-time API, driven from Python with
+    the same sliding velocities (thermofriction.control.friction_steps, tf_rt_step), gives -- to rounding
+    (1e-12 of range)."""
+    from thermofriction.control import friction_steps
+
+    model = _prescribed_gms()
+    step, per = 1e-4, 10
+    t = np.arange(1001) * (step * per)
+    u = 2e-5 * np.sin(2 * np.pi * 1.0 * t) + 5e-6 * np.sin(2 * np.pi * 3.7 * t)
+    run = Run(_realtime(model, tmp_path, "rt-gms", step), tmp_path)
+    got = run.drive(t, {"motion": u}, ["friction_force"])["friction_force"]
+    run.close()
+    F, _ = friction_steps(model, np.repeat(np.diff(u) / (step * per), per), step)
+    want = F[per - 1::per]  # the force after each communication step's last fixed step
+    assert np.max(np.abs(got[1:] - want)) <= 1e-12 * np.ptp(want)
+
+
+def test_realtime_step_not_a_divisor_of_the_communication_step(tmp_path):
+    """A communication step that is not a whole number of fixed steps (1 ms with 0.3 ms steps): the last
+    step is shortened, the FMU's time lands on each communication point (fmpy's clock check in doStep
+    passes) and the result stays within omega * step of tf.simulate (mass with LuGre)."""
+    model = _mass_lugre()
+    step = 3e-4
+    t = np.arange(401) * 1e-3
+    u = 2.2 * np.sin(2 * np.pi * 2.0 * t)
+    run = Run(_realtime(model, tmp_path, "rt-odd", step), tmp_path)
+    got = run.drive(t, {"force": u}, ["displacement", "velocity"])
+    assert run.fmu.getRealStatus(2) == pytest.approx(t[-1], abs=1e-12)  # fmi2LastSuccessfulTime
+    run.close()
+    ref = tf.simulate(model, input=tf.Sampled(t, u), t_eval=t)
+    omega = np.sqrt(model.friction.sigma0 / model.plant.mass)
+    for name, err in _relative_errors(got, ref).items():
+        assert err <= omega * step, f"{name}: {err:.3g} of range > omega step = {omega * step:.3g}"
+
+
+def test_realtime_choice_in_the_model_description(tmp_path):
+    """The real-time FMU declares its step as a fixed parameter integrator.step [s] with the exported
+    value, names the integrator in its description and proposes a whole number of steps as default
+    communication step; the adaptive FMU has no such parameter."""
+    path = _realtime(_mass_lugre(), tmp_path, "rt-md", 2.5e-5)
+    md = read_model_description(str(path))
+    step = next(v for v in md.modelVariables if v.name == "integrator.step")
+    assert (step.causality, step.variability, float(step.start), step.unit) == ("parameter", "fixed", 2.5e-5, "s")
+    assert "fixed-step real-time integrator, step 2.5e-05 s" in md.description
+    n = float(md.defaultExperiment.stepSize) / 2.5e-5
+    assert n == pytest.approx(round(n)) and round(n) >= 1
+    adaptive = read_model_description(str(_export(_mass_lugre(), tmp_path, "adaptive-md")))
+    assert all(v.name != "integrator.step" for v in adaptive.modelVariables)
+    assert "adaptive integrator" in adaptive.description
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"integrator": "realtime", "step": 0.0}, "positive"),
+    ({"integrator": "realtime", "step": -1e-5}, "positive"),
+    ({"integrator": "realtime", "step": float("nan")}, "positive"),
+    ({"integrator": "realtime", "step": "fast"}, "number of seconds"),
+    ({"integrator": "realtime"}, "needs its fixed step"),
+    ({"integrator": "realtime", "step": 1e-3}, "unstable"),  # li2009: wn = 6686 rad/s, 2 / wn = 0.3 ms
+    ({"step": 1e-5}, "realtime integrator's fixed step"),
+    ({"integrator": "euler", "step": 1e-5}, "adaptive, realtime"),
+])
+def test_bad_step_refused_at_export(kwargs, message, tmp_path):
+    """Bad integrator or step values: an InputError naming them, no file written."""
+    with pytest.raises(tf.InputError, match=message):
+        export_fmu(tf.load_model("li2009-model-i"), tmp_path / "bad.fmu", **kwargs)
+    assert not (tmp_path / "bad.fmu").exists()
+
+
+def test_cli_realtime_export_and_bad_steps(tmp_path):
+    """`thermofriction fmu ... --integrator realtime --step 1e-5` writes a valid FMU; bad steps (0, unstable,
+    --step without the realtime integrator) exit with status 2, one message, no file."""
+    path = tmp_path / "rt.fmu"
+    cmd = [sys.executable, "-m", "thermofriction", "fmu", "li2009-model-ii", "-o"]
+    out = subprocess.run(cmd + [str(path), "--integrator", "realtime", "--step", "1e-5"], capture_output=True,
+                         text=True)
+    assert out.returncode == 0, out.stderr
+    assert validate_fmu(str(path)) == [] and "fixed step 1e-05 s" in out.stdout
+    for extra in (["--integrator", "realtime", "--step", "0"], ["--integrator", "realtime", "--step", "1e-3"],
+                  ["--step", "1e-5"]):
+        bad = tmp_path / "bad.fmu"
+        out = subprocess.run(cmd + [str(bad)] + extra, capture_output=True, text=True)
+        assert out.returncode == 2 and "step" in out.stderr and "Traceback" not in out.stderr, (extra, out.stderr)
+        assert not bad.exists()
+
+
+def test_bad_step_refused_inside_the_fmu(tmp_path):
+    """Inside the FMU: integrator.step set to 0, a negative value or NaN before initialisation gives
+    fmi2Error with a logged message and keeps the old step; after initialisation the step is fixed. A
+    valid new step (half the exported one) is taken: the run then matches an FMU exported with it."""
+    model = _mass_lugre()
+    path = _realtime(model, tmp_path, "rt-bad", 2e-4)
+    run = Run(path, tmp_path)
+    for value in (0.0, -1e-4, float("nan")):
+        with pytest.raises(Exception):
+            run.set("integrator.step", value)
+        status, _, message = run.messages[-1]
+        assert status == 3 and ("integrator.step" in message or "not finite" in message), message
+    assert run.get("integrator.step") == [2e-4]
+    run.set("integrator.step", 1e-4)
+    t = np.arange(201) * 1e-3
+    u = 2.2 * np.sin(2 * np.pi * 2.0 * t)
+    got = run.drive(t, {"force": u}, ["displacement"])["displacement"]
+    with pytest.raises(Exception, match="fmi2SetReal"):
+        run.set("integrator.step", 5e-5)
+    assert "fixed" in run.messages[-1][2]
+    run.close()
+    other = Run(_realtime(model, tmp_path, "rt-1e-4", 1e-4), tmp_path)
+    want = other.drive(t, {"force": u}, ["displacement"])["displacement"]
+    other.close()
+    assert np.array_equal(got, want)

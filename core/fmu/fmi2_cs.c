@@ -46,12 +46,12 @@ enum {
 typedef enum {
     ROLE_NONE = 0, ROLE_M, ROLE_M_E, ROLE_C, ROLE_K, ROLE_T_EM, ROLE_XI, ROLE_WN, ROLE_GAIN, ROLE_K_S, ROLE_V_0,
     ROLE_PARAM, ROLE_LAW_A, ROLE_LAW_B, ROLE_LAW_X, ROLE_LAW_Y, ROLE_GMS_K, ROLE_GMS_W,
-    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0
+    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0, ROLE_STEP
 } role_kind;
 
 static const char *const ROLE_NAMES[] = {"", "m", "m_e", "c", "k", "T_em", "xi", "wn", "K", "k_s", "v_0",
                                          "p", "law_a", "law_b", "law_x", "law_y", "gms_k", "gms_w",
-                                         "C_th", "R_th", "eta", "T_0"};
+                                         "C_th", "R_th", "eta", "T_0", "step"};
 
 typedef struct {
     unsigned char role, fixed; /* fixed: settable before initialisation only (law breakpoints, T_0) */
@@ -89,6 +89,7 @@ typedef struct {
     double wave_t[2], wave_v[2], temp_t[2], temp_v[2];
     double t, y[TF_MAX_STATES];
     double rtol;
+    double fixed_step;       /* > 0: the fixed-step real-time integrator at this step [s]; 0: adaptive */
     int out_of_range;        /* the last temperature was outside the range (warn once per excursion) */
 } instance;
 
@@ -226,6 +227,10 @@ static int read_resources(instance *c, const char *dir)
                 c->r[vr] = c->r_start[vr] = start;
                 if ((int)vr > c->max_vr) c->max_vr = (int)vr;
             }
+        } else if (strcmp(key, "integrator") == 0) { /* adaptive | realtime (its step: the "step" variable) */
+            char kind[16];
+            ok = sscanf(rest, "%15s", kind) == 1 && (strcmp(kind, "adaptive") == 0 || strcmp(kind, "realtime") == 0);
+            if (ok) c->fixed_step = strcmp(kind, "realtime") == 0 ? NAN : 0.0; /* NaN until its variable is read */
         } else if (strcmp(key, "input") == 0) { /* start values of the inputs */
             ok = sscanf(rest, "%lf %lf", &c->r_start[VR_DRIVE], &c->r_start[VR_TEMPERATURE]) == 2;
             c->r[VR_DRIVE] = c->r_start[VR_DRIVE];
@@ -237,6 +242,11 @@ static int read_resources(instance *c, const char *dir)
     fclose(f);
     if (!ok) return (fail(c, "%s, line %d: not understood (an FMU made by another version?)", path, lineno), -1);
     if (!have_header) return (fail(c, "%s: not a thermofriction FMU model description", path), -1);
+    if (isnan(c->fixed_step)) {
+        int has_step = 0;
+        for (int vr = VR_FIRST_PARAMETER; vr <= c->max_vr; vr++) has_step |= c->role[vr].role == ROLE_STEP;
+        if (!has_step) return (fail(c, "%s: the realtime integrator without its step variable", path), -1);
+    }
     return 0;
 }
 
@@ -281,6 +291,10 @@ static int build_model(instance *c, tf_model *m)
         case ROLE_R_TH: m->heat.R_th = v; break;
         case ROLE_ETA: m->heat.eta = v; break;
         case ROLE_T_0: m->heat.T_0 = v; break;
+        case ROLE_STEP:
+            if (!(v > 0 && isfinite(v))) return (fail(c, "integrator.step = %g s: the fixed step must be positive", v), -1);
+            c->fixed_step = v;
+            break;
         default: break;
         }
         if (r.role && !isfinite(v)) return (fail(c, "parameter (value reference %d) is not finite", vr), -1);
@@ -561,6 +575,10 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
                          v == VR_DRIVE ? "the drive input" : v == VR_TEMPERATURE ? "the temperature input"
                                                                                   : "a parameter", v, value[k]);
         }
+        if (v >= VR_FIRST_PARAMETER && c->role[v].role == ROLE_STEP && !(value[k] > 0)) {
+            memcpy(c->r, before, sizeof before);
+            return fail(c, "fmi2SetReal: integrator.step = %g s refused: the fixed step must be positive", value[k]);
+        }
         if (v >= VR_FIRST_PARAMETER) {
             if (c->mode == S_STEP && c->role[v].fixed) {
                 memcpy(c->r, before, sizeof before);
@@ -608,6 +626,67 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueRefer
 }
 
 static void no_emit(long i, double t, const double *y, void *ctx) {}
+static fmi2Status step_done(instance *c, double h, const double *y, int n, fmi2Status status);
+
+/* Relative sliding velocity at (t, y): the friction's input (plant.c's states: x_p, v_p, x_e, v_e
+ * for the stick-slip actuator, x, v for a mass; prescribed motion: the input's slope). */
+static double sliding_velocity(const tf_model *m, double t, const double *y)
+{
+    switch (m->plant) {
+    case TF_PLANT_STICK_SLIP: return y[3] - y[1];
+    case TF_PLANT_MASS: return y[1];
+    default: return tf_waveform_slope(&m->input, t);
+    }
+}
+
+/* The fixed-step real-time integrator over [c->t, c->t + h] into y: as many steps of c->fixed_step
+ * as fit, the last one shortened to end on the communication point (docs/fmu.md). Each step:
+ * the friction states by the core's real-time step (realtime.h: exponential Euler at the sliding
+ * velocity held over the step), then the plant by semi-implicit Euler with that force (velocities,
+ * then positions with the new velocities, as tf_loop_run does), the heat balance and frictional
+ * work by explicit Euler; the drive and temperature held at their values at the step's start.
+ * The plant's equations are the simulator's own (tf_model_rhs). 0, or logs why not and returns -1
+ * (y and the model's GMS modes may then be changed: the caller restores them). */
+static int realtime_steps(instance *c, double h, double *y)
+{
+    tf_model *m = &c->model;
+    tf_rt_friction rt;
+    if (tf_rt_from_model(&rt, m) != TF_OK)
+        return (fail(c, "the real-time friction model refused the model ('%s')", rt.what ? rt.what : "?"), -1);
+    int n = tf_model_nstate(m);
+    int nz = tf_friction_nstate(m->friction, m->gms.n);
+    int nm = m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
+    memcpy(rt.z, y + nm, sizeof(double) * nz);
+    memcpy(rt.model.gms.mode, m->gms.mode, sizeof m->gms.mode);
+    double dt = c->fixed_step;
+    /* whole steps, a communication step within 1e-9 of a whole number of steps counting as one */
+    double ratio = h / dt;
+    long whole = (long)floor(ratio * (1.0 + 1e-9));
+    double last = h - whole * dt;
+    if (last <= 1e-9 * dt) last = 0.0;
+    long steps = whole + (last > 0.0);
+    double dy[TF_MAX_STATES];
+    for (long s = 0; s < steps; s++) {
+        double ts = c->t + s * dt, hs = s < whole ? dt : last;
+        if (s == whole - 1 && last == 0.0) hs = h - s * dt; /* end exactly on the communication point */
+        double v = sliding_velocity(m, ts, y), T = tf_model_temperature(m, ts, y), F;
+        int st = tf_rt_step_status(&rt, v, T, hs, &F);
+        if (st != TF_OK)
+            return (fail(c, "the fixed step at %g s (temperature %g C) was refused: %s ('%s')", ts, T,
+                         tf_status_message(st), rt.what ? rt.what : "?"), -1);
+        memcpy(y + nm, rt.z, sizeof(double) * nz);
+        memcpy(m->gms.mode, rt.model.gms.mode, sizeof m->gms.mode);
+        tf_model_rhs(ts, y, dy, m); /* at the new friction states: the force the real-time step gave */
+        for (int i = 1; i < nm; i += 2) y[i] += dy[i] * hs;
+        for (int i = 0; i < nm; i += 2) y[i] += y[i + 1] * hs;
+        for (int i = nm + nz; i < n; i++) y[i] += dy[i] * hs;
+        for (int i = 0; i < n; i++)
+            if (!isfinite(y[i]))
+                return (fail(c, "the fixed step of %g s diverged at %g s (the state is not finite): lower "
+                             "integrator.step below the plant's and the friction's time constants", dt, ts), -1);
+    }
+    return 0;
+}
 
 fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no_prior)
 {
@@ -633,6 +712,14 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     double y[TF_MAX_STATES], atol[TF_MAX_STATES];
     memcpy(y, c->y, sizeof(double) * n);
     tf_gms_elements modes = c->model.gms;
+    if (c->fixed_step > 0) {
+        if (realtime_steps(c, h, y) != 0) {
+            c->model.gms = modes;
+            tf_model_prepare(&c->model);
+            return fmi2Error;
+        }
+        return step_done(c, h, y, n, status);
+    }
     tf_model_state_scale(&c->model, atol);
     for (int i = 0; i < n; i++) atol[i] *= c->rtol;
     tf_ode ode = tf_model_ode(&c->model);
@@ -647,8 +734,14 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
         return fail(c, "the integration from %g s over %g s failed at %g s: %s", c->t, h, st.t_fail,
                      tf_status_message(s));
     }
+    return step_done(c, h, y, n, status);
+}
+
+/* After a successful step of h: the new state and time, the inputs advanced along their derivatives. */
+static fmi2Status step_done(instance *c, double h, const double *y, int n, fmi2Status status)
+{
     memcpy(c->y, y, sizeof(double) * n);
-    c->t = t_out[1];
+    c->t += h;
     c->u_prev = c->wave_v[1];
     c->last_du = (c->wave_v[1] - c->wave_v[0]) / h;
     if (c->temperature_input && !c->heat) c->r[VR_TEMPERATURE] += c->dT * h;

@@ -11,12 +11,18 @@ The FMU has the plant's drive as input (a voltage for the stick-slip actuator, a
 displacement for prescribed motion), the temperature [degC] for Model I and II (the ambient temperature
 with a ``[heat]`` section), and every plant, friction, law and heat parameter as a tunable parameter.
 The model file's own ``[input]`` is not part of the FMU: the importer drives it.
+
+Between communication points the FMU integrates with the core's adaptive integrator (the default), or
+with ``integrator="realtime"`` by fixed steps of ``step`` seconds: the friction by the core's real-time
+step (realtime.h) and the plant by semi-implicit Euler, for a deterministic cost per step. The choice is
+in ``resources/model.tfm`` and the step is the fixed parameter ``integrator.step``.
 """
 
 from __future__ import annotations
 
 import datetime
 import hashlib
+import math
 import os
 import platform
 import re
@@ -39,6 +45,9 @@ MAX_VALUE_REFERENCE = 2048
 MAX_POINTS = 256
 FIRST_PARAMETER = 16
 
+#: The integrators an FMU can carry (docs/fmu.md#integrators).
+INTEGRATORS = ("adaptive", "realtime")
+
 #: Fixed value references of the inputs and outputs (fmi2_cs.c).
 VR_DRIVE, VR_TEMPERATURE, VR_DISPLACEMENT, VR_VELOCITY, VR_FRICTION_FORCE, VR_TEMPERATURE_OUT, VR_STAGE = range(7)
 
@@ -47,7 +56,7 @@ _BINARY = "thermofriction_fmi2.so"
 # SI base units of the units the FMU declares (FMI 2.0 UnitDefinitions); others are declared by name.
 _BASE_UNITS = {
     "m": {"m": 1}, "m/s": {"m": 1, "s": -1}, "N": {"kg": 1, "m": 1, "s": -2}, "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
-    "kg": {"kg": 1}, "N/m": {"kg": 1, "s": -2}, "N s/m": {"kg": 1, "s": -1}, "N/s": {"kg": 1, "m": 1, "s": -3},
+    "kg": {"kg": 1}, "s": {"s": 1}, "N/m": {"kg": 1, "s": -2}, "N s/m": {"kg": 1, "s": -1}, "N/s": {"kg": 1, "m": 1, "s": -3},
     "rad/s": {"rad": 1, "s": -1}, "m/V": {"kg": -1, "m": -1, "s": 3, "A": 1}, "N/V": {"m": -1, "s": 1, "A": 1},
     "J/K": {"kg": 1, "m": 2, "s": -2, "K": -1}, "K/W": {"kg": -1, "m": -2, "s": 3, "K": 1},
 }
@@ -85,7 +94,31 @@ def _check_exportable(model: Model):
             raise InputError(f"[thermal] {name}: a law of {n} points or coefficients; an FMU takes at most {MAX_POINTS}")
 
 
-def _variables(model: Model, spec: dict, temperature: float | None):
+def _check_step(model: Model, step) -> float:
+    """The realtime integrator's step [s]: a positive finite number, below the stability limit 2 / omega
+    of semi-implicit Euler on the plant's stiffest spring (the stage's natural frequency, the mass's
+    pulling spring)."""
+    try:
+        step = float(step)
+    except (TypeError, ValueError):
+        raise InputError(f"export_fmu: step must be a number of seconds, got {shorten(step)}") from None
+    if not (math.isfinite(step) and step > 0):
+        raise InputError(f"export_fmu: step = {step!r} s: the fixed step must be a positive number of seconds")
+    plant = model.plant
+    omega, what = None, ""
+    if isinstance(plant, StickSlipPlant):
+        c, k, _ = plant.physical()
+        omega, what = math.sqrt(k / plant.mass), "the stage's natural frequency"
+    elif isinstance(plant, MassPlant) and plant.spring_stiffness:
+        omega, what = math.sqrt(plant.spring_stiffness / plant.mass), "the pulling spring's frequency"
+    if omega is not None and omega * step >= 2.0:
+        raise InputError(f"export_fmu: step = {step:g} s is unstable for this plant: the fixed step needs "
+                         f"step < 2 / omega = {2.0 / omega:.3g} s ({what}, omega = {omega:.4g} rad/s); take "
+                         f"a tenth of that or less for accuracy")
+    return step
+
+
+def _variables(model: Model, spec: dict, temperature: float | None, step: float | None = None):
     """The FMU's variables: inputs, outputs, then every parameter with its role in the binary."""
     plant = model.plant
     drive = {StickSlipPlant: ("voltage", "V", "drive voltage of the actuator"),
@@ -191,13 +224,16 @@ def _variables(model: Model, spec: dict, temperature: float | None):
         add("heat.R_th", "K/W", "thermal resistance to ambient", h.thermal_resistance, "R_th")
         add("heat.eta", "", "fraction of the friction power that heats the interface", h.heat_fraction, "eta")
         add("heat.T_0", "degC", "start temperature", h.initial_temperature, "T_0", variability="fixed")
+    if step is not None:
+        add("integrator.step", "s", "the fixed step of the real-time integrator (several per communication "
+            "step; the last shortened to end on the communication point)", step, "step", variability="fixed")
     if vr > MAX_VALUE_REFERENCE:
         raise InputError(f"the model has {vr - FIRST_PARAMETER} parameters; an FMU takes at most "
                          f"{MAX_VALUE_REFERENCE - FIRST_PARAMETER}")
     return variables
 
 
-def _resource_text(model: Model, spec: dict, variables) -> str:
+def _resource_text(model: Model, spec: dict, variables, integrator: str = "adaptive") -> str:
     """resources/model.tfm: the structure and the parameters' roles (read by fmi2_cs.c)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
@@ -205,7 +241,8 @@ def _resource_text(model: Model, spec: dict, variables) -> str:
              f"friction {spec['friction']} {0 if spec['gms_k'] is None else len(spec['gms_k'])}",
              f"thermal {spec['thermal']} {spec['dF_form']} {spec['fs_follows_fc']}",
              f"heat {int(model.heat is not None)}",
-             f"temperature_input {int(model.thermal is not None and model.heat is None)}"]
+             f"temperature_input {int(model.thermal is not None and model.heat is None)}",
+             f"integrator {integrator}"]
     rng = model.temperature_range()
     if rng is not None:
         lines.append(f"range {rng[0]!r} {rng[1]!r}")
@@ -225,9 +262,11 @@ def _resource_text(model: Model, spec: dict, variables) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _xml(model: Model, variables, identifier: str, guid: str, source: str | None) -> str:
+def _xml(model: Model, variables, identifier: str, guid: str, source: str | None, step: float | None = None) -> str:
     name = model.name or identifier
     provenance = f"exported by thermofriction {__version__}" + (f" from {source}" if source else "")
+    provenance += (f"; fixed-step real-time integrator, step {step:g} s" if step is not None
+                   else "; adaptive integrator")
     description = ((model.description + " -- ") if model.description else "") + provenance
     units = sorted({v.unit for v in variables if v.unit})
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
@@ -252,7 +291,7 @@ def _xml(model: Model, variables, identifier: str, guid: str, source: str | None
             '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
             '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
             '  </LogCategories>',
-            '  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.0001" tolerance="1e-06"/>',
+            f'  <DefaultExperiment startTime="0" stopTime="1" stepSize="{_default_step(step)!r}" tolerance="1e-06"/>',
             '  <ModelVariables>']
     outputs = []
     for index, v in enumerate(variables, start=1):
@@ -276,13 +315,21 @@ def _xml(model: Model, variables, identifier: str, guid: str, source: str | None
     return "\n".join(out)
 
 
+def _default_step(step: float | None) -> float:
+    """The default communication step: 0.1 ms, with the realtime integrator a whole number of its steps."""
+    return 1e-4 if step is None else step * max(1, round(1e-4 / step))
+
+
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
-               source: str | None = None) -> Path | Target:
+               source: str | None = None, integrator: str = "adaptive", step: float | None = None) -> Path | Target:
     """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 co-simulation FMU to
     ``path`` (docs/fmu.md). ``temperature``: the start value of the temperature input [degC] (with a
     heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
     ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
-    ``source``: where the model came from (a file or preset name), for the FMU's description."""
+    ``source``: where the model came from (a file or preset name), for the FMU's description.
+    ``integrator``: "adaptive" (default: the core's error-controlled integrator between communication
+    points) or "realtime" (fixed steps of ``step`` seconds: the core's real-time friction step and
+    semi-implicit Euler for the plant; docs/fmu.md#integrators)."""
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)
         model = load_model(model)
@@ -298,6 +345,15 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     if not binary.is_file():
         raise InputError(f"this installation has no FMU binary ({binary}): reinstall thermofriction on Linux x86-64 "
                          "(the package builds it with CMake)")
+    if integrator not in INTEGRATORS:
+        raise InputError(f"export_fmu: integrator {shorten(integrator)}: use one of {', '.join(INTEGRATORS)}")
+    if integrator == "realtime":
+        if step is None:
+            raise InputError("export_fmu: the realtime integrator needs its fixed step (step=..., --step SECONDS)")
+        step = _check_step(model, step)
+    elif step is not None:
+        raise InputError("export_fmu: step is the realtime integrator's fixed step; the adaptive integrator chooses "
+                         "its own (give integrator='realtime', --integrator realtime)")
     _check_exportable(model)
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
@@ -306,10 +362,10 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     heat_temperature = temperature if model.heat is None else (
         temperature if temperature is not None else (model.heat.ambient_temperature or 20.0))
     spec = _bridge.model_spec(model, temperature=heat_temperature if model.heat is not None else None)
-    variables = _variables(model, spec, temperature)
-    tfm = _resource_text(model, spec, variables)
+    variables = _variables(model, spec, temperature, step)
+    tfm = _resource_text(model, spec, variables, integrator)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
-    xml = _xml(model, variables, identifier, guid, source)
+    xml = _xml(model, variables, identifier, guid, source, step)
     so = binary.read_bytes()
     target = path if isinstance(path, Target) else Path(os.fspath(path))
     if isinstance(target, Path) and target.is_dir():
@@ -332,4 +388,4 @@ def _headers_licence() -> str:
             "2012-2019 Modelica Association Project \"FMI\", under the 2-Clause BSD License.\n")
 
 
-__all__ = ["export_fmu", "binary_path"]
+__all__ = ["export_fmu", "binary_path", "INTEGRATORS"]

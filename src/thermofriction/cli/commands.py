@@ -335,6 +335,7 @@ def cmd_fmu(args) -> int:
     model = load_model(args.model)
     _refuse_inputs(args, _model_inputs(args.model, model))
     export_fmu(model, _target(args, "output"), temperature=args.temperature, model_identifier=args.model_identifier,
-               source=args.model)
-    print(f"{model.name or args.model}: wrote {args.output} (FMI 2.0 co-simulation, linux64)")
+               source=args.model, integrator=args.integrator, step=args.step)
+    how = f"fixed step {args.step:g} s" if args.integrator == "realtime" else "adaptive integrator"
+    print(f"{model.name or args.model}: wrote {args.output} (FMI 2.0 co-simulation, linux64, {how})")
     return 0

@@ -206,13 +206,20 @@ def _add_fmu_command(sub):
                     "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
                     "The model's [input] is not part of the FMU: the importer drives it.",
-        epilog="Example: thermofriction fmu li2009-model-i -o li2009-model-i.fmu")
+        epilog="Examples: thermofriction fmu li2009-model-i -o li2009-model-i.fmu; "
+               "thermofriction fmu li2009-model-i -o rt.fmu --integrator realtime --step 1e-5")
     f.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
     f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help="the FMU file to write")
     f.add_argument("--temperature", type=_finite_float, metavar="C",
                    help="start value of the temperature input [C] (with [heat]: of the ambient temperature)")
     f.add_argument("--model-identifier", metavar="NAME",
                    help="the FMU's model identifier, letters, digits and _ (default: from the model's name)")
+    f.add_argument("--integrator", choices=("adaptive", "realtime"), default="adaptive",
+                   help="between communication points: the adaptive error-controlled integrator (default; for "
+                        "accuracy) or fixed real-time steps of --step seconds (a deterministic cost per step)")
+    f.add_argument("--step", type=_finite_float, metavar="SECONDS",
+                   help="the realtime integrator's fixed step [s], e.g. 1e-5 (a tenth of the fastest time "
+                        "constant or less)")
     from .commands import cmd_fmu
     f.set_defaults(run=cmd_fmu)
 
