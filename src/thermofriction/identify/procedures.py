@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import time
 
 import numpy as np
@@ -225,8 +226,13 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     if len(groups) < 2:
         raise InputError("Model I needs fit experiments at two or more temperatures")
     names = _fit_parameter_names(init)
-    per_T, previous, held, warns = [], None, [], []
-    for i, group in enumerate(groups):
+    held, warns = [], []
+
+    def fit_at(group, previous, first_of_all=False, neighbour=True):
+        """The fit at one temperature, from the neighbouring temperature's model (continuation) or,
+        without one, from the initial model's values there with the multi-start; returns (T, result,
+        the model the next temperature continues from)."""
+        nonlocal held
         T = float(np.mean([e.temperature for e in group]))
         base = base_model(init, T) if previous is None else previous
         base = dataclasses.replace(base, thermal=None)
@@ -235,11 +241,11 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         if progress:
             progress(f"Model I: fitting {', '.join(n for n in names if n not in held)} at {T:.4g} C")
         first = dict(opts)
-        if previous is not None:  # continuation from the neighbouring temperature
+        if previous is not None and neighbour:  # continuation from the neighbouring temperature
             first["starts"] = 1
         res = fit_friction(group, base, _friction_parameters(base, names + free, fixed=held),
                            method=f"base at {T:.4g} C", **first)
-        if i == 0:
+        if first_of_all:
             undetermined = [n for n in names if not math.isfinite(res.parameters[n].stderr)
                             or res.parameters[n].stderr > abs(res.parameters[n].value)]
             if undetermined and len(undetermined) < len(names):
@@ -256,9 +262,33 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         open_ = [n for n in names if n in res.parameters and n not in held
                  and not (res.parameters[n].stderr is not None and math.isfinite(res.parameters[n].stderr)
                           and res.parameters[n].stderr < abs(res.parameters[n].value))]
-        previous = res.model.with_friction(**{n: base_model(init, T).friction.values()[n] for n in open_
-                                              if n in base_model(init, T).friction.values()}) if open_ else res.model
-        per_T.append((T, res))
+        following = res.model.with_friction(**{n: base_model(init, T).friction.values()[n] for n in open_
+                                               if n in base_model(init, T).friction.values()}) if open_ else res.model
+        return T, res, following
+
+    def chain(order, previous, neighbour=True):
+        out = []
+        for k, i in enumerate(order):
+            T, res, previous = fit_at(groups[i], previous, neighbour=neighbour or k > 0)
+            out.append((T, res))
+        return out
+
+    # the lowest temperature first (it decides what the data cannot determine); then two continuation
+    # chains, one per core: upward from it, and downward from the highest temperature, which starts from
+    # the initial model's laws there or, without laws, from the lowest temperature's fit (not a
+    # neighbour: with the multi-start)
+    T0, res0, following = fit_at(groups[0], None, first_of_all=True)
+    rest = list(range(1, len(groups)))
+    up, down = rest[:(len(rest) + 1) // 2], rest[(len(rest) + 1) // 2:][::-1]
+    if down and (os.cpu_count() or 1) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-i") as chains:
+            lower = chains.submit(chain, up, following)
+            upper = chains.submit(chain, down, None if init.laws else following, False)
+            per_T = [(T0, res0)] + lower.result() + upper.result()
+    else:
+        per_T = [(T0, res0)] + chain(rest, following)
+    per_T.sort(key=lambda tr: tr[0])
     details = {"per_temperature": [
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
          "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
