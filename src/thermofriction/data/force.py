@@ -128,6 +128,9 @@ def motion_waveform(time, velocity) -> Sampled:
 
 def is_force_file(path) -> bool:
     """Whether the CSV's header names a column of a force experiment (read from its first line only)."""
+    import os
+    if not os.path.isfile(path):  # a FIFO or device would block the open: the reader refuses it, by name
+        return False
     try:
         with open(path, "rb") as fh:
             head = fh.readline(1 << 16).decode("utf-8-sig", errors="replace")
