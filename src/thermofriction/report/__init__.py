@@ -5,7 +5,6 @@ and a footer that lets anyone reproduce it."""
 from __future__ import annotations
 
 import dataclasses
-import datetime
 import html
 import math
 import re
@@ -13,14 +12,13 @@ import sys
 
 import numpy as np
 
-from ..data.files import dataset_sha256
 from .._io import atomic_write
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
 from ..validate import ValidationResult, validate
 from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
                       fig_steps)
-from .page import _CSS, Figures, _fmt, _table, _versions
+from .page import Figures, _fmt, _table, page_html
 from .plots import _float
 from .studies import control_report, heating_report
 
@@ -342,17 +340,9 @@ def render(entries, data, *, figures_dir=None, command=None, title=None, truth=N
     fit_T = float(np.mean([e.temperature for e in exps if getattr(e, "role", "fit") != "validate"] or
                           [e.temperature for e in exps]))
     parts.append(parameter_section(entries, fit_T))
-    versions = _versions()
-    footer = (f"thermofriction {versions['thermofriction']} · Python {versions['python']} · NumPy "
-              f"{versions['numpy']} · SciPy {versions['scipy']} · matplotlib {versions['matplotlib']} · "
-              f"data SHA-256 <code>{dataset_sha256(data)[1]}</code> · written "
-              f"{datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}"
-              + (f"<br>command: <code>{html.escape(command)}</code>" if command else ""))
-    name = html.escape(title or f"thermofriction report — {getattr(data, 'name', None) or 'dataset'}")
-    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
-            f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
-            f"<body><header><h1>{name}</h1><p>{', '.join(html.escape(e.label) for e in entries)} on "
-            f"{len(exps)} experiments</p></header><main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
+    return page_html(title or f"thermofriction report — {getattr(data, 'name', None) or 'dataset'}",
+                     f"{', '.join(e.label for e in entries)} on {len(exps)} experiments", parts, command=command,
+                     data=data)
 
 
 def truth_section(truth: dict) -> str:

@@ -5,16 +5,14 @@ hysteresis loops where the motion reverses, errors per experiment and the identi
 
 from __future__ import annotations
 
-import datetime
 import html
 import math
 
 import numpy as np
 
-from ..data.files import dataset_sha256
 from ..errors import InputError
 from ..models import ModelI, ModelII
-from .page import _CSS, _fmt, _plt, _table, _versions
+from .page import _fmt, _plt, _table, page_html
 from .plots import thin as _thin
 
 
@@ -230,16 +228,9 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None) -
     if param_rows:
         parts.append("<section><h2>Identified parameters</h2>" + _table(
             ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
-    versions = _versions()
-    footer = (" · ".join(f"{k} {v}" for k, v in versions.items()) + f" · data SHA-256 <code>{dataset_sha256(data)[1]}</code>"
-              f" · written {datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}"
-              + (f"<br>command: <code>{html.escape(command)}</code>" if command else ""))
-    name = html.escape(title or f"thermofriction report — {getattr(data, 'name', None) or 'force data'}")
-    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
-            f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
-            f"<body><header><h1>{name}</h1><p>{', '.join(html.escape(e.label) for e in entries)} on "
-            f"{len(exps)} {what} experiments</p></header><main>{''.join(parts)}</main><footer>{footer}</footer>"
-            f"</body></html>")
+    return page_html(title or f"thermofriction report — {getattr(data, 'name', None) or 'force data'}",
+                     f"{', '.join(e.label for e in entries)} on {len(exps)} {what} experiments", parts,
+                     command=command, data=data)
 
 
 __all__ = ["render_force"]

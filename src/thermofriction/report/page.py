@@ -138,19 +138,33 @@ def _versions():
     import matplotlib
     import scipy
 
-    return {"thermofriction": __version__, "python": platform.python_version(), "numpy": np.__version__,
-            "scipy": scipy.__version__, "matplotlib": matplotlib.__version__}
+    return {"thermofriction": __version__, "Python": platform.python_version(), "NumPy": np.__version__,
+            "SciPy": scipy.__version__, "matplotlib": matplotlib.__version__}
+
+
+def page_html(title, subtitle, parts, *, command=None, data=None) -> str:
+    """A whole report page in the report's style: the title, a subtitle, the sections, and a footer
+    with the versions, the data's SHA-256 and when it was written (when ``data`` is given: the hash
+    the fitted models' provenance names) and the command line."""
+    import datetime
+
+    footer = " · ".join(f"{k} {v}" for k, v in _versions().items())
+    if data is not None:
+        from ..data.files import dataset_sha256
+        footer += (f" · data SHA-256 <code>{dataset_sha256(data)[1]}</code> · written "
+                   f"{datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}")
+    if command:
+        footer += f"<br>command: <code>{html.escape(command)}</code>"
+    name = html.escape(title)
+    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
+            f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
+            f"<body><header><h1>{name}</h1><p>{html.escape(subtitle)}</p></header>"
+            f"<main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
 
 
 def _write_page(path, title, subtitle, parts, command=None) -> str:
     """A standalone report page (the main report's style) written atomically; returns the HTML."""
-    name = html.escape(title)
-    footer = " · ".join(f"{k} {v}" for k, v in _versions().items()) + (
-        f"<br>command: <code>{html.escape(command)}</code>" if command else "")
-    text = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{name}</title>"
-            f"<meta name='viewport' content='width=device-width, initial-scale=1'><style>{_CSS}</style></head>"
-            f"<body><header><h1>{name}</h1><p>{html.escape(subtitle)}</p></header>"
-            f"<main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
+    text = page_html(title, subtitle, parts, command=command)
     with atomic_write(path, "w", encoding="utf-8") as fh:
         fh.write(text)
     return text
