@@ -21,20 +21,27 @@ TIME_LIMIT = 1e12
 VALUE_LIMIT = 1e100
 
 
+def header_cell(path, j, raw, si, example):
+    """A header cell ``name[unit]`` of column ``j`` (0-based) as (name, unit, the cell, where it is);
+    without a unit, the column's SI unit from ``si``."""
+    cell = raw.strip()
+    where = f"{path}: line 1, column {j + 1}"
+    name, br, unit = cell.partition("[")
+    name = name.strip()
+    if br:
+        if not unit.endswith("]"):
+            raise InputError(f"{where}: {shorten(cell)} must be name[unit], e.g. {example}")
+        unit = unit[:-1].strip()
+    else:
+        unit = si.get(name, "")
+    return name, unit, cell, where
+
+
 def _parse_header(path, header):
     """[(name, scale to SI, the header cell)] for the header row, or one InputError."""
     cols = []
     for j, raw in enumerate(header):
-        cell = raw.strip()
-        where = f"{path}: line 1, column {j + 1}"
-        name, br, unit = cell.partition("[")
-        name = name.strip()
-        if br:
-            if not unit.endswith("]"):
-                raise InputError(f"{where}: {shorten(cell)} must be name[unit], e.g. displacement[um]")
-            unit = unit[:-1].strip()
-        else:
-            unit = _SI.get(name, "")
+        name, unit, cell, where = header_cell(path, j, raw, _SI, "displacement[um]")
         if not name:
             raise InputError(f"{where}: empty column name (columns: {', '.join(_UNITS)})")
         if name not in _UNITS:

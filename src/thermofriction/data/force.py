@@ -20,7 +20,7 @@ import numpy as np
 from .._reading import read_bytes
 from ..errors import InputError, shorten
 from ..waveforms import Sampled
-from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan
+from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell
 from .experiments import MIN_SAMPLES, Experiment, max_rows
 
 _LINEAR_POSITION = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9}
@@ -143,16 +143,7 @@ def is_force_file(path) -> bool:
 def _parse_header(path, header):
     cols, kinds = [], {}
     for j, raw in enumerate(header):
-        cell = raw.strip()
-        where = f"{path}: line 1, column {j + 1}"
-        name, br, unit = cell.partition("[")
-        name = name.strip()
-        if br:
-            if not unit.endswith("]"):
-                raise InputError(f"{where}: {shorten(cell)} must be name[unit], e.g. friction_force[N]")
-            unit = unit[:-1].strip()
-        else:
-            unit = _SI.get(name, "")
+        name, unit, cell, where = header_cell(path, j, raw, _SI, "friction_force[N]")
         if name not in _UNITS:
             hint = " (an actuator's voltage belongs in a dataset of its own)" if name == "voltage" else ""
             raise InputError(f"{where}: unknown column {shorten(name) or '(empty)'} in a force experiment "
