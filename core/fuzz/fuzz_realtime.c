@@ -22,6 +22,7 @@
  * Build: cmake -S core -B build-fuzz -DCMAKE_C_COMPILER=clang -DTF_BUILD_FUZZERS=ON
  * Run:   build-fuzz/fuzz_realtime -max_total_time=60 core/fuzz/corpus_realtime   (docs/hardening.md) */
 #include "thermofriction.h"
+#include "fuzz_reader.h"
 
 #include <float.h>
 #include <math.h>
@@ -35,18 +36,6 @@ static void fail_(const char *why, int line)
 {
     fprintf(stderr, "fuzz_realtime.c:%d: %s\n", line, why);
     abort();
-}
-
-typedef struct {
-    const uint8_t *p;
-    size_t n;
-} reader;
-
-static uint8_t byte(reader *r)
-{
-    if (!r->n) return 0;
-    r->n--;
-    return *r->p++;
 }
 
 /* A number: mostly a signed power of ten between 1e-9 and 1e7, sometimes a special value (NaN,

@@ -21,6 +21,7 @@
  * Build: cmake -S core -B build-fuzz -DCMAKE_C_COMPILER=clang -DTF_BUILD_FUZZERS=ON
  * Run:   build-fuzz/fuzz_simulate -max_total_time=60 core/fuzz/corpus   (see docs/hardening.md) */
 #include "thermofriction.h"
+#include "fuzz_reader.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -46,18 +47,6 @@ static void fail_(const char *why, int line)
         fprintf(stderr, "\n");
     }
     abort();
-}
-
-typedef struct {
-    const uint8_t *p;
-    size_t n;
-} reader;
-
-static uint8_t byte(reader *r)
-{
-    if (!r->n) return 0;
-    r->n--;
-    return *r->p++;
 }
 
 /* A number: mostly a signed power of ten between 1e-9 and 1e7 (where the models live), sometimes
