@@ -194,38 +194,33 @@ def _style_handles():
             Line2D([], [], color="0.3", ls="-", lw=1.3, label="lines: predicted")]
 
 
-@styled
-def displacement_figure(entries):
-    """Measured and predicted displacement, one panel per model: [(label, ValidationResult)]."""
+def _panel_per_model(entries, row_height, draw, key_extra, **subplots):
+    """One panel per model ([(label, ValidationResult)]) drawn by ``draw(ax, predictions, styles)``,
+    the y label on the first column only, one temperature key for the figure."""
     preds = _predictions(entries)
     styles = temperature_styles([(p.temperature, p.role) for _, ps in preds for p in ps])
     rows, cols = _grid(len(preds))
-    fig, axes = new_figure(WIDE, 3.5 * rows + 0.4, nrows=rows, ncols=cols, sharey=True)
+    fig, axes = new_figure(WIDE, row_height * rows + 0.4, nrows=rows, ncols=cols, **subplots)
     for ax, (label, ps) in zip(axes.flat, preds):
-        draw_displacement(ax, ps, styles)
+        draw(ax, ps, styles)
         ax.set_title(label)
     for ax in axes[:, 1:].flat:
         ax.set_ylabel("")
     _hide_unused(axes, len(preds))
-    temperature_key(fig, styles, extra=_style_handles())
+    temperature_key(fig, styles, extra=key_extra)
     return fig
+
+
+@styled
+def displacement_figure(entries):
+    """Measured and predicted displacement, one panel per model: [(label, ValidationResult)]."""
+    return _panel_per_model(entries, 3.5, draw_displacement, _style_handles(), sharey=True)
 
 
 @styled
 def residual_figure(entries):
     """Windowed RMS residuals, one panel per model: [(label, ValidationResult)]."""
-    preds = _predictions(entries)
-    styles = temperature_styles([(p.temperature, p.role) for _, ps in preds for p in ps])
-    rows, cols = _grid(len(preds))
-    fig, axes = new_figure(WIDE, 3.2 * rows + 0.4, nrows=rows, ncols=cols)
-    for ax, (label, ps) in zip(axes.flat, preds):
-        draw_residuals(ax, ps, styles)
-        ax.set_title(label)
-    for ax in axes[:, 1:].flat:
-        ax.set_ylabel("")
-    _hide_unused(axes, len(preds))
-    temperature_key(fig, styles, extra=[_noise_handle()])
-    return fig
+    return _panel_per_model(entries, 3.2, draw_residuals, [_noise_handle()])
 
 
 # -- against temperature ---------------------------------------------------------------------
