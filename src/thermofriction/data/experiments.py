@@ -108,6 +108,9 @@ class Dataset:
     name: str | None = None
     description: str = ""
     experiments: list = dataclasses.field(default_factory=list)
+    #: (what was hashed, SHA-256) of the files as they were loaded (data.files.dataset_sha256); it
+    #: travels with the dataset, to a worker on another machine too
+    sha256: tuple | None = dataclasses.field(default=None, repr=False, compare=False)
 
     @property
     def fit(self) -> list:

@@ -175,7 +175,9 @@ def load_dataset(path) -> Dataset:
             units_of(exps)
     except InputError as err:
         raise InputError(f"{manifest}: {err}") from None
-    return Dataset(path=folder, name=name, description=description, experiments=exps)
+    data = Dataset(path=folder, name=name, description=description, experiments=exps)
+    data.sha256 = dataset_sha256(data)
+    return data
 
 
 def _read_experiment(path: Path, entry: dict, where: str):
@@ -388,10 +390,13 @@ def dataset_sha256(data) -> tuple[str, str]:
     and every experiment file, sorted by path -- hashed as ``sha256sum`` lists them and that list
     hashed again (``sha256sum FILES | sha256sum`` in the folder gives the same); otherwise the
     experiments' numbers (time and each recorded signal -- voltage, displacement, force -- as little-endian
-    float64, in order). The one definition: fitted models' provenance and the reports' footers."""
+    float64, in order). The one definition: fitted models' provenance and the reports' footers. A dataset
+    from ``load_dataset`` carries the hash of its files as they were loaded."""
     import hashlib
     import os
 
+    if getattr(data, "sha256", None) is not None:  # hashed when it was loaded
+        return data.sha256
     folder = getattr(data, "path", None)
     experiments = list(getattr(data, "experiments", data))
     if folder is not None:

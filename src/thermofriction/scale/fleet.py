@@ -80,22 +80,6 @@ def _identify_one(data, method, init, kw):
         return "failed", f"{type(e).__name__}: {e}"
 
 
-def _data_provenance(fit, data):
-    """The data's name and hash in the fitted model's provenance as this machine sees them: a worker on
-    another machine (no shared file system) sees the experiments, not their files."""
-    from ..identify.result import data_sha256
-    where, digest = data_sha256(data)
-
-    def fix(f):
-        prov = dict(getattr(f.model, "provenance", None) or {})
-        if not prov:
-            return f
-        prov.update(data=where, data_sha256=digest)
-        model = dataclasses.replace(f.model, provenance=prov)
-        return dataclasses.replace(f, model=model, alternatives={k: fix(v) for k, v in f.alternatives.items()})
-    return fix(fit)
-
-
 @dataclasses.dataclass(eq=False)
 class FleetResult:
     """``names`` in the order given; ``fits`` name -> FitResult; ``failures`` name -> reason;
@@ -272,7 +256,7 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
         where = runner.describe()
     for name, (status, value) in zip(todo, outs):
         if status == "ok":
-            fits[name] = _data_provenance(value, loaded[name])
+            fits[name] = value
         else:
             failures[name] = value
     failures = {n: failures[n] for n in names if n in failures}
