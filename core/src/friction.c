@@ -67,9 +67,9 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
     double dg;
     double g = tf_stribeck(p, v, jac ? &dg : 0);
     double r = s0 * fabs(v) / g; /* relaxation rate of z */
-    double zd = v - r * z[0];
     double ds1, ds1_dsigma1 = 0.0, ds1_dvd = 0.0;
     double s1 = tf_sigma1(p, v, &ds1, dp ? &ds1_dsigma1 : 0, dp ? &ds1_dvd : 0);
+    double zd, F = tf_lugre_value(p, v, z[0], g, s1, &zd);
     dz[0] = zd;
     if (jac) {
         double dr = s0 * (sgn(v) * g - fabs(v) * dg) / (g * g);
@@ -90,7 +90,7 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
         dp->dF_dp[TF_P_SIGMA2] = v;
         dp->dF_dp[TF_P_VD] = ds1_dvd * zd;
     }
-    return s0 * z[0] + s1 * zd + s2 * v;
+    return F;
 }
 
 /* Static maps: F = G(v) s(v) + sigma2 v with the sign smoothed over v_smooth, s = tanh(v / v_smooth),

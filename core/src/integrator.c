@@ -86,16 +86,19 @@ static int rhs(work *w, double t, const double *y, double *dy)
      * corner (an ideal step) belongs to the next segment only. */
     if (t > w->t_clamp) t = w->t_clamp;
     if (w->ode->rhs(t, y, dy, w->ode->ctx)) return 1;
-    for (int i = 0; i < w->n; i++)
-        if (!isfinite(dy[i])) return 1;
-    return 0;
+    /* one test for all: a NaN or an infinity in any component makes the sum non-finite (finite
+     * components can overflow the sum only within a factor n of DBL_MAX) */
+    double sum = 0.0;
+    for (int i = 0; i < w->n; i++) sum += dy[i];
+    return !isfinite(sum);
 }
 
 static double wnorm(const work *w, const double *e, const double *ya, const double *yb)
 {
     double s = 0.0;
     for (int i = 0; i < w->n; i++) {
-        double sk = w->opt->atol[i] + w->opt->rtol * fmax(fabs(ya[i]), fabs(yb[i]));
+        double a = fabs(ya[i]), b = fabs(yb[i]);
+        double sk = w->opt->atol[i] + w->opt->rtol * (a > b ? a : b);
         double r = e[i] / sk;
         s += r * r;
     }
@@ -104,9 +107,9 @@ static double wnorm(const work *w, const double *e, const double *ya, const doub
 
 static int all_finite(const double *v, int n)
 {
-    for (int i = 0; i < n; i++)
-        if (!isfinite(v[i])) return 0;
-    return 1;
+    double sum = 0.0; /* as in rhs(): a NaN or an infinity anywhere makes the sum non-finite */
+    for (int i = 0; i < n; i++) sum += v[i];
+    return isfinite(sum);
 }
 
 /* ---- dense LU with partial pivoting, for the small systems of a Rosenbrock stage ---- */

@@ -36,6 +36,16 @@ int tf_model_work_index(const tf_model *model)
     return has_work(model) ? nmech(model) + nfric(model) + (model->heat.on != 0) : -1;
 }
 
+/* The common case: LuGre on the stick-slip actuator or the mass, at one constant temperature
+ * (no temperature signal, no heat or work state). Its parameters, lambda and dF are then the
+ * run's, and tf_model_ode gives it a right-hand side (rhs_lugre_constant_T) that dispatches on
+ * nothing per call: a third of the general path's cost on the paper's workload. */
+static int lugre_constant_T(const tf_model *m)
+{
+    return m->friction == TF_FRICTION_LUGRE && m->T_n == 0 && !has_work(m) &&
+           (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS);
+}
+
 /* Relative sliding velocity v_r of the driven body on its driving surface. */
 static double relative_velocity(const tf_model *m, double t, const double *y)
 {
@@ -102,9 +112,24 @@ static double friction(tf_model *m, double t, const double *y, double *dz, tf_fr
     return friction_at(m, tf_model_temperature(m, t, y), t, y, dz, jac, 0, 0);
 }
 
+/* F' and z' of the common case (lugre_constant_T): the same equations as friction_at, with the
+ * run's parameters. */
+static double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
+{
+    double lambda = m->cache_lambda, dF = m->cache_dF;
+    const double *p = m->cache_p;
+    if (!m->cache_valid || !(m->cache_T == m->T_const || (isnan(m->T_const) && isnan(m->cache_T))))
+        p = tf_model_params_cached(m, m->T_const, &lambda, &dF);
+    double g = p[TF_P_FS] == p[TF_P_FC] ? p[TF_P_FC] : tf_stribeck(p, v, 0);
+    double F = tf_lugre_value(p, v, z, g, tf_sigma1(p, v, 0, 0, 0), zd);
+    return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 1, 0);
+}
+
 double tf_model_friction(const tf_model *model, double t, const double *y)
 {
     double dz[TF_MAX_FRICTION_STATES];
+    if (lugre_constant_T(model))
+        return lugre_constant_T_friction((tf_model *)model, relative_velocity(model, t, y), y[nmech(model)], dz);
     return friction((tf_model *)model, t, y, dz, 0);
 }
 
@@ -215,6 +240,26 @@ int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 }
 
 /* dv_r/dy for the mechanical states (prescribed motion: none). */
+/* tf_model_rhs for the common case (lugre_constant_T). */
+static int rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
+{
+    tf_model *m = (tf_model *)ctx;
+    if (m->plant == TF_PLANT_STICK_SLIP) {
+        double F = lugre_constant_T_friction(m, y[VE] - y[VP], y[4], &dy[4]);
+        double u = tf_waveform_value(&m->input, t);
+        dy[XP] = y[VP];
+        dy[VP] = (-m->c * y[VP] - m->k * y[XP] + m->T_em * u + F) / m->m;
+        dy[XE] = y[VE];
+        dy[VE] = -F / m->m_e;
+    } else {
+        double F = lugre_constant_T_friction(m, y[V], y[2], &dy[2]);
+        double f = tf_waveform_value(&m->input, t) + m->k_s * (m->v_0 * t - y[X]);
+        dy[X] = y[V];
+        dy[V] = (f - F) / m->m;
+    }
+    return 0;
+}
+
 static void velocity_partials(const tf_model *m, double *dv_dy)
 {
     memset(dv_dy, 0, sizeof(double) * TF_MAX_STATES);
@@ -485,8 +530,8 @@ static void model_restart(double t, double *y, void *ctx) { tf_model_on_restart(
 
 tf_ode tf_model_ode(tf_model *model)
 {
-    tf_ode ode = {tf_model_nstate(model), model, tf_model_rhs, tf_model_jac, tf_model_next_corner,
-                  tf_model_nevent(model), tf_model_events, model_restart};
+    tf_ode ode = {tf_model_nstate(model), model, lugre_constant_T(model) ? rhs_lugre_constant_T : tf_model_rhs,
+                  tf_model_jac, tf_model_next_corner, tf_model_nevent(model), tf_model_events, model_restart};
     if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
     return ode;
 }

@@ -97,6 +97,16 @@ static inline double tf_sigma1(const double *p, double v, double *d_dv, double *
     if (d_dvd) *d_dvd = s1 * 2.0 * v * v / (vd * vd * vd);
     return s1;
 }
+/* LuGre's bristle rate and force at one sliding velocity, given g(v) and sigma1(v):
+ * z' = v - sigma0 |v| z / g, F = sigma0 z + sigma1 z' + sigma2 v. The one statement of these
+ * equations: the friction library (with its partials) and the plant's fast path both use it. */
+static inline double tf_lugre_value(const double *p, double v, double z, double g, double s1, double *zd)
+{
+    double s0 = p[TF_P_SIGMA0];
+    *zd = v - s0 * fabs(v) / g * z; /* (relaxation rate s0 |v| / g) times z */
+    return s0 * z + s1 * *zd + p[TF_P_SIGMA2] * v;
+}
+
 /* Force and state rates; state partials when jac is not NULL, parameter partials when dp
  * is not NULL (every model, every parameter of the list it reads; dp->ddz_dp is written for
  * the model's states only). gms is read for TF_FRICTION_GMS only. GMS: the partials hold within

@@ -3,6 +3,7 @@ form, their state layout, and the physical checks on their values."""
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, fields, replace
 
@@ -294,8 +295,15 @@ def dissipativity_violation(model_name: str, values: dict):
         return None
     # extreme but finite values (sigma0 = 1e300) overflow the products below; the condition is
     # then decided by the terms that remain finite, and NumPy's warnings are not the user's business
+    # the same values come back for every run of a model (simulate checks before each): decide once
+    key = tuple(sorted((k, float(v)) for k, v in values.items() if isinstance(v, (int, float, np.floating))))
+    return _dissipativity_violation_of(key)
+
+
+@functools.lru_cache(maxsize=512)
+def _dissipativity_violation_of(items: tuple):
     with np.errstate(over="ignore", invalid="ignore", under="ignore", divide="ignore"):
-        return _dissipativity_violation(values)
+        return _dissipativity_violation(dict(items))
 
 
 def _dissipativity_violation(values: dict):
