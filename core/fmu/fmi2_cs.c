@@ -723,7 +723,9 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     tf_model_state_scale(&c->model, atol);
     for (int i = 0; i < n; i++) atol[i] *= c->rtol;
     tf_ode ode = tf_model_ode(&c->model);
-    tf_solver_options opt = {TF_METHOD_AUTO, c->rtol, atol, 0.0, 0.0, 10000000L};
+    double rtol_w[TF_MAX_STATES];
+    tf_model_rtol_weights(&c->model, rtol_w);
+    tf_solver_options opt = {TF_METHOD_AUTO, c->rtol, atol, 0.0, 0.0, 10000000L, rtol_w};
     double t_out[2] = {c->t, c->t + h};
     tf_solver_stats st;
     int s = tf_solve(&ode, &opt, t_out, 2, y, no_emit, 0, &st);

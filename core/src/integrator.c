@@ -22,6 +22,9 @@
 #include <string.h>
 
 enum { PROBE_STEPS = 200, WINDOW_STEPS = 200, FIRST_LOCK = 2000 };
+#ifndef AUTO_EXPLICIT_TOL
+#define AUTO_EXPLICIT_TOL 0.05
+#endif
 
 /* ---- Dormand-Prince 5(4) ---- */
 static const double
@@ -75,6 +78,7 @@ typedef struct {
      * Jpos (nred x npos) holds gamma h J[r][pos[j]], what the eliminated unknowns add to row r */
     int npos, nred, *pos, *partner, *red;
     double gh, *dinv, *Jpos, *xr;
+    double *rtol_w; /* each state's weight of the relative tolerance (opt->rtol_weight, or 1) */
     double t_clamp; /* stages never look past the corner that ends the segment */
     double *block; /* one allocation for all of the above */
 } work;
@@ -98,7 +102,7 @@ static double wnorm(const work *w, const double *e, const double *ya, const doub
     double s = 0.0;
     for (int i = 0; i < w->n; i++) {
         double a = fabs(ya[i]), b = fabs(yb[i]);
-        double sk = w->opt->atol[i] + w->opt->rtol * (a > b ? a : b);
+        double sk = w->opt->atol[i] + w->opt->rtol * w->rtol_w[i] * (a > b ? a : b);
         double r = e[i] / sk;
         s += r * r;
     }
@@ -413,7 +417,7 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     memset(w, 0, sizeof *w);
     w->t_clamp = INFINITY;
     w->ode = ode; w->opt = opt; w->st = st; w->n = n;
-    size_t nvec = 7 + 4 + 5 + 2;
+    size_t nvec = 7 + 4 + 5 + 3;
     w->block = (double *)malloc(sizeof(double) * (nvec * n + 3 * (size_t)n * n) + sizeof(int) * 4 * n);
     if (!w->block) return 1;
     double *p = w->block;
@@ -428,6 +432,8 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     w->Jpos = p; p += n * n;
     w->dinv = p; p += n;
     w->xr = p; p += n;
+    w->rtol_w = p; p += n;
+    for (int i = 0; i < n; i++) w->rtol_w[i] = opt->rtol_weight ? opt->rtol_weight[i] : 1.0;
     w->piv = (int *)p;
     w->pos = w->piv + n;
     w->partner = w->pos + n;
@@ -508,6 +514,18 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     /* without a Jacobian (e.g. sensitivity systems) only the explicit method applies */
     const int requested = ode->jac ? opt->method : TF_METHOD_DOPRI5;
     int method = requested == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : requested;
+    /* AUTO's explicit phases run at AUTO_EXPLICIT_TOL times the tolerances: at equal tolerances
+     * Dopri5's global error is ~10-20x Rodas4's on stick-slip, so that mixing the two at one
+     * tolerance made the error depend on which ran where, not on the tolerance (and the cost
+     * comparison that picks the method compared unequal accuracies) */
+    double *atol_x = (double *)malloc(sizeof(double) * n);
+    tf_solver_options opt_x = *opt;
+    if (atol_x) {
+        for (int i = 0; i < n; i++) atol_x[i] = AUTO_EXPLICIT_TOL * opt->atol[i];
+        opt_x.rtol *= AUTO_EXPLICIT_TOL;
+        opt_x.atol = atol_x;
+    }
+    if (requested == TF_METHOD_AUTO) w.opt = &opt_x;
     double t = t_out[0], t_end = t_out[n_out - 1];
     double *f0 = (double *)malloc(sizeof(double) * n);
     double *yd = (double *)malloc(sizeof(double) * n);
@@ -520,7 +538,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     /* AUTO bookkeeping: the explicit method's recent cost, the probe, the lock-out */
     double win_t = t, win_work = 0.0, explicit_rate = 0.0, probe_t = 0.0, probe_work = 0.0;
     long win_steps = 0, probe_steps = 0, lock_steps = 0, lock_len = FIRST_LOCK;
-    if (!f0 || !yd || !g0) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
+    if (!f0 || !yd || !g0 || !atol_x) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
 
     while (next < n_out && t_out[next] <= t) emit(next, t_out[next], y, emit_ctx), next++;
     if (!all_finite(y, n)) { status = fail(&w, TF_ERR_NONFINITE, t, 0.0); goto done; }
@@ -564,6 +582,24 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                     jac_current = 1;
                 }
                 err = rodas4_step(&w, t, h, y, f0);
+                /* Rodas4 estimates its error at the step's end, but a long step across a fast
+                 * transition (a slip onset after a long stick) can be right there and wrong inside,
+                 * where the output is interpolated. So the dense output at mid-step is compared with
+                 * the cubic Hermite interpolant of the step's ends and slopes, and a disagreement
+                 * above the tolerance counts as the step's error. The end slope is the next step's
+                 * first derivative: the check costs a right-hand side only on rejection. */
+                if (err >= 0.0 && err <= 1.0) {
+                    double *f1 = w.k[6];
+                    if (rhs(&w, t + h, w.y1, f1)) {
+                        err = -1.0;
+                    } else {
+                        rodas4_dense(&w, 0.5, yd);
+                        for (int i = 0; i < n; i++)
+                            w.ytmp[i] = yd[i] - (0.5 * (y[i] + w.y1[i]) + 0.125 * h * (f0[i] - f1[i]));
+                        double e_mid = wnorm(&w, w.ytmp, y, w.y1);
+                        err = isfinite(e_mid) ? fmax(err, e_mid) : -1.0;
+                    }
+                }
             } else {
                 err = dopri5_step(&w, t, h, y, f0);
             }
@@ -630,7 +666,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                     first_rodas = 0;
                     hold = h;
                     errold = fmax(0.01, err);
-                    if (!last && rhs(&w, t_new, w.y1, f0)) { status = fail(&w, TF_ERR_NONFINITE, t_new, h); goto done; }
+                    if (!last) memcpy(f0, w.k[6], sizeof(double) * n); /* f(t_new, y1), from the mid-step check */
                     jac_current = 0;
                 } else {
                     /* PI control, Hairer's DOPRI5 constants */
@@ -655,6 +691,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                             if (requested == TF_METHOD_AUTO && lock_steps <= 0 && t_new > win_t) {
                                 explicit_rate = (work_units(st, n) - win_work) / (t_new - win_t);
                                 method = TF_METHOD_RODAS4;
+                                w.opt = opt;
                                 first_rodas = 1;
                                 st->switch_time = t_new;
                                 probe_t = t_new;
@@ -679,6 +716,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                     double rodas_rate = (work_units(st, n) - probe_work) / (t_new - probe_t);
                     if (rodas_rate >= explicit_rate) { /* the stiff method does not pay: go back */
                         method = TF_METHOD_DOPRI5;
+                        w.opt = &opt_x;
                         st->switch_time = -1.0;
                         lock_steps = lock_len;
                         lock_len *= 2;
@@ -710,6 +748,7 @@ done:
     st->method_used = method;
     free(f0);
     free(yd);
+    free(atol_x);
     free(g0);
     free(w.block);
     return status;

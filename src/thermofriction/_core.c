@@ -273,7 +273,9 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     double y[TF_MAX_STATES];
     tf_model_initial_state(&m, y);
     tf_ode ode = tf_model_ode(&m);
-    tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps};
+    double rtol_w[TF_MAX_STATES];
+    tf_model_rtol_weights(&m, rtol_w);
+    tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps, rtol_w};
     tf_solver_stats st;
     emit_ctx ec = {&m, (double *)outv.buf, nch, columns ? (long)n_out : 0};
     int status;

@@ -37,6 +37,9 @@ typedef struct {
     double h0;          /* first step; <= 0: chosen automatically */
     double hmax;        /* <= 0: unlimited */
     long max_steps;
+    /* n weights of the relative tolerance in the error norm, atol_i + rtol_weight_i rtol |y_i|; NULL: all 1.
+     * A state whose value is relative to an arbitrary origin (a position) gets 0: see tf_model_rtol_weights */
+    const double *rtol_weight;
 } tf_solver_options;
 
 typedef enum {

@@ -121,6 +121,8 @@ const double *tf_model_params_cached(tf_model *model, double T, double *lambda, 
 /* Friction force F' at (t, state). */
 double tf_model_friction(const tf_model *model, double t, const double *y);
 void tf_model_initial_state(const tf_model *model, double *y);
+/* The weights of the relative tolerance per state for tf_solver_options.rtol_weight: 0 for positions. */
+void tf_model_rtol_weights(const tf_model *model, double *w);
 /* What a sensitivity is taken with respect to. */
 typedef enum {
     TF_TARGET_PARAM = 0, /* friction parameter `param` given as a number */

@@ -1,0 +1,130 @@
+"""Accuracy follows the tolerance, and the default settings are accurate.
+
+Oracle (self-convergence against a tight run, itself checked against the independent reference):
+each case is integrated once at rtol 1e-12 with Dopri5; that run agrees with SciPy's DOP853 on the
+plain-Python right-hand side (tests/reference/, rtol 1e-10) far below every error measured here. Errors
+are maxima over the output grid as a fraction of the quantity's range in the run.
+
+- For every method and the default, the error falls as rtol tightens from 1e-4 to 1e-9 (each decade
+  more accurate than the one before), on the paper's workload and on the Canudas de Wit stick-slip case.
+- At default settings, the Canudas de Wit experiments (stick-slip, presliding, break-away, frictional
+  lag) stay within 0.1 % of range of the tight run, in displacement and in friction force.
+"""
+
+import math
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import thermofriction as tf
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "examples"))
+import canudas1995 as ex  # noqa: E402
+import reference as R  # noqa: E402
+
+RTOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)
+TIGHT = tf.StepSizeController(rtol=1e-12)
+SOLVERS = {"default": None, "dopri5": tf.Dopri5(), "rodas4": tf.Rodas4()}
+
+
+def _run(model, solver=None, rtol=None, **kw):
+    if solver is not None:
+        kw["solver"] = solver
+    if rtol is not None:
+        kw["controller"] = tf.StepSizeController(rtol=rtol)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=tf.PassivityWarning)  # the 1995 set: known, see the example
+        return tf.simulate(model, **kw)
+
+
+def _cdw_mass(**plant):
+    return tf.Model(tf.MassPlant(ex.MASS, **plant), ex.lugre())
+
+
+CASES = {
+    "li2009-workload": (lambda: tf.load_model("li2009-model-i"), dict(duration=2.0, temperature=35.7,
+                                                                        sample_rate=10_000)),
+    "canudas-stick-slip": (lambda: _cdw_mass(spring_stiffness=ex.K_SPRING, pull_velocity=ex.V_PULL),
+                           dict(duration=20.0, sample_rate=1000)),
+}
+
+
+@pytest.fixture(scope="module", params=list(CASES))
+def case(request):
+    make, kw = CASES[request.param]
+    model = make()
+    tight = _run(model, tf.Dopri5(), **kw, controller=TIGHT)
+    return request.param, model, kw, tight
+
+
+def _errors(res, tight):
+    """Max |error| of displacement and friction force, each as a fraction of its range."""
+    return (np.max(np.abs(res.displacement - tight.displacement)) / np.ptp(tight.displacement),
+            np.max(np.abs(res.friction_force - tight.friction_force)) / np.ptp(tight.friction_force))
+
+
+def test_tight_run_agrees_with_the_independent_reference(case):
+    """Independent reference (SciPy DOP853, rtol 1e-10, piecewise between the input's corners) for the
+    tight run the tolerance sweep measures against: agreement to 5e-8 of the range, the reference's own
+    accuracy. It shows that the tight run solves the same equations; its own accuracy, below the sweep's
+    smallest error (~1e-9 of the range at rtol 1e-9), rests on the three decades of tolerance between."""
+    name, model, kw, tight = case
+    if name != "li2009-workload":
+        pytest.skip("the reference's mass plant run is covered in test_differential.py")
+    ref = R.reference_simulate(model, tight.time, kw["temperature"], method="DOP853", rtol=1e-10)
+    assert np.max(np.abs(ref.y[:, 2] - tight.displacement)) < 5e-8 * np.ptp(tight.displacement)
+
+
+@pytest.mark.parametrize("solver", list(SOLVERS))
+def test_error_falls_as_the_tolerance_tightens(case, solver):
+    """Self-convergence: from rtol 1e-4 to 1e-9 every decade gives a smaller displacement error and a
+    smaller friction-force error than the decade before, and 1e-9 is at least 1000x better than 1e-4."""
+    name, model, kw, tight = case
+    errs = [_errors(_run(model, SOLVERS[solver], rtol, **kw), tight) for rtol in RTOLS]
+    for what, k in (("displacement", 0), ("friction force", 1)):
+        e = [x[k] for x in errs]
+        assert all(b < a for a, b in zip(e, e[1:])), (what, dict(zip(RTOLS, e)))
+        assert e[-1] < 1e-3 * e[0], (what, dict(zip(RTOLS, e)))
+
+
+# --- the Canudas de Wit experiments at default settings -----------------------------------------------
+
+def _stick_slip(**kw):
+    return _run(_cdw_mass(spring_stiffness=ex.K_SPRING, pull_velocity=ex.V_PULL), duration=60.0,
+                sample_rate=1000.0, **kw)
+
+
+def _presliding(**kw):
+    f_max, frequency = 1.2, 0.02
+    return _run(_cdw_mass(), duration=1.25 / frequency, input=tf.Sine(f_max, frequency), sample_rate=1000.0, **kw)
+
+
+def _break_away(**kw):
+    rate = 0.3
+    T = ex.RAMP_TO / rate
+    return _run(_cdw_mass(), duration=T, input=tf.Step(ex.RAMP_TO, time=0.0, slew=T), sample_rate=20_000 / T, **kw)
+
+
+def _frictional_lag(**kw):
+    omega, knots = 10.0, 4000
+    T = 2 * math.pi / omega
+    tk = np.arange(3 * knots + 1) * (T / knots)
+    xk = ex.LAG_MEAN * tk + ex.LAG_AMPLITUDE * np.sin(omega * tk) / omega
+    t_out = np.concatenate([[0.0], 0.5 * (tk[1:] + tk[:-1])])
+    return _run(tf.Model(tf.PrescribedMotion(), ex.lugre()), input=tf.Sampled(tk, xk), t_eval=t_out, **kw)
+
+
+@pytest.mark.parametrize("experiment", [_stick_slip, _presliding, _break_away, _frictional_lag],
+                         ids=["stick-slip", "presliding", "break-away", "frictional-lag"])
+def test_canudas_experiments_at_default_settings_within_0p1_percent(experiment):
+    """Self-convergence: the default solver and tolerance against a Dopri5 run at rtol 1e-12, within
+    0.1 % of range in displacement and in friction force (under prescribed motion the displacement is the
+    input itself)."""
+    default = experiment()
+    tight = experiment(solver=tf.Dopri5(), controller=TIGHT)
+    dx, dF = _errors(default, tight)
+    assert dx < 1e-3 and dF < 1e-3, (dx, dF)
