@@ -22,6 +22,16 @@
 #include <string.h>
 
 enum { PROBE_STEPS = 200, WINDOW_STEPS = 200, FIRST_LOCK = 2000 };
+
+/* The step functions take the system size (and Rodas4 its reduced sizes) as an argument and are
+ * inlined into dispatchers that pass constants for the common models (5 states: the stick-slip
+ * actuator with LuGre; 3: the mass with LuGre), so that their loops over five numbers compile to
+ * straight-line code; any other size runs the same code with the runtime value. */
+#if defined(__GNUC__) || defined(__clang__)
+#define TF_SIZED static inline __attribute__((always_inline))
+#else
+#define TF_SIZED static inline
+#endif
 #ifndef AUTO_EXPLICIT_TOL
 #define AUTO_EXPLICIT_TOL 0.05
 #endif
@@ -76,14 +86,14 @@ typedef struct {
      * Jacobian row is a unit vector e_q (x' = v) are eliminated, k_p = gamma h (b_p + k_q); the other
      * nred rows (red[]) form the reduced matrix, LU-factored in W with reciprocal pivots in dinv, and
      * Jpos (nred x npos) holds gamma h J[r][pos[j]], what the eliminated unknowns add to row r */
-    int npos, nred, *pos, *partner, *red;
+    int npos, nred, *pos, *partner, *red, *qcol;
     double gh, *dinv, *Jpos, *xr;
     double *rtol_w; /* each state's weight of the relative tolerance (opt->rtol_weight, or 1) */
     double t_clamp; /* stages never look past the corner that ends the segment */
     double *block; /* one allocation for all of the above */
 } work;
 
-static int rhs(work *w, double t, const double *y, double *dy)
+TF_SIZED int rhs_n(work *w, double t, const double *y, double *dy, const int n)
 {
     w->st->rhs_evals++;
     /* A stage at the end of a segment sees the waveform's left limit, so that a jump at a
@@ -93,21 +103,31 @@ static int rhs(work *w, double t, const double *y, double *dy)
     /* one test for all: a NaN or an infinity in any component makes the sum non-finite (finite
      * components can overflow the sum only within a factor n of DBL_MAX) */
     double sum = 0.0;
-    for (int i = 0; i < w->n; i++) sum += dy[i];
+    for (int i = 0; i < n; i++) sum += dy[i];
     return !isfinite(sum);
 }
 
-static double wnorm(const work *w, const double *e, const double *ya, const double *yb)
+static int rhs(work *w, double t, const double *y, double *dy) { return rhs_n(w, t, y, dy, w->n); }
+
+TF_SIZED double wnorm_n(const work *w, const double *e, const double *ya, const double *yb, const int n)
 {
     double s = 0.0;
-    for (int i = 0; i < w->n; i++) {
+    for (int i = 0; i < n; i++) {
         double a = fabs(ya[i]), b = fabs(yb[i]);
         double sk = w->opt->atol[i] + w->opt->rtol * w->rtol_w[i] * (a > b ? a : b);
         double r = e[i] / sk;
         s += r * r;
     }
-    return sqrt(s / w->n);
+    return sqrt(s / n);
 }
+
+static double wnorm(const work *w, const double *e, const double *ya, const double *yb)
+{
+    return wnorm_n(w, e, ya, yb, w->n);
+}
+
+/* x^(1/4) for Rodas4's step-size control: two square roots cost a third of a pow */
+static double root4(double x) { return sqrt(sqrt(x)); }
 
 static int all_finite(const double *v, int n)
 {
@@ -178,11 +198,13 @@ static void structure_of_jacobian(work *w)
         if (w->partner[i] >= 0) w->pos[w->npos++] = i;
         else w->red[w->nred++] = i;
     }
+    for (int j = 0; j < w->npos; j++) /* where each partner sits among the reduced unknowns */
+        for (int b = 0; b < w->nred; b++)
+            if (w->red[b] == w->partner[w->pos[j]]) w->qcol[j] = b;
 }
 
-static int reduced_factor(work *w, double h)
+TF_SIZED int reduced_factor(work *w, double h, const int n, const int nr, const int np)
 {
-    int n = w->n, nr = w->nred, np = w->npos;
     const double *J = w->J;
     double *A = w->W, gh = ro_gamma * h, c = 1.0 / gh;
     w->gh = gh;
@@ -193,10 +215,8 @@ static int reduced_factor(work *w, double h)
         for (int j = 0; j < np; j++) {
             double Jrp = gh * J[r * n + w->pos[j]];
             w->Jpos[a * np + j] = Jrp;
-            /* -J[r][p] k_p = -J[r][p] gh (b_p + k_q): the k_q part moves into column q */
-            int q = w->partner[w->pos[j]];
-            for (int b = 0; b < nr; b++)
-                if (w->red[b] == q) { A[a * nr + b] -= Jrp; break; }
+            /* -J[r][p] k_p = -J[r][p] gh (b_p + k_q): the k_q part moves into q's column */
+            A[a * nr + w->qcol[j]] -= Jrp;
         }
     }
     for (int k = 0; k < nr; k++) {
@@ -218,9 +238,8 @@ static int reduced_factor(work *w, double h)
     return 0;
 }
 
-static void reduced_solve(const work *w, double *b)
+TF_SIZED void reduced_solve(const work *w, double *b, const int nr, const int np)
 {
-    int nr = w->nred, np = w->npos;
     const double *A = w->W;
     double *xr = w->xr;
     for (int a = 0; a < nr; a++) {
@@ -243,32 +262,32 @@ static void reduced_solve(const work *w, double *b)
 
 /* ---- one attempted step of each method: y1, dense coefficients; returns the error norm,
  *      or a negative value when the step produced non-finite numbers ---- */
-static double dopri5_step(work *w, double t, double h, const double *y, const double *f0)
+TF_SIZED double dopri5_step_n(work *w, double t, double h, const double *y, const double *f0, const int n)
 {
-    int n = w->n, i;
+    int i;
     double **k = w->k, *yt = w->ytmp, *y1 = w->y1;
     memcpy(k[0], f0, sizeof(double) * n);
     for (i = 0; i < n; i++) yt[i] = y[i] + h * dp_a21 * k[0][i];
-    if (rhs(w, t + dp_c2 * h, yt, k[1])) return -1;
+    if (rhs_n(w, t + dp_c2 * h, yt, k[1], n)) return -1;
     for (i = 0; i < n; i++) yt[i] = y[i] + h * (dp_a31 * k[0][i] + dp_a32 * k[1][i]);
-    if (rhs(w, t + dp_c3 * h, yt, k[2])) return -1;
+    if (rhs_n(w, t + dp_c3 * h, yt, k[2], n)) return -1;
     for (i = 0; i < n; i++) yt[i] = y[i] + h * (dp_a41 * k[0][i] + dp_a42 * k[1][i] + dp_a43 * k[2][i]);
-    if (rhs(w, t + dp_c4 * h, yt, k[3])) return -1;
+    if (rhs_n(w, t + dp_c4 * h, yt, k[3], n)) return -1;
     for (i = 0; i < n; i++)
         yt[i] = y[i] + h * (dp_a51 * k[0][i] + dp_a52 * k[1][i] + dp_a53 * k[2][i] + dp_a54 * k[3][i]);
-    if (rhs(w, t + dp_c5 * h, yt, k[4])) return -1;
+    if (rhs_n(w, t + dp_c5 * h, yt, k[4], n)) return -1;
     for (i = 0; i < n; i++)
         w->ysti[i] = y[i] + h * (dp_a61 * k[0][i] + dp_a62 * k[1][i] + dp_a63 * k[2][i] +
                                  dp_a64 * k[3][i] + dp_a65 * k[4][i]);
-    if (rhs(w, t + h, w->ysti, k[5])) return -1;
+    if (rhs_n(w, t + h, w->ysti, k[5], n)) return -1;
     for (i = 0; i < n; i++)
         y1[i] = y[i] + h * (dp_a71 * k[0][i] + dp_a73 * k[2][i] + dp_a74 * k[3][i] +
                             dp_a75 * k[4][i] + dp_a76 * k[5][i]);
-    if (rhs(w, t + h, y1, k[6])) return -1;
+    if (rhs_n(w, t + h, y1, k[6], n)) return -1;
     for (i = 0; i < n; i++)
         yt[i] = h * (dp_e1 * k[0][i] + dp_e3 * k[2][i] + dp_e4 * k[3][i] + dp_e5 * k[4][i] +
                      dp_e6 * k[5][i] + dp_e7 * k[6][i]);
-    double err = wnorm(w, yt, y, y1);
+    double err = wnorm_n(w, yt, y, y1, n);
     if (!isfinite(err) || !all_finite(y1, n)) return -1;
     for (i = 0; i < n; i++) {
         double dy = y1[i] - y[i], bspl = h * k[0][i] - dy;
@@ -282,10 +301,19 @@ static double dopri5_step(work *w, double t, double h, const double *y, const do
     return err;
 }
 
-static void dopri5_dense(const work *w, double s, double *y)
+static double dopri5_step(work *w, double t, double h, const double *y, const double *f0)
+{
+    switch (w->n) {
+    case 5: return dopri5_step_n(w, t, h, y, f0, 5);
+    case 3: return dopri5_step_n(w, t, h, y, f0, 3);
+    default: return dopri5_step_n(w, t, h, y, f0, w->n);
+    }
+}
+
+TF_SIZED void dopri5_dense_n(const work *w, double s, double *y, const int n)
 {
     double s1 = 1.0 - s;
-    for (int i = 0; i < w->n; i++)
+    for (int i = 0; i < n; i++)
         y[i] = w->cont[0][i] +
                s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * (w->cont[3][i] + s1 * w->cont[4][i])));
 }
@@ -301,48 +329,49 @@ static int time_derivative(work *w, double t, double t_end, const double *y, con
 }
 
 /* Returns the error norm; -1 for non-finite numbers, -2 for a singular iteration matrix. */
-static double rodas4_step(work *w, double t, double h, const double *y, const double *f0)
+TF_SIZED double rodas4_step_n(work *w, double t, double h, const double *y, const double *f0, const int n,
+                              const int nr, const int np)
 {
-    int n = w->n, i;
+    int i;
     double **k = w->k, *yt = w->ytmp, *fs = w->k[6], *ft = w->ft;
     w->st->decompositions++;
-    if (reduced_factor(w, h)) return -2;
+    if (reduced_factor(w, h, n, nr, np)) return -2;
 
     for (i = 0; i < n; i++) k[0][i] = f0[i] + h * ro_g1 * ft[i];
-    reduced_solve(w, k[0]);
+    reduced_solve(w, k[0], nr, np);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a21 * k[0][i];
-    if (rhs(w, t + ro_c2 * h, yt, fs)) return -1;
+    if (rhs_n(w, t + ro_c2 * h, yt, fs, n)) return -1;
     for (i = 0; i < n; i++) k[1][i] = fs[i] + h * ro_g2 * ft[i] + ro_c21 * k[0][i] / h;
-    reduced_solve(w, k[1]);
+    reduced_solve(w, k[1], nr, np);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a31 * k[0][i] + ro_a32 * k[1][i];
-    if (rhs(w, t + ro_c3 * h, yt, fs)) return -1;
+    if (rhs_n(w, t + ro_c3 * h, yt, fs, n)) return -1;
     for (i = 0; i < n; i++) k[2][i] = fs[i] + h * ro_g3 * ft[i] + (ro_c31 * k[0][i] + ro_c32 * k[1][i]) / h;
-    reduced_solve(w, k[2]);
+    reduced_solve(w, k[2], nr, np);
 
     for (i = 0; i < n; i++) yt[i] = y[i] + ro_a41 * k[0][i] + ro_a42 * k[1][i] + ro_a43 * k[2][i];
-    if (rhs(w, t + ro_c4 * h, yt, fs)) return -1;
+    if (rhs_n(w, t + ro_c4 * h, yt, fs, n)) return -1;
     for (i = 0; i < n; i++)
         k[3][i] = fs[i] + h * ro_g4 * ft[i] + (ro_c41 * k[0][i] + ro_c42 * k[1][i] + ro_c43 * k[2][i]) / h;
-    reduced_solve(w, k[3]);
+    reduced_solve(w, k[3], nr, np);
 
     for (i = 0; i < n; i++)
         yt[i] = y[i] + ro_a51 * k[0][i] + ro_a52 * k[1][i] + ro_a53 * k[2][i] + ro_a54 * k[3][i];
-    if (rhs(w, t + h, yt, fs)) return -1;
+    if (rhs_n(w, t + h, yt, fs, n)) return -1;
     for (i = 0; i < n; i++)
         k[4][i] = fs[i] + (ro_c51 * k[0][i] + ro_c52 * k[1][i] + ro_c53 * k[2][i] + ro_c54 * k[3][i]) / h;
-    reduced_solve(w, k[4]);
+    reduced_solve(w, k[4], nr, np);
 
     for (i = 0; i < n; i++) yt[i] += k[4][i];
-    if (rhs(w, t + h, yt, fs)) return -1;
+    if (rhs_n(w, t + h, yt, fs, n)) return -1;
     for (i = 0; i < n; i++)
         k[5][i] = fs[i] + (ro_c61 * k[0][i] + ro_c62 * k[1][i] + ro_c63 * k[2][i] + ro_c64 * k[3][i] +
                            ro_c65 * k[4][i]) / h;
-    reduced_solve(w, k[5]);
+    reduced_solve(w, k[5], nr, np);
 
     for (i = 0; i < n; i++) w->y1[i] = yt[i] + k[5][i];
-    double err = wnorm(w, k[5], y, w->y1);
+    double err = wnorm_n(w, k[5], y, w->y1, n);
     if (!isfinite(err) || !all_finite(w->y1, n)) return -1;
     for (i = 0; i < n; i++) {
         w->cont[0][i] = y[i];
@@ -355,11 +384,37 @@ static double rodas4_step(work *w, double t, double h, const double *y, const do
     return err;
 }
 
-static void rodas4_dense(const work *w, double s, double *y)
+/* The reduced sizes are known once the Jacobian's structure is (structure_of_jacobian). */
+static double rodas4_step(work *w, double t, double h, const double *y, const double *f0)
+{
+    if (w->n == 5 && w->nred == 3 && w->npos == 2) return rodas4_step_n(w, t, h, y, f0, 5, 3, 2);
+    if (w->n == 3 && w->nred == 2 && w->npos == 1) return rodas4_step_n(w, t, h, y, f0, 3, 2, 1);
+    return rodas4_step_n(w, t, h, y, f0, w->n, w->nred, w->npos);
+}
+
+TF_SIZED void rodas4_dense_n(const work *w, double s, double *y, const int n)
 {
     double s1 = 1.0 - s;
-    for (int i = 0; i < w->n; i++)
+    for (int i = 0; i < n; i++)
         y[i] = w->cont[0][i] * s1 + s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * w->cont[3][i]));
+}
+
+static void dopri5_dense(const work *w, double s, double *y)
+{
+    switch (w->n) {
+    case 5: dopri5_dense_n(w, s, y, 5); break;
+    case 3: dopri5_dense_n(w, s, y, 3); break;
+    default: dopri5_dense_n(w, s, y, w->n);
+    }
+}
+
+static void rodas4_dense(const work *w, double s, double *y)
+{
+    switch (w->n) {
+    case 5: rodas4_dense_n(w, s, y, 5); break;
+    case 3: rodas4_dense_n(w, s, y, 3); break;
+    default: rodas4_dense_n(w, s, y, w->n);
+    }
 }
 
 /* Hairer's starting step: an explicit Euler step's change in f sets the scale. */
@@ -418,7 +473,7 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     w->t_clamp = INFINITY;
     w->ode = ode; w->opt = opt; w->st = st; w->n = n;
     size_t nvec = 7 + 4 + 5 + 3;
-    w->block = (double *)malloc(sizeof(double) * (nvec * n + 3 * (size_t)n * n) + sizeof(int) * 4 * n);
+    w->block = (double *)malloc(sizeof(double) * (nvec * n + 3 * (size_t)n * n) + sizeof(int) * 5 * n);
     if (!w->block) return 1;
     double *p = w->block;
     for (int i = 0; i < 7; i++, p += n) w->k[i] = p;
@@ -438,6 +493,7 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     w->pos = w->piv + n;
     w->partner = w->pos + n;
     w->red = w->partner + n;
+    w->qcol = w->red + n;
     return 0;
 }
 
@@ -555,6 +611,19 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
         if (ode->on_restart) ode->on_restart(t, y, ode->ctx);
         if (ne) ode->events(t, y, g0, ode->ctx);
         if (rhs(&w, t, y, f0)) { status = fail(&w, TF_ERR_NONFINITE, t, h); goto done; }
+#ifdef AUTO_PER_PHASE
+        /* AUTO picks the method per phase: a corner of the input starts a new one (a flyback's
+         * ringing, where the explicit method is cheaper, then a ramp, where the stiff one is) */
+        if (requested == TF_METHOD_AUTO && method == TF_METHOD_RODAS4 && t > t_out[0]) {
+            method = TF_METHOD_DOPRI5;
+            w.opt = &opt_x;
+            iasti = nonsti = 0;
+            probe_steps = -1;
+            win_steps = 0;
+            win_t = t;
+            win_work = work_units(st, n);
+        }
+#endif
         if (h <= 0.0) {
             h = opt->h0 > 0 ? opt->h0 : initial_step(&w, t, y, f0, method == TF_METHOD_DOPRI5 ? 5 : 4, opt->hmax);
         }
@@ -657,9 +726,9 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                 st->steps++;
                 double hnew;
                 if (method == TF_METHOD_RODAS4) {
-                    double fac = fmax(1.0 / 6.0, fmin(5.0, pow(err, 0.25) / 0.9));
+                    double fac = fmax(1.0 / 6.0, fmin(5.0, root4(err) / 0.9));
                     if (!first_rodas) {
-                        double facpred = (hold / h) * pow(err * err / errold, 0.25) / 0.9;
+                        double facpred = (hold / h) * root4(err * err / errold) / 0.9;
                         fac = fmax(fac, fmax(1.0 / 6.0, fmin(5.0, facpred)));
                     }
                     hnew = h / fac;
@@ -737,7 +806,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                 st->rejected++;
                 reject = 1;
                 if (method == TF_METHOD_RODAS4)
-                    h /= fmax(1.0 / 6.0, fmin(5.0, pow(err, 0.25) / 0.9));
+                    h /= fmax(1.0 / 6.0, fmin(5.0, root4(err) / 0.9));
                 else
                     h /= fmin(5.0, pow(err, 0.2 - 0.04 * 0.75) / 0.9);
             }

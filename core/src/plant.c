@@ -548,28 +548,33 @@ tf_ode tf_model_ode(tf_model *model)
     return ode;
 }
 
-void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
+void tf_model_outputs_strided(const tf_model *model, double t, const double *y, double *out, long stride)
 {
     int nm = nmech(model), nz = nfric(model);
     double u = tf_waveform_value(&model->input, t);
-    out[TF_OUT_TIME] = t;
-    out[TF_OUT_INPUT] = u;
     double xp = 0.0, vp = 0.0, x, v;
     switch (model->plant) {
     case TF_PLANT_STICK_SLIP: xp = y[XP]; vp = y[VP]; x = y[XE]; v = y[VE]; break;
     case TF_PLANT_MASS: x = y[X]; v = y[V]; break;
     default: x = u; v = tf_waveform_slope(&model->input, t);
     }
-    out[TF_OUT_STAGE_DISPLACEMENT] = xp;
-    out[TF_OUT_STAGE_VELOCITY] = vp;
-    out[TF_OUT_DISPLACEMENT] = x;
-    out[TF_OUT_VELOCITY] = v;
-    out[TF_OUT_RELATIVE_DISPLACEMENT] = x - xp;
-    out[TF_OUT_RELATIVE_VELOCITY] = v - vp;
-    out[TF_OUT_FRICTION_FORCE] = tf_model_friction(model, t, y);
-    out[TF_OUT_TEMPERATURE] = tf_model_temperature(model, t, y);
-    for (int j = 0; j < nz; j++) out[TF_OUT_NFIXED + j] = y[nm + j];
-    if (has_work(model)) out[TF_OUT_NFIXED + nz] = y[tf_model_work_index(model)];
+    out[TF_OUT_TIME * stride] = t;
+    out[TF_OUT_INPUT * stride] = u;
+    out[TF_OUT_STAGE_DISPLACEMENT * stride] = xp;
+    out[TF_OUT_STAGE_VELOCITY * stride] = vp;
+    out[TF_OUT_DISPLACEMENT * stride] = x;
+    out[TF_OUT_VELOCITY * stride] = v;
+    out[TF_OUT_RELATIVE_DISPLACEMENT * stride] = x - xp;
+    out[TF_OUT_RELATIVE_VELOCITY * stride] = v - vp;
+    out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(model, t, y);
+    out[TF_OUT_TEMPERATURE * stride] = tf_model_temperature(model, t, y);
+    for (int j = 0; j < nz; j++) out[(TF_OUT_NFIXED + j) * stride] = y[nm + j];
+    if (has_work(model)) out[(TF_OUT_NFIXED + nz) * stride] = y[tf_model_work_index(model)];
+}
+
+void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
+{
+    tf_model_outputs_strided(model, t, y, out, 1);
 }
 
 /* ---- model check (the C side of the Python package's parameter checks) ---- */

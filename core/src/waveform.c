@@ -90,7 +90,8 @@ static double eval(const tf_waveform *w, double t, double *slope)
     case TF_WAVE_SAWTOOTH: {
         double x = t * w->frequency;
         double ph = x - floor(x);
-        v = w->offset + w->amplitude * sawtooth_shape(ph, w->rise, w->direction, &d);
+        /* the slope only when asked for: the value is on every right-hand side */
+        v = w->offset + w->amplitude * sawtooth_shape(ph, w->rise, w->direction, slope ? &d : 0);
         d *= w->amplitude * w->frequency;
         break;
     }

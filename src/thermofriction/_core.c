@@ -223,9 +223,7 @@ static void emit_outputs(long i, double t, const double *y, void *ctx)
         tf_model_outputs(e->model, t, y, e->out + (size_t)i * e->nch);
         return;
     }
-    double row[TF_OUT_NFIXED + TF_MAX_FRICTION_STATES + 1];
-    tf_model_outputs(e->model, t, y, row);
-    for (int j = 0; j < e->nch; j++) e->out[(size_t)j * e->n_out + i] = row[j];
+    tf_model_outputs_strided(e->model, t, y, e->out + i, e->n_out);
 }
 
 /* simulate(spec, t_out, out, method, rtol, atol|None, h0, hmax, max_steps) -> stats dict */

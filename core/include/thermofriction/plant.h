@@ -179,6 +179,8 @@ void tf_model_sensitivity_restart(tf_model *model, double t, double *Y, const tf
 tf_ode tf_model_ode(tf_model *model);
 /* Writes the output channels at (t, y). */
 void tf_model_outputs(const tf_model *model, double t, const double *y, double *out);
+/* The same, channel j written to out[j * stride] (a column-major block with stride samples per column). */
+void tf_model_outputs_strided(const tf_model *model, double t, const double *y, double *out, long stride);
 
 #ifdef __cplusplus
 }

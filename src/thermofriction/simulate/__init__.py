@@ -268,7 +268,10 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
     # (e.g. a 1e165 m amplitude) may still overflow: refuse it rather than return it
     outputs = _bridge.OUTPUTS
     finite, bad = np.empty(out.shape[0], bool), None  # column by column: no temporary of the block's size
-    for col in range(out.shape[1]):
+    # one pass first: a NaN or an infinity makes its column's sum non-finite (so may an overflow of
+    # finite values, which the exact test below then clears)
+    suspects = np.flatnonzero(~np.isfinite(out.sum(axis=0)))
+    for col in suspects:
         if col != _bridge.OUTPUT_COLUMN["temperature"]:  # NaN by design without a thermal part
             if not np.isfinite(out[:, col], out=finite).all():
                 bad = min(bad or (math.inf, 0), (int(np.argmin(finite)), col))  # the earliest, as time goes
