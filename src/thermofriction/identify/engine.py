@@ -252,24 +252,62 @@ class Transform:
         return lo_phi, hi_phi
 
 
-def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale):
+#: a step that moves the parameters by less than this many standard errors (in the joint, Mahalanobis,
+#: sense) is not worth its simulation: the fit stops there if its misfit is at the noise
+SMALL_STEP = 0.1
+#: the same for the first, coarse stage (rtol 1e-6), which only brings the fit near the optimum: its
+#: integration error alone makes the Gauss-Newton step ~0.3-1 standard errors on the paper's data
+COARSE_STEP = 1.0
+
+
+class _Converged(Exception):
+    """Raised inside the least-squares iteration at a point that is already the optimum."""
+
+    def __init__(self, phi):
+        self.phi = phi
+
+
+def gauss_newton_length(r, J) -> float:
+    """The length of the Gauss-Newton step from where ``r``, ``J`` were taken, in standard errors: on
+    residuals in units of the noise, |J dx| (the cost it would remove is half its square) bounds
+    every parameter's move divided by its standard error."""
+    dx, *_ = np.linalg.lstsq(J, -r, rcond=None)
+    return float(np.linalg.norm(J @ dx))
+
+
+def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale,
+                   small_step=SMALL_STEP):
     """SciPy's trust-region least squares on residuals divided by ``scale`` (the data's noise level):
     its stopping tests then mean the same on every dataset, whatever the units and magnitudes
-    (on residuals in metres, an absolute gradient test is met at any start)."""
+    (on residuals in metres, an absolute gradient test is met at any start).
+
+    Besides SciPy's tests, it stops at the first evaluated point whose misfit is at the noise and from
+    which the Gauss-Newton step is below SMALL_STEP standard errors (not when ``tight``): another
+    iteration could not move the estimate by a meaningful fraction of its uncertainty. The returned
+    result carries ``evaluated``: the last few points' unscaled (r, J), so that the caller's
+    evaluation at the optimum (for the intervals) is not simulated twice."""
     cache = {}
+    best_cost = [math.inf]
 
     def both(phi):
         key = phi.tobytes()
         if key not in cache:
-            cache.clear()
+            if len(cache) >= 4:
+                cache.pop(next(iter(cache)))
             theta = transform.to_theta(phi)
             r, J = problem.evaluate(theta, jac=True)
             if r is None:  # a failed simulation: a large, flat residual pushes the step back
-                r = np.full(problem.n_points, 1e3 * max(_y_scale(problem), 1e-12))
-                J = np.zeros((problem.n_points, len(phi)))
+                rs = np.full(problem.n_points, 1e3 * max(_y_scale(problem), 1e-12)) / scale
+                Js = np.zeros((problem.n_points, len(phi)))
             else:
-                J = J * transform.dtheta_dphi(theta)[None, :]
-            cache[key] = (r / scale, J / scale)
+                rs, Js = r / scale, J * (transform.dtheta_dphi(theta)[None, :] / scale)
+            cache[key] = (rs, Js, r, J)
+            cost = 0.5 * float(rs @ rs)
+            if (r is not None and not tight and cost <= best_cost[0] + 0.5
+                    and math.sqrt(2.0 * cost / max(rs.size, 1)) <= AT_NOISE
+                    and gauss_newton_length(rs, Js) < small_step):
+                raise _Converged(phi.copy())
+            best_cost[0] = min(best_cost[0], cost)
         return cache[key]
 
     # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
@@ -278,9 +316,17 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
     tol = 1e-15 if tight else max(1e-10, 10 * problem.rtol)
     # on residuals of unit noise, the scaled gradient is the residuals' projection on each parameter's
     # direction: below 1e-4 a further step would move the parameters by ~1e-4 of their standard errors
-    return optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
-                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-15 if tight else 1e-4,
-                                  max_nfev=max_nfev)
+    try:
+        res = optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
+                                     method="trf", x_scale="jac", ftol=tol, xtol=tol,
+                                     gtol=1e-15 if tight else 1e-4, max_nfev=max_nfev)
+    except _Converged as stop:
+        rs = cache[stop.phi.tobytes()][0]
+        res = optimize.OptimizeResult(
+            x=stop.phi, fun=rs, cost=0.5 * float(rs @ rs), success=True, status=1,
+            message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise")
+    res.evaluated = {k: v[2:] for k, v in cache.items()}
+    return res
 
 
 def _y_scale(problem):
@@ -334,7 +380,8 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         phi_first = phi_start
         if rtol < 1e-6:
             coarse = Problem(model, names, traces, rtol=1e-6, parallel=not one_trace)
-            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale)
+            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale,
+                                   COARSE_STEP)
             phi_start = first.x
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
         res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight else 15, tight, scale)
@@ -374,7 +421,9 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
             runs += [run(c) for c in chosen]
     best, best_problem = min(runs, key=lambda rp: rp[0].cost)
     theta = transform.to_theta(best.x)
-    r, J = best_problem.evaluate(theta, jac=True)
+    # the residuals and Jacobian at the optimum, on the full data at the requested tolerance: the last
+    # iteration's, if it evaluated them there
+    r, J = best.evaluated.get(best.x.tobytes()) or best_problem.evaluate(theta, jac=True)
     if r is None:
         raise ComputationError("the fit ended where the model cannot be simulated; try another initial guess")
     nfev = screen.nfev + sum(p.nfev for _, p in runs)

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import Const, Model, ModelI
+from ..models.friction import in_domain
 from .engine import fit, make_traces, uncertainty
 from .laws import fit_law
 from .parameters import Parameters, get_value, unit_of, with_values
@@ -215,6 +216,68 @@ def _fit_parameter_names(model):
     return default_fit_parameters(model)
 
 
+def _laws_on_information(Ts, per_T, laws: dict) -> dict:
+    """The laws' coefficients refitted to the per-temperature estimates weighted by each temperature's
+    full covariance (in log space, where the fits were made), not by its standard errors alone: the
+    per-temperature estimates are strongly correlated (sigma0 with fc), and the joint refinement then
+    starts near its optimum instead of some standard errors away. The law kinds stay as chosen; a law
+    is kept as it was if this fails or leaves its parameter's physical domain."""
+    from scipy import optimize
+
+    names = list(laws)
+    blocks = []
+    for T, res in per_T:
+        varying = [p.name for p in res.parameters.varying]
+        if not all(n in varying for n in names):
+            return laws
+        idx = [varying.index(n) for n in names]
+        value = np.array([res.parameters[n].value for n in names])
+        se = np.array([res.parameters[n].stderr for n in names], float)
+        if np.any(value <= 0) or res.correlation.shape != (len(varying), len(varying)):
+            return laws
+        known = np.isfinite(se) & (se > 0)  # a parameter this temperature leaves open adds nothing
+        corr = res.correlation[np.ix_(idx, idx)][np.ix_(known, known)]
+        if not known.any() or not np.all(np.isfinite(corr)):
+            continue
+        cov_log = corr * np.outer(se[known] / value[known], se[known] / value[known])
+        try:
+            root = np.linalg.cholesky(np.linalg.inv(cov_log))  # W = root root^T
+        except np.linalg.LinAlgError:
+            continue
+        blocks.append((T, np.flatnonzero(known), np.log(value[known]), root))
+    if not blocks:
+        return laws
+    sizes = [len(laws[n].coefficients()) for n in names]
+    c0 = np.concatenate([laws[n].coefficients() for n in names])
+
+    def with_coefficients(c):
+        out, k = {}, 0
+        for n, size in zip(names, sizes):
+            out[n] = laws[n].with_coefficients(c[k:k + size])
+            k += size
+        return out
+
+    def residuals(c):
+        trial = with_coefficients(c)
+        out = []
+        for T, known, log_value, root in blocks:
+            predicted = np.array([float(trial[names[i]](T)) for i in known])
+            if np.any(~np.isfinite(predicted)) or np.any(predicted <= 0):
+                return np.full(sum(len(b[1]) for b in blocks), 1e6)
+            out.append(root.T @ (np.log(predicted) - log_value))
+        return np.concatenate(out)
+
+    try:
+        res = optimize.least_squares(residuals, c0, x_scale=np.where(c0 != 0, np.abs(c0), 1.0))
+    except (ValueError, np.linalg.LinAlgError):
+        return laws
+    if not res.success or 2 * res.cost >= float(np.sum(residuals(c0) ** 2)):
+        return laws
+    refined = with_coefficients(res.x)
+    grid = np.linspace(float(np.min(Ts)), float(np.max(Ts)), 41)
+    return {n: refined[n] if in_domain(n, refined[n](grid)).all() else laws[n] for n in names}
+
+
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
     ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
@@ -308,6 +371,12 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         new_laws[n] = law
         law_tables[n] = {"chosen": law.kind, "candidates": table, "temperatures": Ts, "values": vals,
                          "stderr": ses}
+    fitted = [n for n in names if n not in held]
+    refined = _laws_on_information(Ts, per_T, {n: new_laws[n] for n in fitted})
+    for n in fitted:
+        if refined[n] is not new_laws[n]:  # the candidates' coefficients are by standard errors alone
+            new_laws[n] = refined[n]
+            law_tables[n]["weighted_by_covariance"] = new_laws[n].to_dict()
     details["laws"] = law_tables
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in names})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
