@@ -216,6 +216,9 @@ def _fit_parameter_names(model):
     return default_fit_parameters(model)
 
 
+LOG_SPACE_BELOW = 0.3  # relative standard error below which a parameter's misfit is taken as quadratic in its log
+
+
 def _laws_on_information(Ts, per_T, laws: dict) -> dict:
     """The laws' coefficients refitted to the per-temperature estimates weighted by each temperature's
     full covariance (in log space, where the fits were made), not by its standard errors alone: the
@@ -239,12 +242,16 @@ def _laws_on_information(Ts, per_T, laws: dict) -> dict:
         corr = res.correlation[np.ix_(idx, idx)][np.ix_(known, known)]
         if not known.any() or not np.all(np.isfinite(corr)):
             continue
-        cov_log = corr * np.outer(se[known] / value[known], se[known] / value[known])
+        # well-determined parameters in log space (where the fits were made), a poorly determined one
+        # (sigma1, often) in its own: its misfit is nearer quadratic there
+        log = se[known] < LOG_SPACE_BELOW * value[known]
+        unit = np.where(log, value[known], 1.0)
+        cov = corr * np.outer(se[known] / unit, se[known] / unit)
         try:
-            root = np.linalg.cholesky(np.linalg.inv(cov_log))  # W = root root^T
+            root = np.linalg.cholesky(np.linalg.inv(cov))  # W = root root^T
         except np.linalg.LinAlgError:
             continue
-        blocks.append((T, np.flatnonzero(known), np.log(value[known]), root))
+        blocks.append((T, np.flatnonzero(known), log, np.where(log, np.log(value[known]), value[known]), root))
     if not blocks:
         return laws
     sizes = [len(laws[n].coefficients()) for n in names]
@@ -260,11 +267,11 @@ def _laws_on_information(Ts, per_T, laws: dict) -> dict:
     def residuals(c):
         trial = with_coefficients(c)
         out = []
-        for T, known, log_value, root in blocks:
+        for T, known, log, estimate, root in blocks:
             predicted = np.array([float(trial[names[i]](T)) for i in known])
             if np.any(~np.isfinite(predicted)) or np.any(predicted <= 0):
                 return np.full(sum(len(b[1]) for b in blocks), 1e6)
-            out.append(root.T @ (np.log(predicted) - log_value))
+            out.append(root.T @ (np.where(log, np.log(predicted), predicted) - estimate))
         return np.concatenate(out)
 
     try:
@@ -297,7 +304,19 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         the model the next temperature continues from)."""
         nonlocal held
         T = float(np.mean([e.temperature for e in group]))
-        base = base_model(init, T) if previous is None else previous
+        if previous is None:
+            base = base_model(init, T)
+        else:
+            # the neighbour's values carried along the initial model's laws (by their ratio, which a
+            # wrong level of a law does not change): the paper's sigma0 and fc change by a third over
+            # 3 C, many standard errors that a plain continuation would leave for the fit to walk
+            T_prev, base = previous
+            shifts = {n: float(init.laws[n](T) / init.laws[n](T_prev)) for n in names
+                      if n in init.laws and n not in held}
+            shifts = {n: f for n, f in shifts.items() if math.isfinite(f) and f > 0}
+            if shifts:
+                values = base.friction.values()
+                base = base.with_friction(**{n: values[n] * f for n, f in shifts.items()})
         base = dataclasses.replace(base, thermal=None)
         if held:  # parameters the data cannot determine follow the initial model's law
             base = base.with_friction(**{n: base_model(init, T).friction.values()[n] for n in held})
@@ -327,7 +346,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
                           and res.parameters[n].stderr < abs(res.parameters[n].value))]
         following = res.model.with_friction(**{n: base_model(init, T).friction.values()[n] for n in open_
                                                if n in base_model(init, T).friction.values()}) if open_ else res.model
-        return T, res, following
+        return T, res, (T, following)
 
     def chain(order, previous, neighbour=True):
         out = []
@@ -338,8 +357,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
 
     # the lowest temperature first (it decides what the data cannot determine); then two continuation
     # chains, one per core: upward from it, and downward from the highest temperature, which starts from
-    # the initial model's laws there or, without laws, from the lowest temperature's fit (not a
-    # neighbour: with the multi-start)
+    # the lowest temperature's fit carried there along the initial model's laws (not a neighbour: with
+    # the multi-start)
     T0, res0, following = fit_at(groups[0], None, first_of_all=True)
     rest = list(range(1, len(groups)))
     up, down = rest[:(len(rest) + 1) // 2], rest[(len(rest) + 1) // 2:][::-1]
@@ -347,7 +366,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         from concurrent.futures import ThreadPoolExecutor
         with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-i") as chains:
             lower = chains.submit(chain, up, following)
-            upper = chains.submit(chain, down, None if init.laws else following, False)
+            upper = chains.submit(chain, down, following, False)
             per_T = [(T0, res0)] + lower.result() + upper.result()
     else:
         per_T = [(T0, res0)] + chain(rest, following)
