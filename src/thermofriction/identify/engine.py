@@ -18,6 +18,8 @@ from ..drive import drive
 from ..errors import ComputationError, InputError
 from ..models import Model
 from ..waveforms import Sampled, Waveform
+from .parameters import _TARGET_LAW as _LAW
+from .parameters import _split as split_name
 from .parameters import KNOT, Parameters, get_value, target_of, unit_of, with_values
 from .quality import ADEQUATE_RATIO, noise_level
 
@@ -118,6 +120,17 @@ class Problem:
             self.value_columns = [self.core_names.index(n) for n in values]
             self.core_columns = {j: self.core_names.index(n) for j, n in enumerate(self.names) if j not in self.knots}
         self.targets = np.array([target_of(model, n) for n in self.core_names], dtype=np.int32).reshape(-1, 3)
+        self.chain = None
+        if (not self.knots and _LAW in kinds and model.heat is None
+                and all(isinstance(t.temperature, (int, float)) for t in traces)):
+            # at a constant temperature a Model I law acts only through its value there: the
+            # sensitivities to the parameters themselves, times each law's derivative in its
+            # coefficients, are those to the coefficients at half the cost (3 columns, not 6)
+            laws = sorted({split_name(n)[0] for n, k in zip(self.names, kinds) if k == _LAW})
+            others = [n for n, k in zip(self.names, kinds) if k != _LAW]
+            self.chain = laws + others
+            at = _at_temperature(model, float(traces[0].temperature))
+            self.chain_targets = np.array([target_of(at, n) for n in self.chain], dtype=np.int32).reshape(-1, 3)
         self.traces = traces
         self.rtol = rtol
         self.parallel = parallel
@@ -154,14 +167,22 @@ class Problem:
                     theta = np.array([get_value(model, n) for n in self.core_names])
                     dF_scale = max(float(np.max(np.abs(model.thermal.dF.values))), 1e-300)
                     theta[self.value_columns] = np.maximum(np.abs(theta[self.value_columns]), dF_scale)
+                targets = self.targets
+                if self.chain is not None:  # the model at the run's temperature, sensitivities to its values
+                    model_T = _at_temperature(model, float(trace.temperature))
+                    spec = _bridge.model_spec(model_T, trace.temperature, trace.waveform)
+                    theta = np.array([get_value(model_T, n) for n in self.chain])
+                    targets = self.chain_targets
                 scale = _bridge.state_scale(spec)
                 atol_y = self.rtol * scale
                 atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
                 nstate = len(scale)
                 sens = np.empty((n_out, nstate, len(theta)))
-                _bridge.run_sensitivities(spec, self.targets, trace.time, out, sens, rtol=self.rtol,
+                _bridge.run_sensitivities(spec, targets, trace.time, out, sens, rtol=self.rtol,
                                           atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=_MAX_STEPS)
                 S = sens[:, _bridge.state_index(model, "x_e"), :]
+                if self.chain is not None:
+                    S = S @ self._chain_matrix(model, float(trace.temperature))
                 if self.knots:
                     S_dF = S[:, self.value_columns].sum(axis=1)
                     S = np.column_stack([S_dF * knot_derivative(model.thermal.dF, self.knots[j], trace.temperature)
@@ -180,6 +201,27 @@ class Problem:
             if S is not None:
                 S = np.concatenate([S, w * S_T])
         return r, S
+
+    def _chain_matrix(self, model: Model, T: float) -> np.ndarray:
+        """d(the simulated values)/d(the fitted names) at temperature T: each law's derivative in its
+        coefficients (central differences; exact for the laws linear in them, 1e-8 relative for exp's
+        rate), one for a name simulated as itself."""
+        M = np.zeros((len(self.chain), len(self.names)))
+        for j, name in enumerate(self.names):
+            base, coef = split_name(name)
+            if base not in self.chain or coef is None:
+                M[self.chain.index(name), j] = 1.0
+                continue
+            law = model.laws[base]
+            c = np.array(law.coefficients(), float)
+            k = law.coefficient_names().index(coef)
+            h = 1e-4 * (abs(c[k]) if c[k] != 0 else max(float(np.max(np.abs(c))), 1e-300))
+            up, down = c.copy(), c.copy()
+            up[k] += h
+            down[k] -= h
+            M[self.chain.index(base), j] = (float(law.with_coefficients(up)(T)) -
+                                            float(law.with_coefficients(down)(T))) / (2 * h)
+        return M
 
     def evaluate(self, theta, jac=False):
         """(r, J) at theta; r is None when a simulation failed (the parameters are implausible)."""
@@ -205,6 +247,13 @@ class Problem:
         if model is None:
             return [None] * len(self.traces)
         return [self._run(model, tr, theta, False)[0] for tr in self.traces]
+
+
+def _at_temperature(model: Model, T: float) -> Model:
+    """A Model I model at one constant temperature: its laws' values there as plain parameters."""
+    values = model.parameters_at(T)
+    return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **{n: values[n] for n in model.laws}),
+                               thermal=None)
 
 
 def knot_derivative(law, k, T) -> float:
@@ -357,8 +406,11 @@ class FitOutcome:
 
 
 def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=60,
-        tight=False, progress=None) -> FitOutcome:
-    """Fits the varying parameters; returns the optimum with its residuals and Jacobian."""
+        tight=False, progress=None, near=False) -> FitOutcome:
+    """Fits the varying parameters; returns the optimum with its residuals and Jacobian.
+
+    ``near``: the start is known to be within a standard error or so of the optimum (a refinement from
+    fits that already converged): no coarse stage at rtol 1e-6, whose integration error is of that size."""
     t_start = time.perf_counter()
     varying = params.varying
     if not varying:
@@ -378,13 +430,14 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
         phi_first = phi_start
-        if rtol < 1e-6:
+        if rtol < 1e-6 and not near:
             coarse = Problem(model, names, traces, rtol=1e-6, parallel=not one_trace)
             first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale,
                                    COARSE_STEP)
             phi_start = first.x
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight else 15, tight, scale)
+        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight or near else 15, tight,
+                             scale)
         res.moved = bool(np.any(res.x != phi_first))
         return res, problem
 

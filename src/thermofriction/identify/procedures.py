@@ -425,7 +425,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     ropts = dict(opts)
     ropts["starts"] = 1
     ropts.setdefault("max_nfev", 30)
-    outcome = fit(model, params, traces, **ropts)
+    # from laws through the per-temperature optima weighted by their covariances: near the optimum
+    outcome = fit(model, params, traces, near=True, **ropts)
     res = _result("model-i", model, params, outcome, traces, t0, warns, details)
     res.nfev += sum(r.nfev for _, r in per_T)
     res.njev += sum(r.njev for _, r in per_T)
