@@ -16,8 +16,9 @@ from .. import _bridge
 from .._lazy import lazy
 from ..drive import drive
 from ..errors import ComputationError, InputError
-from ..models import Model
+from ..models import Const, Model, ModelII
 from ..waveforms import Sampled, Waveform
+from .parameters import _TARGET_DF as _DF
 from .parameters import _TARGET_LAW as _LAW
 from .parameters import _split as split_name
 from .parameters import KNOT, Parameters, get_value, target_of, unit_of, with_values
@@ -106,29 +107,22 @@ class Problem:
         self.model = model
         self.names = list(names)
         kinds = [target_of(model, n)[0] for n in self.names]
-        self.knots = {j: target_of(model, n)[2] for j, n in enumerate(self.names) if kinds[j] == KNOT}
-        self.core_names = [n for n, k in zip(self.names, kinds) if k != KNOT]
-        if self.knots:
-            # a breakpoint's column is dx/d(dF at the run's temperature) times d(dF)/d(breakpoint); the
-            # first is the sum of the knot values' columns (their weights sum to one), so every knot
-            # value is a core target, fitted or not
-            if model.heat is not None or any(not isinstance(t.temperature, (int, float)) for t in traces):
-                raise InputError("dF's breakpoints can be fitted only on runs at constant temperature "
-                                 "(no temperature signal, no self-heating)")
-            values = [f"dF.{c}" for c in model.thermal.dF.coefficient_names()]
-            self.core_names += [n for n in values if n not in self.core_names]
-            self.value_columns = [self.core_names.index(n) for n in values]
-            self.core_columns = {j: self.core_names.index(n) for j, n in enumerate(self.names) if j not in self.knots}
-        self.targets = np.array([target_of(model, n) for n in self.core_names], dtype=np.int32).reshape(-1, 3)
+        self.targets = np.array([target_of(model, n) for n in self.names if target_of(model, n)[0] != KNOT],
+                                dtype=np.int32).reshape(-1, 3)
+        # At a constant temperature a temperature law (Model I's laws, Model II's dF) acts only through
+        # its value there: the sensitivities to that value, times the law's derivatives in what is
+        # fitted, are those to the coefficients at a fraction of the cost (Model I: 3 columns, not 6)
+        # -- and the only way to a breakpoint's, which the core has no sensitivity to.
         self.chain = None
-        if (not self.knots and _LAW in kinds and model.heat is None
-                and all(isinstance(t.temperature, (int, float)) for t in traces)):
-            # at a constant temperature a Model I law acts only through its value there: the
-            # sensitivities to the parameters themselves, times each law's derivative in its
-            # coefficients, are those to the coefficients at half the cost (3 columns, not 6)
-            laws = sorted({split_name(n)[0] for n, k in zip(self.names, kinds) if k == _LAW})
-            others = [n for n, k in zip(self.names, kinds) if k != _LAW]
-            self.chain = laws + others
+        thermal = [n for n, k in zip(self.names, kinds) if k in (_LAW, _DF, KNOT)]
+        constant = model.heat is None and all(isinstance(t.temperature, (int, float)) for t in traces)
+        if KNOT in kinds and not constant:
+            raise InputError("dF's breakpoints can be fitted only on runs at constant temperature "
+                             "(no temperature signal, no self-heating)")
+        if thermal and constant:
+            through = ["dF.value"] if isinstance(model.thermal, ModelII) else \
+                sorted({split_name(n)[0] for n in thermal})
+            self.chain = through + [n for n in self.names if n not in thermal]
             at = _at_temperature(model, float(traces[0].temperature))
             self.chain_targets = np.array([target_of(at, n) for n in self.chain], dtype=np.int32).reshape(-1, 3)
         self.traces = traces
@@ -163,16 +157,15 @@ class Problem:
                 _bridge.run(spec, trace.time, out, method="dopri5", rtol=self.rtol, max_steps=_MAX_STEPS)
                 S = None
             else:
-                if self.knots:  # the tolerance of a knot value pinned at zero in the units of dF's scale
-                    theta = np.array([get_value(model, n) for n in self.core_names])
-                    dF_scale = max(float(np.max(np.abs(model.thermal.dF.values))), 1e-300)
-                    theta[self.value_columns] = np.maximum(np.abs(theta[self.value_columns]), dF_scale)
                 targets = self.targets
                 if self.chain is not None:  # the model at the run's temperature, sensitivities to its values
                     model_T = _at_temperature(model, float(trace.temperature))
                     spec = _bridge.model_spec(model_T, trace.temperature, trace.waveform)
                     theta = np.array([get_value(model_T, n) for n in self.chain])
                     targets = self.chain_targets
+                    if isinstance(model.thermal, ModelII):  # dF(T) at or near zero: tolerance in dF's scale
+                        dF_scale = max(float(np.max(np.abs(model.thermal.dF.coefficients() or [0.0]))), 1e-300)
+                        theta[0] = max(abs(theta[0]), dF_scale)
                 scale = _bridge.state_scale(spec)
                 atol_y = self.rtol * scale
                 atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
@@ -183,11 +176,6 @@ class Problem:
                 S = sens[:, _bridge.state_index(model, "x_e"), :]
                 if self.chain is not None:
                     S = S @ self._chain_matrix(model, float(trace.temperature))
-                if self.knots:
-                    S_dF = S[:, self.value_columns].sum(axis=1)
-                    S = np.column_stack([S_dF * knot_derivative(model.thermal.dF, self.knots[j], trace.temperature)
-                                         if j in self.knots else S[:, self.core_columns[j]]
-                                         for j in range(len(self.names))])
                 S_T = sens[:, _bridge.state_index(model, "T"), :] if heated else None
         except _bridge.CoreFailure:
             return None, None
@@ -203,24 +191,27 @@ class Problem:
         return r, S
 
     def _chain_matrix(self, model: Model, T: float) -> np.ndarray:
-        """d(the simulated values)/d(the fitted names) at temperature T: each law's derivative in its
-        coefficients (central differences; exact for the laws linear in them, 1e-8 relative for exp's
-        rate), one for a name simulated as itself."""
+        """d(the simulated values)/d(the fitted names) at temperature T: a law's derivative in a
+        coefficient by central differences (exact for the laws linear in them, 1e-8 relative for
+        exp's rate), in a breakpoint analytically; one for a name simulated as itself."""
         M = np.zeros((len(self.chain), len(self.names)))
         for j, name in enumerate(self.names):
-            base, coef = split_name(name)
-            if base not in self.chain or coef is None:
+            if name in self.chain:
                 M[self.chain.index(name), j] = 1.0
                 continue
-            law = model.laws[base]
+            base, coef = split_name(name)
+            law = model.thermal.dF if base == "dF" else model.laws[base]
+            row = 0 if base == "dF" else self.chain.index(base)
+            kind, _, k = target_of(model, name)
+            if kind == KNOT:
+                M[row, j] = knot_derivative(law, k, T)
+                continue
             c = np.array(law.coefficients(), float)
-            k = law.coefficient_names().index(coef)
             h = 1e-4 * (abs(c[k]) if c[k] != 0 else max(float(np.max(np.abs(c))), 1e-300))
             up, down = c.copy(), c.copy()
             up[k] += h
             down[k] -= h
-            M[self.chain.index(base), j] = (float(law.with_coefficients(up)(T)) -
-                                            float(law.with_coefficients(down)(T))) / (2 * h)
+            M[row, j] = (float(law.with_coefficients(up)(T)) - float(law.with_coefficients(down)(T))) / (2 * h)
         return M
 
     def evaluate(self, theta, jac=False):
@@ -250,7 +241,10 @@ class Problem:
 
 
 def _at_temperature(model: Model, T: float) -> Model:
-    """A Model I model at one constant temperature: its laws' values there as plain parameters."""
+    """The model at one constant temperature: Model I's laws' values there as plain parameters,
+    Model II's dF as a constant."""
+    if isinstance(model.thermal, ModelII):
+        return dataclasses.replace(model, thermal=ModelII(Const(float(model.thermal.dF(T)))))
     values = model.parameters_at(T)
     return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **{n: values[n] for n in model.laws}),
                                thermal=None)

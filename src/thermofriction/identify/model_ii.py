@@ -14,7 +14,7 @@ from ..drive import experiment_waveform
 from ..errors import InputError
 from ..models import PWL, Const, Model, ModelII
 from ..simulate import simulate
-from .engine import Problem, fit, make_traces
+from .engine import Problem, fit, make_traces, pool
 from .laws import _aicc, segmented_fit
 from .parameters import Parameters, get_value, unit_of
 from .procedures import _fit_parameter_names, _groups, _result, base_model, fit_friction
@@ -121,11 +121,22 @@ def _dF_start(group, m, fc, previous, opts):
     neighbouring temperature's value (continuation) in the scan."""
     grid = sorted(set(np.round(np.linspace(-0.9, 0.9, 13) * fc, 12)) | {0.0, float(previous)})
     traces = make_traces(group, m)
-    problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), 1e-6))
-    costs = []
-    for v in grid:
+    problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), 1e-6), parallel=False)
+
+    def cost(v):
         r, _ = problem.evaluate(np.array([v]))
-        costs.append(math.inf if r is None else float(r @ r))
+        return math.inf if r is None else float(r @ r)
+
+    costs = list(pool().map(cost, grid))  # the runs are independent: one per core
+    # the grid is coarse (0.15 fc) against a minimum that can be narrower (a stick-slip step's size
+    # changes fast with friction): a finer look around the best point, at a few plain runs' cost, saves
+    # a fit that would start in a neighbouring local minimum and stay there
+    best = int(np.argmin(costs))
+    step = 0.15 * fc
+    local = [grid[best] + f * step for f in (-2 / 3, -1 / 3, 1 / 3, 2 / 3)]
+    local = [v for v in local if -0.95 * fc < v and all(abs(v - g) > 1e-3 * step for g in grid)]
+    scan = sorted(zip(list(grid) + local, costs + list(pool().map(cost, local))))
+    grid, costs = [v for v, _ in scan], [c for _, c in scan]
     return float(grid[int(np.argmin(costs))]), {"grid": grid, "cost": costs}
 
 
