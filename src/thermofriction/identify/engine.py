@@ -310,12 +310,22 @@ class _Converged(Exception):
         self.phi = phi
 
 
-def gauss_newton_length(r, J) -> float:
-    """The length of the Gauss-Newton step from where ``r``, ``J`` were taken, in standard errors: on
-    residuals in units of the noise, |J dx| (the cost it would remove is half its square) bounds
-    every parameter's move divided by its standard error."""
-    dx, *_ = np.linalg.lstsq(J, -r, rcond=None)
-    return float(np.linalg.norm(J @ dx))
+def gauss_newton_length(qr, R) -> float:
+    """The length of the Gauss-Newton step from where residuals r = Q qr + (the rest) and Jacobian
+    J = Q R were taken, in standard errors: on residuals in units of the noise, |J dx| (the cost it
+    would remove is half its square) bounds every parameter's move divided by its standard error."""
+    dx, *_ = np.linalg.lstsq(R, -qr, rcond=None)
+    return float(np.linalg.norm(R @ dx))
+
+
+def _compressed(r, J):
+    """(f, G), n + 1 rows, with |f| = |r|, G^T f = J^T r and G^T G = J^T J: everything the trust-region
+    iteration uses, so that it takes the same steps, but at the cost of n + 1 rows instead of one per
+    sample (its SVD and products on 10^5 x 6 matrices cost more than a short simulation)."""
+    Q, R = np.linalg.qr(J)
+    qr = Q.T @ r
+    rest = float(np.linalg.norm(r - Q @ qr))
+    return np.append(qr, rest), np.vstack([R, np.zeros((1, J.shape[1]))])
 
 
 def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale,
@@ -340,15 +350,16 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
             theta = transform.to_theta(phi)
             r, J = problem.evaluate(theta, jac=True)
             if r is None:  # a failed simulation: a large, flat residual pushes the step back
-                rs = np.full(problem.n_points, 1e3 * max(_y_scale(problem), 1e-12)) / scale
-                Js = np.zeros((problem.n_points, len(phi)))
+                f = np.zeros(len(phi) + 1)
+                f[-1] = 1e3 * max(_y_scale(problem), 1e-12) / scale * math.sqrt(problem.n_points)
+                G = np.zeros((len(phi) + 1, len(phi)))
             else:
-                rs, Js = r / scale, J * (transform.dtheta_dphi(theta)[None, :] / scale)
-            cache[key] = (rs, Js, r, J)
-            cost = 0.5 * float(rs @ rs)
+                f, G = _compressed(r / scale, J * (transform.dtheta_dphi(theta)[None, :] / scale))
+            cache[key] = (f, G, r, J)
+            cost = 0.5 * float(f @ f)
             if (r is not None and not tight and cost <= best_cost[0] + 0.5
-                    and math.sqrt(2.0 * cost / max(rs.size, 1)) <= AT_NOISE
-                    and gauss_newton_length(rs, Js) < small_step):
+                    and math.sqrt(2.0 * cost / max(r.size, 1)) <= AT_NOISE
+                    and gauss_newton_length(f[:-1], G[:-1]) < small_step):
                 raise _Converged(phi.copy())
             best_cost[0] = min(best_cost[0], cost)
         return cache[key]
@@ -364,9 +375,9 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
                                      method="trf", x_scale="jac", ftol=tol, xtol=tol,
                                      gtol=1e-15 if tight else 1e-4, max_nfev=max_nfev)
     except _Converged as stop:
-        rs = cache[stop.phi.tobytes()][0]
+        f = cache[stop.phi.tobytes()][0]
         res = optimize.OptimizeResult(
-            x=stop.phi, fun=rs, cost=0.5 * float(rs @ rs), success=True, status=1,
+            x=stop.phi, fun=f, cost=0.5 * float(f @ f), success=True, status=1,
             message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise")
     res.evaluated = {k: v[2:] for k, v in cache.items()}
     return res
@@ -418,6 +429,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     one_trace = len(traces) == 1
 
     scale = residual_scale(traces)
+    residual_count = sum(t.n_residuals for t in traces)
 
     def run(phi_start):
         # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
@@ -436,7 +448,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         return res, problem
 
     def at_noise(res):  # residuals at the data's noise: another start cannot do meaningfully better
-        return math.sqrt(2.0 * res.cost / max(res.fun.size, 1)) <= AT_NOISE
+        return math.sqrt(2.0 * res.cost / max(residual_count, 1)) <= AT_NOISE
 
     # The initial guess first. Only if it does not reach the noise, the global phase: screen a Latin
     # hypercube around it (a decade either way for log parameters, +-100 % for the others) by cost

@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -145,12 +147,11 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     popts = dict(opts)
     popts["starts"] = 1
     fc = base.reference_force()
-    # continuation outward from the reference temperature, where dF is smallest
-    order = sorted(range(len(groups)), key=lambda i: abs(float(np.mean([e.temperature for e in groups[i]])) - T_ref))
-    previous, fits, scans = 0.0, {}, {}
-    for i in order:
-        g = groups[i]
-        T = float(np.mean([e.temperature for e in g]))
+    fits, scans = {}, {}
+    temperature = [float(np.mean([e.temperature for e in g])) for g in groups]
+
+    def fit_at(i, previous):
+        g, T = groups[i], temperature[i]
         if progress:
             progress(f"Model II (direct): dF at {T:.4g} C")
         m = dataclasses.replace(base, thermal=ModelII(Const(0.0)))
@@ -161,7 +162,30 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         r = fit_friction(g, dataclasses.replace(m, thermal=ModelII(Const(start))), params,
                          method=f"dF at {T:.4g} C", **popts)
         fits[i] = (T, r)
-        previous = r.parameters["dF.value"].value
+        return r.parameters["dF.value"].value
+
+    def chain(order, previous):
+        for i in order:
+            previous = fit_at(i, previous)
+
+    # continuation outward from the reference temperature, where dF is smallest: two chains, one per
+    # core, below and above it (all on one side: outward from it, and inward from the farthest, whose
+    # scan starts it without a neighbour)
+    order = sorted(range(len(groups)), key=lambda i: abs(temperature[i] - T_ref))
+    at_ref = fit_at(order[0], 0.0)
+    below = [i for i in order[1:] if temperature[i] < T_ref]
+    above = [i for i in order[1:] if temperature[i] >= T_ref]
+    if below and above:
+        chains = [below, above]
+    else:
+        side = below or above
+        chains = [side[:(len(side) + 1) // 2], side[(len(side) + 1) // 2:][::-1]]
+    if chains[1] and (os.cpu_count() or 1) > 1:
+        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-ii") as executor:
+            for future in [executor.submit(chain, c, at_ref) for c in chains]:
+                future.result()
+    else:
+        chain(order[1:], at_ref)
     per_T = [fits[i] for i in range(len(groups))]
     Ts = np.array([T for T, _ in per_T])
     vals = np.array([r.parameters["dF.value"].value for _, r in per_T])
