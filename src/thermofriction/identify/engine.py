@@ -24,7 +24,7 @@ from .parameters import _split as split_name
 from .parameters import KNOT, Parameters, get_value, target_of, unit_of, with_values
 from .quality import ADEQUATE_RATIO, noise_level
 
-optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
+optimize, stats, special = lazy("scipy.optimize"), lazy("scipy.stats"), lazy("scipy.special")
 
 _MAX_STEPS = 2_000_000
 #: RMSE within this factor of the noise: a fit at the noise, where the multi-start stops
@@ -529,7 +529,7 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
         corr = cov / np.outer(se, se)
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
-    tq = stats.t.ppf(0.975, dof)
+    tq = float(special.stdtrit(dof, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
     warnings = []
     for i, par in enumerate(varying):
         par.value = float(theta[i])

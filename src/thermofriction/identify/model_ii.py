@@ -168,24 +168,23 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         for i in order:
             previous = fit_at(i, previous)
 
-    # continuation outward from the reference temperature, where dF is smallest: two chains, one per
-    # core, below and above it (all on one side: outward from it, and inward from the farthest, whose
-    # scan starts it without a neighbour)
+    # continuation outward from the reference temperature, where dF is smallest (zero, which every
+    # scan tries): two chains, one per core, from it downward and upward (all on one side: outward
+    # from it, and inward from the farthest, whose scan starts it without a neighbour)
     order = sorted(range(len(groups)), key=lambda i: abs(temperature[i] - T_ref))
-    at_ref = fit_at(order[0], 0.0)
     below = [i for i in order[1:] if temperature[i] < T_ref]
     above = [i for i in order[1:] if temperature[i] >= T_ref]
     if below and above:
-        chains = [below, above]
+        chains = [[order[0]] + below, above]
     else:
         side = below or above
-        chains = [side[:(len(side) + 1) // 2], side[(len(side) + 1) // 2:][::-1]]
+        chains = [[order[0]] + side[:len(side) // 2], side[len(side) // 2:][::-1]]
     if chains[1] and (os.cpu_count() or 1) > 1:
         with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-ii") as executor:
-            for future in [executor.submit(chain, c, at_ref) for c in chains]:
+            for future in [executor.submit(chain, c, 0.0) for c in chains]:
                 future.result()
     else:
-        chain(order[1:], at_ref)
+        chain(order, 0.0)
     per_T = [fits[i] for i in range(len(groups))]
     Ts = np.array([T for T, _ in per_T])
     vals = np.array([r.parameters["dF.value"].value for _, r in per_T])
