@@ -9,6 +9,7 @@
 
 Run: python benchmarks/bench_identify.py [--baseline-evals N] (default 40: the baseline's budget)
                                          [--quick] (only the end-to-end part, 1.)
+                                         [--repeat N] (N end-to-end runs each, the fastest reported)
                                          [--values FILE] (write the recovered values to FILE (JSON))
                                          [--compare FILE] (compare them with those of an earlier run)
 """
@@ -80,6 +81,19 @@ def baseline_fit(exp, start, max_nfev, rtol):
     return res, time.perf_counter() - t0, count["sims"], dict(zip(names, np.exp(res.x)))
 
 
+def timed(run, repeat):
+    """(result, wall time, CPU time of all threads) of the fastest of ``repeat`` runs: the machine is
+    shared, and the least disturbed run is the one that measures our code."""
+    best = None
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        out = run()
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        if best is None or wall < best[1]:
+            best = (out, wall, cpu)
+    return best
+
+
 def recovered(fit):
     """The fitted parameters with their 95 % intervals: {name: [value, low, high]}."""
     return {n: [p.value, float(p.ci95[0]), float(p.ci95[1])] for n, p in fit.parameters.items() if p.vary}
@@ -105,6 +119,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--baseline-evals", type=int, default=40)
     ap.add_argument("--quick", action="store_true", help="only the end-to-end identifications")
+    ap.add_argument("--repeat", type=int, default=1, help="end-to-end runs of each (the fastest is reported)")
     ap.add_argument("--values", help="write the recovered values (JSON) to this file")
     ap.add_argument("--compare", help="compare the recovered values with those in this file (from --values)")
     args = ap.parse_args()
@@ -112,11 +127,9 @@ def main():
 
     truth_i = perturbed_model_i()
     data_i = experiments(truth_i, 1)
-    t0 = time.perf_counter()
-    fit_i = identify(data_i, "model-i", init="li2009-model-i")
-    t_i = time.perf_counter() - t0
-    print(f"Model I end to end   {t_i:6.2f} s   rmse {fit_i.rmse * 1e9:.1f} nm   {fit_i.nfev} evaluations   "
-          f"(target <= {TARGET_MODEL_I:g} s: {'met' if t_i <= TARGET_MODEL_I else 'NOT met'})")
+    fit_i, t_i, cpu_i = timed(lambda: identify(data_i, "model-i", init="li2009-model-i"), args.repeat)
+    print(f"Model I end to end   {t_i:6.2f} s   (CPU {cpu_i:.2f} s)   rmse {fit_i.rmse * 1e9:.1f} nm   {fit_i.nfev} "
+          f"evaluations   (target <= {TARGET_MODEL_I:g} s: {'met' if t_i <= TARGET_MODEL_I else 'NOT met'})")
     for name in ("sigma0.a", "sigma0.b", "fc.a", "fc.b"):
         p = fit_i.parameters[name]
         true = {"sigma0.a": truth_i.laws["sigma0"].a, "sigma0.b": truth_i.laws["sigma0"].b,
@@ -125,13 +138,11 @@ def main():
 
     truth_ii = perturbed_model_ii()
     data_ii = experiments(truth_ii, 2)
-    t0 = time.perf_counter()
-    fit_ii = identify(data_ii, "model-ii", init="li2009-base")
-    t_ii = time.perf_counter() - t0
+    fit_ii, t_ii, cpu_ii = timed(lambda: identify(data_ii, "model-ii", init="li2009-base"), args.repeat)
     T = np.array(TEMPS)
     dev = np.max(np.abs(fit_ii.model.thermal.dF(T) - truth_ii.thermal.dF(T)))
-    print(f"Model II end to end  {t_ii:6.2f} s   rmse {fit_ii.rmse * 1e9:.1f} nm   {fit_ii.nfev} evaluations   "
-          f"max |dF - truth| {dev * 1e3:.2f} mN   (target <= {TARGET_MODEL_II:g} s: "
+    print(f"Model II end to end  {t_ii:6.2f} s   (CPU {cpu_ii:.2f} s)   rmse {fit_ii.rmse * 1e9:.1f} nm   {fit_ii.nfev} "
+          f"evaluations   max |dF - truth| {dev * 1e3:.2f} mN   (target <= {TARGET_MODEL_II:g} s: "
           f"{'met' if t_ii <= TARGET_MODEL_II else 'NOT met'})\n")
     values = {"model-i": recovered(fit_i), "model-ii": recovered(fit_ii)}
     if args.values:
