@@ -139,7 +139,19 @@ def _dF_start(group, m, fc, previous, opts):
     local = [v for v in local if -0.95 * fc < v and all(abs(v - g) > 1e-3 * step for g in grid)]
     scan = sorted(zip(list(grid) + local, costs + list(pool().map(cost, local))))
     grid, costs = [v for v, _ in scan], [c for _, c in scan]
-    return float(grid[int(np.argmin(costs))]), {"grid": grid, "cost": costs}
+    best = int(np.argmin(costs))
+    start = float(grid[best])
+    if 0 < best < len(grid) - 1 and all(math.isfinite(c) for c in costs[best - 1:best + 2]):
+        # the cost is near quadratic this close to its minimum: the parabola's vertex through the best
+        # point and its neighbours, kept if it is better still (one more run), starts the fit closer
+        (x0, x1, x2), (c0, c1, c2) = grid[best - 1:best + 2], costs[best - 1:best + 2]
+        slope_left, slope_right = (c1 - c0) / (x1 - x0), (c2 - c1) / (x2 - x1)  # at the midpoints
+        if slope_right > slope_left:  # where the slope, linear in between, is zero
+            vertex = 0.5 * (x0 + x1) - slope_left * 0.5 * (x2 - x0) / (slope_right - slope_left)
+            vertex = float(min(max(vertex, x0), x2))
+            if -0.95 * fc < vertex and cost(vertex) < costs[best]:
+                start = vertex
+    return start, {"grid": grid, "cost": costs}
 
 
 def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=()):
