@@ -167,7 +167,10 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         if progress:
             progress(f"Model II (direct): dF at {T:.4g} C")
         m = dataclasses.replace(base, thermal=ModelII(Const(0.0)))
-        start, scans[T] = _dF_start(g, m, fc, previous, popts)
+        if i == order[0]:  # the base model was fitted here: dF = 0 is its optimum, no scan needed
+            start, scans[T] = 0.0, {"grid": [], "cost": [], "note": "the reference temperature: dF = 0"}
+        else:
+            start, scans[T] = _dF_start(g, m, fc, previous, popts)
         params = Parameters()
         # lambda = 1 + dF/fc stays positive: friction never reverses
         params.add("dF.value", start, min=-0.95 * fc, max=10.0 * fc, unit="N")
