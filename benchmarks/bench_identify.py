@@ -8,10 +8,15 @@
    least_squares with finite differences), from the same initial guess, and the ratio.
 
 Run: python benchmarks/bench_identify.py [--baseline-evals N] (default 40: the baseline's budget)
+                                         [--quick] (only the end-to-end part, 1.)
+                                         [--repeat N] (N end-to-end runs each, the fastest reported)
+                                         [--values FILE] (write the recovered values to FILE (JSON))
+                                         [--compare FILE] (compare them with those of an earlier run)
 """
 
 import argparse
 import dataclasses
+import json
 import math
 import sys
 import time
@@ -28,6 +33,8 @@ import thermofriction as tf  # noqa: E402
 from thermofriction.identify import fit_friction, identify  # noqa: E402
 
 TEMPS = (30.8, 33.9, 35.7, 38.4, 41.5)
+#: end-to-end targets on this dataset (issue 18) [s]
+TARGET_MODEL_I, TARGET_MODEL_II = 2.0, 1.0
 
 
 def experiments(model, seed):
@@ -74,18 +81,55 @@ def baseline_fit(exp, start, max_nfev, rtol):
     return res, time.perf_counter() - t0, count["sims"], dict(zip(names, np.exp(res.x)))
 
 
+def timed(run, repeat):
+    """(result, wall time, CPU time of all threads) of the fastest of ``repeat`` runs: the machine is
+    shared, and the least disturbed run is the one that measures our code."""
+    best = None
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        out = run()
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        if best is None or wall < best[1]:
+            best = (out, wall, cpu)
+    return best
+
+
+def recovered(fit):
+    """The fitted parameters with their 95 % intervals: {name: [value, low, high]}."""
+    return {n: [p.value, float(p.ci95[0]), float(p.ci95[1])] for n, p in fit.parameters.items() if p.vary}
+
+
+def compare(now, before):
+    """Each value of this run against the earlier run's, in units of the earlier 95 % half-width."""
+    worst = 0.0
+    for model in now:
+        for name, (v, lo, hi) in now[model].items():
+            if name not in before.get(model, {}):
+                continue
+            v0, lo0, hi0 = before[model][name]
+            half = 0.5 * (hi0 - lo0)
+            shift = abs(v - v0) / half if half > 0 and math.isfinite(half) else 0.0
+            worst = max(worst, shift)
+            print(f"    {model:8s} {name:12s} before {v0:12.6g}  now {v:12.6g}  shift {shift:.3f} x the 95 % "
+                  f"half-width")
+    print(f"  largest shift: {worst:.3f} of a 95 % half-width")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--baseline-evals", type=int, default=40)
+    ap.add_argument("--quick", action="store_true", help="only the end-to-end identifications")
+    ap.add_argument("--repeat", type=int, default=1, help="end-to-end runs of each (the fastest is reported)")
+    ap.add_argument("--values", help="write the recovered values (JSON) to this file")
+    ap.add_argument("--compare", help="compare the recovered values with those in this file (from --values)")
     args = ap.parse_args()
     print("Identification benchmark (2 cores), dataset: 5 temperatures x 2 s at 10 kHz, 20 nm noise\n")
 
     truth_i = perturbed_model_i()
     data_i = experiments(truth_i, 1)
-    t0 = time.perf_counter()
-    fit_i = identify(data_i, "model-i", init="li2009-model-i")
-    t_i = time.perf_counter() - t0
-    print(f"Model I end to end   {t_i:6.2f} s   rmse {fit_i.rmse * 1e9:.1f} nm   (target < 30 s)")
+    fit_i, t_i, cpu_i = timed(lambda: identify(data_i, "model-i", init="li2009-model-i"), args.repeat)
+    print(f"Model I end to end   {t_i:6.2f} s   (CPU {cpu_i:.2f} s)   rmse {fit_i.rmse * 1e9:.1f} nm   {fit_i.nfev} "
+          f"evaluations   (target <= {TARGET_MODEL_I:g} s: {'met' if t_i <= TARGET_MODEL_I else 'NOT met'})")
     for name in ("sigma0.a", "sigma0.b", "fc.a", "fc.b"):
         p = fit_i.parameters[name]
         true = {"sigma0.a": truth_i.laws["sigma0"].a, "sigma0.b": truth_i.laws["sigma0"].b,
@@ -94,13 +138,21 @@ def main():
 
     truth_ii = perturbed_model_ii()
     data_ii = experiments(truth_ii, 2)
-    t0 = time.perf_counter()
-    fit_ii = identify(data_ii, "model-ii", init="li2009-base")
-    t_ii = time.perf_counter() - t0
+    fit_ii, t_ii, cpu_ii = timed(lambda: identify(data_ii, "model-ii", init="li2009-base"), args.repeat)
     T = np.array(TEMPS)
     dev = np.max(np.abs(fit_ii.model.thermal.dF(T) - truth_ii.thermal.dF(T)))
-    print(f"Model II end to end  {t_ii:6.2f} s   rmse {fit_ii.rmse * 1e9:.1f} nm   max |dF - truth| "
-          f"{dev * 1e3:.2f} mN   (target < 10 s)\n")
+    print(f"Model II end to end  {t_ii:6.2f} s   (CPU {cpu_ii:.2f} s)   rmse {fit_ii.rmse * 1e9:.1f} nm   {fit_ii.nfev} "
+          f"evaluations   max |dF - truth| {dev * 1e3:.2f} mN   (target <= {TARGET_MODEL_II:g} s: "
+          f"{'met' if t_ii <= TARGET_MODEL_II else 'NOT met'})\n")
+    values = {"model-i": recovered(fit_i), "model-ii": recovered(fit_ii)}
+    if args.values:
+        Path(args.values).write_text(json.dumps(values, indent=1))
+    if args.compare:
+        print(f"Recovered values against {args.compare}:")
+        compare(values, json.loads(Path(args.compare).read_text()))
+        print()
+    if args.quick:
+        return
 
     exp = data_i.experiments[2]
     p = truth_i.parameters_at(exp.temperature)

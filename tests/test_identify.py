@@ -120,3 +120,60 @@ def test_model_ii_direct_and_paper_procedures__synthetic_truth(model_ii):
     paper = res.alternatives["paper"].model.thermal.dF
     assert np.all(np.diff(paper(T)) < 0)  # friction falls with temperature, as in the paper
     assert res.details["paper"]["linear_fit"]["r2"] > 0.9
+
+
+def test_law_coefficient_jacobian_matches_finite_differences__independent_derivative(model_i):
+    """Model I's law coefficients: their Jacobian columns (the sensitivities to the parameters at each
+    run's temperature times the laws' derivatives) against central differences of whole simulations."""
+    from thermofriction.identify.parameters import get_value
+    exps = synthetic_experiments(model_i, [31.0, 40.0], duration=0.4, noise=20e-9)
+    names = ["sigma0.a", "sigma0.b", "sigma1.a", "fc.b"]
+    problem = Problem(model_i, names, make_traces(exps, model_i), rtol=1e-11, parallel=False)
+    assert problem.chain is not None
+    theta = np.array([get_value(model_i, n) for n in names]) * np.array([1.1, 1.02, 0.9, 0.98])
+    r, J = problem.evaluate(theta, jac=True)
+    problem.rtol = 1e-13
+    for k, name in enumerate(names):
+        h = 1e-4 * abs(theta[k])
+        tp, tm = theta.copy(), theta.copy()
+        tp[k] += h
+        tm[k] -= h
+        fd = (problem.evaluate(tp)[0] - problem.evaluate(tm)[0]) / (2 * h)
+        assert np.linalg.norm(J[:, k] - fd) < 1e-3 * np.linalg.norm(fd), name
+
+
+def test_dF_value_jacobian_matches_finite_differences__independent_derivative(model_ii):
+    """Model II's dF knot values: their columns (the sensitivity to dF at each run's temperature times
+    the law's weights there) against central differences of whole simulations."""
+    from thermofriction.identify.parameters import get_value
+    exps = synthetic_experiments(model_ii, [32.0, 39.0], duration=0.4, noise=20e-9)
+    names = [f"dF.{c}" for c in model_ii.thermal.dF.coefficient_names()] + ["fc"]
+    problem = Problem(model_ii, names, make_traces(exps, model_ii), rtol=1e-11, parallel=False)
+    theta = np.array([get_value(model_ii, n) for n in names])
+    r, J = problem.evaluate(theta, jac=True)
+    problem.rtol = 1e-13
+    scale = max(abs(v) for v in model_ii.thermal.dF.values)
+    for k, name in enumerate(names):
+        h = 1e-4 * (scale if name.startswith("dF") else abs(theta[k]))  # dF values near 0: its scale
+        tp, tm = theta.copy(), theta.copy()
+        tp[k] += h
+        tm[k] -= h
+        fd = (problem.evaluate(tp)[0] - problem.evaluate(tm)[0]) / (2 * h)
+        # a knot no run's temperature reaches has a zero column
+        assert np.linalg.norm(J[:, k] - fd) <= 1e-3 * max(np.linalg.norm(fd), np.linalg.norm(J, axis=0).max()), name
+
+
+def test_a_fit_stopped_by_the_small_step_rule_is_at_the_optimum__tight_reference(model_i):
+    """The fit stops where the Gauss-Newton step is below 0.1 standard errors at a misfit at the
+    noise: driven on from there to the solver's floor (tight), no parameter moves by more than 0.2 of
+    its standard error."""
+    truth = base_at(36.5, model_i)
+    exps = synthetic_experiments(truth, [36.5], duration=1.0, noise=20e-9, seed=5)
+    start = truth.with_friction(sigma0=truth.friction.sigma0 * 1.4, sigma1=truth.friction.sigma1 * 0.6,
+                                fc=truth.friction.fc * 0.75)
+    quick = fit_friction(exps, start, starts=1)
+    assert quick.success
+    polished = fit_friction(exps, quick.model, starts=1, tight=True, max_nfev=40)
+    for name in ("sigma0", "sigma1", "fc"):
+        p = quick.parameters[name]
+        assert abs(polished.parameters[name].value - p.value) < 0.2 * p.stderr, name

@@ -11,7 +11,7 @@ import numbers
 
 from ..errors import InputError, shorten
 from ..models import Model, StickSlipPlant, load_model
-from .engine import fit, make_traces, uncertainty
+from .engine import fit, make_traces, one_blas_thread, uncertainty
 from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
 from .laws import fit_law, segmented_fit
 from .model_ii import identify_model_ii
@@ -85,6 +85,7 @@ def with_friction_model(model: Model, kind: str) -> Model:
 
 
 @stamped  # the fitted model's name and provenance (result.py)
+@one_blas_thread  # (engine.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
              refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None, offset=True) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.

@@ -5,6 +5,7 @@ Levenberg-Marquardt (SciPy ``least_squares``), and uncertainty from the Jacobian
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import time
@@ -16,12 +17,15 @@ from .. import _bridge
 from .._lazy import lazy
 from ..drive import drive
 from ..errors import ComputationError, InputError
-from ..models import Model
+from ..models import Const, Model, ModelII
 from ..waveforms import Sampled, Waveform
+from .parameters import _TARGET_DF as _DF
+from .parameters import _TARGET_LAW as _LAW
+from .parameters import _split as split_name
 from .parameters import KNOT, Parameters, get_value, target_of, unit_of, with_values
 from .quality import ADEQUATE_RATIO, noise_level
 
-optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
+optimize, stats, special = lazy("scipy.optimize"), lazy("scipy.stats"), lazy("scipy.special")
 
 _MAX_STEPS = 2_000_000
 #: RMSE within this factor of the noise: a fit at the noise, where the multi-start stops
@@ -104,20 +108,24 @@ class Problem:
         self.model = model
         self.names = list(names)
         kinds = [target_of(model, n)[0] for n in self.names]
-        self.knots = {j: target_of(model, n)[2] for j, n in enumerate(self.names) if kinds[j] == KNOT}
-        self.core_names = [n for n, k in zip(self.names, kinds) if k != KNOT]
-        if self.knots:
-            # a breakpoint's column is dx/d(dF at the run's temperature) times d(dF)/d(breakpoint); the
-            # first is the sum of the knot values' columns (their weights sum to one), so every knot
-            # value is a core target, fitted or not
-            if model.heat is not None or any(not isinstance(t.temperature, (int, float)) for t in traces):
-                raise InputError("dF's breakpoints can be fitted only on runs at constant temperature "
-                                 "(no temperature signal, no self-heating)")
-            values = [f"dF.{c}" for c in model.thermal.dF.coefficient_names()]
-            self.core_names += [n for n in values if n not in self.core_names]
-            self.value_columns = [self.core_names.index(n) for n in values]
-            self.core_columns = {j: self.core_names.index(n) for j, n in enumerate(self.names) if j not in self.knots}
-        self.targets = np.array([target_of(model, n) for n in self.core_names], dtype=np.int32).reshape(-1, 3)
+        self.targets = np.array([target_of(model, n) for n in self.names if target_of(model, n)[0] != KNOT],
+                                dtype=np.int32).reshape(-1, 3)
+        # At a constant temperature a temperature law (Model I's laws, Model II's dF) acts only through
+        # its value there: the sensitivities to that value, times the law's derivatives in what is
+        # fitted, are those to the coefficients at a fraction of the cost (Model I: 3 columns, not 6)
+        # -- and the only way to a breakpoint's, which the core has no sensitivity to.
+        self.chain = None
+        thermal = [n for n, k in zip(self.names, kinds) if k in (_LAW, _DF, KNOT)]
+        constant = model.heat is None and all(isinstance(t.temperature, (int, float)) for t in traces)
+        if KNOT in kinds and not constant:
+            raise InputError("dF's breakpoints can be fitted only on runs at constant temperature "
+                             "(no temperature signal, no self-heating)")
+        if thermal and constant:
+            through = ["dF.value"] if isinstance(model.thermal, ModelII) else \
+                sorted({split_name(n)[0] for n in thermal})
+            self.chain = through + [n for n in self.names if n not in thermal]
+            at = _at_temperature(model, float(traces[0].temperature))
+            self.chain_targets = np.array([target_of(at, n) for n in self.chain], dtype=np.int32).reshape(-1, 3)
         self.traces = traces
         self.rtol = rtol
         self.parallel = parallel
@@ -150,23 +158,28 @@ class Problem:
                 _bridge.run(spec, trace.time, out, method="dopri5", rtol=self.rtol, max_steps=_MAX_STEPS)
                 S = None
             else:
-                if self.knots:  # the tolerance of a knot value pinned at zero in the units of dF's scale
-                    theta = np.array([get_value(model, n) for n in self.core_names])
-                    dF_scale = max(float(np.max(np.abs(model.thermal.dF.values))), 1e-300)
-                    theta[self.value_columns] = np.maximum(np.abs(theta[self.value_columns]), dF_scale)
+                targets = self.targets
+                if self.chain is not None:  # the model at the run's temperature, sensitivities to its values
+                    model_T = _at_temperature(model, float(trace.temperature))
+                    spec = _bridge.model_spec(model_T, trace.temperature, trace.waveform)
+                    theta = np.array([get_value(model_T, n) for n in self.chain])
+                    targets = self.chain_targets
+                    if isinstance(model.thermal, ModelII):
+                        # dF(T) at or near zero (the reference temperature, a start at zero): its
+                        # sensitivity's tolerance in dF's scale, at least a tenth of the friction level
+                        dF_scale = max(float(np.max(np.abs(model.thermal.dF.coefficients() or [0.0]))),
+                                       0.1 * model_T.reference_force(), 1e-300)
+                        theta[0] = max(abs(theta[0]), dF_scale)
                 scale = _bridge.state_scale(spec)
                 atol_y = self.rtol * scale
                 atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
                 nstate = len(scale)
                 sens = np.empty((n_out, nstate, len(theta)))
-                _bridge.run_sensitivities(spec, self.targets, trace.time, out, sens, rtol=self.rtol,
+                _bridge.run_sensitivities(spec, targets, trace.time, out, sens, rtol=self.rtol,
                                           atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=_MAX_STEPS)
                 S = sens[:, _bridge.state_index(model, "x_e"), :]
-                if self.knots:
-                    S_dF = S[:, self.value_columns].sum(axis=1)
-                    S = np.column_stack([S_dF * knot_derivative(model.thermal.dF, self.knots[j], trace.temperature)
-                                         if j in self.knots else S[:, self.core_columns[j]]
-                                         for j in range(len(self.names))])
+                if self.chain is not None:
+                    S = S @ self._chain_matrix(model, float(trace.temperature))
                 S_T = sens[:, _bridge.state_index(model, "T"), :] if heated else None
         except _bridge.CoreFailure:
             return None, None
@@ -180,6 +193,30 @@ class Problem:
             if S is not None:
                 S = np.concatenate([S, w * S_T])
         return r, S
+
+    def _chain_matrix(self, model: Model, T: float) -> np.ndarray:
+        """d(the simulated values)/d(the fitted names) at temperature T: a law's derivative in a
+        coefficient by central differences (exact for the laws linear in them, 1e-8 relative for
+        exp's rate), in a breakpoint analytically; one for a name simulated as itself."""
+        M = np.zeros((len(self.chain), len(self.names)))
+        for j, name in enumerate(self.names):
+            if name in self.chain:
+                M[self.chain.index(name), j] = 1.0
+                continue
+            base, coef = split_name(name)
+            law = model.thermal.dF if base == "dF" else model.laws[base]
+            row = 0 if base == "dF" else self.chain.index(base)
+            kind, _, k = target_of(model, name)
+            if kind == KNOT:
+                M[row, j] = knot_derivative(law, k, T)
+                continue
+            c = np.array(law.coefficients(), float)
+            h = 1e-4 * (abs(c[k]) if c[k] != 0 else max(float(np.max(np.abs(c))), 1e-300))
+            up, down = c.copy(), c.copy()
+            up[k] += h
+            down[k] -= h
+            M[row, j] = (float(law.with_coefficients(up)(T)) - float(law.with_coefficients(down)(T))) / (2 * h)
+        return M
 
     def evaluate(self, theta, jac=False):
         """(r, J) at theta; r is None when a simulation failed (the parameters are implausible)."""
@@ -205,6 +242,16 @@ class Problem:
         if model is None:
             return [None] * len(self.traces)
         return [self._run(model, tr, theta, False)[0] for tr in self.traces]
+
+
+def _at_temperature(model: Model, T: float) -> Model:
+    """The model at one constant temperature: Model I's laws' values there as plain parameters,
+    Model II's dF as a constant."""
+    if isinstance(model.thermal, ModelII):
+        return dataclasses.replace(model, thermal=ModelII(Const(float(model.thermal.dF(T)))))
+    values = model.parameters_at(T)
+    return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **{n: values[n] for n in model.laws}),
+                               thermal=None)
 
 
 def knot_derivative(law, k, T) -> float:
@@ -252,24 +299,73 @@ class Transform:
         return lo_phi, hi_phi
 
 
-def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale):
+#: a step that moves the parameters by less than this many standard errors (in the joint, Mahalanobis,
+#: sense) is not worth its simulation: the fit stops there if its misfit is at the noise
+SMALL_STEP = 0.1
+#: the same for the first, coarse stage (rtol 1e-6), which only brings the fit near the optimum: its
+#: integration error alone makes the Gauss-Newton step ~0.3-1 standard errors on the paper's data
+COARSE_STEP = 1.0
+
+
+class _Converged(Exception):
+    """Raised inside the least-squares iteration at a point that is already the optimum."""
+
+    def __init__(self, phi):
+        self.phi = phi
+
+
+def gauss_newton_length(qr, R) -> float:
+    """The length of the Gauss-Newton step from where residuals r = Q qr + (the rest) and Jacobian
+    J = Q R were taken, in standard errors: on residuals in units of the noise, |J dx| (the cost it
+    would remove is half its square) bounds every parameter's move divided by its standard error."""
+    dx, *_ = np.linalg.lstsq(R, -qr, rcond=None)
+    return float(np.linalg.norm(R @ dx))
+
+
+def _compressed(r, J):
+    """(f, G), n + 1 rows, with |f| = |r|, G^T f = J^T r and G^T G = J^T J: everything the trust-region
+    iteration uses, so that it takes the same steps, but at the cost of n + 1 rows instead of one per
+    sample (its SVD and products on 10^5 x 6 matrices cost more than a short simulation)."""
+    Q, R = np.linalg.qr(J)
+    qr = Q.T @ r
+    rest = float(np.linalg.norm(r - Q @ qr))
+    return np.append(qr, rest), np.vstack([R, np.zeros((1, J.shape[1]))])
+
+
+def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale,
+                   small_step=SMALL_STEP):
     """SciPy's trust-region least squares on residuals divided by ``scale`` (the data's noise level):
     its stopping tests then mean the same on every dataset, whatever the units and magnitudes
-    (on residuals in metres, an absolute gradient test is met at any start)."""
+    (on residuals in metres, an absolute gradient test is met at any start).
+
+    Besides SciPy's tests, it stops at the first evaluated point whose misfit is at the noise and from
+    which the Gauss-Newton step is below SMALL_STEP standard errors (not when ``tight``): another
+    iteration could not move the estimate by a meaningful fraction of its uncertainty. The returned
+    result carries ``evaluated``: the last few points' unscaled (r, J), so that the caller's
+    evaluation at the optimum (for the intervals) is not simulated twice."""
     cache = {}
+    best_cost = [math.inf]
 
     def both(phi):
         key = phi.tobytes()
         if key not in cache:
-            cache.clear()
+            if len(cache) >= 4:
+                cache.pop(next(iter(cache)))
             theta = transform.to_theta(phi)
             r, J = problem.evaluate(theta, jac=True)
             if r is None:  # a failed simulation: a large, flat residual pushes the step back
-                r = np.full(problem.n_points, 1e3 * max(_y_scale(problem), 1e-12))
-                J = np.zeros((problem.n_points, len(phi)))
+                f = np.zeros(len(phi) + 1)
+                f[-1] = 1e3 * max(_y_scale(problem), 1e-12) / scale * math.sqrt(problem.n_points)
+                G = np.zeros((len(phi) + 1, len(phi)))
             else:
-                J = J * transform.dtheta_dphi(theta)[None, :]
-            cache[key] = (r / scale, J / scale)
+                f, G = _compressed(r / scale, J * (transform.dtheta_dphi(theta)[None, :] / scale))
+            cache[key] = (f, G, r, J)
+            cost = 0.5 * float(f @ f)
+            if (r is not None and not tight and cost <= best_cost[0] + 0.5
+                    and math.sqrt(2.0 * cost / max(r.size, 1)) <= AT_NOISE
+                    and gauss_newton_length(f[:-1], G[:-1]) < small_step):
+                raise _Converged(phi.copy())
+            best_cost[0] = min(best_cost[0], cost)
         return cache[key]
 
     # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
@@ -278,9 +374,17 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
     tol = 1e-15 if tight else max(1e-10, 10 * problem.rtol)
     # on residuals of unit noise, the scaled gradient is the residuals' projection on each parameter's
     # direction: below 1e-4 a further step would move the parameters by ~1e-4 of their standard errors
-    return optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
-                                  method="trf", x_scale="jac", ftol=tol, xtol=tol, gtol=1e-15 if tight else 1e-4,
-                                  max_nfev=max_nfev)
+    try:
+        res = optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
+                                     method="trf", x_scale="jac", ftol=tol, xtol=tol,
+                                     gtol=1e-15 if tight else 1e-4, max_nfev=max_nfev)
+    except _Converged as stop:
+        f = cache[stop.phi.tobytes()][0]
+        res = optimize.OptimizeResult(
+            x=stop.phi, fun=f, cost=0.5 * float(f @ f), success=True, status=1,
+            message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise")
+    res.evaluated = {k: v[2:] for k, v in cache.items()}
+    return res
 
 
 def _y_scale(problem):
@@ -310,9 +414,25 @@ class FitOutcome:
     wall_time: float
 
 
+def one_blas_thread(function):
+    """Runs ``function`` with BLAS on one thread. The fits' linear algebra is on a few columns, and the
+    cores belong to the simulations running beside it: OpenBLAS's threads, spinning between calls,
+    took them (the benchmark's Model II: 1.7 s with them, 1.2 s without)."""
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        from threadpoolctl import threadpool_limits
+        with threadpool_limits(limits=1, user_api="blas"):
+            return function(*args, **kwargs)
+    return wrapper
+
+
+@one_blas_thread
 def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=60,
-        tight=False, progress=None) -> FitOutcome:
-    """Fits the varying parameters; returns the optimum with its residuals and Jacobian."""
+        tight=False, progress=None, near=False) -> FitOutcome:
+    """Fits the varying parameters; returns the optimum with its residuals and Jacobian.
+
+    ``near``: the start is known to be within a standard error or so of the optimum (a refinement from
+    fits that already converged): no coarse stage at rtol 1e-6, whose integration error is of that size."""
     t_start = time.perf_counter()
     varying = params.varying
     if not varying:
@@ -326,23 +446,26 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     one_trace = len(traces) == 1
 
     scale = residual_scale(traces)
+    residual_count = sum(t.n_residuals for t in traces)
 
     def run(phi_start):
         # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
         phi_first = phi_start
-        if rtol < 1e-6:
+        if rtol < 1e-6 and not near:
             coarse = Problem(model, names, traces, rtol=1e-6, parallel=not one_trace)
-            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale)
+            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale,
+                                   COARSE_STEP)
             phi_start = first.x
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight else 15, tight, scale)
+        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight or near else 15, tight,
+                             scale)
         res.moved = bool(np.any(res.x != phi_first))
         return res, problem
 
     def at_noise(res):  # residuals at the data's noise: another start cannot do meaningfully better
-        return math.sqrt(2.0 * res.cost / max(res.fun.size, 1)) <= AT_NOISE
+        return math.sqrt(2.0 * res.cost / max(residual_count, 1)) <= AT_NOISE
 
     # The initial guess first. Only if it does not reach the noise, the global phase: screen a Latin
     # hypercube around it (a decade either way for log parameters, +-100 % for the others) by cost
@@ -374,7 +497,9 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
             runs += [run(c) for c in chosen]
     best, best_problem = min(runs, key=lambda rp: rp[0].cost)
     theta = transform.to_theta(best.x)
-    r, J = best_problem.evaluate(theta, jac=True)
+    # the residuals and Jacobian at the optimum, on the full data at the requested tolerance: the last
+    # iteration's, if it evaluated them there
+    r, J = best.evaluated.get(best.x.tobytes()) or best_problem.evaluate(theta, jac=True)
     if r is None:
         raise ComputationError("the fit ended where the model cannot be simulated; try another initial guess")
     nfev = screen.nfev + sum(p.nfev for _, p in runs)
@@ -421,7 +546,7 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
         corr = cov / np.outer(se, se)
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
-    tq = stats.t.ppf(0.975, dof)
+    tq = float(special.stdtrit(dof, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
     warnings = []
     for i, par in enumerate(varying):
         par.value = float(theta[i])

@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -14,7 +16,7 @@ from ..drive import experiment_waveform
 from ..errors import InputError
 from ..models import PWL, Const, Model, ModelII
 from ..simulate import simulate
-from .engine import Problem, fit, make_traces
+from .engine import Problem, fit, make_traces, pool
 from .laws import _aicc, segmented_fit
 from .parameters import Parameters, get_value, unit_of
 from .procedures import _fit_parameter_names, _groups, _result, base_model, fit_friction
@@ -121,12 +123,35 @@ def _dF_start(group, m, fc, previous, opts):
     neighbouring temperature's value (continuation) in the scan."""
     grid = sorted(set(np.round(np.linspace(-0.9, 0.9, 13) * fc, 12)) | {0.0, float(previous)})
     traces = make_traces(group, m)
-    problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), 1e-6))
-    costs = []
-    for v in grid:
+    problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), 1e-6), parallel=False)
+
+    def cost(v):
         r, _ = problem.evaluate(np.array([v]))
-        costs.append(math.inf if r is None else float(r @ r))
-    return float(grid[int(np.argmin(costs))]), {"grid": grid, "cost": costs}
+        return math.inf if r is None else float(r @ r)
+
+    costs = list(pool().map(cost, grid))  # the runs are independent: one per core
+    # the grid is coarse (0.15 fc) against a minimum that can be narrower (a stick-slip step's size
+    # changes fast with friction): a finer look around the best point, at a few plain runs' cost, saves
+    # a fit that would start in a neighbouring local minimum and stay there
+    best = int(np.argmin(costs))
+    step = 0.15 * fc
+    local = [grid[best] + f * step for f in (-2 / 3, -1 / 3, 1 / 3, 2 / 3)]
+    local = [v for v in local if -0.95 * fc < v and all(abs(v - g) > 1e-3 * step for g in grid)]
+    scan = sorted(zip(list(grid) + local, costs + list(pool().map(cost, local))))
+    grid, costs = [v for v, _ in scan], [c for _, c in scan]
+    best = int(np.argmin(costs))
+    start = float(grid[best])
+    if 0 < best < len(grid) - 1 and all(math.isfinite(c) for c in costs[best - 1:best + 2]):
+        # the cost is near quadratic this close to its minimum: the parabola's vertex through the best
+        # point and its neighbours, kept if it is better still (one more run), starts the fit closer
+        (x0, x1, x2), (c0, c1, c2) = grid[best - 1:best + 2], costs[best - 1:best + 2]
+        slope_left, slope_right = (c1 - c0) / (x1 - x0), (c2 - c1) / (x2 - x1)  # at the midpoints
+        if slope_right > slope_left:  # where the slope, linear in between, is zero
+            vertex = 0.5 * (x0 + x1) - slope_left * 0.5 * (x2 - x0) / (slope_right - slope_left)
+            vertex = float(min(max(vertex, x0), x2))
+            if -0.95 * fc < vertex and cost(vertex) < costs[best]:
+                start = vertex
+    return start, {"grid": grid, "cost": costs}
 
 
 def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=()):
@@ -134,23 +159,47 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     popts = dict(opts)
     popts["starts"] = 1
     fc = base.reference_force()
-    # continuation outward from the reference temperature, where dF is smallest
-    order = sorted(range(len(groups)), key=lambda i: abs(float(np.mean([e.temperature for e in groups[i]])) - T_ref))
-    previous, fits, scans = 0.0, {}, {}
-    for i in order:
-        g = groups[i]
-        T = float(np.mean([e.temperature for e in g]))
+    fits, scans = {}, {}
+    temperature = [float(np.mean([e.temperature for e in g])) for g in groups]
+
+    def fit_at(i, previous):
+        g, T = groups[i], temperature[i]
         if progress:
             progress(f"Model II (direct): dF at {T:.4g} C")
         m = dataclasses.replace(base, thermal=ModelII(Const(0.0)))
-        start, scans[T] = _dF_start(g, m, fc, previous, popts)
+        if i == order[0]:  # the base model was fitted here: dF = 0 is its optimum, no scan needed
+            start, scans[T] = 0.0, {"grid": [], "cost": [], "note": "the reference temperature: dF = 0"}
+        else:
+            start, scans[T] = _dF_start(g, m, fc, previous, popts)
         params = Parameters()
         # lambda = 1 + dF/fc stays positive: friction never reverses
         params.add("dF.value", start, min=-0.95 * fc, max=10.0 * fc, unit="N")
         r = fit_friction(g, dataclasses.replace(m, thermal=ModelII(Const(start))), params,
                          method=f"dF at {T:.4g} C", **popts)
         fits[i] = (T, r)
-        previous = r.parameters["dF.value"].value
+        return r.parameters["dF.value"].value
+
+    def chain(order, previous):
+        for i in order:
+            previous = fit_at(i, previous)
+
+    # continuation outward from the reference temperature, where dF is smallest (zero, which every
+    # scan tries): two chains, one per core, from it downward and upward (all on one side: outward
+    # from it, and inward from the farthest, whose scan starts it without a neighbour)
+    order = sorted(range(len(groups)), key=lambda i: abs(temperature[i] - T_ref))
+    below = [i for i in order[1:] if temperature[i] < T_ref]
+    above = [i for i in order[1:] if temperature[i] >= T_ref]
+    if below and above:
+        chains = [[order[0]] + below, above]
+    else:
+        side = below or above
+        chains = [[order[0]] + side[:len(side) // 2], side[len(side) // 2:][::-1]]
+    if chains[1] and (os.cpu_count() or 1) > 1:
+        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-ii") as executor:
+            for future in [executor.submit(chain, c, 0.0) for c in chains]:
+                future.result()
+    else:
+        chain(order, 0.0)
     per_T = [fits[i] for i in range(len(groups))]
     Ts = np.array([T for T, _ in per_T])
     vals = np.array([r.parameters["dF.value"].value for _, r in per_T])

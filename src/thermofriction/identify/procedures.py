@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import Const, Model, ModelI
+from ..models.friction import in_domain
 from .engine import fit, make_traces, uncertainty
 from .laws import fit_law
 from .parameters import Parameters, get_value, unit_of, with_values
@@ -215,6 +216,75 @@ def _fit_parameter_names(model):
     return default_fit_parameters(model)
 
 
+LOG_SPACE_BELOW = 0.3  # relative standard error below which a parameter's misfit is taken as quadratic in its log
+
+
+def _laws_on_information(Ts, per_T, laws: dict) -> dict:
+    """The laws' coefficients refitted to the per-temperature estimates weighted by each temperature's
+    full covariance (in log space, where the fits were made), not by its standard errors alone: the
+    per-temperature estimates are strongly correlated (sigma0 with fc), and the joint refinement then
+    starts near its optimum instead of some standard errors away. The law kinds stay as chosen; a law
+    is kept as it was if this fails or leaves its parameter's physical domain."""
+    from scipy import optimize
+
+    names = list(laws)
+    blocks = []
+    for T, res in per_T:
+        varying = [p.name for p in res.parameters.varying]
+        if not all(n in varying for n in names):
+            return laws
+        idx = [varying.index(n) for n in names]
+        value = np.array([res.parameters[n].value for n in names])
+        se = np.array([res.parameters[n].stderr for n in names], float)
+        if np.any(value <= 0) or res.correlation.shape != (len(varying), len(varying)):
+            return laws
+        known = np.isfinite(se) & (se > 0)  # a parameter this temperature leaves open adds nothing
+        corr = res.correlation[np.ix_(idx, idx)][np.ix_(known, known)]
+        if not known.any() or not np.all(np.isfinite(corr)):
+            continue
+        # well-determined parameters in log space (where the fits were made), a poorly determined one
+        # (sigma1, often) in its own: its misfit is nearer quadratic there
+        log = se[known] < LOG_SPACE_BELOW * value[known]
+        unit = np.where(log, value[known], 1.0)
+        cov = corr * np.outer(se[known] / unit, se[known] / unit)
+        try:
+            root = np.linalg.cholesky(np.linalg.inv(cov))  # W = root root^T
+        except np.linalg.LinAlgError:
+            continue
+        blocks.append((T, np.flatnonzero(known), log, np.where(log, np.log(value[known]), value[known]), root))
+    if not blocks:
+        return laws
+    sizes = [len(laws[n].coefficients()) for n in names]
+    c0 = np.concatenate([laws[n].coefficients() for n in names])
+
+    def with_coefficients(c):
+        out, k = {}, 0
+        for n, size in zip(names, sizes):
+            out[n] = laws[n].with_coefficients(c[k:k + size])
+            k += size
+        return out
+
+    def residuals(c):
+        trial = with_coefficients(c)
+        out = []
+        for T, known, log, estimate, root in blocks:
+            predicted = np.array([float(trial[names[i]](T)) for i in known])
+            if np.any(~np.isfinite(predicted)) or np.any(predicted <= 0):
+                return np.full(sum(len(b[1]) for b in blocks), 1e6)
+            out.append(root.T @ (np.where(log, np.log(predicted), predicted) - estimate))
+        return np.concatenate(out)
+
+    try:
+        res = optimize.least_squares(residuals, c0, x_scale=np.where(c0 != 0, np.abs(c0), 1.0))
+    except (ValueError, np.linalg.LinAlgError):
+        return laws
+    if not res.success or 2 * res.cost >= float(np.sum(residuals(c0) ** 2)):
+        return laws
+    refined = with_coefficients(res.x)
+    grid = np.linspace(float(np.min(Ts)), float(np.max(Ts)), 41)
+    return {n: refined[n] if in_domain(n, refined[n](grid)).all() else laws[n] for n in names}
+
+
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
     ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
@@ -234,7 +304,19 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         the model the next temperature continues from)."""
         nonlocal held
         T = float(np.mean([e.temperature for e in group]))
-        base = base_model(init, T) if previous is None else previous
+        if previous is None:
+            base = base_model(init, T)
+        else:
+            # the neighbour's values carried along the initial model's laws (by their ratio, which a
+            # wrong level of a law does not change): the paper's sigma0 and fc change by a third over
+            # 3 C, many standard errors that a plain continuation would leave for the fit to walk
+            T_prev, base = previous
+            shifts = {n: float(init.laws[n](T) / init.laws[n](T_prev)) for n in names
+                      if n in init.laws and n not in held}
+            shifts = {n: f for n, f in shifts.items() if math.isfinite(f) and f > 0}
+            if shifts:
+                values = base.friction.values()
+                base = base.with_friction(**{n: values[n] * f for n, f in shifts.items()})
         base = dataclasses.replace(base, thermal=None)
         if held:  # parameters the data cannot determine follow the initial model's law
             base = base.with_friction(**{n: base_model(init, T).friction.values()[n] for n in held})
@@ -264,7 +346,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
                           and res.parameters[n].stderr < abs(res.parameters[n].value))]
         following = res.model.with_friction(**{n: base_model(init, T).friction.values()[n] for n in open_
                                                if n in base_model(init, T).friction.values()}) if open_ else res.model
-        return T, res, following
+        return T, res, (T, following)
 
     def chain(order, previous, neighbour=True):
         out = []
@@ -275,8 +357,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
 
     # the lowest temperature first (it decides what the data cannot determine); then two continuation
     # chains, one per core: upward from it, and downward from the highest temperature, which starts from
-    # the initial model's laws there or, without laws, from the lowest temperature's fit (not a
-    # neighbour: with the multi-start)
+    # the lowest temperature's fit carried there along the initial model's laws (not a neighbour: with
+    # the multi-start)
     T0, res0, following = fit_at(groups[0], None, first_of_all=True)
     rest = list(range(1, len(groups)))
     up, down = rest[:(len(rest) + 1) // 2], rest[(len(rest) + 1) // 2:][::-1]
@@ -284,7 +366,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         from concurrent.futures import ThreadPoolExecutor
         with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-i") as chains:
             lower = chains.submit(chain, up, following)
-            upper = chains.submit(chain, down, None if init.laws else following, False)
+            upper = chains.submit(chain, down, following, False)
             per_T = [(T0, res0)] + lower.result() + upper.result()
     else:
         per_T = [(T0, res0)] + chain(rest, following)
@@ -308,6 +390,12 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         new_laws[n] = law
         law_tables[n] = {"chosen": law.kind, "candidates": table, "temperatures": Ts, "values": vals,
                          "stderr": ses}
+    fitted = [n for n in names if n not in held]
+    refined = _laws_on_information(Ts, per_T, {n: new_laws[n] for n in fitted})
+    for n in fitted:
+        if refined[n] is not new_laws[n]:  # the candidates' coefficients are by standard errors alone
+            new_laws[n] = refined[n]
+            law_tables[n]["weighted_by_covariance"] = new_laws[n].to_dict()
     details["laws"] = law_tables
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in names})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
@@ -337,7 +425,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     ropts = dict(opts)
     ropts["starts"] = 1
     ropts.setdefault("max_nfev", 30)
-    outcome = fit(model, params, traces, **ropts)
+    # from laws through the per-temperature optima weighted by their covariances: near the optimum
+    outcome = fit(model, params, traces, near=True, **ropts)
     res = _result("model-i", model, params, outcome, traces, t0, warns, details)
     res.nfev += sum(r.nfev for _, r in per_T)
     res.njev += sum(r.njev for _, r in per_T)
