@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import warnings
+import weakref
 
 import numpy as np
 
@@ -54,7 +55,7 @@ def check_passivity(model: Model, temperatures=(math.nan,)):
         found = dissipativity_violation(model.friction.model, model.parameters_at(T))
         if found:
             where = f" at {T:g} C" if isinstance(model.thermal, ModelI) else ""
-            warnings.warn(f"{model.friction.model}{where}: {found[1]}", PassivityWarning, stacklevel=4)
+            warnings.warn(f"{model.friction.model}{where}: {found[1]}", PassivityWarning, stacklevel=5)
             return
 
 
@@ -72,10 +73,41 @@ def check_temperature_coverage(temperature, t0: float, t1: float):
                       stacklevel=3)
 
 
+# Models (frozen) checked without a warning at a constant temperature, by identity (a model holds dicts:
+# it is not hashable): a model run again and again at one temperature (identification, sweeps, a
+# benchmark) is checked once. The entry goes with its model (a weak reference's callback).
+_PASSED: dict = {}
+
+
+def _passed(model) -> set:
+    entry = _PASSED.get(id(model))
+    return entry[1] if entry is not None and entry[0]() is model else set()
+
+
 def check_temperatures(model: Model, temperature):
     """Warns for temperatures outside a law's calibrated range; raises where the model is
     invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
     Warns where a LuGre-type model is not dissipative."""
+    key = None if isinstance(temperature, Sampled) else temperature
+    if key is not None and key in _passed(model):
+        return
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _check_temperatures(model, temperature)
+    for w in caught:  # passed on as they came (stacklevel as the checks set it)
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
+    if key is not None and not caught:
+        known = _passed(model)
+        if not known:
+            try:
+                ref = weakref.ref(model, lambda _, k=id(model): _PASSED.pop(k, None))
+            except TypeError:  # a model that cannot be weakly referenced: no cache
+                return
+            _PASSED[id(model)] = (ref, known)
+        known.add(key)
+
+
+def _check_temperatures(model: Model, temperature):
     if model.thermal is None:
         check_passivity(model)
         return
@@ -100,7 +132,7 @@ def check_temperatures(model: Model, temperature):
     if outside:
         span = f"{Ts[0]:g} C" if len(Ts) == 1 else f"{Ts.min():g}..{Ts.max():g} C"
         warnings.warn(f"temperature {span} is outside the calibrated range of the law(s) for "
-                      f"{', '.join(outside)}", TemperatureRangeWarning, stacklevel=3)
+                      f"{', '.join(outside)}", TemperatureRangeWarning, stacklevel=4)
     if isinstance(model.thermal, ModelI):
         for T in (Ts.min(), Ts.max()) if len(Ts) > 1 else Ts:
             check_friction_values(model.parameters_at(T), f"Model I at {T:g} C")
@@ -137,7 +169,7 @@ def check_temperatures(model: Model, temperature):
             warnings.warn(f"Model II offset form: dF = {dF[i]:.4g} N at {Ts[i]:g} C is anti-damped near v = 0 "
                           f"(dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against {what} = "
                           f"{damping:.3g} N s/m); the solution is ill-conditioned: use Dopri5 with rtol <= 1e-8, "
-                          f"or the scale form", ConditioningWarning, stacklevel=3)
+                          f"or the scale form", ConditioningWarning, stacklevel=4)
 
 
 def check_heated_temperatures(model: Model, time, temperature):
