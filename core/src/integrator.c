@@ -130,7 +130,7 @@ static double wnorm(const work *w, const double *e, const double *ya, const doub
 /* x^(1/4) for Rodas4's step-size control: two square roots cost a third of a pow */
 static double root4(double x) { return sqrt(sqrt(x)); }
 
-static int all_finite(const double *v, int n)
+TF_SIZED int all_finite(const double *v, const int n)
 {
     double sum = 0.0; /* as in rhs(): a NaN or an infinity anywhere makes the sum non-finite */
     for (int i = 0; i < n; i++) sum += v[i];

@@ -50,6 +50,15 @@ double tf_pwl_next_knot(int n, const double *x, double t)
     return x[i + 1];
 }
 
+/* floor(x), by truncation where x fits a 64-bit integer (the same value; a third of the
+ * instructions of the portable floor without SSE4.1, and the sawtooth is on every right-hand side) */
+static double fast_floor(double x)
+{
+    if (!(fabs(x) < 4e18)) return floor(x);
+    double f = (double)(long long)x;
+    return f > x ? f - 1.0 : f;
+}
+
 /* Sawtooth shape in [0, 1] at phase ph in [0, 1). */
 static double sawtooth_shape(double ph, double rise, double direction, double *dshape)
 {
@@ -89,7 +98,7 @@ static double eval(const tf_waveform *w, double t, double *slope)
     switch (w->kind) {
     case TF_WAVE_SAWTOOTH: {
         double x = t * w->frequency;
-        double ph = x - floor(x);
+        double ph = x - fast_floor(x);
         /* the slope only when asked for: the value is on every right-hand side */
         v = w->offset + w->amplitude * sawtooth_shape(ph, w->rise, w->direction, slope ? &d : 0);
         d *= w->amplitude * w->frequency;
