@@ -114,7 +114,10 @@ static double friction(tf_model *m, double t, const double *y, double *dz, tf_fr
 
 /* F' and z' of the common case (lugre_constant_T): the same equations as friction_at, with the
  * run's parameters. */
-static double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
 {
     double lambda = m->cache_lambda, dF = m->cache_dF;
     const double *p = m->cache_p;

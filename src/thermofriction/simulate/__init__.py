@@ -10,6 +10,7 @@ core, the explanation of a failed run, and the packing of the outputs into a res
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 import os
@@ -232,7 +233,9 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         check_temperatures(model, temperature)
     friction_work = bool(friction_work) or heat is not None
     waveform = input_of(model, input)
-    grid = _Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period, max_samples)
+    grid = (_Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period, max_samples)
+            if t_eval is not None or not (isinstance(duration, numbers.Real) and isinstance(sample_rate, numbers.Real))
+            else _uniform_grid(float(duration), float(sample_rate), waveform.period, max_samples))
     if model.thermal is not None and heat is None:
         check_temperature_coverage(temperature, float(grid.requested[0]), float(grid.requested[-1]))
     if isinstance(model.plant, PrescribedMotion):
@@ -259,6 +262,16 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         raise _explain(e, model, solver, controller, waveform, state_names) from None
     stats["solver"] = stats.pop("method")
     return _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period)
+
+
+@functools.lru_cache(maxsize=16)
+def _uniform_grid(duration, sample_rate, period, max_samples) -> _Grid:
+    """The uniform grid of a run, built once for runs alike (identification and sweeps repeat them); its
+    arrays are read-only, and a result copies what it keeps of them."""
+    grid = _Grid(output_grid(duration, sample_rate, None, max_samples), period, max_samples)
+    for a in (grid.requested, grid.times, grid.cycle_times, grid.extra):
+        a.setflags(write=False)
+    return grid
 
 
 def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> SimulationResult:
@@ -297,7 +310,7 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
         states=np.ascontiguousarray(out[:, len(outputs):len(outputs) + nfric]),
         state_names=model.friction.state_names,
         state_units=model.friction.state_units,
-        cycle_times=grid.cycle_times,
+        cycle_times=grid.cycle_times.copy(),
         step_sizes=steps,
         mean_velocity=float(steps.mean() / period) if steps.size else math.nan,
         input_unit={"stick-slip": "V", "mass": "N", "prescribed": "m"}[model.plant.type],
