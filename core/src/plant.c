@@ -393,7 +393,8 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
 {
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
-    tf_model_rhs(t, y, dy, m);
+    if (lugre_constant_T(m)) rhs_lugre_constant_T(t, y, dy, m);
+    else tf_model_rhs(t, y, dy, m);
     if (J) tf_model_jac(t, y, J, m);
     if (!np) return 0;
     tf_friction_param_partials dp;

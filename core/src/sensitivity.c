@@ -6,7 +6,8 @@
 int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
 {
     tf_sensitivity_system *s = (tf_sensitivity_system *)ctx;
-    int n = tf_model_nstate(s->model), np = s->np;
+    if (!s->n) s->n = tf_model_nstate(s->model);
+    int n = s->n, np = s->np;
     double J[TF_MAX_STATES * TF_MAX_STATES];
     double *fp = dY + n; /* df/dtheta lands where dS goes, then J S is added */
     tf_model_derivatives(s->model, t, Y, dY, J, s->targets, np, fp);

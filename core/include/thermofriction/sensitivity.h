@@ -18,6 +18,7 @@ typedef struct {
     tf_model *model;
     int np;
     const tf_target *targets;
+    int n; /* the model's states: set on the first evaluation (0 before) */
 } tf_sensitivity_system;
 
 /* Augmented right-hand side: Y = [y (n), S (n x np, row-major)]. */
