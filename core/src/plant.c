@@ -570,8 +570,14 @@ void tf_model_outputs_strided(const tf_model *model, double t, const double *y, 
     out[TF_OUT_VELOCITY * stride] = v;
     out[TF_OUT_RELATIVE_DISPLACEMENT * stride] = x - xp;
     out[TF_OUT_RELATIVE_VELOCITY * stride] = v - vp;
-    out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(model, t, y);
-    out[TF_OUT_TEMPERATURE * stride] = tf_model_temperature(model, t, y);
+    if (lugre_constant_T(model)) { /* the common case, as its right-hand side computes it */
+        double dz;
+        out[TF_OUT_FRICTION_FORCE * stride] = lugre_constant_T_friction((tf_model *)model, v - vp, y[nm], &dz);
+        out[TF_OUT_TEMPERATURE * stride] = model->T_const;
+    } else {
+        out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(model, t, y);
+        out[TF_OUT_TEMPERATURE * stride] = tf_model_temperature(model, t, y);
+    }
     for (int j = 0; j < nz; j++) out[(TF_OUT_NFIXED + j) * stride] = y[nm + j];
     if (has_work(model)) out[(TF_OUT_NFIXED + nz) * stride] = y[tf_model_work_index(model)];
 }
