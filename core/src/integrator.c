@@ -622,6 +622,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
             win_steps = 0;
             win_t = t;
             win_work = work_units(st, n);
+            h = initial_step(&w, t, y, f0, 5, opt->hmax); /* not the stiff method's long ramp step */
         }
         if (h <= 0.0) {
             h = opt->h0 > 0 ? opt->h0 : initial_step(&w, t, y, f0, method == TF_METHOD_DOPRI5 ? 5 : 4, opt->hmax);
