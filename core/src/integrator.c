@@ -714,8 +714,9 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
                     }
                     memcpy(g0, g1, sizeof(double) * ne);
                 }
+                const double hinv = 1.0 / h; /* one division per step, not per output sample */
                 while (next < n_out && t_out[next] <= t_new) {
-                    double s = (t_out[next] - t) / h;
+                    double s = (t_out[next] - t) * hinv;
                     if (method == TF_METHOD_RODAS4) rodas4_dense(&w, s, yd); else dopri5_dense(&w, s, yd);
                     /* finite ends of a step can still interpolate to an overflow in between (found by
                      * fuzzing: a 1e-3 kg mass under a huge sampled force): never emit it as TF_OK */
