@@ -321,13 +321,11 @@ static void heat_jacobian(tf_model *m, double t, const double *y, const tf_frict
 #undef J_
 }
 
-int tf_model_jac(double t, const double *y, double *J, void *ctx)
+/* The state Jacobian from the friction force's partials d (after the thermal model). */
+static void jacobian_from(tf_model *m, double t, const double *y, tf_friction_partials *d_in, double *J)
 {
-    tf_model *m = (tf_model *)ctx;
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
-    double dz[TF_MAX_FRICTION_STATES];
-    tf_friction_partials d;
-    friction(m, t, y, dz, &d);
+    tf_friction_partials d = *d_in;
     memset(J, 0, sizeof(double) * n * n);
 #define J_(i, j) J[(i) * n + (j)]
     if (m->plant == TF_PLANT_STICK_SLIP) {
@@ -356,6 +354,15 @@ int tf_model_jac(double t, const double *y, double *J, void *ctx)
     for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d.ddz_dz[j];
 #undef J_
     if (has_work(m)) heat_jacobian(m, t, y, &d, J);
+}
+
+int tf_model_jac(double t, const double *y, double *J, void *ctx)
+{
+    tf_model *m = (tf_model *)ctx;
+    double dz[TF_MAX_FRICTION_STATES];
+    tf_friction_partials d;
+    friction(m, t, y, dz, &d);
+    jacobian_from(m, t, y, &d, J);
     return 0;
 }
 
@@ -395,13 +402,17 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
     if (lugre_constant_T(m)) rhs_lugre_constant_T(t, y, dy, m);
     else tf_model_rhs(t, y, dy, m);
-    if (J) tf_model_jac(t, y, J, m);
-    if (!np) return 0;
+    if (!np) {
+        if (J) tf_model_jac(t, y, J, m);
+        return 0;
+    }
     tf_friction_param_partials dp;
+    tf_friction_partials d; /* the state and the parameter partials from one evaluation */
     double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
     double T = tf_model_temperature(m, t, y);
     tf_model_params_cached(m, T, &lambda, &dF_offset);
-    double F = friction_at(m, T, t, y, dz, 0, &dp, &Fb);
+    double F = friction_at(m, T, t, y, dz, J ? &d : 0, &dp, &Fb);
+    if (J) jacobian_from(m, t, y, &d, J);
     if (m->fs_follows_fc) { /* one parameter moves both */
         dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
         for (int j = 0; j < nz; j++) dp.ddz_dp[j][TF_P_FC] += dp.ddz_dp[j][TF_P_FS];
