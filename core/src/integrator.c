@@ -612,8 +612,9 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
         if (ode->on_restart) ode->on_restart(t, y, ode->ctx);
         if (ne) ode->events(t, y, g0, ode->ctx);
         if (rhs(&w, t, y, f0)) { status = fail(&w, TF_ERR_NONFINITE, t, h); goto done; }
-        /* AUTO picks the method per phase: a corner of the input starts a new one (a flyback's
-         * ringing, where the explicit method is cheaper, then a ramp, where the stiff one is) */
+        /* AUTO picks the method per phase: every restart -- a corner of the input, or an event
+         * (a GMS mode switch) -- starts a new one (after a flyback its ringing, where the explicit
+         * method is cheaper; then the ramp, where the stiff one is) */
         if (requested == TF_METHOD_AUTO && method == TF_METHOD_RODAS4 && t > t_out[0]) {
             method = TF_METHOD_DOPRI5;
             w.opt = &opt_x;

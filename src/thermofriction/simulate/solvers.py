@@ -36,9 +36,9 @@ class AutoSwitch:
     """Per phase of the input, Dopri5 until its stiffness test fires, then Rodas4 where it is cheaper
     (default).
 
-    Every corner of the input (a sawtooth's flyback and period start) starts a new phase with Dopri5:
-    the ringing after a flyback is cheaper to follow with the explicit method, the slow ramp that
-    follows with the stiff one. The Dopri5 phases run at 1/50 of the tolerances: at equal
+    Every corner of the input (a sawtooth's flyback and period start; and every GMS mode switch)
+    starts a new phase with Dopri5: the ringing after a flyback is cheaper to follow with the
+    explicit method, the slow ramp that follows with the stiff one. The Dopri5 phases run at 1/50 of the tolerances: at equal
     tolerances Dopri5's global error on stick-slip is 10-50x Rodas4's, and the error only follows
     the tolerance when both kinds of phase deliver about the same accuracy."""
 
