@@ -565,7 +565,8 @@ tf_ode tf_model_ode(tf_model *model)
 
 void tf_model_outputs_strided(const tf_model *model, double t, const double *y, double *out, long stride)
 {
-    int nm = nmech(model), nz = nfric(model);
+    const int fast = lugre_constant_T(model); /* LuGre: one state, no work state */
+    int nm = nmech(model), nz = fast ? 1 : nfric(model);
     double u = tf_waveform_value(&model->input, t);
     double xp = 0.0, vp = 0.0, x, v;
     switch (model->plant) {
@@ -581,7 +582,7 @@ void tf_model_outputs_strided(const tf_model *model, double t, const double *y, 
     out[TF_OUT_VELOCITY * stride] = v;
     out[TF_OUT_RELATIVE_DISPLACEMENT * stride] = x - xp;
     out[TF_OUT_RELATIVE_VELOCITY * stride] = v - vp;
-    if (lugre_constant_T(model)) { /* the common case, as its right-hand side computes it */
+    if (fast) { /* the common case, as its right-hand side computes it */
         double dz;
         out[TF_OUT_FRICTION_FORCE * stride] = lugre_constant_T_friction((tf_model *)model, v - vp, y[nm], &dz);
         out[TF_OUT_TEMPERATURE * stride] = model->T_const;
@@ -590,7 +591,7 @@ void tf_model_outputs_strided(const tf_model *model, double t, const double *y, 
         out[TF_OUT_TEMPERATURE * stride] = tf_model_temperature(model, t, y);
     }
     for (int j = 0; j < nz; j++) out[(TF_OUT_NFIXED + j) * stride] = y[nm + j];
-    if (has_work(model)) out[(TF_OUT_NFIXED + nz) * stride] = y[tf_model_work_index(model)];
+    if (!fast && has_work(model)) out[(TF_OUT_NFIXED + nz) * stride] = y[tf_model_work_index(model)];
 }
 
 void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
