@@ -24,6 +24,10 @@ def _kind(mode) -> str:
     return "not a regular file"
 
 
+def _a(what: str) -> str:
+    return ("an " if what[:1] in "aeiou" else "a ") + what
+
+
 def read_bytes(path, what: str = "file") -> bytes:
     """The bytes of the regular file ``path``; InputError for anything else (a folder, a device, a
     FIFO). OSError (a missing file, no permission) is left to the caller, which names it."""
@@ -34,8 +38,8 @@ def read_bytes(path, what: str = "file") -> bytes:
         if not stat.S_ISREG(mode):
             kind = _kind(mode)
             if kind == "a folder":
-                raise InputError(f"{path}: is a folder, not a {what}")
-            raise InputError(f"{path}: is {kind}, not a regular file: give a regular {what} (input from a device "
+                raise InputError(f"{path}: is a folder, not {_a(what)}")
+            raise InputError(f"{path}: is {kind}, not a regular file: give {_a('regular ' + what)} (input from a device "
                              f"or a pipe may never end)")
         os.set_blocking(fd, True)
         with os.fdopen(fd, "rb") as fh:
@@ -44,6 +48,21 @@ def read_bytes(path, what: str = "file") -> bytes:
     finally:
         if fd is not None:
             os.close(fd)
+
+
+def read_input_file(path, what: str = "file") -> bytes:
+    """``read_bytes`` with every failure as one InputError naming the file: missing, a folder, unreadable,
+    or a name the system cannot use (a NUL byte)."""
+    try:
+        return read_bytes(path, what)
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{path}: is a folder, not {_a(what)}") from None
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    except ValueError as e:  # a NUL byte in the path
+        raise InputError(f"{str(path)!r}: not a usable file name ({e})") from None
 
 
 def read_text(path, what: str = "file", encoding: str = "utf-8") -> str:
@@ -59,4 +78,4 @@ def strict_float(text: str) -> float:
     return float(text)
 
 
-__all__ = ["read_bytes", "read_text", "strict_float"]
+__all__ = ["read_bytes", "read_input_file", "read_text", "strict_float"]

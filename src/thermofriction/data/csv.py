@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._reading import read_bytes, strict_float
+from .._reading import read_input_file, strict_float
 from ..errors import InputError, shorten
 from ..plausible import kelvin_hint
 from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
@@ -95,6 +95,19 @@ def _line_of(body, row):
     return row + 2
 
 
+def read_experiment_bytes(path: Path) -> bytes:
+    """An experiment CSV file's bytes, refused as one InputError when it cannot be read or has more data
+    rows than the limit (checked before anything is parsed). Actuator and force experiments alike."""
+    raw = read_input_file(path, "experiment CSV file")
+    rows = raw.count(b"\n") + (not raw.endswith(b"\n")) - 1  # data rows, blank lines included
+    limit = max_rows()
+    if rows > limit:
+        raise InputError(f"{path}: {rows} data rows, more than the limit of {limit} (each row takes ~150 bytes "
+                         f"of memory while loading): downsample the file, or raise the limit with the "
+                         f"environment variable {MAX_ROWS_ENV}=N")
+    return raw
+
+
 def read_experiment_csv(path, with_headers: bool = False) -> dict:
     """Reads one experiment CSV (docs/formats.md) into SI arrays: a dict with ``time``, ``voltage``,
     ``displacement`` and, where the file has them, ``temperature`` and ``stage_displacement``.
@@ -102,22 +115,7 @@ def read_experiment_csv(path, with_headers: bool = False) -> dict:
     The format is strict; any problem is one InputError naming the file and, where it applies, the
     line (the header is line 1) and the column."""
     path = Path(path)
-    try:
-        raw = read_bytes(path, "experiment CSV file")
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{path}: is a folder, not an experiment CSV file") from None
-    except OSError as e:
-        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
-    except ValueError as e:  # a NUL byte in the path
-        raise InputError(f"{str(path)!r}: not a usable file name ({e})") from None
-    rows = raw.count(b"\n") + (not raw.endswith(b"\n")) - 1  # data rows, blank lines included
-    limit = max_rows()
-    if rows > limit:
-        raise InputError(f"{path}: {rows} data rows, more than the limit of {limit} (each row takes ~150 bytes "
-                         f"of memory while loading): downsample the file, or raise the limit with the "
-                         f"environment variable {MAX_ROWS_ENV}=N")
+    raw = read_experiment_bytes(path)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:

@@ -17,11 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .._reading import read_bytes
 from ..errors import InputError, shorten
 from ..waveforms import Sampled
-from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell
-from .experiments import MIN_SAMPLES, Experiment, max_rows
+from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
+from .experiments import MIN_SAMPLES, Experiment
 
 _LINEAR_POSITION = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9}
 _ROTARY_POSITION = {"rad": 1.0, "deg": np.pi / 180.0}
@@ -183,17 +182,7 @@ def read_force_csv(path) -> dict:
     file, line and column. Irregular sampling is accepted (time must increase strictly); a gap of more than
     GAP_RATIO times the median interval is a SamplingWarning."""
     path = Path(path)
-    try:
-        raw = read_bytes(path, "experiment CSV file")
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{path}: is a folder, not an experiment CSV file") from None
-    except OSError as e:
-        raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
-    limit = max_rows()
-    if raw.count(b"\n") - 1 > limit:
-        raise InputError(f"{path}: more than the limit of {limit} data rows: downsample the file")
+    raw = read_experiment_bytes(path)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
