@@ -228,8 +228,9 @@ def test_bad_experiment_files_name_file_line_and_column(text, words, tmp_path):
 
 
 def test_unreadable_experiment_files(tmp_path):
-    with pytest.raises(tf.InputError, match="is a folder"):
+    with pytest.raises(tf.InputError, match="is a folder") as e:
         read_experiment_csv(tmp_path)
+    assert str(e.value) == f"{tmp_path}: is a folder, not an experiment CSV file"  # one message, not wrapped
     path = tmp_path / "latin1.csv"
     path.write_bytes(HEADER.encode() + ROWS.encode() + "0.1,1,2\xb5\n".encode("latin-1"))
     with pytest.raises(tf.InputError, match="line 22: not UTF-8"):

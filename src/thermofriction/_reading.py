@@ -55,6 +55,8 @@ def read_input_file(path, what: str = "file") -> bytes:
     or a name the system cannot use (a NUL byte)."""
     try:
         return read_bytes(path, what)
+    except InputError:  # a folder or a device, named by read_bytes (InputError is a ValueError: not below)
+        raise
     except FileNotFoundError:
         raise InputError(f"{path}: no such file") from None
     except IsADirectoryError:
