@@ -72,9 +72,10 @@ def _simulate(model, duration=None, **kw):
 # (a) stick-slip
 # ---------------------------------------------------------------------------------------------
 
-def run_stick_slip(duration=60.0, sample_rate=1000.0):
+def run_stick_slip(duration=60.0, sample_rate=1000.0, **options):
+    """``options`` (solver=, controller=) go to tf.simulate, here and in the other run_* functions."""
     model = tf.Model(tf.MassPlant(MASS, spring_stiffness=K_SPRING, pull_velocity=V_PULL), lugre())
-    return _simulate(model, duration, sample_rate=sample_rate)
+    return _simulate(model, duration, sample_rate=sample_rate, **options)
 
 
 def slip_prediction(f_spring, v_start=0.0):
@@ -165,11 +166,11 @@ def stick_slip(run=None) -> dict:
 # (b) presliding displacement
 # ---------------------------------------------------------------------------------------------
 
-def run_presliding(f_max=1.2, frequency=0.02, sample_rate=1000.0):
+def run_presliding(f_max=1.2, frequency=0.02, sample_rate=1000.0, **options):
     """The mass (no spring) under F(t) = f_max sin(2 pi f t) for 1.25 periods: the virgin loading
     0 -> f_max, then a full loop f_max -> -f_max -> f_max. At most 2 pi f f_max = 0.15 N/s."""
     model = tf.Model(tf.MassPlant(MASS), lugre())
-    return _simulate(model, 1.25 / frequency, input=tf.Sine(f_max, frequency), sample_rate=sample_rate)
+    return _simulate(model, 1.25 / frequency, input=tf.Sine(f_max, frequency), sample_rate=sample_rate, **options)
 
 
 def presliding_quasistatic(F, f_max, branch):
@@ -237,18 +238,24 @@ def presliding(run=None, f_max=1.2, frequency=0.02) -> dict:
 LAG_MEAN, LAG_AMPLITUDE = 1.5e-3, 1e-3  # v(t) = LAG_AMPLITUDE cos(omega t) + LAG_MEAN
 
 
-def run_frictional_lag(omega, periods=3, knots_per_period=4000):
+def simulate_frictional_lag(omega, periods=3, knots_per_period=4000, **options):
     """Prescribed motion with v(t) = 1e-3 (cos(omega t) + 1.5) m/s, i.e. the displacement
     x(t) = 1.5e-3 t + 1e-3 sin(omega t) / omega. No waveform has that shape (a sine on a ramp), so
     it is given as tf.Sampled knots; its slope between two knots is the exact mean velocity there,
-    and the output is taken at the midpoints, where that equals v(t) to O(dt^2)."""
+    and the output is taken at the midpoints, where that equals v(t) to O(dt^2). The whole run."""
     T = 2 * math.pi / omega
     tk = np.arange(periods * knots_per_period + 1) * (T / knots_per_period)
     xk = LAG_MEAN * tk + LAG_AMPLITUDE * np.sin(omega * tk) / omega
     t_out = np.concatenate([[0.0], 0.5 * (tk[1:] + tk[:-1])])
     model = tf.Model(tf.PrescribedMotion(), lugre())
-    r = _simulate(model, input=tf.Sampled(tk, xk), t_eval=t_out)
-    last = r.time >= (periods - 1) * T  # the last period: the start-up transient has died out
+    return _simulate(model, input=tf.Sampled(tk, xk), t_eval=t_out, **options)
+
+
+def run_frictional_lag(omega, periods=3, knots_per_period=4000, **options):
+    """simulate_frictional_lag's last period (the start-up transient has died out): time, velocity,
+    friction force."""
+    r = simulate_frictional_lag(omega, periods, knots_per_period, **options)
+    last = r.time >= (periods - 1) * 2 * math.pi / omega
     return r.time[last], r.velocity[last], r.friction_force[last]
 
 
@@ -298,11 +305,11 @@ def frictional_lag(omegas=(1.0, 10.0, 25.0), runs=None) -> dict:
 RAMP_TO = 1.6  # N: the applied force ramps from 0 to above fs
 
 
-def run_break_away(rate, samples=20_000):
+def run_break_away(rate, samples=20_000, **options):
     """The mass (no spring) under an applied force ramp u = rate t, up to RAMP_TO."""
     T = RAMP_TO / rate
     model = tf.Model(tf.MassPlant(MASS), lugre())
-    return _simulate(model, T, input=tf.Step(RAMP_TO, time=0.0, slew=T), sample_rate=samples / T)
+    return _simulate(model, T, input=tf.Step(RAMP_TO, time=0.0, slew=T), sample_rate=samples / T, **options)
 
 
 def _creep_rate_max(u, v):

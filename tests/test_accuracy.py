@@ -11,7 +11,6 @@ are maxima over the output grid as a fraction of the quantity's range in the run
   lag) stay within 0.1 % of range of the tight run, in displacement and in friction force.
 """
 
-import math
 import sys
 import warnings
 from pathlib import Path
@@ -94,37 +93,32 @@ def test_error_falls_as_the_tolerance_tightens(case, solver):
 # --- the Canudas de Wit experiments at default settings -----------------------------------------------
 
 def _stick_slip(**kw):
-    return _run(_cdw_mass(spring_stiffness=ex.K_SPRING, pull_velocity=ex.V_PULL), duration=60.0,
-                sample_rate=1000.0, **kw)
+    r = ex.run_stick_slip(**kw)
+    return r.displacement, r.friction_force
 
 
 def _presliding(**kw):
-    f_max, frequency = 1.2, 0.02
-    return _run(_cdw_mass(), duration=1.25 / frequency, input=tf.Sine(f_max, frequency), sample_rate=1000.0, **kw)
+    r = ex.run_presliding(**kw)
+    return r.displacement, r.friction_force
 
 
 def _break_away(**kw):
-    rate = 0.3
-    T = ex.RAMP_TO / rate
-    return _run(_cdw_mass(), duration=T, input=tf.Step(ex.RAMP_TO, time=0.0, slew=T), sample_rate=20_000 / T, **kw)
+    r = ex.run_break_away(0.3, **kw)
+    return r.displacement, r.friction_force
 
 
 def _frictional_lag(**kw):
-    omega, knots = 10.0, 4000
-    T = 2 * math.pi / omega
-    tk = np.arange(3 * knots + 1) * (T / knots)
-    xk = ex.LAG_MEAN * tk + ex.LAG_AMPLITUDE * np.sin(omega * tk) / omega
-    t_out = np.concatenate([[0.0], 0.5 * (tk[1:] + tk[:-1])])
-    return _run(tf.Model(tf.PrescribedMotion(), ex.lugre()), input=tf.Sampled(tk, xk), t_eval=t_out, **kw)
+    r = ex.simulate_frictional_lag(10.0, **kw)
+    return r.displacement, r.friction_force
 
 
 @pytest.mark.parametrize("experiment", [_stick_slip, _presliding, _break_away, _frictional_lag],
                          ids=["stick-slip", "presliding", "break-away", "frictional-lag"])
 def test_canudas_experiments_at_default_settings_within_0p1_percent(experiment):
-    """Self-convergence: the default solver and tolerance against a Dopri5 run at rtol 1e-12, within
-    0.1 % of range in displacement and in friction force (under prescribed motion the displacement is the
-    input itself)."""
-    default = experiment()
-    tight = experiment(solver=tf.Dopri5(), controller=TIGHT)
-    dx, dF = _errors(default, tight)
+    """Self-convergence: the example's run (examples/canudas1995.py) with the default solver and tolerance
+    against the same run with Dopri5 at rtol 1e-12, within 0.1 % of range in displacement and in friction
+    force (under prescribed motion the displacement is the input itself)."""
+    (x, F), (x_tight, F_tight) = experiment(), experiment(solver=tf.Dopri5(), controller=TIGHT)
+    dF = np.max(np.abs(F - F_tight)) / np.ptp(F_tight)
+    dx = np.max(np.abs(x - x_tight)) / np.ptp(x_tight)
     assert dx < 1e-3 and dF < 1e-3, (dx, dF)
