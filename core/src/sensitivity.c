@@ -3,6 +3,28 @@
 
 #include <string.h>
 
+#if defined(__GNUC__) || defined(__clang__)
+#define TF_SIZED static inline __attribute__((always_inline))
+#else
+#define TF_SIZED static inline
+#endif
+
+/* fp += J S (J n x n, S n x np, both row-major). Inlined with np a constant for the usual few
+ * parameters, so that the row of np products compiles to straight-line code. */
+TF_SIZED void add_jacobian_times(const double *J, const double *S, double *fp, int n, const int np)
+{
+    for (int r = 0; r < n; r++) {
+        const double *Jr = J + r * n;
+        double *fr = fp + r * np;
+        for (int c = 0; c < n; c++) {
+            double a = Jr[c];
+            if (a == 0.0) continue; /* J is sparse: most products vanish */
+            const double *Sc = S + c * np;
+            for (int k = 0; k < np; k++) fr[k] += a * Sc[k];
+        }
+    }
+}
+
 int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
 {
     tf_sensitivity_system *s = (tf_sensitivity_system *)ctx;
@@ -12,13 +34,14 @@ int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
     double *fp = dY + n; /* df/dtheta lands where dS goes, then J S is added */
     tf_model_derivatives(s->model, t, Y, dY, J, s->targets, np, fp);
     const double *S = Y + n;
-    for (int r = 0; r < n; r++) {
-        const double *Jr = J + r * n;
-        for (int c = 0; c < n; c++) {
-            double a = Jr[c];
-            if (a == 0.0) continue; /* J is sparse: most products vanish */
-            for (int k = 0; k < np; k++) fp[r * np + k] += a * S[c * np + k];
-        }
+    switch (np) {
+    case 1: add_jacobian_times(J, S, fp, n, 1); break;
+    case 2: add_jacobian_times(J, S, fp, n, 2); break;
+    case 3: add_jacobian_times(J, S, fp, n, 3); break;
+    case 4: add_jacobian_times(J, S, fp, n, 4); break;
+    case 5: add_jacobian_times(J, S, fp, n, 5); break;
+    case 6: add_jacobian_times(J, S, fp, n, 6); break;
+    default: add_jacobian_times(J, S, fp, n, np); break;
     }
     return 0;
 }
