@@ -320,8 +320,10 @@ class Transform:
 COARSE_RTOL = 1e-6
 #: a step that moves the parameters by less than this many standard errors (in the joint, Mahalanobis,
 #: sense) is not worth its simulation: the fit stops there if its misfit is at the noise, and takes it
-#: on the linearized model (whose error is a small fraction of that: _last_step)
-SMALL_STEP = 0.5
+#: on the linearized model (_last_step). The linearization's error grows as the step's square: a poorly
+#: determined sigma1 (a standard error of a third of its value) left 0.72 standard errors of a 0.58 one,
+#: so 0.2 leaves ~0.08 at worst, under the 0.1 this rule stopped at, without the step, before
+SMALL_STEP = 0.2
 #: the same for a fit that only starts another one, and the step under which the first, coarse stage
 #: (rtol 1e-6) ends once it stops converging: its integration error alone can make the Gauss-Newton step
 #: ~0.3-1 standard errors (on the identification benchmark's Model II data: 0.01)
@@ -331,8 +333,8 @@ COARSE_STEP = 1.0
 class _Converged(Exception):
     """Raised inside the least-squares iteration at a point that is already the optimum."""
 
-    def __init__(self, phi):
-        self.phi = phi
+    def __init__(self, phi, step):
+        self.phi, self.step = phi, step
 
 
 def gauss_newton_length(qr, R) -> float:
@@ -389,7 +391,7 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
                     and math.sqrt(2.0 * cost / max(r.size, 1)) <= AT_NOISE):
                 step = gauss_newton_length(f[:-1], G[:-1])
                 if step < small_step or (stall_step is not None and last_step[0] / 2 < step < stall_step):
-                    raise _Converged(phi.copy())
+                    raise _Converged(phi.copy(), step)
                 last_step[0] = step
             best_cost[0] = min(best_cost[0], cost)
         return cache[key]
@@ -405,11 +407,14 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
                                      method="trf", x_scale="jac", ftol=tol, xtol=tol,
                                      gtol=1e-15 if tight else 1e-4, max_nfev=max_nfev)
     except _Converged as stop:
-        x, f = _last_step(cache, transform, stop.phi, bounds)
+        # the step itself is taken where the linearization holds it (a longer one, where a coarse
+        # stage or a fit that only starts another one stops, is left to what follows)
+        linear = stop.step < SMALL_STEP
+        x, f = _last_step(cache, transform, stop.phi, bounds) if linear else (stop.phi, cache[stop.phi.tobytes()][0])
         res = optimize.OptimizeResult(
             x=x, fun=f, cost=0.5 * float(f @ f), success=True, status=1,
-            message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise; "
-                    f"taken on the linearized model")
+            message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise"
+                    + ("; taken on the linearized model" if linear else ""))
     res.evaluated = {k: v[2:] for k, v in cache.items()}
     return res
 
