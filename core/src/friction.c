@@ -29,6 +29,9 @@ double tf_friction_reference_force(int kind, const double *p)
     return p[TF_P_FC];
 }
 
+/* (|v|/vs)^delta: the Gaussian Stribeck curve (delta = 2, the default) without a pow, the same number */
+static double stribeck_power(double r, double delta) { return delta == 2.0 ? r * r : pow(r, delta); }
+
 double tf_stribeck(const double *p, double v, double *dg)
 {
     double fc = p[TF_P_FC], fs = p[TF_P_FS], vs = p[TF_P_VS], delta = p[TF_P_DELTA];
@@ -37,7 +40,7 @@ double tf_stribeck(const double *p, double v, double *dg)
         return v == 0.0 ? fs : fc;
     }
     double r = fabs(v / vs);
-    double rd = pow(r, delta);
+    double rd = stribeck_power(r, delta);
     double e = exp(-rd);
     if (dg) *dg = -(fs - fc) * e * delta * (rd / r) * sgn(v) / vs;
     return fc + (fs - fc) * e;
@@ -53,9 +56,10 @@ void tf_stribeck_param_partials(const double *p, double v, double *dg)
         dg[v == 0.0 ? TF_P_FS : TF_P_FC] = 1.0;
         return;
     }
-    double r = fabs(v / vs), rd = pow(r, delta), e = exp(-rd);
+    double r = fabs(v / vs), rd = stribeck_power(r, delta), e = exp(-rd);
     dg[TF_P_FC] = 1.0 - e;
     dg[TF_P_FS] = e;
+    if (fs == fc) return; /* no Stribeck effect: vs and delta do not act (their partials stay 0) */
     dg[TF_P_VS] = (fs - fc) * e * delta * rd / vs;
     dg[TF_P_DELTA] = -(fs - fc) * e * rd * log(r);
 }

@@ -234,12 +234,13 @@ static void heat_rates(const tf_model *m, double t, const double *y, double F, d
     if (has_work(m)) dy[tf_model_work_index(m)] = P;
 }
 
-int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
+/* The plant's mechanical rows under the friction force F (a prescribed motion has none): the one
+ * statement of the plant equations, for every right-hand side. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline void mechanical_rhs(const tf_model *m, double t, const double *y, double F, double *dy)
 {
-    tf_model *m = (tf_model *)ctx;
-    int nm = nmech(m);
-    double F = friction(m, t, y, dy + nm, 0);
-    if (has_work(m)) heat_rates(m, t, y, F, dy);
     if (m->plant == TF_PLANT_STICK_SLIP) {
         double u = tf_waveform_value(&m->input, t);
         dy[XP] = y[VP];
@@ -251,6 +252,15 @@ int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
         dy[X] = y[V];
         dy[V] = (f - F) / m->m;
     }
+}
+
+int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
+{
+    tf_model *m = (tf_model *)ctx;
+    int nm = nmech(m);
+    double F = friction(m, t, y, dy + nm, 0);
+    if (has_work(m)) heat_rates(m, t, y, F, dy);
+    mechanical_rhs(m, t, y, F, dy);
     return 0;
 }
 
@@ -259,19 +269,9 @@ int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 static int rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
-    if (m->plant == TF_PLANT_STICK_SLIP) {
-        double F = lugre_constant_T_friction(m, y[VE] - y[VP], y[4], &dy[4]);
-        double u = tf_waveform_value(&m->input, t);
-        dy[XP] = y[VP];
-        dy[VP] = (-m->c * y[VP] - m->k * y[XP] + m->T_em * u + F) / m->m;
-        dy[XE] = y[VE];
-        dy[VE] = -F / m->m_e;
-    } else {
-        double F = lugre_constant_T_friction(m, y[V], y[2], &dy[2]);
-        double f = tf_waveform_value(&m->input, t) + m->k_s * (m->v_0 * t - y[X]);
-        dy[X] = y[V];
-        dy[V] = (f - F) / m->m;
-    }
+    int iz = m->plant == TF_PLANT_STICK_SLIP ? 4 : 2;
+    double F = lugre_constant_T_friction(m, relative_velocity(m, t, y), y[iz], &dy[iz]);
+    mechanical_rhs(m, t, y, F, dy);
     return 0;
 }
 
@@ -322,38 +322,37 @@ static void heat_jacobian(tf_model *m, double t, const double *y, const tf_frict
 }
 
 /* The state Jacobian from the friction force's partials d (after the thermal model). */
-static void jacobian_from(tf_model *m, double t, const double *y, tf_friction_partials *d_in, double *J)
+static void jacobian_from(tf_model *m, double t, const double *y, const tf_friction_partials *d, double *J)
 {
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
-    tf_friction_partials d = *d_in;
     memset(J, 0, sizeof(double) * n * n);
 #define J_(i, j) J[(i) * n + (j)]
     if (m->plant == TF_PLANT_STICK_SLIP) {
         J_(XP, VP) = 1.0;
         J_(VP, XP) = -m->k / m->m;
-        J_(VP, VP) = (-m->c - d.dF_dv) / m->m;
-        J_(VP, VE) = d.dF_dv / m->m;
+        J_(VP, VP) = (-m->c - d->dF_dv) / m->m;
+        J_(VP, VE) = d->dF_dv / m->m;
         J_(XE, VE) = 1.0;
-        J_(VE, VP) = d.dF_dv / m->m_e;
-        J_(VE, VE) = -d.dF_dv / m->m_e;
+        J_(VE, VP) = d->dF_dv / m->m_e;
+        J_(VE, VE) = -d->dF_dv / m->m_e;
         for (int j = 0; j < nz; j++) {
-            J_(VP, nm + j) = d.dF_dz[j] / m->m;
-            J_(VE, nm + j) = -d.dF_dz[j] / m->m_e;
-            J_(nm + j, VP) = -d.ddz_dv[j];
-            J_(nm + j, VE) = d.ddz_dv[j];
+            J_(VP, nm + j) = d->dF_dz[j] / m->m;
+            J_(VE, nm + j) = -d->dF_dz[j] / m->m_e;
+            J_(nm + j, VP) = -d->ddz_dv[j];
+            J_(nm + j, VE) = d->ddz_dv[j];
         }
     } else if (m->plant == TF_PLANT_MASS) {
         J_(X, V) = 1.0;
         J_(V, X) = -m->k_s / m->m;
-        J_(V, V) = -d.dF_dv / m->m;
+        J_(V, V) = -d->dF_dv / m->m;
         for (int j = 0; j < nz; j++) {
-            J_(V, nm + j) = -d.dF_dz[j] / m->m;
-            J_(nm + j, V) = d.ddz_dv[j];
+            J_(V, nm + j) = -d->dF_dz[j] / m->m;
+            J_(nm + j, V) = d->ddz_dv[j];
         }
     }
-    for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d.ddz_dz[j];
+    for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d->ddz_dz[j];
 #undef J_
-    if (has_work(m)) heat_jacobian(m, t, y, &d, J);
+    if (has_work(m)) heat_jacobian(m, t, y, d, J);
 }
 
 int tf_model_jac(double t, const double *y, double *J, void *ctx)
@@ -400,8 +399,9 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
 {
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
-    if (lugre_constant_T(m)) rhs_lugre_constant_T(t, y, dy, m);
-    else tf_model_rhs(t, y, dy, m);
+    int fused = np && lugre_constant_T(m); /* the right-hand side from the one friction evaluation below */
+    if (!np && lugre_constant_T(m)) rhs_lugre_constant_T(t, y, dy, m);
+    else if (!fused) tf_model_rhs(t, y, dy, m);
     if (!np) {
         if (J) tf_model_jac(t, y, J, m);
         return 0;
@@ -412,6 +412,10 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
     double T = tf_model_temperature(m, t, y);
     tf_model_params_cached(m, T, &lambda, &dF_offset);
     double F = friction_at(m, T, t, y, dz, J ? &d : 0, &dp, &Fb);
+    if (fused) { /* the same equations as rhs_lugre_constant_T, with the partials' evaluation */
+        dy[nm] = dz[0];
+        mechanical_rhs(m, t, y, F, dy);
+    }
     if (J) jacobian_from(m, t, y, &d, J);
     if (m->fs_follows_fc) { /* one parameter moves both */
         dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
@@ -420,11 +424,11 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
     double Fref = reference_force(m);
     double v = relative_velocity(m, t, y);
     double s = (F * v > 0.0) - (F * v < 0.0); /* d|F v|/dF = s v */
+    memset(fp, 0, sizeof(double) * (size_t)(n * np));
     for (int k = 0; k < np; k++) {
         const tf_target *tg = &targets[k];
         double dF = 0.0, chain = 1.0; /* dF'/dtheta and d(param)/dtheta */
         int i = tg->param;
-        for (int r = 0; r < n; r++) fp[r * np + k] = 0.0;
         if (tg->kind == TF_TARGET_PLANT) {
             plant_partials(m, t, y, dy, i, fp, np, k);
             continue;
