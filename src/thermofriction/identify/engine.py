@@ -239,8 +239,8 @@ class Problem:
 
     def _run_all(self, model, theta, jac):
         """Every trace's run on the pool, the longest first (by its last run's time, or its length):
-        five runs on two cores, one of them twice as long as the others, take 3 units of time so and
-        up to 3.8 in the traces' order, where the long one can start last."""
+        five runs on two cores, one of them twice as long as the others, take 3 units of time this way
+        and up to 3.8 in the traces' order, where the long one can start last."""
         def timed(i):
             t0 = time.perf_counter()
             out = self._run(model, self.traces[i], theta, jac)
@@ -326,7 +326,7 @@ COARSE_RTOL = 1e-6
 SMALL_STEP = 0.2
 #: the same for a fit that only starts another one, and the step under which the first, coarse stage
 #: (rtol 1e-6) ends once it stops converging: its integration error alone can make the Gauss-Newton step
-#: ~0.3-1 standard errors (on the identification benchmark's Model II data: 0.01)
+#: ~0.1-1 standard errors (0.1-0.2 on the identification benchmark's Model II data)
 COARSE_STEP = 1.0
 
 
@@ -421,8 +421,8 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
 
 def _last_step(cache, transform: Transform, phi, bounds):
     """The Gauss-Newton step from the evaluated point phi, taken on the linearized model (within the
-    bounds), with its residuals r + J dx: the fit stops where that step is below a standard error or
-    so, a length at which the linearization's error is a small fraction of it. Simulating the point
+    bounds), with its residuals r + J dx: taken where that step is below SMALL_STEP standard errors, a
+    length at which the linearization's error is well under the step (see SMALL_STEP). Simulating the point
     again would only confirm it; the Jacobian is kept (it changes by a fraction of that). Returns
     the new point and its compressed residuals; the cache gets its (f, G, r, J)."""
     f, G, r, J = cache[phi.tobytes()]

@@ -52,8 +52,8 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     base_init = base_model(init, T_ref)
     # The direct procedure's first fits (the base model here, dF at each temperature) only start its joint
     # refinement, which ends at the requested tolerance and step: they run at rtol 1e-6 (whose integration
-    # error moves a Gauss-Newton step by ~0.01 standard errors on data like the paper's) and stop as the
-    # coarse stage of a fit does, within a standard error. The paper's procedure keeps the base fit as it
+    # error moves a Gauss-Newton step by ~0.1-0.2 standard errors on data like the paper's) and stop as
+    # the coarse stage of a fit does, within a standard error. The paper's procedure keeps the base fit as it
     # is: its result is built on it.
     first_opts = opts
     if refine and procedure == "direct":
