@@ -206,8 +206,7 @@ def test_the_last_gauss_newton_step_on_the_linearized_model_lands_near_the_optim
 
     def compressed(phi):
         r, J = problem.evaluate(transform.to_theta(phi), jac=True)
-        f, G = _compressed(r / noise, J * transform.dtheta_dphi(transform.to_theta(phi))[None, :] / noise)
-        return f, G, r, J
+        return (*_compressed(r, J, transform, transform.to_theta(phi), noise), r, J)
 
     # the optimum (Gauss-Newton steps from the truth until they are below 1e-3), then a point off it
     phi = transform.to_phi(theta)

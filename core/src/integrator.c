@@ -16,6 +16,7 @@
  *   that both methods pay for, so the choice is made on measured work.
  */
 #include "thermofriction/integrator.h"
+#include "inline.h" /* TF_SIZED */
 
 #include <float.h>
 #include <math.h>
@@ -28,11 +29,6 @@ enum { PROBE_STEPS = 200, WINDOW_STEPS = 200, FIRST_LOCK = 2000 };
  * inlined into dispatchers that pass constants for the common models (5 states: the stick-slip
  * actuator with LuGre; 3: the mass with LuGre), so that their loops over five numbers compile to
  * straight-line code; any other size runs the same code with the runtime value. */
-#if defined(__GNUC__) || defined(__clang__)
-#define TF_SIZED static inline __attribute__((always_inline))
-#else
-#define TF_SIZED static inline
-#endif
 #ifndef AUTO_EXPLICIT_TOL
 #define AUTO_EXPLICIT_TOL 0.02 /* 1/50 */
 #endif

@@ -1,5 +1,6 @@
 /* Plants (docs/models.md#plants) with friction and thermal extension, as one ODE system. */
 #include "thermofriction/plant.h"
+#include "inline.h" /* TF_SIZED */
 
 #include <math.h>
 #include <string.h>
@@ -114,10 +115,7 @@ static double friction(tf_model *m, double t, const double *y, double *dz, tf_fr
 
 /* F' and z' of the common case (lugre_constant_T): the same equations as friction_at, with the
  * run's parameters. */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((always_inline))
-#endif
-static inline double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
+TF_SIZED double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
 {
     double lambda = m->cache_lambda, dF = m->cache_dF;
     const double *p = m->cache_p;
@@ -236,10 +234,7 @@ static void heat_rates(const tf_model *m, double t, const double *y, double F, d
 
 /* The plant's mechanical rows under the friction force F (a prescribed motion has none): the one
  * statement of the plant equations, for every right-hand side. */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((always_inline))
-#endif
-static inline void mechanical_rhs(const tf_model *m, double t, const double *y, double F, double *dy)
+TF_SIZED void mechanical_rhs(const tf_model *m, double t, const double *y, double F, double *dy)
 {
     if (m->plant == TF_PLANT_STICK_SLIP) {
         double u = tf_waveform_value(&m->input, t);
@@ -399,20 +394,21 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
 {
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
-    int fused = np && lugre_constant_T(m); /* the right-hand side from the one friction evaluation below */
-    if (!np && lugre_constant_T(m)) rhs_lugre_constant_T(t, y, dy, m);
-    else if (!fused) tf_model_rhs(t, y, dy, m);
+    int fast = lugre_constant_T(m);
     if (!np) {
+        if (fast) rhs_lugre_constant_T(t, y, dy, m);
+        else tf_model_rhs(t, y, dy, m);
         if (J) tf_model_jac(t, y, J, m);
         return 0;
     }
+    if (!fast) tf_model_rhs(t, y, dy, m); /* else from the one friction evaluation below */
     tf_friction_param_partials dp;
     tf_friction_partials d; /* the state and the parameter partials from one evaluation */
     double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
     double T = tf_model_temperature(m, t, y);
     tf_model_params_cached(m, T, &lambda, &dF_offset);
     double F = friction_at(m, T, t, y, dz, J ? &d : 0, &dp, &Fb);
-    if (fused) { /* the same equations as rhs_lugre_constant_T, with the partials' evaluation */
+    if (fast) { /* the same equations as rhs_lugre_constant_T, with the partials' evaluation */
         dy[nm] = dz[0];
         mechanical_rhs(m, t, y, F, dy);
     }

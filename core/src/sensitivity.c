@@ -3,11 +3,7 @@
 
 #include <string.h>
 
-#if defined(__GNUC__) || defined(__clang__)
-#define TF_SIZED static inline __attribute__((always_inline))
-#else
-#define TF_SIZED static inline
-#endif
+#include "inline.h" /* TF_SIZED */
 
 /* fp += J S (J n x n, S n x np, both row-major). Inlined with np a constant for the usual few
  * parameters, so that the row of np products compiles to straight-line code. */

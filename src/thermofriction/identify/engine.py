@@ -345,10 +345,14 @@ def gauss_newton_length(qr, R) -> float:
     return float(np.linalg.norm(R @ dx))
 
 
-def _compressed(r, J):
-    """(f, G), n + 1 rows, with |f| = |r|, G^T f = J^T r and G^T G = J^T J: everything the trust-region
-    iteration uses, so that it takes the same steps, but at the cost of n + 1 rows instead of one per
-    sample (its SVD and products on 10^5 x 6 matrices cost more than a short simulation)."""
+def _compressed(r, J, transform: Transform, theta, scale):
+    """The residuals r and their Jacobian J = dr/dtheta at theta, in units of the noise (``scale``) and
+    in the fitted coordinates phi: (f, G), n + 1 rows, with |f| = |r|, G^T f = J^T r and G^T G = J^T J
+    (r, J so scaled). Everything the trust-region iteration uses, so that it takes the same steps, but
+    at the cost of n + 1 rows instead of one per sample (its SVD and products on 10^5 x 6 matrices cost
+    more than a short simulation)."""
+    r = r / scale
+    J = J * (transform.dtheta_dphi(theta)[None, :] / scale)
     Q, R = np.linalg.qr(J)
     qr = Q.T @ r
     rest = float(np.linalg.norm(r - Q @ qr))
@@ -384,7 +388,7 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
                 f[-1] = 1e3 * max(_y_scale(problem), 1e-12) / scale * math.sqrt(problem.n_points)
                 G = np.zeros((len(phi) + 1, len(phi)))
             else:
-                f, G = _compressed(r / scale, J * (transform.dtheta_dphi(theta)[None, :] / scale))
+                f, G = _compressed(r, J, transform, theta, scale)
             cache[key] = (f, G, r, J)
             cost = 0.5 * float(f @ f)
             if (r is not None and not tight and cost <= best_cost[0] + 0.5
