@@ -16,7 +16,7 @@ from thermofriction.data.force import ForceExperiment, SamplingWarning, motion_w
 from thermofriction.errors import InputError
 from thermofriction.models import PrescribedMotion
 from thermofriction.models.plants import rotary_unit
-from thermofriction.validate_force import steady_state_curve
+from thermofriction.measurements import steady_state_curve
 
 from conftest import run_cli
 

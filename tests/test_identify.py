@@ -9,8 +9,9 @@ import pytest
 import thermofriction as tf
 from conftest import synthetic_experiments
 from thermofriction.identify import Parameters, fit_friction, identify
-from thermofriction.identify.engine import (Problem, Transform, _compressed, _last_step, gauss_newton_length,
-                                             make_traces, residual_scale)
+from thermofriction.identify.optimiser import (Transform, compressed, gauss_newton_length, linearized_step,
+                                                residual_scale)
+from thermofriction.identify.problem import Problem, make_traces
 
 
 def base_at(T, model_i):
@@ -190,7 +191,7 @@ def test_a_fit_stopped_by_the_small_step_rule_is_at_the_optimum__tight_reference
 
 
 def test_the_last_gauss_newton_step_on_the_linearized_model_lands_near_the_optimum__simulated_check(model_i):
-    """_last_step, from a point ~0.2 standard errors (Mahalanobis) off the optimum, on data where the
+    """linearized_step, from a point ~0.2 standard errors (Mahalanobis) off the optimum, on data where the
     model is far from linear in a poorly determined sigma1: simulated at the point it returns, the
     residuals' cost is the one it predicted to within a fifth of what it removes, and the Gauss-Newton
     step from there is below 0.3 of the one it took (0.16 measured; the linearization's error grows as the step's
@@ -206,7 +207,7 @@ def test_the_last_gauss_newton_step_on_the_linearized_model_lands_near_the_optim
 
     def compressed(phi):
         r, J = problem.evaluate(transform.to_theta(phi), jac=True)
-        return (*_compressed(r, J, transform, transform.to_theta(phi), noise), r, J)
+        return (*compressed(r, J, transform, transform.to_theta(phi), noise), r, J)
 
     # the optimum (Gauss-Newton steps from the truth until they are below 1e-3), then a point off it
     phi = transform.to_phi(theta)
@@ -223,7 +224,7 @@ def test_the_last_gauss_newton_step_on_the_linearized_model_lands_near_the_optim
     f_off, G_off = cache[off.tobytes()][:2]
     step_off = gauss_newton_length(f_off[:-1], G_off[:-1])
     assert 0.15 < step_off < 0.25
-    x, f_pred = _last_step(cache, transform, off, (np.full(3, -np.inf), np.full(3, np.inf)))
+    x, f_pred = linearized_step(cache, transform, off, (np.full(3, -np.inf), np.full(3, np.inf)))
     f_real, G_real, _, _ = compressed(x)
     removed = float(f_off @ f_off) - float(f_pred @ f_pred)
     assert abs(float(f_real @ f_real) - float(f_pred @ f_pred)) < 0.2 * removed

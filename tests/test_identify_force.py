@@ -201,7 +201,7 @@ def test_model_ii_from_torque_at_several_temperatures(tmp_path):
 
 def test_friction_models_compared_by_aicc_and_held_out_error(tmp_path):
     """compare_friction_models: on LuGre data LuGre wins on AICc and on the held-out error."""
-    from thermofriction.identify.force import compare_friction_models
+    from thermofriction.identify.compare import compare_friction_models
     truth = tf.Model(JOINT, tf.LuGre(**ROT))
     folder, sd = make_dataset(tmp_path, truth, validate=(35.0,), offset=OFFSET, **DATA)
     out = compare_friction_models(tf.load_dataset(folder), ("coulomb", "stribeck", "lugre"))

@@ -12,7 +12,7 @@ import pytest
 
 import thermofriction as tf
 from thermofriction.identify.laws import fit_law
-from thermofriction.identify.quality import noise_level
+from thermofriction.measurements.quality import noise_level
 from thermofriction.models import ModelI, ModelII, PWL, Linear
 
 from conftest import run_cli
@@ -104,7 +104,7 @@ def test_model_ii_paper_procedure_says_when_its_assumptions_fail():
 def test_breakpoint_sensitivity_matches_finite_differences__independent_derivative(temperatures):
     """The breakpoint's Jacobian column (the chain rule on the knot values' exact sensitivities)
     against central differences of whole simulations, on either side of the break."""
-    from thermofriction.identify.engine import Problem, make_traces
+    from thermofriction.identify.problem import Problem, make_traces
     from thermofriction.identify.parameters import get_value
 
     from conftest import synthetic_experiments
@@ -239,7 +239,7 @@ def test_synth_noise_takes_units_and_refuses_metres_meant_as_nanometres(tmp_path
 def test_plant_sensitivities_match_finite_differences__independent_derivative(name):
     """The C core's exact sensitivities to the plant's parameters (modal form: changing m holds xi, wn
     and K) against central differences of whole simulations, through the identification's residuals."""
-    from thermofriction.identify.engine import Problem, make_traces
+    from thermofriction.identify.problem import Problem, make_traces
     from thermofriction.identify.parameters import get_value
 
     from conftest import synthetic_experiments

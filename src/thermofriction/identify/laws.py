@@ -14,7 +14,7 @@ from ..models.friction import in_domain
 
 optimize = lazy("scipy.optimize")
 
-def _aicc(ssr, n, k):
+def aicc(ssr, n, k):
     if ssr <= 0:
         ssr = 1e-300
     aic = n * math.log(ssr / n) + 2 * k
@@ -57,7 +57,7 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
         else:
             raise InputError(f"unknown law kind '{kind}' for a Model I parameter (linear, exp, const)")
         ssr = float(np.sum(((law(T) - values) * w) ** 2))
-        table[kind] = {"aicc": _aicc(ssr, len(T), k), "law": law.to_dict()}
+        table[kind] = {"aicc": aicc(ssr, len(T), k), "law": law.to_dict()}
         if parameter is not None and not in_domain(parameter, law(np.linspace(rng[0], rng[1], 41))).all():
             table[kind]["excluded"] = f"leaves the physical domain of {parameter} within {rng[0]:g}..{rng[1]:g} C"
             continue
@@ -73,7 +73,7 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
         if in_domain(parameter, value):
             law = Const(value, range=rng)
             ssr = float(np.sum(((law(T) - values) * w) ** 2))
-            table["const"] = {"aicc": _aicc(ssr, len(T), 1), "law": law.to_dict(),
+            table["const"] = {"aicc": aicc(ssr, len(T), 1), "law": law.to_dict(),
                               "note": "the fallback: every other kind left the physical domain"}
             best = ("const", law)
     if best is None:
@@ -108,4 +108,4 @@ def segmented_fit(T, values, weights=None):
     return float(tb), PWL(knots, vals, range=(float(T[0]), float(T[-1]))), best[0]
 
 
-__all__ = ["fit_law", "segmented_fit"]
+__all__ = ["fit_law", "segmented_fit", "aicc"]

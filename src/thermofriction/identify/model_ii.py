@@ -16,10 +16,11 @@ from ..drive import experiment_waveform
 from ..errors import InputError
 from ..models import PWL, Const, Model, ModelII
 from ..simulate import simulate
-from .engine import AT_NOISE, COARSE_RTOL, COARSE_STEP, Problem, fit, make_traces, pool, residual_scale
-from .laws import _aicc, segmented_fit
+from .optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
+from .problem import Problem, make_traces, pool
+from .laws import aicc, segmented_fit
 from .parameters import Parameters, get_value, unit_of
-from .procedures import _fit_parameter_names, _groups, _result, base_model, fit_friction
+from .procedures import base_model, default_fit_parameters, fit_friction, fit_result, temperature_groups
 from .result import FitResult
 
 
@@ -30,7 +31,7 @@ def _final_displacement(exp):
 
 
 def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True, free=(),
-                      progress=None, **opts) -> FitResult:
+                      progress=None, measurement=None, **opts) -> FitResult:
     """Model II. ``procedure="paper"``: base model at the reference temperature; displacement
     against temperature by a segmented linear fit with an estimated breakpoint; displacement
     against dF by simulation; composed dF(T). ``"direct"``: dF fitted per temperature on the
@@ -39,7 +40,7 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     if procedure not in ("direct", "paper", "both"):
         raise InputError(f"Model II procedure must be 'direct', 'paper' or 'both', got {procedure!r}")
     t0 = time.perf_counter()
-    groups = _groups(experiments)
+    groups = temperature_groups(experiments)
     if len(groups) < 2:
         raise InputError("Model II needs fit experiments at two or more temperatures")
     if reference_temperature is None:
@@ -58,8 +59,8 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     first_opts = opts
     if refine and procedure == "direct":
         first_opts = dict(opts, rtol=max(opts.get("rtol", 1e-8), COARSE_RTOL), small_step=COARSE_STEP)
-    base_fit = fit_friction(ref_group, base_init, _fit_parameter_names(base_init) + list(free),
-                            method=f"base at {T_ref:.4g} C", **first_opts)
+    base_fit = fit_friction(ref_group, base_init, default_fit_parameters(base_init) + list(free),
+                            method=f"base at {T_ref:.4g} C", measurement=measurement, **first_opts)
     base = base_fit.model
     details = {"reference_temperature": T_ref, "base": base_fit.to_dict()}
     results = {}
@@ -67,7 +68,7 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
         results["paper"] = _model_ii_paper(groups, base, T_ref, details, t0, progress)
     if procedure in ("direct", "both"):
         results["direct"] = _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts,
-                                             free, first_opts)
+                                             free, first_opts, measurement)
     main = results["direct" if procedure != "paper" else "paper"]
     if procedure == "both":
         main.alternatives["paper"] = results["paper"]
@@ -125,12 +126,12 @@ def _model_ii_paper(groups, base, T_ref, details, t0, progress):
                      details=details)
 
 
-def _dF_start(group, m, fc, previous, opts):
+def _dF_start(group, m, fc, previous, opts, measurement=None):
     """Where to start dF at one temperature: the cost in dF can have two minima (a stick-slip step
     grows and then shrinks as friction falls), so scan it across the friction level, and keep the
     neighbouring temperature's value (continuation) in the scan."""
     grid = sorted(set(np.round(np.linspace(-0.9, 0.9, 13) * fc, 12)) | {0.0, float(previous)})
-    traces = make_traces(group, m)
+    traces = make_traces(group, m, measurement)
     problem = Problem(m, ["dF.value"], traces, rtol=max(opts.get("rtol", 1e-8), COARSE_RTOL), parallel=False)
 
     def cost(v):
@@ -162,7 +163,8 @@ def _dF_start(group, m, fc, previous, opts):
     return start, {"grid": grid, "cost": costs}
 
 
-def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=(), first_opts=None):
+def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=(), first_opts=None,
+                     measurement=None):
     per_T = []
     popts = dict(first_opts or opts)  # the per-temperature fits (first_opts: see identify_model_ii)
     popts["starts"] = 1
@@ -175,7 +177,7 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         # lambda = 1 + dF/fc stays positive: friction never reverses
         params.add("dF.value", start, min=-0.95 * fc, max=10.0 * fc, unit="N")
         return fit_friction(g, dataclasses.replace(m, thermal=ModelII(Const(start))), params,
-                            method=f"dF at {T:.4g} C", **popts)
+                            method=f"dF at {T:.4g} C", measurement=measurement, **popts)
 
     def fit_at(i, previous):
         g, T = groups[i], temperature[i]
@@ -190,11 +192,12 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
             # data's noise there is the optimum (no other minimum can fit meaningfully better), and the
             # scan for the right minimum is needed only when it does not
             r = fit_from(g, T, m, float(previous)) if previous is not None else None
-            if r is not None and r.rmse <= AT_NOISE * residual_scale(make_traces(g, m)):
+            if r is not None and r.rmse <= AT_NOISE * residual_scale(make_traces(g, m, measurement)):
                 scans[T] = {"grid": [], "cost": [], "note": "the fit from the neighbouring temperature's dF "
                                                              f"({previous:.6g} N) reached the noise: no scan"}
             else:
-                start, scans[T] = _dF_start(g, m, fc, 0.0 if previous is None else previous, popts)
+                start, scans[T] = _dF_start(g, m, fc, 0.0 if previous is None else previous, popts,
+                                                  measurement)
                 first, r = r, fit_from(g, T, m, start)
                 if first is not None:
                     r.nfev += first.nfev
@@ -236,10 +239,10 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     coef, *_ = np.linalg.lstsq(A, vals * w, rcond=None)
     lin = PWL([Ts.min(), Ts.max()], [coef[0] * Ts.min() + coef[1], coef[0] * Ts.max() + coef[1]],
               range=(float(Ts.min()), float(Ts.max())))
-    candidates["linear"] = (lin, _aicc(float(np.sum(((lin(Ts) - vals) * w) ** 2)), len(Ts), 2))
+    candidates["linear"] = (lin, aicc(float(np.sum(((lin(Ts) - vals) * w) ** 2)), len(Ts), 2))
     if len(Ts) >= 4:
         tb, seg, ssr = segmented_fit(Ts, vals, w)
-        candidates["two segments"] = (seg, _aicc(ssr, len(Ts), 4))
+        candidates["two segments"] = (seg, aicc(ssr, len(Ts), 4))
     chosen = min(candidates, key=lambda k: candidates[k][1])
     law = candidates[chosen][0]
     details["direct"] = {"temperatures": Ts, "dF": vals, "stderr": ses, "chosen": chosen,
@@ -267,11 +270,11 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
             [0.0 if j == k else v for j, v in enumerate(law.values)])))
         params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
         params[f"dF.values[{k}]"].vary = False
-        for name in _fit_parameter_names(base) + list(free):
+        for name in default_fit_parameters(base) + list(free):
             params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
         # the breakpoint is fitted with the values: held where the per-temperature estimates put it,
         # its error would bias dF between the measured temperatures and leave it out of the intervals
-        traces = make_traces(experiments, model)
+        traces = make_traces(experiments, model, measurement)
         if len(knots) > 2 and all(isinstance(t.temperature, (int, float)) for t in traces) and base.heat is None:
             margin = 0.02 * (knots[-1] - knots[0])
             for k in range(1, len(knots) - 1):
@@ -280,9 +283,9 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     else:
         warns.append(f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters "
                      f"are held at their fit there, so dF's intervals do not include their uncertainty")
-        traces = make_traces(experiments, model)
+        traces = make_traces(experiments, model, measurement)
     outcome = fit(model, params, traces, **dict(opts, starts=1))
-    res = _result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
+    res = fit_result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
     res.nfev += sum(r.nfev for _, r in per_T)
     return res
 

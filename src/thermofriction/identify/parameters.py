@@ -14,7 +14,7 @@ from .. import _bridge
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
 
-_TARGET_PARAM, _TARGET_LAW, _TARGET_DF, _TARGET_HEAT, _TARGET_PLANT = (
+TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
 #: Not a C core target: a breakpoint temperature of a piecewise-linear dF. Its sensitivity is the chain
 #: rule on the knot values' sensitivities (identify/engine.py), exact on constant-temperature runs.
@@ -82,7 +82,7 @@ class Parameters(dict):
 
 # -- names <-> model ----------------------------------------------------------------------------
 
-def _split(name):
+def split_name(name):
     m = re.fullmatch(r"([A-Za-z_0-9]+)(?:\.(.+))?", name)
     if not m:
         raise InputError(f"not a parameter name: '{name}'")
@@ -103,13 +103,13 @@ def _plant_target(model: Model, name: str):
         form = "modal (xi, wn, K)" if getattr(model.plant, "modal", False) else "physical (c, k, T_em)"
         raise InputError(f"'{name}': the plant is given in its {form} form; free those parameters instead")
     if name == "m" and getattr(model.plant, "modal", False):
-        return (_TARGET_PLANT, _bridge.PLANT_PARAMETER_INDEX["m (modal)"], 0)
-    return (_TARGET_PLANT, _bridge.PLANT_PARAMETER_INDEX[name], 0)
+        return (TARGET_PLANT, _bridge.PLANT_PARAMETER_INDEX["m (modal)"], 0)
+    return (TARGET_PLANT, _bridge.PLANT_PARAMETER_INDEX[name], 0)
 
 
 def target_of(model: Model, name: str):
     """(kind, parameter index, coefficient index) of the C core's sensitivity target."""
-    base, coef = _split(name)
+    base, coef = split_name(name)
     if coef is None and base not in PARAMETERS:
         plant = _plant_target(model, base)
         if plant is not None:
@@ -117,7 +117,7 @@ def target_of(model: Model, name: str):
     if base in HEAT_PARAMETERS and coef is None:
         if model.heat is None:
             raise InputError(f"'{name}': the model has no [heat] section")
-        return (_TARGET_HEAT, HEAT_PARAMETERS[base][2], 0)
+        return (TARGET_HEAT, HEAT_PARAMETERS[base][2], 0)
     if base == "dF":
         if not isinstance(model.thermal, ModelII):
             raise InputError(f"'{name}': the model has no Model II dF law")
@@ -133,7 +133,7 @@ def target_of(model: Model, name: str):
         names = model.thermal.dF.coefficient_names()
         if coef not in names:
             raise InputError(f"'{name}': dF ({model.thermal.dF.kind}) has coefficients {', '.join(names) or 'none'}")
-        return (_TARGET_DF, 0, names.index(coef))
+        return (TARGET_DF, 0, names.index(coef))
     if base not in PARAMETERS:
         raise InputError(f"'{name}' is not a parameter ({', '.join(PARAMETERS)}, 'dF', or 'p.coefficient')")
     idx = PARAMETERS.index(base)
@@ -141,26 +141,26 @@ def target_of(model: Model, name: str):
         if base in model.laws:
             raise InputError(f"'{base}' follows a law in this model: fit its coefficients "
                              f"({', '.join(base + '.' + c for c in model.laws[base].coefficient_names())})")
-        return (_TARGET_PARAM, idx, 0)
+        return (TARGET_PARAM, idx, 0)
     if base not in model.laws:
         raise InputError(f"'{name}': '{base}' has no law in this model")
     names = model.laws[base].coefficient_names()
     if coef not in names:
         raise InputError(f"'{name}': the law of '{base}' has coefficients {', '.join(names) or 'none'}")
-    return (_TARGET_LAW, idx, names.index(coef))
+    return (TARGET_LAW, idx, names.index(coef))
 
 
 def get_value(model: Model, name: str) -> float:
     kind, idx, coef = target_of(model, name)
-    if kind == _TARGET_HEAT:
+    if kind == TARGET_HEAT:
         return float(getattr(model.heat, HEAT_PARAMETERS[name][0]))
-    if kind == _TARGET_PLANT:
+    if kind == TARGET_PLANT:
         return float(getattr(model.plant, _plant_field(model, name)))
-    if kind == _TARGET_DF:
+    if kind == TARGET_DF:
         return float(model.thermal.dF.coefficients()[coef])
     if kind == KNOT:
         return float(model.thermal.dF.T[coef])
-    if kind == _TARGET_LAW:
+    if kind == TARGET_LAW:
         return float(model.laws[PARAMETERS[idx]].coefficients()[coef])
     values = model.friction.values()
     base = PARAMETERS[idx]
@@ -181,13 +181,13 @@ def with_values(model: Model, values: dict) -> Model:
         kind, idx, coef = target_of(model, name)
         if kind == KNOT:
             knots[coef] = float(v)
-        elif kind == _TARGET_PLANT:
+        elif kind == TARGET_PLANT:
             plant[_plant_field(model, name)] = float(v)
-        elif kind == _TARGET_HEAT:
+        elif kind == TARGET_HEAT:
             heat[HEAT_PARAMETERS[name][0]] = float(v)
-        elif kind == _TARGET_PARAM:
+        elif kind == TARGET_PARAM:
             friction[PARAMETERS[idx]] = float(v)
-        elif kind == _TARGET_LAW:
+        elif kind == TARGET_LAW:
             p = PARAMETERS[idx]
             c = laws[p].coefficients()
             c[coef] = v
@@ -212,7 +212,7 @@ def with_values(model: Model, values: dict) -> Model:
 
 
 def unit_of(model: Model, name: str) -> str:
-    base, coef = _split(name)
+    base, coef = split_name(name)
     if base in HEAT_PARAMETERS:
         return HEAT_PARAMETERS[base][1]
     if coef is None and base not in PARAMETERS and base in PLANT_UNITS:
@@ -226,4 +226,4 @@ def unit_of(model: Model, name: str) -> str:
     return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["KNOT", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]
+__all__ = ["KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from .._io import dump_json, jsonable
+from ..measurements import amount
 from ..models import Model
 from ..data.files import dataset_sha256 as data_sha256
 from .parameters import Parameters
@@ -21,8 +22,8 @@ class FitResult:
     model: Model
     parameters: Parameters
     correlation: np.ndarray
-    cost: float                 # sum of squared residuals [m^2]
-    rmse: float                 # [m]
+    cost: float                 # sum of squared residuals [unit^2]
+    rmse: float                 # [unit]
     n_points: int
     nfev: int
     njev: int
@@ -35,8 +36,15 @@ class FitResult:
     statistics: dict = dataclasses.field(default_factory=dict)
     details: dict = dataclasses.field(default_factory=dict)
     alternatives: dict = dataclasses.field(default_factory=dict)
-    #: residuals against the noise estimated from the data (identify/quality.py); None where not measured
+    #: residuals against the noise estimated from the data (measurements/quality.py); None where not measured
     fit_quality: dict | None = None
+    #: the measured quantity (thermofriction.measurements) and the SI unit of the residuals and the RMSE
+    measurement: str = "displacement"
+    unit: str = "m"
+    #: what the RMSE has had removed (measurements: ``removed``)
+    removed: str = "each experiment's constant offset"
+    #: force data: the sensor's offset (value, stderr, ci95, unit, fitted); empty where there is none
+    sensor_offset: dict = dataclasses.field(default_factory=dict)
 
     @property
     def adequate(self) -> bool | None:
@@ -114,6 +122,9 @@ class FitResult:
             "correlation": {"names": names, "matrix": self.correlation},
             "cost": self.cost,
             "rmse_offset_removed": self.rmse,
+            "offset_removed": self.removed,
+            "measurement": self.measurement,
+            "unit": self.unit,
             "fit_quality": self.fit_quality,
             "aicc": self.aicc,
             "n_points": self.n_points,
@@ -127,6 +138,9 @@ class FitResult:
             "details": self.details,
             "model": self.model.to_dict(),
         }
+        if self.sensor_offset:
+            d["sensor_offset"] = self.sensor_offset
+            d["rmse"] = self.rmse  # the name force results gave this metric before (docs/formats.md)
         if self.model.provenance:
             d["provenance"] = self.model.provenance
         if self.alternatives:
@@ -172,10 +186,15 @@ class FitResult:
         else:
             lines += [f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
                       f"    data points      = {self.n_points}",
-                      f"    rmse             = {self.rmse * 1e9:.4g} nm (each experiment's offset removed)"]
+                      f"    rmse             = {amount(self.rmse, self.unit)} ({self.removed} removed)"]
+            o = self.sensor_offset
+            if o:
+                how = "fitted, shared by all experiments" if o.get("fitted") else "held (--no-offset)"
+                err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
+                lines.append(f"    sensor offset    = {o['value']:.6g}{err} {self.unit} ({how})")
         if self.fit_quality is not None:
             q = self.fit_quality
-            lines.append(f"    noise (data)     = {q['noise'] * 1e9:.4g} nm; rmse/noise = {q['ratio']:.3g}, "
+            lines.append(f"    noise (data)     = {amount(q['noise'], self.unit)}; rmse/noise = {q['ratio']:.3g}, "
                          f"lag-1 autocorrelation {q['autocorrelation']:.2f}, "
                          f"{'adequate' if q['adequate'] else 'NOT adequate'}")
         lines += [
@@ -238,9 +257,9 @@ class FitResult:
         body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self._rows())
         warn = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
         q = self.fit_quality
-        quality = "" if q is None else (f", noise {q['noise'] * 1e9:.4g} nm: rmse/noise {q['ratio']:.3g}, "
+        quality = "" if q is None else (f", noise {amount(q['noise'], self.unit)}: rmse/noise {q['ratio']:.3g}, "
                                         f"{'adequate' if q['adequate'] else '<b>NOT adequate</b>'}")
-        rmse = "" if self.n_points == 0 else f", rmse {self.rmse * 1e9:.4g} nm"
+        rmse = "" if self.n_points == 0 else f", rmse {amount(self.rmse, self.unit)}"
         prov = self.model.provenance or {}
         origin = (f"<br><small>{html.escape(self.model.name or '')}: data sha256 {html.escape(prov['data_sha256'][:12])}…, "
                   f"{html.escape(prov.get('date', ''))}, thermofriction {html.escape(prov.get('thermofriction', ''))}"

@@ -1,5 +1,8 @@
 """Starting values from the data, for an initial model that gives only its plant (a model file with a
-[plant] section and no [friction]).
+[plant] section and no [friction]): :func:`lugre_start` for displacement data, :func:`force_start` for force
+data; and :func:`with_friction_model`, another friction model built from a model's values.
+
+For displacement data:
 
 A stick-slip actuator slips when the stage's acceleration times the end-effector mass exceeds the
 friction level, so the friction level is of the order of ``m_e`` times the stage's acceleration. That
@@ -13,16 +16,19 @@ multi-start spanning a decade either way of each parameter.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from ..drive import experiment_waveform
 from ..errors import ComputationError, InputError
-from ..models import Coulomb, LuGre, Model
+from ..models import FRICTION_MODELS, Coulomb, LuGre, Model, ModelI, PrescribedMotion
 from ..simulate import simulate
-from .engine import Problem, fit, make_traces
+from .optimiser import fit
 from .parameters import Parameters
+from .problem import Problem, make_traces
+from .procedures import base_model
 
 #: the scan, in units of m_e times the stage's acceleration scale
 SCAN = np.logspace(-3, 1, 13)
@@ -80,4 +86,112 @@ def lugre_start(plant, experiments, input=None) -> dict:
     return {"model": "lugre", **values}
 
 
-__all__ = ["lugre_start"]
+
+
+def with_friction_model(model: Model, kind: str) -> Model:
+    """``model`` with a ``kind`` friction model (docs/identification.md#friction-models), built from
+    its own friction's values where the two share a parameter (a Model I law goes with its
+    parameter; laws of parameters the new model lacks are dropped). What the new model requires
+    and the old one lacks is derived from the level fc and the presliding stiffness sigma0 (a GMS
+    model's sum of k_i; else fc over 1 um): sigma1 = 1e-6 s x sigma0, z_ba = fc / (2 sigma0),
+    C = 1e4 /s x fc, and GMS elements k_i proportional to 1/i summing to sigma0, w_i = 1/4 (four
+    elements breaking loose one after the other)."""
+    if kind not in FRICTION_MODELS:
+        raise InputError(f"unknown friction model '{kind}' (one of: {', '.join(FRICTION_MODELS)})")
+    if model.friction.model == kind:
+        return model
+    cls = FRICTION_MODELS[kind]
+    names = {f.name for f in dataclasses.fields(cls)} - set(cls.arrays)
+    laws = {k: v for k, v in model.laws.items() if k in names}
+    kw = {k: v for k, v in model.friction.values().items() if k in names}
+    kw.update({k: None for k in laws})
+    at = base_model(model).friction.values()  # numbers (laws at mid-range), to derive the rest from
+    fc = at["fc"]
+    sigma0 = at.get("sigma0") or (sum(at["k"]) if "k" in at else fc / 1e-6)
+    derived = {"sigma0": sigma0, "sigma1": 1e-6 * sigma0, "z_ba": 0.5 * fc / sigma0, "C": 1e4 * fc}
+    if kind == "gms":
+        h = sum(1.0 / i for i in range(1, 5))
+        derived.update(k=tuple(sigma0 / (i * h) for i in range(1, 5)), w=(0.25,) * 4)
+    for name in cls.required:
+        if name not in kw:
+            kw[name] = derived[name]
+    thermal = model.thermal
+    if isinstance(thermal, ModelI):
+        thermal = ModelI(laws) if laws else None
+    return dataclasses.replace(model, friction=cls(**kw), thermal=thermal)
+
+
+def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None) -> dict:
+    """A [friction] section of ``kind`` with starting values read off the data:
+
+    - the Coulomb level fc and viscous sigma2 (and the sensor offset, where the motion goes both ways) by
+      linear least squares ``F = b + fc sgn(v) + sigma2 v`` on the faster half of the sliding samples;
+    - a Stribeck excess fs - fc from the slowest sliding samples, and vs where it has fallen by 1/e;
+    - the bristle stiffness sigma0 from the force's rise over the motion after each reversal (the secant
+      over half the swing, times ln 2, is sigma0 for LuGre), else fc over 1/1000 of the stroke;
+    - sigma1 so that its force at the typical sliding speed is a tenth of fc.
+    A rough start: the fit's multi-start spans a decade either way."""
+    exps = list(getattr(experiments, "fit", experiments))
+    if not exps:
+        raise InputError("no experiment to take starting values from")
+    v = np.concatenate([e.drive_velocity for e in exps])
+    F = np.concatenate([e.force for e in exps])
+    x = [np.asarray(e.displacement, float) for e in exps]
+    speed = np.abs(v)
+    top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
+    if not top > 0:
+        raise InputError(f"{exps[0].file}: the motion does not move: no friction can be taken from it")
+    sliding = speed > 0.02 * top
+    fast = sliding & (speed >= np.median(speed[sliding]))
+    both_ways = np.any(v[fast] > 0) and np.any(v[fast] < 0)
+    cols = [np.sign(v[fast]), v[fast]] + ([np.ones(int(fast.sum()))] if both_ways else [])
+    coef, *_ = np.linalg.lstsq(np.column_stack(cols), F[fast], rcond=None)
+    fc = abs(float(coef[0]))
+    b = float(coef[2]) if both_ways else 0.0
+    fc = fc if fc > 0 else float(np.quantile(np.abs(F), 0.5)) or 1.0
+    sigma2 = max(float(coef[1]), 1e-3 * fc / top)
+    # presliding stiffness from the reversals
+    secants, travelled = [], []
+    for e, xe in zip(exps, x):
+        ve, Fe = e.drive_velocity, e.force
+        flips = np.flatnonzero(np.sign(ve[1:]) * np.sign(ve[:-1]) < 0)
+        for i in flips:
+            j = i + 1
+            while j < len(Fe) and abs(Fe[j] - Fe[i]) < fc and j - i < 10_000:
+                j += 1
+            if j < len(Fe) and abs(xe[j] - xe[i]) > 0:
+                secants.append(abs(Fe[j] - Fe[i]) / abs(xe[j] - xe[i]))
+        start = np.zeros(len(xe), int)  # the sample of the last reversal before each sample
+        start[flips + 1] = flips + 1
+        travelled.append(np.abs(xe - xe[np.maximum.accumulate(start)]))
+    stroke = max(float(np.ptp(np.concatenate(x))), 1e-300)
+    sigma0 = math.log(2.0) * float(np.median(secants)) if secants else fc / (1e-3 * stroke)
+    # a swing within one sample gives no stiffness, only a bound: start where the presliding spans a tenth of a
+    # typical sample's motion (stiffer bristles change nothing the data can show, and make the runs stiff)
+    step = float(np.median(np.concatenate([np.abs(np.diff(xe)) for xe in x])))
+    if step > 0:
+        sigma0 = min(sigma0, 2.0 * fc / (0.1 * step))
+    typical = float(np.median(speed[sliding]))
+    section = {"model": "lugre", "fc": fc, "sigma2": sigma2, "sigma0": sigma0, "sigma1": 0.1 * fc / typical}
+    # Stribeck: the excess over the Coulomb-viscous line at the slowest speeds of steady sliding (five
+    # presliding lengths fc/sigma0 past a reversal)
+    steady = sliding & (np.concatenate(travelled) > 5.0 * fc / sigma0)
+    excess = np.sign(v[steady]) * (F[steady] - b) - fc - sigma2 * speed[steady]
+    s = speed[steady]
+    order = np.argsort(s)
+    n_bin = max(len(order) // 40, 5)
+    bins = [order[i:i + n_bin] for i in range(0, len(order), n_bin)]
+    levels = np.array([np.median(excess[i]) for i in bins])
+    speeds = np.array([np.median(s[i]) for i in bins])
+    if levels.size > 2 and levels[0] > 0.05 * fc:
+        fs = fc + float(levels[0])
+        below = np.flatnonzero(levels < levels[0] / math.e)
+        vs = float(speeds[below[0]]) if below.size else float(speeds[-1])
+        section.update(fs=fs, vs=max(vs, float(speeds[0])))
+    if kind == "lugre":
+        return section
+    start = Model(plant or PrescribedMotion(), LuGre.from_dict(section))
+    return with_friction_model(start, kind).friction.to_dict()
+
+
+__all__ = ["lugre_start", "force_start", "with_friction_model"]

@@ -11,8 +11,11 @@ import math
 import numpy as np
 
 from ..errors import InputError
+from ..measurements import steady_state_curve
 from ..models import ModelI, ModelII
-from .page import _fmt, _plt, _table, page_html
+from ..validate import validate
+from .entries import akaike
+from .page import Figures, _fmt, _plt, _table, page_html
 from .plots import thin as _thin
 
 
@@ -77,7 +80,6 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
         ax.plot(e.drive_velocity[::stride], e.force[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature],
                 label="measured" if k == 0 else None)
     v = np.concatenate([-np.geomspace(top, top * 1e-3, 40), np.geomspace(top * 1e-3, top, 40)])
-    from ..validate_force import steady_state_curve
     T_mid = float(np.median(temps))
     for k, e in enumerate(entries):
         try:
@@ -135,13 +137,11 @@ def fig_loops(figs, entries, unit, xunit, what):
 
 
 def _akaike(entries):
-    from . import akaike
     return akaike(entries)[0]
 
 
-def render_force(entries, data, *, figures_dir=None, command=None, title=None) -> str:
-    from ..validate import validate
-    from .page import Figures
+def render_force(entries, data, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
+    """The page for force data (``truth`` and ``bands`` are displacement studies' and not shown here)."""
 
     exps = list(getattr(data, "experiments", data))
     if not any(getattr(e, "role", "fit") == "validate" for e in exps):

@@ -66,14 +66,4 @@ def pooled(qualities, sizes) -> dict:
             "adequate": all(q["adequate"] for q in qualities)}
 
 
-def advice(model) -> str:
-    """What to try when a fit is not adequate."""
-    tips = ["free the plant's masses (--free m_e,m; free=[\"m_e\", \"m\"] in Python), which the fit otherwise "
-            "holds at the initial model's", "check the displacement unit in the files' headers",
-            "check that the friction model and its parameters held fixed (e.g. fs, vs) suit the contact"]
-    if getattr(model, "thermal", None) is None:
-        tips.append("fit a thermal model (--method model-i or model-ii) if the experiments span temperatures")
-    return "; ".join(tips)
-
-
-__all__ = ["noise_level", "fit_quality", "pooled", "advice", "ADEQUATE_RATIO", "RESOLUTION"]
+__all__ = ["noise_level", "fit_quality", "pooled", "ADEQUATE_RATIO", "RESOLUTION"]

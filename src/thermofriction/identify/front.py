@@ -1,0 +1,153 @@
+"""The front door of identification: :func:`identify` checks its arguments, asks the data's measurement once,
+starts from the right model and runs the method's procedure."""
+
+from __future__ import annotations
+
+import dataclasses
+import numbers
+
+import numpy as np
+
+from ..data.experiments import TEMPERATURE_RANGE
+from ..errors import InputError, shorten
+from ..measurements import measurement_of
+from ..models import Model
+from .model_i import identify_model_i
+from .model_ii import identify_model_ii
+from .optimiser import one_blas_thread
+from .parameters import PLANT_UNITS, Parameters, target_of
+from .plant import fit_plant
+from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
+from .result import FitResult, stamped
+from .setup import SETUP
+
+METHODS = ("plant", "base", "model-i", "model-ii", "heat")
+
+
+#: The most starting points of the multi-start phase: each one simulates every fit experiment
+MAX_STARTS = 10_000
+
+
+def _check_arguments(method, reference_temperature, rtol, starts, seed):
+    def whole(v):
+        return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+    if not whole(starts) or not 1 <= starts <= MAX_STARTS:
+        raise InputError(f"starts must be a whole number from 1 to {MAX_STARTS}, got {shorten(starts)}")
+    if not whole(seed) or seed < 0:
+        raise InputError(f"seed must be a whole number, 0 or more, got {shorten(seed)}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not 0 < rtol < 1:
+        raise InputError(f"rtol must be between 0 and 1, got {shorten(rtol)}")
+    if reference_temperature is not None:
+        if method != "model-ii":
+            raise InputError("reference_temperature applies to method 'model-ii' only")
+        lo, hi = TEMPERATURE_RANGE
+        if (isinstance(reference_temperature, bool) or not isinstance(reference_temperature, numbers.Real)
+                or not lo <= reference_temperature <= hi):
+            raise InputError(f"reference_temperature must be a temperature from {lo:g} to {hi:g} C, "
+                             f"got {shorten(reference_temperature)}")
+
+
+@stamped  # the fitted model's name and provenance (result.py)
+@one_blas_thread  # (engine.py) for the whole procedure, whose fits run side by side
+def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
+             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None, offset=True) -> FitResult:
+    """Identifies a model from a dataset's ``fit`` experiments.
+
+    method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
+        (one friction model for all experiments, no thermal model), "model-i" or "model-ii".
+    init: the initial model (its plant, masses and input are kept); a model, a file or a preset
+        name. Default: the paper's preset for the method. A file with a [plant] and no [friction]
+        section starts LuGre from values taken from the data (identify/start.py).
+    friction: the friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb);
+        default the initial model's. When it differs, the initial friction model is built from the
+        initial model's values (:func:`with_friction_model`).
+    parameters: names (or a Parameters object) to fit for "base"; default the friction model's
+        (procedures.FRICTION_FIT_PARAMETERS; LuGre: sigma0, sigma1, fc).
+    procedure: Model II's "direct" (default), "paper" or "both".
+    free: plant parameters fitted too, in any method but "plant", one value shared by all experiments:
+        "m_e", "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a
+        plant given in its physical form).
+    laws: Model I law kinds per parameter, e.g. {"sigma0": "exp"}; default: chosen by AICc.
+    rtol: the simulations' relative tolerance during the fit; starts: the multi-start size.
+    offset: force data only (docs/force-data.md): fit the force sensor's offset, one for all experiments
+        (default), or hold it at the initial model's ``[plant] sensor_offset`` (False).
+
+    What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
+    it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
+    """
+    if method not in METHODS:
+        raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
+    _check_arguments(method, reference_temperature, rtol, starts, seed)
+    measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
+    if method not in measurement.methods:
+        *most, last = measurement.methods
+        raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
+    experiments = list(getattr(data, "fit", data))
+    initial, finish = SETUP[measurement.name]
+    init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure)
+    if not experiments:
+        raise InputError("the dataset has no experiment with role 'fit'")
+    opts = dict(rtol=rtol, starts=starts, seed=seed)
+    free = _plant_parameters(init, free, method)
+    if method == "plant":
+        return _identify_plant(getattr(data, "experiments", data), init)
+    if method == "heat":
+        return identify_heat(experiments, init, parameters, free=free, progress=progress, **opts)
+    if method == "base":
+        model = base_model(init)
+        if free:
+            if isinstance(parameters, Parameters):
+                raise InputError("free= adds plant parameters to the default ones; with a Parameters object, add "
+                                 "them to it instead")
+            parameters = list(parameters or default_fit_parameters(model)) + free
+        res = fit_friction(experiments, model, parameters, method="base", progress=progress, measurement=measurement,
+                           **opts)
+    elif method == "model-i":
+        if init.thermal is not None and not hasattr(init.thermal, "laws"):
+            init = base_model(init)
+        res = identify_model_i(experiments, init, laws=laws, refine=refine, progress=progress, free=free,
+                               measurement=measurement, **opts)
+    else:
+        res = identify_model_ii(experiments, init, procedure=procedure, reference_temperature=reference_temperature,
+                                refine=refine, progress=progress, free=free, measurement=measurement, **opts)
+    return finish(res, experiments, init, measurement)
+
+
+def _plant_parameters(init, free, method) -> list:
+    """The plant parameters to free, checked against the initial model's plant."""
+    if isinstance(free, str):
+        free = [f.strip() for f in free.split(",") if f.strip()]
+    free = list(dict.fromkeys(free or ()))
+    if free and method == "plant":
+        raise InputError("free= applies to the friction methods; --method plant fits xi, wn and K itself")
+    for name in free:
+        if name not in PLANT_UNITS:
+            raise InputError(f"'{name}' is not a plant parameter that can be freed "
+                             f"(one of: {', '.join(PLANT_UNITS)})")
+        target_of(init, name)  # the plant's form: modal plants free xi, wn, K; physical ones c, k, T_em
+    return free
+
+
+def _identify_plant(experiments, init):
+    staged = [e for e in experiments if getattr(e, "stage_displacement", None) is not None]
+    if not staged:
+        raise InputError("no experiment records the stage displacement (a stage_displacement[um] column): "
+                         "the plant fit needs it")
+    exp = staged[0]
+    pf = fit_plant(exp.time, exp.voltage, exp.stage_displacement)
+    model = dataclasses.replace(init, plant=pf.plant(init.plant.mass, init.plant.end_effector_mass))
+    n = len(pf.parameters)
+    corr = np.asarray(pf.correlation, float)[:n, :n] if getattr(pf, "correlation", None) is not None \
+        else np.full((n, n), np.nan)
+    return FitResult("plant", model, pf.parameters, corr, pf.rmse ** 2 * pf.n_points, pf.rmse,
+                     pf.n_points, 0, 0, 1, pf.wall_time, True, f"fitted on {exp.file}",
+                     experiments=[{"file": exp.file, "temperature": exp.temperature, "role": exp.role,
+                                   "rmse": pf.rmse}],
+                     warnings=list(getattr(pf, "warnings", [])) + (
+                         [] if len(staged) == 1 else [f"fitted on {exp.file}; {len(staged) - 1} more "
+                                                      f"experiment(s) with a stage record were not used"]),
+                     details={"note": "the equivalent masses m and m_e are kept from the initial model"})
+
+
+__all__ = ["identify", "METHODS", "MAX_STARTS"]

@@ -1,0 +1,310 @@
+"""The optimiser (the layer above the problem): trust-region least squares on residuals in the data's noise
+scale and in fitted coordinates (log for positive parameters), a coarse-then-fine tolerance schedule, a
+multi-start global phase, and the linearized last step."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import os
+import time
+
+import numpy as np
+
+from .._lazy import lazy
+from ..errors import ComputationError, InputError
+from ..models import Model
+from .parameters import Parameters
+from .problem import Problem, pool
+from ..measurements.quality import ADEQUATE_RATIO, noise_level
+
+optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
+
+#: RMSE within this factor of the noise: a fit at the noise, where the multi-start stops
+AT_NOISE = 1.1
+
+
+@dataclasses.dataclass
+class Transform:
+    """Positive parameters are fitted as log(theta), the others as theta / |theta0|."""
+
+    log: np.ndarray
+    scale: np.ndarray
+
+    def to_phi(self, theta):
+        theta = np.asarray(theta, float)
+        return np.where(self.log, np.log(np.where(self.log, theta, 1.0)), theta / self.scale)
+
+    def to_theta(self, phi):
+        phi = np.asarray(phi, float)
+        return np.where(self.log, np.exp(np.where(self.log, phi, 0.0)), phi * self.scale)
+
+    def dtheta_dphi(self, theta):
+        return np.where(self.log, theta, self.scale)
+
+    def bounds(self, params, theta0):
+        """Bounds in phi; a log parameter stays within e^+-30 of its initial value, so that
+        a parameter the data do not determine cannot run off to 0 or infinity."""
+        lo = np.array([p.min for p in params])
+        hi = np.array([p.max for p in params])
+        with np.errstate(divide="ignore"):
+            lo_phi = np.where(self.log, np.log(np.maximum(lo, 0.0)), lo / self.scale)
+            hi_phi = np.where(self.log, np.log(hi), hi / self.scale)
+        start = self.to_phi(theta0)
+        lo_phi = np.where(self.log, np.maximum(lo_phi, start - 30.0), lo_phi)
+        hi_phi = np.where(self.log, np.minimum(hi_phi, start + 30.0), hi_phi)
+        return lo_phi, hi_phi
+
+
+#: the tolerance of the first, coarse stage of a fit, and of the fits that only start another one
+COARSE_RTOL = 1e-6
+#: a step that moves the parameters by less than this many standard errors (in the joint, Mahalanobis,
+#: sense) is not worth its simulation: the fit stops there if its misfit is at the noise, and takes it
+#: on the linearized model (linearized_step). The linearization's error grows as the step's square: a poorly
+#: determined sigma1 (a standard error of a third of its value) left 0.72 standard errors of a 0.58 one,
+#: so 0.2 leaves ~0.08 at worst, under the 0.1 this rule stopped at, without the step, before
+SMALL_STEP = 0.2
+#: the same for a fit that only starts another one, and the step under which the first, coarse stage
+#: (rtol 1e-6) ends once it stops converging: its integration error alone can make the Gauss-Newton step
+#: ~0.1-1 standard errors (0.1-0.2 on the identification benchmark's Model II data)
+COARSE_STEP = 1.0
+
+
+class _Converged(Exception):
+    """Raised inside the least-squares iteration at a point that is already the optimum."""
+
+    def __init__(self, phi, step):
+        self.phi, self.step = phi, step
+
+
+def gauss_newton_length(qr, R) -> float:
+    """The length of the Gauss-Newton step from where residuals r = Q qr + (the rest) and Jacobian
+    J = Q R were taken, in standard errors: on residuals in units of the noise, |J dx| (the cost it
+    would remove is half its square) bounds every parameter's move divided by its standard error."""
+    dx, *_ = np.linalg.lstsq(R, -qr, rcond=None)
+    return float(np.linalg.norm(R @ dx))
+
+
+def compressed(r, J, transform: Transform, theta, scale):
+    """The residuals r and their Jacobian J = dr/dtheta at theta, in units of the noise (``scale``) and
+    in the fitted coordinates phi: (f, G), n + 1 rows, with |f| = |r|, G^T f = J^T r and G^T G = J^T J
+    (r, J so scaled). Everything the trust-region iteration uses, so that it takes the same steps, but
+    at the cost of n + 1 rows instead of one per sample (its SVD and products on 10^5 x 6 matrices cost
+    more than a short simulation)."""
+    r = r / scale
+    J = J * (transform.dtheta_dphi(theta)[None, :] / scale)
+    Q, R = np.linalg.qr(J)
+    qr = Q.T @ r
+    rest = float(np.linalg.norm(r - Q @ qr))
+    return np.append(qr, rest), np.vstack([R, np.zeros((1, J.shape[1]))])
+
+
+def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale,
+                   small_step=SMALL_STEP, stall_step=None):
+    """SciPy's trust-region least squares on residuals divided by ``scale`` (the data's noise level):
+    its stopping tests then mean the same on every dataset, whatever the units and magnitudes
+    (on residuals in metres, an absolute gradient test is met at any start).
+
+    Besides SciPy's tests, it stops at the first evaluated point whose misfit is at the noise and from
+    which the Gauss-Newton step is below ``small_step`` standard errors (not when ``tight``), and takes that
+    step on the linearized model (linearized_step) instead of simulating it. With ``stall_step``
+    (a coarse stage), also where the step is below that and no shorter than half the last one: the
+    stage's own integration error is then what is left, for the next stage to remove. The returned
+    result carries ``evaluated``: the last few points' unscaled (r, J), so that the caller's
+    evaluation at the optimum (for the intervals) is not simulated twice."""
+    cache = {}
+    best_cost = [math.inf]
+    last_step = [math.inf]
+
+    def both(phi):
+        key = phi.tobytes()
+        if key not in cache:
+            if len(cache) >= 4:
+                cache.pop(next(iter(cache)))
+            theta = transform.to_theta(phi)
+            r, J = problem.evaluate(theta, jac=True)
+            if r is None:  # a failed simulation: a large, flat residual pushes the step back
+                f = np.zeros(len(phi) + 1)
+                f[-1] = 1e3 * max(_y_scale(problem), 1e-12) / scale * math.sqrt(problem.n_points)
+                G = np.zeros((len(phi) + 1, len(phi)))
+            else:
+                f, G = compressed(r, J, transform, theta, scale)
+            cache[key] = (f, G, r, J)
+            cost = 0.5 * float(f @ f)
+            if (r is not None and not tight and cost <= best_cost[0] + 0.5
+                    and math.sqrt(2.0 * cost / max(r.size, 1)) <= AT_NOISE):
+                step = gauss_newton_length(f[:-1], G[:-1])
+                if step < small_step or (stall_step is not None and last_step[0] / 2 < step < stall_step):
+                    raise _Converged(phi.copy(), step)
+                last_step[0] = step
+            best_cost[0] = min(best_cost[0], cost)
+        return cache[key]
+
+    # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
+    # along directions the data do not determine
+    # (tight: down to the solver's own floor, for checks against noise-free data)
+    tol = 1e-15 if tight else max(1e-10, 10 * problem.rtol)
+    # on residuals of unit noise, the scaled gradient is the residuals' projection on each parameter's
+    # direction: below 1e-4 a further step would move the parameters by ~1e-4 of their standard errors
+    try:
+        res = optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
+                                     method="trf", x_scale="jac", ftol=tol, xtol=tol,
+                                     gtol=1e-15 if tight else 1e-4, max_nfev=max_nfev)
+    except _Converged as stop:
+        # the step itself is taken where the linearization holds it (a longer one, where a coarse
+        # stage or a fit that only starts another one stops, is left to what follows)
+        linear = stop.step < SMALL_STEP
+        x, f = linearized_step(cache, transform, stop.phi, bounds) if linear else (stop.phi, cache[stop.phi.tobytes()][0])
+        res = optimize.OptimizeResult(
+            x=x, fun=f, cost=0.5 * float(f @ f), success=True, status=1,
+            message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise"
+                    + ("; taken on the linearized model" if linear else ""))
+    res.evaluated = {k: v[2:] for k, v in cache.items()}
+    return res
+
+
+def linearized_step(cache, transform: Transform, phi, bounds):
+    """The Gauss-Newton step from the evaluated point phi, taken on the linearized model (within the
+    bounds), with its residuals r + J dx: taken where that step is below SMALL_STEP standard errors, a
+    length at which the linearization's error is well under the step (see SMALL_STEP). Simulating the point
+    again would only confirm it; the Jacobian is kept (it changes by a fraction of that). Returns
+    the new point and its compressed residuals; the cache gets its (f, G, r, J)."""
+    f, G, r, J = cache[phi.tobytes()]
+    dphi, *_ = np.linalg.lstsq(G[:-1], -f[:-1], rcond=None)
+    x = np.clip(phi + dphi, bounds[0], bounds[1])
+    dphi = x - phi
+    f_new = np.append(f[:-1] + G[:-1] @ dphi, f[-1])
+    r_new = r + (J * transform.dtheta_dphi(transform.to_theta(phi))[None, :]) @ dphi
+    cache[x.tobytes()] = (f_new, G, r_new, J)
+    return x, f_new
+
+
+def _y_scale(problem):
+    return max(float(np.ptp(t.measured)) for t in problem.traces)
+
+
+def residual_scale(traces) -> float:
+    """The scale residuals are measured in: the displacement noise estimated from the data (pooled
+    over the traces), at least 1e-6 of the largest displacement range (noise-free data)."""
+    noise = [noise_level(t.measured) for t in traces]
+    noise = [s for s in noise if math.isfinite(s)]
+    pooled = math.sqrt(sum(s * s for s in noise) / len(noise)) if noise else 0.0
+    span = max(float(np.ptp(t.measured)) for t in traces)
+    return max(pooled, 1e-6 * span, 1e-300)
+
+
+@dataclasses.dataclass
+class FitOutcome:
+    theta: np.ndarray
+    r: np.ndarray
+    J: np.ndarray
+    nfev: int
+    njev: int
+    success: bool
+    message: str
+    starts: int
+    wall_time: float
+
+
+def one_blas_thread(function):
+    """Runs ``function`` with BLAS on one thread. The fits' linear algebra is on a few columns, and the
+    cores belong to the simulations running beside it: OpenBLAS's threads, spinning between calls,
+    took them (the benchmark's Model II: 1.7 s with them, 1.2 s without)."""
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        from threadpoolctl import threadpool_limits
+        with threadpool_limits(limits=1, user_api="blas"):
+            return function(*args, **kwargs)
+    return wrapper
+
+
+@one_blas_thread
+def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=60,
+        tight=False, progress=None, near=False, small_step=SMALL_STEP) -> FitOutcome:
+    """Fits the varying parameters; returns the optimum with its residuals and Jacobian.
+
+    ``near``: the start is known to be within a standard error or so of the optimum (a refinement from
+    fits that already converged): no coarse stage at rtol 1e-6, whose integration error is of that size.
+    ``small_step``: the fit stops where the Gauss-Newton step is below this many standard errors at a
+    misfit at the noise (COARSE_STEP for a fit that only starts another one)."""
+    t_start = time.perf_counter()
+    varying = params.varying
+    if not varying:
+        raise InputError("no parameter to fit (all are fixed)")
+    names = [p.name for p in varying]
+    theta0 = np.array([p.value for p in varying])
+    transform = Transform(np.array([p.positive for p in varying]),
+                          np.array([abs(v) if v != 0 else 1.0 for v in theta0]))
+    lo, hi = transform.bounds(varying, theta0)
+    phi0 = np.clip(transform.to_phi(theta0), lo, hi)
+    one_trace = len(traces) == 1
+
+    scale = residual_scale(traces)
+    residual_count = sum(t.n_residuals for t in traces)
+
+    def run(phi_start):
+        # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
+        # half the cost per run), then polish at the requested tolerance
+        problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
+        phi_first = phi_start
+        if rtol < COARSE_RTOL and not near:
+            coarse = Problem(model, names, traces, rtol=COARSE_RTOL, parallel=not one_trace)
+            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale,
+                                   stall_step=COARSE_STEP)
+            phi_start = first.x
+            problem.nfev, problem.njev = coarse.nfev, coarse.njev
+        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight or near else 15, tight,
+                             scale, small_step)
+        res.moved = bool(np.any(res.x != phi_first))
+        return res, problem
+
+    def at_noise(res):  # residuals at the data's noise: another start cannot do meaningfully better
+        return math.sqrt(2.0 * res.cost / max(residual_count, 1)) <= AT_NOISE
+
+    # The initial guess first. Only if it does not reach the noise, the global phase: screen a Latin
+    # hypercube around it (a decade either way for log parameters, +-100 % for the others) by cost
+    # alone, then refine the best few. (A start off in a direction the data hardly determine, sigma1,
+    # can screen best and yet take ten times longer to converge to the same optimum.)
+    runs = [run(phi0)]
+    screen = Problem(model, names, traces, rtol=max(rtol, COARSE_RTOL), parallel=not one_trace)
+    n_candidates = 1
+    if starts > 1 and not at_noise(runs[0][0]):
+        width = np.where(transform.log, math.log(10.0), 1.0)
+        sample = stats.qmc.LatinHypercube(d=len(phi0), seed=seed).random(starts - 1)
+        candidates = [np.clip(phi0 + (2 * u - 1) * width, lo + 1e-9, hi - 1e-9) for u in sample]
+        n_candidates += len(candidates)
+
+        def cost(phi):
+            r, _ = screen.evaluate(transform.to_theta(phi))
+            return math.inf if r is None else float(r @ r)
+
+        costs = list(pool().map(cost, candidates)) if one_trace else [cost(c) for c in candidates]
+        order = np.argsort(costs)
+        n_refine = min(max(os.cpu_count() or 1, 2), 3) if one_trace else 1  # one per core
+        chosen = [candidates[i] for i in order[:n_refine] if math.isfinite(costs[i])]
+        if progress:
+            progress(f"the initial guess is not at the noise: {len(candidates)} more starts screened; refining "
+                     f"{len(chosen)}")
+        if one_trace and len(chosen) > 1:
+            runs += list(pool().map(run, chosen))
+        else:
+            runs += [run(c) for c in chosen]
+    best, best_problem = min(runs, key=lambda rp: rp[0].cost)
+    theta = transform.to_theta(best.x)
+    # the residuals and Jacobian at the optimum, on the full data at the requested tolerance: the last
+    # iteration's, if it evaluated them there
+    r, J = best.evaluated.get(best.x.tobytes()) or best_problem.evaluate(theta, jac=True)
+    if r is None:
+        raise ComputationError("the fit ended where the model cannot be simulated; try another initial guess")
+    nfev = screen.nfev + sum(p.nfev for _, p in runs)
+    njev = sum(p.njev for _, p in runs)
+    success, message = bool(best.success and best.status > 0), best.message
+    if not best.moved and math.sqrt(float(r @ r) / r.size) > ADEQUATE_RATIO * scale:
+        # a small gradient at a start that does not fit the data is not convergence
+        success, message = False, f"stopped at its starting point ({message})"
+    return FitOutcome(theta, r, J, nfev, njev, success, message, n_candidates, time.perf_counter() - t_start)
+
+
+__all__ = ["Transform", "fit", "FitOutcome", "residual_scale", "gauss_newton_length", "compressed",
+           "linearized_step", "one_blas_thread", "AT_NOISE", "COARSE_RTOL", "SMALL_STEP", "COARSE_STEP"]

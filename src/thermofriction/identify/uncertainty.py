@@ -1,0 +1,76 @@
+"""Uncertainty (the layer above the optimiser): standard errors, intervals and correlations of a fit from the
+Jacobian at its optimum."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._lazy import lazy
+from ..models import Model
+from .optimiser import FitOutcome
+from .parameters import Parameters, unit_of
+
+special = lazy("scipy.special")
+
+
+def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
+    """Standard errors, 95 % intervals and correlations from the Jacobian at the optimum.
+
+    cov = s^2 (J^T J)^-1 by SVD of the column-scaled Jacobian; a direction the data do not
+    determine (singular value below 1e-9 of the largest) gives the parameters on it an infinite
+    error instead of a falsely tight one. s^2 is inflated by (1 + rho)/(1 - rho), rho the residuals'
+    lag-1 autocorrelation, so that coloured (non-white) residuals do not make the intervals
+    too narrow. Returns the correlation matrix and warnings."""
+    varying = params.varying
+    theta, r, J = outcome.theta, outcome.r, outcome.J
+    n, p = J.shape
+    dof = max(n - p - traces[0].measurement.offsets_in(traces), 1)
+    s2 = float(r @ r) / dof
+    rhos, start = [], 0
+    for tr in traces:
+        seg = r[start:start + tr.n_residuals]
+        start += tr.n_residuals
+        if len(seg) > 3 and np.dot(seg, seg) > 0:
+            rhos.append(float(np.dot(seg[1:], seg[:-1]) / np.dot(seg, seg)))
+    rho = min(max(float(np.mean(rhos)) if rhos else 0.0, 0.0), 0.99)
+    inflation = (1 + rho) / (1 - rho)
+    col = np.linalg.norm(J, axis=0)
+    col[col == 0] = 1.0
+    U, S, Vt = np.linalg.svd(J / col, full_matrices=False)
+    bad = S <= S[0] * 1e-9 if S.size and S[0] > 0 else np.ones_like(S, bool)
+    inv = np.where(bad, 0.0, 1.0 / np.where(bad, 1.0, S) ** 2)
+    cov = (Vt.T * inv) @ Vt / np.outer(col, col) * s2 * inflation
+    var = np.diag(cov).copy()
+    loading = (Vt[bad] ** 2).sum(axis=0) if bad.any() else np.zeros(p)
+    var[loading > 1e-6] = math.inf
+    se = np.sqrt(var)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    corr[~np.isfinite(corr)] = np.nan
+    np.fill_diagonal(corr, 1.0)
+    tq = float(special.stdtrit(dof, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
+    warnings = []
+    for i, par in enumerate(varying):
+        par.value = float(theta[i])
+        par.stderr = float(se[i])
+        if not math.isfinite(se[i]):
+            par.ci95 = (0.0 if par.positive else -math.inf, math.inf)
+            warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)")
+            continue
+        if par.positive:
+            f = math.exp(min(tq * se[i] / theta[i], 700.0))
+            par.ci95 = (theta[i] / f, theta[i] * f)
+        else:
+            par.ci95 = (theta[i] - tq * se[i], theta[i] + tq * se[i])
+        if se[i] > 0.5 * abs(theta[i]):
+            rel = f"{100 * se[i] / abs(theta[i]):.0f} % of its value" if theta[i] else f"{se[i]:.3g} around 0"
+            warnings.append(f"'{par.name}' is poorly determined by these data (standard error {rel})")
+    for par in params.values():
+        if not par.vary:
+            par.stderr, par.ci95 = 0.0, (par.value, par.value)
+        if not par.unit:
+            par.unit = unit_of(model, par.name)
+    return corr, warnings, {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho,
+                            "variance_inflation": inflation}

@@ -1,0 +1,40 @@
+"""Measurements: what an experiment recorded, and how a model is held against it (docs/architecture.md#measurements).
+
+A registry of the measured quantities -- :class:`Displacement` (driven by a voltage) and :class:`Force` (friction
+force or torque under a measured motion). ``identify``, ``validate`` and ``report`` ask a dataset's measurement
+once, with :func:`measurement_of`, and then ask it what they need. A new measured quantity is a module here that
+implements :class:`Measurement` and an entry in :data:`REGISTRY`.
+"""
+
+from __future__ import annotations
+
+from ..errors import InputError
+from .base import Measurement, MetricWarning, Trace, amount, center
+from .displacement import Displacement, Prediction, step_sizes
+from .force import Force, ForcePrediction, steady_state_curve
+
+#: The measured quantities, the most specific first: an experiment is the first one's that recognises it.
+REGISTRY = {"force": Force, "displacement": Displacement}
+
+
+def kind_of(exp) -> str:
+    return next(name for name, cls in REGISTRY.items() if cls.recognises(exp))
+
+
+def measurement_of(data, *, offset=None) -> Measurement:
+    """The measurement of ``data`` (a dataset or a list of experiments), with its offset policy: ``offset``
+    None or True for the measurement's default, False to hold the model's own (force data), or a policy's
+    name. A dataset that mixes measurements is refused."""
+    exps = list(getattr(data, "experiments", data))
+    kinds = {kind_of(e) for e in exps} or {"displacement"}
+    if len(kinds) > 1:
+        raise InputError("the dataset mixes force (torque) experiments with actuator (voltage, displacement) ones; "
+                         "keep them in separate datasets")
+    cls = REGISTRY[kinds.pop()]
+    if offset is None or offset is True:
+        return cls()
+    return cls("held" if offset is False else offset)
+
+
+__all__ = ["Measurement", "MetricWarning", "Trace", "Displacement", "Force", "Prediction", "ForcePrediction",
+           "REGISTRY", "measurement_of", "kind_of", "amount", "center", "step_sizes", "steady_state_curve"]

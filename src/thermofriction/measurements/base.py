@@ -1,0 +1,140 @@
+"""What every measured quantity provides (docs/architecture.md#measurements).
+
+A measurement is what an experiment recorded and how a model is held against it: the quantity and its unit,
+how a run of the model becomes a trace and its residuals (and their Jacobian), which offset of the record is
+removed, the parameters fitted by default, what to advise when a fit misses, and how a prediction is measured
+when validating. ``identify``, ``validate`` and ``report`` ask the dataset's measurement once
+(:func:`thermofriction.measurements.measurement_of`) and then only ask it."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..waveforms import Sampled, Waveform
+
+
+@dataclasses.dataclass
+class Trace:
+    """One measured run, ready to fit: the model is driven by ``waveform`` at ``temperature``; ``measured``
+    is the record the residuals are taken against, in SI units, and ``measurement`` says how.
+
+    With a heat model (docs/models.md#self-heating) ``temperature`` is the ambient one, the run starts at
+    ``initial_temperature``, and ``measured_temperature`` (the record) is fitted too: its residuals
+    are multiplied by ``temperature_weight`` [m/K] to share the displacement residuals' scale."""
+
+    name: str
+    time: np.ndarray
+    measured: np.ndarray
+    temperature: float | Sampled
+    waveform: Waveform
+    role: str = "fit"
+    nominal_temperature: float = math.nan
+    measurement: "Measurement" = None
+    measured_temperature: np.ndarray | None = None
+    initial_temperature: float = math.nan
+    temperature_weight: float = 1.0
+    #: the offset held where the measurement's policy is "held" (a force sensor's, from the model)
+    held_offset: float = 0.0
+    #: the SI unit of ``measured``
+    unit: str = "m"
+
+    @property
+    def n_residuals(self) -> int:
+        return len(self.time) * (1 if self.measured_temperature is None else 2)
+
+
+class MetricWarning(UserWarning):
+    """A validation metric is undefined for this experiment (NaN), e.g. a percentage of a measured
+    displacement that does not move."""
+
+
+class Measurement:
+    """The interface; :mod:`.displacement` and :mod:`.force` implement it.
+
+    Attributes: ``name`` (the registry's key and the results' ``measurement``), ``quantity`` (in words),
+    ``plants`` (the plant types whose models it is fitted with), ``fit_parameters`` (the default fitted
+    parameters per friction model), ``offset`` (the offset policy: ``"each"``, each run's own zero;
+    ``"shared"``, one fitted offset for all runs; ``"held"``, the model's own)."""
+
+    name = ""
+    quantity = ""
+    plants: tuple = ()
+    fit_parameters: dict = {}
+    offset = "each"
+    methods: tuple = ()
+
+    # -- identification --------------------------------------------------------------------------
+    def make_trace(self, exp, model) -> Trace:
+        """One experiment ready to fit."""
+        raise NotImplementedError
+
+    def residuals(self, problem, model, theta, jac):
+        """(r, J) over all of ``problem``'s traces, offsets removed as :attr:`offset` says; (None, None)
+        where a run failed."""
+        raise NotImplementedError
+
+    def per_trace(self, problem, model, theta):
+        r, _ = self.residuals(problem, model, theta, False)
+        if r is None:
+            return [None] * len(problem.traces)
+        edges = np.cumsum([0] + [tr.n_residuals for tr in problem.traces])
+        return [r[a:b] for a, b in zip(edges[:-1], edges[1:])]
+
+    def offsets_in(self, traces) -> int:
+        """Offsets fitted besides the parameters (the degrees of freedom they take)."""
+        return {"each": len(traces), "shared": int(bool(traces)), "held": 0}[self.offset]
+
+    def unit(self, experiments) -> str:
+        raise NotImplementedError
+
+    def advice(self, model) -> str:
+        """What to try when a fit is not adequate."""
+        raise NotImplementedError
+
+    # -- validation ------------------------------------------------------------------------------
+    def predict(self, model, exp):
+        """One experiment predicted by ``model``, with its metrics (a Prediction)."""
+        raise NotImplementedError
+
+    #: the validation table's columns: (header, metric key, format); headers may hold ``{unit}``
+    columns: tuple = ()
+    #: what the table's RMSE has had removed, for its footer and the JSON
+    removed = ""
+
+    #: what a validation's RMSE has had removed
+    validation_removed = ""
+    #: columns shown in another unit than the metric's SI one (metric key -> factor)
+    column_scale: dict = {}
+    #: the validation table's caption (terminal) and footer (HTML)
+    caption = ""
+    footer = ""
+
+    def check_model(self, model, experiments):
+        """Refuses a model that cannot predict these experiments at all (InputError)."""
+
+    def validation_extras(self, model) -> dict:
+        """What a validation's JSON adds for this measurement."""
+        return {}
+
+    def summary(self, predictions) -> dict:
+        raise NotImplementedError
+
+
+def amount(value: float, unit: str) -> str:
+    """A residual or an RMSE in its unit: metres shown in nm, N and N m as they are."""
+    return f"{value * 1e9:.4g} nm" if unit == "m" else f"{value:.4g} {unit}"
+
+
+def center(r, S=None):
+    """Residuals (and their Jacobian's columns) about their mean: an offset fitted by linear least squares,
+    profiled out."""
+    r = r - r.mean()
+    if S is not None:
+        S = S - S.mean(axis=0)
+    return r, S
+
+
+__all__ = ["Measurement", "MetricWarning", "Trace", "amount", "center"]

@@ -1,0 +1,250 @@
+"""Friction force or torque under a measured motion (docs/force-data.md): a prescribed-motion model driven by
+each experiment's measured motion, its friction force held against the measured one.
+
+The residuals are the force (torque) errors ``F_sim + offset - F_meas``. The offset (the force sensor's bias)
+is, by the policy this measurement is made with, one constant shared by all experiments of a fit ("shared":
+profiled out, the mean residual removed over all of them and the Jacobian's columns centred likewise, then
+estimated at the optimum with its standard error and written into the fitted model's ``[plant]
+sensor_offset``, where validation uses it as it is, never re-fitting it on held-out data), or the model's own
+("held").
+
+The Jacobian is by forward differences of whole runs at a tighter tolerance (a prescribed-motion model has only
+the friction states, so a run costs little): the C core's sensitivities are those of the states, and the friction
+force is an output of them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .. import _bridge
+from ..drive import drive
+from ..errors import InputError
+from ..data.force import ForceExperiment
+from ..models import Model
+from ..simulate import StepSizeController, simulate
+from ..waveforms import Sampled
+from .base import Measurement, Trace, center
+from .quality import fit_quality
+
+#: Relative step of the forward differences, and the tolerance of the runs they difference: the solver's
+#: error over the step (1e-9 / 1e-5) and the truncation error (~1e-5) make the Jacobian good to ~1e-4, ample
+#: for Gauss-Newton steps and for the intervals (1e-10 costs half as much again for nothing visible).
+FD_STEP = 1e-5
+FD_RTOL = 1e-9
+#: What to try when a fit to force data is not adequate.
+FORCE_ADVICE = ("check the units in the files' headers; check that the sampling resolves the force's swing after "
+                "each reversal (a few samples at least); try another friction model (--friction) or fit the "
+                "parameters held fixed (--parameters); fit a thermal model (--method model-i or model-ii) if the "
+                "experiments span temperatures")
+#: Force data see the whole friction-velocity map: the Stribeck and viscous parameters are fitted too.
+FIT_PARAMETERS = {
+    "lugre": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
+    "elastoplastic": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
+    "dahl": ("sigma0", "fc"),
+    "coulomb": ("fc", "sigma2"),
+    "stribeck": ("fc", "fs", "vs", "sigma2"),
+    "gms": ("C", "fc", "fs", "vs", "sigma2"),
+}
+OFFSETS = ("shared", "held")
+
+
+def _steps(model, names, theta):
+    """The forward-difference step of each parameter: FD_STEP of its magnitude, of the friction level for a
+    Model II value that starts at zero."""
+    out = []
+    for name, v in zip(names, theta):
+        scale = abs(v) if v != 0 else (abs(model.reference_force()) if name.startswith("dF") else 1.0)
+        out.append(FD_STEP * max(scale, 1e-300))
+    return np.array(out)
+
+
+class Force(Measurement):
+    name = "force"
+    quantity = "friction force (torque)"
+    plants = ("prescribed",)
+    fit_parameters = FIT_PARAMETERS
+    methods = ("base", "model-i", "model-ii")
+
+    @staticmethod
+    def recognises(exp) -> bool:
+        return isinstance(exp, ForceExperiment)
+
+    def __init__(self, offset: str = "shared"):
+        if offset not in OFFSETS:
+            raise InputError(f"offset must be one of {', '.join(OFFSETS)} for force data, got {offset!r}")
+        self.offset = offset
+
+    @property
+    def removed(self) -> str:
+        return "the shared sensor offset (fitted)" if self.offset == "shared" else "the model's sensor offset (held)"
+
+    def unit(self, experiments=()) -> str:
+        exps = list(getattr(experiments, "experiments", experiments))
+        return "N m" if exps and exps[0].rotary else "N"
+
+    def make_trace(self, exp, model) -> Trace:
+        if model.plant.type != "prescribed":
+            raise InputError(f"{exp.file}: force data are fitted with a prescribed-motion model ([plant] type = "
+                             f"\"prescribed\"), not a '{model.plant.type}' plant")
+        if model.heat is not None:
+            raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet; fit Model I or II on "
+                             "the measured temperatures instead")
+        d = drive(exp, model, start="record")
+        return Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.force, float),
+                     d.temperature, d.waveform, getattr(exp, "role", "fit"), float(exp.temperature), self,
+                     held_offset=model.plant.sensor_offset, unit=exp.force_unit)
+
+    def _forces(self, problem, model, rtol):
+        """The simulated force of every trace, concatenated; None when a run fails. (No sensitivities: the
+        solver may switch to Rodas4 where stiff bristles would hold Dormand-Prince to tiny steps, a start far
+        above the data's stiffness.)"""
+        def run(i):
+            out, _ = problem.simulate(model, problem.traces[i], None, False, method="auto", rtol=rtol)
+            return None if out is None else out[:, _bridge.OUTPUT_COLUMN["friction_force"]]
+        forces = problem.run_all(run, False)
+        return None if any(f is None for f in forces) else np.concatenate(forces)
+
+    def residuals(self, problem, model, theta, jac):
+        rtol = min(problem.rtol, FD_RTOL) if jac else problem.rtol
+        F = self._forces(problem, model, rtol)
+        if F is None:
+            return None, None
+        measured = np.concatenate([tr.measured - (tr.held_offset if self.offset == "held" else 0.0)
+                                   for tr in problem.traces])
+        r = F - measured
+        J = None
+        if jac:
+            h = _steps(problem.model, problem.names, theta)
+            J = np.empty((r.size, theta.size))
+            for k in range(theta.size):
+                for sign in (1.0, -1.0):  # backwards where a step forwards breaks a rule (fs >= fc)
+                    step = theta.copy()
+                    step[k] += sign * h[k]
+                    mk = problem.model_at(step)
+                    Fk = None if mk is None else self._forces(problem, mk, rtol)
+                    if Fk is not None:
+                        J[:, k] = (Fk - F) / (sign * h[k])
+                        break
+                else:
+                    return None, None
+        if self.offset == "shared":
+            r, J = center(r, J)
+        return r, J
+
+    def advice(self, model) -> str:
+        return FORCE_ADVICE
+
+    # -- validation --------------------------------------------------------------------------------
+    validation_removed = "the model's sensor offset ([plant] sensor_offset), as fitted"
+
+    def check_model(self, model, experiments):
+        if model.plant.type != "prescribed":
+            raise InputError(f"force data are predicted with a prescribed-motion model ([plant] type = "
+                             f"\"prescribed\"); this model's plant is '{model.plant.type}'")
+        for exp in experiments:
+            if model.plant.rotary != exp.rotary:
+                raise InputError(f"{exp.file}: the data are {'rotary' if exp.rotary else 'linear'} but the model's "
+                                 f"motion is {model.plant.motion}")
+
+    def validation_extras(self, model) -> dict:
+        return {"sensor_offset": model.plant.sensor_offset}
+    caption = "RMSE: the model's sensor offset removed (fitted on the fit experiments, never re-fitted); " \
+              "NRMSE = RMSE / measured span"
+    footer = ("RMSE: the model's sensor offset ([plant] sensor_offset) removed, as fitted on the fit experiments and "
+              "never re-fitted on held-out ones; NRMSE = RMSE / measured span; max error: 100 max|error| / measured "
+              "span; mean error: the prediction's mean minus the measurement's (docs/force-data.md#validation)")
+
+    def columns_for(self, unit):
+        return (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
+                (f"RMSE [{unit}]", "rmse_offset_removed", "{:.4g}"), ("NRMSE", "nrmse", "{:.3g}"),
+                ("max error [%]", "max_error_pct", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
+
+    def predict(self, model, exp, rtol=1e-8) -> "ForcePrediction":
+        """Simulates one force experiment on its own samples and compares the force."""
+        if model.plant.type != "prescribed":
+            raise InputError(f"force data are predicted with a prescribed-motion model ([plant] type = "
+                             f"\"prescribed\"); this model's plant is '{model.plant.type}'")
+        if model.plant.rotary != exp.rotary:
+            raise InputError(f"{exp.file}: the data are {'rotary' if exp.rotary else 'linear'} but the model's "
+                             f"motion is {model.plant.motion}")
+        d = drive(exp, model, start="model")
+        res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
+                       controller=StepSizeController(rtol=rtol))
+        pred = res.friction_force + model.plant.sensor_offset
+        meas = np.asarray(exp.force, float)
+        err = pred - meas
+        span = float(np.ptp(meas))
+        quality = fit_quality(err, meas)
+        rmse = float(np.sqrt(np.mean(err ** 2)))
+        return ForcePrediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time),
+                               np.asarray(exp.displacement), np.asarray(exp.drive_velocity), meas, pred, rmse,
+                               rmse / span if span > 0 else math.nan,
+                               100 * float(np.max(np.abs(err))) / span if span > 0 else math.nan,
+                               float(np.mean(err)), exp.force_unit, quality)
+
+    def summary(self, predictions) -> dict:
+        out = {}
+        for role in ("fit", "validate"):
+            ps = [p for p in predictions if p.role == role]
+            if ps:
+                pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
+                rmse = float(np.sqrt(np.mean([p.rmse ** 2 for p in ps])))
+                out[role] = {"max_error_pct": max(pcts) if pcts else math.nan, "rmse": rmse,
+                             "rmse_offset_removed": rmse, "unit": ps[0].unit, "n": len(ps)}
+        return out
+
+
+@dataclasses.dataclass
+class ForcePrediction:
+    """One force experiment: measured and predicted force [N or N m], the motion, and the metrics."""
+
+    file: str
+    temperature: float
+    role: str
+    time: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    measured: np.ndarray
+    predicted: np.ndarray
+    rmse: float
+    nrmse: float
+    max_error_pct: float
+    bias: float
+    unit: str
+    fit_quality: dict | None = None
+
+    def metrics(self) -> dict:
+        # "rmse": the name this metric had before it was named as displacement's is (kept for readers of
+        # earlier results; docs/formats.md)
+        return {"file": self.file, "temperature": self.temperature, "role": self.role,
+                "rmse_offset_removed": self.rmse, "rmse": self.rmse, "nrmse": self.nrmse,
+                "max_error_pct": self.max_error_pct, "bias": self.bias, "unit": self.unit,
+                "fit_quality": self.fit_quality}
+
+
+def steady_state_curve(model: Model, velocities, temperature=None) -> np.ndarray:
+    """The model's friction force in steady sliding at each of ``velocities`` [m/s or rad/s], by simulation
+    (any friction model, any thermal form): a constant velocity held over thirty presliding lengths (g/stiffness),
+    where the bristles have long settled. Without the sensor offset."""
+    p = model.parameters_at(temperature if temperature is not None else 25.0)
+    stiffness = p.get("sigma0") or (sum(p["k"]) if p.get("k") is not None else None)
+    level = max(p.get("fc") or 0.0, p.get("fs") or 0.0)
+    distance = 30.0 * level / stiffness if stiffness else 1e-9
+    out = []
+    for v in np.asarray(velocities, float):
+        if v == 0:
+            out.append(0.0)
+            continue
+        T = distance / abs(v)
+        res = simulate(model, t_eval=np.array([0.0, T]), temperature=temperature,
+                       input=Sampled(np.array([0.0, 2 * T]), np.array([0.0, 2 * T * v])),
+                       controller=StepSizeController(rtol=1e-8))
+        out.append(float(res.friction_force[-1]))
+    return np.array(out)
+
+
+__all__ = ["Force", "ForcePrediction", "steady_state_curve", "FD_STEP", "FD_RTOL", "FORCE_ADVICE", "FIT_PARAMETERS"]
