@@ -9,7 +9,8 @@ import pytest
 import thermofriction as tf
 from conftest import synthetic_experiments
 from thermofriction.identify import Parameters, fit_friction, identify
-from thermofriction.identify.optimiser import (Transform, compressed, gauss_newton_length, linearized_step,
+from thermofriction.identify.optimiser import compressed as compress_residuals
+from thermofriction.identify.optimiser import (Transform, gauss_newton_length, linearized_step,
                                                 residual_scale)
 from thermofriction.identify.problem import Problem, make_traces
 
@@ -207,7 +208,7 @@ def test_the_last_gauss_newton_step_on_the_linearized_model_lands_near_the_optim
 
     def compressed(phi):
         r, J = problem.evaluate(transform.to_theta(phi), jac=True)
-        return (*compressed(r, J, transform, transform.to_theta(phi), noise), r, J)
+        return (*compress_residuals(r, J, transform, transform.to_theta(phi), noise), r, J)
 
     # the optimum (Gauss-Newton steps from the truth until they are below 1e-3), then a point off it
     phi = transform.to_phi(theta)

@@ -5,10 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import html
-import math
 import warnings
-
-import numpy as np
 
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError

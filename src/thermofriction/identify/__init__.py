@@ -28,4 +28,5 @@ from .uncertainty import uncertainty
 __all__ = ["with_friction_model", "fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter",
            "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit", "identify_model_i", "identify_model_ii",
            "identify_heat", "base_model", "make_traces", "uncertainty", "compare_friction_models", "force_start",
-           "METHODS", "MAX_STARTS"]
+           "METHODS", "MAX_STARTS", "one_blas_thread", "PLANT_UNITS", "target_of", "Problem", "default_fit_parameters",
+           "stamped", "lugre_start"]

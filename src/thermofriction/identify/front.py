@@ -11,7 +11,6 @@ import numpy as np
 from ..data.experiments import TEMPERATURE_RANGE
 from ..errors import InputError, shorten
 from ..measurements import measurement_of
-from ..models import Model
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread

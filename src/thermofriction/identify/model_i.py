@@ -5,9 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -19,7 +17,8 @@ from .laws import fit_law
 from .optimiser import fit
 from .parameters import Parameters, get_value, unit_of, with_values
 from .problem import make_traces
-from .procedures import base_model, default_fit_parameters, fit_friction, fit_result, friction_parameters, temperature_groups
+from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
+                         friction_parameters, temperature_groups)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
@@ -91,32 +90,43 @@ def _laws_on_information(Ts, per_T, laws: dict) -> dict:
     return {n: refined[n] if in_domain(n, refined[n](grid)).all() else laws[n] for n in names}
 
 
-def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
-                     **opts) -> FitResult:
-    """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
-    ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
-    ``free``: plant parameters (e.g. m_e) fitted too, one value shared by all experiments (per
-    temperature first; their median starts the joint refinement)."""
-    free = list(free)
-    t0 = time.perf_counter()
-    groups = temperature_groups(experiments)
-    if len(groups) < 2:
-        raise InputError("Model I needs fit experiments at two or more temperatures")
-    names = default_fit_parameters(init)
-    held, warns = [], []
+class _PerTemperature:
+    """Model I's per-temperature fits: the lowest temperature first (it decides what the data cannot
+    determine, which is then held at the initial model's law), then two continuation chains, one per core:
+    upward from it, and downward from the highest temperature, which starts from the lowest temperature's fit
+    carried there along the initial model's laws (not a neighbour: with the multi-start)."""
 
-    def fit_at(group, previous, first_of_all=False, neighbour=True):
-        """The fit at one temperature, from the neighbouring temperature's model (continuation) or,
-        without one, from the initial model's values there with the multi-start; returns (T, result,
-        the model the next temperature continues from)."""
-        nonlocal held
-        T = float(np.mean([e.temperature for e in group]))
+    def __init__(self, init, names, free, opts, measurement, progress):
+        self.init, self.names, self.free, self.opts = init, names, free, opts
+        self.measurement, self.progress = measurement, progress
+        self.held, self.warnings = [], []
+
+    def run(self, groups):
+        """[(temperature, result)] in temperature order."""
+        T0, res0, following = self.fit_at(groups[0], None, first_of_all=True)
+        fits = {}
+
+        def step(i, carried, first):
+            previous, neighbour = carried
+            T, res, next_ = self.fit_at(groups[i], previous, neighbour=neighbour)
+            fits[i] = (T, res)
+            return next_, True
+
+        rest = list(range(1, len(groups)))
+        up, down = rest[:(len(rest) + 1) // 2], rest[(len(rest) + 1) // 2:][::-1]
+        along_temperatures([(up, (following, True)), (down, (following, False))], step,
+                           alone=(rest, (following, True)))
+        return sorted([(T0, res0)] + [fits[i] for i in rest], key=lambda tr: tr[0])
+
+    def start_at(self, T, previous):
+        """The model a temperature's fit starts from: the neighbour's values carried along the initial model's
+        laws (by their ratio, which a wrong level of a law does not change: the paper's sigma0 and fc change by
+        a third over 3 C, many standard errors that a plain continuation would leave for the fit to walk), or
+        the initial model's there; the held parameters always at the initial model's law."""
+        init, names, held = self.init, self.names, self.held
         if previous is None:
             base = base_model(init, T)
         else:
-            # the neighbour's values carried along the initial model's laws (by their ratio, which a
-            # wrong level of a law does not change): the paper's sigma0 and fc change by a third over
-            # 3 C, many standard errors that a plain continuation would leave for the fit to walk
             T_prev, base = previous
             shifts = {n: float(init.laws[n](T) / init.laws[n](T_prev)) for n in names
                       if n in init.laws and n not in held}
@@ -127,59 +137,47 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         base = dataclasses.replace(base, thermal=None)
         if held:  # parameters the data cannot determine follow the initial model's law
             base = base.with_friction(**{n: base_model(init, T).friction.values()[n] for n in held})
-        if progress:
-            progress(f"Model I: fitting {', '.join(n for n in names if n not in held)} at {T:.4g} C")
-        first = dict(opts)
+        return base
+
+    def fit_at(self, group, previous, first_of_all=False, neighbour=True):
+        """The fit at one temperature, from the neighbouring temperature's model (continuation) or,
+        without one, from the initial model's values there with the multi-start; returns (T, result,
+        what the next temperature continues from)."""
+        init, names, free = self.init, self.names, self.free
+        T = float(np.mean([e.temperature for e in group]))
+        base = self.start_at(T, previous)
+        if self.progress:
+            self.progress(f"Model I: fitting {', '.join(n for n in names if n not in self.held)} at {T:.4g} C")
+        first = dict(self.opts)
         if previous is not None and neighbour:  # continuation from the neighbouring temperature
             first["starts"] = 1
-        res = fit_friction(group, base, friction_parameters(base, names + free, fixed=held),
-                           method=f"base at {T:.4g} C", measurement=measurement, **first)
+        res = fit_friction(group, base, friction_parameters(base, names + free, fixed=self.held),
+                           method=f"base at {T:.4g} C", measurement=self.measurement, **first)
         if first_of_all:
             undetermined = [n for n in names if not math.isfinite(res.parameters[n].stderr)
                             or res.parameters[n].stderr > abs(res.parameters[n].value)]
             if undetermined and len(undetermined) < len(names):
-                held = undetermined
-                warns.append(f"{', '.join(held)} cannot be determined from these data (standard error above 100 % "
-                             f"at {T:.4g} C): held at the initial model's law")
+                self.held = undetermined
+                self.warnings.append(f"{', '.join(undetermined)} cannot be determined from these data (standard "
+                                     f"error above 100 % at {T:.4g} C): held at the initial model's law")
                 res = fit_friction(group, base.with_friction(**{n: base_model(init, T).friction.values()[n]
-                                                                for n in held}),
-                                   friction_parameters(base, names + free, fixed=held), method=f"base at {T:.4g} C",
-                                   measurement=measurement, **opts)
+                                                                for n in undetermined}),
+                                   friction_parameters(base, names + free, fixed=undetermined),
+                                   method=f"base at {T:.4g} C", measurement=self.measurement, **self.opts)
         # continuation carries only what this temperature determined: a parameter the data leave open
         # (standard error above its value, e.g. sigma1 run to its bound) restarts from the initial model,
         # or the next fit spends most of its evaluations walking back from a bound
-        open_ = [n for n in names if n in res.parameters and n not in held
+        open_ = [n for n in names if n in res.parameters and n not in self.held
                  and not (res.parameters[n].stderr is not None and math.isfinite(res.parameters[n].stderr)
                           and res.parameters[n].stderr < abs(res.parameters[n].value))]
-        following = res.model.with_friction(**{n: base_model(init, T).friction.values()[n] for n in open_
-                                               if n in base_model(init, T).friction.values()}) if open_ else res.model
+        at_T = base_model(init, T).friction.values()
+        following = res.model.with_friction(**{n: at_T[n] for n in open_ if n in at_T}) if open_ else res.model
         return T, res, (T, following)
 
-    def chain(order, previous, neighbour=True):
-        out = []
-        for k, i in enumerate(order):
-            T, res, previous = fit_at(groups[i], previous, neighbour=neighbour or k > 0)
-            out.append((T, res))
-        return out
 
-    # the lowest temperature first (it decides what the data cannot determine); then two continuation
-    # chains, one per core: upward from it, and downward from the highest temperature, which starts from
-    # the lowest temperature's fit carried there along the initial model's laws (not a neighbour: with
-    # the multi-start)
-    T0, res0, following = fit_at(groups[0], None, first_of_all=True)
-    rest = list(range(1, len(groups)))
-    up, down = rest[:(len(rest) + 1) // 2], rest[(len(rest) + 1) // 2:][::-1]
-    if down and (os.cpu_count() or 1) > 1:
-        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-i") as chains:
-            lower = chains.submit(chain, up, following)
-            upper = chains.submit(chain, down, following, False)
-            per_T = [(T0, res0)] + lower.result() + upper.result()
-    else:
-        per_T = [(T0, res0)] + chain(rest, following)
-    per_T.sort(key=lambda tr: tr[0])
-    details = {"per_temperature": [
-        {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
-         "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
+def _laws_through(per_T, names, held, init, laws):
+    """A law per parameter through the per-temperature estimates (linear or exponential by AICc unless
+    ``laws`` names one), refitted on the estimates' covariances; a held parameter keeps the initial model's."""
     Ts = np.array([T for T, _ in per_T])
     new_laws, law_tables = {}, {}
     for n in names:
@@ -202,7 +200,42 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         if refined[n] is not new_laws[n]:  # the candidates' coefficients are by standard errors alone
             new_laws[n] = refined[n]
             law_tables[n]["weighted_by_covariance"] = new_laws[n].to_dict()
-    details["laws"] = law_tables
+    return new_laws, law_tables
+
+
+def _law_parameters(new_laws, held, free, model) -> Parameters:
+    """The law coefficients (and the freed plant parameters) as the joint refinement's parameters."""
+    params = Parameters()
+    for n, law in new_laws.items():
+        for cname, v in zip(law.coefficient_names(), law.coefficients()):
+            name = f"{n}.{cname}"
+            positive = law.kind == "exp" and cname == "a" and v > 0
+            params.add(name, v, min=0.0 if positive else -math.inf, unit=unit_of(model, name), vary=n not in held)
+    for n in free:
+        params.add(n, get_value(model, n), min=0.0, unit=unit_of(model, n))
+    return params
+
+
+def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
+                     **opts) -> FitResult:
+    """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
+    ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
+    ``free``: plant parameters (e.g. m_e) fitted too, one value shared by all experiments (per
+    temperature first; their median starts the joint refinement)."""
+    free = list(free)
+    t0 = time.perf_counter()
+    groups = temperature_groups(experiments)
+    if len(groups) < 2:
+        raise InputError("Model I needs fit experiments at two or more temperatures")
+    names = default_fit_parameters(init)
+    per_temperature = _PerTemperature(init, names, free, opts, measurement, progress)
+    per_T = per_temperature.run(groups)
+    held, warns = per_temperature.held, per_temperature.warnings
+    details = {"per_temperature": [
+        {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
+         "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
+    new_laws, details["laws"] = _laws_through(per_T, names, held, init, laws)
+    Ts = np.array([T for T, _ in per_T])
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in names})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
     if free:  # one plant for all temperatures: the median of the per-temperature estimates
@@ -212,21 +245,13 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         for n, law in new_laws.items():
             for cname, v in zip(law.coefficient_names(), law.coefficients()):
                 params.add(f"{n}.{cname}", v, unit=unit_of(model, f"{n}.{cname}"))
-        res = FitResult("model-i", model, params, np.full((0, 0), np.nan), math.nan, math.nan, 0,
-                        sum(r.nfev for _, r in per_T), sum(r.njev for _, r in per_T), 0,
-                        time.perf_counter() - t0, True, "per-temperature fits and laws (no joint refinement)",
-                        warnings=warns, details=details)
-        return res
+        return FitResult("model-i", model, params, np.full((0, 0), np.nan), math.nan, math.nan, 0,
+                         sum(r.nfev for _, r in per_T), sum(r.njev for _, r in per_T), 0,
+                         time.perf_counter() - t0, True, "per-temperature fits and laws (no joint refinement)",
+                         warnings=warns, details=details)
     if progress:
         progress("Model I: joint refinement of the law coefficients on all experiments")
-    params = Parameters()
-    for n, law in new_laws.items():
-        for cname, v in zip(law.coefficient_names(), law.coefficients()):
-            name = f"{n}.{cname}"
-            positive = law.kind == "exp" and cname == "a" and v > 0
-            params.add(name, v, min=0.0 if positive else -math.inf, unit=unit_of(model, name), vary=n not in held)
-    for n in free:
-        params.add(n, get_value(model, n), min=0.0, unit=unit_of(model, n))
+    params = _law_parameters(new_laws, held, free, model)
     traces = make_traces(experiments, model, measurement)
     ropts = dict(opts)
     ropts["starts"] = 1

@@ -6,9 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -20,7 +18,8 @@ from .optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
 from .problem import Problem, make_traces, pool
 from .laws import aicc, segmented_fit
 from .parameters import Parameters, get_value, unit_of
-from .procedures import base_model, default_fit_parameters, fit_friction, fit_result, temperature_groups
+from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
+                         temperature_groups)
 from .result import FitResult
 
 
@@ -163,14 +162,15 @@ def _dF_start(group, m, fc, previous, opts, measurement=None):
     return start, {"grid": grid, "cost": costs}
 
 
-def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=(), first_opts=None,
-                     measurement=None):
-    per_T = []
-    popts = dict(first_opts or opts)  # the per-temperature fits (first_opts: see identify_model_ii)
-    popts["starts"] = 1
+def _dF_per_temperature(groups, base, T_ref, popts, measurement, progress):
+    """dF fitted at each temperature, continued outward from the reference temperature, where dF is smallest
+    (zero, which every scan tries): two chains, one per core, from it downward and upward (all on one side:
+    outward from it, and inward from the farthest, whose scan starts it without a neighbour). Returns
+    ([(T, result)] in the groups' order, the scans)."""
     fc = base.reference_force()
     fits, scans = {}, {}
     temperature = [float(np.mean([e.temperature for e in g])) for g in groups]
+    order = sorted(range(len(groups)), key=lambda i: abs(temperature[i] - T_ref))
 
     def fit_from(g, T, m, start):
         params = Parameters()
@@ -179,7 +179,7 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         return fit_friction(g, dataclasses.replace(m, thermal=ModelII(Const(start))), params,
                             method=f"dF at {T:.4g} C", measurement=measurement, **popts)
 
-    def fit_at(i, previous):
+    def step(i, previous, first):
         g, T = groups[i], temperature[i]
         if progress:
             progress(f"Model II (direct): dF at {T:.4g} C")
@@ -196,25 +196,16 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
                 scans[T] = {"grid": [], "cost": [], "note": "the fit from the neighbouring temperature's dF "
                                                              f"({previous:.6g} N) reached the noise: no scan"}
             else:
-                start, scans[T] = _dF_start(g, m, fc, 0.0 if previous is None else previous, popts,
-                                                  measurement)
-                first, r = r, fit_from(g, T, m, start)
-                if first is not None:
-                    r.nfev += first.nfev
-                    r.njev += first.njev
+                start, scans[T] = _dF_start(g, m, fc, 0.0 if previous is None else previous, popts, measurement)
+                first_fit, r = r, fit_from(g, T, m, start)
+                if first_fit is not None:
+                    r.nfev += first_fit.nfev
+                    r.njev += first_fit.njev
         fits[i] = (T, r)
         # the next temperature continues from this one's dF, except from the reference's (zero by
         # definition): a fit's steps start at the scale of its start value, and from zero they crawl
         return None if i == order[0] else r.parameters["dF.value"].value
 
-    def chain(order, previous):
-        for i in order:
-            previous = fit_at(i, previous)
-
-    # continuation outward from the reference temperature, where dF is smallest (zero, which every
-    # scan tries): two chains, one per core, from it downward and upward (all on one side: outward
-    # from it, and inward from the farthest, whose scan starts it without a neighbour)
-    order = sorted(range(len(groups)), key=lambda i: abs(temperature[i] - T_ref))
     below = [i for i in order[1:] if temperature[i] < T_ref]
     above = [i for i in order[1:] if temperature[i] >= T_ref]
     if below and above:
@@ -222,13 +213,13 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     else:
         side = below or above
         chains = [[order[0]] + side[:len(side) // 2], side[len(side) // 2:][::-1]]
-    if chains[1] and (os.cpu_count() or 1) > 1:
-        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-model-ii") as executor:
-            for future in [executor.submit(chain, c, None) for c in chains]:  # None: no neighbour yet
-                future.result()
-    else:
-        chain(order, None)
-    per_T = [fits[i] for i in range(len(groups))]
+    along_temperatures([(c, None) for c in chains], step, alone=(order, None))  # None: no neighbour yet
+    return [fits[i] for i in range(len(groups))], scans
+
+
+def _dF_law(per_T):
+    """dF's law through the per-temperature estimates: a line, or two segments (from four temperatures), by
+    AICc. Returns (law, its details)."""
     Ts = np.array([T for T, _ in per_T])
     vals = np.array([r.parameters["dF.value"].value for _, r in per_T])
     ses = np.array([r.parameters["dF.value"].stderr for _, r in per_T])
@@ -244,9 +235,17 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
         tb, seg, ssr = segmented_fit(Ts, vals, w)
         candidates["two segments"] = (seg, aicc(ssr, len(Ts), 4))
     chosen = min(candidates, key=lambda k: candidates[k][1])
-    law = candidates[chosen][0]
-    details["direct"] = {"temperatures": Ts, "dF": vals, "stderr": ses, "chosen": chosen,
-                         "candidates": {k: {"aicc": a, "law": l.to_dict()} for k, (l, a) in candidates.items()}}
+    return candidates[chosen][0], {
+        "temperatures": Ts, "dF": vals, "stderr": ses, "chosen": chosen,
+        "candidates": {k: {"aicc": a, "law": l.to_dict()} for k, (l, a) in candidates.items()}}
+
+
+def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=(), first_opts=None,
+                     measurement=None):
+    popts = dict(first_opts or opts)  # the per-temperature fits (first_opts: see identify_model_ii)
+    popts["starts"] = 1
+    per_T, scans = _dF_per_temperature(groups, base, T_ref, popts, measurement, progress)
+    law, details["direct"] = _dF_law(per_T)
     model = dataclasses.replace(base, thermal=ModelII(law))
     details["direct"]["scans"] = [{"temperature": T, **scans[T]} for T in sorted(scans)]
     params = Parameters()
@@ -258,36 +257,40 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
                          "per-temperature dF and law (no joint refinement)", details=details)
     if progress:
         progress("Model II (direct): joint refinement of dF(T) and the base parameters on all experiments")
-    # The base parameters are refined with dF, so that dF's intervals carry their uncertainty. Scaling
-    # sigma0, sigma1, fc by 1/c and shifting dF by fc (1 - 1/c) leaves the scale form unchanged, so
-    # dF is pinned to zero at the reference temperature (its definition: the base model holds there).
-    knots = np.asarray(law.T)
-    at_ref = np.flatnonzero(np.abs(knots - T_ref) <= 0.05)
-    warns = []
-    if at_ref.size:
-        k = int(at_ref[0])
-        model = dataclasses.replace(model, thermal=ModelII(law.with_coefficients(
-            [0.0 if j == k else v for j, v in enumerate(law.values)])))
-        params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
-        params[f"dF.values[{k}]"].vary = False
-        for name in default_fit_parameters(base) + list(free):
-            params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
-        # the breakpoint is fitted with the values: held where the per-temperature estimates put it,
-        # its error would bias dF between the measured temperatures and leave it out of the intervals
-        traces = make_traces(experiments, model, measurement)
-        if len(knots) > 2 and all(isinstance(t.temperature, (int, float)) for t in traces) and base.heat is None:
-            margin = 0.02 * (knots[-1] - knots[0])
-            for k in range(1, len(knots) - 1):
-                params.add(f"dF.T[{k}]", float(knots[k]), min=float(knots[k - 1] + margin),
-                           max=float(knots[k + 1] - margin), unit="C")
-    else:
-        warns.append(f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters "
-                     f"are held at their fit there, so dF's intervals do not include their uncertainty")
-        traces = make_traces(experiments, model, measurement)
+    model, params, traces, warns = _refinement(model, law, params, base, T_ref, free, experiments, measurement)
     outcome = fit(model, params, traces, **dict(opts, starts=1))
     res = fit_result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
     res.nfev += sum(r.nfev for _, r in per_T)
     return res
+
+
+def _refinement(model, law, params, base, T_ref, free, experiments, measurement):
+    """What the joint refinement fits. The base parameters are refined with dF, so that dF's intervals carry
+    their uncertainty. Scaling sigma0, sigma1, fc by 1/c and shifting dF by fc (1 - 1/c) leaves the scale form
+    unchanged, so dF is pinned to zero at the reference temperature (its definition: the base model holds
+    there). Returns (model, parameters, traces, warnings)."""
+    knots = np.asarray(law.T)
+    at_ref = np.flatnonzero(np.abs(knots - T_ref) <= 0.05)
+    if not at_ref.size:
+        return model, params, make_traces(experiments, model, measurement), [
+            f"the reference temperature {T_ref:.4g} C is not a breakpoint of dF's law: the base parameters are held "
+            f"at their fit there, so dF's intervals do not include their uncertainty"]
+    k = int(at_ref[0])
+    model = dataclasses.replace(model, thermal=ModelII(law.with_coefficients(
+        [0.0 if j == k else v for j, v in enumerate(law.values)])))
+    params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
+    params[f"dF.values[{k}]"].vary = False
+    for name in default_fit_parameters(base) + list(free):
+        params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
+    # the breakpoint is fitted with the values: held where the per-temperature estimates put it,
+    # its error would bias dF between the measured temperatures and leave it out of the intervals
+    traces = make_traces(experiments, model, measurement)
+    if len(knots) > 2 and all(isinstance(t.temperature, (int, float)) for t in traces) and base.heat is None:
+        margin = 0.02 * (knots[-1] - knots[0])
+        for k in range(1, len(knots) - 1):
+            params.add(f"dF.T[{k}]", float(knots[k]), min=float(knots[k - 1] + margin),
+                       max=float(knots[k + 1] - margin), unit="C")
+    return model, params, traces, []
 
 
 __all__ = ["identify_model_ii"]

@@ -8,7 +8,6 @@ coefficients of temperature laws."""
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor

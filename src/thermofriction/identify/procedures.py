@@ -8,11 +8,12 @@ import dataclasses
 import math
 import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from ..errors import InputError
-from ..models import Const, Model, ModelI
+from ..models import Model, ModelI
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
@@ -169,6 +170,24 @@ def identify_heat(experiments, init: Model, parameters=None, free=(), **opts) ->
                    details={"temperature_weights_m_per_K": [tr.temperature_weight for tr in traces]})
 
 
+def along_temperatures(chains, step, *, alone):
+    """The per-temperature continuation that Model I and Model II share: ``step(i, carried, first)`` fits the
+    i-th temperature group from what its chain carried (the chain's start, then what the previous fit
+    returned; ``first`` for a chain's first fit) and returns what the next fit continues from. ``chains``,
+    [(indices, start)]: two of them run side by side, one per core; on one core, or where the second chain is
+    empty, ``alone`` (indices, start) runs as one chain instead."""
+    def run(indices, carried):
+        for k, i in enumerate(indices):
+            carried = step(i, carried, k == 0)
+
+    if len(chains) > 1 and chains[1][0] and (os.cpu_count() or 1) > 1:
+        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-continuation") as executor:
+            for future in [executor.submit(run, *chain) for chain in chains]:
+                future.result()
+    else:
+        run(*alone)
+
+
 def temperature_groups(experiments):
     """Fit experiments grouped by temperature (0.05 C apart count as one)."""
     exps = sorted(experiments, key=lambda e: e.temperature)
@@ -181,6 +200,6 @@ def temperature_groups(experiments):
     return groups
 
 
-__all__ = ["fit_friction", "fit_result", "base_model", "default_fit_parameters", "friction_parameters",
+__all__ = ["fit_friction", "fit_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters",
            "identify_heat", "temperature_groups", "FRICTION_FIT_PARAMETERS", "DEFAULT_FRICTION_PARAMETERS",
            "DEFAULT_HEAT_PARAMETERS"]

@@ -17,7 +17,6 @@ from ..measurements.force import FD_RTOL
 from ..models.plants import rotary_unit
 from .parameters import get_value
 from .problem import Problem, make_traces
-from .procedures import base_model
 from .start import force_start, lugre_start, with_friction_model
 
 stats = lazy("scipy.stats")

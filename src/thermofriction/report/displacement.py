@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import html
 import math
-import re
 
 import numpy as np
 
 from ..errors import InputError
 from ..models import ModelI, ModelII
 from ..validate import validate
-from .entries import Entry, akaike, comparison_rows, law_at, parameter_section, reference_temperature
+from .entries import COMPARISON_COLUMNS, EXPERIMENT_COLUMNS, akaike, comparison_rows, parameter_section
 from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
                       fig_steps)
 from .page import Figures, _fmt, _table, page_html

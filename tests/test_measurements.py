@@ -1,0 +1,91 @@
+"""Measurements as peers (thermofriction.measurements): displacement and force data go through one front door
+each for identify, validate and report, asked of the data's measurement once; what a result says (its unit,
+what its RMSE has had removed) is the measurement's. Force data from the independent reference implementation
+(tests/force_truths.py)."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from force_truths import make_dataset  # noqa: E402
+
+import thermofriction as tf  # noqa: E402
+from thermofriction.measurements import REGISTRY, Displacement, Force, measurement_of  # noqa: E402
+from thermofriction.models import PrescribedMotion  # noqa: E402
+
+JOINT = PrescribedMotion(motion="rotary")
+
+
+@pytest.fixture(scope="module")
+def torque(tmp_path_factory):
+    """A joint's torque (N m) from the reference integrator, one fit and one held-out run, a Stribeck map (cheap
+    to fit): the fit and its validation."""
+    truth = tf.Model(JOINT, tf.Stribeck(fc=0.9, fs=1.4, vs=0.3, sigma2=0.35))
+    folder, sd = make_dataset(tmp_path_factory.mktemp("torque"), truth, validate=(35.0,), offset=0.05, n=600,
+                              duration=2.0)
+    data = tf.load_dataset(folder)
+    fit = tf.identify(data, "base", friction="stribeck")
+    return data, fit, tf.validate(fit.model, data), sd
+
+
+def test_the_data_say_which_measurement_they_are(torque):
+    data, *_ = torque
+    assert isinstance(measurement_of(data), Force) and measurement_of(data).offset == "shared"
+    assert measurement_of(data, offset=False).offset == "held"
+    synthetic = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05)
+    assert isinstance(measurement_of(synthetic), Displacement)
+    with pytest.raises(tf.InputError, match="mixes force"):
+        measurement_of(list(data.experiments) + list(synthetic.experiments))
+    assert set(REGISTRY) == {"displacement", "force"}
+
+
+def test_force_validation_table_displays_in_a_notebook_in_newton_metres(torque):
+    """Defect: ForceValidationResult._repr_html_ raised KeyError 'rmse_offset_removed'; now one table for every
+    measurement, its RMSE in the data's unit."""
+    _, _, v, sd = torque
+    page = v._repr_html_()
+    assert "RMSE [N m]" in page and " nm" not in page
+    summary = v.summary()["validate"]
+    assert f"{summary['rmse_offset_removed']:.4g} N m" in page
+    assert summary["rmse_offset_removed"] == summary["rmse"]  # the earlier name, kept for readers of old JSON
+
+
+def test_force_fit_shows_its_rmse_in_newton_metres(torque):
+    """Defect: ForceFitResult._repr_html_ printed a 0.01 N m RMSE as '1.005e+07 nm'."""
+    _, fit, _, sd = torque
+    page = fit._repr_html_()
+    assert f"rmse {fit.rmse:.4g} N m" in page and "nm" not in page.replace("N m", "")
+    assert fit.rmse < 2 * sd  # the value shown is the force error itself, at the noise
+    assert f"{fit.rmse:.4g} N m" in fit.report() and "sensor offset" in fit.report()
+
+
+def test_validate_footer_says_what_was_removed_for_each_measurement(torque):
+    """Defect: the validate table's footer said each experiment's offset was removed, false for force data
+    (the model's fitted sensor offset is used, never re-fitted on held-out runs)."""
+    _, fit, v, _ = torque
+    page = v._repr_html_()
+    assert "constant offset removed" not in page and "sensor offset" in page
+    d = v.to_dict()
+    assert d["measurement"] == "force" and "sensor offset" in d["offset_removed"]
+    assert d["sensor_offset"] == fit.model.plant.sensor_offset
+    synthetic = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05)
+    shown = tf.validate(tf.load_model("li2009-base"), synthetic)
+    assert "each experiment's constant offset removed" in shown._repr_html_()
+    assert shown.to_dict()["measurement"] == "displacement" and "sensor_offset" not in shown.to_dict()
+
+
+def test_one_metric_name_in_fit_and_validation_json(torque):
+    """Fit and validation JSON name the RMSE rmse_offset_removed for every measurement and say what was removed."""
+    _, fit, v, _ = torque
+    d = fit.to_dict()
+    assert d["rmse_offset_removed"] == fit.rmse and "shared sensor offset" in d["offset_removed"]
+    assert d["unit"] == "N m" and d["measurement"] == "force"
+    assert all(e["rmse_offset_removed"] >= 0 for e in v.to_dict()["experiments"])
+    held = tf.identify(torque[0], "base", friction="stribeck", offset=False)
+    assert "held" in held.to_dict()["offset_removed"]
+    assert held.statistics["dof"] == fit.statistics["dof"] + 1  # a held offset takes no degree of freedom
