@@ -5,6 +5,7 @@ what its RMSE has had removed) is the measurement's. Force data from the indepen
 
 from __future__ import annotations
 
+import html
 import math
 import sys
 from pathlib import Path
@@ -68,14 +69,14 @@ def test_validate_footer_says_what_was_removed_for_each_measurement(torque):
     """Defect: the validate table's footer said each experiment's offset was removed, false for force data
     (the model's fitted sensor offset is used, never re-fitted on held-out runs)."""
     _, fit, v, _ = torque
-    page = v._repr_html_()
+    page = html.unescape(v._repr_html_())
     assert "constant offset removed" not in page and "sensor offset" in page
     d = v.to_dict()
     assert d["measurement"] == "force" and "sensor offset" in d["offset_removed"]
     assert d["sensor_offset"] == fit.model.plant.sensor_offset
     synthetic = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05)
     shown = tf.validate(tf.load_model("li2009-base"), synthetic)
-    assert "each experiment's constant offset removed" in shown._repr_html_()
+    assert "each experiment's constant offset removed" in html.unescape(shown._repr_html_())
     assert shown.to_dict()["measurement"] == "displacement" and "sensor_offset" not in shown.to_dict()
 
 

@@ -23,6 +23,9 @@ optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
 
 #: RMSE within this factor of the noise: a fit at the noise, where the multi-start stops
 AT_NOISE = 1.1
+#: a direction of the parameters whose singular value is below this fraction of the largest is not determined by
+#: the data (the column-scaled Jacobian's; uncertainty() gives the parameters on it an infinite error)
+UNDETERMINED = 1e-9
 
 
 @dataclasses.dataclass
@@ -171,7 +174,11 @@ def linearized_step(cache, transform: Transform, phi, bounds):
     again would only confirm it; the Jacobian is kept (it changes by a fraction of that). Returns
     the new point and its compressed residuals; the cache gets its (f, G, r, J)."""
     f, G, r, J = cache[phi.tobytes()]
-    dphi, *_ = np.linalg.lstsq(G[:-1], -f[:-1], rcond=None)
+    # no step along a direction the data do not determine (a singular value below UNDETERMINED of the largest,
+    # where uncertainty() gives an infinite error): there the linearized model says nothing, and the
+    # least-squares step along it is as large as rounding makes it (a heat fit without a heater went from
+    # R_th 1.6e4 to 1.5e-9 in one such step on one machine, not on another)
+    dphi, *_ = np.linalg.lstsq(G[:-1], -f[:-1], rcond=UNDETERMINED)
     x = np.clip(phi + dphi, bounds[0], bounds[1])
     dphi = x - phi
     f_new = np.append(f[:-1] + G[:-1] @ dphi, f[-1])
@@ -219,6 +226,30 @@ def one_blas_thread(function):
     return wrapper
 
 
+def _screened_starts(screen: Problem, transform: Transform, phi0, bounds, starts, seed, one_trace, progress):
+    """The global phase: screen a Latin hypercube around ``phi0`` (a decade either way for log parameters,
+    +-100 % for the others) by cost alone, and return the best few to refine (one per core on one trace, else
+    one) with the number screened. (A start off in a direction the data hardly determine, sigma1, can screen
+    best and yet take ten times longer to converge to the same optimum.)"""
+    lo, hi = bounds
+    width = np.where(transform.log, math.log(10.0), 1.0)
+    sample = stats.qmc.LatinHypercube(d=len(phi0), seed=seed).random(starts - 1)
+    candidates = [np.clip(phi0 + (2 * u - 1) * width, lo + 1e-9, hi - 1e-9) for u in sample]
+
+    def cost(phi):
+        r, _ = screen.evaluate(transform.to_theta(phi))
+        return math.inf if r is None else float(r @ r)
+
+    costs = list(pool().map(cost, candidates)) if one_trace else [cost(c) for c in candidates]
+    order = np.argsort(costs)
+    n_refine = min(max(os.cpu_count() or 1, 2), 3) if one_trace else 1  # one per core
+    chosen = [candidates[i] for i in order[:n_refine] if math.isfinite(costs[i])]
+    if progress:
+        progress(f"the initial guess is not at the noise: {len(candidates)} more starts screened; refining "
+                 f"{len(chosen)}")
+    return chosen, len(candidates)
+
+
 @one_blas_thread
 def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=60,
         tight=False, progress=None, near=False, small_step=SMALL_STEP) -> FitOutcome:
@@ -262,30 +293,13 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     def at_noise(res):  # residuals at the data's noise: another start cannot do meaningfully better
         return math.sqrt(2.0 * res.cost / max(residual_count, 1)) <= AT_NOISE
 
-    # The initial guess first. Only if it does not reach the noise, the global phase: screen a Latin
-    # hypercube around it (a decade either way for log parameters, +-100 % for the others) by cost
-    # alone, then refine the best few. (A start off in a direction the data hardly determine, sigma1,
-    # can screen best and yet take ten times longer to converge to the same optimum.)
+    # The initial guess first. Only if it does not reach the noise, the global phase (_screened_starts).
     runs = [run(phi0)]
     screen = Problem(model, names, traces, rtol=max(rtol, COARSE_RTOL), parallel=not one_trace)
     n_candidates = 1
     if starts > 1 and not at_noise(runs[0][0]):
-        width = np.where(transform.log, math.log(10.0), 1.0)
-        sample = stats.qmc.LatinHypercube(d=len(phi0), seed=seed).random(starts - 1)
-        candidates = [np.clip(phi0 + (2 * u - 1) * width, lo + 1e-9, hi - 1e-9) for u in sample]
-        n_candidates += len(candidates)
-
-        def cost(phi):
-            r, _ = screen.evaluate(transform.to_theta(phi))
-            return math.inf if r is None else float(r @ r)
-
-        costs = list(pool().map(cost, candidates)) if one_trace else [cost(c) for c in candidates]
-        order = np.argsort(costs)
-        n_refine = min(max(os.cpu_count() or 1, 2), 3) if one_trace else 1  # one per core
-        chosen = [candidates[i] for i in order[:n_refine] if math.isfinite(costs[i])]
-        if progress:
-            progress(f"the initial guess is not at the noise: {len(candidates)} more starts screened; refining "
-                     f"{len(chosen)}")
+        chosen, n_screened = _screened_starts(screen, transform, phi0, (lo, hi), starts, seed, one_trace, progress)
+        n_candidates += n_screened
         if one_trace and len(chosen) > 1:
             runs += list(pool().map(run, chosen))
         else:

@@ -258,15 +258,8 @@ def _initial(initial):
     return float(xi), float(wn)
 
 
-def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") -> PlantFit:
-    """Fits xi, wn [rad/s] and K [m/V] to a measured stage displacement [m] under a measured
-    voltage [V] (any input that moves the stage: a step, a sawtooth...).
-
-    initial: optional (xi, wn[, K]) or dict; default: the best of a coarse grid over wn (from
-        about one period per record to the Nyquist frequency) and xi (0.01 to 3); K is always
-        solved for exactly.
-    hold: how the input behaves between samples, "foh" (linear; default) or "zoh" (constant)."""
-    t0 = _time.perf_counter()
+def _checked_record(time, voltage, stage_displacement, hold):
+    """The record as float arrays, refused with the reason where a plant fit cannot use it."""
     t = np.asarray(time, float).ravel()
     u = np.asarray(voltage, float).ravel()
     y = np.asarray(stage_displacement, float).ravel()
@@ -282,54 +275,54 @@ def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") ->
         raise InputError("the recorded voltage is constant: a plant fit needs an input that moves the stage")
     if np.ptp(y) == 0:
         raise InputError("the recorded stage displacement is constant: nothing to fit")
-    warns = []
-    if not _is_uniform(t):
-        warns.append("sampling is not uniform: the response was simulated on a uniform grid and interpolated")
+    return t, u, y
 
-    ym = float(y.mean())
-    yc = y - ym
-    evals = [0]
 
-    def linear_part(xi, wn):
-        evals[0] += 1
-        g = unit_gain_response(t, u, xi, wn, hold)
-        # K and the offset: linear least squares on [g 1], solved centred (well conditioned, exact,
-        # and fast for 10^6 points)
+class _LinearPart:
+    """The response's linear part: for given xi, wn, the gain K and the offset by linear least squares on
+    [g 1] (solved centred: well conditioned, exact, and fast for 10^6 points), g the unit-gain response."""
+
+    def __init__(self, t, u, y, hold):
+        self.t, self.u, self.y, self.hold = t, u, y, hold
+        self.ym = float(y.mean())
+        self.yc = y - self.ym
+        self.evals = 0
+
+    def __call__(self, xi, wn):
+        """(K and offset, g, residuals)"""
+        self.evals += 1
+        g = unit_gain_response(self.t, self.u, xi, wn, self.hold)
         gm = float(g.mean())
         gc = g - gm
         gg = float(gc @ gc)
-        k = float(gc @ yc) / gg if gg > 0 else 0.0
-        coef = np.array([k, ym - k * gm])
-        return coef, g, k * g + coef[1] - y
+        k = float(gc @ self.yc) / gg if gg > 0 else 0.0
+        coef = np.array([k, self.ym - k * gm])
+        return coef, g, k * g + coef[1] - self.y
 
-    def cost(xi, wn):
-        r = linear_part(xi, wn)[2]
+    def cost(self, xi, wn):
+        r = self(xi, wn)[2]
         return float(r @ r)
 
-    h = float(np.median(np.diff(t)))
-    nyq = math.pi / h
-    if initial is None:
-        duration = float(t[-1] - t[0])
-        lo = max(2 * math.pi / duration, 1e-6 * nyq)
-        xis = (0.01, 0.03, 0.07, 0.15, 0.25, 0.4, 0.6, 0.85, 1.2, 2.0, 3.0)
-        wns = np.geomspace(lo, 0.9 * nyq, max(24, int(12 * math.log10(0.9 * nyq / lo)) + 1))
-        costs = np.array([[cost(xi, wn) for xi in xis] for wn in wns])
-        i, j = np.unravel_index(int(np.argmin(costs)), costs.shape)
-        guess = (xis[j], float(wns[i]))
-    else:
-        guess = _initial(initial)
 
-    def residual(phi):
-        return linear_part(math.exp(phi[0]), math.exp(phi[1]))[2]
+def _start(linear_part, t, initial, nyq):
+    """(xi, wn) to start from: ``initial``, or the best of a coarse grid over wn (from about one period per
+    record to the Nyquist frequency) and xi (0.01 to 3)."""
+    if initial is not None:
+        return _initial(initial)
+    duration = float(t[-1] - t[0])
+    lo = max(2 * math.pi / duration, 1e-6 * nyq)
+    xis = (0.01, 0.03, 0.07, 0.15, 0.25, 0.4, 0.6, 0.85, 1.2, 2.0, 3.0)
+    wns = np.geomspace(lo, 0.9 * nyq, max(24, int(12 * math.log10(0.9 * nyq / lo)) + 1))
+    costs = np.array([[linear_part.cost(xi, wn) for xi in xis] for wn in wns])
+    i, j = np.unravel_index(int(np.argmin(costs)), costs.shape)
+    return xis[j], float(wns[i])
 
-    scale = max(float(np.sqrt(np.mean(y * y))), 1e-300)  # residuals in units of the signal: a tame problem
-    res = optimize.least_squares(lambda p: residual(p) / scale, np.log(guess), method="lm",
-                                 xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=1000)
-    xi, wn = (math.exp(v) for v in res.x)
-    (K, offset), g, r = linear_part(xi, wn)
 
-    # the full Jacobian in (xi, wn, K, offset): central differences for xi and wn (the response is
-    # smooth and cheap), exact columns for the linear K and offset
+def _plant_covariance(t, u, hold, xi, wn, K, g, r):
+    """The covariance of (xi, wn, K, offset) from the full Jacobian: central differences for xi and wn (the
+    response is smooth and cheap), exact columns for the linear K and offset. As in the friction fits,
+    coloured residuals (model error, quantisation) carry less information than white ones: s^2 is inflated by
+    (1 + rho) / (1 - rho), rho their lag-1 autocorrelation. Returns (cov, corr, undetermined, statistics)."""
     J = np.empty((t.size, 4))
     d = 1e-6 * xi
     J[:, 0] = K * (unit_gain_response(t, u, xi + d, wn, hold) - unit_gain_response(t, u, xi - d, wn, hold)) / (2 * d)
@@ -340,8 +333,6 @@ def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") ->
     n, p = t.size, 4
     dof = max(n - p, 1)
     sse = float(r @ r)
-    # as in the friction fits: coloured residuals (model error, quantisation) carry less
-    # information than white ones; inflate s^2 by (1 + rho) / (1 - rho), rho their lag-1 autocorrelation
     rho = min(max(float(r[1:] @ r[:-1]) / sse, 0.0), 0.99) if sse > 0 else 0.0
     inflation = (1 + rho) / (1 - rho)
     s2 = sse / dof * inflation
@@ -352,13 +343,38 @@ def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") ->
     cov_s = (Vt[keep].T / sv[keep] ** 2) @ Vt[keep]
     cov = s2 * cov_s / np.outer(col, col)
     null = np.abs(Vt[~keep]).max(axis=0) > 1e-6 if np.any(~keep) else np.zeros(p, bool)
-    var = np.where(null, np.inf, np.clip(np.diag(cov), 0.0, None))
-    se = np.sqrt(var)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))
     corr[null, :] = np.nan
     corr[:, null] = np.nan
-    tq = float(stats.t.ppf(0.975, dof))
+    return cov, corr, null, {"dof": dof, "residual_std": math.sqrt(sse / dof), "autocorrelation": rho,
+                             "variance_inflation": inflation}
+
+
+def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") -> PlantFit:
+    """Fits xi, wn [rad/s] and K [m/V] to a measured stage displacement [m] under a measured
+    voltage [V] (any input that moves the stage: a step, a sawtooth...).
+
+    initial: optional (xi, wn[, K]) or dict; default: the best of a coarse grid over wn (from
+        about one period per record to the Nyquist frequency) and xi (0.01 to 3); K is always
+        solved for exactly.
+    hold: how the input behaves between samples, "foh" (linear; default) or "zoh" (constant)."""
+    t0 = _time.perf_counter()
+    t, u, y = _checked_record(time, voltage, stage_displacement, hold)
+    warns = []
+    if not _is_uniform(t):
+        warns.append("sampling is not uniform: the response was simulated on a uniform grid and interpolated")
+    linear_part = _LinearPart(t, u, y, hold)
+    nyq = math.pi / float(np.median(np.diff(t)))
+    guess = _start(linear_part, t, initial, nyq)
+    scale = max(float(np.sqrt(np.mean(y * y))), 1e-300)  # residuals in units of the signal: a tame problem
+    res = optimize.least_squares(lambda p: linear_part(math.exp(p[0]), math.exp(p[1]))[2] / scale, np.log(guess),
+                                 method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=1000)
+    xi, wn = (math.exp(v) for v in res.x)
+    (K, offset), g, r = linear_part(xi, wn)
+    cov, corr, null, statistics = _plant_covariance(t, u, hold, xi, wn, K, g, r)
+    se = np.sqrt(np.where(null, np.inf, np.clip(np.diag(cov), 0.0, None)))
+    tq = float(stats.t.ppf(0.975, statistics["dof"]))
     params = Parameters()
     for k, (name, v) in enumerate(zip(NAMES, (xi, wn, K))):
         par = params.add(name, v, unit=UNITS[name])
@@ -371,17 +387,18 @@ def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") ->
                      f"sample faster")
     if 2 * math.pi / wn > 0.5 * (t[-1] - t[0]):
         warns.append("the record is shorter than two natural periods: record longer")
-    if rho > 0.5:
-        warns.append(f"the residuals are strongly correlated (lag-1 autocorrelation {rho:.2f}): the model "
-                     f"does not explain the record fully; intervals widened by {math.sqrt(inflation):.2g}x")
+    if statistics["autocorrelation"] > 0.5:
+        warns.append(f"the residuals are strongly correlated (lag-1 autocorrelation {statistics['autocorrelation']:.2f}): "
+                     f"the model does not explain the record fully; intervals widened by "
+                     f"{math.sqrt(statistics['variance_inflation']):.2g}x")
     success = bool(res.status > 0)
     if not success:
         warns.append(f"the optimiser stopped early: {res.message}")
-    return PlantFit(xi, wn, float(K), params, math.sqrt(sse / n), int(n), _time.perf_counter() - t0,
+    sse = float(r @ r)
+    return PlantFit(xi, wn, float(K), params, math.sqrt(sse / t.size), int(t.size), _time.perf_counter() - t0,
                     offset=float(offset), covariance=cov[:3, :3], correlation=corr[:3, :3], cost=sse,
-                    nfev=evals[0], success=success, message=str(res.message), hold=hold, warnings=warns,
-                    statistics={"dof": dof, "residual_std": math.sqrt(sse / dof), "autocorrelation": rho,
-                                "variance_inflation": inflation})
+                    nfev=linear_part.evals, success=success, message=str(res.message), hold=hold, warnings=warns,
+                    statistics=statistics)
 
 
 __all__ = ["fit_plant", "step_response", "unit_gain_response", "PlantFit"]

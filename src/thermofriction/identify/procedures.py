@@ -75,7 +75,8 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                      njev=outcome.njev, starts=outcome.starts, wall_time=time.perf_counter() - t0,
                      success=outcome.success, message=str(outcome.message), experiments=per,
                      warnings=first + list(extra_warnings) + warns, statistics=stats, details=details or {},
-                     fit_quality=overall, unit=unit, measurement=measurement.name)
+                     fit_quality=overall, unit=unit, measurement=measurement.name,
+                     removed=measurement.removed)
 
 
 def friction_parameters(model: Model, names, fixed=()) -> Parameters:

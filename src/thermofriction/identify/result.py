@@ -245,7 +245,7 @@ class FitResult:
         this model on it) measured against predicted displacement and the residuals' RMS; for Model
         I and II the laws with the per-temperature estimates and their 95 % intervals (``paper``:
         the paper's Eqs. (9)-(11) and (13) beside them)."""
-        from ..report.plots import fit_figure
+        from ..report.fit_plots import fit_figure
         validation = data
         if data is not None and not hasattr(data, "predictions"):
             from ..validate import validate

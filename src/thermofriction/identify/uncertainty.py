@@ -9,7 +9,7 @@ import numpy as np
 
 from .._lazy import lazy
 from ..models import Model
-from .optimiser import FitOutcome
+from .optimiser import UNDETERMINED, FitOutcome
 from .parameters import Parameters, unit_of
 
 special = lazy("scipy.special")
@@ -39,7 +39,7 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
     col = np.linalg.norm(J, axis=0)
     col[col == 0] = 1.0
     U, S, Vt = np.linalg.svd(J / col, full_matrices=False)
-    bad = S <= S[0] * 1e-9 if S.size and S[0] > 0 else np.ones_like(S, bool)
+    bad = S <= S[0] * UNDETERMINED if S.size and S[0] > 0 else np.ones_like(S, bool)
     inv = np.where(bad, 0.0, 1.0 / np.where(bad, 1.0, S) ** 2)
     cov = (Vt.T * inv) @ Vt / np.outer(col, col) * s2 * inflation
     var = np.diag(cov).copy()

@@ -14,7 +14,7 @@ from ..validate import validate
 from .entries import COMPARISON_COLUMNS, EXPERIMENT_COLUMNS, akaike, comparison_rows, parameter_section
 from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
                       fig_steps)
-from .page import Figures, _fmt, _table, page_html
+from .page import Figures, fmt_number, html_table, page_html
 
 def render(entries, data, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
     exps = list(getattr(data, "experiments", data))
@@ -26,38 +26,14 @@ def render(entries, data, *, figures_dir=None, command=None, title=None, truth=N
             e.validation = validate(e.model, data)
     figs = Figures(figures_dir)
     parts = []
-    best = min(entries, key=lambda e: e.validation.summary().get("validate", {}).get("max_error_pct", math.inf))
-    bs = best.validation.summary()["validate"]
-    cards = [("best on held-out temperatures", best.label,
-              f"max error {bs['max_error_pct']:.2g} % (the paper: 7–8 %)"),
-             ("experiments", f"{len(exps)}", f"{sum(getattr(e, 'role', 'fit') == 'validate' for e in exps)} held out"),
-             ("temperatures", f"{min(e.temperature for e in exps):.1f}–{max(e.temperature for e in exps):.1f} °C",
-              "")]
-    for e in entries:
-        if e.fit and e.fit.get("wall_time") is not None:
-            cards.append((f"identification, {e.label}", f"{float(e.fit['wall_time']):.2f} s",
-                          "the paper: ~2 h per temperature" if e.label == "Model I" else ""))
-    card_html = "".join(f'<div class="card"><div class="k">{html.escape(k)}</div><div class="v">{html.escape(v)}'
-                        f'</div><div class="s">{html.escape(s)}</div></div>' for k, v, s in cards)
-    parts.append(f'<div class="cards">{card_html}</div>')
-    # never silently: a fit that misses the data, or did not converge, first, and in every report
-    fit_warnings = {e.label: list((e.fit or {}).get("warnings", [])) for e in entries}
-    warns = []
-    for e in entries:
-        if ((e.fit or {}).get("fit_quality") or {}).get("adequate") is False:
-            first = [w for w in fit_warnings[e.label] if w.startswith("the fit is not adequate")]
-            warns += [f"{e.label}: {w}" for w in first]
-            fit_warnings[e.label] = [w for w in fit_warnings[e.label] if w not in first]
-    warns += [f"{e.label}: the fit did not converge: {(e.fit or {}).get('message', '')}" for e in entries
-              if (e.fit or {}).get("success") is False]
-    warns += [f"{e.label}: {f.file} could not be predicted: {f.reason}" for e in entries for f in e.validation.failures]
-    warns += [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + fit_warnings[e.label]]
+    parts.append(_cards(entries, exps))
+    warns = _warnings(entries)
     if warns:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
     groups = akaike(entries)[1]
     parts.append("<section><h2>Model comparison</h2>" +
-                 _table(COMPARISON_COLUMNS, comparison_rows(entries), text=(1,)) +
+                 html_table(COMPARISON_COLUMNS, comparison_rows(entries), text=(1,)) +
                  definitions(*COMPARISON_COLUMNS[2:8]) +
                  ("" if groups <= 1 else "<p class='note'>Fits of different data are compared within their own "
                   "group.</p>") +
@@ -73,18 +49,7 @@ def render(entries, data, *, figures_dir=None, command=None, title=None, truth=N
     thermal = "".join(fig_model_i(figs, e, held) for e in mi) + "".join(fig_model_ii(figs, e, held) for e in mii)
     if thermal:
         parts.append("<section><h2>Thermal models</h2>" + thermal + "</section>")
-    err_rows = []
-    for e in entries:
-        for m in e.validation.experiments:
-            err_rows.append([e.label, m["file"], _fmt(m["temperature"], "{:.4g}"),
-                             "held out" if m["role"] == "validate" else m["role"],
-                             _fmt(m["max_error_pct"]), _fmt(m["rmse_offset_removed"] * 1e9, "{:.4g}"), _fmt(m["nrmse"]),
-                             _fmt(m["final_error_pct"], "{:+.3g}"), _fmt(m["step_error_pct"])])
-    parts.append("<section><h2>Errors per experiment</h2>" + _table(
-        EXPERIMENT_COLUMNS, err_rows, row_class=lambda r: "held" if r[3] == "held out" else "", text=(1, 3)) +
-                 "<p class='note'>e = x_sim − x_meas at each sample: the predicted minus the measured end-effector "
-                 "displacement, both starting from zero (the measurement's arbitrary zero matched on the first 1 % "
-                 "of the run). Held-out rows are shaded.</p>" + definitions(*EXPERIMENT_COLUMNS[4:]) + "</section>")
+    parts.append(_errors_section(entries))
     if bands is not None:
         parts.append("<section><h2>Prediction bands</h2>" + figs.render(
             bands.plot(), "prediction-bands",
@@ -103,6 +68,57 @@ def render(entries, data, *, figures_dir=None, command=None, title=None, truth=N
                      data=data)
 
 
+def _cards(entries, exps) -> str:
+    """The page's head: the best model on held-out temperatures, the experiments, the identification times."""
+    best = min(entries, key=lambda e: e.validation.summary().get("validate", {}).get("max_error_pct", math.inf))
+    bs = best.validation.summary()["validate"]
+    cards = [("best on held-out temperatures", best.label,
+              f"max error {bs['max_error_pct']:.2g} % (the paper: 7–8 %)"),
+             ("experiments", f"{len(exps)}", f"{sum(getattr(e, 'role', 'fit') == 'validate' for e in exps)} held out"),
+             ("temperatures", f"{min(e.temperature for e in exps):.1f}–{max(e.temperature for e in exps):.1f} °C",
+              "")]
+    for e in entries:
+        if e.fit and e.fit.get("wall_time") is not None:
+            cards.append((f"identification, {e.label}", f"{float(e.fit['wall_time']):.2f} s",
+                          "the paper: ~2 h per temperature" if e.label == "Model I" else ""))
+    card_html = "".join(f'<div class="card"><div class="k">{html.escape(k)}</div><div class="v">{html.escape(v)}'
+                        f'</div><div class="s">{html.escape(s)}</div></div>' for k, v, s in cards)
+    return f'<div class="cards">{card_html}</div>'
+
+
+def _warnings(entries) -> list:
+    """Never silently: a fit that misses the data, or did not converge, first, and in every report."""
+    fit_warnings = {e.label: list((e.fit or {}).get("warnings", [])) for e in entries}
+    warns = []
+    for e in entries:
+        if ((e.fit or {}).get("fit_quality") or {}).get("adequate") is False:
+            first = [w for w in fit_warnings[e.label] if w.startswith("the fit is not adequate")]
+            warns += [f"{e.label}: {w}" for w in first]
+            fit_warnings[e.label] = [w for w in fit_warnings[e.label] if w not in first]
+    warns += [f"{e.label}: the fit did not converge: {(e.fit or {}).get('message', '')}" for e in entries
+              if (e.fit or {}).get("success") is False]
+    warns += [f"{e.label}: {f.file} could not be predicted: {f.reason}" for e in entries for f in e.validation.failures]
+    warns += [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + fit_warnings[e.label]]
+    return warns
+
+
+def _errors_section(entries) -> str:
+    """Each model's errors on each experiment."""
+    rows = []
+    for e in entries:
+        for m in e.validation.experiments:
+            rows.append([e.label, m["file"], fmt_number(m["temperature"], "{:.4g}"),
+                         "held out" if m["role"] == "validate" else m["role"],
+                         fmt_number(m["max_error_pct"]), fmt_number(m["rmse_offset_removed"] * 1e9, "{:.4g}"),
+                         fmt_number(m["nrmse"]), fmt_number(m["final_error_pct"], "{:+.3g}"),
+                         fmt_number(m["step_error_pct"])])
+    return ("<section><h2>Errors per experiment</h2>" + html_table(
+        EXPERIMENT_COLUMNS, rows, row_class=lambda r: "held" if r[3] == "held out" else "", text=(1, 3)) +
+        "<p class='note'>e = x_sim − x_meas at each sample: the predicted minus the measured end-effector "
+        "displacement, both starting from zero (the measurement's arbitrary zero matched on the first 1 % "
+        "of the run). Held-out rows are shaded.</p>" + definitions(*EXPERIMENT_COLUMNS[4:]) + "</section>")
+
+
 def truth_section(truth: dict) -> str:
     """Data made from a known model (the demo, a study): whether each fit's 95 % intervals cover it, or
     why a fit cannot be compared with it. ``truth``: label -> FitResult.recovery summary."""
@@ -116,15 +132,15 @@ def truth_section(truth: dict) -> str:
                 mine = [r for r in rows if r["parameter"] == name]
                 scale = max(abs(r["truth"]) for r in mine) or 1.0
                 summary.append([name, f"{sum(r['covered'] for r in mine)} of {len(mine)}",
-                                _fmt(100 * max(abs(r["value"] - r["truth"]) for r in mine) / scale, "{:.2g}"),
-                                _fmt(100 * max((r["upper"] - r["lower"]) / 2 for r in mine) / scale, "{:.2g}")])
-            parts.append(_table(["parameter", "covered", "largest error [% of the truth's largest value]",
+                                fmt_number(100 * max(abs(r["value"] - r["truth"]) for r in mine) / scale, "{:.2g}"),
+                                fmt_number(100 * max((r["upper"] - r["lower"]) / 2 for r in mine) / scale, "{:.2g}")])
+            parts.append(html_table(["parameter", "covered", "largest error [% of the truth's largest value]",
                                  "largest interval half-width [%]"], summary, text=(0,)))
-            detail = [[r["parameter"], _fmt(r["temperature"], "{:.4g}"), _fmt(r["truth"], "{:.5g}"),
-                       _fmt(r["value"], "{:.5g}"), f"[{r['lower']:.5g}, {r['upper']:.5g}]",
+            detail = [[r["parameter"], fmt_number(r["temperature"], "{:.4g}"), fmt_number(r["truth"], "{:.5g}"),
+                       fmt_number(r["value"], "{:.5g}"), f"[{r['lower']:.5g}, {r['upper']:.5g}]",
                        "yes" if r["covered"] else "NO"] for r in rows]
             parts.append("<details><summary>every (parameter, temperature) point</summary>" +
-                         _table(["parameter", "temperature [°C]", "truth", "fitted", "95 % interval", "covered"],
+                         html_table(["parameter", "temperature [°C]", "truth", "fitted", "95 % interval", "covered"],
                                 detail, text=(0, 5)) + "</details>")
     return ("<section><h2>Against the truth</h2><p class='note'>These data were made by simulation from a known "
             "model: each fitted law at the fit temperatures, with its 95 % interval (delta method over the fitted "

@@ -11,8 +11,8 @@ import numpy as np
 
 from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
 from ..validate import ValidationResult
-from .page import _fmt, _table
-from .plots import _float, law_outside_intervals, per_temperature_estimates
+from .page import fmt_number, html_table
+from .fit_plots import as_float, law_outside_intervals, per_temperature_estimates
 
 @dataclasses.dataclass
 class Entry:
@@ -80,9 +80,9 @@ def comparison_rows(entries):
         s = e.validation.summary()
         v = s.get("validate", s.get("fit", {}))
         f = e.fit or {}
-        rows.append([e.label, e.model.friction.model, _fmt(v.get("max_error_pct")), _fmt(v.get("mean_max_error_pct")),
-                     _fmt(v.get("rmse_offset_removed", math.nan) * 1e9, "{:.4g}"), _fmt(s.get("fit", {}).get("max_error_pct")),
-                     *_aicc_cells(a), _fmt(f.get("wall_time"), "{:.2f} s")])
+        rows.append([e.label, e.model.friction.model, fmt_number(v.get("max_error_pct")), fmt_number(v.get("mean_max_error_pct")),
+                     fmt_number(v.get("rmse_offset_removed", math.nan) * 1e9, "{:.4g}"), fmt_number(s.get("fit", {}).get("max_error_pct")),
+                     *_aicc_cells(a), fmt_number(f.get("wall_time"), "{:.2f} s")])
     return rows
 
 
@@ -103,7 +103,7 @@ def _covariance(fit: dict, names):
         p = params.get(n)
         if p is None:
             return None
-        x = _float(p.get("stderr"))  # None, "inf" (JSON), a number
+        x = as_float(p.get("stderr"))  # None, "inf" (JSON), a number
         se.append(x if n in idx else 0.0)
     if not all(math.isfinite(x) for x in se):
         return None
@@ -166,13 +166,13 @@ def law_rows(entry, fallback_T):
         value, se = law_at(law, Tr, entry.fit, name)
         per_deg = 100 * float(law.slope(Tr)) / value if value else math.nan
         rng = getattr(law, "range", None)
-        ends = (f"{_fmt(law(rng[0]), '{:.4g}')} at {rng[0]:g} °C, {_fmt(law(rng[1]), '{:.4g}')} at {rng[1]:g} °C"
+        ends = (f"{fmt_number(law(rng[0]), '{:.4g}')} at {rng[0]:g} °C, {fmt_number(law(rng[1]), '{:.4g}')} at {rng[1]:g} °C"
                 if rng else "—")
         T = per_temperature_estimates(entry.fit or {}, name)[0]
         inside = ("—" if not T.size else f"yes, all {T.size}" if name not in outside else
                   f"no: outside at {', '.join(f'{t:g}' for t in outside[name])} °C")
-        rows.append([name, _equation(name, law, Tr, unit), f"{Tr:g}", _fmt(value, "{:.5g}"), _fmt(se, "{:.3g}"), unit,
-                     _fmt(per_deg, "{:+.3g} %/°C"), ends, inside])
+        rows.append([name, _equation(name, law, Tr, unit), f"{Tr:g}", fmt_number(value, "{:.5g}"), fmt_number(se, "{:.3g}"), unit,
+                     fmt_number(per_deg, "{:+.3g} %/°C"), ends, inside])
     return rows, outside
 
 
@@ -190,8 +190,8 @@ def breakpoint_rows(entry):
         p = params.get(pname) or {}
         fixed = bool(params) and pname not in varying
         lam = entry.model.thermal_factor(float(T)) if entry.model.thermal.form == "scale" else math.nan
-        rows.append([f"{T:.2f}", _fmt(v, "{:.5g}"), "fixed" if fixed else _fmt(p.get("stderr"), "{:.3g}"),
-                     _fmt(lam, "{:.4f}"), "reference temperature (dF = 0 by definition)" if fixed and v == 0 else ""])
+        rows.append([f"{T:.2f}", fmt_number(v, "{:.5g}"), "fixed" if fixed else fmt_number(p.get("stderr"), "{:.3g}"),
+                     fmt_number(lam, "{:.4f}"), "reference temperature (dF = 0 by definition)" if fixed and v == 0 else ""])
     return rows
 
 
@@ -201,8 +201,8 @@ def _parameter_table(entry, keep):
         if not keep(name):
             continue
         ci = p.get("ci95") or ["", ""]
-        rows.append([name, _fmt(p.get("value"), "{:.6g}"), _fmt(p.get("stderr"), "{:.3g}"),
-                     f"[{_fmt(ci[0], '{:.5g}')}, {_fmt(ci[1], '{:.5g}')}]", _unit(p.get("unit", ""))])
+        rows.append([name, fmt_number(p.get("value"), "{:.6g}"), fmt_number(p.get("stderr"), "{:.3g}"),
+                     f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", _unit(p.get("unit", ""))])
     return rows
 
 
@@ -214,13 +214,13 @@ def parameter_section(entries, fit_T) -> str:
         parts = []
         plain = _parameter_table(e, lambda n: "." not in n and not n.startswith("dF"))
         if plain:
-            parts.append(_table(["parameter", "value", "std. error", "95 % interval", "unit"], plain, text=(4,)))
+            parts.append(html_table(["parameter", "value", "std. error", "95 % interval", "unit"], plain, text=(4,)))
         if e.model.laws:
             rows, outside = law_rows(e, fit_T)
             parts.append("<p class='note'>Temperature laws (Model I). Each is given at a reference temperature "
                          "in the middle of the range it was calibrated on; the standard error there follows from "
                          "the coefficients' covariance. An exponential law's coefficient <code>a</code> in the "
-                         "model file is its value extrapolated to 0 °C, far outside the data.</p>" + _table(
+                         "model file is its value extrapolated to 0 °C, far outside the data.</p>" + html_table(
                 ["parameter", "law", "T_ref [°C]", "value at T_ref", "std. error", "unit", "change per °C",
                  "at the range's ends", "inside the per-temperature 95 % intervals"], rows, text=(5,), wrap=(1, 7, 8)))
             if outside:
@@ -237,12 +237,12 @@ def parameter_section(entries, fit_T) -> str:
             if rows:
                 parts.append("<p class='note'>Thermal-induced friction dF(T) (Model II), linear between its "
                              "breakpoints; the friction force is scaled by λ = 1 + dF/fc"
-                             f" (fc = {_fmt(e.model.friction.values().get('fc'), '{:.4g}')} N).</p>" +
-                             _table(["breakpoint T [°C]", "dF [N]", "std. error [N]", "λ", "note"], rows, wrap=(4,)))
+                             f" (fc = {fmt_number(e.model.friction.values().get('fc'), '{:.4g}')} N).</p>" +
+                             html_table(["breakpoint T [°C]", "dF [N]", "std. error [N]", "λ", "note"], rows, wrap=(4,)))
         coef = _parameter_table(e, lambda n: "." in n or n.startswith("dF"))
         if coef:
             parts.append("<details><summary>the fitted coefficients as stored in the model file</summary>" +
-                         _table(["coefficient", "value", "std. error", "95 % interval", "unit"], coef, text=(4,)) +
+                         html_table(["coefficient", "value", "std. error", "95 % interval", "unit"], coef, text=(4,)) +
                          "</details>")
         if parts:
             out.append(f"<h3>{html.escape(e.label)}</h3>" + "".join(parts))

@@ -5,7 +5,7 @@ definitions of the metrics the report shows."""
 from __future__ import annotations
 
 from ..models import ModelII
-from . import plots
+from . import fit_plots, plots
 
 #: every metric the report shows, defined where it is shown (docs/formats.md#validation-metrics);
 #: e = x_sim − x_meas at each sample, x_meas zeroed so that the first 1 % of the run agrees on average
@@ -80,7 +80,7 @@ def fig_residuals(figs, entries):
 def fig_model_i(figs, entry, held_out=()):
     if not entry.model.laws or not ((entry.fit or {}).get("details") or {}).get("per_temperature"):
         return ""
-    fig = plots.laws_figure(entry.fit, entry.model, held_out)
+    fig = fit_plots.laws_figure(entry.fit, entry.model, held_out)
     return figs.render(fig, "model-i-parameters",
                        f"{entry.label}: each parameter identified per temperature with its 95 % interval (an "
                        "orange triangle where the interval is open upwards: the data do not bound the parameter "
@@ -95,7 +95,7 @@ def fig_model_ii(figs, entry, held_out=()):
     alt = ((fit.get("alternatives") or {}).get("paper") or {}).get("details") or {}
     if not (det.get("paper") or alt.get("paper") or det.get("direct")) or not isinstance(entry.model.thermal, ModelII):
         return ""
-    fig = plots.model_ii_figure(fit, entry.model, held_out)
+    fig = fit_plots.model_ii_figure(fit, entry.model, held_out)
     return figs.render(fig, "model-ii",
                        f"{entry.label}: the paper's procedure (net displacement against temperature with an "
                        "estimated breakpoint, Fig. 6; net displacement against dF by simulation, Fig. 7) where it "

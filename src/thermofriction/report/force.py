@@ -15,7 +15,7 @@ from ..measurements import steady_state_curve
 from ..models import ModelI, ModelII
 from ..validate import validate
 from .entries import akaike
-from .page import Figures, _fmt, _plt, _table, page_html
+from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
 from .plots import thin as _thin
 
 
@@ -47,11 +47,11 @@ def _units(exps):
     return ("N m", "rad/s", "rad", "torque") if rotary else ("N", "m/s", "m", "force")
 
 
+@page_styled
 def fig_force_time(figs, entries, unit, what):
-    plt = _plt()
     preds0 = entries[0].validation.predictions
     shown = sorted(preds0, key=lambda p: (p.role != "validate", p.temperature))[:MAX_PANELS]
-    fig, axes = plt.subplots(len(shown), 1, figsize=(8.5, 2.4 * len(shown) + 0.5), squeeze=False,
+    fig, axes = subplots(len(shown), 1, figsize=(8.5, 2.4 * len(shown) + 0.5), squeeze=False,
                              constrained_layout=True)
     for ax, p0 in zip(axes[:, 0], shown):
         stride = max(len(p0.time) // 400, 1)
@@ -69,9 +69,9 @@ def fig_force_time(figs, entries, unit, what):
                        f"the model's sensor offset included; held-out experiments first.")
 
 
+@page_styled
 def fig_velocity_map(figs, entries, exps, unit, vunit, what):
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    fig, ax = subplots(figsize=(6.5, 4.2))
     temps = sorted({e.temperature for e in exps})
     col = _colors(temps)
     top = max(float(np.max(np.abs(e.drive_velocity))) for e in exps)
@@ -102,9 +102,9 @@ def _reversals(p, n):
     return [int(i) for i in flips if 5 <= i < len(v) - 5][:n]
 
 
+@page_styled
 def fig_loops(figs, entries, unit, xunit, what):
     """Force against position after each reversal: the presliding hysteresis, measured and predicted."""
-    plt = _plt()
     loops = []
     for p in entries[0].validation.predictions:
         for i in _reversals(p, MAX_LOOPS - len(loops)):
@@ -113,7 +113,7 @@ def fig_loops(figs, entries, unit, xunit, what):
             break
     if not loops:
         return ""
-    fig, axes = plt.subplots(1, len(loops), figsize=(3.2 * len(loops), 3.0), squeeze=False)
+    fig, axes = subplots(1, len(loops), figsize=(3.2 * len(loops), 3.0), squeeze=False)
     for ax, (file, i) in zip(axes[0], loops):
         p0 = next(q for q in entries[0].validation.predictions if q.file == file)
         swing = abs(float(np.median(p0.measured[max(i - 20, 0):i])) - float(np.median(p0.measured[i + 1:i + 40])))
@@ -182,23 +182,7 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
     if warns:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
-    rows = []
-    for e, a in zip(entries, _akaike(entries)):
-        s = e.validation.summary()
-        f = e.fit or {}
-        k = sum(1 for p in (f.get("parameters") or {}).values() if p.get("vary"))
-        rows.append([e.label, _fmt(k if f else None, "{:.0f}"), _fmt(a[0] if a else None, "{:.1f}"),
-                     _fmt(a[1] if a else None, "{:.3f}"), _fmt(s.get("fit", {}).get("rmse"), "{:.4g}"),
-                     _fmt(s.get("validate", {}).get("rmse"), "{:.4g}"), _fmt(s.get("validate", {}).get("max_error_pct")),
-                     _fmt(e.model.plant.sensor_offset, "{:.4g}")])
-    parts.append("<section><h2>Friction models compared</h2>" + _table(
-        ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
-         "max error, held out [%]", f"sensor offset [{unit}]"], rows) +
-        "<p style='font-size:13px;color:#4a5266'>ΔAICc is each fit's AICc minus the lowest among fits of the same "
-        "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
-        "to one. The held-out RMSE compares the models on experiments none was fitted to; the sensor offset was "
-        "fitted once, on the fit experiments, and is used there as it is. Max error is "
-        "max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
+    parts.append(_comparison_section(entries, unit, what))
     parts.append(f"<section><h2>Measured and predicted {what}</h2>" + fig_force_time(figs, entries, unit, what)
                  + "</section>")
     parts.append("<section><h2>Friction–velocity map</h2>" + fig_velocity_map(figs, entries, exps, unit, vunit, what)
@@ -206,31 +190,60 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
     loops = fig_loops(figs, entries, unit, xunit, what)
     if loops:
         parts.append("<section><h2>Presliding hysteresis</h2>" + loops + "</section>")
-    err_rows = [[e.label, m["file"], _fmt(m["temperature"], "{:.4g}"), m["role"], _fmt(m["rmse"], "{:.4g}"),
-                 _fmt(m["nrmse"]), _fmt(m["max_error_pct"]), _fmt(m["bias"], "{:+.3g}")]
+    err_rows = [[e.label, m["file"], fmt_number(m["temperature"], "{:.4g}"), m["role"], fmt_number(m["rmse"], "{:.4g}"),
+                 fmt_number(m["nrmse"]), fmt_number(m["max_error_pct"]), fmt_number(m["bias"], "{:+.3g}")]
                 for e in entries for m in e.validation.experiments]
-    parts.append("<section><h2>Errors per experiment</h2>" + _table(
+    parts.append("<section><h2>Errors per experiment</h2>" + html_table(
         ["model", "file", "T [°C]", "role", f"RMSE [{unit}]", "NRMSE", "max error [%]", f"mean error [{unit}]"],
         err_rows) + "</section>")
+    parameters = _parameters_section(entries, unit)
+    if parameters:
+        parts.append(parameters)
+    return page_html(title or f"thermofriction report — {getattr(data, 'name', None) or 'force data'}",
+                     f"{', '.join(e.label for e in entries)} on {len(exps)} {what} experiments", parts,
+                     command=command, data=data)
+
+
+def _comparison_section(entries, unit, what) -> str:
+    """The friction models compared: AICc among fits of the same data, and errors on held-out experiments."""
+    rows = []
+    for e, a in zip(entries, _akaike(entries)):
+        s = e.validation.summary()
+        f = e.fit or {}
+        k = sum(1 for p in (f.get("parameters") or {}).values() if p.get("vary"))
+        rows.append([e.label, fmt_number(k if f else None, "{:.0f}"), fmt_number(a[0] if a else None, "{:.1f}"),
+                     fmt_number(a[1] if a else None, "{:.3f}"), fmt_number(s.get("fit", {}).get("rmse"), "{:.4g}"),
+                     fmt_number(s.get("validate", {}).get("rmse"), "{:.4g}"), fmt_number(s.get("validate", {}).get("max_error_pct")),
+                     fmt_number(e.model.plant.sensor_offset, "{:.4g}")])
+    return ("<section><h2>Friction models compared</h2>" + html_table(
+        ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
+         "max error, held out [%]", f"sensor offset [{unit}]"], rows) +
+        "<p style='font-size:13px;color:#4a5266'>ΔAICc is each fit's AICc minus the lowest among fits of the same "
+        "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
+        "to one. The held-out RMSE compares the models on experiments none was fitted to; the sensor offset was "
+        "fitted once, on the fit experiments, and is used there as it is. Max error is "
+        "max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
+
+
+def _parameters_section(entries, unit) -> str:
+    """Each fit's parameters with their intervals, the sensor offset among them."""
     param_rows = []
     for e in entries:
         f = e.fit or {}
         for name, p in (f.get("parameters") or {}).items():
             ci = p.get("ci95") or ["", ""]
-            param_rows.append([e.label, name, _fmt(p.get("value"), "{:.6g}"), _fmt(p.get("stderr"), "{:.3g}"),
-                               f"[{_fmt(ci[0], '{:.5g}')}, {_fmt(ci[1], '{:.5g}')}]", p.get("unit", "")])
+            param_rows.append([e.label, name, fmt_number(p.get("value"), "{:.6g}"), fmt_number(p.get("stderr"), "{:.3g}"),
+                               f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", p.get("unit", "")])
         o = f.get("sensor_offset")
         if o:
             ci = o.get("ci95") or ["", ""]
             param_rows.append([e.label, "sensor offset" + ("" if o.get("fitted") else " (held)"),
-                               _fmt(o.get("value"), "{:.6g}"), _fmt(o.get("stderr"), "{:.3g}"),
-                               f"[{_fmt(ci[0], '{:.5g}')}, {_fmt(ci[1], '{:.5g}')}]", o.get("unit", unit)])
-    if param_rows:
-        parts.append("<section><h2>Identified parameters</h2>" + _table(
-            ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
-    return page_html(title or f"thermofriction report — {getattr(data, 'name', None) or 'force data'}",
-                     f"{', '.join(e.label for e in entries)} on {len(exps)} {what} experiments", parts,
-                     command=command, data=data)
+                               fmt_number(o.get("value"), "{:.6g}"), fmt_number(o.get("stderr"), "{:.3g}"),
+                               f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", o.get("unit", unit)])
+    if not param_rows:
+        return ""
+    return ("<section><h2>Identified parameters</h2>" + html_table(
+        ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
 
 
 __all__ = ["render_force"]

@@ -3,6 +3,7 @@ tables, number formatting, the footer's versions, and writing a page atomically.
 
 from __future__ import annotations
 
+import functools
 import html
 import io
 import math
@@ -53,13 +54,28 @@ code{background:#eef0f5;padding:1px 4px;border-radius:3px}
 
 
 
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    plt.rcParams.update({"svg.fonttype": "none", "font.size": 9, "axes.grid": True, "grid.alpha": 0.3,
-                         "axes.spines.top": False, "axes.spines.right": False})
-    return plt
+#: the look of the force and study pages' figures (the others': plots.STYLE)
+PAGE_STYLE = {"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False,
+              "axes.spines.right": False}
+
+
+def page_styled(function):
+    """Runs a figure-drawing ``function`` in PAGE_STYLE, for it alone: the user's matplotlib settings and
+    backend are left as they are."""
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        import matplotlib  # (heavy: loaded when a page is drawn, not with the package)
+        with matplotlib.rc_context(PAGE_STYLE):
+            return function(*args, **kwargs)
+    return wrapper
+
+
+def subplots(nrows=1, ncols=1, *, figsize=None, constrained_layout=None, **kwargs):
+    """pyplot's ``subplots`` without pyplot: a ``matplotlib.figure.Figure`` and its axes; no backend is chosen
+    and nothing is left open."""
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=figsize, layout="constrained" if constrained_layout else None)
+    return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
 class Figures:
@@ -89,8 +105,6 @@ class Figures:
                     fh.write(svg)
                 with atomic_write(self.folder / f"{name}.png", "wb") as fh:
                     fig.savefig(fh, format="png", dpi=150, bbox_inches="tight")
-        if getattr(fig.canvas, "manager", None) is not None:  # a pyplot figure (the studies' pages)
-            _plt().close(fig)
         return f'<figure id="fig-{name}">{svg}<figcaption>{html.escape(caption)}</figcaption></figure>'
 
 
@@ -111,7 +125,7 @@ def _compact(svg: str) -> str:
                   svg)
 
 
-def _table(head, rows, row_class=None, text=(), wrap=()):
+def html_table(head, rows, row_class=None, text=(), wrap=()):
     """An HTML table; columns ``text`` (indices) hold words and are left-aligned, ``wrap`` ones also
     wrap (numbers and units never do)."""
     def cell(tag, i, c):
@@ -126,7 +140,7 @@ def _table(head, rows, row_class=None, text=(), wrap=()):
     return f"<table><thead><tr>{h}</tr></thead><tbody>{b}</tbody></table>"
 
 
-def _fmt(x, f="{:.3g}"):
+def fmt_number(x, f="{:.3g}"):
     try:
         x = float(x)
     except (TypeError, ValueError):
@@ -162,7 +176,7 @@ def page_html(title, subtitle, parts, *, command=None, data=None) -> str:
             f"<main>{''.join(parts)}</main><footer>{footer}</footer></body></html>")
 
 
-def _write_page(path, title, subtitle, parts, command=None) -> str:
+def write_page(path, title, subtitle, parts, command=None) -> str:
     """A standalone report page (the main report's style) written atomically; returns the HTML."""
     text = page_html(title, subtitle, parts, command=command)
     with atomic_write(path, "w", encoding="utf-8") as fh:

@@ -19,8 +19,6 @@ import math
 
 import numpy as np
 
-from ..models import PARAMETER_UNITS, ModelII, load_model
-
 #: font sizes in points; the report draws figures 11 in wide at the card's full width (~1070 px), so
 #: a point renders at ~1.35 px: 9 pt legend text is ~12 px on the page
 STYLE = {"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10.5, "xtick.labelsize": 9.5,
@@ -117,12 +115,12 @@ def mark_held_out(ax, temperatures, label=True):
                    label="held-out temperature" if (label and i == 0) else None)
 
 
-def _grid(n, per_row=3):
+def panel_grid(n, per_row=3):
     cols = min(n, per_row)
     return math.ceil(n / cols), cols
 
 
-def _hide_unused(axes, n):
+def hide_unused(axes, n):
     for ax in axes.flat[n:]:
         ax.set_visible(False)
 
@@ -183,7 +181,7 @@ def draw_residuals(ax, predictions, styles, windows=50):
     ax.set_ylabel("RMS(predicted − measured) [nm]")
 
 
-def _noise_handle():
+def noise_handle():
     from matplotlib.lines import Line2D
     return Line2D([], [], color="k", ls=":", lw=1.2, label="measurement noise\n(estimated from the data)")
 
@@ -199,14 +197,14 @@ def _panel_per_model(entries, row_height, draw, key_extra, **subplots):
     the y label on the first column only, one temperature key for the figure."""
     preds = _predictions(entries)
     styles = temperature_styles([(p.temperature, p.role) for _, ps in preds for p in ps])
-    rows, cols = _grid(len(preds))
+    rows, cols = panel_grid(len(preds))
     fig, axes = new_figure(WIDE, row_height * rows + 0.4, nrows=rows, ncols=cols, **subplots)
     for ax, (label, ps) in zip(axes.flat, preds):
         draw(ax, ps, styles)
         ax.set_title(label)
     for ax in axes[:, 1:].flat:
         ax.set_ylabel("")
-    _hide_unused(axes, len(preds))
+    hide_unused(axes, len(preds))
     temperature_key(fig, styles, extra=key_extra)
     return fig
 
@@ -220,7 +218,7 @@ def displacement_figure(entries):
 @styled
 def residual_figure(entries):
     """Windowed RMS residuals, one panel per model: [(label, ValidationResult)]."""
-    return _panel_per_model(entries, 3.2, draw_residuals, [_noise_handle()])
+    return _panel_per_model(entries, 3.2, draw_residuals, [noise_handle()])
 
 
 # -- against temperature ---------------------------------------------------------------------
@@ -329,253 +327,6 @@ def steps_figure(entries, width=HALF):
 
 # -- thermal laws ------------------------------------------------------------------------------
 
-def _float(x):
-    try:
-        x = float(x)
-    except (TypeError, ValueError):
-        return math.nan
-    return x
-
-
-def per_temperature_estimates(fit: dict, name: str):
-    """(T, value, lower, upper) arrays of a Model I parameter's per-temperature estimates and their
-    95 % intervals (NaN where open), from a fit's results (FitResult.to_dict())."""
-    per_T = ((fit or {}).get("details") or {}).get("per_temperature") or []
-    rows = [(r["temperature"], r["parameters"][name]) for r in per_T if name in r.get("parameters", {})]
-    T = np.array([t for t, _ in rows], float)
-    v = np.array([_float(p.get("value")) for _, p in rows])
-    ci = [p.get("ci95") or [None, None] for _, p in rows]
-    lo = np.array([_float(c[0]) for c in ci])
-    hi = np.array([_float(c[1]) for c in ci])
-    return T, v, lo, hi
-
-
-def law_outside_intervals(fit: dict, model) -> dict:
-    """parameter -> temperatures where the (refined) law lies outside the per-temperature 95 % interval."""
-    out = {}
-    for name, law in model.laws.items():
-        T, v, lo, hi = per_temperature_estimates(fit, name)
-        if not T.size:
-            continue
-        at = np.asarray(law(T), float)
-        bad = (np.isfinite(lo) & (at < lo)) | (np.isfinite(hi) & (at > hi))
-        if bad.any():
-            out[name] = [float(x) for x in T[bad]]
-    return out
-
-
-def draw_law(ax, fit, model, name, held_out=(), paper=True):
-    """A Model I parameter against temperature: per-temperature estimates with 95 % intervals,
-    the law through them before refinement, the refined law, the paper's, held-out temperatures."""
-    T, vals, lo, hi = per_temperature_estimates(fit, name)
-    unit = PARAMETER_UNITS.get(name, "")
-    lims = [x for x in vals if math.isfinite(x)]
-    if T.size:
-        # an interval that spans decades (a parameter the data do not determine) would flatten the
-        # panel: it is drawn to the panel's edge instead (an upward triangle)
-        span = np.nanmax(np.abs(vals)) if np.any(np.isfinite(vals)) else 1.0
-        open_hi = ~np.isfinite(hi) | (hi > vals + 3 * span)
-        hi_d = np.where(open_hi, np.nan, hi)
-        yerr = np.vstack([np.clip(vals - lo, 0, None), np.clip(hi_d - vals, 0, None)])
-        yerr = np.where(np.isfinite(yerr), yerr, 0)
-        ax.errorbar(T, vals, yerr=yerr, fmt="o", ms=5, capsize=3, color="k", zorder=4,
-                    label="per temperature, 95 % interval")
-        if open_hi.any():
-            ax.plot(T[open_hi], vals[open_hi], "^", ms=8, color="#ff7f0e", zorder=5, label="interval open upwards")
-        lims += [x for x in np.concatenate([lo, hi_d]) if math.isfinite(x)]
-    lo_T, hi_T = (float(T.min()), float(T.max())) if T.size else (model.laws[name].range or (30.0, 40.0))
-    allT = list(held_out) + ([lo_T, hi_T])
-    grid = np.linspace(min(allT) - 0.5, max(allT) + 0.5, 200)
-    chosen = (((fit or {}).get("details") or {}).get("laws") or {}).get(name, {})
-    first = (chosen.get("candidates") or {}).get(chosen.get("chosen"), {}).get("law")
-    if first:
-        from ..models.laws import law_from_dict
-        try:
-            before = law_from_dict(first, name)
-            ax.plot(grid, before(grid), ":", color=MODEL_COLOURS[0], lw=1.4, label="law through the estimates")
-        except Exception:  # a law the reader does not know: the refined one is still drawn
-            pass
-    law = model.laws.get(name)
-    if law is not None:
-        y = law(grid)
-        ax.plot(grid, y, "-", color=MODEL_COLOURS[0], lw=2, label=f"refined law ({law.kind})", zorder=3)
-        lims += list(y)
-        if T.size:
-            at = np.asarray(law(T), float)
-            bad = (np.isfinite(lo) & (at < lo)) | (np.isfinite(hi) & (at > hi))
-            if bad.any():
-                ax.plot(T[bad], vals[bad], "o", ms=12, mfc="none", mec="#d62728", mew=1.6, zorder=6,
-                        label="law outside the interval")
-    if paper:
-        ref = load_model("li2009-model-i").laws  # the paper's Eqs. (9)-(11)
-        if name in ref:
-            ax.plot(grid, ref[name](grid), label="paper, Eqs. (9)–(11)", **PAPER)
-    mark_held_out(ax, held_out)
-    if lims:  # the paper's law may leave the panel; the data and the fitted law may not
-        a, b = min(lims), max(lims)
-        pad = 0.08 * (b - a if b > a else abs(a) or 1.0)
-        ax.set_ylim(a - pad, b + pad)
-    ax.set_xlabel("temperature [°C]")
-    ax.set_ylabel(f"{name} [{unit}]" if unit else name)
-    ax.set_title(name)
-
-
-@styled
-def laws_figure(fit, model, held_out=(), paper=True):
-    """Model I: every parameter with a law, one panel each (a fit's results dict and its model)."""
-    names = list(model.laws)
-    if not names:
-        return None
-    rows, cols = _grid(len(names))
-    fig, axes = new_figure(WIDE, 3.6 * rows + 0.3, nrows=rows, ncols=cols)
-    for ax, n in zip(axes.flat, names):
-        draw_law(ax, fit, model, n, held_out, paper)
-    _hide_unused(axes, len(names))
-    handles = {}
-    for ax in axes.flat[:len(names)]:
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            handles.setdefault(lab, h)
-    fig.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
-    return fig
-
-
-def draw_dF(ax, fit, model, label="fitted dF(T)", held_out=(), paper=True):
-    """Model II's dF(T): per-temperature (direct) estimates, the fitted law with its breakpoints,
-    the paper's procedure's law and Eq. (13)."""
-    det = (fit or {}).get("details") or {}
-    alt = (((fit or {}).get("alternatives") or {}).get("paper") or {}).get("details") or {}
-    procedure = det.get("paper") or alt.get("paper")
-    direct = det.get("direct")
-    Ts = list(held_out)
-    if direct:
-        T = np.array(direct["temperatures"], float)
-        v = np.array(direct["dF"], float)
-        se = np.array([_float(x) for x in direct["stderr"]])
-        ax.errorbar(T, v, yerr=np.where(np.isfinite(se), 1.96 * se, 0), fmt="o", ms=5, capsize=3, color="k",
-                    zorder=4, label="per temperature (direct), 95 % interval")
-        Ts += list(T)
-    dF = model.thermal.dF if isinstance(model.thermal, ModelII) else None
-    if dF is not None and getattr(dF, "range", None):
-        Ts += list(dF.range)
-    if not Ts:
-        Ts = [30.0, 41.5]
-    grid = np.linspace(min(Ts) - 0.5, max(Ts) + 0.5, 200)
-    if dF is not None:
-        ax.plot(grid, dF(grid), "-", color=MODEL_COLOURS[0], lw=2, label=label, zorder=3)
-        if dF.kind in ("pwl", "table"):
-            ax.plot(dF.T, dF.values, "s", ms=7, color=MODEL_COLOURS[0], zorder=5, label="breakpoints")
-            for t, y in zip(dF.T, dF.values):
-                ax.annotate(f"{t:.1f} °C", (t, y), xytext=(4, 6), textcoords="offset points", fontsize=9,
-                            color=MODEL_COLOURS[0])
-    if procedure:
-        law = procedure["dF_law"]
-        ax.plot(law["T"], law["values"], "-", color=MODEL_COLOURS[1], lw=1.4, label="the paper's procedure")
-    if paper:
-        ax.plot(grid, load_model("li2009-model-ii").thermal.dF(grid), label="paper, Eq. (13)", **PAPER)
-    mark_held_out(ax, held_out)
-    ax.set_xlabel("temperature [°C]")
-    ax.set_ylabel("dF [N]")
-    ax.set_title("thermal-induced friction dF(T)")
-
-
-@styled
-def model_ii_figure(fit, model, held_out=(), paper=True):
-    """Model II: the paper's procedure (displacement against temperature, against dF) when it ran,
-    and dF(T)."""
-    det = (fit or {}).get("details") or {}
-    alt = (((fit or {}).get("alternatives") or {}).get("paper") or {}).get("details") or {}
-    procedure = det.get("paper") or alt.get("paper")
-    if not procedure and not det.get("direct") and not isinstance(model.thermal, ModelII):
-        return None
-    panels = 3 if procedure else 1
-    fig, axes = new_figure(WIDE if procedure else HALF + 1.5, 3.9, nrows=1, ncols=panels)
-    axl = list(axes[0])
-    if procedure:
-        ax = axl.pop(0)
-        T = np.array(procedure["temperatures"], float)
-        D = np.array(procedure["displacement"], float)
-        ax.plot(T, D * 1e6, "ko", ms=5, label="measured")
-        knots = np.array(procedure["displacement_law"]["T"], float)
-        vals = np.array(procedure["displacement_law"]["values"], float)
-        ax.plot(knots, vals * 1e6, "-", color=MODEL_COLOURS[1],
-                label=f"two segments,\nbreak at {procedure['breakpoint']:.1f} °C")
-        mark_held_out(ax, held_out, label=False)
-        ax.set_xlabel("temperature [°C]")
-        ax.set_ylabel("net displacement [µm]")
-        ax.set_title("displacement vs temperature (Fig. 6)")
-        ax.legend(loc="best")
-        ax = axl.pop(0)
-        dFg = np.array(procedure["dF_grid"], float)
-        Ds = np.array(procedure["displacement_vs_dF"], float)
-        lf = procedure["linear_fit"]
-        ax.plot(dFg, Ds * 1e6, "ko", ms=5, label="simulated")
-        ax.plot(dFg, (lf["intercept"] + lf["slope"] * dFg) * 1e6, "-", color=MODEL_COLOURS[1],
-                label=f"linear, R² = {lf['r2']:.4f}")
-        ax.set_xlabel("dF [N]")
-        ax.set_ylabel("net displacement [µm]")
-        ax.set_title("displacement vs dF (Fig. 7)")
-        ax.legend(loc="best")
-    ax = axl.pop(0)
-    draw_dF(ax, fit, model, held_out=held_out, paper=paper)
-    fig.legend(handles=ax.get_legend_handles_labels()[0], loc="outside right upper")
-    return fig
-
-
-# -- the result objects' .plot() ---------------------------------------------------------------
-
-def _held_out_temperatures(predictions):
-    return sorted({p.temperature for p in predictions if is_held_out(p.role)})
-
-
-@styled
-def fit_figure(fit, validation=None, paper=False):
-    """An identification result (FitResult or its dict with ``model``): measured vs predicted and
-    residual RMS (when ``validation`` of its model on the data is given), and its thermal law(s)
-    with the per-temperature estimates and intervals."""
-    from ..models import Model
-    from ..models.model import model_from_dict
-    d = fit.to_dict() if hasattr(fit, "to_dict") else fit
-    model = fit.model if isinstance(getattr(fit, "model", None), Model) else model_from_dict(d["model"])
-    laws = list(model.laws)
-    model_ii = isinstance(model.thermal, ModelII)
-    law_panels = len(laws) + (1 if model_ii else 0)
-    rows = (1 if validation is not None else 0) + (1 if law_panels else 0)
-    if rows == 0:
-        raise ValueError("nothing to plot: this fit has no thermal law; give its validation on the data "
-                         "(fit.plot(data)) to see measured against predicted")
-    fig, _ = new_figure(WIDE, 3.7 * rows + 0.3, none=True)
-    subs = fig.subfigures(rows, 1, squeeze=False)[:, 0] if rows > 1 else [fig]
-    held = []
-    k = 0
-    if validation is not None:
-        preds = list(validation.predictions)
-        held = _held_out_temperatures(preds)
-        styles = temperature_styles([(p.temperature, p.role) for p in preds])
-        sub = subs[k]
-        k += 1
-        a = sub.subplots(1, 2)
-        draw_displacement(a[0], preds, styles)
-        a[0].set_title("measured (markers) and predicted (lines)")
-        draw_residuals(a[1], preds, styles)
-        a[1].set_title("residual RMS over 2 % windows of the run")
-        temperature_key(sub, styles, extra=[_noise_handle()])
-    if law_panels:
-        sub = subs[k]
-        a = sub.subplots(1, max(law_panels, 2) if rows > 1 else law_panels, squeeze=False)[0]
-        for ax, n in zip(a, laws):
-            draw_law(ax, d, model, n, held, paper)
-        if model_ii:
-            draw_dF(a[len(laws)], d, model, held_out=held, paper=paper)
-        for ax in a[law_panels:]:
-            ax.set_visible(False)
-        handles = {}
-        for ax in a[:law_panels]:
-            for h, lab in zip(*ax.get_legend_handles_labels()):
-                handles.setdefault(lab, h)
-        sub.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
-    return fig
-
-
 @styled
 def simulation_figure(result, what=None):
     """A simulation result against time: input, displacement, friction force, and the temperature
@@ -605,6 +356,5 @@ def simulation_figure(result, what=None):
     return fig
 
 
-__all__ = ["STYLE", "displacement_figure", "residual_figure", "error_figure", "steps_figure", "laws_figure",
-           "model_ii_figure", "fit_figure", "simulation_figure", "law_outside_intervals", "temperature_styles",
-           "window_rms"]
+__all__ = ["STYLE", "displacement_figure", "residual_figure", "error_figure", "steps_figure", "simulation_figure",
+           "temperature_styles", "window_rms"]

@@ -7,19 +7,23 @@ import html
 
 import numpy as np
 
-from .page import Figures, _fmt, _plt, _table, _write_page
+from .._lazy import lazy
+from .page import Figures, fmt_number, html_table, page_styled, subplots, write_page
 
+matplotlib = lazy("matplotlib")
+
+
+@page_styled
 def heating_report(runs, path, *, figures_dir=None, title=None, command=None) -> str:
     """Writes an HTML report of long heated runs: ``runs`` is a list of dicts with ``label``,
     ``result`` (a HeatingResult, the prediction with self-heating), optionally ``reference`` (the
     full simulation on the same grid) and ``constant`` (the displacement predicted at the start
     temperature, on the same grid). Figures: temperature rise, step-size drift, and the error of
     the constant-temperature prediction; a table of the figures that matter."""
-    plt = _plt()
     figs = Figures(figures_dir)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     parts = []
-    fig, ax = plt.subplots(figsize=(7, 3.4))
+    fig, ax = subplots(figsize=(7, 3.4))
     for i, r in enumerate(runs):
         res = r["result"]
         ax.plot(res.time, res.temperature, color=colors[i % len(colors)], label=r["label"])
@@ -30,7 +34,7 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
     ax.legend()
     temp_fig = figs.render(fig, "heating_temperature", "Temperature of the friction interface (lines: two-time-scale "
                            "method; dotted: the full simulation through every cycle).")
-    fig, ax = plt.subplots(figsize=(7, 3.4))
+    fig, ax = subplots(figsize=(7, 3.4))
     for i, r in enumerate(runs):
         res = r["result"]
         ax.plot(res.time, res.step_size * 1e6, color=colors[i % len(colors)], label=r["label"])
@@ -41,7 +45,7 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
     ax.set_ylabel("step per cycle [µm]")
     ax.legend()
     step_fig = figs.render(fig, "heating_step_size", "Step size drift as the interface heats (dotted: full simulation).")
-    fig, ax = plt.subplots(figsize=(7, 3.4))
+    fig, ax = subplots(figsize=(7, 3.4))
     rows = []
     for i, r in enumerate(runs):
         res, ref, const = r["result"], r.get("reference"), r.get("constant")
@@ -49,46 +53,46 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
         if const is not None:
             err = (const - truth.displacement) / np.maximum(np.abs(truth.displacement), 1e-300) * 100
             ax.plot(truth.time[1:], err[1:], color=colors[i % len(colors)], label=r["label"])
-        rows.append([r["label"], _fmt(res.temperature[-1] - res.temperature[0], "{:.3g}"),
-                     _fmt(res.step_size[0] * 1e6, "{:.4g}"), _fmt(res.step_size[-1] * 1e6, "{:.4g}"),
-                     _fmt(truth.displacement[-1] * 1e3, "{:.5g}"),
-                     _fmt(None if const is None else (const[-1] - truth.displacement[-1]) * 1e3, "{:+.4g}"),
-                     _fmt(None if ref is None else np.max(np.abs(res.temperature - ref.temperature)), "{:.2g}"),
-                     _fmt(None if ref is None else abs(res.displacement[-1] - ref.displacement[-1])
+        rows.append([r["label"], fmt_number(res.temperature[-1] - res.temperature[0], "{:.3g}"),
+                     fmt_number(res.step_size[0] * 1e6, "{:.4g}"), fmt_number(res.step_size[-1] * 1e6, "{:.4g}"),
+                     fmt_number(truth.displacement[-1] * 1e3, "{:.5g}"),
+                     fmt_number(None if const is None else (const[-1] - truth.displacement[-1]) * 1e3, "{:+.4g}"),
+                     fmt_number(None if ref is None else np.max(np.abs(res.temperature - ref.temperature)), "{:.2g}"),
+                     fmt_number(None if ref is None else abs(res.displacement[-1] - ref.displacement[-1])
                           / abs(ref.displacement[-1]) * 100, "{:.2g}"),
-                     _fmt(res.stats.get("seconds"), "{:.3g}"),
-                     _fmt(None if ref is None else ref.stats.get("seconds"), "{:.3g}")])
+                     fmt_number(res.stats.get("seconds"), "{:.3g}"),
+                     fmt_number(None if ref is None else ref.stats.get("seconds"), "{:.3g}")])
     ax.set_xlabel("time [s]")
     ax.set_ylabel("constant-temperature error [%]")
     ax.set_yscale("symlog", linthresh=1.0)
     ax.legend()
     err_fig = figs.render(fig, "heating_constant_temperature_error", "Error of the displacement predicted at the "
                           "start temperature (no self-heating), relative to the prediction with self-heating.")
-    parts.append("<section><h2>Summary</h2>" + _table(
+    parts.append("<section><h2>Summary</h2>" + html_table(
         ["run", "temperature rise [K]", "first step [µm]", "last step [µm]", "displacement [mm]",
          "constant-T error [mm]", "max |ΔT| vs full [K]", "displacement error vs full [%]",
          "two-time-scale [s]", "full [s]"], rows) + "</section>")
     parts.append("<section><h2>Temperature</h2>" + temp_fig + "</section>")
     parts.append("<section><h2>Step size</h2>" + step_fig + err_fig + "</section>")
-    return _write_page(path, title or "thermofriction — self-heating", ", ".join(r["label"] for r in runs), parts,
+    return write_page(path, title or "thermofriction — self-heating", ", ".join(r["label"] for r in runs), parts,
                        command)
 
 
+@page_styled
 def control_report(rows, path, *, figures_dir=None, title=None, command=None) -> str:
     """Writes an HTML report of thermofriction.control.compare_compensation's rows: the table of RMS
     and maximum tracking errors per reference, stage temperature and compensation, and for each
     reference the tracking error over time at the hottest temperature."""
-    plt = _plt()
     figs = Figures(figures_dir)
-    table = [[r["reference"], _fmt(r["temperature"], "{:.1f}"), r["compensation"], _fmt(r["rms_error"] * 1e6, "{:.3g}"),
-              _fmt(r["max_error"] * 1e6, "{:.3g}")] for r in rows]
-    parts = ["<section><h2>Tracking error</h2>" + _table(
+    table = [[r["reference"], fmt_number(r["temperature"], "{:.1f}"), r["compensation"], fmt_number(r["rms_error"] * 1e6, "{:.3g}"),
+              fmt_number(r["max_error"] * 1e6, "{:.3g}")] for r in rows]
+    parts = ["<section><h2>Tracking error</h2>" + html_table(
         ["reference", "stage T [°C]", "compensation", "RMS error [µm]", "max error [µm]"], table) +
         "<p style='font-size:13px;color:#4a5266'>Blind: the compensation's model is told the calibration "
         "temperature (30 °C); aware: the measured temperature.</p></section>"]
     hottest = max(r["temperature"] for r in rows)
     for i, name in enumerate(dict.fromkeys(r["reference"] for r in rows)):
-        fig, ax = plt.subplots(figsize=(7, 3.4))
+        fig, ax = subplots(figsize=(7, 3.4))
         for r in rows:
             if r["reference"] == name and r["temperature"] == hottest:
                 res = r["result"]
@@ -100,7 +104,7 @@ def control_report(rows, path, *, figures_dir=None, title=None, command=None) ->
         parts.append("<section><h2>" + html.escape(name) + "</h2>" + figs.render(
             fig, f"control_error_{i}", f"Tracking error at {hottest:g} °C, {name}: no compensation, and "
             f"feed-forward or observer compensation, temperature-blind or temperature-aware.") + "</section>")
-    return _write_page(path, title or "thermofriction — friction compensation", "closed-loop tracking", parts, command)
+    return write_page(path, title or "thermofriction — friction compensation", "closed-loop tracking", parts, command)
 
 
 
