@@ -239,14 +239,19 @@ def velocity_lag(time, position, velocity, max_lag: float = MAX_LAG):
     a = a - a.mean()
     b = v - v.mean()
     n = a.size
-    norm = math.sqrt(float(a @ a) * float(b @ b))
-    if n < 4 or norm == 0:
+    if n < 4 or not (np.any(a) and np.any(b)):
         return 0.0, 0.0, 0.0
     k_max = max(1, min(n // 4, int(round(max_lag / dt))))
     size = 1 << int(math.ceil(math.log2(2 * n)))
     r = np.fft.irfft(np.fft.rfft(b, size) * np.conj(np.fft.rfft(a, size)), size)  # r[k] = sum_j b[j + k] a[j]
     lags = np.arange(-k_max, k_max + 1)
-    c = r[lags % size] / norm
+    # each lag normalised by the energies of its own overlap (j and j + k both in the record): a correlation
+    # coefficient at every lag, without the taper of a plain sum that pulls the peak towards lag 0
+    ca, cb = np.concatenate([[0.0], np.cumsum(a * a)]), np.concatenate([[0.0], np.cumsum(b * b)])
+    lo_a, hi_a = np.maximum(0, -lags), n - np.maximum(0, lags)
+    ea, eb = ca[hi_a] - ca[lo_a], cb[hi_a + lags] - cb[lo_a + lags]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = np.nan_to_num(r[lags % size] / np.sqrt(ea * eb))
     i = int(np.argmax(c))
     frac = 0.0
     if 0 < i < c.size - 1:
