@@ -343,14 +343,14 @@ def choose_motion(path, time, position, velocity, motion: str = "auto", headers=
 def quantum(values, tolerance: float = 0.05, share: float = 0.9) -> float | None:
     """The step of a quantised signal (a firmware's fixed-point velocity, an encoder's counts), or None when
     it is not quantised. The step is the median of the spacings of its distinct values that are single steps
-    (below 1.5 times the smallest spacing); the signal is quantised when it takes fewer distinct values than
-    half its samples and ``share`` of those spacings are whole multiples of the step (up to 20) to within
-    ``tolerance`` steps. (Spacings rather than a global lattice: a logger's float32 numbers, or counts scaled
+    (below 1.5 times the smallest spacing); the signal is quantised when ``share`` of those spacings are whole
+    multiples of the step (up to 20) to within ``tolerance`` steps (a continuous signal's smallest spacing is
+    far below its typical one, which then is no small multiple of it). (Spacings rather than a global lattice: a logger's float32 numbers, or counts scaled
     by a gear ratio, drift off any one lattice by a fraction of a step over thousands of steps.)"""
     a = np.asarray(values, float)
     a = a[np.isfinite(a)]
     u = np.unique(a)
-    if u.size < 3 or u.size > a.size // 2:
+    if u.size < 3:
         return None
     span = float(u[-1] - u[0])
     d = np.diff(u)
