@@ -119,6 +119,9 @@ def test_motion_in_the_manifest_per_dataset_and_per_experiment(tmp_path):
                                                                            "motion": "auto"}]}))
     with pytest.raises(InputError, match=r"\[\[experiment\]\] 1: 'motion' applies to force experiments only"):
         tf.load_dataset(tmp_path)
+    (folder / "dataset.toml").write_text(meta.replace('motion = "position"', 'struct = "run1"'))
+    with pytest.raises(InputError, match=r"\[\[experiment\]\] 2: 'struct' applies to MATLAB files \(.mat\) only"):
+        _quiet_load(folder)
 
 
 def test_save_dataset_keeps_the_motion(tmp_path):

@@ -18,7 +18,7 @@ from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
 from .force import ForceExperiment, check_motion_option, force_experiment, is_force_data, is_force_file, units_of
-from .matlab import is_matlab
+from .matlab import force_mat_variables, is_matlab, read_force_mat
 from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
@@ -178,6 +178,10 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
         if force_cols is not None or is_force_file(folder / f):  # measured motion and friction: data/force.py
             if inp is not None:
                 raise InputError(f"{where}: 'input' does not apply to a force experiment (its motion is measured)")
+            for key in ("struct", "units"):
+                if force_cols is None and key in e:
+                    raise InputError(f"{where}: '{key}' applies to MATLAB files (.mat) only; a CSV file declares its "
+                                     f"units in its header")
             exps.append(force_experiment(folder / f, f, temperature=T, role=role, description=desc,
                                          from_zero=_from_zero, struct=e.get("struct"), columns=force_cols,
                                          **opts))
@@ -252,7 +256,6 @@ def _units_where(path, where):
 
 def _read_force_mat(path: Path, entry: dict, where: str):
     """A MATLAB file's force experiment columns (data/matlab.py: read_force_mat), or None for an actuator's."""
-    from .matlab import read_force_mat
     struct, units = _mat_options(entry, where)
     with _units_where(path, where):
         return read_force_mat(path, struct=struct, units=units)
@@ -338,7 +341,6 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
             mat = {}  # MATLAB file -> its variables, written once all its runs are in
             for e in dataset.experiments:
                 if isinstance(e, ForceExperiment) and _is_mat(e.file):
-                    from .matlab import force_mat_variables
                     if e.struct:
                         mat.setdefault(e.file, {})[e.struct] = force_mat_variables(e)
                     else:
