@@ -17,7 +17,8 @@ torque ripple periodic in the position (cogging, gear mesh). What the logger add
 
 ``lookalike_runs(...)`` returns the runs (arrays and their truth); ``write_dataset(folder, runs)`` writes a
 dataset folder (rad, rad/s, N m, one CSV per run and dataset.toml); ``lookalike_dataset(folder, ...)`` does
-both. Every default is a measured number (tests/data/README.md), so ``lookalike_runs()`` looks like the
+both; ``lookalike_experiments(...)`` makes a thermofriction Dataset in memory (no files), loaded as a folder
+would be (the motion chosen, the sign checked). Every default is a measured number (tests/data/README.md), so ``lookalike_runs()`` looks like the
 OpenArm/CICESE logs; tests set what they study.
 """
 
@@ -30,6 +31,9 @@ from pathlib import Path
 import numpy as np
 import tomli_w
 from scipy.integrate import solve_ivp
+
+from thermofriction.data.experiments import Dataset
+from thermofriction.data.force import force_experiment
 
 
 @dataclasses.dataclass(frozen=True)
@@ -192,3 +196,19 @@ def lookalike_dataset(folder, *, velocity=True, manifest_extra=None, entry_extra
     runs = lookalike_runs(**params)
     return write_dataset(folder, runs, velocity=velocity, manifest_extra=manifest_extra,
                          entry_extra=entry_extra), runs
+
+
+def lookalike_experiments(*, motion="auto", flip_sign=False, **params):
+    """(a thermofriction Dataset of ForceExperiments in memory, the runs): :func:`lookalike_runs` with
+    ``params``, each run read as a dataset's force experiment would be (``motion`` chosen, ``flip_sign``
+    applied, the sign checked), without files."""
+    runs = lookalike_runs(**params)
+    exps = []
+    for k, r in enumerate(runs):
+        columns = {"time": r.time, "position": r.position, "velocity": r.velocity, "force": r.force,
+                   "rotary": True, "headers": {"time": "time[s]", "position": "position[rad]",
+                                               "velocity": "velocity[rad/s]", "force": "friction_torque[N*m]"}}
+        exps.append(force_experiment(f"lookalike run{k}", f"run{k}.csv", temperature=r.temperature, role=r.role,
+                                     description="look-alike (tests/lookalike.py)", from_zero=lambda t, i: (t, i),
+                                     motion=motion, flip_sign=flip_sign, columns=columns))
+    return Dataset(name="lookalike", experiments=exps), runs

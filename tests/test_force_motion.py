@@ -248,6 +248,11 @@ def test_force_matlab_variables_in_other_units(tmp_path):
     np.testing.assert_allclose(e.displacement, x, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(e.velocity, v, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(e.force, F, rtol=1e-12, atol=1e-15)
+    bad = F.copy()
+    bad[4] = np.nan
+    scipy.io.savemat(tmp_path / "r.mat", {"time": t, "position_rad": x, "friction_torque_N_m": bad})
+    with pytest.raises(InputError, match=r"r.mat: variable 'friction_torque_N_m', element 5: not a finite number"):
+        tf.load_dataset(tmp_path)
     scipy.io.savemat(tmp_path / "r.mat", {"time": t, "friction_force_N": F})
     with pytest.raises(InputError, match=r"r.mat: a force experiment needs the motion: a position\[...\].*"
                                          r"position_rad"):
@@ -293,3 +298,16 @@ def test_lookalike_has_the_character_it_was_given():
     pos = np.median(r.true_force[fast & (r.true_velocity > 0)] - 0.1 * r.true_velocity[fast & (r.true_velocity > 0)])
     neg = np.median(r.true_force[fast & (r.true_velocity < 0)] - 0.1 * r.true_velocity[fast & (r.true_velocity < 0)])
     assert abs(pos - 0.363) < 0.02 and abs(neg + 0.406) < 0.02
+
+
+def test_lookalike_experiments_in_memory_are_loaded_as_files_are(tmp_path):
+    """The in-memory look-alike dataset has the same numbers and the same motion choice as the same runs
+    written to files and loaded (to the CSV's 12 digits)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MotionWarning)
+        data, runs = L.lookalike_experiments(offsets=(0.01, 0.02), lag=0.07, seed=4)
+        files = tf.load_dataset(L.write_dataset(tmp_path / "d", runs))
+    for a, b in zip(data.experiments, files.experiments):
+        assert a.motion_source == b.motion_source == "position"
+        for name in ("time", "displacement", "velocity", "force"):
+            np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-11, atol=1e-12, err_msg=name)

@@ -120,7 +120,9 @@ class MotionCheck:
             out.append(f"it {'lags' if self.lag > 0 else 'leads'} the position's derivative by "
                        f"{abs(self.lag) * 1e3:.3g} ms ({abs(self.lag_samples):.3g} sampling intervals; the limit is "
                        f"{LAG_LIMIT:g})")
-        if not abs(self.scale - 1.0) <= SCALE_TOLERANCE:
+        if not math.isfinite(self.scale):
+            out.append("its scale against the derivative cannot be measured")
+        elif not abs(self.scale - 1.0) <= SCALE_TOLERANCE:
             out.append(f"its scale is {self.scale:.4g} times the derivative's (more than {100 * SCALE_TOLERANCE:g} % "
                        f"off)")
         return out
