@@ -136,18 +136,26 @@ def test_bad_files_get_one_clear_message(tmp_path, header, rows, message):
 
 
 def test_a_velocity_in_the_wrong_unit_is_an_error(tmp_path):
-    """The position checks the velocity: deg/s written as rad/s (57 times too fast) is refused, a small
-    disagreement warned about."""
+    """The position checks the velocity: deg/s written as rad/s (57 times too fast) is refused at loading,
+    naming the scale; a velocity 20 % off is warned about (motion "auto" then drives by the position);
+    motion = "position" ignores the column, whatever its unit."""
+    from thermofriction.data.force import MotionWarning
     t, x, v, F = _sine_rows(200)
-    p = _write(tmp_path / "u.csv", "time[s],position[rad],velocity[rad/s],friction_torque[N*m]",
-               np.column_stack([t, x, np.degrees(v), F]))
+    _write(tmp_path / "u.csv", "time[s],position[rad],velocity[rad/s],friction_torque[N*m]",
+           np.column_stack([t, x, np.degrees(v), F]))
+    _dataset(tmp_path, ["u.csv"])
     with pytest.raises(InputError, match=r"u.csv: the velocity column velocity\[rad/s\], integrated over time, "
-                                         r"departs from the position column position\[rad\] by .*check the units"):
-        read_force_csv(p)
-    p = _write(tmp_path / "w.csv", "time[s],position[rad],velocity[rad/s],friction_torque[N*m]",
-               np.column_stack([t, x, 1.2 * v, F]))
-    with pytest.warns(SamplingWarning, match="departs from the position"):
-        read_force_csv(p)
+                                         r"departs from the position column position\[rad\] by .*57.\d+ times "
+                                         r"the position's derivative.*check the units"):
+        tf.load_dataset(tmp_path)
+    exp = tf.load_dataset(tmp_path, motion="position").experiments[0]
+    assert exp.motion_source == "position"
+    _write(tmp_path / "u.csv", "time[s],position[rad],velocity[rad/s],friction_torque[N*m]",
+           np.column_stack([t, x, 1.2 * v, F]))
+    with pytest.warns(MotionWarning, match=r"u.csv: the velocity column velocity\[rad/s\] is not the position's "
+                                           r"derivative: its scale is 1.2\d* times.*the position drives the model"):
+        exp = tf.load_dataset(tmp_path).experiments[0]
+    assert exp.motion_source == "position"
 
 
 def test_datasets_do_not_mix_kinds_or_units(tmp_path):

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import tomllib
@@ -13,15 +14,19 @@ import tomli_w
 
 from .._io import atomic_write
 from .._reading import read_text
-from ..errors import InputError, unknown_keys
+from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
-from .force import ForceExperiment, force_experiment, is_force_data, is_force_file, units_of
+from .force import ForceExperiment, check_motion_option, force_experiment, is_force_data, is_force_file, units_of
+from .matlab import force_mat_variables, is_matlab, read_force_mat
 from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
-_MANIFEST_KEYS = ("name", "description", "experiment")
-_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units")
+_MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "experiment")
+_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units", "motion", "flip_sign")
+#: the manifest's keys that apply to force experiments only (data/force.py), at the top (every experiment)
+#: or in an [[experiment]] entry
+_FORCE_KEYS = ("motion", "flip_sign")
 
 
 def _is_inside(f: str) -> bool:
@@ -63,10 +68,28 @@ def _from_zero(time, inp):
     return time - t0, inp
 
 
-def load_dataset(path) -> Dataset:
+def _force_options(table: dict, where: str, defaults: dict) -> dict:
+    """The force experiments' options (``motion``, ``flip_sign``) of a manifest table, over ``defaults``."""
+    out = dict(defaults)
+    if "motion" in table:
+        out["motion"] = check_motion_option(table["motion"], where)
+    if "flip_sign" in table:
+        if not isinstance(table["flip_sign"], bool):
+            raise InputError(f"{where}: 'flip_sign' must be true or false, got {shorten(table['flip_sign'])}")
+        out["flip_sign"] = table["flip_sign"]
+    return out
+
+
+def load_dataset(path, *, motion: str | None = None) -> Dataset:
     """Reads a dataset folder (docs/formats.md): ``dataset.toml`` and the experiment files it lists,
     all checked; any problem is one InputError naming the file (and its line, column or
-    ``[[experiment]] N`` entry)."""
+    ``[[experiment]] N`` entry).
+
+    motion: what drives the models of force experiments, "auto", "position" or "velocity"
+        (docs/force-data.md#the-motion-that-drives-the-model); given, it overrides the manifest's ``motion``
+        keys; None: the manifest's, else "auto"."""
+    if motion is not None:
+        check_motion_option(motion, "motion")
     folder = Path(path)
     if folder.is_dir():
         manifest = folder / "dataset.toml"
@@ -103,6 +126,7 @@ def load_dataset(path) -> Dataset:
     description = meta.get("description", "")
     if not isinstance(description, str):
         raise InputError(f"{manifest}: 'description' must be a string, got {description!r}")
+    options = _force_options(meta, str(manifest), {"motion": "auto", "flip_sign": False})
     entries = meta.get("experiment")
     if entries is None:
         raise InputError(f"{manifest}: no [[experiment]] entries (a dataset needs at least one)")
@@ -147,12 +171,25 @@ def load_dataset(path) -> Dataset:
                 inp = parse_waveform(e["input"])
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
-        if is_force_file(folder / f):  # measured motion and friction force (torque): data/force.py
+        opts = _force_options(e, where, options)
+        if motion is not None:
+            opts["motion"] = motion
+        force_cols = _read_force_mat(folder / f, e, where) if is_matlab(folder / f) else None
+        if force_cols is not None or is_force_file(folder / f):  # measured motion and friction: data/force.py
             if inp is not None:
                 raise InputError(f"{where}: 'input' does not apply to a force experiment (its motion is measured)")
+            for key in ("struct", "units"):
+                if force_cols is None and key in e:
+                    raise InputError(f"{where}: '{key}' applies to MATLAB files (.mat) only; a CSV file declares its "
+                                     f"units in its header")
             exps.append(force_experiment(folder / f, f, temperature=T, role=role, description=desc,
-                                         from_zero=_from_zero))
+                                         from_zero=_from_zero, struct=e.get("struct"), columns=force_cols,
+                                         **opts))
             continue
+        for key in _FORCE_KEYS:
+            if key in e or key in meta:
+                raise InputError(f"{where if key in e else manifest}: '{key}' applies to force experiments only "
+                                 f"({f} records a voltage and a displacement)")
         cols, headers = _read_experiment(folder / f, e, where)
         for column in ("displacement", "stage_displacement"):  # a parser reads any numbers; a dataset is physics
             if column in cols:
@@ -191,17 +228,37 @@ def _read_experiment(path: Path, entry: dict, where: str):
                                  f"units in its header")
         cols, headers = read_experiment_csv(path, with_headers=True)
         return cols, {k: (f"column {h}", h.partition("[")[2].rstrip("]")) for k, h in headers.items()}
+    struct, units = _mat_options(entry, where)
+    with _units_where(path, where):
+        return read_experiment_mat(path, struct=struct, units=units, with_headers=True)
+
+
+def _mat_options(entry: dict, where: str):
+    """A MATLAB file's manifest options, 'struct' and 'units', checked."""
     struct, units = entry.get("struct"), entry.get("units")
     if struct is not None and (not isinstance(struct, str) or not struct.isidentifier()):
         raise InputError(f"{where}: 'struct' must be the name of a struct variable in {entry['file']}, got {struct!r}")
     if units is not None and not isinstance(units, dict):
         raise InputError(f"{where}: 'units' must be a table such as {{ displacement = \"um\" }}, got {units!r}")
+    return struct, units
+
+
+@contextlib.contextmanager
+def _units_where(path, where):
+    """An error in the manifest's 'units' table named by its [[experiment]] entry."""
     try:
-        return read_experiment_mat(path, struct=struct, units=units, with_headers=True)
+        yield
     except InputError as err:
         if str(err).startswith(f"{path}: units:"):  # the manifest's table: say where it is
             raise InputError(f"{where}: {str(err)[len(str(path)) + 2:]}") from None
         raise
+
+
+def _read_force_mat(path: Path, entry: dict, where: str):
+    """A MATLAB file's force experiment columns (data/matlab.py: read_force_mat), or None for an actuator's."""
+    struct, units = _mat_options(entry, where)
+    with _units_where(path, where):
+        return read_force_mat(path, struct=struct, units=units)
 
 
 def check_dataset_folder(folder, overwrite=False, hint="overwrite=True"):
@@ -283,9 +340,14 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
             entries = []
             mat = {}  # MATLAB file -> its variables, written once all its runs are in
             for e in dataset.experiments:
+                if isinstance(e, ForceExperiment) and _is_mat(e.file):
+                    if e.struct:
+                        mat.setdefault(e.file, {})[e.struct] = force_mat_variables(e)
+                    else:
+                        mat[e.file] = force_mat_variables(e)
+                    entries.append(_entry(e))
+                    continue
                 if isinstance(e, ForceExperiment):  # measured motion and friction: its own columns
-                    if _is_mat(e.file):
-                        raise InputError(f"{e.file}: force experiments are written as CSV files only; name it .csv")
                     unit = ("rad", "rad/s", "friction_torque[N*m]") if e.rotary else ("m", "m/s", "friction_force[N]")
                     cols = {"time[s]": e.time, f"position[{unit[0]}]": e.displacement}
                     if e.velocity is not None:
@@ -374,6 +436,8 @@ def _entry(e) -> dict:
         entry["description"] = e.description
     if e.input is not None and not isinstance(e, ForceExperiment):  # a force run's motion is its record
         entry["input"] = e.input.spec()
+    if isinstance(e, ForceExperiment) and e.velocity is not None:  # what drove it, as it was loaded
+        entry["motion"] = e.motion_source
     return entry
 
 

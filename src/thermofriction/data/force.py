@@ -1,17 +1,31 @@
 """Force and torque experiments (docs/force-data.md): a measured motion and the friction force or torque it
-produced, read from CSV files whose headers give the units, linear (m, N) or rotary (rad, N m).
+produced, read from CSV files whose headers give the units, linear (m, N) or rotary (rad, N m), or from MATLAB
+files (data/matlab.py: read_force_mat) with the same columns.
 
-The motion drives a prescribed-motion model. A ``velocity`` column drives it when given (the position is then
-only checked against it); otherwise the velocity is estimated from the position (``numpy.gradient``, second
-order on irregular samples). Either way the driving waveform is a piecewise-linear position whose slope is the
-sample's own velocity within half an interval of each sample (:func:`motion_waveform`), so that the model sees
-at each sample time exactly the velocity measured there, with no half-sample lag.
+**The motion that drives the model** (``motion = "auto" | "position" | "velocity"``, the dataset's option): with
+"auto" (the default) a ``velocity`` column drives the model when it is the position's derivative -- the lag
+between them (cross-correlation, sub-sample) at most LAG_LIMIT samples, their scales within SCALE_TOLERANCE, their
+correlation at least MIN_CORRELATION (:func:`check_motion`); otherwise, and without a velocity column, the
+position's derivative does (``numpy.gradient``, second order on irregular samples), with a MotionWarning giving
+the numbers. Either way the driving waveform is a piecewise-linear position whose slope is the sample's own
+velocity within half an interval of each sample (:func:`motion_waveform`), so that the model sees at each sample
+time exactly the velocity used there, with no half-sample lag.
+
+**Sign convention**: the friction column has the sign of the velocity in sliding (the force or torque that the
+drive spends against friction). A column that opposes the motion (a reaction-torque sensor) is refused at loading
+(:func:`check_sign`); ``flip_sign = true`` in the manifest reads it negated.
+
+**Velocity resolution**: a quantised velocity (a firmware's fixed steps) makes static friction models chatter at
+rest when their ``v_smooth`` is far below a step; :func:`velocity_resolution` estimates the step and
+:func:`with_v_smooth` sets a model's ``v_smooth`` from it.
 """
 
 from __future__ import annotations
 
 import csv
 import dataclasses
+import functools
+import math
 import warnings
 from pathlib import Path
 
@@ -48,31 +62,110 @@ MARKERS = ("friction_force", "friction_torque", "position", "velocity")
 #: A sampling interval this many times the median one is a gap in the record (warned about).
 GAP_RATIO = 10.0
 #: The integrated velocity may depart from the recorded position by this fraction of the position's range
-#: before a warning; by POSITION_MISMATCH_ERROR (a wrong unit in a header, typically) it is an error.
-POSITION_MISMATCH_WARN = 0.05
+#: before it is an error (a wrong unit in a header, typically), unless the position drives the model.
 POSITION_MISMATCH_ERROR = 0.5
 EXAMPLE = "time[s],position[rad],velocity[rad/s],friction_torque[N*m]"
+
+#: What drives the model: "auto" (the velocity column where it is the position's derivative, else the
+#: position), "position" (its derivative, the velocity column ignored), "velocity" (the column, as it is).
+MOTIONS = ("auto", "position", "velocity")
+#: "auto" rejects a velocity column lagging (or leading) the position's derivative by more than this many
+#: sampling intervals ...
+LAG_LIMIT = 1.0
+#: ... or whose scale departs from the derivative's by more than this fraction ...
+SCALE_TOLERANCE = 0.05
+#: ... or whose correlation with the derivative (at the best lag) is below this.
+MIN_CORRELATION = 0.5
+#: The lag search spans at most this long either way [s] (and a quarter of the record).
+MAX_LAG = 2.0
+#: The sign check: sliding samples are those faster than this fraction of the 95th percentile speed; a
+#: friction column whose sign (the offset removed) opposes the velocity's on at least OPPOSED_FRACTION of them
+#: is refused.
+SLIDING_FRACTION = 0.05
+OPPOSED_FRACTION = 0.75
+#: with_v_smooth: v_smooth = this many velocity steps (the data resolve no slower sliding than one step).
+V_SMOOTH_STEPS = 1.0
 
 
 class SamplingWarning(UserWarning):
     """A force experiment's record has a gap, or its velocity and position disagree."""
 
 
+class MotionWarning(SamplingWarning):
+    """A velocity column is not the position's derivative (lag, scale or shape): the numbers and the motion
+    that drives the model."""
+
+
+@dataclasses.dataclass(frozen=True)
+class MotionCheck:
+    """How a velocity column compares with the position's derivative (:func:`check_motion`).
+
+    ``lag`` [s]: how late the column is (positive: it lags the derivative); ``lag_samples``: the same in median
+    sampling intervals; ``scale``: the column over the derivative (1 for the same quantity in the same unit);
+    ``correlation``: their correlation coefficient at that lag."""
+
+    lag: float
+    lag_samples: float
+    scale: float
+    correlation: float
+
+    @property
+    def problems(self) -> list:
+        """Why the column is not the position's derivative, as phrases ([] when it is)."""
+        out = []
+        if not self.correlation >= MIN_CORRELATION:
+            out.append(f"it correlates with the position's derivative only at r = {self.correlation:.2f} "
+                       f"(below {MIN_CORRELATION:g})")
+        if not abs(self.lag_samples) <= LAG_LIMIT:
+            out.append(f"it {'lags' if self.lag > 0 else 'leads'} the position's derivative by "
+                       f"{abs(self.lag) * 1e3:.3g} ms ({abs(self.lag_samples):.3g} sampling intervals; the limit is "
+                       f"{LAG_LIMIT:g})")
+        if not math.isfinite(self.scale):
+            out.append("its scale against the derivative cannot be measured")
+        elif not abs(self.scale - 1.0) <= SCALE_TOLERANCE:
+            out.append(f"its scale is {self.scale:.4g} times the derivative's (more than {100 * SCALE_TOLERANCE:g} % "
+                       f"off)")
+        return out
+
+    @property
+    def agrees(self) -> bool:
+        return not self.problems
+
+
 @dataclasses.dataclass(eq=False)
 class ForceExperiment(Experiment):
     """One run of measured motion and measured friction, in SI units: ``displacement`` is the position [m or
-    rad], ``force`` the friction force or torque [N or N m], ``velocity`` the recorded velocity (None when
-    the position drives the model), ``rotary`` whether the units are angles and torques. ``input`` is the
+    rad], ``force`` the friction force or torque [N or N m] (sign convention: that of the velocity in sliding),
+    ``velocity`` the recorded velocity column (None without one), ``rotary`` whether the units are angles and
+    torques. ``motion`` is what drives the model, "velocity" (the column) or "position" (its derivative); None
+    means the column where there is one. ``motion_check`` compares the column with the position's derivative
+    (:class:`MotionCheck`; None without a column or when ``motion = "position"`` was asked). ``input`` is the
     motion waveform that drives a prescribed-motion model (:func:`motion_waveform`); ``voltage`` is None."""
 
     force: np.ndarray | None = None
     velocity: np.ndarray | None = None
     rotary: bool = False
+    motion: str | None = None
+    motion_check: MotionCheck | None = None
+
+    @property
+    def motion_source(self) -> str:
+        """"velocity" or "position": what drives the model."""
+        if self.motion is not None:
+            return self.motion
+        return "velocity" if self.velocity is not None else "position"
 
     @property
     def drive_velocity(self) -> np.ndarray:
         """The velocity the model is driven with at the sample times."""
-        return _velocity(self.time, self.displacement, self.velocity)
+        return _velocity(self.time, self.displacement, self.velocity if self.motion_source == "velocity" else None)
+
+    @functools.cached_property
+    def velocity_resolution(self) -> float | None:
+        """The step of the driving velocity [m/s or rad/s] where it is quantised, else None
+        (:func:`velocity_resolution`)."""
+        return velocity_resolution(self.time, self.displacement,
+                                   self.velocity if self.motion_source == "velocity" else None)
 
     @property
     def force_unit(self) -> str:
@@ -125,6 +218,216 @@ def motion_waveform(time, velocity) -> Sampled:
     return Sampled(knots, values)
 
 
+# -- the velocity column against the position ----------------------------------------------------
+
+def _uniform(time, *signals):
+    """The signals linearly interpolated onto a uniform grid at the median sampling interval: (dt, arrays)."""
+    t = np.asarray(time, float)
+    dt = float(np.median(np.diff(t)))
+    n = int(math.floor((t[-1] - t[0]) / dt)) + 1
+    tu = t[0] + dt * np.arange(n)
+    return dt, [np.interp(tu, t, np.asarray(s, float)) for s in signals]
+
+
+def velocity_lag(time, position, velocity, max_lag: float = MAX_LAG):
+    """How late ``velocity`` is on the position's derivative: (lag [s], lag in median sampling intervals,
+    correlation coefficient at that lag). Both signals are interpolated onto a uniform grid at the median
+    interval, the derivative taken there by central differences (no lag of its own); the lag is the peak of
+    their cross-correlation within ``max_lag`` either way (and a quarter of the record), refined to a fraction
+    of an interval by a parabola through the peak and its neighbours. A positive lag means the column comes
+    late: velocity(t) ~ d position/dt (t - lag)."""
+    dt, (x, v) = _uniform(time, position, velocity)
+    a = np.gradient(x, dt)
+    a = a - a.mean()
+    b = v - v.mean()
+    n = a.size
+    if n < 4 or not (np.any(a) and np.any(b)):
+        return 0.0, 0.0, 0.0
+    k_max = max(1, min(n // 4, int(round(max_lag / dt))))
+    size = 1 << int(math.ceil(math.log2(2 * n)))
+    r = np.fft.irfft(np.fft.rfft(b, size) * np.conj(np.fft.rfft(a, size)), size)  # r[k] = sum_j b[j + k] a[j]
+    lags = np.arange(-k_max, k_max + 1)
+    # each lag normalised by the energies of its own overlap (j and j + k both in the record): a correlation
+    # coefficient at every lag, without the taper of a plain sum that pulls the peak towards lag 0
+    ca, cb = np.concatenate([[0.0], np.cumsum(a * a)]), np.concatenate([[0.0], np.cumsum(b * b)])
+    lo_a, hi_a = np.maximum(0, -lags), n - np.maximum(0, lags)
+    ea, eb = ca[hi_a] - ca[lo_a], cb[hi_a + lags] - cb[lo_a + lags]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = np.nan_to_num(r[lags % size] / np.sqrt(ea * eb))
+    i = int(np.argmax(c))
+    frac = 0.0
+    if 0 < i < c.size - 1:
+        den = c[i - 1] - 2 * c[i] + c[i + 1]
+        if den < 0:
+            frac = float(np.clip(0.5 * (c[i - 1] - c[i + 1]) / den, -0.5, 0.5))
+    k = float(lags[i]) + frac
+    return k * dt, k, float(c[i])
+
+
+def velocity_scale(time, position, velocity, lag: float = 0.0, window: int = 5) -> float:
+    """The velocity column's scale on the position's derivative: the position's increments over ``window``
+    samples regressed on the column's integral over the same spans (trapezoidal, shifted by ``lag``), with a
+    constant; the scale is one over the slope. Integrating averages the column's quantisation and noise out;
+    the position's noise enters the response only, so it biases nothing (a regression on the differentiated
+    position would be biased low by it), and the constant takes up a bias of the column (a drift that the
+    whole record's integral would accumulate)."""
+    t = np.asarray(time, float)
+    x = np.asarray(position, float)
+    v = np.asarray(velocity, float)
+    V = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(t) * (v[:-1] + v[1:]))])
+    keep = (t + lag >= t[0]) & (t + lag <= t[-1])
+    ts, xs = t[keep], x[keep]
+    Vs = np.interp(ts + lag, t, V)
+    m = max(1, min(int(window), ts.size // 4))
+    dx, dV = xs[m:] - xs[:-m], Vs[m:] - Vs[:-m]
+    if dV.size < 3 or not np.ptp(dV) > 0:
+        return math.nan
+    A = np.column_stack([dV - dV.mean(), np.ones(dV.size)])
+    slope = float(np.linalg.lstsq(A, dx, rcond=None)[0][0])
+    return 1.0 / slope if slope != 0 else math.inf
+
+
+def check_motion(time, position, velocity) -> MotionCheck:
+    """The velocity column against the position's derivative: lag, scale and correlation (:class:`MotionCheck`)."""
+    lag, lag_samples, corr = velocity_lag(time, position, velocity)
+    return MotionCheck(lag=lag, lag_samples=lag_samples, scale=velocity_scale(time, position, velocity, lag),
+                       correlation=corr)
+
+
+def check_motion_option(value, where: str) -> str:
+    """``value`` as a motion option, or one InputError naming ``where``."""
+    if value not in MOTIONS:
+        raise InputError(f"{where}: 'motion' must be one of {', '.join(repr(m) for m in MOTIONS)}, got "
+                         f"{shorten(value)}")
+    return value
+
+
+def choose_motion(path, time, position, velocity, motion: str = "auto", headers=None):
+    """What drives the model of one experiment: ("velocity" | "position", the MotionCheck or None). With
+    "auto" a velocity column drives it when it agrees with the position's derivative; a column that does not
+    is named with its numbers in one MotionWarning. A column that, integrated, departs from the position by
+    more than POSITION_MISMATCH_ERROR of its range is an InputError (a wrong unit, typically) unless the
+    position was asked for."""
+    motion = check_motion_option(motion, str(path))
+    if velocity is None:
+        if motion == "velocity":
+            raise InputError(f"{path}: motion = \"velocity\" asks for a velocity column, and the file has none")
+        return "position", None
+    if motion == "position":
+        return "position", None
+    head = headers or {}
+    vname, xname = head.get("velocity", "velocity"), head.get("position", "position")
+    t, x, v = (np.asarray(a, float) for a in (time, position, velocity))
+    span = float(np.ptp(x))
+    moved = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(t) * (v[:-1] + v[1:]))])
+    dev = float(np.max(np.abs(moved - (x - x[0])))) if span > 0 else 0.0
+    check = check_motion(t, x, v)
+    if span > 0 and dev > POSITION_MISMATCH_ERROR * span:
+        raise InputError(f"{path}: the velocity column {vname}, integrated over time, departs from the position "
+                         f"column {xname} by {dev / span:.3g} of the position's range (the velocity is "
+                         f"{check.scale:.4g} times the position's derivative): check the units in the header, or "
+                         f"give motion = \"position\" to drive the model from the position alone")
+    if check.agrees:
+        return "velocity", check
+    problems = "; ".join(check.problems)
+    if motion == "velocity":
+        warnings.warn(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; it "
+                      f"drives the model as asked (motion = \"velocity\")", MotionWarning, stacklevel=3)
+        return "velocity", check
+    warnings.warn(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; the "
+                  f"position drives the model (motion = \"auto\"; motion = \"velocity\" uses the column as it is)",
+                  MotionWarning, stacklevel=3)
+    return "position", check
+
+
+# -- quantisation ----------------------------------------------------------------------------------
+
+def quantum(values, tolerance: float = 0.05, share: float = 0.9) -> float | None:
+    """The step of a quantised signal (a firmware's fixed-point velocity, an encoder's counts), or None when
+    it is not quantised. The step is the median of the spacings of its distinct values that are single steps
+    (below 1.5 times the smallest spacing); the signal is quantised when ``share`` of those spacings are whole
+    multiples of the step (up to 20) to within ``tolerance`` steps (a continuous signal's smallest spacing is
+    far below its typical one, which then is no small multiple of it). (Spacings rather than a global lattice: a logger's float32 numbers, or counts scaled
+    by a gear ratio, drift off any one lattice by a fraction of a step over thousands of steps.)"""
+    a = np.asarray(values, float)
+    a = a[np.isfinite(a)]
+    u = np.unique(a)
+    if u.size < 3:
+        return None
+    span = float(u[-1] - u[0])
+    d = np.diff(u)
+    d = d[d > 1e-9 * span]
+    if not d.size:
+        return None
+    q = float(np.median(d[d < 1.5 * d.min()]))
+    k = d / q
+    whole = (np.abs(k - np.round(k)) <= tolerance) & (k < 20.5)
+    return q if float(np.mean(whole)) >= share else None
+
+
+def velocity_resolution(time, position, velocity=None) -> float | None:
+    """The resolution of the velocity that drives a model [m/s or rad/s]: the step of a quantised velocity
+    column; without one (the position drives), the position's step over the median sampling interval, the
+    smallest velocity its derivative resolves. None when neither is quantised."""
+    if velocity is not None:
+        return quantum(velocity)
+    qx = quantum(position)
+    if qx is None:
+        return None
+    return qx / float(np.median(np.diff(np.asarray(time, float))))
+
+
+def v_smooth_for(experiments, steps: float = V_SMOOTH_STEPS) -> float | None:
+    """The sign smoothing ``v_smooth`` the data support: ``steps`` times the coarsest velocity resolution of the
+    experiments (a dataset or a list), None when no experiment's velocity is quantised."""
+    res = [e.velocity_resolution for e in getattr(experiments, "experiments", experiments)
+           if getattr(e, "velocity_resolution", None) is not None]
+    return steps * max(res) if res else None
+
+
+def with_v_smooth(model, experiments, steps: float = V_SMOOTH_STEPS):
+    """``model`` with its friction's ``v_smooth`` set from the data (:func:`v_smooth_for`), never below the
+    model's own; the model unchanged when the data's velocity is not quantised or the friction model has no
+    ``v_smooth``."""
+    value = v_smooth_for(experiments, steps)
+    current = getattr(model.friction, "v_smooth", None)
+    if value is None or current is None or value <= current:
+        return model
+    return model.with_friction(v_smooth=value)
+
+
+# -- sign convention -------------------------------------------------------------------------------
+
+def check_sign(path, velocity, force, column: str = "friction_force"):
+    """Refuses a friction column that opposes the motion: over the sliding samples (faster than
+    SLIDING_FRACTION of the 95th percentile speed), ``force - b`` has the sign opposite to the velocity's on at
+    least OPPOSED_FRACTION of them and the fitted level c of ``force = b + c sgn(v)`` is negative (b, the
+    sensor's offset, fitted where the motion goes both ways, else 0)."""
+    v = np.asarray(velocity, float)
+    F = np.asarray(force, float)
+    speed = np.abs(v)
+    top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
+    sliding = speed > SLIDING_FRACTION * top
+    if not top > 0 or int(sliding.sum()) < 10:
+        return
+    s, f = np.sign(v[sliding]), F[sliding]
+    if np.any(s > 0) and np.any(s < 0):
+        (b, c), *_ = np.linalg.lstsq(np.column_stack([np.ones(s.size), s]), f, rcond=None)
+    else:
+        b, c = 0.0, float(np.mean(s * f))
+    tol = 1e-9 * float(np.max(np.abs(f)))  # (a constant column's rounding is no sign)
+    opposed = float(np.mean((f - b) * s < -tol))
+    if c < -1e3 * tol and opposed >= OPPOSED_FRACTION:
+        raise InputError(f"{path}: the {column} column opposes the motion: on {100 * opposed:.0f} % of the "
+                         f"{s.size} sliding samples its sign (offset {b:.4g} removed) is the opposite of the "
+                         f"velocity's (level {c:.4g}). thermofriction reads friction with the sign of the velocity "
+                         f"(the force the drive spends against it); a reaction sensor measures the opposite: give "
+                         f"flip_sign = true in the experiment's [[experiment]] entry of dataset.toml (or at the top "
+                         f"of it, for every experiment) to read the column negated")
+
+
+# -- files -----------------------------------------------------------------------------------------
+
 def is_force_file(path) -> bool:
     """Whether the CSV's header names a column of a force experiment (read from its first line only)."""
     import os
@@ -139,6 +442,13 @@ def is_force_file(path) -> bool:
     return any(m in names for m in MARKERS)
 
 
+def column_key(name: str) -> str:
+    """The key of a force file's column in the columns read (:func:`read_force_csv`)."""
+    if name == "displacement":
+        return "position"
+    return "force" if name in ("friction_force", "friction_torque") else name
+
+
 def _parse_header(path, header):
     cols, kinds = [], {}
     for j, raw in enumerate(header):
@@ -150,8 +460,7 @@ def _parse_header(path, header):
         if unit not in _UNITS[name]:
             raise InputError(f"{where} ({shorten(cell)}): unknown unit {shorten(unit)} for {name} "
                              f"(one of: {', '.join(u for u in _UNITS[name] if u not in ('μm', 'Nm', 'N m', 'mNm', 'mN m'))})")
-        key = "position" if name == "displacement" else name
-        key = "force" if name in ("friction_force", "friction_torque") else key
+        key = column_key(name)
         for k, c in enumerate(cols):
             if c[0] == key:
                 raise InputError(f"{where}: {shorten(cell)} duplicates column {k + 1} ({c[2]})")
@@ -159,28 +468,82 @@ def _parse_header(path, header):
         if kind is not None:
             kinds[cell] = kind
         cols.append((key, scale, cell))
-    names = [c[0] for c in cols]
+    check_force_columns_present(path, [c[0] for c in cols], "line 1: ", EXAMPLE)
+    return cols, units_kind(path, kinds, "line 1: ")
+
+
+def check_force_columns_present(path, names, where: str, example: str):
+    """The columns a force experiment needs (``names``: the keys of :func:`column_key`), or one InputError."""
     if "force" not in names:
-        raise InputError(f"{path}: line 1: no friction_force[N] or friction_torque[N*m] column: a force experiment "
-                         f"records the friction it measures (e.g. {EXAMPLE})")
+        raise InputError(f"{path}: {where}no friction_force[N] or friction_torque[N*m] column: a force experiment "
+                         f"records the friction it measures (e.g. {example})")
     missing = [n for n in ("time", "position") if n not in names]
     if missing:
         what = "the motion: a position[...] (or displacement[...]) column" if "position" in missing else "time[s]"
-        raise InputError(f"{path}: line 1: a force experiment needs {what}"
-                         f"{' and time[s]' if len(missing) > 1 else ''} (e.g. {EXAMPLE})")
+        raise InputError(f"{path}: {where}a force experiment needs {what}"
+                         f"{' and time[s]' if len(missing) > 1 else ''} (e.g. {example})")
+
+
+def units_kind(path, kinds: dict, where: str) -> bool:
+    """Whether the columns' units (``kinds``: label -> "linear" | "rotary") are rotary; a mix is an error."""
     if len(set(kinds.values())) > 1:
         lin = [c for c, k in kinds.items() if k == "linear"]
         rot = [c for c, k in kinds.items() if k == "rotary"]
-        raise InputError(f"{path}: line 1: mixed linear ({', '.join(lin)}) and rotary ({', '.join(rot)}) units: a "
+        raise InputError(f"{path}: {where}mixed linear ({', '.join(lin)}) and rotary ({', '.join(rot)}) units: a "
                          f"linear experiment records m, m/s and N; a rotary one rad, rad/s and N*m")
-    return cols, set(kinds.values()) == {"rotary"}
+    return set(kinds.values()) == {"rotary"}
+
+
+def check_force_values(path, out: dict, where, where_row):
+    """The rules of every force experiment on its columns in SI units (``out``: key -> array): finite values
+    within the limits, at least MIN_SAMPLES rows, time strictly increasing (a gap of more than GAP_RATIO
+    median intervals warned about), plausible temperatures. ``where(key, row)`` says where a value is (CSV: line
+    and column; MATLAB: variable and element), ``where_row(row)`` where a row is."""
+    from ..plausible import kelvin_hint
+    from .experiments import TEMPERATURE_RANGE
+    first = [(int(np.argmax(~np.isfinite(a))), k, key) for k, (key, a) in enumerate(out.items())
+             if not np.isfinite(a).all()]
+    if first:  # the first bad value row by row, as a reader meets it
+        r, _, key = min(first)
+        raise InputError(f"{path}: {where(key, r)}: not a finite number")
+    n = out["time"].size
+    if n < MIN_SAMPLES:
+        raise InputError(f"{path}: {n} data row{'s' if n != 1 else ''}; an experiment needs at least {MIN_SAMPLES}")
+    for key, a in out.items():
+        lim = TIME_LIMIT if key == "time" else VALUE_LIMIT
+        big = np.abs(a) > lim
+        if big.any():
+            raise InputError(f"{path}: {where(key, int(np.argmax(big)))}: beyond the limit of {lim:g} in magnitude")
+    t = out["time"]
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        i = int(np.argmax(dt <= 0))
+        raise InputError(f"{path}: {where('time', i + 1)}: time must increase strictly ({t[i + 1]:.10g} s after "
+                         f"{t[i]:.10g} s on {where_row(i)})")
+    med = float(np.median(dt))
+    gaps = np.flatnonzero(dt > GAP_RATIO * med)
+    if gaps.size:
+        i = int(gaps[np.argmax(dt[gaps])])
+        warnings.warn(f"{path}: {where_row(i + 1)}: a gap of {dt[i]:.4g} s in the record, "
+                      f"{dt[i] / med:.0f} times the typical interval of {med:.4g} s ({gaps.size} such gap"
+                      f"{'s' if gaps.size > 1 else ''}); the motion is interpolated linearly across it",
+                      SamplingWarning, stacklevel=3)
+    if "temperature" in out:
+        lo, hi = TEMPERATURE_RANGE
+        T = out["temperature"]
+        badT = (T < lo) | (T > hi)
+        if badT.any():
+            i = int(np.argmax(badT))
+            raise InputError(f"{path}: {where('temperature', i)}: {T[i]:g} C is not a plausible temperature "
+                             f"(expected {lo:g} to {hi:g} C{kelvin_hint(float(T[i]))})")
 
 
 def read_force_csv(path) -> dict:
     """Reads one force (torque) experiment CSV into SI arrays: a dict with ``time``, ``position``, ``force``,
-    ``rotary`` and, where given, ``velocity`` and ``temperature``. Any problem is one InputError naming the
-    file, line and column. Irregular sampling is accepted (time must increase strictly); a gap of more than
-    GAP_RATIO times the median interval is a SamplingWarning."""
+    ``rotary``, ``headers`` (key -> the header cell) and, where given, ``velocity`` and ``temperature``. Any
+    problem is one InputError naming the file, line and column. Irregular sampling is accepted (time must
+    increase strictly); a gap of more than GAP_RATIO times the median interval is a SamplingWarning. The
+    velocity is not compared with the position here (:func:`choose_motion` does, at loading)."""
     path = Path(path)
     raw = read_experiment_bytes(path)
     try:
@@ -199,76 +562,28 @@ def read_force_csv(path) -> dict:
     if not body.strip():
         raise InputError(f"{path}: no data rows (only the header)")
     arr = _scan(path, body, cols)
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        r, j = (int(v) for v in np.argwhere(bad)[0])
-        raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cols[j][2]}): not a finite number")
-    n = arr.shape[0]
-    if n < MIN_SAMPLES:
-        raise InputError(f"{path}: {n} data row{'s' if n != 1 else ''}; an experiment needs at least {MIN_SAMPLES}")
+    index = {c[0]: j for j, c in enumerate(cols)}
     out = {name: arr[:, j] * scale for j, (name, scale, _) in enumerate(cols)}
-    for j, (name, _, cell) in enumerate(cols):
-        lim = TIME_LIMIT if name == "time" else VALUE_LIMIT
-        big = np.abs(out[name]) > lim
-        if big.any():
-            r = int(np.argmax(big))
-            raise InputError(f"{path}: line {_line_of(body, r)}, column {j + 1} ({cell}): beyond the limit of "
-                             f"{lim:g} in magnitude")
-    jt = [c[0] for c in cols].index("time")
-    t = out["time"]
-    dt = np.diff(t)
-    if np.any(dt <= 0):
-        i = int(np.argmax(dt <= 0))
-        raise InputError(f"{path}: line {_line_of(body, i + 1)}, column {jt + 1} ({cols[jt][2]}): time must increase "
-                         f"strictly ({t[i + 1]:.10g} s after {t[i]:.10g} s on line {_line_of(body, i)})")
-    med = float(np.median(dt))
-    gaps = np.flatnonzero(dt > GAP_RATIO * med)
-    if gaps.size:
-        i = int(gaps[np.argmax(dt[gaps])])
-        warnings.warn(f"{path}: line {_line_of(body, i + 1)}: a gap of {dt[i]:.4g} s in the record, "
-                      f"{dt[i] / med:.0f} times the typical interval of {med:.4g} s ({gaps.size} such gap"
-                      f"{'s' if gaps.size > 1 else ''}); the motion is interpolated linearly across it",
-                      SamplingWarning, stacklevel=2)
-    if "temperature" in out:
-        from ..plausible import kelvin_hint
-        from .experiments import TEMPERATURE_RANGE
-        lo, hi = TEMPERATURE_RANGE
-        T = out["temperature"]
-        badT = (T < lo) | (T > hi)
-        if badT.any():
-            i = int(np.argmax(badT))
-            jT = [c[0] for c in cols].index("temperature")
-            raise InputError(f"{path}: line {_line_of(body, i)}, column {jT + 1}: {T[i]:g} C is not a plausible "
-                             f"temperature (expected {lo:g} to {hi:g} C{kelvin_hint(float(T[i]))})")
-    if "velocity" in out:
-        _check_consistency(path, t, out["position"], out["velocity"], rotary, cols)
+
+    def where(key, row):
+        j = index[key]
+        return f"line {_line_of(body, row)}, column {j + 1} ({cols[j][2]})"
+
+    check_force_values(path, out, where, lambda row: f"line {_line_of(body, row)}")
     out["rotary"] = rotary
     out["headers"] = {c[0]: c[2] for c in cols}
     return out
 
 
-def _check_consistency(path, t, x, v, rotary, cols):
-    """The recorded velocity, integrated, against the recorded position."""
-    span = float(np.ptp(x))
-    moved = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(t) * (v[:-1] + v[1:]))])
-    if span <= 0:
-        return
-    dev = float(np.max(np.abs(moved - (x - x[0]))))
-    if dev <= POSITION_MISMATCH_WARN * span:
-        return
-    head = {c[0]: c[2] for c in cols}
-    message = (f"{path}: the velocity column {head['velocity']}, integrated over time, departs from the position "
-               f"column {head['position']} by {dev / span:.3g} of the position's range")
-    if dev > POSITION_MISMATCH_ERROR * span:
-        raise InputError(f"{message}: check the units in the header (the velocity drives the model; the position "
-                         f"is only checked against it)")
-    warnings.warn(f"{message} (the velocity drives the model)", SamplingWarning, stacklevel=3)
-
-
-def force_experiment(path, name, *, temperature, role, description, from_zero) -> ForceExperiment:
-    """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it); ``temperature``
-    is the manifest's (None: the column's mean); ``from_zero`` moves a clock time to start at zero."""
-    cols = read_force_csv(path)
+def force_experiment(path, name, *, temperature, role, description, from_zero, motion: str = "auto",
+                     flip_sign: bool = False, struct=None, columns=None) -> ForceExperiment:
+    """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it; ``struct``: the
+    MATLAB struct holding the run); ``temperature`` is the manifest's (None: the column's
+    mean); ``from_zero`` moves a clock time to start at zero; ``motion`` chooses what drives the model
+    (:func:`choose_motion`); ``flip_sign`` negates the friction column (a reaction sensor); the friction's sign
+    is then checked (:func:`check_sign`). ``columns``: the file's columns when already read (a MATLAB file's,
+    data/matlab.py: read_force_mat); None reads ``path`` as a CSV file."""
+    cols = read_force_csv(path) if columns is None else columns
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
     if temperature is None:
@@ -276,11 +591,16 @@ def force_experiment(path, name, *, temperature, role, description, from_zero) -
             raise InputError(f"{path}: no temperature: give 'temperature' in the manifest or a temperature[C] column")
         temperature = float(np.mean(sig))
     v = cols.get("velocity")
-    drive_v = _velocity(t, cols["position"], v)
+    F = -cols["force"] if flip_sign else cols["force"]
+    source, check = choose_motion(path, t, cols["position"], v, motion, cols.get("headers"))
+    drive_v = _velocity(t, cols["position"], v if source == "velocity" else None)
+    column = cols.get("headers", {}).get("force", "friction_torque" if cols["rotary"] else "friction_force")
+    if not flip_sign:
+        check_sign(path, drive_v, F, column)
     return ForceExperiment(file=name, time=t, voltage=None, displacement=cols["position"], temperature=temperature,
                            temperature_signal=sig, role=role, description=description,
-                           input=motion_waveform(t, drive_v), force=cols["force"], velocity=v,
-                           rotary=cols["rotary"])
+                           input=motion_waveform(t, drive_v), force=F, velocity=v, rotary=cols["rotary"],
+                           struct=struct, motion=source, motion_check=check)
 
 
 def write_force_csv(path, time, position, force, *, velocity=None, temperature=None, rotary=False):
@@ -302,5 +622,7 @@ def write_force_csv(path, time, position, force, *, velocity=None, temperature=N
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 
 
-__all__ = ["ForceExperiment", "SamplingWarning", "read_force_csv", "force_experiment", "is_force_file",
-           "is_force_data", "units_of", "motion_waveform", "write_force_csv", "GAP_RATIO"]
+__all__ = ["ForceExperiment", "SamplingWarning", "MotionWarning", "MotionCheck", "MOTIONS", "read_force_csv",
+           "force_experiment", "is_force_file", "is_force_data", "units_of", "motion_waveform", "write_force_csv",
+           "GAP_RATIO", "velocity_lag", "velocity_scale", "check_motion", "choose_motion", "quantum",
+           "velocity_resolution", "v_smooth_for", "with_v_smooth", "check_sign"]

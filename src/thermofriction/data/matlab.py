@@ -19,6 +19,8 @@ import numpy as np
 
 from ..errors import InputError, shorten
 from .experiments import _SI, _UNITS, MIN_SAMPLES, REQUIRED, max_rows, MAX_ROWS_ENV
+from . import force
+from .force import EXAMPLE, check_force_columns_present, check_force_values, column_key, units_kind
 
 #: longest first, so that stage_displacement_um is not read as a "displacement" with unit "stage..."
 _COLUMNS = sorted(_UNITS, key=len, reverse=True)
@@ -256,5 +258,135 @@ def save_results_mat(document: dict, path):
     save_mat(path, {re.sub(r"\W", "_", k): results_to_mat(v, table=k == "parameters") for k, v in document.items()})
 
 
-__all__ = ["read_experiment_mat", "is_matlab", "simulation_to_mat", "save_mat", "save_results_mat", "results_to_mat",
+# -- force (torque) experiments -------------------------------------------------------------------
+
+def _force_suffixes() -> dict:
+    """column -> {variable suffix: unit} for force experiments: the CSV units as ``matlab_name`` spells them
+    (``N*m`` -> ``N_m``, ``rad/s`` -> ``rad_per_s``), ASCII only."""
+    out = {}
+    for name, units in force._UNITS.items():
+        out[name] = {matlab_name(f"x[{u}]")[2:]: u for u in units if u.isascii()}
+    return out
+
+
+def _force_column_of(variable: str, suffixes: dict):
+    """(column, unit or None for an unknown suffix, the suffix) that a variable's name declares, or None."""
+    for name in sorted(suffixes, key=len, reverse=True):
+        if variable == name:
+            return name, force._SI[name], ""
+        if variable.startswith(name + "_"):
+            suffix = variable[len(name) + 1:]
+            return name, suffixes[name].get(suffix), suffix
+    return None
+
+
+def _run_variables(path, variables: dict, struct):
+    """The run's variables (the file's, or the fields of struct ``struct``) and how to name one."""
+    if struct is None:
+        return variables, "variable"
+    if struct not in variables:
+        found = ", ".join(sorted(variables)) or "none"
+        raise InputError(f"{path}: no variable '{struct}' (the manifest's 'struct'; variables: {found})")
+    s = variables[struct]
+    if not (isinstance(s, np.ndarray) and s.dtype.names):
+        raise InputError(f"{path}: variable '{struct}': must be a struct (the manifest's 'struct' names one), "
+                         f"got {'a ' + s.dtype.name + ' array' if isinstance(s, np.ndarray) else shorten(s)}")
+    if s.size != 1:
+        raise InputError(f"{path}: variable '{struct}': must be one struct, got a "
+                         f"{'x'.join(map(str, s.shape))} struct array (give each run its own struct)")
+    rec = s.reshape(-1)[0]
+    return {name: rec[name] for name in s.dtype.names}, f"struct '{struct}', field"
+
+
+def read_force_mat(path, struct: str | None = None, units: dict | None = None, *, variables=None) -> dict | None:
+    """Reads one force (torque) experiment from a MATLAB file into SI arrays, as
+    :func:`thermofriction.data.force.read_force_csv` does from a CSV file: a dict with ``time``, ``position``,
+    ``force``, ``rotary``, ``headers`` and, where present, ``velocity`` and ``temperature``. The vectors are
+    named as the CSV columns with the unit a suffix (``time``, ``position_rad``, ``velocity_deg_per_s``,
+    ``friction_torque_N_m``, ``friction_force_mN``, ``temperature``; no suffix: SI), the file's variables or
+    the fields of struct ``struct``; ``units`` gives units of variables without a suffix (the manifest's table).
+
+    Returns None when the run holds no force variable (a ``friction_force`` or ``friction_torque``, or a
+    ``position`` or ``velocity`` without a ``voltage``): an actuator's run, for :func:`read_experiment_mat`.
+    ``variables``: the file's variables when already loaded."""
+    FORCE_UNITS = force._UNITS
+    path = Path(path)
+    if variables is None:
+        variables = {k: v for k, v in _load(path).items() if not k.startswith("__")}
+    run, origin = _run_variables(path, variables, struct)
+    suffixes = _force_suffixes()
+    columns = {v: c for v in run if (c := _force_column_of(v, suffixes)) is not None}
+    names = {c[0] for c in columns.values()}
+    voltage = any((column_of(v) or ("",))[0] == "voltage" for v in run)
+    if not ({"friction_force", "friction_torque"} & names or ({"position", "velocity"} & names and not voltage)):
+        return None
+    units = dict(units or {})
+    for name, unit in units.items():
+        if name not in FORCE_UNITS:
+            raise InputError(f"{path}: units: unknown column '{shorten(name)}' (columns: {', '.join(FORCE_UNITS)})")
+        if not isinstance(unit, str) or unit not in FORCE_UNITS[name]:
+            raise InputError(f"{path}: units: unknown unit {shorten(unit)} for {name} "
+                             f"(one of: {', '.join(u for u in FORCE_UNITS[name] if u.isascii())})")
+    found, odd = {}, {}  # key -> (variable, column, unit); key -> why a variable of its name is not it
+    for var, (name, unit, suffix) in columns.items():
+        key = column_key(name)
+        if unit is None:
+            odd.setdefault(key, f"'{var}': unknown unit suffix {shorten(suffix)} for {name} (one of: "
+                                f"{', '.join(name + '_' + s for s in suffixes[name])})")
+            continue
+        if key in found:
+            raise InputError(f"{path}: {origin} '{var}' and '{found[key][0]}' are both the {key} (give one)")
+        if var == name and name in units:
+            unit = units[name]
+        elif name in units and units[name] != unit:
+            raise InputError(f"{path}: {origin} '{var}' declares {unit}, the manifest's units {units[name]}: "
+                             f"give the unit once")
+        found[key] = (var, name, unit)
+    for key, why in odd.items():
+        if key not in found:
+            raise InputError(f"{path}: {origin} {why}")
+    mat_example = "time, position_rad, velocity_rad_per_s, friction_torque_N_m"
+    check_force_columns_present(path, list(found), f"{'struct ' + repr(struct) + ': ' if struct else ''}",
+                                f"{EXAMPLE}, as MATLAB variables {mat_example}")
+    raw = {key: _vector(path, f"{origin} '{var}'", run[var]) for key, (var, _, _) in found.items()}
+    n = len(raw["time"])
+    for key, a in raw.items():
+        if len(a) != n:
+            raise InputError(f"{path}: {origin} '{found[key][0]}' has {len(a)} values, '{found['time'][0]}' "
+                             f"{n}: the vectors of a run must have one value per sample")
+    limit = max_rows()
+    if n > limit:
+        raise InputError(f"{path}: {n} samples, more than the limit of {limit}: downsample the run, or raise the "
+                         f"limit with the environment variable {MAX_ROWS_ENV}=N")
+    kinds = {}
+    out = {}
+    for key, (var, name, unit) in found.items():
+        scale, kind = FORCE_UNITS[name][unit]
+        if kind is not None:
+            kinds[f"'{var}' ({unit})" if var == name else f"'{var}'"] = kind
+        out[key] = raw[key] * scale
+    rotary = units_kind(path, kinds, "")
+    check_force_values(path, out, lambda key, row: f"{origin} '{found[key][0]}', element {row + 1}",
+                       lambda row: f"element {row + 1}")
+    out["rotary"] = rotary
+    out["headers"] = {key: f"{origin} '{var}'" for key, (var, _, _) in found.items()}
+    return out
+
+
+def force_mat_variables(e) -> dict:
+    """A force experiment as MATLAB variables, SI with the unit a suffix as ``matlab_name`` spells it:
+    ``time``, ``position_rad`` (``position_m``), ``velocity_rad_per_s`` (``velocity_m_per_s``) when recorded,
+    ``friction_torque_N_m`` (``friction_force_N``), ``temperature`` when recorded."""
+    rot = e.rotary
+    out = {"time": np.asarray(e.time, float),
+           "position_rad" if rot else "position_m": np.asarray(e.displacement, float)}
+    if e.velocity is not None:
+        out["velocity_rad_per_s" if rot else "velocity_m_per_s"] = np.asarray(e.velocity, float)
+    out["friction_torque_N_m" if rot else "friction_force_N"] = np.asarray(e.force, float)
+    if e.temperature_signal is not None:
+        out["temperature"] = np.asarray(e.temperature_signal, float)
+    return out
+
+
+__all__ = ["read_experiment_mat", "read_force_mat", "force_mat_variables", "is_matlab", "simulation_to_mat", "save_mat", "save_results_mat", "results_to_mat",
            "matlab_name"]
