@@ -37,7 +37,7 @@ def torque(tmp_path_factory):
 def test_the_data_say_which_measurement_they_are(torque):
     data, *_ = torque
     assert isinstance(measurement_of(data), Force) and measurement_of(data).offset == "shared"
-    assert measurement_of(data, offset=False).offset == "held"
+    assert measurement_of(data, offset=False).offset == "none"
     synthetic = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05)
     assert isinstance(measurement_of(synthetic), Displacement)
     with pytest.raises(tf.InputError, match="mixes force"):
@@ -88,5 +88,44 @@ def test_one_metric_name_in_fit_and_validation_json(torque):
     assert d["unit"] == "N m" and d["measurement"] == "force"
     assert all(e["rmse_offset_removed"] >= 0 for e in v.to_dict()["experiments"])
     held = tf.identify(torque[0], "base", friction="stribeck", offset=False)
-    assert "held" in held.to_dict()["offset_removed"]
+    assert "held" in held.to_dict()["offset_removed"] and held.sensor_offset["policy"] == "none"
     assert held.statistics["dof"] == fit.statistics["dof"] + 1  # a held offset takes no degree of freedom
+
+
+def test_per_experiment_offsets_follow_a_sensor_re_zeroed_between_runs(tmp_path):
+    """A torque estimator re-zeroed per run (offsets 0.05 and 0.35 N m on two fit runs, -0.25 on the held-out one;
+    data by the reference integrator): with one shared offset the fit and the held-out prediction carry the
+    offsets' spread; with per-experiment offsets (nuisance parameters on every run, held-out ones included) both
+    come to the noise, each run's offset is recovered within its interval, and the offsets take their degrees of
+    freedom."""
+    import numpy as np
+    truth = tf.Model(JOINT, tf.Stribeck(fc=0.9, fs=1.4, vs=0.3, sigma2=0.35))
+    folder, sd = make_dataset(tmp_path / "a", truth, temperatures=(35.0, 35.0), validate=(35.0,), offset=0.05,
+                              n=600, duration=2.0)
+    # re-zero the second fit run and the held-out one (a constant added to the torque column)
+    import csv
+    files = sorted(p for p in folder.glob("*.csv"))
+    shifts = {files[1].name: 0.3, files[2].name: -0.3}
+    for f in files[1:]:
+        rows = list(csv.reader(f.open()))
+        k = next(i for i, h in enumerate(rows[0]) if h.startswith("friction_torque"))
+        for r in rows[1:]:
+            r[k] = repr(float(r[k]) + shifts[f.name])
+        with f.open("w", newline="") as fh:
+            csv.writer(fh).writerows(rows)
+    data = tf.load_dataset(folder)
+    shared = tf.identify(data, "base", friction="stribeck")
+    each = tf.identify(data, "base", friction="stribeck", offset="per-experiment")
+    assert shared.rmse > 5 * sd and each.rmse < 1.3 * sd
+    assert each.statistics["dof"] == shared.statistics["dof"] - 1
+    runs = each.sensor_offset["per_experiment"]
+    for r, true in zip(runs, (0.05, 0.35)):
+        assert r["ci95"][0] <= true <= r["ci95"][1], r
+    held = tf.validate(each.model, data, offset="per-experiment")
+    v = [p for p in held.predictions if p.role == "validate"][0]
+    assert v.rmse < 1.3 * sd and abs(v.bias - (each.model.plant.sensor_offset - (0.05 - 0.3))) < 5 * sd / np.sqrt(600)
+    assert "held-out ones included" in held.to_dict()["offset_removed"]
+    plain = tf.validate(each.model, data)
+    assert [p for p in plain.predictions if p.role == "validate"][0].rmse > 0.3
+    with pytest.raises(tf.InputError, match="per-experiment"):
+        tf.identify(tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05), "base", offset="shared")

@@ -133,15 +133,15 @@ class ValidationResult:
                 + (f"<ul>{notes}</ul>" if notes else "") + "</div>")
 
 
-def validate(model: Model, data, experiments=None) -> ValidationResult:
+def validate(model: Model, data, experiments=None, *, offset=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
-    zero; force: with the model's sensor offset). Temperatures outside a law's calibrated range are reported as
-    warnings."""
+    zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
+    it, held-out runs included). Temperatures outside a law's calibrated range are reported as warnings."""
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")
-    measurement = measurement_of(exps)  # asked once
+    measurement = measurement_of(exps, offset=offset)  # asked once
     measurement.check_model(model, exps)
     caught, preds, failures = [], [], []
     for exp in exps:

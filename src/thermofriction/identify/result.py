@@ -188,8 +188,11 @@ class FitResult:
                       f"    data points      = {self.n_points}",
                       f"    rmse             = {amount(self.rmse, self.unit)} ({self.removed} removed)"]
             o = self.sensor_offset
-            if o:
-                how = "fitted, shared by all experiments" if o.get("fitted") else "held (--no-offset)"
+            if o.get("per_experiment"):
+                lines += [f"    sensor offset    = {r['value']:.6g} +- {r['stderr']:.3g} {self.unit} ({r['file']}, "
+                          f"its own)" for r in o["per_experiment"]]
+            elif o:
+                how = "fitted, shared by all experiments" if o.get("fitted") else "held (--offset none)"
                 err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
                 lines.append(f"    sensor offset    = {o['value']:.6g}{err} {self.unit} ({how})")
         if self.fit_quality is not None:

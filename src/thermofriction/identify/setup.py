@@ -101,18 +101,23 @@ def _from_plant_only(init, experiments, rotary):
 
 
 def force_finish(res, experiments, init, measurement):
-    """The fit completed for force data: the sensor offset estimated at the optimum (shared) or the initial
-    model's (held), written into the fitted model; a rotary joint's parameters in its units."""
+    """The fit completed for force data: the sensor offset estimated at the optimum ("shared": one, written into
+    the fitted model; "per-experiment": one per run, their mean written into the model; "none": the initial
+    model's); a rotary joint's parameters in its units."""
     traces = make_traces(experiments, res.model, measurement)
     unit = traces[0].unit
     names = [p.name for p in res.parameters.varying] if res.n_points else []
+    inflation = res.statistics.get("variance_inflation", 1.0)
     if measurement.offset == "shared":
-        est = estimate_offset(res.model, names, traces, res.statistics.get("variance_inflation", 1.0))
-        model = dataclasses.replace(res.model, plant=dataclasses.replace(res.model.plant, sensor_offset=est["value"]))
+        est = estimate_offset(res.model, names, traces, inflation)
+    elif measurement.offset == "per-experiment":
+        runs = [dict(estimate_offset(res.model, names, [tr], inflation), file=tr.name) for tr in traces]
+        est = {"value": float(np.mean([r["value"] for r in runs])), "stderr": None, "ci95": None,
+               "per_experiment": runs}
     else:
         est = {"value": init.plant.sensor_offset, "stderr": 0.0, "ci95": (init.plant.sensor_offset,) * 2}
-        model = res.model
-    est.update(unit=unit, fitted=measurement.offset == "shared")
+    model = dataclasses.replace(res.model, plant=dataclasses.replace(res.model.plant, sensor_offset=est["value"]))
+    est.update(unit=unit, fitted=measurement.offset != "none", policy=measurement.offset)
     if unit == "N m":  # the equations are the same, the numbers mean angles and torques
         for p in res.parameters.values():
             if p.unit and "C" != p.unit:
@@ -128,7 +133,7 @@ def estimate_offset(model: Model, names, traces, variance_inflation=1.0) -> dict
     """The shared offset at ``model`` (``names`` the fitted parameters): the mean of ``F_meas - F_sim`` over
     all traces, and its standard error from the Jacobian augmented with the offset's column of ones (so that
     the parameters' uncertainty is in it)."""
-    plain_measurement = type(traces[0].measurement)("held")
+    plain_measurement = type(traces[0].measurement)("none")
     plain = [dataclasses.replace(tr, measurement=plain_measurement, held_offset=0.0) for tr in traces]
     problem = Problem(model, names, plain, rtol=FD_RTOL, parallel=len(plain) > 1)
     theta = np.array([get_value(model, n) for n in names], float)

@@ -8,8 +8,8 @@ implements :class:`Measurement` and an entry in :data:`REGISTRY`.
 
 from __future__ import annotations
 
-from ..errors import InputError
-from .base import Measurement, MetricWarning, Trace, amount, center
+from ..errors import InputError, shorten
+from .base import OFFSETS, Measurement, MetricWarning, Trace, amount, center
 from .displacement import Displacement, Prediction, step_sizes
 from .force import Force, ForcePrediction, steady_state_curve
 
@@ -23,8 +23,9 @@ def kind_of(exp) -> str:
 
 def measurement_of(data, *, offset=None) -> Measurement:
     """The measurement of ``data`` (a dataset or a list of experiments), with its offset policy: ``offset``
-    None or True for the measurement's default, False to hold the model's own (force data), or a policy's
-    name. A dataset that mixes measurements is refused."""
+    None or True for the measurement's default, a policy's name (OFFSETS: "shared", "per-experiment", "none"),
+    or False for "none" (the model's own offset, fitted by none). A dataset that mixes measurements is
+    refused."""
     exps = list(getattr(data, "experiments", data))
     kinds = {kind_of(e) for e in exps} or {"displacement"}
     if len(kinds) > 1:
@@ -33,8 +34,12 @@ def measurement_of(data, *, offset=None) -> Measurement:
     cls = REGISTRY[kinds.pop()]
     if offset is None or offset is True:
         return cls()
-    return cls("held" if offset is False else offset)
+    if offset is False:
+        offset = "none"
+    if offset not in OFFSETS:
+        raise InputError(f"offset must be one of {', '.join(OFFSETS)}, got {shorten(offset)}")
+    return cls(offset)
 
 
-__all__ = ["Measurement", "MetricWarning", "Trace", "Displacement", "Force", "Prediction", "ForcePrediction",
+__all__ = ["Measurement", "MetricWarning", "Trace", "OFFSETS", "Displacement", "Force", "Prediction", "ForcePrediction",
            "REGISTRY", "measurement_of", "kind_of", "amount", "center", "step_sizes", "steady_state_curve"]

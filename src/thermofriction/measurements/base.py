@@ -36,7 +36,7 @@ class Trace:
     measured_temperature: np.ndarray | None = None
     initial_temperature: float = math.nan
     temperature_weight: float = 1.0
-    #: the offset held where the measurement's policy is "held" (a force sensor's, from the model)
+    #: the offset held where the measurement's policy is "none" (a force sensor's, from the model)
     held_offset: float = 0.0
     #: the SI unit of ``measured``
     unit: str = "m"
@@ -56,14 +56,15 @@ class Measurement:
 
     Attributes: ``name`` (the registry's key and the results' ``measurement``), ``quantity`` (in words),
     ``plants`` (the plant types whose models it is fitted with), ``fit_parameters`` (the default fitted
-    parameters per friction model), ``offset`` (the offset policy: ``"each"``, each run's own zero;
-    ``"shared"``, one fitted offset for all runs; ``"held"``, the model's own)."""
+    parameters per friction model), ``offset`` (the offset policy, OFFSETS: ``"per-experiment"``, each
+    run's own, a nuisance parameter estimated on every run; ``"shared"``, one fitted offset for all runs;
+    ``"none"``, none fitted: the model's own is used)."""
 
     name = ""
     quantity = ""
     plants: tuple = ()
     fit_parameters: dict = {}
-    offset = "each"
+    offset = "per-experiment"
     methods: tuple = ()
 
     # -- identification --------------------------------------------------------------------------
@@ -85,7 +86,7 @@ class Measurement:
 
     def offsets_in(self, traces) -> int:
         """Offsets fitted besides the parameters (the degrees of freedom they take)."""
-        return {"each": len(traces), "shared": int(bool(traces)), "held": 0}[self.offset]
+        return {"per-experiment": len(traces), "shared": int(bool(traces)), "none": 0}[self.offset]
 
     def unit(self, experiments) -> str:
         raise NotImplementedError
@@ -123,6 +124,10 @@ class Measurement:
         raise NotImplementedError
 
 
+#: the offset policies, by the names the API, the command line (--offset) and the JSON use
+OFFSETS = ("shared", "per-experiment", "none")
+
+
 def amount(value: float, unit: str) -> str:
     """A residual or an RMSE in its unit: metres shown in nm, N and N m as they are."""
     return f"{value * 1e9:.4g} nm" if unit == "m" else f"{value:.4g} {unit}"
@@ -137,4 +142,17 @@ def center(r, S=None):
     return r, S
 
 
-__all__ = ["Measurement", "MetricWarning", "Trace", "amount", "center"]
+def center_each(r, S, sizes):
+    """Each run's residuals (and Jacobian rows) about their own mean: one offset per run, profiled out."""
+    r = r.copy()
+    S = None if S is None else S.copy()
+    start = 0
+    for n in sizes:
+        r[start:start + n], seg = center(r[start:start + n], None if S is None else S[start:start + n])
+        if S is not None:
+            S[start:start + n] = seg
+        start += n
+    return r, S
+
+
+__all__ = ["center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center"]

@@ -40,7 +40,7 @@ class Displacement(Measurement):
     quantity = "displacement"
     plants = ("stick-slip",)
     fit_parameters = FIT_PARAMETERS
-    offset = "each"
+    offset = "per-experiment"
     methods = ("plant", "base", "model-i", "model-ii", "heat")
     removed = "each experiment's constant offset"
 
@@ -48,10 +48,10 @@ class Displacement(Measurement):
     def recognises(exp) -> bool:
         return True  # the default: a record of voltage and displacement
 
-    def __init__(self, offset: str = "each"):
-        if offset != "each":
-            raise InputError(f"offset={offset!r} (--no-offset) applies to force data; displacement data remove each "
-                             f"experiment's zero")
+    def __init__(self, offset: str = "per-experiment"):
+        if offset != "per-experiment":
+            raise InputError(f"offset={offset!r} (--offset, --no-offset) applies to force data; displacement data "
+                             f"remove each experiment's zero (per-experiment)")
 
     def unit(self, experiments=()) -> str:
         return "m"
