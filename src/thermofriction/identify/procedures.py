@@ -63,8 +63,11 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
     overall = pooled(qualities, [len(tr.time) for tr in traces])
     measurement, unit = traces[0].measurement, traces[0].unit
     first = []
-    if not overall["adequate"]:
-        bad = [p["file"] for p, q in zip(per, qualities) if not q["adequate"]]
+    if overall["adequate"] is None:
+        first.append(f"adequacy unknown: {overall['why']}; the residuals ({amount(overall['rmse'], unit)}) cannot be "
+                     f"held against it: judge the fit by its error on held-out experiments (validate) instead")
+    elif not overall["adequate"]:
+        bad = [p["file"] for p, q in zip(per, qualities) if q["adequate"] is False]
         first.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
                         f"noise estimated from the data ({amount(overall['rmse'], unit)} against "
                         f"{amount(overall['noise'], unit)}; not adequate in {len(bad)} of {len(per)} experiments): "

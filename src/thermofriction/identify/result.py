@@ -48,8 +48,10 @@ class FitResult:
 
     @property
     def adequate(self) -> bool | None:
-        """Whether the residuals are at the measurement noise (None where not measured)."""
-        return None if self.fit_quality is None else bool(self.fit_quality["adequate"])
+        """Whether the residuals are at the measurement noise (None where not measured, or where the noise cannot
+        be estimated from the data: fit_quality["why"])."""
+        return None if self.fit_quality is None or self.fit_quality["adequate"] is None else \
+            bool(self.fit_quality["adequate"])
 
     @property
     def aicc(self) -> float:
@@ -199,7 +201,7 @@ class FitResult:
             q = self.fit_quality
             lines.append(f"    noise (data)     = {amount(q['noise'], self.unit)}; rmse/noise = {q['ratio']:.3g}, "
                          f"lag-1 autocorrelation {q['autocorrelation']:.2f}, "
-                         f"{'adequate' if q['adequate'] else 'NOT adequate'}")
+                         f"{_verdict(q)}")
         lines += [
                  f"    evaluations      = {self.nfev} (Jacobians {self.njev}), starts = {self.starts}",
                  f"    wall time        = {self.wall_time:.3g} s",
@@ -261,7 +263,7 @@ class FitResult:
         warn = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
         q = self.fit_quality
         quality = "" if q is None else (f", noise {amount(q['noise'], self.unit)}: rmse/noise {q['ratio']:.3g}, "
-                                        f"{'adequate' if q['adequate'] else '<b>NOT adequate</b>'}")
+                                        f"{html.escape(_verdict(q)).replace('NOT adequate', '<b>NOT adequate</b>')}")
         rmse = "" if self.n_points == 0 else f", rmse {amount(self.rmse, self.unit)}"
         prov = self.model.provenance or {}
         origin = (f"<br><small>{html.escape(self.model.name or '')}: data sha256 {html.escape(prov['data_sha256'][:12])}…, "
@@ -271,6 +273,12 @@ class FitResult:
                 f"{rmse}{quality}, {self.wall_time:.3g} s{origin}"
                 f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
                 + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
+
+
+def _verdict(q) -> str:
+    if q["adequate"] is None:
+        return f"adequacy unknown ({q.get('why') or 'the noise cannot be estimated from the data'})"
+    return "adequate" if q["adequate"] else "NOT adequate"
 
 
 # -- provenance (docs/formats.md#provenance) -------------------------------------------------------

@@ -20,22 +20,17 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
 
     cov = s^2 (J^T J)^-1 by SVD of the column-scaled Jacobian; a direction the data do not
     determine (singular value below 1e-9 of the largest) gives the parameters on it an infinite
-    error instead of a falsely tight one. s^2 is inflated by (1 + rho)/(1 - rho), rho the residuals'
-    lag-1 autocorrelation, so that coloured (non-white) residuals do not make the intervals
-    too narrow. Returns the correlation matrix and warnings."""
+    error instead of a falsely tight one. Correlated residuals carry less information than as many
+    independent ones: s^2 is inflated by the residuals' integrated autocorrelation time (n over the
+    effective sample size, :func:`inflation_of`), and the t quantile takes the effective number of degrees of
+    freedom. Returns the correlation matrix and warnings."""
     varying = params.varying
     theta, r, J = outcome.theta, outcome.r, outcome.J
     n, p = J.shape
     dof = max(n - p - traces[0].measurement.offsets_in(traces), 1)
     s2 = float(r @ r) / dof
-    rhos, start = [], 0
-    for tr in traces:
-        seg = r[start:start + tr.n_residuals]
-        start += tr.n_residuals
-        if len(seg) > 3 and np.dot(seg, seg) > 0:
-            rhos.append(float(np.dot(seg[1:], seg[:-1]) / np.dot(seg, seg)))
-    rho = min(max(float(np.mean(rhos)) if rhos else 0.0, 0.0), 0.99)
-    inflation = (1 + rho) / (1 - rho)
+    inflation, rho = inflation_of(r, [tr.n_residuals for tr in traces])
+    dof_eff = max(n / inflation - p - traces[0].measurement.offsets_in(traces), 1.0)
     col = np.linalg.norm(J, axis=0)
     col[col == 0] = 1.0
     U, S, Vt = np.linalg.svd(J / col, full_matrices=False)
@@ -50,7 +45,7 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
         corr = cov / np.outer(se, se)
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
-    tq = float(special.stdtrit(dof, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
+    tq = float(special.stdtrit(dof_eff, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
     warnings = []
     for i, par in enumerate(varying):
         par.value = float(theta[i])
@@ -73,4 +68,45 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
         if not par.unit:
             par.unit = unit_of(model, par.name)
     return corr, warnings, {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho,
-                            "variance_inflation": inflation}
+                            "variance_inflation": inflation, "effective_samples": n / inflation}
+
+
+def integrated_autocorrelation(x) -> float:
+    """The integrated autocorrelation time of the series ``x`` (1 for independent values; (1 + rho)/(1 - rho)
+    for an AR(1) series), by Geyer's initial positive sequence: the autocorrelations summed in pairs
+    rho_2k + rho_2k+1 while the pairs stay positive (past that they are the estimate's own noise)."""
+    x = np.asarray(x, float)
+    x = x - x.mean()
+    n = x.size
+    var = float(x @ x)
+    if n < 4 or var <= 0:
+        return 1.0
+    spectrum = np.fft.rfft(x, 2 * n)
+    acf = np.fft.irfft(spectrum * np.conj(spectrum))[:n] / var
+    tau, k = -1.0, 0
+    while 2 * k + 1 < n:
+        pair = acf[2 * k] + acf[2 * k + 1]
+        if pair <= 0:
+            break
+        tau += 2.0 * pair
+        k += 1
+    return max(tau, 1.0)
+
+
+def inflation_of(r, sizes):
+    """(the variance inflation, the mean lag-1 autocorrelation) of residuals ``r`` made of runs of ``sizes``:
+    each run's integrated autocorrelation time, averaged over the runs by their lengths."""
+    taus, rhos, weights, start = [], [], [], 0
+    for size in sizes:
+        seg = r[start:start + size]
+        start += size
+        if len(seg) > 3 and np.dot(seg, seg) > 0:
+            taus.append(integrated_autocorrelation(seg))
+            rhos.append(float(np.dot(seg[1:], seg[:-1]) / np.dot(seg, seg)))
+            weights.append(len(seg))
+    if not taus:
+        return 1.0, 0.0
+    return float(np.average(taus, weights=weights)), float(np.mean(rhos))
+
+
+__all__ = ["uncertainty", "integrated_autocorrelation", "inflation_of"]

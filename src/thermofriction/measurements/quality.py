@@ -21,6 +21,8 @@ ADEQUATE_RATIO = 2.0
 RESOLUTION = 1e-4
 
 _MAD_TO_SIGMA = 1.0 / 0.6744897501960817  # for a normal distribution
+#: the lag-1 autocorrelation of white noise's second differences
+WHITE_D2 = -2.0 / 3.0
 
 
 def noise_level(x) -> float:
@@ -34,6 +36,29 @@ def noise_level(x) -> float:
     return mad * _MAD_TO_SIGMA / math.sqrt(6.0)
 
 
+def noise_check(x) -> tuple:
+    """Whether :func:`noise_level` can be trusted on the record ``x``: (reliable, why not). Second differences of
+    white noise have a lag-1 autocorrelation of -2/3; a record whose noise is correlated from sample to sample
+    (an estimator's output, a filtered velocity, a command minus a filtered J a) gives up to -1/2 and a noise
+    estimate that is a fraction of the real one (a quarter at a lag-1 autocorrelation of 0.9); a record smooth at
+    the sample scale (no visible noise) gives up to +1; a quantised one mostly zero differences."""
+    x = np.asarray(x, float)
+    if x.size < 20:
+        return False, "the record is too short to estimate its noise"
+    d2 = x[2:] - 2.0 * x[1:-1] + x[:-2]
+    spread = float(np.median(np.abs(d2 - np.median(d2))))
+    if spread == 0.0:
+        return False, ("most of the record's second differences are zero (a quantised or held signal): its noise "
+                       "cannot be estimated from it")
+    clipped = np.clip(d2 - np.median(d2), -5 * _MAD_TO_SIGMA * spread, 5 * _MAD_TO_SIGMA * spread)  # slips aside
+    rho = lag1_autocorrelation(clipped)
+    if rho > WHITE_D2 + max(0.05, 4.0 / math.sqrt(d2.size)):
+        return False, (f"the record's noise is not white at the sample scale (its second differences have a lag-1 "
+                       f"autocorrelation of {rho:.2f}, white noise gives -0.67): a filtered or estimated signal, "
+                       f"whose noise the data cannot tell")
+    return True, ""
+
+
 def lag1_autocorrelation(r) -> float:
     r = np.asarray(r, float)
     r = r - r.mean()
@@ -42,28 +67,40 @@ def lag1_autocorrelation(r) -> float:
 
 
 def fit_quality(residuals, measured, noise: float | None = None) -> dict:
-    """``{"rmse", "noise", "ratio", "autocorrelation", "adequate"}`` for residuals (prediction minus
-    measurement, offset already removed) of the record ``measured``; ``noise`` overrides the
-    estimate (e.g. one pooled over several records)."""
+    """``{"rmse", "noise", "ratio", "autocorrelation", "adequate", "noise_reliable", "why"}`` for residuals
+    (prediction minus measurement, offset already removed) of the record ``measured``; ``noise`` overrides the
+    estimate (e.g. one pooled over several records). ``adequate`` is None (unknown, ``why`` says why) where the
+    noise cannot be estimated from the record (:func:`noise_check`): a ratio to a wrong noise level says
+    nothing about the model."""
     r = np.asarray(residuals, float)
     rmse = float(np.sqrt(np.mean(r ** 2))) if r.size else math.nan
+    reliable, why = (True, "") if noise is not None else noise_check(measured)
     noise = noise_level(measured) if noise is None else float(noise)
     span = float(np.ptp(measured)) if np.size(measured) else 0.0
     ratio = rmse / noise if noise > 0 else math.inf
-    adequate = bool(ratio <= ADEQUATE_RATIO or rmse <= RESOLUTION * span)
+    if rmse <= RESOLUTION * span:
+        adequate = True
+    elif not reliable:
+        adequate = None
+    else:
+        adequate = bool(ratio <= ADEQUATE_RATIO)
     return {"rmse": rmse, "noise": noise, "ratio": ratio, "autocorrelation": lag1_autocorrelation(r),
-            "adequate": adequate}
+            "adequate": adequate, "noise_reliable": reliable, "why": why}
 
 
 def pooled(qualities, sizes) -> dict:
-    """The fit as a whole: RMSE and noise pooled over the experiments (by their numbers of samples),
-    adequate only when every experiment is."""
+    """The fit as a whole: RMSE and noise pooled over the experiments (by their numbers of samples); adequate
+    when every experiment is, not adequate when one is not, else unknown (None, with the first reason)."""
     n = np.asarray(sizes, float)
     rmse = float(np.sqrt(np.sum(n * np.array([q["rmse"] for q in qualities]) ** 2) / n.sum()))
     noise = float(np.sqrt(np.sum(n * np.array([q["noise"] for q in qualities]) ** 2) / n.sum()))
     ac = float(np.sum(n * np.array([q["autocorrelation"] for q in qualities])) / n.sum())
+    verdicts = [q["adequate"] for q in qualities]
+    adequate = False if False in verdicts else None if None in verdicts else True
+    why = next((q.get("why", "") for q in qualities if q["adequate"] is None), "")
     return {"rmse": rmse, "noise": noise, "ratio": rmse / noise if noise > 0 else math.inf, "autocorrelation": ac,
-            "adequate": all(q["adequate"] for q in qualities)}
+            "adequate": adequate, "noise_reliable": all(q.get("noise_reliable", True) for q in qualities),
+            "why": why}
 
 
-__all__ = ["noise_level", "fit_quality", "pooled", "ADEQUATE_RATIO", "RESOLUTION"]
+__all__ = ["noise_level", "noise_check", "lag1_autocorrelation", "fit_quality", "pooled", "ADEQUATE_RATIO", "RESOLUTION"]
