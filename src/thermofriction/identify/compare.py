@@ -14,8 +14,11 @@ from .front import identify
 
 def compare_friction_models(data, kinds=("coulomb", "stribeck", "lugre"), init=None, *, offset=True, **opts) -> dict:
     """Fits each friction model of ``kinds`` (method base) to the fit experiments and predicts the held-out ones:
-    ``{kind: {"aicc", "delta_aicc", "rmse", "heldout_rmse", "n_parameters", "result"}}``, delta_aicc against
-    the best. A model that fails to fit is reported with its reason (``failed``)."""
+    ``{kind: {"aicc", "delta_aicc", "rmse", "heldout_rmse", "n_parameters", "result", "rank", "basis"}}``,
+    delta_aicc against the best, divided by the residuals' integrated autocorrelation time where they are
+    correlated; ``rank`` by ``basis``: AICc, or the held-out RMSE where the residuals are far from white (an
+    autocorrelation time above 2) and every model predicted the held-out runs. A model that fails to fit is
+    reported with its reason (``failed``)."""
     out = {}
     held = list(getattr(data, "validate", []))
     for kind in kinds:
@@ -31,12 +34,22 @@ def compare_friction_models(data, kinds=("coulomb", "stribeck", "lugre"), init=N
             errs = [p.rmse for p in v.predictions]
             entry["heldout_rmse"] = float(np.sqrt(np.mean(np.square(errs)))) if errs else math.nan
         out[kind] = entry
-    fitted = [e["aicc"] for e in out.values() if "aicc" in e and math.isfinite(e["aicc"])]
-    best = min(fitted) if fitted else math.nan
-    for e in out.values():
-        if "aicc" in e:
-            e["delta_aicc"] = e["aicc"] - best
+    fitted = {k: e for k, e in out.items() if "aicc" in e and math.isfinite(e["aicc"])}
+    if not fitted:
+        return out
+    # correlated residuals carry less information than their count: the differences divided by the most general
+    # fit's integrated autocorrelation time (QAIC's overdispersion); far from white, held-out error decides
+    general = max(fitted.values(), key=lambda e: (e["n_parameters"], -e["aicc"]))
+    c = max(general["result"].statistics.get("variance_inflation", 1.0), 1.0)
+    best = min(e["aicc"] for e in fitted.values())
+    by_heldout = c > 2.0 and all(math.isfinite(e["heldout_rmse"]) for e in fitted.values())
+    basis = ("held-out RMSE (the residuals are correlated: c = %.3g)" % c if by_heldout else
+             "AICc" + (" divided by c = %.3g, the residuals' integrated autocorrelation time" % c if c > 1.5 else ""))
+    ranked = sorted(fitted, key=lambda k: fitted[k]["heldout_rmse"] if by_heldout else fitted[k]["aicc"])
+    for k, e in fitted.items():
+        e["delta_aicc"] = (e["aicc"] - best) / c
+        e["basis"] = basis
+        e["rank"] = ranked.index(k) + 1
     return out
-
 
 __all__ = ["compare_friction_models"]

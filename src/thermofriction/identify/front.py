@@ -4,13 +4,14 @@ starts from the right model and runs the method's procedure."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import numbers
 
 import numpy as np
 
 from ..data.experiments import TEMPERATURE_RANGE
-from ..errors import InputError, shorten
-from ..measurements import measurement_of
+from ..errors import InputError, ThermofrictionError, shorten
+from ..measurements import amount, measurement_of
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
@@ -19,6 +20,7 @@ from .plant import fit_plant
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
 from .result import FitResult, stamped
 from .setup import SETUP
+from ..validate import validate
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
@@ -110,7 +112,38 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     else:
         res = identify_model_ii(experiments, init, procedure=procedure, reference_temperature=reference_temperature,
                                 refine=refine, progress=progress, free=free, measurement=measurement, **opts)
-    return finish(res, experiments, init, measurement)
+    res = finish(res, experiments, init, measurement)
+    held = list(getattr(data, "validate", None) or [])
+    return _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
+
+
+#: held-out RMS over fit RMS above which a fit is said not to generalise
+GENERALISATION_WARN = 1.5
+
+
+def _with_generalisation(res, data, held, measurement):
+    """The fit's held-out error where the dataset holds experiments out: the generalisation ratio (held-out RMS
+    over fit RMS, each run's error as validate measures it, with the fit's offset policy) in
+    ``fit_quality["generalisation"]``, and a warning where it is large. It says what the noise estimate
+    cannot when the residuals are correlated."""
+    try:
+        v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None)
+    except ThermofrictionError as e:
+        res.warnings.append(f"the held-out experiments could not be predicted: {e}")
+        return res
+    if not v.predictions:
+        return res
+    heldout = float(np.sqrt(np.mean([p.rmse ** 2 for p in v.predictions])))
+    ratio = heldout / res.rmse if res.rmse > 0 else math.inf
+    res.fit_quality["generalisation"] = {"heldout_rmse": heldout, "fit_rmse": res.rmse, "ratio": ratio,
+                                         "heldout_files": [p.file for p in v.predictions]}
+    if ratio > GENERALISATION_WARN:
+        res.warnings.insert(0, f"the model predicts the {len(v.predictions)} held-out experiment(s) {ratio:.3g} times "
+                               f"worse than it fits the others (RMSE {amount(heldout, res.unit)} against "
+                               f"{amount(res.rmse, res.unit)}): it does not generalise; look for what differs "
+                               f"between runs (an offset re-zeroed per run: --offset per-experiment; the "
+                               f"temperature; the motion)")
+    return res
 
 
 def _plant_parameters(init, free, method) -> list:

@@ -39,7 +39,10 @@ def entry_label(model: Model, fit: dict | None = None) -> str:
 def akaike(entries):
     """AICc difference to the best and Akaike weight of each entry's fit, or None: only between fits
     of the same data (the same experiments and points), where AICc is comparable; the weights sum to
-    one over such a group."""
+    one over such a group. Correlated residuals carry less information than their count: the differences
+    are divided by c, the integrated autocorrelation time of the most general fit's residuals (its variance
+    inflation; as QAIC divides by overdispersion), so that a comparison on smooth, correlated residuals is not
+    absurdly sure. Returns ([(difference, weight, c) or None per entry], the number of groups)."""
     groups = {}
     for i, e in enumerate(entries):
         f = e.fit or {}
@@ -50,12 +53,22 @@ def akaike(entries):
         groups.setdefault(key, []).append((i, float(a)))
     out = [None] * len(entries)
     for members in groups.values():
+        c = inflation_of_most_general([entries[i].fit for i, _ in members])
         best = min(a for _, a in members)
-        w = {i: math.exp(-0.5 * (a - best)) for i, a in members}
+        w = {i: math.exp(-0.5 * (a - best) / c) for i, a in members}
         total = sum(w.values())
         for i, a in members:
-            out[i] = (a - best, w[i] / total)
+            out[i] = ((a - best) / c, w[i] / total, c)
     return out, len(groups)
+
+
+def inflation_of_most_general(fits) -> float:
+    """The variance inflation (residuals' integrated autocorrelation time, at least 1) of the fit with the most
+    fitted parameters among ``fits`` (dicts), the lowest AICc among those."""
+    def size(f):
+        return sum(1 for p in (f.get("parameters") or {}).values() if p.get("vary"))
+    general = max(fits, key=lambda f: (size(f), -float(f.get("aicc", math.inf))))
+    return max(float((general.get("statistics") or {}).get("variance_inflation", 1.0) or 1.0), 1.0)
 
 
 def _aicc_cells(a):
@@ -63,8 +76,9 @@ def _aicc_cells(a):
     print as "< 0.001" rather than a misleading 0.000."""
     if not a:
         return "—", "—"
-    d, w = a
-    return (f"{d:+,.1f}" if d else "0 (best)"), ("< 0.001" if w < 1e-3 else f"{w:.3f}")
+    d, w, c = a
+    scaled = f" (÷ c = {c:.3g})" if c > 1.5 else ""
+    return (f"{d:+,.1f}{scaled}" if d else f"0 (best){scaled}"), ("< 0.001" if w < 1e-3 else f"{w:.3f}")
 
 
 COMPARISON_COLUMNS = ["model", "friction", "max error, held out [%]", "mean max error, held out [%]",
@@ -249,5 +263,5 @@ def parameter_section(entries, fit_T) -> str:
     return ("<section><h2>Identified parameters</h2>" + "".join(out) + "</section>") if out else ""
 
 
-__all__ = ["Entry", "entry_label", "akaike", "comparison_rows", "law_at", "reference_temperature", "law_rows",
+__all__ = ["Entry", "entry_label", "akaike", "inflation_of_most_general", "comparison_rows", "law_at", "reference_temperature", "law_rows",
            "breakpoint_rows", "parameter_section"]

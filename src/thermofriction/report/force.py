@@ -207,7 +207,12 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
 def _comparison_section(entries, unit, what) -> str:
     """The friction models compared: AICc among fits of the same data, and errors on held-out experiments."""
     rows = []
-    for e, a in zip(entries, _akaike(entries)):
+    aic = _akaike(entries)
+    c = max([a[2] for a in aic if a] or [1.0])
+    basis = (f"The residuals are correlated (the most general fit's integrated autocorrelation time c = {c:.3g}): "
+             f"ΔAICc is divided by c (as QAIC does), and the models are best compared by their held-out RMSE. "
+             if c > 1.5 else "")
+    for e, a in zip(entries, aic):
         s = e.validation.summary()
         f = e.fit or {}
         k = sum(1 for p in (f.get("parameters") or {}).values() if p.get("vary"))
@@ -218,7 +223,7 @@ def _comparison_section(entries, unit, what) -> str:
     return ("<section><h2>Friction models compared</h2>" + html_table(
         ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
          "max error, held out [%]", f"sensor offset [{unit}]"], rows) +
-        "<p style='font-size:13px;color:#4a5266'>ΔAICc is each fit's AICc minus the lowest among fits of the same "
+        "<p style='font-size:13px;color:#4a5266'>" + basis + "ΔAICc is each fit's AICc minus the lowest among fits of the same "
         "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
         "to one. The held-out RMSE compares the models on experiments none was fitted to; the sensor offset was "
         "fitted once, on the fit experiments, and is used there as it is. Max error is "
