@@ -112,3 +112,72 @@ def test_fit_quality_of_white_residuals_is_unchanged():
     measured = np.sin(t) + 0.01 * rng.standard_normal(t.size)
     q = fit_quality(measured - np.sin(t), measured)
     assert q["adequate"] is True and q["noise_reliable"] and q["ratio"] == pytest.approx(1.0, abs=0.1)
+
+
+def test_presliding_reversals_are_real_reversals_not_velocity_noise():
+    """The report's presliding panels: turning points of the position by excursion. A sine's turning points are
+    found where they are (analytic: t = 1, 3, 5, ... s at 0.25 Hz); a hold with velocity noise at rest (sign
+    flips at every sample) adds none."""
+    from thermofriction.report.force import reversals
+    t = np.linspace(0, 10, 2001)
+    x = np.sin(2 * np.pi * 0.25 * t)
+    assert [round(float(t[i]), 2) for i in reversals(x, 10)] == [1.0, 3.0, 5.0, 7.0, 9.0]
+    held = np.concatenate([x[:300], np.full(500, x[300]) + 1e-9 * np.random.default_rng(0).standard_normal(500)])
+    v = np.gradient(held, t[:800])
+    assert np.sum(np.sign(v[1:]) * np.sign(v[:-1]) < 0) > 100  # what velocity sign flips would have picked
+    assert [round(float(t[i]), 2) for i in reversals(held, 10)] == [1.0]
+
+
+def coulomb_data(seed=0, n=800):
+    """As stribeck_data, from a Coulomb-viscous map (no Stribeck excess), white noise."""
+    rng = np.random.default_rng(seed)
+    exps = []
+    for k in range(2):
+        t = np.linspace(0.0, 8.0, n)
+        A, f = 0.6 * (1 + 0.2 * k), 0.25 * (1 + 0.1 * k)
+        x, v = A * np.sin(2 * np.pi * f * t), A * 2 * np.pi * f * np.cos(2 * np.pi * f * t)
+        F = 0.4 * np.sign(v) + 0.12 * v + 0.02 * rng.standard_normal(n)
+        cols = {"time": t, "position": x, "velocity": v, "force": F, "rotary": True,
+                "headers": {"time": "time[s]", "position": "position[rad]", "velocity": "velocity[rad/s]",
+                            "force": "friction_torque[N*m]"}}
+        exps.append(force_experiment(f"run{k}", f"run{k}.csv", temperature=25.0, role="fit", description="",
+                                     from_zero=lambda t, i: (t, i), motion="velocity", flip_sign=False, columns=cols))
+    return Dataset(name="coulomb", experiments=exps)
+
+
+def test_a_stribeck_excess_the_data_do_not_show_is_said():
+    """--friction stribeck on Coulomb-viscous data: from a start without an excess (fs = fc) the fit says fs and
+    vs were not fitted; from one with an excess it says the data show none (fs - fc within two standard errors)."""
+    data = coulomb_data()
+    flat = tf.Model(tf.PrescribedMotion(motion="rotary"), tf.Stribeck(fc=0.5, fs=0.5, vs=0.1, sigma2=0.1))
+    fit = tf.identify(data, "base", init=flat, starts=1)
+    assert "fs" not in fit.parameters and any("fs and vs were not fitted" in w for w in fit.warnings)
+    fit = tf.identify(data, "base", init=start(), starts=1)
+    assert any("no Stribeck excess" in w for w in fit.warnings), fit.warnings
+    with_excess = tf.identify(stribeck_data(0, 0.0), "base", init=start(), starts=1)
+    assert not any("Stribeck" in w for w in with_excess.warnings)
+
+
+def test_a_parameter_at_its_bound_is_shown_at_bound_with_a_one_sided_interval():
+    """fc held below its true value by a bound (max 0.3 N m, truth 0.4): it ends at the bound, shown "at upper
+    bound" with a one-sided interval from the bound, not a two-sided one around it."""
+    from thermofriction.identify import Parameters, fit_friction
+    model = start()
+    params = Parameters()
+    params.add("fc", 0.25, min=0.0, max=0.3, unit="N m")
+    params.add("sigma2", 0.1, min=0.0, unit="N m s/rad")
+    fit = fit_friction(stribeck_data(0, 0.0).experiments, model, params, starts=1)
+    fc = fit.parameters["fc"]
+    assert fc.at_bound == "upper" and fc.ci95[1] == pytest.approx(0.3) and fc.ci95[0] < 0.3
+    assert fit.parameters["sigma2"].at_bound is None
+    assert "at upper bound" in fit.report() and "(one-sided)" in fit.report()
+    assert fit.parameters.to_dict()["fc"]["at_bound"] == "upper"
+
+
+def test_the_evaluation_limit_can_be_raised_and_is_named_when_reached():
+    data = stribeck_data(0, 0.0)
+    short = tf.identify(data, "base", init=start(), starts=1, max_evaluations=2)
+    assert not short.success and "max-evaluations" in short.message
+    assert tf.identify(data, "base", init=start(), starts=1, max_evaluations=200).success
+    with pytest.raises(tf.InputError, match="max_evaluations"):
+        tf.identify(data, "base", init=start(), max_evaluations=0)

@@ -52,7 +52,8 @@ def _check_arguments(method, reference_temperature, rtol, starts, seed):
 @stamped  # the fitted model's name and provenance (result.py)
 @one_blas_thread  # (engine.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
-             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None, offset=True) -> FitResult:
+             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None, offset=True,
+             max_evaluations=None) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
@@ -71,8 +72,10 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         plant given in its physical form).
     laws: Model I law kinds per parameter, e.g. {"sigma0": "exp"}; default: chosen by AICc.
     rtol: the simulations' relative tolerance during the fit; starts: the multi-start size.
-    offset: force data only (docs/force-data.md): fit the force sensor's offset, one for all experiments
-        (default), or hold it at the initial model's ``[plant] sensor_offset`` (False).
+    offset: force data only (docs/force-data.md): "shared" (default: one sensor offset fitted for all
+        experiments), "per-experiment" (one per run: a sensor re-zeroed between runs) or "none" (or False: the
+        initial model's ``[plant] sensor_offset`` held).
+    max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
 
     What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
     it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
@@ -90,6 +93,11 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
+    if max_evaluations is not None:
+        if isinstance(max_evaluations, bool) or not isinstance(max_evaluations, numbers.Integral) \
+                or not 1 <= max_evaluations <= 100_000:
+            raise InputError(f"max_evaluations must be a whole number from 1 to 100000, got {shorten(max_evaluations)}")
+        opts["max_nfev"] = int(max_evaluations)
     free = _plant_parameters(init, free, method)
     if method == "plant":
         return _identify_plant(getattr(data, "experiments", data), init)

@@ -212,6 +212,9 @@ class FitOutcome:
     message: str
     starts: int
     wall_time: float
+    #: per parameter: "lower" / "upper" where the optimum is at a bound, else None; and the bounds in its units
+    at_bound: list = dataclasses.field(default_factory=list)
+    bounds: tuple = ()
 
 
 def one_blas_thread(function):
@@ -251,14 +254,16 @@ def _screened_starts(screen: Problem, transform: Transform, phi0, bounds, starts
 
 
 @one_blas_thread
-def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=60,
+def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=None,
         tight=False, progress=None, near=False, small_step=SMALL_STEP) -> FitOutcome:
     """Fits the varying parameters; returns the optimum with its residuals and Jacobian.
 
     ``near``: the start is known to be within a standard error or so of the optimum (a refinement from
     fits that already converged): no coarse stage at rtol 1e-6, whose integration error is of that size.
     ``small_step``: the fit stops where the Gauss-Newton step is below this many standard errors at a
-    misfit at the noise (COARSE_STEP for a fit that only starts another one)."""
+    misfit at the noise (COARSE_STEP for a fit that only starts another one). ``max_nfev``: the most
+    evaluations of each least-squares stage (default: 40 for the coarse stage, 15 for the fine one, 60 for a
+    ``near`` or ``tight`` fit)."""
     t_start = time.perf_counter()
     varying = params.varying
     if not varying:
@@ -281,11 +286,12 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         phi_first = phi_start
         if rtol < COARSE_RTOL and not near:
             coarse = Problem(model, names, traces, rtol=COARSE_RTOL, parallel=not one_trace)
-            first = _least_squares(coarse, transform, phi_start, (lo, hi), min(max_nfev, 40), False, scale,
+            first = _least_squares(coarse, transform, phi_start, (lo, hi), 40 if max_nfev is None else max_nfev, False, scale,
                                    stall_step=COARSE_STEP)
             phi_start = first.x
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-        res = _least_squares(problem, transform, phi_start, (lo, hi), max_nfev if tight or near else 15, tight,
+        fine = max_nfev if max_nfev is not None else 60 if tight or near else 15
+        res = _least_squares(problem, transform, phi_start, (lo, hi), fine, tight,
                              scale, small_step)
         res.moved = bool(np.any(res.x != phi_first))
         return res, problem
@@ -314,10 +320,16 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     nfev = screen.nfev + sum(p.nfev for _, p in runs)
     njev = sum(p.njev for _, p in runs)
     success, message = bool(best.success and best.status > 0), best.message
+    if best.status == 0:
+        message = f"{message} (the evaluation limit; raise it with --max-evaluations, max_evaluations=)"
     if not best.moved and math.sqrt(float(r @ r) / r.size) > ADEQUATE_RATIO * scale:
         # a small gradient at a start that does not fit the data is not convergence
         success, message = False, f"stopped at its starting point ({message})"
-    return FitOutcome(theta, r, J, nfev, njev, success, message, n_candidates, time.perf_counter() - t_start)
+    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0)
+    at_bound = ["lower" if x <= a + 1e-9 * s else "upper" if x >= b - 1e-9 * s else None
+                for x, a, b, s in zip(best.x, lo, hi, span)]
+    return FitOutcome(theta, r, J, nfev, njev, success, message, n_candidates, time.perf_counter() - t_start,
+                      at_bound, (transform.to_theta(lo), transform.to_theta(hi)))
 
 
 __all__ = ["Transform", "fit", "FitOutcome", "residual_scale", "gauss_newton_length", "compressed",

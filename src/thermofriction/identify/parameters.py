@@ -41,6 +41,9 @@ class Parameter:
     stderr: float | None = None
     ci95: tuple | None = None
     init_value: float | None = None
+    #: "lower" or "upper" where the fit ended at a bound (its own, or the fit's e^+-30 around the start): the
+    #: interval is then one-sided, from the bound
+    at_bound: str | None = None
 
     @property
     def positive(self) -> bool:
@@ -51,8 +54,10 @@ class Parameter:
         def f(x):
             return None if x is None else (float(x) if math.isfinite(x) else ("inf" if x > 0 else "-inf"))
         ci = None if self.ci95 is None else [f(self.ci95[0]), f(self.ci95[1])]
-        return {"value": f(self.value), "stderr": f(self.stderr), "ci95": ci, "unit": self.unit,
-                "vary": self.vary}
+        out = {"value": f(self.value), "stderr": f(self.stderr), "ci95": ci, "unit": self.unit, "vary": self.vary}
+        if self.at_bound:
+            out["at_bound"] = self.at_bound
+        return out
 
     def __repr__(self):
         err = "" if self.stderr is None else f" +/- {self.stderr:.3g}"

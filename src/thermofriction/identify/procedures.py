@@ -73,6 +73,7 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                         f"{amount(overall['noise'], unit)}; not adequate in {len(bad)} of {len(per)} experiments): "
                         f"the model misses what the data show. Try: {measurement.advice(model)}")
     cost = float(outcome.r @ outcome.r)
+    warns += _unsupported_excess(params, corr, unit)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
                      rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
                      njev=outcome.njev, starts=outcome.starts, wall_time=time.perf_counter() - t0,
@@ -116,7 +117,36 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", m
     else:
         params = friction_parameters(model, parameters or default_fit_parameters(model))
     outcome = fit(model, params, traces, **opts)
-    return fit_result(method, model, params, outcome, traces, t0)
+    return fit_result(method, model, params, outcome, traces, t0, stribeck_notes(model, params))
+
+
+def _unsupported_excess(params: Parameters, corr, unit) -> list:
+    """A fitted Stribeck excess fs - fc the data do not support (within two standard errors of zero): said."""
+    names = [p.name for p in params.varying]
+    if "fs" not in names or "fc" not in params:
+        return []
+    fs, fc = params["fs"], params["fc"]
+    se_fs, se_fc = fs.stderr or 0.0, (fc.stderr or 0.0) if fc.vary else 0.0
+    rho = float(corr[names.index("fs"), names.index("fc")]) if fc.vary and np.isfinite(
+        corr[names.index("fs"), names.index("fc")]) else 0.0
+    se = math.sqrt(max(se_fs ** 2 + se_fc ** 2 - 2 * rho * se_fs * se_fc, 0.0))
+    excess = fs.value - fc.value
+    if math.isfinite(se) and excess < 2 * se:
+        return [f"the data show no Stribeck excess: fs - fc = {excess:.3g} +- {se:.3g} {fs.unit}, within two standard "
+                f"errors of zero; the fitted map is Coulomb-viscous, and vs says nothing"]
+    return []
+
+
+def stribeck_notes(model: Model, params: Parameters) -> list:
+    """A friction model with a Stribeck term whose excess fs - fc is not fitted because the initial model has
+    none (fs = fc): said, instead of a result that silently equals Coulomb's."""
+    values = model.friction.values()
+    if "fs" not in values or "fs" in params or isinstance(model.thermal, ModelI) and "fs" in model.laws:
+        return []
+    if values.get("fs") in (None, values.get("fc")):
+        return [f"fs and vs were not fitted: the initial {model.friction.model} model has no Stribeck excess (fs = fc), "
+                f"so the fitted map is Coulomb-viscous; give a start with fs > fc (or --parameters fs,vs) to fit one"]
+    return []
 
 
 DEFAULT_HEAT_PARAMETERS = ("C_th", "R_th", "eta")
@@ -204,6 +234,6 @@ def temperature_groups(experiments):
     return groups
 
 
-__all__ = ["fit_friction", "fit_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters",
+__all__ = ["fit_friction", "fit_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes",
            "identify_heat", "temperature_groups", "FRICTION_FIT_PARAMETERS", "DEFAULT_FRICTION_PARAMETERS",
            "DEFAULT_HEAT_PARAMETERS"]

@@ -171,6 +171,9 @@ class FitResult:
         for p in self.parameters.values():
             if p.stderr is None or not p.vary:
                 err, ci, rel = "", "", "fixed" if not p.vary else ""
+            elif p.at_bound:
+                err, rel = "", f"at {p.at_bound} bound"
+                ci = f"[{p.ci95[0]:.5g}, {p.ci95[1]:.5g}] (one-sided)"
             else:
                 err = f"{p.stderr:.4g}"
                 rel = f"{100 * p.stderr / abs(p.value):.2g} %" if p.value and math.isfinite(p.stderr) else ""

@@ -50,6 +50,13 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
     for i, par in enumerate(varying):
         par.value = float(theta[i])
         par.stderr = float(se[i])
+        side = outcome.at_bound[i] if outcome.at_bound else None
+        if side:
+            par.at_bound, par.ci95 = side, _one_sided(par, side, float(theta[i]), float(se[i]), outcome, i, dof_eff)
+            warnings.append(f"'{par.name}' ended at its {side} bound ({par.value:.4g}): the data put it "
+                            f"{'below' if side == 'lower' else 'above'} {par.ci95[1 if side == 'lower' else 0]:.4g} "
+                            f"(one-sided 95 %), not at a value; hold it, or fit another model")
+            continue
         if not math.isfinite(se[i]):
             par.ci95 = (0.0 if par.positive else -math.inf, math.inf)
             warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)")
@@ -69,6 +76,20 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
             par.unit = unit_of(model, par.name)
     return corr, warnings, {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho,
                             "variance_inflation": inflation, "effective_samples": n / inflation}
+
+
+def _one_sided(par, side, value, se, outcome, i, dof) -> tuple:
+    """The one-sided 95 % interval of a parameter that ended at a bound: from the bound to the value plus (or
+    minus) the one-sided t quantile times its standard error (in log for a positive parameter)."""
+    bound = float(outcome.bounds[0][i] if side == "lower" else outcome.bounds[1][i])
+    if not math.isfinite(se):
+        return (bound, math.inf) if side == "lower" else (-math.inf if not par.positive else 0.0, bound)
+    tq = float(special.stdtrit(dof, 0.95))
+    if par.positive:
+        far = value * math.exp(min(tq * se / value, 700.0) * (1 if side == "lower" else -1))
+    else:
+        far = value + tq * se * (1 if side == "lower" else -1)
+    return (bound, far) if side == "lower" else (far, bound)
 
 
 def integrated_autocorrelation(x) -> float:

@@ -95,11 +95,25 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
                        f"{what} (simulated at constant velocity; sensor offset included).")
 
 
-def _reversals(p, n):
-    """Up to ``n`` reversals of the motion of prediction ``p`` with enough samples either side."""
-    v = p.velocity
-    flips = np.flatnonzero(np.sign(v[1:]) * np.sign(v[:-1]) < 0) + 1
-    return [int(i) for i in flips if 5 <= i < len(v) - 5][:n]
+def reversals(position, n, excursion=0.05):
+    """Up to ``n`` real reversals of a motion: turning points of ``position`` between which it travels at least
+    ``excursion`` of its range both ways (a zigzag filter), with enough samples either side. Velocity sign flips
+    would also pick the noise of a velocity at rest (1e-17 deg/s flips) and a quantised velocity's dither."""
+    x = np.asarray(position, float)
+    threshold = excursion * float(np.ptp(x)) if x.size else 0.0
+    if threshold <= 0:
+        return []
+    turns, direction, extreme = [], 0, 0  # extreme: the farthest point since the last turn
+    for i in range(1, len(x)):
+        if direction == 0:  # until the motion has left its start by the threshold
+            direction = 1 if x[i] - x[0] >= threshold else -1 if x[0] - x[i] >= threshold else 0
+            extreme = i
+        elif direction * (x[i] - x[extreme]) > 0:
+            extreme = i
+        elif direction * (x[extreme] - x[i]) >= threshold:
+            turns.append(extreme)
+            direction, extreme = -direction, i
+    return [int(i) for i in turns if 5 <= i < len(x) - 5][:n]
 
 
 @page_styled
@@ -107,7 +121,7 @@ def fig_loops(figs, entries, unit, xunit, what):
     """Force against position after each reversal: the presliding hysteresis, measured and predicted."""
     loops = []
     for p in entries[0].validation.predictions:
-        for i in _reversals(p, MAX_LOOPS - len(loops)):
+        for i in reversals(p.position, MAX_LOOPS - len(loops)):
             loops.append((p.file, i))
         if len(loops) >= MAX_LOOPS:
             break
@@ -251,4 +265,4 @@ def _parameters_section(entries, unit) -> str:
         ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
 
 
-__all__ = ["render_force"]
+__all__ = ["render_force", "reversals"]
