@@ -25,6 +25,7 @@ from . import _bridge
 from ._bridge import model_spec
 from .errors import InputError, SolverError
 from .models import MassPlant, Model
+from .results import Result
 
 
 # -- argument checks: the package's InputError naming the argument, before the C core sees it -----
@@ -170,7 +171,7 @@ def point_to_point(distance: float, move_time: float, dwell: float, dt: float = 
 
 
 @dataclass(eq=False)
-class LoopResult:
+class LoopResult(Result):
     """One closed-loop run, per control period (plain arrays, SI)."""
 
     time: np.ndarray
@@ -191,6 +192,25 @@ class LoopResult:
     @property
     def max_error(self) -> float:
         return float(np.max(np.abs(self.error)))
+
+    title = "closed-loop run"
+
+    def summary(self) -> list:
+        return [("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
+                ("RMS error", f"{self.rms_error * 1e6:.4g} um"), ("max error", f"{self.max_error * 1e6:.4g} um")]
+
+    def _frame(self) -> dict:
+        return {"time": self.time, "reference": self.reference, "position": self.position, "error": self.error,
+                "control": self.control, "compensation": self.compensation}
+
+    def to_dict(self) -> dict:
+        return {"summary": dict(self.summary()), "rms_error": self.rms_error, "max_error": self.max_error,
+                "stats": self.stats, "samples": self._frame()}
+
+    def plot(self):
+        """A matplotlib figure: reference and position, and the tracking error, against time."""
+        from .report.study_plots import loop_figure
+        return loop_figure(self)
 
 
 #: Gains for the stage-model-i preset (1 kg): ~30 Hz bandwidth, well damped, at 10 kHz.

@@ -29,6 +29,7 @@ import numpy as np
 from ._lazy import lazy
 from .errors import InputError, SolverError, TemperatureRangeWarning
 from .models import Model
+from .results import Result
 from .drive import input_of
 from .simulate import StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
@@ -78,7 +79,7 @@ class CycleTable:
 
 
 @dataclass(eq=False)
-class HeatingResult:
+class HeatingResult(Result):
     """A long heated run, sampled at cycle starts (plain arrays, SI; temperature in degC).
 
     ``displacement`` is the end effector's at each sampled cycle start; ``step_size`` the step of
@@ -96,6 +97,29 @@ class HeatingResult:
     method: str
     table: CycleTable | None = None
     stats: dict = field(default_factory=dict)
+
+    title = "heated run"
+
+    def summary(self) -> list:
+        return [("method", self.method), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
+                ("temperature", f"{self.temperature[0]:.4g} -> {self.temperature[-1]:.4g} C "
+                                f"(max {np.max(self.temperature):.4g} C)"),
+                ("displacement", f"{self.displacement[-1] * 1e3:.6g} mm"),
+                ("step per cycle", f"{self.step_size[0] * 1e6:.4g} -> {self.step_size[-1] * 1e6:.4g} um"),
+                ("friction work", f"{self.friction_work[-1]:.4g} J")]
+
+    def _frame(self) -> dict:
+        return {"time": self.time, "temperature": self.temperature, "displacement": self.displacement,
+                "step_size": self.step_size, "friction_work": self.friction_work}
+
+    def to_dict(self) -> dict:
+        return {"method": self.method, "frequency": self.frequency, "summary": dict(self.summary()),
+                "stats": self.stats, "samples": self._frame()}
+
+    def plot(self):
+        """A matplotlib figure: the interface temperature and the step per cycle against time."""
+        from .report.study_plots import heating_figure
+        return heating_figure(self)
 
 
 def _periodic_input(model: Model, input: Waveform | None) -> Waveform:

@@ -11,6 +11,7 @@ from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
+from .results import Result
 
 
 @dataclasses.dataclass
@@ -32,7 +33,7 @@ def predict(model: Model, exp, rtol=1e-8):
 
 
 @dataclasses.dataclass
-class ValidationResult:
+class ValidationResult(Result):
     model: Model
     predictions: list
     warnings: list
@@ -60,8 +61,20 @@ class ValidationResult:
         """Every experiment was predicted."""
         return not self.failures
 
+    title = "validation"
+
     def summary(self) -> dict:
+        """Per role (fit, validate): the errors over its experiments (the measurement's metrics)."""
         return self.measurement.summary(self.predictions)
+
+    def report(self) -> str:
+        return self.table()
+
+    def _frame(self) -> dict:
+        """One row per experiment: its metrics."""
+        rows = self.experiments
+        keys = [k for k in (rows[0] if rows else {}) if k != "fit_quality"]
+        return {k: [r.get(k) for r in rows] for k in keys}
 
     def to_dict(self) -> dict:
         d = {"model": self.model.name, "measurement": self.measurement.name, "unit": self.unit,

@@ -12,12 +12,13 @@ import numpy as np
 from .._io import dump_json, jsonable
 from ..measurements import amount
 from ..models import Model
+from ..results import Result
 from ..data.files import dataset_sha256 as data_sha256
 from .parameters import Parameters
 
 
 @dataclasses.dataclass
-class FitResult:
+class FitResult(Result):
     method: str
     model: Model
     parameters: Parameters
@@ -161,6 +162,22 @@ class FitResult:
     def to_json(self, path=None) -> str:
         """The results as JSON (docs/formats.md#results-json), written atomically to ``path`` when given."""
         return dump_json(self.to_dict(), path)
+
+    title = "fit"
+
+    def summary(self) -> list:
+        q = self.fit_quality or {}
+        return [("method", self.method), ("converged", str(self.success)),
+                ("rmse", amount(self.rmse, self.unit) if self.n_points else "-"),
+                ("adequate", "-" if not q else _verdict(q)), ("evaluations", str(self.nfev))]
+
+    def _frame(self) -> dict:
+        """One row per parameter: value, standard error, 95 % interval, unit, fitted or held."""
+        ps = list(self.parameters.values())
+        return {"name": [p.name for p in ps], "value": [p.value for p in ps],
+                "stderr": [p.stderr for p in ps], "ci95_low": [None if p.ci95 is None else p.ci95[0] for p in ps],
+                "ci95_high": [None if p.ci95 is None else p.ci95[1] for p in ps], "unit": [p.unit for p in ps],
+                "vary": [p.vary for p in ps]}
 
     def to_mat(self, path):
         """The same results as a MATLAB file (docs/formats.md#results-in-matlab-files)."""

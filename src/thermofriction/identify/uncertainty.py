@@ -63,7 +63,7 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
             continue
         if par.positive:
             f = math.exp(min(tq * se[i] / theta[i], 700.0))
-            par.ci95 = (theta[i] / f, theta[i] * f)
+            par.ci95 = (float(theta[i]) / f, float(theta[i]) * f)  # (Python floats: inf, not an overflow warning)
         else:
             par.ci95 = (theta[i] - tq * se[i], theta[i] + tq * se[i])
         if se[i] > 0.5 * abs(theta[i]):

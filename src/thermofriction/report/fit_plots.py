@@ -211,6 +211,32 @@ def _held_out_temperatures(predictions):
 
 
 @styled
+def parameters_figure(fit: dict):
+    """A fit's parameters with their 95 % intervals, relative to each value (log axis): how well the data
+    determine each. For a fit without a thermal law, when no data are given to compare with."""
+    rows = [(n, p) for n, p in (fit.get("parameters") or {}).items() if p.get("vary")]
+    fig, axes = new_figure(HALF, 0.5 + 0.45 * max(len(rows), 1))
+    ax = axes[0][0]
+    for k, (name, p) in enumerate(rows):
+        v, ci = as_float(p.get("value")), p.get("ci95") or [None, None]
+        lo, hi = as_float(ci[0]), as_float(ci[1])
+        if not (v > 0 and math.isfinite(lo) and math.isfinite(hi)):
+            ax.text(1.0, k, "interval not finite", fontsize=8, ha="center", va="center", color="#d62728",
+                    bbox={"facecolor": "white", "edgecolor": "none", "pad": 1})
+            continue
+        ax.plot([max(lo / v, 1e-3), min(hi / v, 1e3)], [k, k], color=MODEL_COLOURS[0], lw=2)
+        ax.plot([1.0], [k], "o", color=MODEL_COLOURS[0])
+    ax.set_yticks(range(len(rows)), [f"{n} [{p.get('unit', '')}]" for n, p in rows])
+    ax.set_ylim(-0.6, len(rows) - 0.4)
+    ax.set_xlim(1e-3, 1e3)
+    ax.set_xscale("log")
+    ax.axvline(1.0, color="0.6", lw=0.8)
+    ax.set_xlabel("95 % interval / value")
+    ax.set_title(f"{fit.get('method', 'fit')}: parameters")
+    return fig
+
+
+@styled
 def fit_figure(fit, validation=None, paper=False):
     """An identification result (FitResult or its dict with ``model``): measured vs predicted and
     residual RMS (when ``validation`` of its model on the data is given), and its thermal law(s)
@@ -223,9 +249,8 @@ def fit_figure(fit, validation=None, paper=False):
     model_ii = isinstance(model.thermal, ModelII)
     law_panels = len(laws) + (1 if model_ii else 0)
     rows = (1 if validation is not None else 0) + (1 if law_panels else 0)
-    if rows == 0:
-        raise ValueError("nothing to plot: this fit has no thermal law; give its validation on the data "
-                         "(fit.plot(data)) to see measured against predicted")
+    if rows == 0:  # no law and no data: the parameters with their intervals
+        return parameters_figure(d)
     fig, _ = new_figure(WIDE, 3.7 * rows + 0.3, none=True)
     subs = fig.subfigures(rows, 1, squeeze=False)[:, 0] if rows > 1 else [fig]
     held = []
@@ -259,5 +284,5 @@ def fit_figure(fit, validation=None, paper=False):
     return fig
 
 
-__all__ = ["per_temperature_estimates", "law_outside_intervals", "draw_law", "laws_figure", "draw_dF",
+__all__ = ["parameters_figure", "per_temperature_estimates", "law_outside_intervals", "draw_law", "laws_figure", "draw_dF",
            "model_ii_figure", "fit_figure"]

@@ -8,10 +8,11 @@ import numpy as np
 
 from .._bridge import OUTPUTS
 from .._io import atomic_write
+from ..results import Result
 
 
 @dataclass(eq=False)
-class SimulationResult:
+class SimulationResult(Result):
     """Plain arrays with named fields (SI units; temperature in degC).
 
     ``displacement``/``velocity`` are the driven body's (the end effector's, the mass's, or the
@@ -59,18 +60,21 @@ class SimulationResult:
         cols["friction_work[J]"] = self.friction_work
         return {k: v for k, v in cols.items() if v is not None}
 
-    def to_dataframe(self):
-        """A pandas DataFrame of every output (pandas is an optional dependency)."""
-        try:
-            import pandas as pd
-        except ImportError:  # pragma: no cover - depends on the environment
-            raise ImportError("to_dataframe() needs pandas: pip install 'thermofriction[dataframe]'") from None
+    title = "simulation"
+
+    def _frame(self) -> dict:
+        """Every output by name (the DataFrame's columns)."""
         data = {name: getattr(self, name) for name in OUTPUTS if getattr(self, name) is not None}
         for j, name in enumerate(self.state_names):
             data[name] = self.states[:, j]
         if self.friction_work is not None:
             data["friction_work"] = self.friction_work
-        return pd.DataFrame(data)
+        return data
+
+    def to_dict(self) -> dict:
+        """The summary, the solver's statistics and every output column (docs/formats.md#simulation-output)."""
+        return {"summary": dict(self.summary()), "stats": self.stats,
+                "columns": {k: v for k, v in self.columns().items()}}
 
     def to_csv(self, path):
         """Writes the simulation CSV (docs/formats.md#simulation-output) atomically."""
@@ -87,7 +91,7 @@ class SimulationResult:
         from ..report.plots import simulation_figure
         return simulation_figure(self, what)
 
-    def _repr_html_(self):
+    def summary(self) -> list:
         rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
                 ("final displacement", f"{self.displacement[-1] * 1e6:.6g} µm"),
                 ("peak friction force", f"{np.max(np.abs(self.friction_force)):.4g} N")]
@@ -96,8 +100,7 @@ class SimulationResult:
                      ("mean step per cycle", f"{self.step_sizes.mean() * 1e6:.6g} µm"),
                      ("mean velocity", f"{self.mean_velocity * 1e6:.6g} µm/s")]
         rows.append(("solver", f"{self.stats.get('solver', '?')}: {self.stats.get('steps', '?')} steps"))
-        body = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{v}</td></tr>" for k, v in rows)
-        return f"<table><caption>SimulationResult</caption>{body}</table>"
+        return rows
 
     def __repr__(self):
         return (f"SimulationResult({len(self.time)} samples over {self.time[-1] - self.time[0]:.6g} s, "
