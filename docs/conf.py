@@ -13,6 +13,7 @@ from pathlib import Path
 import thermofriction
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent / "_ext"))  # tf_gallery: the gallery's figure scraper
 
 project = "thermofriction"
 author = "the thermofriction developers"
@@ -32,7 +33,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "gallery/*.ipynb", "gallery/*.py", "gallery/*.zip",
+exclude_patterns = ["_build", "_ext", "Thumbs.db", ".DS_Store", "gallery/*.ipynb", "gallery/*.py", "gallery/*.zip",
                     "gallery/*.md5", "gallery/*.json"]
 templates_path = ["_templates"]
 
@@ -65,7 +66,8 @@ sphinx_gallery_conf = {
     "remove_config_comments": True,
     "within_subsection_order": "FileNameSortKey",
     "matplotlib_animations": False,
-    "image_scrapers": ("matplotlib",),
+    # the library's own (pyplot-free) figures, then pyplot's (first: pyplot's scraper closes its figures)
+    "image_scrapers": ("tf_gallery.figures", "matplotlib"),
     "show_memory": False,
     "min_reported_time": 1,
     "abort_on_example_error": True,
@@ -81,33 +83,41 @@ html_show_sourcelink = False
 
 
 # --- The docstrings' own style -----------------------------------------------------------------------
-# The package's docstrings are plain text: "name: what it is" with indented continuation lines, and
-# |x| for absolute values. Read as reStructuredText, the former is a definition list whose items must be
-# separated by blank lines and the latter a substitution reference. These two rewrites (the only ones)
-# make them valid reStructuredText without changing what they say.
+# The package's docstrings are plain text: "name: what it is" items with indented continuation lines,
+# and |x| for absolute values. Read as reStructuredText, the items would run into each other and |x|
+# would be a substitution reference. These rewrites (the only ones) make each item a definition-list
+# entry (term "name", the text as its definition) and escape the bars, without changing what they say.
 
-_ITEM = re.compile(r"[A-Za-z_][\w ,.*()\[\]\"'=-]{0,40}: ")
+_ITEM = re.compile(r"([A-Za-z_][\w ,.*()\[\]\"'=-]{0,40}): (\S.*)")
 
 
 def _docstring_as_rst(app, what, name, obj, options, lines):
     if what == "data" and type(obj).__doc__ and lines and "\n".join(lines).strip() == type(obj).__doc__.strip():
         lines[:] = []  # a constant without a docstring of its own: not its type's (dict's, tuple's) docstring
         return
-    out, prev_indent, in_literal = [], None, False
-    for line in lines:
+    out, prev_indent, literal_indent, in_item = [], None, None, False
+    for k, line in enumerate(lines):
         stripped = line.lstrip()
         indent = len(line) - len(stripped)
-        if stripped and in_literal and indent <= literal_indent:
-            in_literal = False
-        if stripped and not in_literal:
-            if out and out[-1].strip() and prev_indent is not None and (
-                    indent < prev_indent or (indent == prev_indent and _ITEM.match(stripped))):
-                out.append("")  # a dedent or a new "name: ..." item ends the previous one
+        if stripped and literal_indent is not None and indent <= literal_indent:
+            literal_indent = None
+        if stripped and literal_indent is None:
+            after = not out or not out[-1].strip() or in_item or out[-1].rstrip()[-1:] in ".:;"
+            item = _ITEM.fullmatch(stripped) if indent == 0 and k > 0 and after else None
+            if out and out[-1].strip() and prev_indent is not None and (indent < prev_indent or item):
+                out.append("")  # a dedent or a new "name: ..." item ends the previous paragraph or item
             line = line.replace("|", r"\|")
-            if stripped.endswith("::"):
-                in_literal, literal_indent = True, indent
+            if item:  # "name: text" -> the term "name" and its definition "text"
+                out.append(item.group(1).replace("|", r"\|"))
+                line, indent, in_item = "    " + item.group(2).replace("|", r"\|"), 4, True
+            elif in_item and (indent > 0 or out[-1].strip()):
+                line = "    " + line.lstrip()  # the item's continuation lines, at its definition's indent
+            else:
+                in_item = False
+            if line.rstrip().endswith("::"):
+                literal_indent = len(line) - len(line.lstrip())
         if stripped:
-            prev_indent = indent
+            prev_indent = 0 if in_item else indent
         out.append(line)
     lines[:] = out
 
