@@ -24,15 +24,32 @@ joint = tf.Model(tf.PrescribedMotion(motion="rotary"),
                  tf.LuGre(sigma0=3000.0, sigma1=0.3, fc=0.9, fs=1.4, vs=0.3, sigma2=0.35))
 rng = np.random.default_rng(3)
 motion = tf.Sine(amplitude=0.5, frequency=0.5)          # +-0.5 rad at 0.5 Hz
-for i, name in enumerate(("run0.csv", "run1-validate.csv")):
+for name in ("run0.csv", "run1-validate.csv"):
     res = tf.simulate(joint, input=motion, duration=2.0, sample_rate=1000)
-    torque = res.friction_force + 0.05 + 0.01 * rng.standard_normal(res.time.size)   # offset, noise
-    np.savetxt(folder / name, np.column_stack([res.time, res.displacement, torque]), delimiter=",",
-               header="time[s],position[rad],friction_torque[N*m]", comments="", fmt="%.10g")
-(folder / "dataset.toml").write_text(
-    'name = "joint"\n\n[[experiment]]\nfile = "run0.csv"\ntemperature = 35.0\n\n'
-    '[[experiment]]\nfile = "run1-validate.csv"\ntemperature = 35.0\nrole = "validate"\n')
-(folder / "joint.toml").write_text('[plant]\ntype = "prescribed"\nmotion = "rotary"\n\n[friction]\nmodel = "lugre"\n')
+    noise = 0.01 * rng.standard_normal(res.time.size)
+    torque = res.friction_force + 0.05 + noise  # the sensor's offset and noise
+    np.savetxt(folder / name, np.column_stack([res.time, res.displacement, torque]),
+               delimiter=",", header="time[s],position[rad],friction_torque[N*m]",
+               comments="", fmt="%.10g")
+(folder / "dataset.toml").write_text("""name = "joint"
+
+[[experiment]]
+file = "run0.csv"
+temperature = 35.0
+
+[[experiment]]
+file = "run1-validate.csv"
+temperature = 35.0
+role = "validate"
+""")
+# the initial model: only the plant and the friction model, no values
+(folder / "joint.toml").write_text("""[plant]
+type = "prescribed"
+motion = "rotary"
+
+[friction]
+model = "lugre"
+""")
 
 # %%
 # Identify LuGre (six parameters and the sensor's offset) on the fit run.
@@ -48,7 +65,8 @@ print(metrics.table())
 pred = metrics.predictions[1]
 exp = data.experiments[1]
 fig, ax = plt.subplots(figsize=(6, 4))
-ax.plot(exp.displacement, pred.measured, ".", ms=1.5, color="0.6", label="measured")
+ax.plot(exp.displacement, pred.measured, ".", ms=1.5, color="0.6",
+        label="measured")
 ax.plot(exp.displacement, pred.predicted, lw=1.2, label="fitted LuGre")
 ax.set(xlabel="position [rad]", ylabel="friction torque [N m]", title="held-out run")
 ax.legend()

@@ -12,10 +12,12 @@ fitted model is validated on a temperature held out of the fit. The models are t
 import thermofriction as tf
 
 truth = tf.load_model("li2009-model-i")
-data = tf.synthesize(truth, [30.8, 35.7, 38.4, 41.5], validate=[33.0], duration=0.6, sample_rate=5000,
-                     noise=20e-9, seed=1, name="paper-workflow")
+data = tf.synthesize(truth, [30.8, 35.7, 38.4, 41.5], validate=[33.0],
+                     duration=0.6, sample_rate=5000, noise=20e-9, seed=1,
+                     name="paper-workflow")
 for e in data.experiments:
-    print(f"{e.file:20s} {e.temperature:5.1f} C  {e.role:8s} {e.duration:.1f} s at {e.sample_rate:.0f} Hz")
+    print(f"{e.file:18s} {e.temperature:5.1f} C  {e.role:8s} "
+          f"{e.duration:.1f} s at {e.sample_rate:.0f} Hz")
 
 # %%
 # Identify Model I: per-temperature LuGre fits, a law through each parameter's estimates (chosen by

@@ -17,8 +17,9 @@ import thermofriction as tf
 
 temperatures = np.arange(30.0, 42.01, 1.0)
 amplitudes = (15.0, 20.0, 25.0, 30.0)
-res = tf.sweep("li2009-model-i", {"temperature": temperatures, "amplitude": amplitudes}, duration=0.6,
-               sample_rate=2000, scheduler="sequential")
+grid = {"temperature": temperatures, "amplitude": amplitudes}
+res = tf.sweep("li2009-model-i", grid, duration=0.6, sample_rate=2000,
+               scheduler="sequential")
 print(res)
 print(f"{res.failed} failed points, {res.wall_time:.2f} s")
 
@@ -28,6 +29,8 @@ print(f"{res.failed} failed points, {res.wall_time:.2f} s")
 fig, ax = plt.subplots(figsize=(6, 4))
 for a in amplitudes:
     row = res["amplitude"] == a
-    ax.plot(res["temperature"][row], res["mean_step"][row] * 1e6, "o-", ms=3, label=f"{a:g} V")
-ax.set(xlabel="temperature [C]", ylabel="mean step per cycle [um]", title="li2009-model-i, 5 Hz sawtooth")
+    ax.plot(res["temperature"][row], res["mean_step"][row] * 1e6, "o-", ms=3,
+            label=f"{a:g} V")
+ax.set(xlabel="temperature [C]", ylabel="mean step per cycle [um]",
+       title="li2009-model-i, 5 Hz sawtooth")
 ax.legend(title="amplitude")
