@@ -84,32 +84,44 @@ html_show_sourcelink = False
 
 # --- The docstrings' own style -----------------------------------------------------------------------
 # The package's docstrings are plain text: "name: what it is" items with indented continuation lines,
-# and |x| for absolute values. Read as reStructuredText, the items would run into each other and |x|
-# would be a substitution reference. These rewrites (the only ones) make each item a definition-list
-# entry (term "name", the text as its definition) and escape the bars, without changing what they say.
+# indented code or equations after a plain paragraph, and |x| for absolute values. Read as
+# reStructuredText, the items would run into each other, the code would be a quotation and |x| a
+# substitution reference. These rewrites (the only ones) make each item a definition-list entry (term
+# "name", the text as its definition) and each such indented block a literal block, and escape the bars
+# outside inline literals, without changing what the docstrings say.
 
 _ITEM = re.compile(r"([A-Za-z_][\w ,.*()\[\]\"'=-]{0,40}): (\S.*)")
+
+
+def _bars(text):
+    """``|`` escaped outside the ``inline literals``."""
+    parts = text.split("``")
+    return "``".join(p if i % 2 else p.replace("|", r"\|") for i, p in enumerate(parts))
 
 
 def _docstring_as_rst(app, what, name, obj, options, lines):
     if what == "data" and type(obj).__doc__ and lines and "\n".join(lines).strip() == type(obj).__doc__.strip():
         lines[:] = []  # a constant without a docstring of its own: not its type's (dict's, tuple's) docstring
         return
-    out, prev_indent, literal_indent, in_item = [], None, None, False
+    out, prev_indent, literal_indent, in_item, last = [], None, None, False, ""
     for k, line in enumerate(lines):
         stripped = line.lstrip()
         indent = len(line) - len(stripped)
         if stripped and literal_indent is not None and indent <= literal_indent:
             literal_indent = None
+        if (stripped and literal_indent is None and indent > 0 and not in_item and out and not out[-1].strip()
+                and last and not last[0].isspace()):
+            out += ["::", ""]  # an indented block after a plain paragraph: code or an equation, verbatim
+            literal_indent = 0
         if stripped and literal_indent is None:
             after = not out or not out[-1].strip() or in_item or out[-1].rstrip()[-1:] in ".:;"
             item = _ITEM.fullmatch(stripped) if indent == 0 and k > 0 and after else None
             if out and out[-1].strip() and prev_indent is not None and (indent < prev_indent or item):
                 out.append("")  # a dedent or a new "name: ..." item ends the previous paragraph or item
-            line = line.replace("|", r"\|")
+            line = _bars(line)
             if item:  # "name: text" -> the term "name" and its definition "text"
-                out.append(item.group(1).replace("|", r"\|"))
-                line, indent, in_item = "    " + item.group(2).replace("|", r"\|"), 4, True
+                out.append(_bars(item.group(1)))
+                line, indent, in_item = "    " + _bars(item.group(2)), 4, True
             elif in_item and (indent > 0 or out[-1].strip()):
                 line = "    " + line.lstrip()  # the item's continuation lines, at its definition's indent
             else:
@@ -118,6 +130,7 @@ def _docstring_as_rst(app, what, name, obj, options, lines):
                 literal_indent = len(line) - len(line.lstrip())
         if stripped:
             prev_indent = 0 if in_item else indent
+            last = line
         out.append(line)
     lines[:] = out
 
