@@ -69,6 +69,31 @@ def test_cli_reference_lists_the_presets():
     assert re.findall(r"`([\w.-]+)`", common.group(1)) == list(tf.PRESETS)
 
 
+def test_friction_model_tables_are_the_registry():
+    """docs/models.md and docs/formats.md#model-files each have one row per friction model: the
+    registry's names (models.md with their classes), and their required keys are the classes' fields
+    that have no default."""
+    import dataclasses
+    models = re.findall(r"^\| `\"(\w+)\"` \| `tf\.(\w+)` \|", (DOCS / "models.md").read_text(), re.M)
+    assert sorted(models) == sorted((name, cls.__name__) for name, cls in FRICTION_MODELS.items())
+    table = re.search(r"^\| `model` \| required keys \|.*?\n\n", (DOCS / "formats.md").read_text(), re.M | re.S)
+    formats = re.findall(r"^\| `\"(\w+)\"` \| (.*?) \|", table.group(0), re.M)
+    assert sorted(name for name, _ in formats) == sorted(FRICTION_MODELS)
+    for name, required in formats:
+        listed = set(re.findall(r"`(\w+)(?: = \[\.\.\.\])?`", required))
+        fields = {f.name for f in dataclasses.fields(FRICTION_MODELS[name])
+                  if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING}
+        assert listed == fields, name
+
+
+def test_cli_reference_lists_the_methods():
+    cli = (DOCS / "cli.md").read_text()
+    synopsis = re.search(r"thermofriction identify DATASET \[--method \{([\w,-]+)\}\]", cli).group(1)
+    assert synopsis.split(",") == list(METHODS)
+    table = re.search(r"^\| `--method` \| `model-i` \| (.*)$", cli, re.M).group(1)
+    assert re.findall(r"(?:: |, )`([\w-]+)` \(", table) == list(METHODS)
+
+
 def _autosummary_entries(rst):
     names, inside = [], False
     for line in rst.splitlines():
