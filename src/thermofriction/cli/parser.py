@@ -11,6 +11,7 @@ from ..errors import shorten
 from ..models import PRESETS
 from ..simulate import MAX_SAMPLES, SOLVERS
 from .commands import cmd_demo, cmd_identify, cmd_report, cmd_simulate, cmd_validate
+from .presets import add_presets_command
 
 
 def _number(positive):
@@ -193,6 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
     from ..data import add_synth_command  # dataset tools (synth) live with the data module
     add_synth_command(sub)
     _add_sweep_command(sub)
+    add_presets_command(sub)
     return p
 
 

@@ -4,6 +4,7 @@ shipped preset."""
 
 from __future__ import annotations
 
+import difflib
 import os
 import tomllib
 from dataclasses import dataclass, field, fields, replace
@@ -304,6 +305,12 @@ def require_actuator(model: Model, task: str):
 PRESETS = ("li2009-model-i", "li2009-model-ii", "li2009-base", "li2009-self-heating", "canudas1995", "stage-model-i")
 
 
+def preset_hint(name: str) -> str:
+    """For a name that is not a preset: `` (did you mean the preset 'X'?)`` for a near miss, else the list."""
+    close = difflib.get_close_matches(name, PRESETS, n=1, cutoff=0.6)
+    return f" (did you mean the preset '{close[0]}'?)" if close else f" (presets: {', '.join(PRESETS)})"
+
+
 def preset_path(name: str):
     return resources.files("thermofriction").joinpath("presets", f"{name}.toml")
 
@@ -323,7 +330,7 @@ def load_model(source, friction_from=None) -> Model:
         base_dir = None
     else:
         if not exists:
-            hint = f" (presets: {', '.join(PRESETS)})" if os.sep not in source and not source.endswith(".toml") else ""
+            hint = preset_hint(source) if os.sep not in source and not source.endswith(".toml") else ""
             raise InputError(f"{source}: no such file{hint}")
         try:
             text = read_text(p, "model file (TOML)")
@@ -342,4 +349,4 @@ def load_model(source, friction_from=None) -> Model:
 
 
 
-__all__ = ["Model", "model_from_dict", "require_actuator", "PRESETS", "preset_path", "load_model"]
+__all__ = ["Model", "model_from_dict", "require_actuator", "PRESETS", "preset_path", "preset_hint", "load_model"]

@@ -28,7 +28,7 @@ from .result import SimulationResult
 from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 
 #: Default limit on output samples: each takes ~8 x (10 + internal states) bytes of outputs, ~1.1 times
-#: that at the peak (README "Speed": 97 MB for 1,000,001 samples), so 10 million need ~1 GB.
+#: that at the peak (docs/performance.md: 97 MB for 1,000,001 samples), so 10 million need ~1 GB.
 MAX_SAMPLES = 10_000_000
 
 
