@@ -19,7 +19,7 @@ import pytest
 
 import thermofriction as tf
 from conftest import run_cli
-from thermofriction import _io
+from thermofriction import _io, _signals
 
 SIM = ("simulate", "li2009-model-i", "--temperature", "35", "--duration", "0.1", "--sample-rate", "1000")
 ROOT = os.geteuid() == 0
@@ -451,14 +451,11 @@ def test_sigterm_and_sighup_while_writing_remove_the_temporary_file(sig, tmp_pat
 
 def test_signals_wait_while_a_set_is_renamed():
     """Between the renames of a set a signal only is recorded; it takes effect right after."""
-    _io._critical += 1
-    try:
-        _io._handler(signal.SIGTERM, None)  # no exception: deferred
-    finally:
-        _io._critical -= 1
+    with _signals.critical(raise_after=False):
+        _signals._handler(signal.SIGTERM, None)  # no exception: deferred
     with pytest.raises(_io.Terminated) as info:
-        _io._raise_deferred()
-    assert info.value.signum == signal.SIGTERM and not _io._deferred
+        _signals.raise_deferred()
+    assert info.value.signum == signal.SIGTERM and not _signals._deferred
 
 
 def _dead_pid():

@@ -15,15 +15,15 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import os
-import signal
 import stat
 import tempfile
 import threading
 import time
 from pathlib import Path
 
+from ._json import jsonable
+from ._signals import Terminated, critical, install_signal_handlers, raise_deferred, restore_signal_handlers
 from .errors import InputError
 
 #: marks the temporary files this package creates: ``.NAME`` + TMP_TAG + ``PID-XXXX.tmp``
@@ -189,59 +189,8 @@ def _fsync_folder(folder):
             os.close(fd)
 
 
-# -- signals: the command line turns SIGTERM/SIGHUP into an exception so that temporaries are removed --
-
-class Terminated(BaseException):
-    """SIGTERM or SIGHUP arrived (raised by the handler :func:`install_signal_handlers` sets)."""
-
-    def __init__(self, signum):
-        super().__init__(signum)
-        self.signum = signum
-
-
 _state = threading.local()
-_critical = 0        # > 0 while a set of renames runs: signals wait until it is done
-_deferred = []       # signals that arrived meanwhile
 published = []       # targets renamed into place by this process (the CLI's message on a signal)
-
-
-def _handler(signum, frame):
-    if _critical:
-        _deferred.append(signum)
-        return
-    if signum == signal.SIGINT:
-        raise KeyboardInterrupt
-    raise Terminated(signum)
-
-
-def install_signal_handlers() -> dict:
-    """SIGINT raises KeyboardInterrupt and SIGTERM/SIGHUP raise :class:`Terminated`, except while a
-    set of outputs is being renamed into place (then they take effect right after it). Only the
-    command line calls this (a library must not take over a program's signals); returns the
-    previous handlers for :func:`restore_signal_handlers`."""
-    previous = {}
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        with contextlib.suppress(ValueError, OSError):  # not the main thread
-            old = signal.getsignal(s)
-            if old is not signal.SIG_IGN:  # e.g. under nohup: keep ignoring
-                signal.signal(s, _handler)
-                previous[s] = old
-    return previous
-
-
-def restore_signal_handlers(previous: dict):
-    for s, old in previous.items():
-        with contextlib.suppress(ValueError, OSError, TypeError):
-            signal.signal(s, old if old is not None else signal.SIG_DFL)
-
-
-def _raise_deferred():
-    if _deferred:
-        signum = _deferred[0]
-        _deferred.clear()
-        if signum == signal.SIGINT:
-            raise KeyboardInterrupt
-        raise Terminated(signum)
 
 
 class _Staged:
@@ -259,29 +208,25 @@ class _Staged:
         self.files.clear()
 
     def publish(self):
-        global _critical
-        _critical += 1
         label, done = "the outputs", []
-        try:
-            for path in self.remove_before:
-                with contextlib.suppress(FileNotFoundError):
-                    os.unlink(path)
-            for target, tmp in self.files:
-                label = target.label
-                os.replace(tmp, target.real)
-                done.append(target)
-                published.append(target.path)
-            for path in self.remove_after:
-                with contextlib.suppress(FileNotFoundError):
-                    os.unlink(path)
-            for folder in {t.folder for t in done}:
-                _fsync_folder(folder)
-        except OSError as e:
-            self.discard_remaining(done)
-            raise OutputError(f"{label}: cannot write ({_why(e)})", exit_status=1) from None
-        finally:
-            _critical -= 1
-        _raise_deferred()
+        with critical():  # a signal meanwhile takes effect after the whole set, not in its middle
+            try:
+                for path in self.remove_before:
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(path)
+                for target, tmp in self.files:
+                    label = target.label
+                    os.replace(tmp, target.real)
+                    done.append(target)
+                    published.append(target.path)
+                for path in self.remove_after:
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(path)
+                for folder in {t.folder for t in done}:
+                    _fsync_folder(folder)
+            except OSError as e:
+                self.discard_remaining(done)
+                raise OutputError(f"{label}: cannot write ({_why(e)})", exit_status=1) from None
 
     def discard_remaining(self, done):
         for target, tmp in self.files:
@@ -362,14 +307,10 @@ def atomic_write(path, mode="w", **kwargs):
             raise OutputError(f"{target.label}: cannot write ({_why(e)})", exit_status=1) from None
         return
     remove_stale_temporaries(target.folder)
-    global _critical
-    _critical += 1  # a signal between creating the temporary file and the try below would leave it
-    try:
+    with critical(raise_after=False):  # a signal between creating the temporary file and the try would leave it
         fd, tmp = target._mkstemp()
-    finally:
-        _critical -= 1
     try:
-        _raise_deferred()
+        raise_deferred()
         with os.fdopen(fd, mode, **kwargs) as fh:
             yield fh
             fh.flush()
@@ -386,12 +327,9 @@ def atomic_write(path, mode="w", **kwargs):
         if staged is not None:
             staged.files.append((target, tmp))
             return
-        _critical += 1
-        try:
+        with critical(raise_after=False):
             os.replace(tmp, target.real)
             published.append(target.path)
-        finally:
-            _critical -= 1
         _fsync_folder(target.folder)
     except OSError as e:
         _discard(tmp)
@@ -399,38 +337,13 @@ def atomic_write(path, mode="w", **kwargs):
     except BaseException:
         _discard(tmp)
         raise
-    _raise_deferred()
+    raise_deferred()
 
 
 def _discard(tmp):
     """Removes a temporary file; a second signal meanwhile waits (it would skip the removal)."""
-    global _critical
-    _critical += 1
-    try:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-    finally:
-        _critical -= 1
-
-
-def jsonable(obj):
-    """Plain JSON types: arrays to lists, non-finite floats to "inf"/"-inf"/"nan" strings (JSON
-    has none), numpy scalars to Python ones."""
-    import numpy as np
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return jsonable(obj.tolist())
-    if isinstance(obj, (float, np.floating)):
-        x = float(obj)
-        return x if math.isfinite(x) else ("inf" if x > 0 else "-inf" if x < 0 else "nan")
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
+    with critical(raise_after=False), contextlib.suppress(OSError):
+        os.unlink(tmp)
 
 
 def dump_json(data: dict, path=None) -> str:
@@ -443,5 +356,5 @@ def dump_json(data: dict, path=None) -> str:
 
 
 __all__ = ["atomic_write", "publish_together", "refuse_inputs", "Target", "OutputError", "Terminated",
-           "install_signal_handlers", "remove_stale_temporaries", "stale_temporaries", "jsonable", "dump_json",
+           "install_signal_handlers", "restore_signal_handlers", "remove_stale_temporaries", "stale_temporaries", "jsonable", "dump_json",
            "TMP_TAG"]
