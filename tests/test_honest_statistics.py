@@ -55,7 +55,8 @@ def test_integrated_autocorrelation_of_an_ar1_series_analytic(phi):
 
 def test_noise_estimate_says_when_it_cannot_be_trusted():
     """White noise on a smooth signal: trusted and right. AR(1) noise (an estimator's output), a signal with no
-    visible noise, a quantised one: not trusted, with the reason."""
+    visible noise, a quantised one: not trusted, with the reason. A stick-slip record with white noise and 5 nm
+    quantisation (the your-data guide's): trusted."""
     rng = np.random.default_rng(2)
     t = np.linspace(0, 10, 20_000)
     white = np.sin(t) + 0.01 * rng.standard_normal(t.size)
@@ -67,6 +68,9 @@ def test_noise_estimate_says_when_it_cannot_be_trusted():
     assert not noise_check(np.sin(t))[0]
     ok, why = noise_check(np.round(np.sin(t) * 20) / 20)
     assert not ok and ("quantised" in why or "not white" in why)
+    data = tf.synthesize(tf.load_model("li2009-model-i"), [30.5, 41.0], duration=0.4, sample_rate=5000,
+                         noise=20e-9, quantization=5e-9, seed=12)
+    assert all(noise_check(e.displacement)[0] for e in data.experiments)
 
 
 def test_adequacy_is_unknown_not_a_false_alarm_on_a_smooth_estimator_output():
