@@ -141,7 +141,7 @@ def estimate_offset(model: Model, names, traces, variance_inflation=1.0) -> dict
     """The shared offset at ``model`` (``names`` the fitted parameters): the mean of ``F_meas - F_sim`` over
     all traces, and its standard error from the Jacobian augmented with the offset's column of ones (so that
     the parameters' uncertainty is in it)."""
-    return estimate_linear(model, names, traces, None, variance_inflation)[0]
+    return estimate_linear(model, names, traces, None, variance_inflation)[0][0]
 
 
 def estimate_linear(model: Model, names, traces, columns=None, variance_inflation=1.0, at=None):
