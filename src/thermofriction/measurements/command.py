@@ -215,6 +215,16 @@ class DelaySearch:
         return delay, self.residuals(F, delay), se
 
 
+def implied_friction(model, exp):
+    """(velocity, friction) that a command record implies with ``model``'s inertia and delay: ``u(t) - J a(t +
+    delay)`` against ``v(t + delay)`` (the offset left in, as a force sensor's is); a friction record as it is."""
+    if not Command.recognises(exp):
+        return exp.drive_velocity, exp.force
+    d = model.plant.delay
+    return (shifted(exp.time, exp.drive_velocity, -d),
+            np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, acceleration(exp), -d))
+
+
 class Command(Force):
     """A drive's command (force, torque, or current times the torque constant) under a measured motion."""
 
@@ -230,6 +240,17 @@ class Command(Force):
         offset = {"shared": "the shared offset", "none": "the model's offset (held)",
                   "per-experiment": "each experiment's own offset"}[self.offset]
         return f"the inertia term J a and {offset} (fitted)"
+
+    @property
+    def caption(self) -> str:
+        return super().caption.replace("the model's sensor offset removed", "the command predicted with the "
+                                       "model's inertia term and offset")
+
+    @property
+    def footer(self) -> str:
+        return super().footer.replace("the model's sensor offset ([plant] sensor_offset) removed", "the command "
+                                      "predicted with the model's inertia term and offset ([plant] inertia, "
+                                      "sensor_offset, at its delay)")
 
     @property
     def validation_removed(self) -> str:
@@ -284,5 +305,5 @@ class Command(Force):
                 "delay": model.plant.delay}
 
 
-__all__ = ["Command", "CommandTrace", "DelaySearch", "acceleration", "shifted", "delay_scan", "linear_fit", "coulomb_columns",
+__all__ = ["Command", "CommandTrace", "DelaySearch", "implied_friction", "acceleration", "shifted", "delay_scan", "linear_fit", "coulomb_columns",
            "applied_delay", "nuisance_columns", "ACCEL_WINDOW", "MAX_DELAY", "MIN_DELAY_SAMPLES"]
