@@ -68,8 +68,9 @@ def _lugre_run(start: float, duration: float, k: int):
 
 
 def make_command_dataset(folder, *, delay=0.0, current=False, validate=False, duration=4.0, seed=0, manifest=None,
-                         entry=None):
-    """A dataset folder of command runs (the held-out one, with ``validate``, under another motion)."""
+                         entry=None, offsets=(OFFSET, OFFSET), second_role="validate"):
+    """A dataset folder of command runs (the second one, with ``validate``, under another motion, its role
+    ``second_role``; ``offsets`` the runs' command offsets)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
@@ -78,13 +79,13 @@ def make_command_dataset(folder, *, delay=0.0, current=False, validate=False, du
         t = np.arange(0.0, duration, DT)
         x, v, _ = motion(t, k)
         _, _, a_late = motion(t + delay, k)
-        u = J_TRUE * a_late + _lugre_run(delay, duration, k) + OFFSET + rng.normal(0.0, NOISE, t.size)
+        u = J_TRUE * a_late + _lugre_run(delay, duration, k) + offsets[k] + rng.normal(0.0, NOISE, t.size)
         column = "current[A]" if current else "command_torque[N*m]"
         values = u / KT if current else u
         name = f"run{k}.csv"
         np.savetxt(folder / name, np.column_stack([t, x, v, values]), delimiter=",", comments="", fmt="%.12g",
                    header=f"time[s],position[rad],velocity[rad/s],{column}")
-        entries.append({"file": name, "temperature": 25.0, "role": "validate" if k else "fit", **(entry or {})})
+        entries.append({"file": name, "temperature": 25.0, "role": second_role if k else "fit", **(entry or {})})
     meta = {"name": "drive", **(manifest if manifest is not None else ({"torque_constant": KT} if current else {})),
             "experiment": entries}
     (folder / "dataset.toml").write_text(tomli_w.dumps(meta))
@@ -147,8 +148,24 @@ def test_current_times_torque_constant_without_delay(tmp_path):
     bare = tf.models.Model(PrescribedMotion(motion="rotary", sensor_offset=res.model.plant.sensor_offset,
                                             inertia=1e-9), res.model.friction)
     assert tf.validate(bare, data).predictions[1].rmse > 5 * NOISE
+    res.model.save(tmp_path / "fitted.toml")  # J, the offset and the delay travel in the model file
+    again = tf.validate(tf.load_model(tmp_path / "fitted.toml"), data).predictions[1].rmse
+    assert again == pytest.approx(held[0].rmse, rel=1e-6)
     html = tf.report([res], data, tmp_path / "report.html")
     assert "<svg" in html
+
+
+def test_per_experiment_offsets_with_one_inertia(tmp_path):
+    """Two runs whose drive was re-zeroed between them (offsets 0.03 and -0.02 N m): one J for both, each run's
+    offset recovered within its interval."""
+    data = make_command_dataset(tmp_path / "d", validate=True, second_role="fit", offsets=(OFFSET, -0.02),
+                                duration=2.0)
+    res = tf.identify(data, method="base", starts=1, offset="per-experiment")
+    within(res.details["plant"]["inertia"], J_TRUE)
+    runs = res.sensor_offset["per_experiment"]
+    for run, truth in zip(runs, (OFFSET, -0.02)):
+        within(run, truth)
+    assert res.rmse < 1.3 * NOISE
 
 
 def test_saved_and_read_back_is_the_same_command(tmp_path):
