@@ -17,16 +17,18 @@ from .._reading import read_text
 from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
+from .command import check_torque_constant
 from .force import ForceExperiment, check_motion_option, force_experiment, is_force_data, is_force_file, units_of
 from .matlab import force_mat_variables, is_matlab, read_force_mat
 from ..plausible import displacement_problem, kelvin_hint
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
-_MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "experiment")
-_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units", "motion", "flip_sign")
+_MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "torque_constant", "experiment")
+_EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units", "motion", "flip_sign",
+                    "torque_constant")
 #: the manifest's keys that apply to force experiments only (data/force.py), at the top (every experiment)
 #: or in an [[experiment]] entry
-_FORCE_KEYS = ("motion", "flip_sign")
+_FORCE_KEYS = ("motion", "flip_sign", "torque_constant")
 
 
 def _is_inside(f: str) -> bool:
@@ -69,8 +71,11 @@ def _from_zero(time, inp):
 
 
 def _force_options(table: dict, where: str, defaults: dict) -> dict:
-    """The force experiments' options (``motion``, ``flip_sign``) of a manifest table, over ``defaults``."""
+    """The force experiments' options (``motion``, ``flip_sign``, ``torque_constant``: data/command.py) of a
+    manifest table, over ``defaults``."""
     out = dict(defaults)
+    if "torque_constant" in table:
+        out["torque_constant"] = check_torque_constant(table["torque_constant"], where)
     if "motion" in table:
         out["motion"] = check_motion_option(table["motion"], where)
     if "flip_sign" in table:
@@ -126,7 +131,7 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
     description = meta.get("description", "")
     if not isinstance(description, str):
         raise InputError(f"{manifest}: 'description' must be a string, got {description!r}")
-    options = _force_options(meta, str(manifest), {"motion": "auto", "flip_sign": False})
+    options = _force_options(meta, str(manifest), {"motion": "auto", "flip_sign": False, "torque_constant": None})
     entries = meta.get("experiment")
     if entries is None:
         raise InputError(f"{manifest}: no [[experiment]] entries (a dataset needs at least one)")
@@ -185,6 +190,9 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
             exps.append(force_experiment(folder / f, f, temperature=T, role=role, description=desc,
                                          from_zero=_from_zero, struct=e.get("struct"), columns=force_cols,
                                          **opts))
+            if "torque_constant" in e and not (exps[-1].column or "").startswith("current"):
+                raise InputError(f"{where}: 'torque_constant' applies to a current[A] column; {f} records "
+                                 f"{exps[-1].column}")
             continue
         for key in _FORCE_KEYS:
             if key in e or key in meta:
@@ -348,11 +356,11 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
                     entries.append(_entry(e))
                     continue
                 if isinstance(e, ForceExperiment):  # measured motion and friction: its own columns
-                    unit = ("rad", "rad/s", "friction_torque[N*m]") if e.rotary else ("m", "m/s", "friction_force[N]")
+                    unit = ("rad", "rad/s") if e.rotary else ("m", "m/s")
                     cols = {"time[s]": e.time, f"position[{unit[0]}]": e.displacement}
                     if e.velocity is not None:
                         cols[f"velocity[{unit[1]}]"] = e.velocity
-                    cols[unit[2]] = e.force
+                    cols[e.force_column] = e.force  # a command read from a current is written in N or N m
                     if e.temperature_signal is not None:
                         cols["temperature[C]"] = e.temperature_signal
                     with atomic_write(folder / e.file, "w", newline="") as fh:

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import InputError, shorten
 from ..waveforms import Sampled
+from .command import COMMAND_SI, COMMAND_UNITS, MEASURED_KEYS, column_key_of, measured_force
 from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
 from .experiments import MIN_SAMPLES, Experiment
 
@@ -53,12 +54,13 @@ _UNITS = {
     "friction_force": {u: (s, "linear") for u, s in _FORCE.items()},
     "friction_torque": {u: (s, "rotary") for u, s in _TORQUE.items()},
     "temperature": {"C": (1.0, None)},
+    **COMMAND_UNITS,  # a drive's command instead of the friction (data/command.py)
 }
 _UNITS["displacement"] = _UNITS["position"]
 _SI = {"time": "s", "position": "m", "displacement": "m", "velocity": "m/s", "friction_force": "N",
-       "friction_torque": "N*m", "temperature": "C"}
+       "friction_torque": "N*m", "temperature": "C", **COMMAND_SI}
 #: Header names that mark a force (torque) experiment, as opposed to an actuator's (voltage, displacement).
-MARKERS = ("friction_force", "friction_torque", "position", "velocity")
+MARKERS = ("friction_force", "friction_torque", "position", "velocity", *COMMAND_UNITS)
 #: A sampling interval this many times the median one is a gap in the record (warned about).
 GAP_RATIO = 10.0
 #: The integrated velocity may depart from the recorded position by this fraction of the position's range
@@ -147,6 +149,10 @@ class ForceExperiment(Experiment):
     rotary: bool = False
     motion: str | None = None
     motion_check: MotionCheck | None = None
+    #: "friction" (a friction sensor's record) or "command" (a drive's command, or current x torque_constant,
+    #: in ``force``: data/command.py), and the header of the column it was read from
+    measured_quantity: str = "friction"
+    column: str | None = None
 
     @property
     def motion_source(self) -> str:
@@ -170,6 +176,12 @@ class ForceExperiment(Experiment):
     @property
     def force_unit(self) -> str:
         return "N m" if self.rotary else "N"
+
+    @property
+    def force_column(self) -> str:
+        """The header of ``force`` in SI units as a CSV file writes it."""
+        kind = "command" if self.measured_quantity == "command" else "friction"
+        return f"{kind}_torque[N*m]" if self.rotary else f"{kind}_force[N]"
 
 
 def is_force_data(experiments) -> bool:
@@ -446,6 +458,8 @@ def column_key(name: str) -> str:
     """The key of a force file's column in the columns read (:func:`read_force_csv`)."""
     if name == "displacement":
         return "position"
+    if column_key_of(name):
+        return column_key_of(name)
     return "force" if name in ("friction_force", "friction_torque") else name
 
 
@@ -474,9 +488,14 @@ def _parse_header(path, header):
 
 def check_force_columns_present(path, names, where: str, example: str):
     """The columns a force experiment needs (``names``: the keys of :func:`column_key`), or one InputError."""
-    if "force" not in names:
+    measured = [n for n in MEASURED_KEYS if n in names]
+    if not measured:
         raise InputError(f"{path}: {where}no friction_force[N] or friction_torque[N*m] column: a force experiment "
-                         f"records the friction it measures (e.g. {example})")
+                         f"records the friction it measures (e.g. {example}), or, for a drive without a torque "
+                         f"sensor, its command_force[N], command_torque[N*m] or current[A]")
+    if len(measured) > 1:
+        raise InputError(f"{path}: {where}both a friction and a command (current) column: a force experiment "
+                         f"records one of them")
     missing = [n for n in ("time", "position") if n not in names]
     if missing:
         what = "the motion: a position[...] (or displacement[...]) column" if "position" in missing else "time[s]"
@@ -576,13 +595,14 @@ def read_force_csv(path) -> dict:
 
 
 def force_experiment(path, name, *, temperature, role, description, from_zero, motion: str = "auto",
-                     flip_sign: bool = False, struct=None, columns=None) -> ForceExperiment:
+                     flip_sign: bool = False, struct=None, columns=None, torque_constant=None) -> ForceExperiment:
     """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it; ``struct``: the
     MATLAB struct holding the run); ``temperature`` is the manifest's (None: the column's
     mean); ``from_zero`` moves a clock time to start at zero; ``motion`` chooses what drives the model
     (:func:`choose_motion`); ``flip_sign`` negates the friction column (a reaction sensor); the friction's sign
     is then checked (:func:`check_sign`). ``columns``: the file's columns when already read (a MATLAB file's,
-    data/matlab.py: read_force_mat); None reads ``path`` as a CSV file."""
+    data/matlab.py: read_force_mat); None reads ``path`` as a CSV file. A drive's command (or a current times
+    ``torque_constant``) in place of the friction is read by data/command.py: measured_force."""
     cols = read_force_csv(path) if columns is None else columns
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
@@ -591,27 +611,30 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
             raise InputError(f"{path}: no temperature: give 'temperature' in the manifest or a temperature[C] column")
         temperature = float(np.mean(sig))
     v = cols.get("velocity")
-    F = -cols["force"] if flip_sign else cols["force"]
+    F, quantity, column = measured_force(path, cols, torque_constant)
+    F = -F if flip_sign else F
     source, check = choose_motion(path, t, cols["position"], v, motion, cols.get("headers"))
     drive_v = _velocity(t, cols["position"], v if source == "velocity" else None)
-    column = cols.get("headers", {}).get("force", "friction_torque" if cols["rotary"] else "friction_force")
+    column = column or ("friction_torque" if cols["rotary"] else "friction_force")
     if not flip_sign:
         check_sign(path, drive_v, F, column)
     return ForceExperiment(file=name, time=t, voltage=None, displacement=cols["position"], temperature=temperature,
                            temperature_signal=sig, role=role, description=description,
                            input=motion_waveform(t, drive_v), force=F, velocity=v, rotary=cols["rotary"],
-                           struct=struct, motion=source, motion_check=check)
+                           struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
+                           column=column)
 
 
-def write_force_csv(path, time, position, force, *, velocity=None, temperature=None, rotary=False):
-    """Writes a force experiment CSV (SI units in the header), atomically."""
+def write_force_csv(path, time, position, force, *, velocity=None, temperature=None, rotary=False, column=None):
+    """Writes a force experiment CSV (SI units in the header), atomically; ``column`` the force column's header
+    (default the friction's, e.g. ``command_torque[N*m]`` or ``current[A]`` for a drive's command)."""
     from .._io import atomic_write
     head = ["time[s]", "position[rad]" if rotary else "position[m]"]
     data = [time, position]
     if velocity is not None:
         head.append("velocity[rad/s]" if rotary else "velocity[m/s]")
         data.append(velocity)
-    head.append("friction_torque[N*m]" if rotary else "friction_force[N]")
+    head.append(column or ("friction_torque[N*m]" if rotary else "friction_force[N]"))
     data.append(force)
     if temperature is not None:
         head.append("temperature[C]")

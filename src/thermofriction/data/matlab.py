@@ -382,7 +382,8 @@ def force_mat_variables(e) -> dict:
            "position_rad" if rot else "position_m": np.asarray(e.displacement, float)}
     if e.velocity is not None:
         out["velocity_rad_per_s" if rot else "velocity_m_per_s"] = np.asarray(e.velocity, float)
-    out["friction_torque_N_m" if rot else "friction_force_N"] = np.asarray(e.force, float)
+    kind = "command" if getattr(e, "measured_quantity", "friction") == "command" else "friction"
+    out[f"{kind}_torque_N_m" if rot else f"{kind}_force_N"] = np.asarray(e.force, float)
     if e.temperature_signal is not None:
         out["temperature"] = np.asarray(e.temperature_signal, float)
     return out

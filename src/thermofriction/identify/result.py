@@ -217,6 +217,7 @@ class FitResult(Result):
                 how = "fitted, shared by all experiments" if o.get("fitted") else "held (--offset none)"
                 err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
                 lines.append(f"    sensor offset    = {o['value']:.6g}{err} {self.unit} ({how})")
+            lines += _plant_lines(self.details.get("plant"))
         if self.fit_quality is not None:
             q = self.fit_quality
             lines.append(f"    noise (data)     = {amount(q['noise'], self.unit)}; rmse/noise = {q['ratio']:.3g}, "
@@ -293,6 +294,18 @@ class FitResult(Result):
                 f"{rmse}{quality}, {self.wall_time:.3g} s{origin}"
                 f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
                 + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
+
+
+def _plant_lines(plant) -> list:
+    """A drive's inertia and delay (command data: identify/setup.py command_finish), as the report says them."""
+    if not plant:
+        return []
+    J, d = plant["inertia"], plant["delay"]
+    lines = [f"    inertia J        = {J['value']:.6g} +- {J['stderr']:.3g} {J['unit']} (95 %: [{J['ci95'][0]:.5g}, "
+             f"{J['ci95'][1]:.5g}])"]
+    est = f"estimate {d['estimate'] * 1e3:.4g} +- {d['stderr'] * 1e3:.2g} ms"
+    lines.append(f"    delay            = {d['value'] * 1e3:.4g} ms ({est}; {d['note']})")
+    return lines
 
 
 def _verdict(q) -> str:

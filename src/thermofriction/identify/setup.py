@@ -13,7 +13,9 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import InputError
 from ..models import LuGre, Model, PrescribedMotion, StickSlipPlant, load_model
-from ..measurements.force import FD_RTOL
+from ..measurements.command import (MIN_DELAY_SAMPLES, DelaySearch, acceleration, applied_delay, coulomb_columns, delay_scan, nuisance_columns,
+                                    shifted)
+from ..measurements.force import FD_RTOL, Force
 from ..models.plants import rotary_unit
 from .parameters import get_value
 from .problem import Problem, make_traces
@@ -118,6 +120,12 @@ def force_finish(res, experiments, init, measurement):
         est = {"value": init.plant.sensor_offset, "stderr": 0.0, "ci95": (init.plant.sensor_offset,) * 2}
     model = dataclasses.replace(res.model, plant=dataclasses.replace(res.model.plant, sensor_offset=est["value"]))
     est.update(unit=unit, fitted=measurement.offset != "none", policy=measurement.offset)
+    return completed(res, model, est, unit)
+
+
+def completed(res, model, offset: dict, unit: str):
+    """A force fit's result with its model, its offset's estimate and its unit; a rotary joint's parameters in
+    its units."""
     if unit == "N m":  # the equations are the same, the numbers mean angles and torques
         for p in res.parameters.values():
             if p.unit and "C" != p.unit:
@@ -126,31 +134,125 @@ def force_finish(res, experiments, init, measurement):
         q = e.get("fit_quality") or {}
         e["rmse"] = q.get("rmse", e.get("rmse_offset_removed"))
         e["unit"] = unit
-    return dataclasses.replace(res, model=model, sensor_offset=est, unit=unit)
+    return dataclasses.replace(res, model=model, sensor_offset=offset, unit=unit)
 
 
 def estimate_offset(model: Model, names, traces, variance_inflation=1.0) -> dict:
     """The shared offset at ``model`` (``names`` the fitted parameters): the mean of ``F_meas - F_sim`` over
     all traces, and its standard error from the Jacobian augmented with the offset's column of ones (so that
     the parameters' uncertainty is in it)."""
-    plain_measurement = type(traces[0].measurement)("none")
-    plain = [dataclasses.replace(tr, measurement=plain_measurement, held_offset=0.0) for tr in traces]
+    return estimate_linear(model, names, traces, None, variance_inflation)[0][0]
+
+
+def estimate_linear(model: Model, names, traces, columns=None, variance_inflation=1.0, at=None):
+    """The linear parameters profiled out of a fit, at ``model`` (``names`` the fitted parameters): the least
+    squares ``F_sim + columns beta = F_meas`` (``columns`` None: one column of ones, the shared offset), and
+    their standard errors from the Jacobian augmented with those columns (so that the parameters' uncertainty
+    is in them); ``at(r, J)``, where given, transforms the residuals and Jacobian first (a delay's shift).
+    Returns (one dict per column: value, stderr, ci95; the residuals at the estimate)."""
+    plain = [dataclasses.replace(tr, measurement=Force("none"), held_offset=0.0) for tr in traces]
     problem = Problem(model, names, plain, rtol=FD_RTOL, parallel=len(plain) > 1)
     theta = np.array([get_value(model, n) for n in names], float)
     r, J = problem.evaluate(theta, jac=bool(names))
+    if at is not None and r is not None:
+        r, J = at(r, J)
+    X = np.ones((sum(tr.n_residuals for tr in traces), 1)) if columns is None else columns
     if r is None:
-        return {"value": math.nan, "stderr": math.nan, "ci95": (math.nan, math.nan)}
-    offset = -float(r.mean())
-    res = r + offset
-    A = np.column_stack([J, np.ones(r.size)]) if names else np.ones((r.size, 1))
+        return [{"value": math.nan, "stderr": math.nan, "ci95": (math.nan, math.nan)}] * X.shape[1], None
+    beta = np.linalg.lstsq(X, -r, rcond=None)[0]
+    res = r + X @ beta
+    A = np.column_stack([J, X]) if names else X
     dof = max(r.size - A.shape[1], 1)
     s2 = float(res @ res) / dof * variance_inflation
     col = np.linalg.norm(A, axis=0)
     col[col == 0] = 1.0
     cov = np.linalg.pinv((A / col).T @ (A / col), rcond=1e-12) / np.outer(col, col) * s2
-    se = math.sqrt(max(float(cov[-1, -1]), 0.0))
     tq = float(stats.t.ppf(0.975, dof))
-    return {"value": offset, "stderr": se, "ci95": (offset - tq * se, offset + tq * se)}
+    out = []
+    for k, value in enumerate(beta):
+        se = math.sqrt(max(float(cov[A.shape[1] - X.shape[1] + k, A.shape[1] - X.shape[1] + k]), 0.0))
+        out.append({"value": float(value), "stderr": se, "ci95": (float(value) - tq * se, float(value) + tq * se)})
+    return out, res
+
+
+def command_initial(init, method, data, experiments, **options):
+    """The initial model for a drive's command: the delay, the inertia J0 and a first offset by linear least
+    squares ``u(t - delay) = J0 a + b + fc sgn(v) + sigma2 v`` on a scan of delays (measurements/command.py:
+    delay_scan); force data's initial model (:func:`force_initial`) with friction values read off
+    ``u(t - delay) - J0 a``; then the delay again with that model's friction as one more column (its Stribeck
+    curve). The model's [plant]
+    gets J0 and the delay (applied only beyond about a sample)."""
+    if not experiments:
+        raise InputError("the dataset has no experiment with role 'fit'")
+    d0, _, coef, _ = delay_scan(experiments, [coulomb_columns(e) for e in experiments])
+    adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * acceleration(e))
+                for e in experiments]
+    init = force_initial(init, method, data, adjusted, **options)
+    columns = [np.column_stack([coulomb_columns(e), Force().friction_of(init, e)]) for e in experiments]
+    delay, _, coef, dt = delay_scan(experiments, columns)
+    plant = dataclasses.replace(init.plant, inertia=max(float(coef[0]), 0.0), delay=applied_delay(delay, dt))
+    return dataclasses.replace(init, plant=plant)
+
+
+def command_finish(res, experiments, init, measurement):
+    """The fit completed for a drive's command: the inertia J and the offsets (as the policy says) estimated
+    together at the optimum with their standard errors (:func:`estimate_linear` on the acceleration's and the
+    offsets' columns, at the delay), the delay at the fitted friction with its standard error (the curvature of
+    the cost over the delay, the friction held: measurements/command.py DelaySearch), all written into the
+    fitted model's [plant] and ``details["plant"]``."""
+    traces = make_traces(experiments, res.model, measurement)
+    unit, policy = traces[0].unit, measurement.offset
+    names = [p.name for p in res.parameters.varying] if res.n_points else []
+    if policy == "none":  # the model's own offset, held
+        traces = [dataclasses.replace(tr, measured=tr.measured - tr.held_offset) for tr in traces]
+    search = DelaySearch(traces, "shared")
+    m = np.concatenate([tr.measured for tr in traces])
+    plain = [dataclasses.replace(tr, measurement=Force("none"), held_offset=0.0) for tr in traces]
+    r, _ = Problem(res.model, [], plain, rtol=FD_RTOL, parallel=len(plain) > 1).evaluate(np.array([]), jac=False)
+    estimate, _, se = search.best(r + m) if r is not None else (math.nan, None, math.nan)
+    delay = estimate if res.model.plant.delay and math.isfinite(estimate) else 0.0
+    X = search.shift(nuisance_columns(traces, policy), delay)
+    if delay:  # the delay's column, so that its error has the friction's in it: d(model at t + delay)/d delay
+        X = np.column_stack([X, _delay_column(search, r + m, X, m, delay)])
+    ests, _ = estimate_linear(res.model, names, traces, X, res.statistics.get("variance_inflation", 1.0),
+                              at=lambda r, J: (search.shift(r + m, delay) - m, None if J is None else search.shift(J, delay)))
+    if delay:
+        se = ests.pop()["stderr"]
+    inertia, offsets = ests[0], ests[1:]
+    if policy == "shared":
+        offset = offsets[0]
+    elif policy == "per-experiment":
+        offset = {"value": float(np.mean([o["value"] for o in offsets])), "stderr": None, "ci95": None,
+                  "per_experiment": [dict(o, file=tr.name) for o, tr in zip(offsets, traces)]}
+    else:
+        held = init.plant.sensor_offset
+        offset = {"value": held, "stderr": 0.0, "ci95": (held, held)}
+    offset.update(unit=unit, fitted=policy != "none", policy=policy)
+    tq = float(stats.norm.ppf(0.975))
+    plant = {"inertia": dict(inertia, unit="kg m^2" if unit == "N m" else "kg"),
+             "delay": {"value": delay, "estimate": estimate, "stderr": se, "ci95": (estimate - tq * se,
+                                                                                   estimate + tq * se),
+                       "applied": bool(delay), "sampling_interval": search.dt,
+                       "note": "fitted with the friction (the model's friction and acceleration taken at t + delay)"
+                       if delay else f"not applied: the estimate before the fit was within {MIN_DELAY_SAMPLES:g} "
+                                     f"sampling interval ({search.dt * 1e3:.3g} ms)"}}
+    model = dataclasses.replace(res.model, plant=dataclasses.replace(
+        res.model.plant, inertia=max(inertia["value"], 0.0), sensor_offset=offset["value"], delay=delay))
+    out = completed(res, model, offset, unit)
+    out.details["plant"] = plant
+    if not inertia["value"] > 0:
+        out.warnings.append(f"the fitted inertia is not positive ({inertia['value']:.4g} {plant['inertia']['unit']}): "
+                            f"the motion's acceleration does not explain the command; the model holds 0")
+    return out
+
+
+def _delay_column(search, F, X, m, delay):
+    """The derivative of the model's side ``F + J a`` at ``t + delay`` by the delay (J by least squares first;
+    central differences over half a sampling interval either way)."""
+    J = float(np.linalg.lstsq(X, m - search.shift(F, delay), rcond=None)[0][0])
+    model_side = F + J * search.X[:, 0]
+    h = 0.5 * search.dt
+    return (search.shift(model_side, delay + h) - search.shift(model_side, delay - h)) / (2 * h)
 
 
 def _no_finish(res, experiments, init, measurement):
@@ -158,6 +260,8 @@ def _no_finish(res, experiments, init, measurement):
 
 
 #: measurement name -> (the initial model, the result's completion)
-SETUP = {"displacement": (displacement_initial, _no_finish), "force": (force_initial, force_finish)}
+SETUP = {"displacement": (displacement_initial, _no_finish), "force": (force_initial, force_finish),
+         "command": (command_initial, command_finish)}
 
-__all__ = ["SETUP", "PRESET_OF_METHOD", "displacement_initial", "force_initial", "force_finish", "estimate_offset"]
+__all__ = ["SETUP", "PRESET_OF_METHOD", "displacement_initial", "force_initial", "force_finish", "estimate_offset",
+           "estimate_linear", "command_initial", "command_finish"]

@@ -1,7 +1,8 @@
 """Measurements: what an experiment recorded, and how a model is held against it (docs/architecture.md#measurements).
 
-A registry of the measured quantities -- :class:`Displacement` (driven by a voltage) and :class:`Force` (friction
-force or torque under a measured motion). ``identify``, ``validate`` and ``report`` ask a dataset's measurement
+A registry of the measured quantities -- :class:`Displacement` (driven by a voltage), :class:`Force` (friction
+force or torque under a measured motion) and :class:`Command` (a drive's command under a measured motion: friction
+plus the inertia's force). ``identify``, ``validate`` and ``report`` ask a dataset's measurement
 once, with :func:`measurement_of`, and then ask it what they need. A new measured quantity is a module here that
 implements :class:`Measurement` and an entry in :data:`REGISTRY`.
 """
@@ -12,9 +13,10 @@ from ..errors import InputError, shorten
 from .base import OFFSETS, Measurement, MetricWarning, Trace, amount, center
 from .displacement import Displacement, Prediction, step_sizes
 from .force import Force, ForcePrediction, steady_state_curve
+from .command import Command
 
 #: The measured quantities, the most specific first: an experiment is the first one's that recognises it.
-REGISTRY = {"force": Force, "displacement": Displacement}
+REGISTRY = {"command": Command, "force": Force, "displacement": Displacement}
 
 
 def kind_of(exp) -> str:
@@ -29,6 +31,9 @@ def measurement_of(data, *, offset=None) -> Measurement:
     exps = list(getattr(data, "experiments", data))
     kinds = {kind_of(e) for e in exps} or {"displacement"}
     if len(kinds) > 1:
+        if kinds == {"command", "force"}:
+            raise InputError("the dataset mixes experiments that record the friction with ones that record a drive's "
+                             "command (or current); keep them in separate datasets")
         raise InputError("the dataset mixes force (torque) experiments with actuator (voltage, displacement) ones; "
                          "keep them in separate datasets")
     cls = REGISTRY[kinds.pop()]
@@ -41,5 +46,5 @@ def measurement_of(data, *, offset=None) -> Measurement:
     return cls(offset)
 
 
-__all__ = ["Measurement", "MetricWarning", "Trace", "OFFSETS", "Displacement", "Force", "Prediction", "ForcePrediction",
+__all__ = ["Measurement", "MetricWarning", "Trace", "OFFSETS", "Displacement", "Force", "Command", "Prediction", "ForcePrediction",
            "REGISTRY", "measurement_of", "kind_of", "amount", "center", "step_sizes", "steady_state_curve"]

@@ -138,10 +138,14 @@ class Force(Measurement):
                         break
                 else:
                     return None, None
+        return self.profiled(problem.traces, r, J)
+
+    def profiled(self, traces, r, J):
+        """The residuals and Jacobian with the offsets the policy fits profiled out."""
         if self.offset == "shared":
             r, J = center(r, J)
         elif self.offset == "per-experiment":
-            r, J = center_each(r, J, [tr.n_residuals for tr in problem.traces])
+            r, J = center_each(r, J, [tr.n_residuals for tr in traces])
         return r, J
 
     def advice(self, model) -> str:
@@ -184,6 +188,17 @@ class Force(Measurement):
                 (f"RMSE [{unit}]", "rmse_offset_removed", "{:.4g}"), ("NRMSE", "nrmse", "{:.3g}"),
                 ("max error [%]", "max_error_pct", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
 
+    def friction_of(self, model, exp, rtol=1e-8) -> np.ndarray:
+        """The friction force (torque) ``model`` predicts along one experiment's measured motion, on its samples."""
+        d = drive(exp, model, start="model")
+        res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
+                       controller=StepSizeController(rtol=rtol))
+        return res.friction_force
+
+    def predicted(self, model, exp, rtol=1e-8):
+        """(predicted, measured) of one experiment: the friction plus the sensor offset, and the record."""
+        return self.friction_of(model, exp, rtol) + model.plant.sensor_offset, np.asarray(exp.force, float)
+
     def predict(self, model, exp, rtol=1e-8) -> "ForcePrediction":
         """Simulates one force experiment on its own samples and compares the force."""
         if model.plant.type != "prescribed":
@@ -192,11 +207,7 @@ class Force(Measurement):
         if model.plant.rotary != exp.rotary:
             raise InputError(f"{exp.file}: the data are {'rotary' if exp.rotary else 'linear'} but the model's "
                              f"motion is {model.plant.motion}")
-        d = drive(exp, model, start="model")
-        res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
-                       controller=StepSizeController(rtol=rtol))
-        pred = res.friction_force + model.plant.sensor_offset
-        meas = np.asarray(exp.force, float)
+        pred, meas = self.predicted(model, exp, rtol)
         err = pred - meas
         span = float(np.ptp(meas))
         bias = float(np.mean(err))

@@ -158,10 +158,15 @@ class PrescribedMotion:
     friction a torque [N m], and the parameters' units follow (N m/rad, N m s/rad, N m, rad/s;
     :func:`rotary_unit`). ``sensor_offset`` [N or N m]: the constant bias of the force (torque) sensor, fitted
     with the friction from measured force (docs/force-data.md) and added to the predicted measurement; it is
-    not part of the friction."""
+    not part of the friction. ``inertia`` [kg, or kg m^2 for a joint] and ``delay`` [s]: what a drive's
+    command adds to the friction (docs/force-data.md#drives-without-a-torque-sensor): the command recorded at
+    ``t - delay`` is ``F + inertia * a + sensor_offset`` at ``t``; both are fitted from command data and
+    used to predict a command; a simulation of prescribed motion does not use them."""
 
     motion: str = "linear"
     sensor_offset: float = 0.0
+    inertia: float = 0.0
+    delay: float = 0.0
 
     type = "prescribed"
     MOTIONS = ("linear", "rotary")
@@ -169,7 +174,10 @@ class PrescribedMotion:
     def __post_init__(self):
         if self.motion not in self.MOTIONS:
             raise InputError(f"[plant]: 'motion' must be \"linear\" or \"rotary\", got {self.motion!r}")
-        object.__setattr__(self, "sensor_offset", num(self.sensor_offset, "[plant]", "sensor_offset"))
+        for key in ("sensor_offset", "inertia", "delay"):
+            object.__setattr__(self, key, num(getattr(self, key), "[plant]", key))
+        if self.inertia < 0:
+            raise InputError(f"[plant]: 'inertia' must not be negative, got {self.inertia!r}")
 
     @property
     def rotary(self) -> bool:
@@ -183,17 +191,18 @@ class PrescribedMotion:
         d = {"type": self.type}
         if self.rotary:
             d["motion"] = self.motion
-        if self.sensor_offset:
-            d["sensor_offset"] = self.sensor_offset
+        for key in ("sensor_offset", "inertia", "delay"):
+            if getattr(self, key):
+                d[key] = getattr(self, key)
         return d
 
     @classmethod
     def from_dict(cls, d: dict, where="[plant]"):
-        keys = ["type", "motion", "sensor_offset"]
+        keys = ["type", "motion", "sensor_offset", "inertia", "delay"]
         unknown = set(d) - set(keys)
         if unknown:
             raise InputError(f"{where}: {unknown_keys(unknown, keys, 'prescribed motion')}")
-        return cls(**{k: d[k] for k in ("motion", "sensor_offset") if k in d})
+        return cls(**{k: d[k] for k in keys[1:] if k in d})
 
 
 def rotary_unit(unit: str) -> str:

@@ -1,6 +1,6 @@
 """The HTML report: one self-contained file (figures inlined as SVG, no scripts) comparing models on a dataset.
 The page is the data's measurement's: ``displacement.py`` (the paper's figures and tables) or ``force.py``
-(friction-velocity map, presliding loops); ``entries.py`` holds what both share."""
+(friction-velocity map, presliding loops; a drive's command too); ``entries.py`` holds what both share."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from .force import render_force
 from .studies import control_report, heating_report
 
 #: measurement name -> the page that shows it
-PAGES = {"displacement": render, "force": render_force}
+PAGES = {"displacement": render, "force": render_force, "command": render_force}
 
 
 def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..measurements import steady_state_curve
+from ..measurements.command import implied_friction
 from ..models import ModelI, ModelII
 from ..validate import validate
 from .entries import akaike
@@ -77,7 +78,8 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
     top = max(float(np.max(np.abs(e.drive_velocity))) for e in exps)
     for k, e in enumerate(exps):
         stride = max(len(e.time) // 1500, 1)
-        ax.plot(e.drive_velocity[::stride], e.force[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature],
+        v_e, F_e = implied_friction(entries[0].model, e)  # a drive's command: less the first model's J a
+        ax.plot(v_e[::stride], F_e[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature],
                 label="measured" if k == 0 else None)
     v = np.concatenate([-np.geomspace(top, top * 1e-3, 40), np.geomspace(top * 1e-3, top, 40)])
     T_mid = float(np.median(temps))

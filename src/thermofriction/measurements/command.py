@@ -1,0 +1,309 @@
+"""A drive's command under a measured motion (docs/force-data.md#drives-without-a-torque-sensor): the force or
+torque a drive was commanded (or its motor current times the torque constant) moves a single mass (a rotary
+inertia) against friction, so that
+
+    u(t - delay) = F(t) + J a(t) + offset
+
+with F the friction of a prescribed-motion model driven by the measured motion, a the motion's acceleration, J
+the mass (inertia), ``offset`` the command's bias and ``delay`` how late the drive realises its command. The
+residuals are ``F + J a + offset - u(t - delay)``.
+
+- **J and the offset** enter linearly: they are profiled out, as the force sensor's offset is -- the residuals
+  and the Jacobian's columns projected onto the complement of the columns ``[a, 1]`` (per-experiment offsets:
+  one column of ones per run; none: ``[a]`` and the model's own offset) -- and estimated with their standard
+  errors at the optimum (identify/setup.py: command_finish). The fitted model keeps its prescribed motion and
+  holds J, the offset and the delay in its ``[plant]`` (``inertia``, ``sensor_offset``, ``delay``), so that
+  validation predicts a command from a model file alone.
+- **The acceleration** is a Savitzky-Golay derivative (SciPy's ``savgol_filter``: a quadratic fitted by least
+  squares over ACCEL_WINDOW samples, its slope at the centre) of the velocity that drives the model, on a uniform
+  grid at the median sampling interval. A centred window is a symmetric (zero-phase) filter: it delays nothing,
+  so that J a lines up with the friction; it averages the differentiation's noise over the window. (Noise left in
+  ``a`` is an error in a regressor and pulls J towards zero: the position must resolve the acceleration.)
+- **The delay** is read off the data before the fit (:func:`delay_scan`) and applied by shifting the command
+  (linear interpolation, the first value held before the record's start); it is used only where it exceeds
+  about a sample (MIN_DELAY_SAMPLES), else it is 0, and the result says which.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .._lazy import lazy
+from ..data.force import ForceExperiment, _uniform
+from ..errors import InputError
+from .base import Trace
+from .force import FORCE_ADVICE, Force
+
+signal = lazy("scipy.signal")
+
+#: the Savitzky-Golay window of the acceleration [samples, odd] and its polynomial's degree
+ACCEL_WINDOW = 9
+ACCEL_ORDER = 2
+#: the delay scan spans this long either way [s] (at most MAX_DELAY_SAMPLES samples and a quarter of the record)
+MAX_DELAY = 0.05
+MAX_DELAY_SAMPLES = 200
+#: a delay of less than this many sampling intervals is not applied (0)
+MIN_DELAY_SAMPLES = 1.0
+#: the delay is read off the sliding samples, faster than this fraction of the 95th percentile speed
+SCAN_SPEED_FRACTION = 0.2
+#: sliding samples for the sign of the velocity in the linear first estimate: faster than this fraction of the
+#: 95th percentile speed (slower ones ramp linearly through zero, so that noise at rest does not flip it)
+SIGN_FRACTION = 0.02
+
+
+@dataclasses.dataclass
+class CommandTrace(Trace):
+    """A trace of a drive's command: ``measured`` is the command as recorded, ``acceleration`` the motion's
+    [m/s^2 or rad/s^2]."""
+
+    acceleration: np.ndarray | None = None
+    #: the command as recorded, and whether the fit searches the delay (the model has one)
+    command: np.ndarray | None = None
+    search_delay: bool = False
+    delay: float = 0.0
+
+
+def acceleration(exp, window: int = ACCEL_WINDOW) -> np.ndarray:
+    """The acceleration of an experiment's driving motion at its samples (Savitzky-Golay, zero-phase)."""
+    t = np.asarray(exp.time, float)
+    dt, (v,) = _uniform(t, exp.drive_velocity)
+    w = min(window, v.size - (1 - v.size % 2))
+    if w <= ACCEL_ORDER:
+        return np.gradient(np.asarray(exp.drive_velocity, float), t)
+    a = signal.savgol_filter(v, w, ACCEL_ORDER, deriv=1, delta=dt)
+    return np.interp(t, t[0] + dt * np.arange(v.size), a)
+
+
+def shifted(time, values, delay: float) -> np.ndarray:
+    """``values(t - delay)`` at the sample times: linear interpolation, the end values held beyond the record."""
+    t = np.asarray(time, float)
+    return np.interp(t - delay, t, np.asarray(values, float)) if delay else np.asarray(values, float)
+
+
+def sign_of(velocity) -> np.ndarray:
+    """The velocity's sign, ramping linearly through zero below SIGN_FRACTION of the 95th percentile speed."""
+    v = np.asarray(velocity, float)
+    top = float(np.quantile(np.abs(v), 0.95)) if v.size else 0.0
+    return np.clip(v / (SIGN_FRACTION * top), -1.0, 1.0) if top > 0 else np.zeros_like(v)
+
+
+def coulomb_columns(exp) -> np.ndarray:
+    """The regressors of the linear first estimate ``u = J a + b + fc sgn(v) + sigma2 v``."""
+    v = exp.drive_velocity
+    return np.column_stack([acceleration(exp), np.ones(v.size), sign_of(v), v])
+
+
+def sliding(exp) -> np.ndarray:
+    """The samples faster than SCAN_SPEED_FRACTION of the 95th percentile speed (True)."""
+    speed = np.abs(np.asarray(exp.drive_velocity, float))
+    return speed > SCAN_SPEED_FRACTION * float(np.quantile(speed, 0.95))
+
+
+def linear_fit(experiments, columns, delay: float, rows=None):
+    """Least squares of the commands on ``columns`` (one matrix per experiment) at ``t + delay``, over
+    ``rows`` (one mask per experiment; None: all): (coefficients, the sum of squared residuals, the number of
+    samples)."""
+    rows = rows or [slice(None)] * len(columns)
+    A = np.vstack([np.column_stack([shifted(e.time, c, -delay) for c in cols.T])[m]
+                   for e, cols, m in zip(experiments, columns, rows)])
+    u = np.concatenate([np.asarray(e.force, float)[m] for e, m in zip(experiments, rows)])
+    coef, *_ = np.linalg.lstsq(A, u, rcond=None)
+    res = u - A @ coef
+    return coef, float(res @ res), u.size
+
+
+def delay_scan(experiments, columns):
+    """The delay of the commands on the motion: the sum of squared residuals of :func:`linear_fit` on whole
+    sampling intervals either way (MAX_DELAY), a parabola through the least and its neighbours for the fraction.
+    Only the sliding samples count (:func:`sliding`): around a reversal the friction's own lag (presliding) is
+    what a rough friction model gets wrong, and a delay would take it up. Returns (delay [s], its standard error
+    from the parabola's curvature, the coefficients there, the sampling interval)."""
+    exps = list(experiments)
+    dt = float(np.median(np.concatenate([np.diff(np.asarray(e.time, float)) for e in exps])))
+    shortest = min(len(e.time) for e in exps)
+    K = max(1, min(int(round(MAX_DELAY / dt)), MAX_DELAY_SAMPLES, shortest // 4))
+    ks = np.arange(-K, K + 1)
+    rows = [sliding(e) for e in exps]
+    cost = np.array([linear_fit(exps, columns, k * dt, rows)[1] for k in ks])
+    i = int(np.argmin(cost))
+    frac, curvature = 0.0, math.nan
+    if 0 < i < ks.size - 1:
+        curvature = (cost[i - 1] - 2 * cost[i] + cost[i + 1]) / dt ** 2
+        if curvature > 0:
+            frac = float(np.clip(0.5 * (cost[i - 1] - cost[i + 1]) / (cost[i - 1] - 2 * cost[i] + cost[i + 1]),
+                                 -0.5, 0.5))
+    delay = (ks[i] + frac) * dt
+    coef, S, n = linear_fit(exps, columns, delay, rows)
+    dof = max(n - len(coef) - 1, 1)
+    se = math.sqrt(2 * S / dof / curvature) if curvature > 0 else math.nan  # (S'' = 2 sum (dr/dd)^2)
+    return delay, se, coef, dt
+
+
+def applied_delay(delay: float, dt: float) -> float:
+    """The delay applied: ``delay`` where it exceeds MIN_DELAY_SAMPLES sampling intervals, else 0."""
+    return delay if abs(delay) > MIN_DELAY_SAMPLES * dt else 0.0
+
+
+def nuisance_columns(traces, policy: str) -> np.ndarray:
+    """The linear parameters' columns over all traces: the acceleration (J), and the offsets the policy fits."""
+    a = np.concatenate([tr.acceleration for tr in traces])
+    sizes = [tr.n_residuals for tr in traces]
+    if policy == "shared":
+        offsets = [np.ones(a.size)]
+    elif policy == "per-experiment":
+        edges = np.cumsum([0] + sizes)
+        offsets = [((np.arange(a.size) >= lo) & (np.arange(a.size) < hi)).astype(float)
+                   for lo, hi in zip(edges[:-1], edges[1:])]
+    else:
+        offsets = []
+    return np.column_stack([a] + offsets)
+
+
+class DelaySearch:
+    """The delay that leaves the least residuals ``P_d (y(t + d) - u(t))`` (y: the friction, P_d: the projection
+    that profiles J and the offsets out, on the acceleration at t + d) over a grid of whole sampling intervals
+    either way (MAX_DELAY), refined by a parabola through the least cost and its neighbours. The model's side
+    is shifted, not the command: interpolating a noisy record between its samples would average its noise, and
+    a delay half a sample off would look better than the true one."""
+
+    def __init__(self, traces, policy: str, search: bool = True):
+        self.traces = traces
+        self.edges = np.cumsum([0] + [tr.n_residuals for tr in traces])
+        self.dt = float(np.median(np.concatenate([np.diff(tr.time) for tr in traces])))
+        K = max(1, min(int(round(MAX_DELAY / self.dt)), MAX_DELAY_SAMPLES, min(tr.time.size for tr in traces) // 4))
+        self.ks = np.arange(-K, K + 1) if search else np.array([0])
+        held = [tr.held_offset if policy == "none" else 0.0 for tr in traces]
+        self.u = np.concatenate([tr.command - h for tr, h in zip(traces, held)])
+        self.X = nuisance_columns(traces, policy)
+        self._Q = {}
+
+    def shift(self, y, delay: float):
+        """A concatenated vector (or matrix) at each trace's ``t + delay``."""
+        if not delay:
+            return y
+        out = np.empty_like(y)
+        for tr, lo, hi in zip(self.traces, self.edges[:-1], self.edges[1:]):
+            seg = y[lo:hi].reshape(hi - lo, -1)
+            out[lo:hi] = np.column_stack([shifted(tr.time, c, -delay) for c in seg.T]).reshape(y[lo:hi].shape)
+        return out
+
+    def project(self, y, delay: float = 0.0):
+        if delay not in self._Q:
+            self._Q[delay] = np.linalg.qr(self.shift(self.X, delay))[0]
+        Q = self._Q[delay]
+        return y - Q @ (Q.T @ y)
+
+    def residuals(self, F, delay: float):
+        """``P_d (F(t + d) - u(t))``."""
+        return self.project(self.shift(F, delay) - self.u, delay)
+
+    def best(self, F):
+        """(the best delay, the residuals there, its standard error) for the friction ``F`` at the samples."""
+        cost = np.array([float(np.sum(self.residuals(F, k * self.dt) ** 2)) for k in self.ks])
+        i = int(np.argmin(cost))
+        frac, se = 0.0, math.nan
+        if 0 < i < cost.size - 1:
+            den = cost[i - 1] - 2 * cost[i] + cost[i + 1]
+            if den > 0:
+                frac = float(np.clip(0.5 * (cost[i - 1] - cost[i + 1]) / den, -0.5, 0.5))
+                dof = max(F.size - self.X.shape[1] - 1, 1)
+                se = math.sqrt(2 * cost[i] / dof / (den / self.dt ** 2))  # (S'' = 2 sum (dr/dd)^2)
+        delay = float((self.ks[i] + frac) * self.dt)
+        return delay, self.residuals(F, delay), se
+
+
+def implied_friction(model, exp):
+    """(velocity, friction) that a command record implies with ``model``'s inertia and delay: ``u(t) - J a(t +
+    delay)`` against ``v(t + delay)`` (the offset left in, as a force sensor's is); a friction record as it is."""
+    if not Command.recognises(exp):
+        return exp.drive_velocity, exp.force
+    d = model.plant.delay
+    return (shifted(exp.time, exp.drive_velocity, -d),
+            np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, acceleration(exp), -d))
+
+
+class Command(Force):
+    """A drive's command (force, torque, or current times the torque constant) under a measured motion."""
+
+    name = "command"
+    quantity = "drive command (force or torque)"
+
+    @staticmethod
+    def recognises(exp) -> bool:
+        return isinstance(exp, ForceExperiment) and exp.measured_quantity == "command"
+
+    @property
+    def removed(self) -> str:
+        offset = {"shared": "the shared offset", "none": "the model's offset (held)",
+                  "per-experiment": "each experiment's own offset"}[self.offset]
+        return f"the inertia term J a and {offset} (fitted)"
+
+    @property
+    def caption(self) -> str:
+        return super().caption.replace("the model's sensor offset removed", "the command predicted with the "
+                                       "model's inertia term and offset")
+
+    @property
+    def footer(self) -> str:
+        return super().footer.replace("the model's sensor offset ([plant] sensor_offset) removed", "the command "
+                                      "predicted with the model's inertia term and offset ([plant] inertia, "
+                                      "sensor_offset, at its delay)")
+
+    @property
+    def validation_removed(self) -> str:
+        if self.offset == "per-experiment":
+            return super().validation_removed
+        return "the model's inertia term and offset ([plant] inertia, sensor_offset), as fitted"
+
+    def offsets_in(self, traces) -> int:
+        return super().offsets_in(traces) + 1  # the inertia
+
+    def make_trace(self, exp, model) -> CommandTrace:
+        tr = super().make_trace(exp, model)
+        fields = {f.name: getattr(tr, f.name) for f in dataclasses.fields(tr)}
+        return CommandTrace(**fields, acceleration=acceleration(exp), command=np.asarray(exp.force, float),
+                            search_delay=model.plant.delay != 0, delay=model.plant.delay)
+
+    def profiled(self, traces, r, J):
+        """The residuals and Jacobian with J and the offsets profiled out: projected onto the complement of the
+        acceleration's and the offsets' columns (variable projection; the columns do not depend on the
+        parameters, so the projected Jacobian is exact). Where the model has a delay, the delay is profiled out
+        too: the one that leaves the least residuals for this friction (:class:`DelaySearch`), the friction and
+        the acceleration taken at t + delay; the Jacobian is then that at the best delay (its gradient of the
+        cost is exact, by the envelope theorem)."""
+        search = self._search(traces)
+        F = r + search.u  # (Force: r = F - measured, the command as recorded)
+        delay = search.best(F)[0] if traces[0].search_delay else 0.0
+        return search.residuals(F, delay), None if J is None else search.project(search.shift(J, delay), delay)
+
+    def _search(self, traces):
+        key = (id(traces), len(traces), traces[0].search_delay, self.offset)
+        if getattr(self, "_cached", (None,))[0] != key:
+            self._cached = (key, DelaySearch(traces, self.offset, traces[0].search_delay))
+        return self._cached[1]
+
+    def advice(self, model) -> str:
+        return (FORCE_ADVICE + "; for a drive's command: check the torque constant, and that the position resolves "
+                "the acceleration (docs/force-data.md#drives-without-a-torque-sensor)")
+
+    def check_model(self, model, experiments):
+        super().check_model(model, experiments)
+        if not model.plant.inertia > 0:
+            raise InputError("a drive's command is predicted with the moving part's inertia ([plant] inertia), and "
+                             "this model has none: fit the model to command data (identify), or give it")
+
+    def predicted(self, model, exp, rtol=1e-8):
+        """(predicted, measured): ``F + J a + offset`` at ``t + delay``, and the command as recorded."""
+        pred = self.friction_of(model, exp, rtol) + model.plant.inertia * acceleration(exp) + model.plant.sensor_offset
+        return shifted(exp.time, pred, -model.plant.delay), np.asarray(exp.force, float)
+
+    def validation_extras(self, model) -> dict:
+        return {"sensor_offset": model.plant.sensor_offset, "inertia": model.plant.inertia,
+                "delay": model.plant.delay}
+
+
+__all__ = ["Command", "CommandTrace", "DelaySearch", "implied_friction", "acceleration", "shifted", "delay_scan", "linear_fit", "coulomb_columns",
+           "applied_delay", "nuisance_columns", "ACCEL_WINDOW", "MAX_DELAY", "MIN_DELAY_SAMPLES"]
