@@ -25,17 +25,18 @@ from __future__ import annotations
 import csv
 import dataclasses
 import functools
-import math
 import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError, shorten
-from ..waveforms import Sampled
 from .command import COMMAND_SI, COMMAND_UNITS, MEASURED_KEYS, column_key_of, measured_force
 from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
 from .experiments import MIN_SAMPLES, Experiment
+from .motion import (MOTIONS, POSITION_MISMATCH_ERROR, MotionCheck, MotionWarning, SamplingWarning, check_motion,
+                     check_motion_option, choose_motion, motion_waveform, quantum, v_smooth_for, velocity_lag,
+                     velocity_of, velocity_resolution, velocity_scale, with_v_smooth)
 
 _LINEAR_POSITION = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9}
 _ROTARY_POSITION = {"rad": 1.0, "deg": np.pi / 180.0}
@@ -63,75 +64,13 @@ _SI = {"time": "s", "position": "m", "displacement": "m", "velocity": "m/s", "fr
 MARKERS = ("friction_force", "friction_torque", "position", "velocity", *COMMAND_UNITS)
 #: A sampling interval this many times the median one is a gap in the record (warned about).
 GAP_RATIO = 10.0
-#: The integrated velocity may depart from the recorded position by this fraction of the position's range
-#: before it is an error (a wrong unit in a header, typically), unless the position drives the model.
-POSITION_MISMATCH_ERROR = 0.5
 EXAMPLE = "time[s],position[rad],velocity[rad/s],friction_torque[N*m]"
 
-#: What drives the model: "auto" (the velocity column where it is the position's derivative, else the
-#: position), "position" (its derivative, the velocity column ignored), "velocity" (the column, as it is).
-MOTIONS = ("auto", "position", "velocity")
-#: "auto" rejects a velocity column lagging (or leading) the position's derivative by more than this many
-#: sampling intervals ...
-LAG_LIMIT = 1.0
-#: ... or whose scale departs from the derivative's by more than this fraction ...
-SCALE_TOLERANCE = 0.05
-#: ... or whose correlation with the derivative (at the best lag) is below this.
-MIN_CORRELATION = 0.5
-#: The lag search spans at most this long either way [s] (and a quarter of the record).
-MAX_LAG = 2.0
 #: The sign check: sliding samples are those faster than this fraction of the 95th percentile speed; a
 #: friction column whose sign (the offset removed) opposes the velocity's on at least OPPOSED_FRACTION of them
 #: is refused.
 SLIDING_FRACTION = 0.05
 OPPOSED_FRACTION = 0.75
-#: with_v_smooth: v_smooth = this many velocity steps (the data resolve no slower sliding than one step).
-V_SMOOTH_STEPS = 1.0
-
-
-class SamplingWarning(UserWarning):
-    """A force experiment's record has a gap, or its velocity and position disagree."""
-
-
-class MotionWarning(SamplingWarning):
-    """A velocity column is not the position's derivative (lag, scale or shape): the numbers and the motion
-    that drives the model."""
-
-
-@dataclasses.dataclass(frozen=True)
-class MotionCheck:
-    """How a velocity column compares with the position's derivative (:func:`check_motion`).
-
-    ``lag`` [s]: how late the column is (positive: it lags the derivative); ``lag_samples``: the same in median
-    sampling intervals; ``scale``: the column over the derivative (1 for the same quantity in the same unit);
-    ``correlation``: their correlation coefficient at that lag."""
-
-    lag: float
-    lag_samples: float
-    scale: float
-    correlation: float
-
-    @property
-    def problems(self) -> list:
-        """Why the column is not the position's derivative, as phrases ([] when it is)."""
-        out = []
-        if not self.correlation >= MIN_CORRELATION:
-            out.append(f"it correlates with the position's derivative only at r = {self.correlation:.2f} "
-                       f"(below {MIN_CORRELATION:g})")
-        if not abs(self.lag_samples) <= LAG_LIMIT:
-            out.append(f"it {'lags' if self.lag > 0 else 'leads'} the position's derivative by "
-                       f"{abs(self.lag) * 1e3:.3g} ms ({abs(self.lag_samples):.3g} sampling intervals; the limit is "
-                       f"{LAG_LIMIT:g})")
-        if not math.isfinite(self.scale):
-            out.append("its scale against the derivative cannot be measured")
-        elif not abs(self.scale - 1.0) <= SCALE_TOLERANCE:
-            out.append(f"its scale is {self.scale:.4g} times the derivative's (more than {100 * SCALE_TOLERANCE:g} % "
-                       f"off)")
-        return out
-
-    @property
-    def agrees(self) -> bool:
-        return not self.problems
 
 
 @dataclasses.dataclass(eq=False)
@@ -164,7 +103,7 @@ class ForceExperiment(Experiment):
     @property
     def drive_velocity(self) -> np.ndarray:
         """The velocity the model is driven with at the sample times."""
-        return _velocity(self.time, self.displacement, self.velocity if self.motion_source == "velocity" else None)
+        return velocity_of(self.time, self.displacement, self.velocity if self.motion_source == "velocity" else None)
 
     @functools.cached_property
     def velocity_resolution(self) -> float | None:
@@ -204,208 +143,6 @@ def units_of(experiments) -> bool:
         raise InputError(f"the dataset mixes rotary ({rot}) and linear ({lin}) experiments: one joint or one "
                          f"stage per dataset")
     return kinds == {True}
-
-
-def _velocity(time, position, velocity):
-    if velocity is not None:
-        return np.asarray(velocity, float)
-    return np.gradient(np.asarray(position, float), np.asarray(time, float))
-
-
-def motion_waveform(time, velocity) -> Sampled:
-    """A continuous position whose slope is ``velocity[i]`` on each sample's half-intervals either side: knots
-    at the samples and at the midpoints between them, positions by the trapezoidal rule at the samples. At a
-    sample time both one-sided slopes equal the sample's velocity, so the model sees it exactly there."""
-    t = np.asarray(time, float)
-    v = np.asarray(velocity, float)
-    dt = np.diff(t)
-    x = np.concatenate([[0.0], np.cumsum(0.5 * dt * (v[:-1] + v[1:]))])
-    knots = np.empty(2 * len(t))
-    values = np.empty_like(knots)
-    knots[0::2], values[0::2] = t, x
-    knots[1:-1:2], values[1:-1:2] = t[:-1] + 0.5 * dt, x[:-1] + 0.5 * dt * v[:-1]
-    # half an interval beyond the last sample, so that the velocity there is the last sample's too (a
-    # sampled waveform is held constant after its last knot)
-    knots[-1], values[-1] = t[-1] + 0.5 * dt[-1], x[-1] + 0.5 * dt[-1] * v[-1]
-    return Sampled(knots, values)
-
-
-# -- the velocity column against the position ----------------------------------------------------
-
-def _uniform(time, *signals):
-    """The signals linearly interpolated onto a uniform grid at the median sampling interval: (dt, arrays)."""
-    t = np.asarray(time, float)
-    dt = float(np.median(np.diff(t)))
-    n = int(math.floor((t[-1] - t[0]) / dt)) + 1
-    tu = t[0] + dt * np.arange(n)
-    return dt, [np.interp(tu, t, np.asarray(s, float)) for s in signals]
-
-
-def velocity_lag(time, position, velocity, max_lag: float = MAX_LAG):
-    """How late ``velocity`` is on the position's derivative: (lag [s], lag in median sampling intervals,
-    correlation coefficient at that lag). Both signals are interpolated onto a uniform grid at the median
-    interval, the derivative taken there by central differences (no lag of its own); the lag is the peak of
-    their cross-correlation within ``max_lag`` either way (and a quarter of the record), refined to a fraction
-    of an interval by a parabola through the peak and its neighbours. A positive lag means the column comes
-    late: velocity(t) ~ d position/dt (t - lag)."""
-    dt, (x, v) = _uniform(time, position, velocity)
-    a = np.gradient(x, dt)
-    a = a - a.mean()
-    b = v - v.mean()
-    n = a.size
-    if n < 4 or not (np.any(a) and np.any(b)):
-        return 0.0, 0.0, 0.0
-    k_max = max(1, min(n // 4, int(round(max_lag / dt))))
-    size = 1 << int(math.ceil(math.log2(2 * n)))
-    r = np.fft.irfft(np.fft.rfft(b, size) * np.conj(np.fft.rfft(a, size)), size)  # r[k] = sum_j b[j + k] a[j]
-    lags = np.arange(-k_max, k_max + 1)
-    # each lag normalised by the energies of its own overlap (j and j + k both in the record): a correlation
-    # coefficient at every lag, without the taper of a plain sum that pulls the peak towards lag 0
-    ca, cb = np.concatenate([[0.0], np.cumsum(a * a)]), np.concatenate([[0.0], np.cumsum(b * b)])
-    lo_a, hi_a = np.maximum(0, -lags), n - np.maximum(0, lags)
-    ea, eb = ca[hi_a] - ca[lo_a], cb[hi_a + lags] - cb[lo_a + lags]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        c = np.nan_to_num(r[lags % size] / np.sqrt(ea * eb))
-    i = int(np.argmax(c))
-    frac = 0.0
-    if 0 < i < c.size - 1:
-        den = c[i - 1] - 2 * c[i] + c[i + 1]
-        if den < 0:
-            frac = float(np.clip(0.5 * (c[i - 1] - c[i + 1]) / den, -0.5, 0.5))
-    k = float(lags[i]) + frac
-    return k * dt, k, float(c[i])
-
-
-def velocity_scale(time, position, velocity, lag: float = 0.0, window: int = 5) -> float:
-    """The velocity column's scale on the position's derivative: the position's increments over ``window``
-    samples regressed on the column's integral over the same spans (trapezoidal, shifted by ``lag``), with a
-    constant; the scale is one over the slope. Integrating averages the column's quantisation and noise out;
-    the position's noise enters the response only, so it biases nothing (a regression on the differentiated
-    position would be biased low by it), and the constant takes up a bias of the column (a drift that the
-    whole record's integral would accumulate)."""
-    t = np.asarray(time, float)
-    x = np.asarray(position, float)
-    v = np.asarray(velocity, float)
-    V = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(t) * (v[:-1] + v[1:]))])
-    keep = (t + lag >= t[0]) & (t + lag <= t[-1])
-    ts, xs = t[keep], x[keep]
-    Vs = np.interp(ts + lag, t, V)
-    m = max(1, min(int(window), ts.size // 4))
-    dx, dV = xs[m:] - xs[:-m], Vs[m:] - Vs[:-m]
-    if dV.size < 3 or not np.ptp(dV) > 0:
-        return math.nan
-    A = np.column_stack([dV - dV.mean(), np.ones(dV.size)])
-    slope = float(np.linalg.lstsq(A, dx, rcond=None)[0][0])
-    return 1.0 / slope if slope != 0 else math.inf
-
-
-def check_motion(time, position, velocity) -> MotionCheck:
-    """The velocity column against the position's derivative: lag, scale and correlation (:class:`MotionCheck`)."""
-    lag, lag_samples, corr = velocity_lag(time, position, velocity)
-    return MotionCheck(lag=lag, lag_samples=lag_samples, scale=velocity_scale(time, position, velocity, lag),
-                       correlation=corr)
-
-
-def check_motion_option(value, where: str) -> str:
-    """``value`` as a motion option, or one InputError naming ``where``."""
-    if value not in MOTIONS:
-        raise InputError(f"{where}: 'motion' must be one of {', '.join(repr(m) for m in MOTIONS)}, got "
-                         f"{shorten(value)}")
-    return value
-
-
-def choose_motion(path, time, position, velocity, motion: str = "auto", headers=None):
-    """What drives the model of one experiment: ("velocity" | "position", the MotionCheck or None). With
-    "auto" a velocity column drives it when it agrees with the position's derivative; a column that does not
-    is named with its numbers in one MotionWarning. A column that, integrated, departs from the position by
-    more than POSITION_MISMATCH_ERROR of its range is an InputError (a wrong unit, typically) unless the
-    position was asked for."""
-    motion = check_motion_option(motion, str(path))
-    if velocity is None:
-        if motion == "velocity":
-            raise InputError(f"{path}: motion = \"velocity\" asks for a velocity column, and the file has none")
-        return "position", None
-    if motion == "position":
-        return "position", None
-    head = headers or {}
-    vname, xname = head.get("velocity", "velocity"), head.get("position", "position")
-    t, x, v = (np.asarray(a, float) for a in (time, position, velocity))
-    span = float(np.ptp(x))
-    moved = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(t) * (v[:-1] + v[1:]))])
-    dev = float(np.max(np.abs(moved - (x - x[0])))) if span > 0 else 0.0
-    check = check_motion(t, x, v)
-    if span > 0 and dev > POSITION_MISMATCH_ERROR * span:
-        raise InputError(f"{path}: the velocity column {vname}, integrated over time, departs from the position "
-                         f"column {xname} by {dev / span:.3g} of the position's range (the velocity is "
-                         f"{check.scale:.4g} times the position's derivative): check the units in the header, or "
-                         f"give motion = \"position\" to drive the model from the position alone")
-    if check.agrees:
-        return "velocity", check
-    problems = "; ".join(check.problems)
-    if motion == "velocity":
-        warnings.warn(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; it "
-                      f"drives the model as asked (motion = \"velocity\")", MotionWarning, stacklevel=3)
-        return "velocity", check
-    warnings.warn(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; the "
-                  f"position drives the model (motion = \"auto\"; motion = \"velocity\" uses the column as it is)",
-                  MotionWarning, stacklevel=3)
-    return "position", check
-
-
-# -- quantisation ----------------------------------------------------------------------------------
-
-def quantum(values, tolerance: float = 0.05, share: float = 0.9) -> float | None:
-    """The step of a quantised signal (a firmware's fixed-point velocity, an encoder's counts), or None when
-    it is not quantised. The step is the median of the spacings of its distinct values that are single steps
-    (below 1.5 times the smallest spacing); the signal is quantised when ``share`` of those spacings are whole
-    multiples of the step (up to 20) to within ``tolerance`` steps (a continuous signal's smallest spacing is
-    far below its typical one, which then is no small multiple of it). (Spacings rather than a global lattice: a logger's float32 numbers, or counts scaled
-    by a gear ratio, drift off any one lattice by a fraction of a step over thousands of steps.)"""
-    a = np.asarray(values, float)
-    a = a[np.isfinite(a)]
-    u = np.unique(a)
-    if u.size < 3:
-        return None
-    span = float(u[-1] - u[0])
-    d = np.diff(u)
-    d = d[d > 1e-9 * span]
-    if not d.size:
-        return None
-    q = float(np.median(d[d < 1.5 * d.min()]))
-    k = d / q
-    whole = (np.abs(k - np.round(k)) <= tolerance) & (k < 20.5)
-    return q if float(np.mean(whole)) >= share else None
-
-
-def velocity_resolution(time, position, velocity=None) -> float | None:
-    """The resolution of the velocity that drives a model [m/s or rad/s]: the step of a quantised velocity
-    column; without one (the position drives), the position's step over the median sampling interval, the
-    smallest velocity its derivative resolves. None when neither is quantised."""
-    if velocity is not None:
-        return quantum(velocity)
-    qx = quantum(position)
-    if qx is None:
-        return None
-    return qx / float(np.median(np.diff(np.asarray(time, float))))
-
-
-def v_smooth_for(experiments, steps: float = V_SMOOTH_STEPS) -> float | None:
-    """The sign smoothing ``v_smooth`` the data support: ``steps`` times the coarsest velocity resolution of the
-    experiments (a dataset or a list), None when no experiment's velocity is quantised."""
-    res = [e.velocity_resolution for e in getattr(experiments, "experiments", experiments)
-           if getattr(e, "velocity_resolution", None) is not None]
-    return steps * max(res) if res else None
-
-
-def with_v_smooth(model, experiments, steps: float = V_SMOOTH_STEPS):
-    """``model`` with its friction's ``v_smooth`` set from the data (:func:`v_smooth_for`), never below the
-    model's own; the model unchanged when the data's velocity is not quantised or the friction model has no
-    ``v_smooth``."""
-    value = v_smooth_for(experiments, steps)
-    current = getattr(model.friction, "v_smooth", None)
-    if value is None or current is None or value <= current:
-        return model
-    return model.with_friction(v_smooth=value)
 
 
 # -- sign convention -------------------------------------------------------------------------------
@@ -614,7 +351,7 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
     F, quantity, column = measured_force(path, cols, torque_constant)
     F = -F if flip_sign else F
     source, check = choose_motion(path, t, cols["position"], v, motion, cols.get("headers"))
-    drive_v = _velocity(t, cols["position"], v if source == "velocity" else None)
+    drive_v = velocity_of(t, cols["position"], v if source == "velocity" else None)
     column = column or ("friction_torque" if cols["rotary"] else "friction_force")
     if not flip_sign:
         check_sign(path, drive_v, F, column)
@@ -648,4 +385,5 @@ def write_force_csv(path, time, position, force, *, velocity=None, temperature=N
 __all__ = ["ForceExperiment", "SamplingWarning", "MotionWarning", "MotionCheck", "MOTIONS", "read_force_csv",
            "force_experiment", "is_force_file", "is_force_data", "units_of", "motion_waveform", "write_force_csv",
            "GAP_RATIO", "velocity_lag", "velocity_scale", "check_motion", "choose_motion", "quantum",
-           "velocity_resolution", "v_smooth_for", "with_v_smooth", "check_sign"]
+           "velocity_resolution", "v_smooth_for", "with_v_smooth", "check_sign", "check_motion_option",
+           "POSITION_MISMATCH_ERROR"]

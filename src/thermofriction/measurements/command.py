@@ -32,7 +32,8 @@ import math
 import numpy as np
 
 from .._lazy import lazy
-from ..data.force import ForceExperiment, _uniform
+from ..data.force import ForceExperiment
+from ..data.motion import on_uniform_grid
 from ..errors import InputError
 from .base import Trace
 from .force import FORCE_ADVICE, Force
@@ -69,7 +70,7 @@ class CommandTrace(Trace):
 def acceleration(exp, window: int = ACCEL_WINDOW) -> np.ndarray:
     """The acceleration of an experiment's driving motion at its samples (Savitzky-Golay, zero-phase)."""
     t = np.asarray(exp.time, float)
-    dt, (v,) = _uniform(t, exp.drive_velocity)
+    dt, (v,) = on_uniform_grid(t, exp.drive_velocity)
     w = min(window, v.size - (1 - v.size % 2))
     if w <= ACCEL_ORDER:
         return np.gradient(np.asarray(exp.drive_velocity, float), t)
