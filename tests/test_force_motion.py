@@ -311,3 +311,18 @@ def test_lookalike_experiments_in_memory_are_loaded_as_files_are(tmp_path):
         assert a.motion_source == b.motion_source == "position"
         for name in ("time", "displacement", "velocity", "force"):
             np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-11, atol=1e-12, err_msg=name)
+
+
+def test_identify_derives_v_smooth_from_a_quantised_velocity():
+    """A firmware velocity quantised in 0.063 rad/s steps (look-alike data): a start whose v_smooth is left at its
+    default (1e-6) is fitted with v_smooth one step; a v_smooth the start gives is kept."""
+    import thermofriction as tf
+    from lookalike import lookalike_experiments
+    data, _ = lookalike_experiments(offsets=(0.0, 0.0), lag=0.0, velocity_step=0.063, motion="velocity", seed=3,
+                                    duration=4.0)
+    start = tf.Model(tf.PrescribedMotion(motion="rotary"), tf.Stribeck(fc=0.4, fs=0.5, vs=0.1, sigma2=0.1))
+    fit = tf.identify(data, "base", init=start, starts=1)
+    assert fit.model.friction.v_smooth == pytest.approx(0.063, rel=0.05)
+    given = tf.Model(tf.PrescribedMotion(motion="rotary"),
+                     tf.Stribeck(fc=0.4, fs=0.5, vs=0.1, sigma2=0.1, v_smooth=0.01))
+    assert tf.identify(data, "base", init=given, starts=1).model.friction.v_smooth == 0.01

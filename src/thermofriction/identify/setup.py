@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from .._lazy import lazy
+from ..data.motion import with_v_smooth
 from ..errors import InputError
 from ..models import LuGre, Model, PrescribedMotion, StickSlipPlant, load_model
 from ..measurements.command import (MIN_DELAY_SAMPLES, DelaySearch, acceleration, applied_delay, coulomb_columns, delay_scan, nuisance_columns,
@@ -73,7 +74,16 @@ def force_initial(init, method, data, experiments, *, friction=None, free=(), pr
         init = with_friction_model(init, friction)
     if init.heat is not None:
         raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet")
-    return init
+    return _v_smooth_from_data(init, experiments)
+
+
+def _v_smooth_from_data(init, experiments):
+    """A friction model whose ``v_smooth`` is left at its default gets one velocity step of the data where the
+    velocity is quantised (a firmware's fixed steps): far below a step, a static model chatters at rest."""
+    default = {f.name: f.default for f in dataclasses.fields(init.friction)}.get("v_smooth")
+    if default is None or getattr(init.friction, "v_smooth", None) != default:
+        return init
+    return with_v_smooth(init, experiments)
 
 
 def _rotary(experiments) -> bool:
