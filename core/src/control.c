@@ -109,13 +109,15 @@ static int loop_check(tf_loop *L, long n, const double *x_ref, const double *v_r
         return stop(L, B, "loop", "compensation (kind)", -1);
     int ff = L->compensation == TF_COMP_FEEDFORWARD;
     if (ff && !v_ref) return stop(L, B, "reference", "v_ref (NULL)", -1);
+    if (!(isfinite(L->mass) && L->mass > 0.0)) return stop(L, B, "loop", "mass (finite, > 0)", -1);
+    if (!(isfinite(L->dt) && L->dt > 0.0)) return stop(L, B, "loop", "dt (finite, > 0)", -1);
+    if (L->substeps < 1) return stop(L, B, "loop", "substeps (1 or more)", -1);
+    if ((double)n * L->substeps > TF_LOOP_MAX_SUBSTEPS) /* the work of one call is bounded */
+        return stop(L, B, "loop", "n x substeps (at most 1e8 plant substeps in one run)", -1);
     for (long i = 0; i < n; i++) {
         if (!isfinite(x_ref[i])) return stop(L, B, "reference", "x_ref (not finite)", i);
         if (ff && !isfinite(v_ref[i])) return stop(L, B, "reference", "v_ref (not finite)", i);
     }
-    if (!(isfinite(L->mass) && L->mass > 0.0)) return stop(L, B, "loop", "mass (finite, > 0)", -1);
-    if (!(isfinite(L->dt) && L->dt > 0.0)) return stop(L, B, "loop", "dt (finite, > 0)", -1);
-    if (L->substeps < 1) return stop(L, B, "loop", "substeps (1 or more)", -1);
     if (!gains_ok(L->pid.kp, L->pid.ki, L->pid.kd, L->pid.tau_d))
         return stop(L, B, "pid", "gains (finite; tau_d >= 0)", -1);
     if (!L->plant) return stop(L, B, "plant", "plant (NULL)", -1);

@@ -459,6 +459,7 @@ const char *tf_status_message(int status)
     case TF_ERR_MAX_STEPS: return "the maximum number of steps was reached";
     case TF_ERR_BAD_ARGUMENT: return "invalid solver arguments";
     case TF_ERR_NO_MEMORY: return "out of memory";
+    case TF_ERR_INTERRUPTED: return "interrupted";
     default: return "unknown error";
     }
 }
@@ -591,6 +592,7 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
     /* AUTO bookkeeping: the explicit method's recent cost, the probe, the lock-out */
     double win_t = t, win_work = 0.0, explicit_rate = 0.0, probe_t = 0.0, probe_work = 0.0;
     long win_steps = 0, probe_steps = 0, lock_steps = 0, lock_len = FIRST_LOCK;
+    int poll = TF_POLL_STEPS; /* steps to the next interrupt poll */
     if (!f0 || !yd || !g0 || !atol_x) { status = TF_ERR_NO_MEMORY; st->status = status; goto done; }
 
     while (next < n_out && t_out[next] <= t) emit(next, t_out[next], y, emit_ctx), next++;
@@ -628,6 +630,10 @@ int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_ou
         int jac_current = 0;
         while (t < seg_end) {
             if (st->steps + st->rejected >= opt->max_steps) { status = fail(&w, TF_ERR_MAX_STEPS, t, h); goto done; }
+            if (opt->interrupt && --poll <= 0) {
+                poll = TF_POLL_STEPS;
+                if (opt->interrupt(opt->interrupt_ctx)) { status = fail(&w, TF_ERR_INTERRUPTED, t, h); goto done; }
+            }
             if (opt->hmax > 0) h = fmin(h, opt->hmax);
             int last = 0;
             if (t + 1.01 * h >= seg_end) { h = seg_end - t; last = 1; }

@@ -25,6 +25,8 @@ static void emit_record(long i, double t, const double *y, void *ctx)
     memcpy(r->y + i * r->dim, y, sizeof(double) * r->dim);
 }
 
+static void emit_none(long i, double t, const double *y, void *ctx);
+
 /* harmonic oscillator x'' = -w^2 x */
 static int osc_rhs(double t, const double *y, double *dy, void *ctx)
 {
@@ -73,6 +75,36 @@ static void test_oscillator_dense_output(int method)
     CHECK(worst < 1e-6, "oscillator method %d dense output error %g", method, worst);
     CHECK(st.steps < 2000, "oscillator method %d took %ld steps", method, st.steps);
     free(t); free(buf);
+}
+
+/* The interrupt poll (tf_solver_options.interrupt): a long integration stops within TF_POLL_STEPS
+ * steps of the poll's answer, with TF_ERR_INTERRUPTED and the state where it stopped (the oscillator's
+ * energy, conserved by the exact solution, tells that it is a real state of the run). */
+static int polls_left(void *ctx) { return --*(int *)ctx <= 0; }
+static void test_interrupt_poll_stops_a_long_integration(int method)
+{
+    double w = 2.0 * 3.14159265358979;
+    tf_ode ode = {2, &w, osc_rhs, osc_jac, 0};
+    double atol[2] = {1e-10, 1e-10}, t[2] = {0.0, 1e6}, y[2] = {1.0, 0.0};
+    int polls = 5;
+    tf_solver_options opt = {.method = method, .rtol = 1e-8, .atol = atol, .max_steps = 1000000000L,
+                             .interrupt = polls_left, .interrupt_ctx = &polls};
+    tf_solver_stats st;
+    int status = tf_solve(&ode, &opt, t, 2, y, emit_none, 0, &st);
+    CHECK(status == TF_ERR_INTERRUPTED && st.status == TF_ERR_INTERRUPTED && polls == 0,
+          "interrupt (method %d): status %d after %d polls", method, status, 5 - polls);
+    CHECK(st.steps + st.rejected <= 5 * TF_POLL_STEPS && st.steps + st.rejected > 4 * TF_POLL_STEPS &&
+              st.t_fail > 0.0 && st.t_fail < 1e6,
+          "interrupt (method %d): stopped after %ld steps at t = %g", method, st.steps + st.rejected, st.t_fail);
+    double energy = y[0] * y[0] + y[1] * y[1] / (w * w);
+    CHECK(fabs(energy - 1.0) < 1e-5, "interrupt (method %d): the state at the stop is the run's (energy %g)",
+          method, energy);
+    polls = 1 << 30; /* a poll that never fires changes nothing */
+    double y2[2] = {1.0, 0.0}, t2[2] = {0.0, 3.0}, y3[2] = {1.0, 0.0};
+    tf_solve(&ode, &opt, t2, 2, y2, emit_none, 0, &st);
+    opt.interrupt = 0;
+    tf_solve(&ode, &opt, t2, 2, y3, emit_none, 0, &st);
+    CHECK(y2[0] == y3[0] && y2[1] == y3[1], "interrupt (method %d): a silent poll changes no result", method);
 }
 
 static void test_stiff_prothero_robinson(void)
@@ -738,6 +770,14 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
     }
     L.substeps = 0;
     CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: substeps = 0");
+    /* issue 32: substeps = INT_MAX ran 200 x 2^31 plant steps (a hang); the work is bounded */
+    L.substeps = 2147483647;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "loop") &&
+              strstr(L.what, "substeps") && x[0] == -7.0,
+          "loop: n x substeps beyond TF_LOOP_MAX_SUBSTEPS refused before anything is written");
+    L.substeps = (int)(TF_LOOP_MAX_SUBSTEPS / N) + 1;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && strstr(L.what, "substeps"),
+          "loop: one substep per run beyond the bound refused");
     L.substeps = 10, L.compensation = 9;
     CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: unknown compensation");
     L.compensation = TF_COMP_OBSERVER, L.comp = NULL;
@@ -855,6 +895,8 @@ int main(void)
     test_oscillator_dense_output(TF_METHOD_DOPRI5);
     test_oscillator_dense_output(TF_METHOD_RODAS4);
     test_stiff_prothero_robinson();
+    test_interrupt_poll_stops_a_long_integration(TF_METHOD_DOPRI5);
+    test_interrupt_poll_stops_a_long_integration(TF_METHOD_RODAS4);
     test_waveforms();
     test_laws();
     test_lugre_steady_sliding();

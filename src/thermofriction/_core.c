@@ -186,6 +186,59 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
     return 0;
 }
 
+/* ---- Ctrl-C during a long integration ----
+ * tf_solve runs with the GIL released, so Python's signal handlers (KeyboardInterrupt, the command
+ * line's SIGTERM handler) cannot run until it returns. The solver polls interrupt_poll every
+ * TF_POLL_STEPS steps; at most every POLL_SECONDS it takes the GIL back and runs the pending handlers
+ * (PyErr_CheckSignals). A handler that raises stops the integration (TF_ERR_INTERRUPTED) and its
+ * exception is what the call raises. Only in the main thread: Python runs signal handlers there
+ * only, and other threads need not wait for the GIL. */
+#define POLL_SECONDS 0.05
+static unsigned long main_thread_ident;
+
+typedef struct {
+    PyThreadState *ts; /* the released thread state, NULL when not polling */
+    double last;       /* when the handlers last ran [s, monotonic] */
+    int raised;        /* a handler raised: the exception is set */
+} signal_poll;
+
+static double monotonic_seconds(void)
+{
+#ifdef CLOCK_MONOTONIC
+    struct timespec ts;
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) == 0) return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#endif
+    return (double)clock() / CLOCKS_PER_SEC;
+}
+
+static int interrupt_poll(void *ctx)
+{
+    signal_poll *p = (signal_poll *)ctx;
+    double now = monotonic_seconds();
+    if (now - p->last < POLL_SECONDS) return 0;
+    p->last = now;
+    PyEval_RestoreThread(p->ts);
+    p->raised = PyErr_CheckSignals() != 0;
+    p->ts = PyEval_SaveThread();
+    return p->raised;
+}
+
+/* tf_solve without the GIL, polled for signals in the main thread. */
+static int solve_released(const tf_ode *ode, tf_solver_options *opt, const double *t_out, long n_out, double *y,
+                          tf_emit_fn emit, void *ctx, tf_solver_stats *st, int *raised)
+{
+    signal_poll poll = {NULL, monotonic_seconds(), 0};
+    if (PyThread_get_thread_ident() == main_thread_ident) {
+        opt->interrupt = interrupt_poll;
+        opt->interrupt_ctx = &poll;
+    }
+    poll.ts = PyEval_SaveThread();
+    int status = tf_solve(ode, opt, t_out, n_out, y, emit, ctx, st);
+    PyEval_RestoreThread(poll.ts);
+    *raised = poll.raised;
+    return status;
+}
+
 /* SolverError(message, status, t_fail, h_fail, state, stiff_suspected) */
 static void raise_solver_error(int status, const tf_solver_stats *st, const double *y, int n)
 {
@@ -273,15 +326,14 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     tf_ode ode = tf_model_ode(&m);
     double rtol_w[TF_MAX_STATES];
     tf_model_rtol_weights(&m, rtol_w);
-    tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps, rtol_w};
+    tf_solver_options opt = {.method = method, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
+                             .max_steps = max_steps, .rtol_weight = rtol_w};
     tf_solver_stats st;
     emit_ctx ec = {&m, (double *)outv.buf, nch, columns ? (long)n_out : 0};
-    int status;
-    Py_BEGIN_ALLOW_THREADS
-    status = tf_solve(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st);
-    Py_END_ALLOW_THREADS
+    int raised;
+    int status = solve_released(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st, &raised);
     if (status != TF_OK) {
-        raise_solver_error(status, &st, y, n);
+        if (!raised) raise_solver_error(status, &st, y, n);
         goto done;
     }
     result = Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:i,s:d,s:l}", "steps", st.steps, "rejected", st.rejected,
@@ -373,15 +425,14 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
             Y[n + tf_model_temperature_index(&m) * np + k] = 1.0;
     tf_sensitivity_system sys = {&m, np, targets};
     tf_ode ode = tf_sensitivity_ode(&sys);
-    tf_solver_options opt = {TF_METHOD_DOPRI5, rtol, atol, h0, hmax, max_steps};
+    tf_solver_options opt = {.method = TF_METHOD_DOPRI5, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
+                             .max_steps = max_steps};
     tf_solver_stats st;
     sens_emit_ctx ec = {&m, (double *)outv.buf, (double *)sensv.buf, nch, n, np};
-    int status;
-    Py_BEGIN_ALLOW_THREADS
-    status = tf_solve(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st);
-    Py_END_ALLOW_THREADS
+    int raised;
+    int status = solve_released(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st, &raised);
     if (status != TF_OK) {
-        raise_solver_error(status, &st, Y, n);
+        if (!raised) raise_solver_error(status, &st, Y, n);
         goto done;
     }
     result = Py_BuildValue("{s:l,s:l,s:l}", "steps", st.steps, "rejected", st.rejected, "rhs_evals", st.rhs_evals);
@@ -555,11 +606,17 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
 {
     PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *outs[3];
     double T_plant, T_comp, gain, mass, kp, ki, kd, tau_d, dt;
-    int compensation, substeps;
-    if (!PyArg_ParseTuple(args, "OdOdidd(dddd)diOOOOO", &plant_spec, &T_plant, &comp_spec, &T_comp, &compensation,
-                          &gain, &mass, &kp, &ki, &kd, &tau_d, &dt, &substeps, &xr_obj, &vr_obj, &outs[0], &outs[1],
+    int compensation;
+    long substeps_in;
+    if (!PyArg_ParseTuple(args, "OdOdidd(dddd)dlOOOOO", &plant_spec, &T_plant, &comp_spec, &T_comp, &compensation,
+                          &gain, &mass, &kp, &ki, &kd, &tau_d, &dt, &substeps_in, &xr_obj, &vr_obj, &outs[0], &outs[1],
                           &outs[2]))
         return NULL;
+    if (substeps_in > TF_LOOP_MAX_SUBSTEPS) { /* beyond an int: the core's own bound, in its words */
+        PyErr_SetString(PyExc_ValueError, "loop: n x substeps (at most 1e8 plant substeps in one run)");
+        return NULL;
+    }
+    int substeps = (int)(substeps_in < 0 ? 0 : substeps_in);
     arena a = {0}, b = {0};
     tf_model pm, cm;
     tf_rt_friction *rt = PyMem_Malloc(2 * sizeof(tf_rt_friction)); /* ~3 kB each: not on the stack */
@@ -694,6 +751,7 @@ static const tf_constant constants[] = {
     C("status", "ok", TF_OK), C("status", "nonfinite", TF_ERR_NONFINITE),
     C("status", "step_underflow", TF_ERR_STEP_UNDERFLOW), C("status", "max_steps", TF_ERR_MAX_STEPS),
     C("status", "bad_argument", TF_ERR_BAD_ARGUMENT), C("status", "no_memory", TF_ERR_NO_MEMORY),
+    C("status", "interrupted", TF_ERR_INTERRUPTED),
     C("output", "time", TF_OUT_TIME), C("output", "input", TF_OUT_INPUT),
     C("output", "stage_displacement", TF_OUT_STAGE_DISPLACEMENT), C("output", "stage_velocity", TF_OUT_STAGE_VELOCITY),
     C("output", "displacement", TF_OUT_DISPLACEMENT), C("output", "velocity", TF_OUT_VELOCITY),
@@ -782,5 +840,14 @@ PyMODINIT_FUNC PyInit__core(void)
     if (PyModule_AddObject(mod, "SolverError", SolverError) < 0) return NULL;
     Py_INCREF(SolverError);
     if (add_constants(mod) < 0) return NULL;
+    main_thread_ident = PyThread_get_thread_ident(); /* Python imports extension modules ... */
+    PyObject *threading = PyImport_ImportModule("threading"); /* ... but ask, in case this is not the main thread */
+    PyObject *main = threading ? PyObject_CallMethod(threading, "main_thread", NULL) : NULL;
+    PyObject *ident = main ? PyObject_GetAttrString(main, "ident") : NULL;
+    if (ident && PyLong_Check(ident)) main_thread_ident = PyLong_AsUnsignedLong(ident);
+    Py_XDECREF(ident);
+    Py_XDECREF(main);
+    Py_XDECREF(threading);
+    PyErr_Clear(); /* no answer: the importing thread it is */
     return mod;
 }

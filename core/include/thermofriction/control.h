@@ -76,11 +76,15 @@ typedef struct {
     long period;
 } tf_loop;
 
+/* The most plant substeps (n x substeps) one tf_loop_run takes (~10 s of work): more is refused. */
+#define TF_LOOP_MAX_SUBSTEPS 100000000.0
+
 /* Runs n >= 1 control periods from rest at x = x_ref[0]. x_ref, v_ref: the reference at each
  * period start (v_ref may be NULL without feed-forward). Writes, when not NULL, per period: x
  * (position at the period start), u (the control held over it, compensation included), F_comp
  * (the compensation in it). Returns TF_OK; TF_ERR_BAD_ARGUMENT, before writing anything, for a
- * NULL or non-finite argument (mass, dt > 0, substeps >= 1, gains, a reference sample), an
+ * NULL or non-finite argument (mass, dt > 0, substeps >= 1, n x substeps <= TF_LOOP_MAX_SUBSTEPS,
+ * gains, a reference sample), an
  * unknown compensation, an observer on a model without a bristle state, or a plant or
  * compensation model refused at its temperature; or TF_ERR_NONFINITE if the loop goes unstable
  * (outputs written up to that period). */

@@ -40,7 +40,14 @@ typedef struct {
     /* n weights of the relative tolerance in the error norm, atol_i + rtol_weight_i rtol |y_i|; NULL: all 1.
      * A state whose value is relative to an arbitrary origin (a position) gets 0: see tf_model_rtol_weights */
     const double *rtol_weight;
+    /* Polled every TF_POLL_STEPS attempted steps (NULL: never): a nonzero return stops the integration
+     * with TF_ERR_INTERRUPTED, y0 holding the state at the last accepted step (stats: t_fail). For a
+     * caller that must react to a signal (Ctrl-C) during one long integration. */
+    int (*interrupt)(void *ctx);
+    void *interrupt_ctx;
 } tf_solver_options;
+
+#define TF_POLL_STEPS 64
 
 typedef enum {
     TF_OK = 0,
@@ -48,7 +55,8 @@ typedef enum {
     TF_ERR_STEP_UNDERFLOW = 2,
     TF_ERR_MAX_STEPS = 3,
     TF_ERR_BAD_ARGUMENT = 4,
-    TF_ERR_NO_MEMORY = 5
+    TF_ERR_NO_MEMORY = 5,
+    TF_ERR_INTERRUPTED = 6     /* the caller's interrupt poll asked to stop */
 } tf_status;
 
 typedef struct {
