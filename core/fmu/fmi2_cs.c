@@ -395,13 +395,13 @@ temperature:
 
 static int check_model(instance *c, const tf_model *m)
 {
-    const char *what = 0;
-    if (tf_model_check(m, &what) == TF_OK) return 0;
+    tf_error e;
+    if (tf_model_check(m, &e) == TF_OK) return 0;
     if (c->temperature_input || c->heat)
         fail(c, "at time %g s, temperature %g C: the model is outside its domain ('%s')", c->t,
-              c->r[VR_TEMPERATURE], what ? what : "?");
+             c->r[VR_TEMPERATURE], e.what);
     else
-        fail(c, "at time %g s: the model is outside its domain ('%s')", c->t, what ? what : "?");
+        fail(c, "at time %g s: the model is outside its domain ('%s')", c->t, e.what);
     return -1;
 }
 
@@ -703,8 +703,9 @@ static int realtime_steps(instance *c, double h, double *y)
 {
     tf_model *m = &c->model;
     tf_rt_friction rt;
-    if (tf_rt_from_model(&rt, m) != TF_OK)
-        return (fail(c, "the real-time friction model refused the model ('%s')", rt.what ? rt.what : "?"), -1);
+    tf_error e;
+    if (tf_rt_from_model(&rt, m, &e) != TF_OK)
+        return (fail(c, "the real-time friction model refused the model ('%s')", e.what), -1);
     int n = tf_model_nstate(m);
     int nz = tf_friction_nstate(m->friction, m->gms.n);
     int nm = m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
@@ -725,10 +726,10 @@ static int realtime_steps(instance *c, double h, double *y)
         double ts = c->t + s * dt, hs = s < whole ? dt : last;
         if (s == whole - 1 && last == 0.0) hs = h - s * dt; /* end exactly on the communication point */
         double v = sliding_velocity(m, ts, y), T = tf_model_temperature(m, ts, y), F;
-        int st = tf_rt_step_status(&rt, v, T, hs, &F);
+        tf_status st = tf_rt_step(&rt, v, T, hs, &F, &e);
         if (st != TF_OK)
             return (fail(c, "the fixed step at %g s (temperature %g C) was refused: %s ('%s')", ts, T,
-                         tf_status_message(st), rt.what ? rt.what : "?"), -1);
+                         tf_status_message(st), e.what), -1);
         memcpy(y + nm, rt.z, sizeof(double) * nz);
         memcpy(m->gms.mode, rt.model.gms.mode, sizeof m->gms.mode);
         tf_model_rhs(ts, y, dy, m); /* at the new friction states: the force the real-time step gave */
@@ -794,13 +795,14 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
                              .rtol_weight = rtol_w};
     double t_out[2] = {c->t, c->t + h};
     tf_solver_stats st;
-    int s = tf_solve(&ode, &opt, t_out, 2, y, no_emit, 0, &st);
+    tf_error e;
+    tf_status s = tf_solve(&ode, &opt, t_out, 2, y, no_emit, 0, &st, &e);
     for (int i = 0; s == TF_OK && i < n; i++)
-        if (!isfinite(y[i])) s = TF_ERR_NONFINITE;
+        if (!isfinite(y[i])) s = TF_ERR_NONFINITE, e.t = c->t + h, snprintf(e.what, sizeof e.what, "%s", "state");
     if (s != TF_OK) {
         c->model.gms = modes;
-        return fail(c, "the integration from %g s over %g s failed at %g s: %s", c->t, h, st.t_fail,
-                     tf_status_message(s));
+        return fail(c, "the integration from %g s over %g s failed at %g s: %s (%s)", c->t, h, e.t,
+                    tf_status_message(s), e.what);
     }
     return step_done(c, h, y, n, status);
 }

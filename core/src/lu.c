@@ -3,7 +3,7 @@
 #include "lu_reduced.h"
 
 /* ---- dense LU with partial pivoting, for the small systems of a Rosenbrock stage ---- */
-int tf_lu_factor(double *A, int n, int *piv)
+tf_status tf_lu_factor(double *A, int n, int *piv)
 {
     for (int k = 0; k < n; k++) {
         int p = k;
@@ -11,7 +11,7 @@ int tf_lu_factor(double *A, int n, int *piv)
         for (int i = k + 1; i < n; i++)
             if (fabs(A[i * n + k]) > big) { big = fabs(A[i * n + k]); p = i; }
         piv[k] = p;
-        if (big == 0.0 || !isfinite(big)) return 1;
+        if (big == 0.0 || !isfinite(big)) return TF_ERR_SINGULAR;
         /* LINPACK style: only the trailing columns move; the multipliers of earlier columns stay
          * where they were made, matching lu_solve, which interleaves interchanges and elimination */
         if (p != k)
@@ -23,7 +23,7 @@ int tf_lu_factor(double *A, int n, int *piv)
                 for (int j = k + 1; j < n; j++) A[i * n + j] -= l * A[k * n + j];
         }
     }
-    return 0;
+    return TF_OK;
 }
 
 void tf_lu_solve(const double *A, int n, const int *piv, double *b)

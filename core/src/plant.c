@@ -250,25 +250,25 @@ TF_SIZED void mechanical_rhs(const tf_model *m, double t, const double *y, doubl
     }
 }
 
-int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
+tf_status tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     int nm = nmech(m);
     double F = friction(m, t, y, dy + nm, 0);
     if (has_work(m)) heat_rates(m, t, y, F, dy);
     mechanical_rhs(m, t, y, F, dy);
-    return 0;
+    return TF_OK;
 }
 
 /* dv_r/dy for the mechanical states (prescribed motion: none). */
 /* tf_model_rhs for the common case (lugre_constant_T). */
-static int rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
+static tf_status rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     int iz = m->plant == TF_PLANT_STICK_SLIP ? 4 : 2;
     double F = lugre_constant_T_friction(m, relative_velocity(m, t, y), y[iz], &dy[iz]);
     mechanical_rhs(m, t, y, F, dy);
-    return 0;
+    return TF_OK;
 }
 
 static void velocity_partials(const tf_model *m, double *dv_dy)
@@ -351,14 +351,14 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
     if (has_work(m)) heat_jacobian(m, t, y, d, J);
 }
 
-int tf_model_jac(double t, const double *y, double *J, void *ctx)
+tf_status tf_model_jac(double t, const double *y, double *J, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double dz[TF_MAX_FRICTION_STATES];
     tf_friction_partials d;
     friction(m, t, y, dz, &d);
     jacobian_from(m, t, y, &d, J);
-    return 0;
+    return TF_OK;
 }
 
 /* d(rhs)/d(plant parameter) into column k of fp (stride np): only the mechanical rows depend on
@@ -390,8 +390,8 @@ static void plant_partials(const tf_model *m, double t, const double *y, const d
     }
 }
 
-int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
-                         const tf_target *targets, int np, double *fp)
+tf_status tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
+                               const tf_target *targets, int np, double *fp)
 {
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
@@ -400,7 +400,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         if (fast) rhs_lugre_constant_T(t, y, dy, m);
         else tf_model_rhs(t, y, dy, m);
         if (J) tf_model_jac(t, y, J, m);
-        return 0;
+        return TF_OK;
     }
     if (!fast) tf_model_rhs(t, y, dy, m); /* else from the one friction evaluation below */
     tf_friction_param_partials dp;
@@ -452,7 +452,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         if (iT >= 0) fp[iT * np + k] = tf_heat_rate_dP(&m->heat, dP);
         if (iW >= 0) fp[iW * np + k] = dP;
     }
-    return 0;
+    return TF_OK;
 }
 
 double tf_model_next_corner(double t, void *ctx)
@@ -603,22 +603,31 @@ void tf_model_outputs(const tf_model *model, double t, const double *y, double *
 /* ---- model check (the C side of the Python package's parameter checks); the checks of each part
  *      are in its file (checks.h) ---- */
 
-int tf_model_check_params(const tf_model *m, const double *p, double lambda, double dF_offset, const char **what)
+/* NULL, or the field refused: the rules of tf_model_check_params. */
+static const char *params_problem(const tf_model *m, const double *p, double lambda, double dF_offset)
 {
     int offset = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET;
     const char *bad = tf_friction_params_problem(m->friction, p, offset);
-    if (!bad) bad = tf_thermal_lambda_problem(m->thermal, m->dF_form, lambda, dF_offset);
-    if (what) *what = bad;
-    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
+    return bad ? bad : tf_thermal_lambda_problem(m->thermal, m->dF_form, lambda, dF_offset);
+}
+
+/* The outcome of a check: TF_OK, or TF_ERR_BAD_ARGUMENT naming the field (where "model"). */
+static tf_status checked(const char *bad, tf_error *err)
+{
+    return tf_error_set(err, bad ? TF_ERR_BAD_ARGUMENT : TF_OK, bad ? "model" : 0, bad, NAN, -1);
+}
+
+tf_status tf_model_check_params(const tf_model *m, const double *p, double lambda, double dF_offset, tf_error *err)
+{
+    if (!m || !p) return checked("model or p (NULL)", err);
+    return checked(params_problem(m, p, lambda, dF_offset), err);
 }
 
 static const char *check_at(const tf_model *m, double T)
 {
     double p[TF_NPARAM];
-    const char *bad;
     tf_model_params_at(m, T, p);
-    tf_model_check_params(m, p, tf_model_lambda(m, T), tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T), &bad);
-    return bad;
+    return params_problem(m, p, tf_model_lambda(m, T), tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T));
 }
 
 /* The friction model and its thermal extension, apart from the parameters' values. */
@@ -628,16 +637,17 @@ static const char *check_friction_structure(const tf_model *m)
     return bad ? bad : tf_thermal_structure_problem(m->thermal, m->law, &m->dF, m->dF_form);
 }
 
-int tf_model_check_friction(const tf_model *m, double T, const char **what)
+tf_status tf_model_check_friction(const tf_model *m, double T, tf_error *err)
 {
+    if (!m) return checked("model (NULL)", err);
     const char *bad = check_friction_structure(m);
     if (!bad && (m->thermal == TF_THERMAL_NONE || isfinite(T))) bad = check_at(m, m->thermal ? T : NAN);
-    if (what) *what = bad;
-    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
+    return checked(bad, err);
 }
 
-int tf_model_check(const tf_model *m, const char **what)
+tf_status tf_model_check(const tf_model *m, tf_error *err)
 {
+    if (!m) return checked("model (NULL)", err);
     const char *bad = 0;
     switch (m->plant) {
     case TF_PLANT_STICK_SLIP:
@@ -684,6 +694,5 @@ int tf_model_check(const tf_model *m, const char **what)
     } else if (!bad) {
         bad = check_at(m, NAN);
     }
-    if (what) *what = bad;
-    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
+    return checked(bad, err);
 }

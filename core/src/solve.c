@@ -8,12 +8,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int fail(tf_solver_stats *st, int status, double t, double h)
+/* A failure: the step size in the statistics, the rest in the error record (status.h). */
+static tf_status fail(tf_solver_stats *st, tf_error *err, tf_status status, double t, double h, long index,
+                      const char *what)
 {
-    st->status = status;
-    st->t_fail = t;
     st->h_fail = h;
-    return status;
+    return tf_error_set(err, status, "solver", what ? what : tf_status_message(status), t, index);
 }
 
 /* Hairer's starting step: an explicit Euler step's change in f sets the scale. */
@@ -33,7 +33,7 @@ double tf_initial_step(work *w, double t, const double *y, const double *f0, int
 }
 
 /* The work space: one allocation for all of the methods' vectors. */
-static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_solver_stats *st)
+static tf_status setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_solver_stats *st)
 {
     int n = ode->n;
     memset(w, 0, sizeof *w);
@@ -41,7 +41,7 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     w->ode = ode; w->opt = opt; w->st = st; w->n = n;
     size_t nvec = 7 + 4 + 5 + 3;
     w->block = (double *)malloc(sizeof(double) * (nvec * n + 3 * (size_t)n * n) + sizeof(int) * 5 * n);
-    if (!w->block) return 1;
+    if (!w->block) return TF_ERR_NO_MEMORY;
     double *p = w->block;
     for (int i = 0; i < 7; i++, p += n) w->k[i] = p;
     w->ytmp = p; p += n;
@@ -61,32 +61,34 @@ static int setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_so
     w->partner = w->pos + n;
     w->red = w->partner + n;
     w->qcol = w->red + n;
-    return 0;
+    return TF_OK;
 }
 
 /* The grid is non-decreasing, finite and within +-1e12 s (beyond it a double resolves time to ~1e-4 s,
  * coarser than any dynamics here, and periodic inputs lose their phase); the options make sense. */
-static int check_arguments(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
-                           tf_solver_stats *st)
+static tf_status check_arguments(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
+                                 tf_solver_stats *st, tf_error *err)
 {
-    int n = ode->n;
-    if (n < 0 || n_out < 1 || !(opt->rtol > 0) || (n > 0 && !opt->atol) || opt->max_steps <= 0)
-        return fail(st, TF_ERR_BAD_ARGUMENT, n_out >= 1 ? t_out[0] : 0.0, 0.0);
+    const tf_status B = TF_ERR_BAD_ARGUMENT;
+    if (!ode || !opt || !t_out || ode->n < 0 || n_out < 1)
+        return fail(st, err, B, NAN, 0.0, -1, "ode, opt or t_out (NULL, no states or no output time)");
+    if (!(opt->rtol > 0) || (ode->n > 0 && !opt->atol) || opt->max_steps <= 0)
+        return fail(st, err, B, NAN, 0.0, -1, "options (rtol > 0, atol given, max_steps > 0)");
     for (long i = 0; i < n_out; i++)
         if (!(fabs(t_out[i]) <= 1e12) || (i && !(t_out[i] >= t_out[i - 1])))
-            return fail(st, TF_ERR_BAD_ARGUMENT, t_out[i], 0.0);
+            return fail(st, err, B, t_out[i], 0.0, i, "t_out (finite, within +-1e12 s, not decreasing)");
     return TF_OK;
 }
 
 /* The driver's state at t_out[0] and its allocations (released by finish, whatever this returns). */
-static int start(tf_driver *d, const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
-                 double *y, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *st)
+static tf_status start(tf_driver *d, const tf_ode *ode, const tf_solver_options *opt, const double *t_out,
+                       long n_out, double *y, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *st, tf_error *err)
 {
     memset(d, 0, sizeof *d);
-    d->ode = ode, d->opt = opt, d->st = st;
+    d->ode = ode, d->opt = opt, d->st = st, d->err = err;
     d->t_out = t_out, d->n_out = n_out, d->emit = emit, d->emit_ctx = emit_ctx;
     d->n = ode->n, d->y = y, d->t = t_out[0];
-    if (setup(&d->w, ode, opt, st)) return fail(st, TF_ERR_NO_MEMORY, d->t, 0.0);
+    if (setup(&d->w, ode, opt, st)) return fail(st, err, TF_ERR_NO_MEMORY, d->t, 0.0, -1, 0);
     /* without a Jacobian (e.g. sensitivity systems) only the explicit method applies */
     d->requested = ode->jac ? opt->method : TF_METHOD_DOPRI5;
     d->method = d->requested == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : d->requested;
@@ -99,7 +101,7 @@ static int start(tf_driver *d, const tf_ode *ode, const tf_solver_options *opt, 
     d->facold = 1e-4;
     d->rc = (tf_rodas4_control){1, 0.0, 1.0};
     d->poll = TF_POLL_STEPS; /* steps to the next interrupt poll */
-    if (!d->f0 || !d->yd || !d->g0 || no_memory) return fail(st, TF_ERR_NO_MEMORY, d->t, 0.0);
+    if (!d->f0 || !d->yd || !d->g0 || no_memory) return fail(st, err, TF_ERR_NO_MEMORY, d->t, 0.0, -1, 0);
     return TF_OK;
 }
 
@@ -116,13 +118,14 @@ static void finish(tf_driver *d)
  * (finite ends of a step can still interpolate to an overflow in between; found by fuzzing: a 1e-3 kg
  * mass under a huge sampled force). The fraction of the step is (t_i - t) * (1 / h) after a whole step
  * (one division per step, not per sample) and (t_i - t) / h before an event. */
-static int emit_until(tf_driver *d, double t_lim, int reciprocal)
+static tf_status emit_until(tf_driver *d, double t_lim, int reciprocal)
 {
     const double hinv = 1.0 / d->h;
     while (d->next < d->n_out && d->t_out[d->next] <= t_lim) {
         double s = reciprocal ? (d->t_out[d->next] - d->t) * hinv : (d->t_out[d->next] - d->t) / d->h;
         dense(&d->w, d->method, s, d->yd);
-        if (!all_finite(d->yd, d->n)) return fail(d->st, TF_ERR_NONFINITE, d->t_out[d->next], d->h);
+        if (!all_finite(d->yd, d->n))
+            return fail(d->st, d->err, TF_ERR_NONFINITE, d->t_out[d->next], d->h, d->next, 0);
         d->emit(d->next, d->t_out[d->next], d->yd, d->emit_ctx);
         d->next++;
     }
@@ -131,13 +134,13 @@ static int emit_until(tf_driver *d, double t_lim, int reciprocal)
 
 /* A restart at t (the start, a corner, an event): the modes for what follows, f0, the method (AUTO),
  * a first step if none is known, and the clamp that keeps the stages before seg_end. */
-static int restart(tf_driver *d, double seg_end)
+static tf_status restart(tf_driver *d, double seg_end)
 {
     const tf_ode *ode = d->ode;
     d->w.t_clamp = INFINITY;
     if (ode->on_restart) ode->on_restart(d->t, d->y, ode->ctx);
     if (d->ne) ode->events(d->t, d->y, d->g0, ode->ctx);
-    if (rhs(&d->w, d->t, d->y, d->f0)) return fail(d->st, TF_ERR_NONFINITE, d->t, d->h);
+    if (rhs(&d->w, d->t, d->y, d->f0)) return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, d->h, -1, 0);
     tf_auto_restart(d);
     if (d->h <= 0.0)
         d->h = d->opt->h0 > 0 ? d->opt->h0
@@ -149,12 +152,12 @@ static int restart(tf_driver *d, double seg_end)
 }
 
 /* One attempted step of the current method into *err (negative: non-finite or singular). */
-static int attempt(tf_driver *d, double seg_end, double *err)
+static tf_status attempt(tf_driver *d, double seg_end, double *err)
 {
     if (d->method == TF_METHOD_RODAS4) {
         if (!d->jac_current) {
             if (tf_rodas4_jacobian(&d->w, d->t, seg_end, d->y, d->f0))
-                return fail(d->st, TF_ERR_NONFINITE, d->t, d->h);
+                return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, d->h, -1, 0);
             d->jac_current = 1;
         }
         *err = tf_rodas4_step(&d->w, d->t, d->h, d->y, d->f0, d->yd);
@@ -165,13 +168,14 @@ static int attempt(tf_driver *d, double seg_end, double *err)
 }
 
 /* A step that failed (non-finite numbers, a singular matrix) or whose error is too large: retried smaller. */
-static int reject(tf_driver *d, double err)
+static tf_status reject(tf_driver *d, double err)
 {
     d->st->rejected++;
     d->reject = 1;
     if (err < 0.0) {
         d->h *= 0.25;
-        if (d->h <= 16.0 * DBL_EPSILON * fmax(fabs(d->t), 1e-300)) return fail(d->st, TF_ERR_NONFINITE, d->t, d->h);
+        if (d->h <= 16.0 * DBL_EPSILON * fmax(fabs(d->t), 1e-300))
+            return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, d->h, -1, 0);
     } else {
         d->h = d->method == TF_METHOD_RODAS4 ? tf_rodas4_rejected_h(err, d->h) : tf_dopri5_rejected_h(err, d->h);
     }
@@ -182,7 +186,7 @@ static int reject(tf_driver *d, double err)
  * *at_event is set (the segment restarts). An event located within the corner margin of the corner
  * that ends this segment is taken at the corner: a restart just before it would find the corner
  * already passed and integrate across it. */
-static int end_at_event(tf_driver *d, double t_new, int last, double seg_end, double corner, int *at_event)
+static tf_status end_at_event(tf_driver *d, double t_new, int last, double seg_end, double corner, int *at_event)
 {
     const tf_ode *ode = d->ode;
     double t = d->t, h = d->h;
@@ -229,7 +233,7 @@ static double next_step(tf_driver *d, double err, double t_new, int last)
 }
 
 /* An accepted step: to an event inside it (*at_event), else to its end with the samples on the way. */
-static int accept(tf_driver *d, double err, int last, double seg_end, double corner, int *at_event)
+static tf_status accept(tf_driver *d, double err, int last, double seg_end, double corner, int *at_event)
 {
     double t_new = last ? seg_end : d->t + d->h;
     int status;
@@ -246,20 +250,22 @@ static int accept(tf_driver *d, double err, int last, double seg_end, double cor
 }
 
 /* Steps from t to seg_end (a corner, or the grid's end), or to the first event before it. */
-static int segment(tf_driver *d, double seg_end, double corner)
+static tf_status segment(tf_driver *d, double seg_end, double corner)
 {
     const tf_solver_options *opt = d->opt;
     while (d->t < seg_end) {
-        if (d->st->steps + d->st->rejected >= opt->max_steps) return fail(d->st, TF_ERR_MAX_STEPS, d->t, d->h);
+        if (d->st->steps + d->st->rejected >= opt->max_steps)
+            return fail(d->st, d->err, TF_ERR_MAX_STEPS, d->t, d->h, -1, 0);
         if (opt->interrupt && --d->poll <= 0) {
             d->poll = TF_POLL_STEPS;
-            if (opt->interrupt(opt->interrupt_ctx)) return fail(d->st, TF_ERR_INTERRUPTED, d->t, d->h);
+            if (opt->interrupt(opt->interrupt_ctx)) return fail(d->st, d->err, TF_ERR_INTERRUPTED, d->t, d->h, -1, 0);
         }
         if (opt->hmax > 0) d->h = fmin(d->h, opt->hmax);
         int last = 0, at_event = 0, status;
         if (d->t + 1.01 * d->h >= seg_end) { d->h = seg_end - d->t; last = 1; }
-        if (d->h <= 16.0 * DBL_EPSILON * fmax(fabs(d->t), 1e-300)) return fail(d->st, TF_ERR_STEP_UNDERFLOW, d->t, d->h);
-        double err;
+        if (d->h <= 16.0 * DBL_EPSILON * fmax(fabs(d->t), 1e-300))
+            return fail(d->st, d->err, TF_ERR_STEP_UNDERFLOW, d->t, d->h, -1, 0);
+        double err = -1.0; /* set by attempt */
         if ((status = attempt(d, seg_end, &err))) return status;
         if (err < 0.0 || !(err <= 1.0)) status = reject(d, err);
         else status = accept(d, err, last, seg_end, corner, &at_event);
@@ -269,11 +275,11 @@ static int segment(tf_driver *d, double seg_end, double corner)
 }
 
 /* The whole grid: segments between the input's corners, each begun by a restart. */
-static int integrate(tf_driver *d)
+static tf_status integrate(tf_driver *d)
 {
     double t_end = d->t_out[d->n_out - 1];
     while (d->next < d->n_out && d->t_out[d->next] <= d->t) d->emit(d->next, d->t_out[d->next], d->y, d->emit_ctx), d->next++;
-    if (!all_finite(d->y, d->n)) return fail(d->st, TF_ERR_NONFINITE, d->t, 0.0);
+    if (!all_finite(d->y, d->n)) return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, 0.0, -1, 0);
     while (d->t < t_end) {
         /* what is left may be a rounding residue (a corner computed one ulp before the grid's
          * end): nothing to integrate, and a step that small would count as an underflow */
@@ -289,22 +295,25 @@ static int integrate(tf_driver *d)
     return TF_OK;
 }
 
-int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
-             double *y, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *st)
+tf_status tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
+                   double *y, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *st, tf_error *err)
 {
+    tf_solver_stats unused;
+    if (!st) st = &unused;
     memset(st, 0, sizeof *st);
     st->switch_time = -1.0;
-    int status = check_arguments(ode, opt, t_out, n_out, st);
+    tf_status status = check_arguments(ode, opt, t_out, n_out, st, err);
     if (status) return status;
+    if (!y || !emit) return fail(st, err, TF_ERR_BAD_ARGUMENT, NAN, 0.0, -1, "y0 or emit (NULL)");
     if (ode->n == 0) { /* nothing to integrate (a static friction map under prescribed motion) */
         for (long i = 0; i < n_out; i++) emit(i, t_out[i], y, emit_ctx);
         st->method_used = opt->method;
-        return TF_OK;
+        return tf_error_set(err, TF_OK, 0, 0, NAN, -1);
     }
     tf_driver d;
-    status = start(&d, ode, opt, t_out, n_out, y, emit, emit_ctx, st);
+    status = start(&d, ode, opt, t_out, n_out, y, emit, emit_ctx, st, err);
     if (!status) status = integrate(&d);
     st->method_used = d.method;
     finish(&d);
-    return status;
+    return status ? status : tf_error_set(err, TF_OK, 0, 0, NAN, -1);
 }

@@ -18,6 +18,7 @@ typedef struct {
     tf_solver_options opt_x;       /* AUTO's explicit phases: AUTO_EXPLICIT_TOL times them (auto.c) */
     double *atol_x;
     tf_solver_stats *st;
+    tf_error *err;                 /* the caller's record (may be NULL) */
     const double *t_out;
     long n_out, next;              /* the output grid and its next sample */
     tf_emit_fn emit;
