@@ -198,7 +198,7 @@ static tf_status end_at_event(tf_driver *d, double t_new, int last, double seg_e
         return TF_OK;
     }
     double t_ev = s_ev >= 1.0 ? t_new : t + s_ev * h;
-    int status = emit_until(d, t_ev, 0);
+    tf_status status = emit_until(d, t_ev, 0);
     if (status) return status;
     if (s_ev >= 1.0) memcpy(d->y, d->w.y1, sizeof(double) * d->n);
     else dense(&d->w, d->method, s_ev, d->y);
@@ -236,7 +236,7 @@ static double next_step(tf_driver *d, double err, double t_new, int last)
 static tf_status accept(tf_driver *d, double err, int last, double seg_end, double corner, int *at_event)
 {
     double t_new = last ? seg_end : d->t + d->h;
-    int status;
+    tf_status status;
     if (d->ne && ((status = end_at_event(d, t_new, last, seg_end, corner, at_event)) || *at_event)) return status;
     if ((status = emit_until(d, t_new, 1))) return status;
     d->st->steps++;
@@ -261,7 +261,8 @@ static tf_status segment(tf_driver *d, double seg_end, double corner)
             if (opt->interrupt(opt->interrupt_ctx)) return fail(d->st, d->err, TF_ERR_INTERRUPTED, d->t, d->h, -1, 0);
         }
         if (opt->hmax > 0) d->h = fmin(d->h, opt->hmax);
-        int last = 0, at_event = 0, status;
+        int last = 0, at_event = 0;
+        tf_status status;
         if (d->t + 1.01 * d->h >= seg_end) { d->h = seg_end - d->t; last = 1; }
         if (d->h <= 16.0 * DBL_EPSILON * fmax(fabs(d->t), 1e-300))
             return fail(d->st, d->err, TF_ERR_STEP_UNDERFLOW, d->t, d->h, -1, 0);
@@ -287,7 +288,7 @@ static tf_status integrate(tf_driver *d)
         double corner = d->ode->next_corner ? d->ode->next_corner(d->t, d->ode->ctx) : INFINITY;
         double seg_end = fmin(corner, t_end);
         if (!(seg_end > d->t) || t_end - seg_end <= 64.0 * DBL_EPSILON * fabs(t_end)) seg_end = t_end;
-        int status = restart(d, seg_end);
+        tf_status status = restart(d, seg_end);
         if (!status) status = segment(d, seg_end, corner);
         if (status) return status;
     }
