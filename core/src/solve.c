@@ -120,16 +120,24 @@ static void finish(tf_driver *d)
  * (one division per step, not per sample) and (t_i - t) / h before an event. */
 static tf_status emit_until(tf_driver *d, double t_lim, int reciprocal)
 {
-    const double hinv = 1.0 / d->h;
-    while (d->next < d->n_out && d->t_out[d->next] <= t_lim) {
-        double s = reciprocal ? (d->t_out[d->next] - d->t) * hinv : (d->t_out[d->next] - d->t) / d->h;
-        dense(&d->w, d->method, s, d->yd);
-        if (!all_finite(d->yd, d->n))
-            return fail(d->st, d->err, TF_ERR_NONFINITE, d->t_out[d->next], d->h, d->next, 0);
-        d->emit(d->next, d->t_out[d->next], d->yd, d->emit_ctx);
-        d->next++;
+    /* in locals: the emit callback could alias the driver, so that its fields would be reloaded */
+    const double t = d->t, h = d->h, hinv = 1.0 / h, *t_out = d->t_out;
+    const long n_out = d->n_out;
+    const int method = d->method, n = d->n;
+    double *yd = d->yd;
+    long next = d->next;
+    tf_status status = TF_OK;
+    for (; next < n_out && t_out[next] <= t_lim; next++) {
+        double s = reciprocal ? (t_out[next] - t) * hinv : (t_out[next] - t) / h;
+        dense(&d->w, method, s, yd);
+        if (!all_finite(yd, n)) {
+            status = fail(d->st, d->err, TF_ERR_NONFINITE, t_out[next], h, next, 0);
+            break;
+        }
+        d->emit(next, t_out[next], yd, d->emit_ctx);
     }
-    return TF_OK;
+    d->next = next;
+    return status;
 }
 
 /* A restart at t (the start, a corner, an event): the modes for what follows, f0, the method (AUTO),
