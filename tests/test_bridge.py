@@ -123,3 +123,65 @@ def test_failure_status_is_named():
     assert e.value.status == "max_steps"
     with pytest.raises(tf.SolverError, match="raise max_steps"):
         tf.simulate(model, 0.1, input=tf.Sawtooth(30, 50, 0.99), controller=tf.StepSizeController(max_steps=5))
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 32, item 7: Ctrl-C during one long C integration took effect 48-67 s late (the binding runs
+# tf_solve without the GIL, so Python's handlers waited for it). The core now polls the binding
+# every TF_POLL_STEPS steps, and the binding runs the pending signal handlers every 50 ms.
+# ---------------------------------------------------------------------------------------------
+
+def test_ctrl_c_stops_a_long_simulation_within_a_second(tmp_path):
+    """`thermofriction simulate` of 1e5 s (minutes of integration) gets SIGINT once it is integrating: it
+    exits within 2 s with the command line's interrupted status (130) and message, no traceback and no
+    output file."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "long.csv"
+    cmd = [sys.executable, "-m", "thermofriction", "simulate", "li2009-model-i", "--temperature", "35",
+           "--duration", "1e5", "--sample-rate", "1", "--max-steps", "1000000000", "-o", str(out)]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(4.0)  # start-up is 0.3-2 s: by now it integrates (the whole run takes minutes)
+        assert p.poll() is None, p.communicate()
+        sent = time.monotonic()
+        p.send_signal(signal.SIGINT)
+        stdout, stderr = p.communicate(timeout=30)
+        late = time.monotonic() - sent
+    finally:
+        p.kill()
+        p.wait()
+    assert p.returncode == 130, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr, stderr
+    assert late < 2.0, f"exited {late:.1f} s after SIGINT"
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_signal_handler_that_raises_stops_the_integration():
+    """In the library: a Python signal handler that raises (here on SIGALRM, 0.3 s into a simulation of
+    minutes) ends tf.simulate within a second with that exception, not a SolverError; a later
+    simulation runs normally."""
+    import signal
+    import time
+
+    class Alarm(Exception):
+        pass
+
+    def handler(signum, frame):
+        raise Alarm
+
+    model = tf.load_model("li2009-model-i")
+    old = signal.signal(signal.SIGALRM, handler)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        start = time.monotonic()
+        with pytest.raises(Alarm):
+            tf.simulate(model, 1e5, temperature=35.0, sample_rate=1.0, solver=None, max_samples=None)
+        assert time.monotonic() - start < 1.5
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert np.isfinite(tf.simulate(model, 0.01, temperature=35.0).displacement).all()

@@ -33,6 +33,10 @@ def test_c_library_builds_standalone_and_its_tests_pass(tmp_path):
 
 CORPUS = CORE / "fuzz" / "corpus"
 CORPUS_REALTIME = CORE / "fuzz" / "corpus_realtime"  # fuzz_realtime.c: the real-time and control APIs
+CORPUS_FMU = CORE / "fuzz" / "corpus_fmu"  # fuzz_fmu.c: the FMU's resource file and entry points
+# GCC's and clang's "undefined" leave out float-cast-overflow (a double converted to an integer type that
+# cannot hold it: the FMU's step count once overflowed so); every sanitised build adds it
+SANITIZE = "-DTF_SANITIZE=address,undefined,float-cast-overflow"
 
 
 def need(tool):
@@ -48,24 +52,26 @@ def build_core(build, *cmake_args):
     subprocess.run(["cmake", "--build", str(build), "-j", "2"], check=True, capture_output=True)
 
 
-def corpus(folder=CORPUS):
+def corpus(folder=CORPUS, least=100):
     files = sorted(folder.iterdir())
-    assert len(files) > 100  # the seed corpus is there (a replay of nothing proves nothing)
+    assert len(files) > least  # the seed corpus is there (a replay of nothing proves nothing)
     return [str(f) for f in files]
 
 
 def test_c_tests_and_fuzz_corpus_are_clean_under_address_and_undefined_behaviour_sanitizers(tmp_path):
-    """Sanitisers: the C tests and a replay of the fuzz corpus (every model, plant, law, input and
-    method, with NaN, infinite and extreme parameters) built with -fsanitize=address,undefined and
-    no recovery: any out-of-bounds access, leak or undefined behaviour fails the run."""
+    """Sanitisers: the C tests and a replay of the fuzz corpora (every model, plant, law, input and
+    method, with NaN, infinite and extreme parameters; the real-time programs; the FMU's resource files
+    and call programs) built with -fsanitize=address,undefined,float-cast-overflow and no recovery: any
+    out-of-bounds access, leak or undefined behaviour fails the run."""
     need("cc")
     build = tmp_path / "asan"
-    build_core(build, "-DCMAKE_BUILD_TYPE=Debug", "-DTF_SANITIZE=address,undefined")
+    build_core(build, "-DCMAKE_BUILD_TYPE=Debug", SANITIZE)
     env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=1", UBSAN_OPTIONS="print_stacktrace=1")
     out = subprocess.run([str(build / "test_core")], capture_output=True, text=True, env=env)
     assert out.returncode == 0 and "0 failed" in out.stdout, out.stdout + out.stderr
-    for replay, folder in (("fuzz_replay", CORPUS), ("fuzz_replay_realtime", CORPUS_REALTIME)):
-        files = corpus(folder)
+    for replay, folder, least in (("fuzz_replay", CORPUS, 100), ("fuzz_replay_realtime", CORPUS_REALTIME, 100),
+                                  ("fuzz_replay_fmu", CORPUS_FMU, 30)):
+        files = corpus(folder, least)
         rep = subprocess.run([str(build / replay), *files], capture_output=True, text=True, env=env)
         assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
 
@@ -85,6 +91,9 @@ def test_c_tests_and_fuzz_corpus_are_valgrind_clean(tmp_path):
     files = corpus(CORPUS_REALTIME)  # the real-time programs are short: all of them (~2 s)
     rep = subprocess.run([*vg, str(build / "fuzz_replay_realtime"), *files], capture_output=True, text=True)
     assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
+    files = corpus(CORPUS_FMU, 30)[::4]  # a quarter, as for the models' corpus
+    rep = subprocess.run([*vg, str(build / "fuzz_replay_fmu"), *files], capture_output=True, text=True)
+    assert rep.returncode == 0 and f"replayed {len(files)} inputs" in rep.stdout, rep.stdout + rep.stderr[-3000:]
 
 
 def run_fuzzer(tmp_path, target, corpus, default_seconds):
@@ -93,7 +102,7 @@ def run_fuzzer(tmp_path, target, corpus, default_seconds):
     need("clang")
     build = tmp_path / "fuzz"
     build_core(build, "-DCMAKE_C_COMPILER=clang", "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DTF_BUILD_FUZZERS=ON",
-               "-DTF_SANITIZE=address,undefined", "-DTF_BUILD_TESTS=OFF")
+               SANITIZE, "-DTF_BUILD_TESTS=OFF")
     work = tmp_path / "corpus"
     shutil.copytree(corpus, work)
     seconds = int(os.environ.get("TF_FUZZ_SECONDS", str(default_seconds)))
@@ -122,6 +131,18 @@ def test_realtime_fuzz_target_runs_20_seconds_without_a_finding(tmp_path):
     PID or a loop output; TF_OK with a non-finite force, state or output; a NaN force that does not
     match the status) fails the run. 20 s on CI (TF_FUZZ_SECONDS changes it, as for the other)."""
     run_fuzzer(tmp_path, "fuzz_realtime", CORPUS_REALTIME, default_seconds=20)
+
+
+def test_fmu_fuzz_target_runs_10_seconds_without_a_finding(tmp_path):
+    """Coverage-guided fuzzing (libFuzzer, ASan, UBSan with float-cast-overflow) of the FMI 2.0 wrapper
+    (core/fuzz/fuzz_fmu.c): a resource file (model.tfm) from the fuzzer's bytes, then up to 48 FMI calls --
+    set-up, initialisation, setting and reading values (undeclared references, NULL arrays), input
+    derivatives, steps from 1e-9 s to 1e300 s, FMU states, reset, terminate. A crash, sanitiser report,
+    hang (10 s) or broken contract (a status other than OK, Warning, Error; fmi2Error without a logged
+    message; a step answered OK that did not move the time by h or left a non-finite output; a refused
+    call that changed a variable, the time or an output; fmi2OK for the undeclared references 7-15)
+    fails the run. 10 s on CI (TF_FUZZ_SECONDS changes it, as for the others)."""
+    run_fuzzer(tmp_path, "fuzz_fmu", CORPUS_FMU, default_seconds=10)
 
 
 # ---------------------------------------------------------------------------------------------

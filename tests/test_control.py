@@ -270,3 +270,21 @@ def test_an_unstable_loop_is_a_solver_error():
     with pytest.raises(tf.SolverError, match="unstable"):
         C.simulate_loop(tf.load_model("stage-model-i"), C.sine_reference(1e-3, 0.5, 0.2), temperature=41.5,
                         pid=C.PID(kp=-1e12, ki=0.0, kd=0.0))
+
+
+def test_loop_work_is_bounded_substeps_int_max_refused_at_once():
+    """Issue 32, item 8: tf_loop_run put no bound on n x substeps, and substeps = 2**31 - 1 (INT_MAX) ran
+    for hours. The core now refuses more than 1e8 plant substeps in one run (TF_LOOP_MAX_SUBSTEPS) before
+    it starts, which the package reports as an InputError naming substeps; values beyond a C int too.
+    A loop at the bound's scale but below it still runs."""
+    import time
+
+    stage = tf.load_model("stage-model-i")
+    ref = C.sine_reference(1e-3, 0.5, 0.1)  # 0.1 s at 10 kHz: 1001 periods
+    for substeps in (2**31 - 1, 10**5 + 1, 10**30):
+        start = time.monotonic()
+        with pytest.raises(tf.InputError, match="substeps"):
+            C.simulate_loop(stage, ref, temperature=41.5, substeps=substeps)
+        assert time.monotonic() - start < 2.0
+    res = C.simulate_loop(stage, ref, temperature=41.5, substeps=20)
+    assert np.isfinite(res.position).all()

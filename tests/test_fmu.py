@@ -480,3 +480,142 @@ def test_bad_step_refused_inside_the_fmu(tmp_path):
     want = other.drive(t, {"force": u}, ["displacement"])["displacement"]
     other.close()
     assert np.array_equal(got, want)
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 32 (items 3 and 4): entry points that returned fmi2OK for what they could not do, or crashed
+# ---------------------------------------------------------------------------------------------
+
+def _refused(run, call, *words):
+    """``call`` raises (fmi2Error) and the last logged message is an error naming each of ``words``."""
+    with pytest.raises(Exception):
+        call()
+    status, _, message = run.messages[-1]
+    assert status == 3, message
+    for word in words:
+        assert word in message, message
+    return message
+
+
+def test_realtime_step_count_that_cannot_be_taken_is_refused(tmp_path):
+    """The real-time FMU counted its fixed steps as (long)floor(h / step), undefined (it overflowed) for
+    doStep(t, 1e300) and for every ordinary step once integrator.step was 1e-300: it answered fmi2OK,
+    integrated nothing and moved its clock. Now such a step is refused with fmi2Error and a message, the
+    clock and the outputs stay, and an ordinary step afterwards runs."""
+    model = _mass_lugre()
+    path = _realtime(model, tmp_path, "rt-count", 1e-4)
+    run = Run(path, tmp_path)
+    run.set("force", 2.0)
+    run.fmu.exitInitializationMode()
+    _refused(run, lambda: run.fmu.doStep(0.0, 1e300), "1e+300")
+    _refused(run, lambda: run.fmu.doStep(0.0, 1e11), "fixed steps", "integrator.step")  # 1e15 steps
+    assert run.fmu.getRealStatus(2) == 0.0  # fmi2LastSuccessfulTime: the clock did not move
+    run.fmu.doStep(0.0, 1e-3)
+    assert run.get("velocity")[0] > 0.0  # 2 N against fs = 1.75 N: the mass moves
+    run.close()
+
+    tiny = Run(path, tmp_path, {"integrator.step": 1e-300})
+    tiny.set("force", 2.0)
+    tiny.fmu.exitInitializationMode()
+    _refused(tiny, lambda: tiny.fmu.doStep(0.0, 1e-3), "fixed steps", "integrator.step = 1e-300")
+    assert tiny.fmu.getRealStatus(2) == 0.0 and tiny.get("displacement", "velocity") == [0.0, 0.0]
+    tiny.close()
+
+
+def test_undeclared_value_references_and_a_wrong_guid_are_refused(tmp_path):
+    """Value references the model description does not declare (7-15 here, an unused parameter number,
+    the temperature output of a model without a heat balance) gave fmi2OK for getReal and setReal; a
+    wrong GUID was instantiated. Both are refused now, with a message."""
+    path = _export(_mass_lugre(), tmp_path, "undeclared")
+    run = Run(path, tmp_path)
+    declared = {v.valueReference for v in run.md.modelVariables}
+    for vr in (1, 5, 6, 7, 9, 15, max(declared) + 1, 2047, 5000):
+        assert vr not in declared
+        _refused(run, lambda: run.fmu.getReal([vr]), str(vr), "not a variable")
+        _refused(run, lambda: run.fmu.setReal([vr], [1.0]), str(vr))
+    run.fmu.exitInitializationMode()
+    assert len(run.fmu.getReal(sorted(declared))) == len(declared)  # the declared ones still read
+    run.close()
+
+    md = read_model_description(str(path))
+    unzipped = extract(str(path), unzipdir=str(tmp_path / "guid"))
+    messages = []
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: messages.append(m.decode()))
+    cb.allocateMemory, cb.freeMemory = defaultCallbacks.allocateMemory, defaultCallbacks.freeMemory
+    wrong = "{" + "0" * 8 + "-0000-0000-0000-" + "0" * 12 + "}"
+    fmu = FMU2Slave(guid=wrong, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="wrong-guid")
+    with pytest.raises(Exception, match="instantiate"):
+        fmu.instantiate(callbacks=cb, loggingOn=True)
+    assert any("GUID" in m and wrong in m and md.guid in m for m in messages), messages
+    fmu.freeLibrary()
+
+
+def test_start_time_and_temperatures_outside_the_packages_ranges_are_refused(tmp_path):
+    """A start time of 1e300 s was accepted (a later step then blamed the sampled input); a temperature of
+    -300 C was taken with a warning while the command line refuses anything outside -100 ... 300 C. Now
+    fmi2SetupExperiment refuses a start beyond the core's +-1e12 s, fmi2SetReal a temperature outside
+    -100 ... 300 C (its ends are taken), and fmi2DoStep a temperature ramp that leaves the range."""
+    path = _export(tf.load_model("li2009-model-i"), tmp_path, "ranges")
+    md = read_model_description(str(path))
+    unzipped = extract(str(path), unzipdir=str(tmp_path / "start"))
+    run = Run(path, tmp_path)
+    for T in (-300.0, -100.5, 300.5, 1e6):
+        _refused(run, lambda: run.set("temperature", T), "not a plausible temperature", "-100 to 300 C")
+    for T in (-100.0, 300.0, 35.0):
+        run.set("temperature", T)
+    run.fmu.exitInitializationMode()
+    run.set("voltage", 10.0)
+    run.fmu.doStep(0.0, 1e-4)
+    run.fmu.setRealInputDerivatives([run.vr["temperature"]], [1], [3e6])  # 35 C + 300 C over the step
+    _refused(run, lambda: run.fmu.doStep(1e-4, 1e-4), "335 C", "not a plausible temperature")
+    assert run.fmu.getRealStatus(2) == pytest.approx(1e-4)  # the clock did not move
+    run.fmu.setRealInputDerivatives([run.vr["temperature"]], [1], [0.0])
+    run.fmu.doStep(1e-4, 1e-4)  # held at 35 C: taken
+    run.close()
+
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="start")
+    messages = []
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: messages.append(m.decode()))
+    cb.allocateMemory, cb.freeMemory = defaultCallbacks.allocateMemory, defaultCallbacks.freeMemory
+    fmu.instantiate(callbacks=cb, loggingOn=True)
+    for start in (1e300, -2e12):
+        with pytest.raises(Exception):
+            fmu.setupExperiment(startTime=start)
+        assert "start time" in messages[-1] and "1e+12" in messages[-1], messages
+    fmu.setupExperiment(startTime=1e6)  # within the limit: taken
+    fmu.freeInstance()
+
+
+def test_input_derivatives_with_null_arrays_are_refused_not_a_crash(tmp_path):
+    """fmi2SetRealInputDerivatives dereferenced NULL arrays (a segmentation fault; the only entry point
+    without fmi2SetReal's check). Run in a child process, so that a crash fails this test instead of
+    ending the session: every NULL combination gives fmi2Error (3) and the instance still steps."""
+    path = _export(_mass_lugre(), tmp_path, "null")
+    script = f"""
+import ctypes, sys
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+md = read_model_description({str(path)!r})
+fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract({str(path)!r}, unzipdir={str(tmp_path / 'null-x')!r}),
+                modelIdentifier=md.coSimulation.modelIdentifier, instanceName="null")
+fmu.instantiate()
+fmu.setupExperiment(startTime=0.0)
+fmu.enterInitializationMode()
+fmu.exitInitializationMode()
+f = fmu.dll.fmi2SetRealInputDerivatives
+f.restype = ctypes.c_int
+f.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
+vr, order, value = (ctypes.c_uint * 1)(0), (ctypes.c_int * 1)(1), (ctypes.c_double * 1)(1.0)
+codes = [f(fmu.component, a, 1, b, c) for a, b, c in ((None, order, value), (vr, None, value), (vr, order, None),
+                                                       (None, None, None))]
+codes.append(f(fmu.component, None, 0, None, None))  # nothing to set: fmi2OK
+fmu.doStep(0.0, 1e-3)
+print(codes)
+"""
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.splitlines()[-1] == "[3, 3, 3, 3, 0]", out.stdout

@@ -25,10 +25,20 @@
 #include "fmi2Functions.h"
 #include "thermofriction.h"
 
-#define FMU_FORMAT 1
+#define FMU_FORMAT 2 /* 2: the "guid" line */
 #define MAX_VR 2048     /* value references 0 .. MAX_VR-1 */
 #define MAX_POINTS 256  /* points (or coefficients) of one law */
 #define NLAW (TF_NPARAM + 1) /* the parameters' laws, then Model II's dF */
+/* The work of one communication step is bounded (a fuzzer builds with smaller bounds): */
+#ifndef MAX_FIXED_STEPS
+#define MAX_FIXED_STEPS 100000000L /* fixed steps (~10 s of work): more is refused */
+#endif
+#ifndef MAX_ADAPTIVE_STEPS
+#define MAX_ADAPTIVE_STEPS 10000000L /* the adaptive integrator's steps: more fails */
+#endif
+#define T_MIN (-100.0)  /* [degC] the temperatures a sensor on an actuator can read: the package's range */
+#define T_MAX 300.0     /* (thermofriction.plausible.TEMPERATURE_RANGE); outside it an input is refused */
+#define TIME_LIMIT 1e12 /* [s] the core's time limit (integrator.h: beyond it a double resolves time poorly) */
 
 /* Fixed value references of the inputs and outputs; parameters come from the resource file. */
 enum {
@@ -76,6 +86,7 @@ typedef struct {
     law_store law[NLAW];
     role_t role[MAX_VR];
     int max_vr;
+    char guid[64];           /* the model description's GUID (resources: "guid" line) */
 
     /* values: parameters and inputs by value reference, their start values for fmi2Reset */
     double r[MAX_VR], r_start[MAX_VR];
@@ -138,6 +149,9 @@ static fmi2Status fail(instance *c, const char *fmt, ...)
     return fmi2Error;
 }
 
+/* A temperature [degC] the package would take (thermofriction.plausible: -100 to 300 C). */
+static int plausible_temperature(double T) { return T >= T_MIN && T <= T_MAX; }
+
 /* ---- the resource file ---- */
 
 /* file:///a/b%20c/resources -> /a/b c/resources (the forms FMI importers pass). */
@@ -194,6 +208,8 @@ static int read_resources(instance *c, const char *dir)
             int version;
             ok = sscanf(rest, "%d", &version) == 1 && version == FMU_FORMAT;
             have_header = ok;
+        } else if (strcmp(key, "guid") == 0) {
+            ok = sscanf(rest, "%63s", c->guid) == 1;
         } else if (strcmp(key, "plant") == 0) {
             ok = sscanf(rest, "%d %d", &c->plant, &c->modal) == 2;
         } else if (strcmp(key, "friction") == 0) {
@@ -242,6 +258,7 @@ static int read_resources(instance *c, const char *dir)
     fclose(f);
     if (!ok) return (fail(c, "%s, line %d: not understood (an FMU made by another version?)", path, lineno), -1);
     if (!have_header) return (fail(c, "%s: not a thermofriction FMU model description", path), -1);
+    if (!c->guid[0]) return (fail(c, "%s: no guid line (the model description's GUID)", path), -1);
     if (isnan(c->fixed_step)) {
         int has_step = 0;
         for (int vr = VR_FIRST_PARAMETER; vr <= c->max_vr; vr++) has_step |= c->role[vr].role == ROLE_STEP;
@@ -378,13 +395,13 @@ temperature:
 
 static int check_model(instance *c, const tf_model *m)
 {
-    const char *what = 0;
-    if (tf_model_check(m, &what) == TF_OK) return 0;
+    tf_error e;
+    if (tf_model_check(m, &e) == TF_OK) return 0;
     if (c->temperature_input || c->heat)
         fail(c, "at time %g s, temperature %g C: the model is outside its domain ('%s')", c->t,
-              c->r[VR_TEMPERATURE], what ? what : "?");
+             c->r[VR_TEMPERATURE], e.what);
     else
-        fail(c, "at time %g s: the model is outside its domain ('%s')", c->t, what ? what : "?");
+        fail(c, "at time %g s: the model is outside its domain ('%s')", c->t, e.what);
     return -1;
 }
 
@@ -451,8 +468,13 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
     c->name = cb->allocateMemory(len, 1);
     if (c->name) memcpy(c->name, name ? name : "", len);
     c->rtol = 1e-6;
-    if (!resources || read_resources(c, resources) != 0 || build_model(c, &c->model) != 0) {
+    int bad_guid = 0;
+    if (!resources || read_resources(c, resources) != 0 ||
+        (bad_guid = !guid || strcmp(guid, c->guid) != 0) || build_model(c, &c->model) != 0) {
         if (!resources) fail(c, "no resource location given");
+        if (bad_guid)
+            fail(c, "fmi2Instantiate: GUID %s is not this FMU's %s (a model description of another FMU?)",
+                 guid ? guid : "(NULL)", c->guid);
         if (c->name) cb->freeMemory(c->name);
         cb->freeMemory(c);
         return NULL;
@@ -480,7 +502,9 @@ fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tol_defined, fmi2
         if (!(tol > 0 && tol < 1)) return fail(c, "fmi2SetupExperiment: tolerance %g must be between 0 and 1", tol);
         c->rtol = tol;
     }
-    if (!isfinite(start)) return fail(c, "fmi2SetupExperiment: start time is not finite");
+    if (!(fabs(start) <= TIME_LIMIT))
+        return fail(c, "fmi2SetupExperiment: start time %g s: must be finite and within +-%g s (the integrator's "
+                    "time limit)", start, TIME_LIMIT);
     c->t = start;
     return fmi2OK;
 }
@@ -502,6 +526,9 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
     if (!isfinite(c->r[VR_DRIVE]) || !isfinite(c->r[VR_TEMPERATURE]))
         return fail(c, "the inputs at the start are not finite (drive %g, temperature %g)", c->r[VR_DRIVE],
                      c->r[VR_TEMPERATURE]);
+    if ((c->temperature_input || c->heat) && !plausible_temperature(c->r[VR_TEMPERATURE]))
+        return fail(c, "the temperature at the start %g C is not a plausible temperature (expected %g to %g C)",
+                    c->r[VR_TEMPERATURE], T_MIN, T_MAX);
     if (build_model(c, &c->model) != 0) return fmi2Error;
     c->u_prev = c->r[VR_DRIVE];
     set_signals(c, &c->model, c->t, 0.0);
@@ -541,13 +568,27 @@ static int is_output(fmi2ValueReference vr)
     return vr >= VR_DISPLACEMENT && vr <= VR_STAGE_DISPLACEMENT;
 }
 
+/* The value references the model description declares (fmu.py's _variables): the drive, the
+ * temperature input with a thermal extension or a heat model, the outputs of this plant, and the
+ * parameters the resource file gives a role. Every other one is refused. */
+static int declared(const instance *c, fmi2ValueReference vr)
+{
+    switch (vr) {
+    case VR_DRIVE: case VR_DISPLACEMENT: case VR_VELOCITY: case VR_FRICTION_FORCE: return 1;
+    case VR_TEMPERATURE: return c->temperature_input || c->heat;
+    case VR_TEMPERATURE_OUT: return c->heat;
+    case VR_STAGE_DISPLACEMENT: return c->plant == TF_PLANT_STICK_SLIP;
+    default: return vr >= VR_FIRST_PARAMETER && vr < MAX_VR && c->role[vr].role != ROLE_NONE;
+    }
+}
+
 fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
 {
     instance *c = comp;
     if (!c) return fmi2Error;
     if (n > 0 && (!vr || !value)) return fail(c, "fmi2GetReal: NULL argument");
     for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= MAX_VR) return fail(c, "fmi2GetReal: unknown value reference %u", vr[k]);
+        if (!declared(c, vr[k])) return fail(c, "fmi2GetReal: value reference %u is not a variable of this FMU", vr[k]);
         value[k] = is_output(vr[k]) ? output(c, (int)vr[k]) : c->r[vr[k]];
     }
     return fmi2OK;
@@ -564,8 +605,7 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
     memcpy(before, c->r, sizeof before);
     for (size_t k = 0; k < n; k++) {
         fmi2ValueReference v = vr[k];
-        if (v >= MAX_VR || is_output(v) || (v >= VR_FIRST_PARAMETER && !c->role[v].role) ||
-            (v == VR_TEMPERATURE && !c->temperature_input && !c->heat)) {
+        if (!declared(c, v) || is_output(v)) {
             memcpy(c->r, before, sizeof before);
             return fail(c, "fmi2SetReal: value reference %u cannot be set", v);
         }
@@ -574,6 +614,12 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
             return fail(c, "fmi2SetReal: %s (value reference %u) is not finite (%g): refused",
                          v == VR_DRIVE ? "the drive input" : v == VR_TEMPERATURE ? "the temperature input"
                                                                                   : "a parameter", v, value[k]);
+        }
+        if ((v == VR_TEMPERATURE || c->role[v].role == ROLE_T_0) && !plausible_temperature(value[k])) {
+            memcpy(c->r, before, sizeof before);
+            return fail(c, "fmi2SetReal: %s %g C is not a plausible temperature (expected %g to %g C): refused",
+                        v == VR_TEMPERATURE ? (c->heat ? "the ambient temperature" : "the temperature input")
+                                            : "the start temperature T_0", value[k], T_MIN, T_MAX);
         }
         if (v >= VR_FIRST_PARAMETER && c->role[v].role == ROLE_STEP && !(value[k] > 0)) {
             memcpy(c->r, before, sizeof before);
@@ -609,13 +655,19 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueRefere
 {
     instance *c = comp;
     if (!c) return fmi2Error;
+    if (n > 0 && (!vr || !order || !value)) return fail(c, "fmi2SetRealInputDerivatives: NULL argument");
+    if (c->mode == S_TERMINATED || c->mode == S_ERROR)
+        return fail(c, "fmi2SetRealInputDerivatives: the instance is terminated");
+    double du = c->du, dT = c->dT; /* a refusal changes nothing */
+    int du_set = c->du_set;
     for (size_t k = 0; k < n; k++) {
         if (order[k] != 1) return fail(c, "fmi2SetRealInputDerivatives: only first derivatives (order 1)");
         if (!isfinite(value[k])) return fail(c, "fmi2SetRealInputDerivatives: derivative is not finite (%g)", value[k]);
-        if (vr[k] == VR_DRIVE) c->du = value[k], c->du_set = 1;
-        else if (vr[k] == VR_TEMPERATURE && c->temperature_input) c->dT = value[k];
+        if (vr[k] == VR_DRIVE) du = value[k], du_set = 1;
+        else if (vr[k] == VR_TEMPERATURE && c->temperature_input) dT = value[k];
         else return fail(c, "fmi2SetRealInputDerivatives: value reference %u is no continuous input", vr[k]);
     }
+    c->du = du, c->dT = dT, c->du_set = du_set;
     return fmi2OK;
 }
 
@@ -651,8 +703,9 @@ static int realtime_steps(instance *c, double h, double *y)
 {
     tf_model *m = &c->model;
     tf_rt_friction rt;
-    if (tf_rt_from_model(&rt, m) != TF_OK)
-        return (fail(c, "the real-time friction model refused the model ('%s')", rt.what ? rt.what : "?"), -1);
+    tf_error e;
+    if (tf_rt_from_model(&rt, m, &e) != TF_OK)
+        return (fail(c, "the real-time friction model refused the model ('%s')", e.what), -1);
     int n = tf_model_nstate(m);
     int nz = tf_friction_nstate(m->friction, m->gms.n);
     int nm = m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
@@ -661,6 +714,9 @@ static int realtime_steps(instance *c, double h, double *y)
     double dt = c->fixed_step;
     /* whole steps, a communication step within 1e-9 of a whole number of steps counting as one */
     double ratio = h / dt;
+    if (!(ratio <= MAX_FIXED_STEPS)) /* (long)floor(ratio) would overflow, or the step would not end */
+        return (fail(c, "fmi2DoStep: a communication step of %g s is %.3g fixed steps of integrator.step = %g s; "
+                     "at most %ld are taken in one communication step: refused", h, ratio, dt, MAX_FIXED_STEPS), -1);
     long whole = (long)floor(ratio * (1.0 + 1e-9));
     double last = h - whole * dt;
     if (last <= 1e-9 * dt) last = 0.0;
@@ -670,10 +726,10 @@ static int realtime_steps(instance *c, double h, double *y)
         double ts = c->t + s * dt, hs = s < whole ? dt : last;
         if (s == whole - 1 && last == 0.0) hs = h - s * dt; /* end exactly on the communication point */
         double v = sliding_velocity(m, ts, y), T = tf_model_temperature(m, ts, y), F;
-        int st = tf_rt_step_status(&rt, v, T, hs, &F);
+        tf_status st = tf_rt_step(&rt, v, T, hs, &F, &e);
         if (st != TF_OK)
             return (fail(c, "the fixed step at %g s (temperature %g C) was refused: %s ('%s')", ts, T,
-                         tf_status_message(st), rt.what ? rt.what : "?"), -1);
+                         tf_status_message(st), e.what), -1);
         memcpy(y + nm, rt.z, sizeof(double) * nz);
         memcpy(m->gms.mode, rt.model.gms.mode, sizeof m->gms.mode);
         tf_model_rhs(ts, y, dy, m); /* at the new friction states: the force the real-time step gave */
@@ -699,6 +755,16 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     if (!isfinite(c->r[VR_DRIVE]) || !isfinite(c->r[VR_TEMPERATURE]))
         return fail(c, "at time %g s the inputs are not finite (drive %g, temperature %g)", t, c->r[VR_DRIVE],
                      c->r[VR_TEMPERATURE]);
+    if (!(fabs(t + h) <= TIME_LIMIT))
+        return fail(c, "fmi2DoStep: the step ends at %g s, beyond +-%g s (the integrator's time limit)", t + h,
+                    TIME_LIMIT);
+    if (c->temperature_input || c->heat) {
+        double T0 = c->r[VR_TEMPERATURE], T1 = T0 + (c->heat ? 0.0 : c->dT * h);
+        if (!plausible_temperature(T0) || !plausible_temperature(T1))
+            return fail(c, "fmi2DoStep: the %s reaches %g C over the step, not a plausible temperature (expected "
+                        "%g to %g C)", c->heat ? "ambient temperature" : "temperature input",
+                        plausible_temperature(T0) ? T1 : T0, T_MIN, T_MAX);
+    }
     fmi2Status status = fmi2OK;
     if (c->temperature_input && !c->heat) {
         status = check_range(c, c->r[VR_TEMPERATURE]);
@@ -725,16 +791,18 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     tf_ode ode = tf_model_ode(&c->model);
     double rtol_w[TF_MAX_STATES];
     tf_model_rtol_weights(&c->model, rtol_w);
-    tf_solver_options opt = {TF_METHOD_AUTO, c->rtol, atol, 0.0, 0.0, 10000000L, rtol_w};
+    tf_solver_options opt = {.method = TF_METHOD_AUTO, .rtol = c->rtol, .atol = atol, .max_steps = MAX_ADAPTIVE_STEPS,
+                             .rtol_weight = rtol_w};
     double t_out[2] = {c->t, c->t + h};
     tf_solver_stats st;
-    int s = tf_solve(&ode, &opt, t_out, 2, y, no_emit, 0, &st);
+    tf_error e;
+    tf_status s = tf_solve(&ode, &opt, t_out, 2, y, no_emit, 0, &st, &e);
     for (int i = 0; s == TF_OK && i < n; i++)
-        if (!isfinite(y[i])) s = TF_ERR_NONFINITE;
+        if (!isfinite(y[i])) s = TF_ERR_NONFINITE, e.t = c->t + h, snprintf(e.what, sizeof e.what, "%s", "state");
     if (s != TF_OK) {
         c->model.gms = modes;
-        return fail(c, "the integration from %g s over %g s failed at %g s: %s", c->t, h, st.t_fail,
-                     tf_status_message(s));
+        return fail(c, "the integration from %g s over %g s failed at %g s: %s (%s)", c->t, h, e.t,
+                    tf_status_message(s), e.what);
     }
     return step_done(c, h, y, n, status);
 }

@@ -9,13 +9,12 @@
  * Contract checked (abort() on a violation, so that the fuzzer keeps the input):
  * - nothing crashes, reads or writes out of bounds (ASan), hits undefined behaviour (UBSan) or hangs
  *   (the work per input is bounded: libFuzzer's -timeout catches a loop that is not);
- * - every call returns TF_OK, TF_ERR_BAD_ARGUMENT or TF_ERR_NONFINITE; an object's status and what
- *   agree with it (what is NULL exactly on TF_OK);
+ * - every call returns TF_OK, TF_ERR_BAD_ARGUMENT or TF_ERR_NONFINITE, and its error record (status.h)
+ *   agrees: the same code, `what` and `where` empty exactly on TF_OK; a loop names a period in the run;
  * - a refused call changes nothing: the object (states, GMS modes, parameters, laws) or the PID is
  *   byte for byte what it was; a refused loop writes no output;
- * - a step on TF_OK gives a finite force and finite states; a refused one gives NaN, and the
- *   force-returning variants (tf_rt_step, tf_observer_step, tf_pid_step) return NaN exactly when the
- *   status variants refuse; the internal states are finite at all times.
+ * - a step on TF_OK gives a finite force and finite states; a refused one writes NaN to the force (or
+ *   the PID's u) exactly then; the internal states are finite at all times.
  * The one precondition kept by construction: a law's arrays hold the n values it claims and are
  * not changed while an object may use them (each decoded law has its own storage).
  *
@@ -127,13 +126,21 @@ static int same_object(const tf_rt_friction *f, const tf_rt_friction *g)
     return 1;
 }
 
-static void check_object(const tf_rt_friction *f, int status, const tf_rt_friction *before)
+/* The error record of every call (status.h). */
+static tf_error err;
+
+static void check_record(tf_status status)
 {
     if (status != TF_OK && status != TF_ERR_BAD_ARGUMENT && status != TF_ERR_NONFINITE) FAIL("unknown status");
-    if (!f) return;
-    if (f->status != status) FAIL("f->status is not the status returned");
-    if ((status == TF_OK) != (f->what == NULL)) FAIL("what is not NULL exactly on TF_OK");
-    if (status != TF_OK && before && !same_object(f, before)) FAIL("a refused call changed the object");
+    if (err.code != status) FAIL("the error record's code is not the status returned");
+    if ((status == TF_OK) != (err.what[0] == 0) || (status == TF_OK) != (err.where[0] == 0))
+        FAIL("what and where are not empty exactly on TF_OK");
+}
+
+static void check_object(const tf_rt_friction *f, tf_status status, const tf_rt_friction *before)
+{
+    check_record(status);
+    if (f && status != TF_OK && before && !same_object(f, before)) FAIL("a refused call changed the object");
 }
 
 static int same_pid(const tf_pid *a, const tf_pid *b)
@@ -180,7 +187,7 @@ static void run_loop(reader *r)
     L.plant = pick(r);
     L.T_plant = number(r);
     L.pid = pid;
-    if (byte(r) & 1) tf_pid_init(&L.pid, 1e3 * (1 + byte(r)), 1e4 * byte(r), byte(r), 1e-4 * byte(r));
+    if (byte(r) & 1) tf_pid_init(&L.pid, 1e3 * (1 + byte(r)), 1e4 * byte(r), byte(r), 1e-4 * byte(r), NULL);
     L.compensation = byte(r) % 4; /* 3: unknown */
     L.comp = pick(r);
     L.T_comp = number(r);
@@ -197,9 +204,11 @@ static void run_loop(reader *r)
     if (n > 0 && byte(r) < 32) x_ref[byte(r) % n] = number(r);
     if (n > 0 && byte(r) < 32) v_ref[byte(r) % n] = number(r);
     uint8_t nulls = byte(r);
-    int status = tf_loop_run(byte(r) < 4 ? NULL : &L, n, nulls & 1 ? NULL : x_ref, nulls & 2 ? NULL : v_ref,
-                             nulls & 4 ? NULL : out[0], nulls & 8 ? NULL : out[1], nulls & 16 ? NULL : out[2]);
-    if (status != TF_OK && status != TF_ERR_BAD_ARGUMENT && status != TF_ERR_NONFINITE) FAIL("loop: unknown status");
+    tf_status status = tf_loop_run(byte(r) < 4 ? NULL : &L, n, nulls & 1 ? NULL : x_ref, nulls & 2 ? NULL : v_ref,
+                                   nulls & 4 ? NULL : out[0], nulls & 8 ? NULL : out[1], nulls & 16 ? NULL : out[2],
+                                   &err);
+    check_record(status);
+    if (status != TF_OK && !(err.index >= -1 && err.index < (n > 0 ? n : 1))) FAIL("loop: a period outside the run");
     if (status == TF_ERR_BAD_ARGUMENT)
         for (int k = 0; k < 3; k++)
             for (int i = 0; i < MAXN; i++)
@@ -220,7 +229,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (int op = 0; op < NOPS && r.n; op++) {
         tf_rt_friction *f = pick(&r);
         if (f) before = *f;
-        int status = TF_OK;
+        tf_status status = TF_OK;
         tf_law L;
         double p[TF_NPARAM], F;
         switch (byte(&r) % 12) {
@@ -229,7 +238,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             params(&r, p);
             if (kind == TF_FRICTION_GMS || byte(&r) < 16) decode_gms(&r);
             uint8_t nulls = byte(&r);
-            status = tf_rt_init(f, kind, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &gms);
+            status = tf_rt_init(f, kind, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &gms, &err);
             check_object(f, status, NULL);
             break;
         }
@@ -252,37 +261,38 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 if (l) m.dF = *l;
                 m.dF_form = byte(&r) % 3;
             }
-            status = tf_rt_from_model(f, byte(&r) < 8 ? NULL : &m);
+            status = tf_rt_from_model(f, byte(&r) < 8 ? NULL : &m, &err);
             check_object(f, status, f ? &before : NULL);
             break;
         }
         case 2: { /* Model I */
             int param = (int)(byte(&r) % (TF_NPARAM + 2)) - 1;
-            status = tf_rt_set_model_i(f, param, law(&r, &L));
+            status = tf_rt_set_model_i(f, param, law(&r, &L), &err);
             check_object(f, status, f ? &before : NULL);
             break;
         }
         case 3: { /* Model II */
             const tf_law *l = law(&r, &L);
-            status = tf_rt_set_model_ii(f, l, byte(&r) % 3);
+            status = tf_rt_set_model_ii(f, l, byte(&r) % 3, &err);
             check_object(f, status, f ? &before : NULL);
             break;
         }
         case 4: { /* set_param */
             int param = (int)(byte(&r) % (TF_NPARAM + 2)) - 1;
-            status = tf_rt_set_param(f, param, number(&r));
+            status = tf_rt_set_param(f, param, number(&r), &err);
             check_object(f, status, f ? &before : NULL);
             break;
         }
         case 5:
-            status = tf_rt_reset(f);
+            status = tf_rt_reset(f, &err);
             check_object(f, status, NULL);
             break;
         case 6: { /* params_at */
             double T = number(&r), lambda = -1.0, dF = -1.0;
             uint8_t nulls = byte(&r);
             for (int i = 0; i < TF_NPARAM; i++) p[i] = -7.0;
-            status = tf_rt_params_at(f, T, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &lambda, nulls & 4 ? NULL : &dF);
+            status = tf_rt_params_at(f, T, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &lambda, nulls & 4 ? NULL : &dF,
+                                     &err);
             check_object(f, status, f ? &before : NULL);
             if (status != TF_OK && (p[0] != -7.0 || lambda != -1.0 || dF != -1.0)) FAIL("a refused params_at wrote");
             break;
@@ -293,16 +303,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             for (int i = 0; i < k; i++) {
                 double vi = i == bad ? number(&r) : v * sin(w * i);
                 if (f) before = *f;
-                int use_status = byte(&r) & 1;
-                if (use_status) {
-                    status = tf_rt_step_status(f, vi, T, dt, byte(&r) < 4 ? NULL : &F);
-                } else {
-                    F = tf_rt_step(f, vi, T, dt);
-                    status = f ? f->status : TF_ERR_BAD_ARGUMENT;
-                }
+                int null_F = (byte(&r) & 1) && byte(&r) < 4; /* (the bytes of the former two variants) */
+                F = 0.0;
+                status = tf_rt_step(f, vi, T, dt, null_F ? NULL : &F, &err);
                 check_object(f, status, f ? &before : NULL);
                 if (status == TF_OK && !isfinite(F)) FAIL("step: TF_OK with a non-finite force");
-                if (!use_status && (status != TF_OK) != isnan(F)) FAIL("tf_rt_step: NaN not exactly on a refusal");
+                if (!null_F && (status != TF_OK) != isnan(F)) FAIL("tf_rt_step: *F NaN not exactly on a refusal");
             }
             break;
         }
@@ -312,16 +318,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             double dt = byte(&r) & 1 ? 1e-4 : number(&r);
             for (int i = 0; i < k; i++) {
                 if (f) before = *f;
-                int use_status = byte(&r) & 1;
-                if (use_status) {
-                    status = tf_observer_step_status(f, v, e * i, gain, T, dt, byte(&r) < 4 ? NULL : &F);
-                } else {
-                    F = tf_observer_step(f, v, e * i, gain, T, dt);
-                    status = f ? f->status : TF_ERR_BAD_ARGUMENT;
-                }
+                int null_F = (byte(&r) & 1) && byte(&r) < 4;
+                F = 0.0;
+                status = tf_observer_step(f, v, e * i, gain, T, dt, null_F ? NULL : &F, &err);
                 check_object(f, status, f ? &before : NULL);
                 if (status == TF_OK && !isfinite(F)) FAIL("observer: TF_OK with a non-finite force");
-                if (!use_status && (status != TF_OK) != isnan(F)) FAIL("tf_observer_step: NaN not exactly on a refusal");
+                if (!null_F && (status != TF_OK) != isnan(F)) FAIL("tf_observer_step: *F NaN not exactly on a refusal");
             }
             break;
         }
@@ -332,9 +334,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             for (int i = 0; i < TF_MAX_FRICTION_STATES; i++) extra[i] = 1e-3 * i;
             uint8_t nulls = byte(&r);
             if (kind == TF_FRICTION_GMS || nulls & 32) decode_gms(&r);
-            (void)tf_rt_advance(kind, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &gms, nulls & 4 ? NULL : z,
-                                number(&r), number(&r), nulls & 8 ? NULL : extra, nulls & 16 ? NULL : dz);
-            (void)tf_rt_thermal_force(number(&r), number(&r), nulls & 64 ? NULL : p, number(&r), number(&r));
+            status = tf_rt_advance(kind, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &gms, nulls & 4 ? NULL : z,
+                                   number(&r), number(&r), nulls & 8 ? NULL : extra, nulls & 16 ? NULL : dz, &F, &err);
+            if (status != TF_OK && status != TF_ERR_BAD_ARGUMENT) FAIL("advance: unknown status");
+            if (err.code != status || (status != TF_OK && !isnan(F))) FAIL("advance: record or *F wrong");
+            status = tf_rt_thermal_force(number(&r), number(&r), nulls & 64 ? NULL : p, number(&r), number(&r), &F,
+                                         &err);
+            if (err.code != status || (status != TF_OK && !isnan(F))) FAIL("thermal_force: record or *F wrong");
+            status = TF_OK;
             break;
         }
         case 10: { /* PID */
@@ -342,25 +349,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (byte(&r) & 1) {
                 double kp = number(&r), ki = number(&r), kd = number(&r), tau = number(&r);
                 tf_pid keep = pid;
-                status = tf_pid_init(c, kp, ki, kd, tau);
+                status = tf_pid_init(c, kp, ki, kd, tau, &err);
                 if (status != TF_OK && status != TF_ERR_BAD_ARGUMENT) FAIL("pid_init: unknown status");
+                check_record(status);
                 if (status != TF_OK && !same_pid(&keep, &pid)) FAIL("a refused pid_init changed the PID");
             }
             int k = 1 + byte(&r) % 16;
             double e = number(&r), dt = byte(&r) & 1 ? 1e-4 : number(&r);
             for (int i = 0; i < k; i++) {
                 tf_pid keep = pid;
-                double u;
-                int refused;
-                if (byte(&r) & 1) {
-                    status = tf_pid_step_status(c, e * i, dt, byte(&r) < 4 ? NULL : &u);
-                    if (status != TF_OK && status != TF_ERR_BAD_ARGUMENT && status != TF_ERR_NONFINITE)
-                        FAIL("pid: unknown status");
-                    refused = status != TF_OK;
-                } else {
-                    u = tf_pid_step(c, e * i, dt);
-                    refused = isnan(u);
-                }
+                double u = 0.0;
+                int null_u = (byte(&r) & 1) && byte(&r) < 4;
+                status = tf_pid_step(c, e * i, dt, null_u ? NULL : &u, &err);
+                check_record(status);
+                int refused = status != TF_OK;
+                if (!null_u && refused != isnan(u)) FAIL("pid: *u NaN not exactly on a refusal");
                 if (refused && !same_pid(&keep, &pid)) FAIL("a refused pid step changed the PID");
                 if (!refused && !isfinite(u)) FAIL("pid: an accepted step with a non-finite u");
             }

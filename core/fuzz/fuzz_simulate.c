@@ -204,10 +204,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tf_model_prepare(&m);
 
     /* user data goes through tf_model_check first; what it refuses is not simulated */
-    const char *what = 0;
-    int valid = tf_model_check(&m, &what) == TF_OK;
-    if (!valid && !what) FAIL("refused without naming a field");
-    if (valid && what) FAIL("accepted but named a field");
+    tf_error e;
+    tf_status checked = tf_model_check(&m, &e);
+    int valid = checked == TF_OK;
+    if (e.code != checked) FAIL("the error record's code is not the status returned");
+    if (!valid && (checked != TF_ERR_BAD_ARGUMENT || !e.what[0] || strcmp(e.where, "model") != 0))
+        FAIL("refused without naming a field");
+    if (valid && (e.what[0] || e.where[0])) FAIL("accepted but named a field");
 
     /* the waveform and laws on their own, at an arbitrary time/temperature */
     double probe = number(&r);
@@ -233,12 +236,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tf_model_state_scale(&m, atol);
     double rtol = pow(10.0, -(double)(2 + byte(&r) % 9));
     for (int i = 0; i < n; i++) atol[i] = isfinite(atol[i]) && atol[i] > 0 ? rtol * atol[i] : rtol;
-    tf_solver_options opt = {byte(&r) % 3, rtol, atol, 0.0, 0.0, 400};
+    tf_solver_options opt = {.method = byte(&r) % 3, .rtol = rtol, .atol = atol, .max_steps = 400};
     tf_ode ode = tf_model_ode(&m);
     tf_solver_stats stats;
     sink s = {&m, 0, 0.0, 0, 0, 0.0};
-    int status = tf_solve(&ode, &opt, t_out, n_out, y, emit, &s, &stats);
-    if (status < TF_OK || status > TF_ERR_BAD_ARGUMENT) FAIL("unknown status");
+    tf_status status = tf_solve(&ode, &opt, t_out, n_out, y, emit, &s, &stats, &e);
+    if (status != TF_OK && status != TF_ERR_NONFINITE && status != TF_ERR_STEP_UNDERFLOW &&
+        status != TF_ERR_MAX_STEPS && status != TF_ERR_BAD_ARGUMENT)
+        FAIL("unknown status");
+    if (e.code != status || (status != TF_OK && (strcmp(e.where, "solver") != 0 || !e.what[0])))
+        FAIL("the error record does not match the status");
     if (status == TF_OK && s.count != n_out) FAIL("TF_OK but not every sample emitted");
     if (status == TF_OK && s.nonfinite) {
         fprintf(stderr, "state %d at t = %g\n", s.channel, s.t_bad);

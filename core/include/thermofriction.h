@@ -1,6 +1,7 @@
 /* thermofriction C core: everything in one include. */
 #ifndef THERMOFRICTION_H
 #define THERMOFRICTION_H
+#include "thermofriction/status.h"
 #include "thermofriction/waveform.h"
 #include "thermofriction/law.h"
 #include "thermofriction/thermal.h"

@@ -1,5 +1,6 @@
 /* Friction models (docs/models.md#friction-models). */
 #include "thermofriction/friction.h"
+#include "checks.h"
 
 #include <math.h>
 #include <string.h>
@@ -291,4 +292,49 @@ void tf_friction_update_modes(int kind, const double *p, tf_gms_elements *el, do
             el->mode[i] = 0; /* the motion reversed (or stopped): it sticks where it is */
         }
     }
+}
+
+/* ---- checks (tf_model_check, plant.h) ---- */
+
+/* The friction model's kind and its GMS elements. */
+const char *tf_friction_structure_problem(int kind, const tf_gms_elements *gms)
+{
+    if (kind < TF_FRICTION_LUGRE || kind > TF_FRICTION_GMS) return "friction";
+    if (kind != TF_FRICTION_GMS) return 0;
+    double sum = 0.0;
+    if (gms->n < 1 || gms->n > TF_MAX_FRICTION_STATES) return "gms.n (1 to 64 elements)";
+    for (int i = 0; i < gms->n; i++) {
+        if (!tf_pos(gms->k[i])) return "gms.k";
+        if (!tf_pos(gms->w[i])) return "gms.w";
+        sum += gms->w[i];
+    }
+    if (!(fabs(sum - 1.0) <= 1e-9)) return "gms.w (must sum to one)";
+    return 0;
+}
+
+/* The friction parameters the model uses, at one temperature. */
+const char *tf_friction_params_problem(int k, const double *p, int offset_form)
+{
+    int stribeck = k == TF_FRICTION_STRIBECK || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC ||
+                   k == TF_FRICTION_GMS;
+    if (!tf_pos(p[TF_P_FC])) return "fc";
+    if (k != TF_FRICTION_DAHL && !tf_nonneg(p[TF_P_SIGMA2])) return "sigma2";
+    if (k == TF_FRICTION_DAHL || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
+        if (!tf_pos(p[TF_P_SIGMA0])) return "sigma0";
+    }
+    if (k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
+        if (!tf_nonneg(p[TF_P_SIGMA1])) return "sigma1";
+        if (isnan(p[TF_P_VD]) || p[TF_P_VD] == INFINITY) return "vd"; /* <= 0: sigma1 constant */
+    }
+    if (stribeck) {
+        if (!isfinite(p[TF_P_FS]) || p[TF_P_FS] < p[TF_P_FC]) return "fs";
+        if (p[TF_P_FS] != p[TF_P_FC] && !tf_pos(p[TF_P_VS])) return "vs";
+        if (p[TF_P_FS] != p[TF_P_FC] && !tf_pos(p[TF_P_DELTA])) return "delta";
+    }
+    if ((k == TF_FRICTION_COULOMB || k == TF_FRICTION_STRIBECK || offset_form) && !tf_pos(p[TF_P_VSMOOTH]))
+        return "v_smooth";
+    if (k == TF_FRICTION_ELASTOPLASTIC && !(tf_nonneg(p[TF_P_ZBA]) && p[TF_P_ZBA] < p[TF_P_FC] / p[TF_P_SIGMA0]))
+        return "z_ba";
+    if (k == TF_FRICTION_GMS && !tf_pos(p[TF_P_C])) return "C";
+    return 0;
 }

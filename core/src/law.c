@@ -1,5 +1,6 @@
 /* Temperature laws (see law.h). */
 #include "thermofriction/law.h"
+#include "checks.h"
 
 #include <math.h>
 
@@ -117,4 +118,15 @@ double tf_law_coef_derivative(const tf_law *law, int coef, double T)
     }
     default: return NAN;
     }
+}
+
+/* ---- checks (tf_model_check, plant.h) ---- */
+
+int tf_law_ok(const tf_law *L)
+{
+    if (L->kind < TF_LAW_NONE || L->kind > TF_LAW_TABLE) return 0;
+    if (L->kind == TF_LAW_POLY && (L->n < 1 || !L->y)) return 0;
+    if (L->kind == TF_LAW_PWL || L->kind == TF_LAW_TABLE)
+        return tf_knots_ok(L->n, L->x, L->y) && (L->kind != TF_LAW_TABLE || L->d);
+    return 1;
 }

@@ -249,25 +249,25 @@ TF_SIZED void mechanical_rhs(const tf_model *m, double t, const double *y, doubl
     }
 }
 
-int tf_model_rhs(double t, const double *y, double *dy, void *ctx)
+tf_status tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     int nm = nmech(m);
     double F = friction(m, t, y, dy + nm, 0);
     if (has_work(m)) heat_rates(m, t, y, F, dy);
     mechanical_rhs(m, t, y, F, dy);
-    return 0;
+    return TF_OK;
 }
 
 /* dv_r/dy for the mechanical states (prescribed motion: none). */
 /* tf_model_rhs for the common case (lugre_constant_T). */
-static int rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
+static tf_status rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     int iz = m->plant == TF_PLANT_STICK_SLIP ? 4 : 2;
     double F = lugre_constant_T_friction(m, relative_velocity(m, t, y), y[iz], &dy[iz]);
     mechanical_rhs(m, t, y, F, dy);
-    return 0;
+    return TF_OK;
 }
 
 static void velocity_partials(const tf_model *m, double *dv_dy)
@@ -350,14 +350,14 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
     if (has_work(m)) heat_jacobian(m, t, y, d, J);
 }
 
-int tf_model_jac(double t, const double *y, double *J, void *ctx)
+tf_status tf_model_jac(double t, const double *y, double *J, void *ctx)
 {
     tf_model *m = (tf_model *)ctx;
     double dz[TF_MAX_FRICTION_STATES];
     tf_friction_partials d;
     friction(m, t, y, dz, &d);
     jacobian_from(m, t, y, &d, J);
-    return 0;
+    return TF_OK;
 }
 
 /* d(rhs)/d(plant parameter) into column k of fp (stride np): only the mechanical rows depend on
@@ -389,8 +389,8 @@ static void plant_partials(const tf_model *m, double t, const double *y, const d
     }
 }
 
-int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
-                         const tf_target *targets, int np, double *fp)
+tf_status tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
+                               const tf_target *targets, int np, double *fp)
 {
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
@@ -399,7 +399,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         if (fast) rhs_lugre_constant_T(t, y, dy, m);
         else tf_model_rhs(t, y, dy, m);
         if (J) tf_model_jac(t, y, J, m);
-        return 0;
+        return TF_OK;
     }
     if (!fast) tf_model_rhs(t, y, dy, m); /* else from the one friction evaluation below */
     tf_friction_param_partials dp;
@@ -451,7 +451,7 @@ int tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, dou
         if (iT >= 0) fp[iT * np + k] = tf_heat_rate_dP(&m->heat, dP);
         if (iW >= 0) fp[iW * np + k] = dP;
     }
-    return 0;
+    return TF_OK;
 }
 
 double tf_model_next_corner(double t, void *ctx)
@@ -597,216 +597,4 @@ void tf_model_outputs_strided(const tf_model *model, double t, const double *y, 
 void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
 {
     tf_model_outputs_strided(model, t, y, out, 1);
-}
-
-/* ---- model check (the C side of the Python package's parameter checks) ---- */
-
-static int pos(double x) { return isfinite(x) && x > 0.0; }
-static int nonneg(double x) { return isfinite(x) && x >= 0.0; }
-
-/* The friction parameters the model uses, at one temperature. */
-static const char *check_friction_params(const tf_model *m, const double *p, int offset_form)
-{
-    int k = m->friction;
-    int stribeck = k == TF_FRICTION_STRIBECK || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC ||
-                   k == TF_FRICTION_GMS;
-    if (!pos(p[TF_P_FC])) return "fc";
-    if (k != TF_FRICTION_DAHL && !nonneg(p[TF_P_SIGMA2])) return "sigma2";
-    if (k == TF_FRICTION_DAHL || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
-        if (!pos(p[TF_P_SIGMA0])) return "sigma0";
-    }
-    if (k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
-        if (!nonneg(p[TF_P_SIGMA1])) return "sigma1";
-        if (isnan(p[TF_P_VD]) || p[TF_P_VD] == INFINITY) return "vd"; /* <= 0: sigma1 constant */
-    }
-    if (stribeck) {
-        if (!isfinite(p[TF_P_FS]) || p[TF_P_FS] < p[TF_P_FC]) return "fs";
-        if (p[TF_P_FS] != p[TF_P_FC] && !pos(p[TF_P_VS])) return "vs";
-        if (p[TF_P_FS] != p[TF_P_FC] && !pos(p[TF_P_DELTA])) return "delta";
-    }
-    if ((k == TF_FRICTION_COULOMB || k == TF_FRICTION_STRIBECK || offset_form) && !pos(p[TF_P_VSMOOTH]))
-        return "v_smooth";
-    if (k == TF_FRICTION_ELASTOPLASTIC && !(nonneg(p[TF_P_ZBA]) && p[TF_P_ZBA] < p[TF_P_FC] / p[TF_P_SIGMA0]))
-        return "z_ba";
-    if (k == TF_FRICTION_GMS && !pos(p[TF_P_C])) return "C";
-    return 0;
-}
-
-int tf_model_check_params(const tf_model *m, const double *p, double lambda, double dF_offset, const char **what)
-{
-    int offset = m->thermal == TF_THERMAL_MODEL_II && m->dF_form == TF_DF_OFFSET;
-    const char *bad = check_friction_params(m, p, offset);
-    if (!bad && m->thermal == TF_THERMAL_MODEL_II) {
-        if (offset ? !isfinite(dF_offset) : !isfinite(lambda)) bad = "dF";
-        else if (!offset && !(lambda > 0.0)) bad = "dF (lambda <= 0 or not finite)";
-    }
-    if (what) *what = bad;
-    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
-}
-
-static const char *check_at(const tf_model *m, double T)
-{
-    double p[TF_NPARAM];
-    const char *bad;
-    tf_model_params_at(m, T, p);
-    tf_model_check_params(m, p, tf_model_lambda(m, T), tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T), &bad);
-    return bad;
-}
-
-/* n >= 2 points with finite values and strictly increasing finite times (knots). */
-static int knots_ok(int n, const double *x, const double *y)
-{
-    if (n < 2 || !x || !y) return 0;
-    for (int i = 0; i < n; i++)
-        if (!isfinite(x[i]) || !isfinite(y[i]) || (i && !(x[i] > x[i - 1]))) return 0;
-    return 1;
-}
-
-static int law_ok(const tf_law *L)
-{
-    if (L->kind < TF_LAW_NONE || L->kind > TF_LAW_TABLE) return 0;
-    if (L->kind == TF_LAW_POLY && (L->n < 1 || !L->y)) return 0;
-    if (L->kind == TF_LAW_PWL || L->kind == TF_LAW_TABLE)
-        return knots_ok(L->n, L->x, L->y) && (L->kind != TF_LAW_TABLE || L->d);
-    return 1;
-}
-
-static const char *check_waveform(const tf_waveform *w, int prescribed)
-{
-    if (w->kind == TF_WAVE_ZERO) return 0;
-    if (w->kind == TF_WAVE_SAMPLED) {
-        if (!knots_ok(w->n, w->t, w->v)) return "input (sampled: two or more finite points, times increasing)";
-        for (int i = 1; prescribed && i < w->n; i++)
-            if (!isfinite((w->v[i] - w->v[i - 1]) / (w->t[i] - w->t[i - 1])))
-                return "input (sampled: slope not finite)";
-        return 0;
-    }
-    if (!isfinite(w->amplitude) || !isfinite(w->offset)) return "input (amplitude, offset)";
-    switch (w->kind) {
-    case TF_WAVE_SAWTOOTH:
-        if (!pos(w->frequency)) return "input (frequency)";
-        if (!(w->rise > 0.0 && w->rise < 1.0) && !(!prescribed && (w->rise == 0.0 || w->rise == 1.0)))
-            return "input (rise)";
-        if (w->direction != 1.0 && w->direction != -1.0) return "input (direction)";
-        /* a prescribed motion's velocity is the slope: it must be finite on both flanks */
-        if (prescribed && !(isfinite(w->amplitude * w->frequency / w->rise) &&
-                            isfinite(w->amplitude * w->frequency / (1.0 - w->rise))))
-            return "input (rise: slope not finite)";
-        return 0;
-    case TF_WAVE_SINE:
-        if (!pos(w->frequency)) return "input (frequency)";
-        if (prescribed && !isfinite(6.283185307179586 * w->frequency * w->amplitude)) return "input (slope not finite)";
-        return 0;
-    case TF_WAVE_SQUARE: {
-        if (!pos(w->frequency)) return "input (frequency)";
-        double P = 1.0 / w->frequency;
-        if (!(w->rise > 0.0 && w->rise < 1.0)) return "input (duty)";
-        if (!nonneg(w->slew) || (prescribed && !(w->slew > 0.0)) ||
-            !(w->slew < fmin(w->rise, 1.0 - w->rise) * P))
-            return "input (slew)";
-        if (prescribed && !isfinite(w->amplitude / w->slew)) return "input (slew: slope not finite)";
-        return 0;
-    }
-    case TF_WAVE_STEP:
-        if (!isfinite(w->t0)) return "input (time)";
-        if (!nonneg(w->slew) || (prescribed && !(w->slew > 0.0))) return "input (slew)";
-        if (prescribed && !isfinite(w->amplitude / w->slew)) return "input (slew: slope not finite)";
-        return 0;
-    default:
-        return "input (kind)";
-    }
-}
-
-/* The friction model and its thermal extension, apart from the parameters' values. */
-static const char *check_friction_structure(const tf_model *m)
-{
-    const char *bad = 0;
-    if (m->friction < TF_FRICTION_LUGRE || m->friction > TF_FRICTION_GMS) bad = "friction";
-    if (!bad && m->friction == TF_FRICTION_GMS) {
-        double sum = 0.0;
-        if (m->gms.n < 1 || m->gms.n > TF_MAX_FRICTION_STATES) bad = "gms.n (1 to 64 elements)";
-        for (int i = 0; !bad && i < m->gms.n; i++) {
-            if (!pos(m->gms.k[i])) bad = "gms.k";
-            else if (!pos(m->gms.w[i])) bad = "gms.w";
-            sum += m->gms.w[i];
-        }
-        if (!bad && !(fabs(sum - 1.0) <= 1e-9)) bad = "gms.w (must sum to one)";
-    }
-    if (!bad && (m->thermal < TF_THERMAL_NONE || m->thermal > TF_THERMAL_MODEL_II)) bad = "thermal";
-    if (!bad && m->thermal == TF_THERMAL_MODEL_I)
-        for (int i = 0; !bad && i < TF_NPARAM; i++)
-            if (!law_ok(&m->law[i])) bad = "law";
-    if (!bad && m->thermal == TF_THERMAL_MODEL_II) {
-        if (m->dF.kind == TF_LAW_NONE || !law_ok(&m->dF)) bad = "dF";
-        else if (m->dF_form != TF_DF_SCALE && m->dF_form != TF_DF_OFFSET) bad = "dF form";
-    }
-    return bad;
-}
-
-int tf_model_check_friction(const tf_model *m, double T, const char **what)
-{
-    const char *bad = check_friction_structure(m);
-    if (!bad && (m->thermal == TF_THERMAL_NONE || isfinite(T))) bad = check_at(m, m->thermal ? T : NAN);
-    if (what) *what = bad;
-    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
-}
-
-int tf_model_check(const tf_model *m, const char **what)
-{
-    const char *bad = 0;
-    switch (m->plant) {
-    case TF_PLANT_STICK_SLIP:
-        if (!pos(m->m)) bad = "m";
-        else if (!nonneg(m->c)) bad = "c";
-        else if (!pos(m->k)) bad = "k";
-        else if (!isfinite(m->T_em)) bad = "T_em";
-        else if (!pos(m->m_e)) bad = "m_e";
-        break;
-    case TF_PLANT_MASS:
-        if (!pos(m->m)) bad = "m";
-        else if (!nonneg(m->k_s)) bad = "k_s";
-        else if (!isfinite(m->v_0)) bad = "v_0";
-        break;
-    case TF_PLANT_PRESCRIBED:
-        if (m->input.kind == TF_WAVE_ZERO) bad = "input (prescribed motion needs one)";
-        break;
-    default:
-        bad = "plant";
-    }
-    if (!bad) bad = check_friction_structure(m);
-    if (!bad) bad = check_waveform(&m->input, m->plant == TF_PLANT_PRESCRIBED);
-    if (!bad && m->heat.on) {
-        const tf_heat *h = &m->heat;
-        if (!pos(h->C_th)) bad = "heat.C_th";
-        else if (!pos(h->R_th)) bad = "heat.R_th";
-        else if (!(nonneg(h->eta) && h->eta <= 1.0)) bad = "heat.eta (0 to 1)";
-        else if (!isfinite(h->T_amb)) bad = "heat.T_amb";
-        else if (!isfinite(h->T_0)) bad = "heat.T_0";
-        else if (check_waveform(&h->P_ext, 0)) bad = "heat.P_ext";
-    }
-    if (!bad && m->T_n > 0 && !knots_ok(m->T_n, m->T_t, m->T_v))
-        bad = "temperature (sampled: two or more finite points, times increasing)";
-    if (!bad && m->thermal != TF_THERMAL_NONE) {
-        if (m->heat.on) { /* the temperature is a state: where it starts and where it tends */
-            bad = check_at(m, m->heat.T_0);
-            if (!bad) bad = check_at(m, m->heat.T_amb);
-        } else if (m->T_n > 0) {
-            /* the temperature sweeps [min, max] of its samples: the knots and a fine grid */
-            double lo = INFINITY, hi = -INFINITY;
-            for (int i = 0; !bad && i < m->T_n; i++) {
-                lo = fmin(lo, m->T_v[i]);
-                hi = fmax(hi, m->T_v[i]);
-                bad = check_at(m, m->T_v[i]);
-            }
-            for (int j = 0; !bad && j <= 64; j++) bad = check_at(m, lo + (hi - lo) * j / 64.0);
-        } else if (!isfinite(m->T_const)) {
-            bad = "temperature";
-        } else {
-            bad = check_at(m, m->T_const);
-        }
-    } else if (!bad) {
-        bad = check_at(m, NAN);
-    }
-    if (what) *what = bad;
-    return bad ? TF_ERR_BAD_ARGUMENT : TF_OK;
 }

@@ -21,7 +21,7 @@ TF_SIZED void add_jacobian_times(const double *J, const double *S, double *fp, i
     }
 }
 
-int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
+tf_status tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
 {
     tf_sensitivity_system *s = (tf_sensitivity_system *)ctx;
     if (!s->n) s->n = tf_model_nstate(s->model);
@@ -39,7 +39,7 @@ int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *ctx)
     case 6: add_jacobian_times(J, S, fp, n, 6); break;
     default: add_jacobian_times(J, S, fp, n, np); break;
     }
-    return 0;
+    return TF_OK;
 }
 
 double tf_sensitivity_next_corner(double t, void *ctx)

@@ -1,5 +1,6 @@
 /* Thermal extensions: Model I, Model II and the lumped heat balance (see thermal.h). */
 #include "thermofriction/thermal.h"
+#include "checks.h"
 
 #include <math.h>
 #include <string.h>
@@ -43,4 +44,40 @@ double tf_heat_param_partial(const tf_heat *h, int param, double T, double P, do
     case TF_HEAT_T_AMB: return 1.0 / (h->R_th * h->C_th);
     default: return 0.0; /* T_0: through the initial state only */
     }
+}
+
+/* ---- checks (tf_model_check, plant.h) ---- */
+
+/* The thermal extension's kind, Model I's laws, Model II's law and form. */
+const char *tf_thermal_structure_problem(int thermal, const tf_law *laws, const tf_law *dF, int dF_form)
+{
+    if (thermal < TF_THERMAL_NONE || thermal > TF_THERMAL_MODEL_II) return "thermal";
+    if (thermal == TF_THERMAL_MODEL_I)
+        for (int i = 0; i < TF_NPARAM; i++)
+            if (!tf_law_ok(&laws[i])) return "law";
+    if (thermal == TF_THERMAL_MODEL_II) {
+        if (dF->kind == TF_LAW_NONE || !tf_law_ok(dF)) return "dF";
+        if (dF_form != TF_DF_SCALE && dF_form != TF_DF_OFFSET) return "dF form";
+    }
+    return 0;
+}
+
+const char *tf_thermal_lambda_problem(int thermal, int dF_form, double lambda, double dF_offset)
+{
+    if (thermal != TF_THERMAL_MODEL_II) return 0;
+    int offset = dF_form == TF_DF_OFFSET;
+    if (offset ? !isfinite(dF_offset) : !isfinite(lambda)) return "dF";
+    if (!offset && !(lambda > 0.0)) return "dF (lambda <= 0 or not finite)";
+    return 0;
+}
+
+const char *tf_heat_problem(const tf_heat *h)
+{
+    if (!tf_pos(h->C_th)) return "heat.C_th";
+    if (!tf_pos(h->R_th)) return "heat.R_th";
+    if (!(tf_nonneg(h->eta) && h->eta <= 1.0)) return "heat.eta (0 to 1)";
+    if (!isfinite(h->T_amb)) return "heat.T_amb";
+    if (!isfinite(h->T_0)) return "heat.T_0";
+    if (tf_waveform_problem(&h->P_ext, 0)) return "heat.P_ext";
+    return 0;
 }

@@ -1,5 +1,6 @@
 /* Input waveforms (docs/formats.md#inputs). */
 #include "thermofriction/waveform.h"
+#include "checks.h"
 
 #include <math.h>
 
@@ -188,4 +189,61 @@ double tf_waveform_next_reversal(const tf_waveform *w, double t)
     if (w->kind != TF_WAVE_SINE || !(w->frequency > 0)) return INFINITY; /* the others: corners */
     double c[2] = {0.25, 0.75};
     return periodic_next(t, w->frequency, c, 2);
+}
+
+/* ---- checks (tf_model_check, plant.h) ---- */
+
+/* n >= 2 points with finite values and strictly increasing finite times (knots). */
+int tf_knots_ok(int n, const double *x, const double *y)
+{
+    if (n < 2 || !x || !y) return 0;
+    for (int i = 0; i < n; i++)
+        if (!isfinite(x[i]) || !isfinite(y[i]) || (i && !(x[i] > x[i - 1]))) return 0;
+    return 1;
+}
+
+const char *tf_waveform_problem(const tf_waveform *w, int prescribed)
+{
+    if (w->kind == TF_WAVE_ZERO) return 0;
+    if (w->kind == TF_WAVE_SAMPLED) {
+        if (!tf_knots_ok(w->n, w->t, w->v)) return "input (sampled: two or more finite points, times increasing)";
+        for (int i = 1; prescribed && i < w->n; i++)
+            if (!isfinite((w->v[i] - w->v[i - 1]) / (w->t[i] - w->t[i - 1])))
+                return "input (sampled: slope not finite)";
+        return 0;
+    }
+    if (!isfinite(w->amplitude) || !isfinite(w->offset)) return "input (amplitude, offset)";
+    switch (w->kind) {
+    case TF_WAVE_SAWTOOTH:
+        if (!tf_pos(w->frequency)) return "input (frequency)";
+        if (!(w->rise > 0.0 && w->rise < 1.0) && !(!prescribed && (w->rise == 0.0 || w->rise == 1.0)))
+            return "input (rise)";
+        if (w->direction != 1.0 && w->direction != -1.0) return "input (direction)";
+        /* a prescribed motion's velocity is the slope: it must be finite on both flanks */
+        if (prescribed && !(isfinite(w->amplitude * w->frequency / w->rise) &&
+                            isfinite(w->amplitude * w->frequency / (1.0 - w->rise))))
+            return "input (rise: slope not finite)";
+        return 0;
+    case TF_WAVE_SINE:
+        if (!tf_pos(w->frequency)) return "input (frequency)";
+        if (prescribed && !isfinite(6.283185307179586 * w->frequency * w->amplitude)) return "input (slope not finite)";
+        return 0;
+    case TF_WAVE_SQUARE: {
+        if (!tf_pos(w->frequency)) return "input (frequency)";
+        double P = 1.0 / w->frequency;
+        if (!(w->rise > 0.0 && w->rise < 1.0)) return "input (duty)";
+        if (!tf_nonneg(w->slew) || (prescribed && !(w->slew > 0.0)) ||
+            !(w->slew < fmin(w->rise, 1.0 - w->rise) * P))
+            return "input (slew)";
+        if (prescribed && !isfinite(w->amplitude / w->slew)) return "input (slew: slope not finite)";
+        return 0;
+    }
+    case TF_WAVE_STEP:
+        if (!isfinite(w->t0)) return "input (time)";
+        if (!tf_nonneg(w->slew) || (prescribed && !(w->slew > 0.0))) return "input (slew)";
+        if (prescribed && !isfinite(w->amplitude / w->slew)) return "input (slew: slope not finite)";
+        return 0;
+    default:
+        return "input (kind)";
+    }
 }

@@ -25,15 +25,40 @@ static void emit_record(long i, double t, const double *y, void *ctx)
     memcpy(r->y + i * r->dim, y, sizeof(double) * r->dim);
 }
 
+static void emit_none(long i, double t, const double *y, void *ctx);
+static void paper_like(tf_model *m, double T);
+
+/* The error record of the last call (status.h), and the force or control of a step as a number (NaN
+ * when the step is refused: E says why). */
+static tf_error E;
+static double rt_force(tf_rt_friction *f, double v, double T, double dt)
+{
+    double F;
+    tf_rt_step(f, v, T, dt, &F, &E);
+    return F;
+}
+static double observer_force(tf_rt_friction *f, double v, double e, double k, double T, double dt)
+{
+    double F;
+    tf_observer_step(f, v, e, k, T, dt, &F, &E);
+    return F;
+}
+static double pid_u(tf_pid *c, double e, double dt)
+{
+    double u;
+    tf_pid_step(c, e, dt, &u, &E);
+    return u;
+}
+
 /* harmonic oscillator x'' = -w^2 x */
-static int osc_rhs(double t, const double *y, double *dy, void *ctx)
+static tf_status osc_rhs(double t, const double *y, double *dy, void *ctx)
 {
     double w = *(double *)ctx;
     dy[0] = y[1];
     dy[1] = -w * w * y[0];
     return 0;
 }
-static int osc_jac(double t, const double *y, double *J, void *ctx)
+static tf_status osc_jac(double t, const double *y, double *J, void *ctx)
 {
     double w = *(double *)ctx;
     J[0] = 0; J[1] = 1; J[2] = -w * w; J[3] = 0;
@@ -41,13 +66,13 @@ static int osc_jac(double t, const double *y, double *J, void *ctx)
 }
 
 /* Prothero-Robinson: y' = -L (y - sin t) + cos t, exact y = sin t; stiff for large L. */
-static int pr_rhs(double t, const double *y, double *dy, void *ctx)
+static tf_status pr_rhs(double t, const double *y, double *dy, void *ctx)
 {
     double L = *(double *)ctx;
     dy[0] = -L * (y[0] - sin(t)) + cos(t);
     return 0;
 }
-static int pr_jac(double t, const double *y, double *J, void *ctx)
+static tf_status pr_jac(double t, const double *y, double *J, void *ctx)
 {
     J[0] = -*(double *)ctx;
     return 0;
@@ -65,7 +90,7 @@ static void test_oscillator_dense_output(int method)
     double y0[2] = {1.0, 0.0};
     record r = {n, 2, buf};
     tf_solver_stats st;
-    int status = tf_solve(&ode, &opt, t, n, y0, emit_record, &r, &st);
+    int status = tf_solve(&ode, &opt, t, n, y0, emit_record, &r, &st, &E);
     CHECK(status == TF_OK, "oscillator method %d status %d", method, status);
     double worst = 0;
     for (long i = 0; i < n; i++) worst = fmax(worst, fabs(buf[2 * i] - cos(w * t[i])));
@@ -73,6 +98,85 @@ static void test_oscillator_dense_output(int method)
     CHECK(worst < 1e-6, "oscillator method %d dense output error %g", method, worst);
     CHECK(st.steps < 2000, "oscillator method %d took %ld steps", method, st.steps);
     free(t); free(buf);
+}
+
+/* The interrupt poll (tf_solver_options.interrupt): a long integration stops within TF_POLL_STEPS
+ * steps of the poll's answer, with TF_ERR_INTERRUPTED and the state where it stopped (the oscillator's
+ * energy, conserved by the exact solution, tells that it is a real state of the run). */
+static int polls_left(void *ctx) { return --*(int *)ctx <= 0; }
+static void test_interrupt_poll_stops_a_long_integration(int method)
+{
+    double w = 2.0 * 3.14159265358979;
+    tf_ode ode = {2, &w, osc_rhs, osc_jac, 0};
+    double atol[2] = {1e-10, 1e-10}, t[2] = {0.0, 1e6}, y[2] = {1.0, 0.0};
+    int polls = 5;
+    tf_solver_options opt = {.method = method, .rtol = 1e-8, .atol = atol, .max_steps = 1000000000L,
+                             .interrupt = polls_left, .interrupt_ctx = &polls};
+    tf_solver_stats st;
+    int status = tf_solve(&ode, &opt, t, 2, y, emit_none, 0, &st, &E);
+    CHECK(status == TF_ERR_INTERRUPTED && E.code == TF_ERR_INTERRUPTED && polls == 0,
+          "interrupt (method %d): status %d after %d polls", method, status, 5 - polls);
+    CHECK(st.steps + st.rejected <= 5 * TF_POLL_STEPS && st.steps + st.rejected > 4 * TF_POLL_STEPS &&
+              E.t > 0.0 && E.t < 1e6,
+          "interrupt (method %d): stopped after %ld steps at t = %g", method, st.steps + st.rejected, E.t);
+    double energy = y[0] * y[0] + y[1] * y[1] / (w * w);
+    CHECK(fabs(energy - 1.0) < 1e-5, "interrupt (method %d): the state at the stop is the run's (energy %g)",
+          method, energy);
+    polls = 1 << 30; /* a poll that never fires changes nothing */
+    double y2[2] = {1.0, 0.0}, t2[2] = {0.0, 3.0}, y3[2] = {1.0, 0.0};
+    tf_solve(&ode, &opt, t2, 2, y2, emit_none, 0, &st, &E);
+    opt.interrupt = 0;
+    tf_solve(&ode, &opt, t2, 2, y3, emit_none, 0, &st, &E);
+    CHECK(y2[0] == y3[0] && y2[1] == y3[1], "interrupt (method %d): a silent poll changes no result", method);
+}
+
+/* One error record from every entry point (status.h): the code returned, what and where named on a
+ * failure, empty on success; the time and the output sample where an integration failed; NULL
+ * accepted for the record everywhere. */
+static void test_one_error_record_from_every_entry_point(void)
+{
+    double w = 1.0;
+    tf_ode ode = {2, &w, osc_rhs, osc_jac, 0};
+    double atol[2] = {1e-9, 1e-9}, y[2] = {1.0, 0.0}, t[4] = {0.0, 0.5, 0.4, 1.0};
+    tf_solver_options opt = {.method = TF_METHOD_DOPRI5, .rtol = 1e-8, .atol = atol, .max_steps = 1000};
+    tf_solver_stats st;
+    tf_status s = tf_solve(&ode, &opt, t, 4, y, emit_none, 0, &st, &E);
+    CHECK(s == TF_ERR_BAD_ARGUMENT && E.code == s && !strcmp(E.where, "solver") && strstr(E.what, "t_out") &&
+              E.index == 2 && E.t == 0.4,
+          "solve: a decreasing grid named at its sample (%s / %s / %ld)", E.where, E.what, E.index);
+    t[2] = 0.7;
+    opt.max_steps = 3;
+    s = tf_solve(&ode, &opt, t, 4, y, emit_none, 0, &st, &E);
+    CHECK(s == TF_ERR_MAX_STEPS && E.code == s && !strcmp(E.what, tf_status_message(s)) && E.t > 0.0 && E.t < 1.0,
+          "solve: max_steps with the time it stopped at (%g)", E.t);
+    opt.max_steps = 100000, y[0] = 1.0, y[1] = 0.0;
+    s = tf_solve(&ode, &opt, t, 4, y, emit_none, 0, NULL, &E);
+    CHECK(s == TF_OK && E.code == TF_OK && !E.what[0] && !E.where[0] && E.index == -1 && isnan(E.t),
+          "solve: TF_OK leaves an empty record (stats may be NULL)");
+    CHECK(tf_solve(&ode, &opt, t, 4, y, emit_none, 0, &st, NULL) == TF_OK, "solve: NULL record");
+
+    static tf_model m;
+    paper_like(&m, 30.0);
+    m.p[TF_P_FC] = -1.0;
+    CHECK(tf_model_check(&m, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "fc") && !strcmp(E.where, "model"),
+          "model check: fc named (%s / %s)", E.where, E.what);
+    CHECK(tf_model_check(&m, NULL) == TF_ERR_BAD_ARGUMENT && tf_model_check(NULL, &E) == TF_ERR_BAD_ARGUMENT,
+          "model check: NULL record, NULL model");
+
+    double A[4] = {1.0, 2.0, 2.0, 4.0};
+    int piv[2];
+    CHECK(tf_lu_factor(A, 2, piv) == TF_ERR_SINGULAR, "lu: a singular matrix has its status");
+
+    tf_pid c;
+    CHECK(tf_pid_init(&c, NAN, 0, 0, 0, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.where, "pid") &&
+              strstr(E.what, "gains"),
+          "pid: the gains named");
+    char big[200];
+    memset(big, 'x', sizeof big - 1);
+    big[sizeof big - 1] = 0;
+    CHECK(tf_error_set(&E, TF_ERR_NONFINITE, big, big, 1.0, 7) == TF_ERR_NONFINITE &&
+              strlen(E.what) == TF_ERROR_WHAT - 1 && strlen(E.where) == TF_ERROR_WHERE - 1 && E.index == 7,
+          "tf_error_set truncates what and where to the record");
 }
 
 static void test_stiff_prothero_robinson(void)
@@ -85,7 +189,7 @@ static void test_stiff_prothero_robinson(void)
     record r = {2, 1, out};
     tf_solver_stats st;
     tf_solver_options opt = {TF_METHOD_RODAS4, 1e-6, atol, 0, 0, 100000};
-    int status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st);
+    int status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st, &E);
     CHECK(status == TF_OK && fabs(out[1] - sin(10.0)) < 1e-5, "Rodas4 stiff: status %d err %g",
           status, fabs(out[1] - sin(10.0)));
     CHECK(st.steps < 500, "Rodas4 stiff took %ld steps (should step over the stiff mode)", st.steps);
@@ -93,7 +197,7 @@ static void test_stiff_prothero_robinson(void)
     /* AUTO starts explicit, detects stiffness and switches */
     y[0] = 0.0;
     opt.method = TF_METHOD_AUTO;
-    status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st);
+    status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st, &E);
     CHECK(status == TF_OK && st.switch_time >= 0 && st.method_used == TF_METHOD_RODAS4,
           "AUTO did not switch: status %d switch %g", status, st.switch_time);
     CHECK(fabs(out[1] - sin(10.0)) < 1e-5, "AUTO stiff error %g", fabs(out[1] - sin(10.0)));
@@ -102,7 +206,7 @@ static void test_stiff_prothero_robinson(void)
     y[0] = 0.0;
     opt.method = TF_METHOD_DOPRI5;
     opt.max_steps = 5000;
-    status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st);
+    status = tf_solve(&ode, &opt, t, 2, y, emit_record, &r, &st, &E);
     CHECK(status == TF_ERR_MAX_STEPS && st.stiff_suspected, "DOPRI5 on stiff: status %d suspected %d",
           status, st.stiff_suspected);
 }
@@ -250,7 +354,7 @@ static void test_frictionless_step_response(void)
         tf_solver_options opt = {method, 1e-8, atol, 0, 0, 100000};
         tf_solver_stats st;
         tf_model_initial_state(&m, y);
-        int status = tf_solve(&ode, &opt, t, N, y, emit_stage, xp, &st);
+        int status = tf_solve(&ode, &opt, t, N, y, emit_stage, xp, &st, &E);
         double wn = 6685.5, xi = 0.2488, K = 0.096e-6, wd = wn * sqrt(1 - xi * xi), worst = 0;
         for (int i = 0; i < N; i++) {
             double tau = t[i] - 1e-3, exact = 0;
@@ -281,7 +385,7 @@ static void test_grid_end_one_ulp_past_a_corner(void)
     for (int k = 0; k < 3; k++) {
         double t[2] = {0.0, ends[k]};
         tf_model_initial_state(&m, y);
-        int status = tf_solve(&ode, &opt, t, 2, y, emit_none, 0, &st);
+        int status = tf_solve(&ode, &opt, t, 2, y, emit_none, 0, &st, &E);
         CHECK(status == TF_OK, "end %.17g next to the corner %.17g: status %d", ends[k], corner, status);
     }
 }
@@ -404,7 +508,7 @@ static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
         tf_solver_options opt = {method, 1e-9, atol, 0, 0, 100000};
         tf_solver_stats st;
         memset(m.gms.mode, 0, sizeof m.gms.mode);
-        int status = tf_solve(&ode, &opt, t, 6, y, emit_force, &r, &st);
+        int status = tf_solve(&ode, &opt, t, 6, y, emit_force, &r, &st, &E);
         double worst = 0.0;
         for (int i = 0; i < 6; i++) worst = fmax(worst, fabs(F[i] - exact[i]));
         CHECK(status == TF_OK && worst < 1e-6 * fc && st.events >= 2,
@@ -419,7 +523,7 @@ static void rt_lugre(tf_rt_friction *f)
     double p[TF_NPARAM] = {0};
     p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
     p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_VSMOOTH] = 1e-6;
-    CHECK(tf_rt_init(f, TF_FRICTION_LUGRE, p, NULL) == TF_OK, "tf_rt_init");
+    CHECK(tf_rt_init(f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_OK, "tf_rt_init");
 }
 
 static void test_rt_exact_for_constant_velocity_and_stable_at_large_steps(void)
@@ -433,7 +537,7 @@ static void test_rt_exact_for_constant_velocity_and_stable_at_large_steps(void)
         rt_lugre(&f);
         double t = 0.0, worst = 0.0, F = 0.0;
         for (int i = 0; i < 2000; i++) {
-            F = tf_rt_step(&f, v, NAN, dts[k]);
+            F = rt_force(&f, v, NAN, dts[k]);
             t += dts[k];
             worst = fmax(worst, fabs(f.z[0] - zss * -expm1(-1e5 * v * t / g)) / zss);
         }
@@ -453,8 +557,8 @@ static void test_rt_observer_converges(void)
     obs.z[0] = -g / 1e5;
     double F = 0.0, Fh = 0.0;
     for (int i = 0; i < (int)(25 * tau / dt); i++) {
-        F = tf_rt_step(&plant, v, NAN, dt);
-        Fh = tf_observer_step(&obs, v, 0.0, 100.0, NAN, dt);
+        F = rt_force(&plant, v, NAN, dt);
+        Fh = observer_force(&obs, v, 0.0, 100.0, NAN, dt);
     }
     CHECK(fabs(obs.z[0] - plant.z[0]) < 1e-9 * g / 1e5, "observer error %g", obs.z[0] - plant.z[0]);
     CHECK(fabs(Fh - F) < 1e-8, "observer force %g vs %g", Fh, F);
@@ -467,13 +571,13 @@ static void test_rt_parameter_update_and_reset(void)
     static tf_rt_friction f;
     rt_lugre(&f);
     double v = 0.1, F0 = 0.0, F1;
-    for (int i = 0; i < 100; i++) F0 = tf_rt_step(&f, v, NAN, 1e-3);
-    CHECK(tf_rt_set_param(&f, TF_P_SIGMA2, 1.4) == TF_OK, "set_param");
-    F1 = tf_rt_step(&f, v, NAN, 1e-3);
+    for (int i = 0; i < 100; i++) F0 = rt_force(&f, v, NAN, 1e-3);
+    CHECK(tf_rt_set_param(&f, TF_P_SIGMA2, 1.4, &E) == TF_OK, "set_param");
+    F1 = rt_force(&f, v, NAN, 1e-3);
     CHECK(fabs(F1 - F0 - v) < 1e-12, "sigma2 update: %g -> %g", F0, F1);
-    CHECK(tf_rt_set_param(&f, TF_NPARAM, 1.0) == TF_ERR_BAD_ARGUMENT, "bad parameter index accepted");
-    tf_rt_reset(&f);
-    CHECK(f.z[0] == 0.0 && fabs(tf_rt_step(&f, v, NAN, 0.0) - (1.4 + 316.2) * v) < 1e-12, "reset to rest");
+    CHECK(tf_rt_set_param(&f, TF_NPARAM, 1.0, &E) == TF_ERR_BAD_ARGUMENT, "bad parameter index accepted");
+    tf_rt_reset(&f, &E);
+    CHECK(f.z[0] == 0.0 && fabs(rt_force(&f, v, NAN, 0.0) - (1.4 + 316.2) * v) < 1e-12, "reset to rest");
 }
 
 /* The shared helpers of friction.h and thermal.h against central differences: sigma1(v) in v,
@@ -541,7 +645,7 @@ static void rt_gms(tf_rt_friction *f)
     p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5, p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0;
     p[TF_P_C] = 20.0;
     static tf_gms_elements g = {3, {5e4, 3e4, 2e4}, {0.3, 0.3, 0.4}, {0}};
-    CHECK(tf_rt_init(f, TF_FRICTION_GMS, p, &g) == TF_OK, "tf_rt_init GMS: %s", f->what);
+    CHECK(tf_rt_init(f, TF_FRICTION_GMS, p, &g, &E) == TF_OK, "tf_rt_init GMS: %s", E.what);
 }
 
 static void test_rt_init_and_setters_refuse_bad_arguments(void)
@@ -550,21 +654,21 @@ static void test_rt_init_and_setters_refuse_bad_arguments(void)
     double p[TF_NPARAM] = {0};
     p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
     p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_VSMOOTH] = 1e-6;
-    CHECK(tf_rt_init(NULL, TF_FRICTION_LUGRE, p, NULL) == B, "init: NULL f");
-    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, NULL, NULL) == B && f.status == B && !strcmp(f.what, "p (NULL)"),
+    CHECK(tf_rt_init(NULL, TF_FRICTION_LUGRE, p, NULL, &E) == B, "init: NULL f");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, NULL, NULL, &E) == B && E.code == B && !strcmp(E.what, "p (NULL)"),
           "init: NULL p");
-    CHECK(tf_rt_init(&f, 99, p, NULL) == B, "init: unknown kind");
-    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, NULL) == B, "init: GMS without elements");
+    CHECK(tf_rt_init(&f, 99, p, NULL, &E) == B, "init: unknown kind");
+    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, NULL, &E) == B, "init: GMS without elements");
     tf_gms_elements g = {0};
-    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, &g) == B, "init: GMS with 0 elements");
+    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, &g, &E) == B, "init: GMS with 0 elements");
     g.n = TF_MAX_FRICTION_STATES + 1;
-    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, &g) == B, "init: GMS with 65 elements");
+    CHECK(tf_rt_init(&f, TF_FRICTION_GMS, p, &g, &E) == B, "init: GMS with 65 elements");
     p[TF_P_SIGMA0] = -1e5; /* the simulator's rules: sigma0 > 0 */
-    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL) == B && !strcmp(f.what, "sigma0"), "init: sigma0 < 0");
-    CHECK(isnan(tf_rt_step(&f, 1e-3, NAN, 1e-4)), "a refused init leaves a model that every step refuses");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == B && !strcmp(E.what, "sigma0"), "init: sigma0 < 0");
+    CHECK(isnan(rt_force(&f, 1e-3, NAN, 1e-4)), "a refused init leaves a model that every step refuses");
     p[TF_P_SIGMA0] = 1e5;
     p[TF_P_FS] = 0.5;
-    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL) == B && !strcmp(f.what, "fs"), "init: fs < fc");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == B && !strcmp(E.what, "fs"), "init: fs < fc");
     p[TF_P_FS] = 1.5;
 
     rt_lugre(&f);
@@ -573,94 +677,97 @@ static void test_rt_init_and_setters_refuse_bad_arguments(void)
     tf_law table_null = {TF_LAW_TABLE, 0, 0, 2, NULL, NULL, NULL};
     tf_law duplicate = {TF_LAW_PWL, 0, 0, 2, x2, y2, 0};
     tf_law table_no_slopes = {TF_LAW_TABLE, 0, 0, 2, x2, y2, NULL};
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &pwl0) == B, "PWL law with n = 0");
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &table_null) == B, "TABLE law with NULL data");
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &duplicate) == B, "duplicate breakpoints");
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &table_no_slopes) == B, "TABLE law without slopes");
-    CHECK(tf_rt_set_model_i(&f, -1, &pwl0) == B && tf_rt_set_model_i(&f, TF_NPARAM, &pwl0) == B,
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &pwl0, &E) == B, "PWL law with n = 0");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &table_null, &E) == B, "TABLE law with NULL data");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &duplicate, &E) == B, "duplicate breakpoints");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &table_no_slopes, &E) == B, "TABLE law without slopes");
+    CHECK(tf_rt_set_model_i(&f, -1, &pwl0, &E) == B && tf_rt_set_model_i(&f, TF_NPARAM, &pwl0, &E) == B,
           "Model I: bad index");
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, NULL) == B && tf_rt_set_model_i(NULL, TF_P_FC, &pwl0) == B,
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, NULL, &E) == B && tf_rt_set_model_i(NULL, TF_P_FC, &pwl0, &E) == B,
           "Model I: NULL law or model");
     CHECK(f.model.thermal == TF_THERMAL_NONE && f.model.law[TF_P_FC].kind == TF_LAW_NONE,
           "a refused law leaves the model without it");
-    CHECK(tf_rt_set_model_ii(&f, NULL, TF_DF_SCALE) == B && tf_rt_set_model_ii(NULL, &pwl0, TF_DF_SCALE) == B,
+    CHECK(tf_rt_set_model_ii(&f, NULL, TF_DF_SCALE, &E) == B && tf_rt_set_model_ii(NULL, &pwl0, TF_DF_SCALE, &E) == B,
           "Model II: NULL");
     tf_law lin = {TF_LAW_LINEAR, -0.02, 0.6, 0, 0, 0, 0};
-    CHECK(tf_rt_set_model_ii(&f, &lin, 7) == B && f.model.thermal == TF_THERMAL_NONE, "Model II: bad form");
-    CHECK(tf_rt_set_param(NULL, TF_P_FC, 1.0) == B, "set_param: NULL");
-    CHECK(tf_rt_set_param(&f, TF_P_SIGMA0, -1.0) == B && f.model.p[TF_P_SIGMA0] == 1e5 && !strcmp(f.what, "sigma0"),
+    CHECK(tf_rt_set_model_ii(&f, &lin, 7, &E) == B && f.model.thermal == TF_THERMAL_NONE, "Model II: bad form");
+    CHECK(tf_rt_set_param(NULL, TF_P_FC, 1.0, &E) == B, "set_param: NULL");
+    CHECK(tf_rt_set_param(&f, TF_P_SIGMA0, -1.0, &E) == B && f.model.p[TF_P_SIGMA0] == 1e5 && !strcmp(E.what, "sigma0"),
           "set_param: sigma0 < 0 refused, the old value kept");
-    CHECK(tf_rt_set_param(&f, TF_P_FC, NAN) == B && f.model.p[TF_P_FC] == 1.0, "set_param: NaN fc");
-    CHECK(tf_rt_set_param(&f, TF_P_FS, NAN) == TF_OK && f.model.fs_follows_fc, "set_param: NaN fs = no Stribeck");
-    CHECK(tf_rt_reset(NULL) == B && tf_rt_params_at(NULL, 30.0, p, 0, 0) == B, "reset, params_at: NULL");
-    CHECK(tf_rt_from_model(NULL, &f.model) == B && tf_rt_from_model(&f, NULL) == B, "from_model: NULL");
+    CHECK(tf_rt_set_param(&f, TF_P_FC, NAN, &E) == B && f.model.p[TF_P_FC] == 1.0, "set_param: NaN fc");
+    CHECK(tf_rt_set_param(&f, TF_P_FS, NAN, &E) == TF_OK && f.model.fs_follows_fc, "set_param: NaN fs = no Stribeck");
+    CHECK(tf_rt_reset(NULL, &E) == B && tf_rt_params_at(NULL, 30.0, p, 0, 0, &E) == B, "reset, params_at: NULL");
+    CHECK(tf_rt_from_model(NULL, &f.model, &E) == B && tf_rt_from_model(&f, NULL, &E) == B, "from_model: NULL");
     tf_model bad = f.model;
     bad.p[TF_P_SIGMA0] = -1.0;
-    CHECK(tf_rt_from_model(&f, &bad) == B && f.model.p[TF_P_SIGMA0] == 1e5, "from_model: sigma0 < 0");
-    double z[1] = {0}, dz[1];
-    CHECK(isnan(tf_rt_advance(TF_FRICTION_LUGRE, NULL, NULL, z, 1e-3, 1e-4, 0, dz)) &&
-              isnan(tf_rt_advance(TF_FRICTION_GMS, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz)) &&
-              isnan(tf_rt_advance(42, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz)) && z[0] == 0.0,
-          "advance: NULL p, GMS without elements, unknown kind");
+    CHECK(tf_rt_from_model(&f, &bad, &E) == B && f.model.p[TF_P_SIGMA0] == 1e5, "from_model: sigma0 < 0");
+    double z[1] = {0}, dz[1], Fa = 0.0;
+    CHECK(tf_rt_advance(TF_FRICTION_LUGRE, NULL, NULL, z, 1e-3, 1e-4, 0, dz, &Fa, &E) == B && isnan(Fa) &&
+              tf_rt_advance(TF_FRICTION_GMS, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz, &Fa, &E) == B &&
+              tf_rt_advance(42, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz, &Fa, &E) == B && isnan(Fa) && z[0] == 0.0 &&
+              tf_rt_advance(TF_FRICTION_LUGRE, f.model.p, NULL, z, 1e-3, 1e-4, 0, dz, NULL, &E) == B,
+          "advance: NULL p, GMS without elements, unknown kind, NULL F");
     p[TF_P_FS] = 1.5;
-    CHECK(isfinite(tf_rt_advance(TF_FRICTION_LUGRE, p, NULL, z, 1e-3, 1e-4, 0, dz)),
+    CHECK(tf_rt_advance(TF_FRICTION_LUGRE, p, NULL, z, 1e-3, 1e-4, 0, dz, &Fa, &E) == TF_OK && isfinite(Fa) &&
+              E.code == TF_OK && !E.what[0] && !E.where[0],
           "advance: LuGre needs no GMS elements");
-    CHECK(isnan(tf_rt_thermal_force(1.0, 1e-3, NULL, 1.0, 0.0)), "thermal_force: NULL p");
+    CHECK(tf_rt_thermal_force(1.0, 1e-3, NULL, 1.0, 0.0, &Fa, &E) == B && isnan(Fa) && !strcmp(E.where, "realtime"),
+          "thermal_force: NULL p");
 }
 
 static void test_rt_step_refuses_bad_samples_and_keeps_its_state(void)
 {
     static tf_rt_friction f, twin;
     double F;
-    CHECK(isnan(tf_rt_step(NULL, 1e-3, NAN, 1e-4)), "step(NULL) is NaN");
-    CHECK(tf_rt_step_status(NULL, 1e-3, NAN, 1e-4, &F) == B && isnan(F), "step_status(NULL)");
+    CHECK(isnan(rt_force(NULL, 1e-3, NAN, 1e-4)), "step(NULL) is NaN");
+    CHECK(tf_rt_step(NULL, 1e-3, NAN, 1e-4, &F, &E) == B && isnan(F), "step_status(NULL)");
     rt_lugre(&f);
-    CHECK(tf_rt_step_status(&f, 1e-3, NAN, 1e-4, NULL) == B, "step_status: NULL F");
+    CHECK(tf_rt_step(&f, 1e-3, NAN, 1e-4, NULL, &E) == B, "step_status: NULL F");
     rt_lugre(&twin);
-    for (int i = 0; i < 10; i++) tf_rt_step(&f, 1e-3, NAN, 1e-4), tf_rt_step(&twin, 1e-3, NAN, 1e-4);
+    for (int i = 0; i < 10; i++) rt_force(&f, 1e-3, NAN, 1e-4), rt_force(&twin, 1e-3, NAN, 1e-4);
     const double bad[] = {NAN, INFINITY, -INFINITY};
     for (int k = 0; k < 3; k++) {
-        CHECK(isnan(tf_rt_step(&f, bad[k], NAN, 1e-4)) && f.status == B && !strcmp(f.what, "v (not finite)"),
+        CHECK(isnan(rt_force(&f, bad[k], NAN, 1e-4)) && E.code == B && !strcmp(E.what, "v (not finite)"),
               "v = %g refused", bad[k]);
-        CHECK(tf_rt_step_status(&f, 1e-3, NAN, bad[k], &F) == B && isnan(F), "dt = %g refused", bad[k]);
+        CHECK(tf_rt_step(&f, 1e-3, NAN, bad[k], &F, &E) == B && isnan(F), "dt = %g refused", bad[k]);
     }
-    CHECK(tf_rt_step(&f, 1e-3, INFINITY, 1e-4) == tf_rt_step(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
+    CHECK(rt_force(&f, 1e-3, INFINITY, 1e-4) == rt_force(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
           "without a thermal model T is ignored (NaN, inf), and the refused samples left the state as it was");
     /* an overflow: sigma1 |v| at v = 1e308 is infinite; the step is refused, the state kept */
-    CHECK(tf_rt_step_status(&f, 1e308, NAN, 1e-4, &F) == TF_ERR_NONFINITE && isnan(F) && f.z[0] == twin.z[0],
-          "overflowing step: status %d, z %g vs %g", f.status, f.z[0], twin.z[0]);
-    CHECK(tf_rt_step(&f, 1e-3, NAN, 1e-4) == tf_rt_step(&twin, 1e-3, NAN, 1e-4) && f.status == TF_OK && !f.what,
+    CHECK(tf_rt_step(&f, 1e308, NAN, 1e-4, &F, &E) == TF_ERR_NONFINITE && isnan(F) && f.z[0] == twin.z[0],
+          "overflowing step: status %d, z %g vs %g", E.code, f.z[0], twin.z[0]);
+    CHECK(rt_force(&f, 1e-3, NAN, 1e-4) == rt_force(&twin, 1e-3, NAN, 1e-4) && E.code == TF_OK && !E.what[0],
           "the next good sample continues as if the bad ones had not come");
 
     /* Model I: fc = 2.5 - 0.05 T turns negative above 50 C (the issue: F = -1.6e17 N at 60 C) */
     rt_lugre(&f);
     rt_lugre(&twin);
     tf_law fc = {TF_LAW_LINEAR, -0.05, 2.5, 0, 0, 0, 0};
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &fc) == TF_OK && tf_rt_set_model_i(&twin, TF_P_FC, &fc) == TF_OK, "law");
-    CHECK(tf_rt_set_model_i(&f, TF_P_FS, &fc) == TF_OK && tf_rt_set_model_i(&twin, TF_P_FS, &fc) == TF_OK, "law");
-    for (int i = 0; i < 10; i++) tf_rt_step(&f, 1e-3, 35.0, 1e-4), tf_rt_step(&twin, 1e-3, 35.0, 1e-4);
-    CHECK(isnan(tf_rt_step(&f, 1e-3, 60.0, 1e-4)) && f.status == B && !strcmp(f.what, "fc"),
-          "Model I: fc < 0 at 60 C refused (%s)", f.what ? f.what : "accepted");
-    CHECK(isnan(tf_rt_step(&f, 1e-3, 60.0, 1e-4)), "and refused again at the same temperature");
-    CHECK(tf_rt_params_at(&f, 60.0, 0, 0, 0) == B, "params_at 60 C refused");
-    CHECK(isnan(tf_rt_step(&f, 1e-3, NAN, 1e-4)) && !strcmp(f.what, "T (not finite)"), "NaN T with a thermal model");
-    CHECK(isnan(tf_rt_step(&f, 1e-3, INFINITY, 1e-4)) && !strcmp(f.what, "T (not finite)"), "inf T refused");
-    CHECK(tf_rt_step(&f, 1e-3, 35.0, 1e-4) == tf_rt_step(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &fc, &E) == TF_OK && tf_rt_set_model_i(&twin, TF_P_FC, &fc, &E) == TF_OK, "law");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FS, &fc, &E) == TF_OK && tf_rt_set_model_i(&twin, TF_P_FS, &fc, &E) == TF_OK, "law");
+    for (int i = 0; i < 10; i++) rt_force(&f, 1e-3, 35.0, 1e-4), rt_force(&twin, 1e-3, 35.0, 1e-4);
+    CHECK(isnan(rt_force(&f, 1e-3, 60.0, 1e-4)) && E.code == B && !strcmp(E.what, "fc"),
+          "Model I: fc < 0 at 60 C refused (%s)", E.what);
+    CHECK(isnan(rt_force(&f, 1e-3, 60.0, 1e-4)), "and refused again at the same temperature");
+    CHECK(tf_rt_params_at(&f, 60.0, 0, 0, 0, &E) == B, "params_at 60 C refused");
+    CHECK(isnan(rt_force(&f, 1e-3, NAN, 1e-4)) && !strcmp(E.what, "T (not finite)"), "NaN T with a thermal model");
+    CHECK(isnan(rt_force(&f, 1e-3, INFINITY, 1e-4)) && !strcmp(E.what, "T (not finite)"), "inf T refused");
+    CHECK(rt_force(&f, 1e-3, 35.0, 1e-4) == rt_force(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
           "back at 35 C as if 60 C had not come");
-    CHECK(tf_rt_set_param(&f, TF_P_SIGMA0, -5.0) == B && !strcmp(f.what, "sigma0"),
+    CHECK(tf_rt_set_param(&f, TF_P_SIGMA0, -5.0, &E) == B && !strcmp(E.what, "sigma0"),
           "set_param with Model I: checked at the last temperature");
     tf_law neg = {TF_LAW_CONST, -1.0, 0, 0, 0, 0, 0};
-    CHECK(tf_rt_set_model_i(&f, TF_P_SIGMA0, &neg) == B && f.model.law[TF_P_SIGMA0].kind == TF_LAW_NONE,
+    CHECK(tf_rt_set_model_i(&f, TF_P_SIGMA0, &neg, &E) == B && f.model.law[TF_P_SIGMA0].kind == TF_LAW_NONE,
           "a law negative at the last temperature refused");
 
     /* Model II: lambda = 1 + dF / fc <= 0 reverses friction: refused at that step */
     rt_lugre(&f);
     tf_law dF = {TF_LAW_LINEAR, -0.1, 0.6, 0, 0, 0, 0}; /* lambda = 1.6 - 0.1 T <= 0 from 16 C */
-    CHECK(tf_rt_set_model_ii(&f, &dF, TF_DF_SCALE) == TF_OK, "Model II");
-    CHECK(isfinite(tf_rt_step(&f, 1e-3, 5.0, 1e-4)) && tf_rt_step(&f, 1e-3, 5.0, 1e-4) > 0.0, "lambda > 0 at 5 C");
-    CHECK(isnan(tf_rt_step(&f, 1e-3, 35.0, 1e-4)) && f.status == B && !strncmp(f.what, "dF", 2),
+    CHECK(tf_rt_set_model_ii(&f, &dF, TF_DF_SCALE, &E) == TF_OK, "Model II");
+    CHECK(isfinite(rt_force(&f, 1e-3, 5.0, 1e-4)) && rt_force(&f, 1e-3, 5.0, 1e-4) > 0.0, "lambda > 0 at 5 C");
+    CHECK(isnan(rt_force(&f, 1e-3, 35.0, 1e-4)) && E.code == B && !strncmp(E.what, "dF", 2),
           "Model II: lambda < 0 at 35 C refused");
-    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &fc) == B, "Model I on a Model II model refused");
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &fc, &E) == B, "Model I on a Model II model refused");
 }
 
 static void test_observer_pid_and_loop_refuse_bad_arguments(void)
@@ -670,46 +777,46 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
     /* the issue's stack buffer overflow: one `extra` for every GMS element; now a clear refusal */
     rt_gms(&f);
     double z0[3] = {f.z[0], f.z[1], f.z[2]};
-    CHECK(isnan(tf_observer_step(&f, 1e-3, 1e-6, 100.0, NAN, 1e-4)) && f.status == B &&
+    CHECK(isnan(observer_force(&f, 1e-3, 1e-6, 100.0, NAN, 1e-4)) && E.code == B &&
               f.z[0] == z0[0] && f.z[1] == z0[1] && f.z[2] == z0[2],
           "observer on GMS refused");
     double p[TF_NPARAM] = {0};
     p[TF_P_FC] = 1.0, p[TF_P_SIGMA2] = 0.4, p[TF_P_VSMOOTH] = 1e-4;
-    CHECK(tf_rt_init(&f, TF_FRICTION_COULOMB, p, NULL) == TF_OK &&
-              tf_observer_step_status(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, &F) == B,
+    CHECK(tf_rt_init(&f, TF_FRICTION_COULOMB, p, NULL, &E) == TF_OK &&
+              tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, &F, &E) == B,
           "observer on Coulomb refused (no state)");
-    CHECK(isnan(tf_observer_step(NULL, 1e-3, 0, 100, NAN, 1e-4)), "observer(NULL)");
+    CHECK(isnan(observer_force(NULL, 1e-3, 0, 100, NAN, 1e-4)), "observer(NULL)");
     rt_lugre(&f);
     rt_lugre(&twin);
-    CHECK(tf_observer_step_status(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, NULL) == B, "observer: NULL F");
+    CHECK(tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, NULL, &E) == B, "observer: NULL F");
     const double bad[] = {NAN, INFINITY};
     for (int k = 0; k < 2; k++) {
-        CHECK(tf_observer_step_status(&f, bad[k], 0.0, 100.0, NAN, 1e-4, &F) == B && isnan(F), "observer v");
-        CHECK(tf_observer_step_status(&f, 1e-3, bad[k], 100.0, NAN, 1e-4, &F) == B, "observer e");
-        CHECK(tf_observer_step_status(&f, 1e-3, 0.0, bad[k], NAN, 1e-4, &F) == B, "observer k");
-        CHECK(tf_observer_step_status(&f, 1e-3, 0.0, 100.0, NAN, bad[k], &F) == B, "observer dt");
+        CHECK(tf_observer_step(&f, bad[k], 0.0, 100.0, NAN, 1e-4, &F, &E) == B && isnan(F), "observer v");
+        CHECK(tf_observer_step(&f, 1e-3, bad[k], 100.0, NAN, 1e-4, &F, &E) == B, "observer e");
+        CHECK(tf_observer_step(&f, 1e-3, 0.0, bad[k], NAN, 1e-4, &F, &E) == B, "observer k");
+        CHECK(tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, bad[k], &F, &E) == B, "observer dt");
     }
-    CHECK(tf_observer_step_status(&f, 1e-3, 0.0, -1.0, NAN, 1e-4, &F) == B, "observer: negative gain");
-    CHECK(tf_observer_step(&f, 1e-3, 1e-7, 100.0, NAN, 1e-4) == tf_observer_step(&twin, 1e-3, 1e-7, 100.0, NAN, 1e-4) &&
+    CHECK(tf_observer_step(&f, 1e-3, 0.0, -1.0, NAN, 1e-4, &F, &E) == B, "observer: negative gain");
+    CHECK(observer_force(&f, 1e-3, 1e-7, 100.0, NAN, 1e-4) == observer_force(&twin, 1e-3, 1e-7, 100.0, NAN, 1e-4) &&
               f.z[0] == twin.z[0],
           "observer state untouched by the refusals");
 
     tf_pid c, ctwin;
-    CHECK(tf_pid_init(NULL, 1, 1, 1, 0) == B && tf_pid_init(&c, NAN, 1, 1, 0) == B &&
-              tf_pid_init(&c, 1, INFINITY, 1, 0) == B && tf_pid_init(&c, 1, 1, 1, -1e-3) == B,
+    CHECK(tf_pid_init(NULL, 1, 1, 1, 0, &E) == B && tf_pid_init(&c, NAN, 1, 1, 0, &E) == B &&
+              tf_pid_init(&c, 1, INFINITY, 1, 0, &E) == B && tf_pid_init(&c, 1, 1, 1, -1e-3, &E) == B,
           "pid_init: NULL, non-finite gains, tau_d < 0");
-    CHECK(tf_pid_init(&c, 4e4, 4e5, 280.0, 2e-4) == TF_OK && tf_pid_init(&ctwin, 4e4, 4e5, 280.0, 2e-4) == TF_OK,
+    CHECK(tf_pid_init(&c, 4e4, 4e5, 280.0, 2e-4, &E) == TF_OK && tf_pid_init(&ctwin, 4e4, 4e5, 280.0, 2e-4, &E) == TF_OK,
           "pid_init");
     double u;
-    tf_pid_step(&c, 1e-6, 1e-4), tf_pid_step(&ctwin, 1e-6, 1e-4);
-    CHECK(isnan(tf_pid_step(&c, 2e-6, 0.0)) && tf_pid_step_status(&c, 2e-6, 0.0, &u) == B && isnan(u),
+    pid_u(&c, 1e-6, 1e-4), pid_u(&ctwin, 1e-6, 1e-4);
+    CHECK(isnan(pid_u(&c, 2e-6, 0.0)) && tf_pid_step(&c, 2e-6, 0.0, &u, &E) == B && isnan(u),
           "pid: dt = 0 refused (it gave NaN forever)");
-    CHECK(tf_pid_step_status(&c, 2e-6, -1e-4, &u) == B && tf_pid_step_status(&c, NAN, 1e-4, &u) == B &&
-              tf_pid_step_status(&c, 2e-6, NAN, &u) == B && tf_pid_step_status(NULL, 0, 1e-4, &u) == B &&
-              tf_pid_step_status(&c, 0, 1e-4, NULL) == B,
+    CHECK(tf_pid_step(&c, 2e-6, -1e-4, &u, &E) == B && tf_pid_step(&c, NAN, 1e-4, &u, &E) == B &&
+              tf_pid_step(&c, 2e-6, NAN, &u, &E) == B && tf_pid_step(NULL, 0, 1e-4, &u, &E) == B &&
+              tf_pid_step(&c, 0, 1e-4, NULL, &E) == B,
           "pid: negative or NaN dt, NaN e, NULL");
-    CHECK(tf_pid_step_status(&c, 1e305, 1e-4, &u) == TF_ERR_NONFINITE, "pid: an overflowing u");
-    CHECK(tf_pid_step(&c, 2e-6, 1e-4) == tf_pid_step(&ctwin, 2e-6, 1e-4), "pid state untouched by the refusals");
+    CHECK(tf_pid_step(&c, 1e305, 1e-4, &u, &E) == TF_ERR_NONFINITE, "pid: an overflowing u");
+    CHECK(pid_u(&c, 2e-6, 1e-4) == pid_u(&ctwin, 2e-6, 1e-4), "pid state untouched by the refusals");
 
     enum { N = 200 };
     static double x_ref[N], v_ref[N], x[N];
@@ -717,58 +824,66 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
     rt_lugre(&plant);
     rt_lugre(&comp);
     tf_loop L = {1.0, &plant, 30.0, {0}, TF_COMP_FEEDFORWARD, &comp, 30.0, 100.0, 1e-4, 10};
-    tf_pid_init(&L.pid, 4e4, 4e5, 280.0, 2e-4);
-    CHECK(tf_loop_run(NULL, N, x_ref, v_ref, x, 0, 0) == B, "loop(NULL)");
-    CHECK(tf_loop_run(&L, 0, NULL, v_ref, x, 0, 0) == B && !strcmp(L.where, "loop"), "loop: n = 0, x_ref NULL");
-    CHECK(tf_loop_run(&L, N, NULL, v_ref, x, 0, 0) == B && !strcmp(L.what, "x_ref (NULL)"), "loop: x_ref NULL");
-    CHECK(tf_loop_run(&L, N, x_ref, NULL, x, 0, 0) == B && !strcmp(L.what, "v_ref (NULL)"),
+    tf_pid_init(&L.pid, 4e4, 4e5, 280.0, 2e-4, &E);
+    CHECK(tf_loop_run(NULL, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop(NULL)");
+    CHECK(tf_loop_run(&L, 0, NULL, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "loop"), "loop: n = 0, x_ref NULL");
+    CHECK(tf_loop_run(&L, N, NULL, v_ref, x, 0, 0, &E) == B && !strcmp(E.what, "x_ref (NULL)"), "loop: x_ref NULL");
+    CHECK(tf_loop_run(&L, N, x_ref, NULL, x, 0, 0, &E) == B && !strcmp(E.what, "v_ref (NULL)"),
           "loop: feed-forward without v_ref");
     x_ref[150] = NAN;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && L.period == 150 && x[0] == -7.0,
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && E.index == 150 && x[0] == -7.0,
           "loop: a NaN reference sample refused before anything is written");
     x_ref[150] = 150e-6;
     double *fields[] = {&L.mass, &L.dt};
     for (int k = 0; k < 2; k++) {
         double keep = *fields[k];
         *fields[k] = 0.0;
-        CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: %s = 0", k ? "dt" : "mass");
+        CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: %s = 0", k ? "dt" : "mass");
         *fields[k] = NAN;
-        CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: %s = NaN", k ? "dt" : "mass");
+        CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: %s = NaN", k ? "dt" : "mass");
         *fields[k] = keep;
     }
     L.substeps = 0;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: substeps = 0");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: substeps = 0");
+    /* issue 32: substeps = INT_MAX ran 200 x 2^31 plant steps (a hang); the work is bounded */
+    L.substeps = 2147483647;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "loop") &&
+              strstr(E.what, "substeps") && x[0] == -7.0,
+          "loop: n x substeps beyond TF_LOOP_MAX_SUBSTEPS refused before anything is written");
+    L.substeps = (int)(TF_LOOP_MAX_SUBSTEPS / N) + 1;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && strstr(E.what, "substeps"),
+          "loop: one substep per run beyond the bound refused");
     L.substeps = 10, L.compensation = 9;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: unknown compensation");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: unknown compensation");
     L.compensation = TF_COMP_OBSERVER, L.comp = NULL;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: compensation NULL");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: compensation NULL");
     rt_gms(&comp);
     L.comp = &comp;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "compensation"),
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "compensation"),
           "loop: observer on GMS (the issue's overflow, through the loop)");
     rt_lugre(&comp);
     L.observer_gain = -1.0;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: negative observer gain");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: negative observer gain");
     L.observer_gain = 100.0, L.pid.kd = NAN;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "pid"), "loop: NaN gain");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "pid"), "loop: NaN gain");
     L.pid.kd = 280.0, L.plant = NULL;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: plant NULL");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: plant NULL");
     L.plant = &plant;
     tf_law fc = {TF_LAW_LINEAR, -0.05, 2.5, 0, 0, 0, 0};
-    tf_rt_set_model_i(&plant, TF_P_FC, &fc);
-    tf_rt_set_model_i(&plant, TF_P_FS, &fc);
+    tf_rt_set_model_i(&plant, TF_P_FC, &fc, &E);
+    tf_rt_set_model_i(&plant, TF_P_FS, &fc, &E);
     L.T_plant = 60.0;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B && !strcmp(L.where, "plant") && !strcmp(L.what, "fc") &&
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "plant") && !strcmp(E.what, "fc") &&
               x[0] == -7.0,
           "loop: the plant's Model I invalid at 60 C, refused before the first period");
     L.T_plant = NAN;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == B, "loop: NaN plant temperature");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B, "loop: NaN plant temperature");
     L.T_plant = 35.0;
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == TF_OK && isfinite(x[N - 1]) && x[0] == 0.0, "loop runs");
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == TF_OK && isfinite(x[N - 1]) && x[0] == 0.0, "loop runs");
     L.pid.kp = -1e12; /* positive feedback */
-    tf_rt_reset(&plant), tf_rt_reset(&comp);
-    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0) == TF_ERR_NONFINITE && L.period >= 0,
-          "loop: unstable gains stop the run (at period %ld: %s)", L.period, L.what);
+    tf_rt_reset(&plant, &E), tf_rt_reset(&comp, &E);
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == TF_ERR_NONFINITE && E.index >= 0,
+          "loop: unstable gains stop the run (at period %ld: %s)", E.index, E.what);
 }
 #undef B
 
@@ -855,6 +970,9 @@ int main(void)
     test_oscillator_dense_output(TF_METHOD_DOPRI5);
     test_oscillator_dense_output(TF_METHOD_RODAS4);
     test_stiff_prothero_robinson();
+    test_one_error_record_from_every_entry_point();
+    test_interrupt_poll_stops_a_long_integration(TF_METHOD_DOPRI5);
+    test_interrupt_poll_stops_a_long_integration(TF_METHOD_RODAS4);
     test_waveforms();
     test_laws();
     test_lugre_steady_sliding();

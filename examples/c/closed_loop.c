@@ -28,10 +28,13 @@ static void stage_friction(tf_rt_friction *f)
     double p[TF_NPARAM] = {0};
     p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
     p[TF_P_SIGMA2] = 0.4, p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_VSMOOTH] = 1e-6;
-    if (tf_rt_init(f, TF_FRICTION_LUGRE, p, NULL) != 0) exit(1);
-    if (tf_rt_set_model_i(f, TF_P_SIGMA0, &SIGMA0) || tf_rt_set_model_i(f, TF_P_SIGMA1, &SIGMA1) ||
-        tf_rt_set_model_i(f, TF_P_FC, &FC) || tf_rt_set_model_i(f, TF_P_FS, &FS))
+    tf_error err;
+    if (tf_rt_init(f, TF_FRICTION_LUGRE, p, NULL, &err) != TF_OK || tf_rt_set_model_i(f, TF_P_SIGMA0, &SIGMA0, &err) ||
+        tf_rt_set_model_i(f, TF_P_SIGMA1, &SIGMA1, &err) || tf_rt_set_model_i(f, TF_P_FC, &FC, &err) ||
+        tf_rt_set_model_i(f, TF_P_FS, &FS, &err)) {
+        fprintf(stderr, "the friction model was refused: %s: %s\n", err.where, err.what);
         exit(1);
+    }
 }
 
 int main(void)
@@ -58,9 +61,10 @@ int main(void)
             stage_friction(&comp);
             tf_loop loop = {1.0, &plant, temps[k], {0}, cases[c].kind, &comp,
                             cases[c].aware ? temps[k] : 30.0, 100.0, DT, 10};
-            tf_pid_init(&loop.pid, 4e4, 4e5, 280.0, 2e-4);
-            if (tf_loop_run(&loop, N, x_ref, v_ref, x, NULL, NULL) != 0) {
-                fprintf(stderr, "the loop stopped at period %ld: %s: %s\n", loop.period, loop.where, loop.what);
+            tf_error err;
+            tf_pid_init(&loop.pid, 4e4, 4e5, 280.0, 2e-4, NULL);
+            if (tf_loop_run(&loop, N, x_ref, v_ref, x, NULL, NULL, &err) != TF_OK) {
+                fprintf(stderr, "the loop stopped at period %ld: %s: %s\n", err.index, err.where, err.what);
                 return 1;
             }
             double ss = 0.0, mx = 0.0;

@@ -239,9 +239,10 @@ def target(kind: str, index: int = 0, coefficient: int = 0) -> tuple:
 
 def loop(plant_spec, T_plant, comp_spec, T_comp, compensation: str, gain, mass, pid, dt, substeps, x_ref, v_ref,
          x_out, u_out, F_out) -> str:
-    """The fixed-step closed loop of control.h; returns its status name."""
+    """The fixed-step closed loop of control.h; returns its status name. ``substeps`` beyond any C integer
+    is passed as 2**31, which the core refuses as it does any n x substeps above TF_LOOP_MAX_SUBSTEPS."""
     status = _core.loop(plant_spec, float(T_plant), comp_spec, float(T_comp), COMPENSATION_CODES[compensation],
-                        float(gain), float(mass), tuple(float(g) for g in pid), float(dt), int(substeps), x_ref,
+                        float(gain), float(mass), tuple(float(g) for g in pid), float(dt), min(int(substeps), 2**31), x_ref,
                         v_ref, x_out, u_out, F_out)
     return STATUS_NAMES.get(status, f"status {status}")
 

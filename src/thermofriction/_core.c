@@ -186,12 +186,67 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
     return 0;
 }
 
-/* SolverError(message, status, t_fail, h_fail, state, stiff_suspected) */
-static void raise_solver_error(int status, const tf_solver_stats *st, const double *y, int n)
+/* ---- Ctrl-C during a long integration ----
+ * tf_solve runs with the GIL released, so Python's signal handlers (KeyboardInterrupt, the command
+ * line's SIGTERM handler) cannot run until it returns. The solver polls interrupt_poll every
+ * TF_POLL_STEPS steps; at most every POLL_SECONDS it takes the GIL back and runs the pending handlers
+ * (PyErr_CheckSignals). A handler that raises stops the integration (TF_ERR_INTERRUPTED) and its
+ * exception is what the call raises. Only in the main thread: Python runs signal handlers there
+ * only, and other threads need not wait for the GIL. */
+#define POLL_SECONDS 0.05
+static unsigned long main_thread_ident;
+
+typedef struct {
+    PyThreadState *ts; /* the released thread state, NULL when not polling */
+    double last;       /* when the handlers last ran [s, monotonic] */
+    int raised;        /* a handler raised: the exception is set */
+} signal_poll;
+
+static double monotonic_seconds(void)
+{
+#ifdef CLOCK_MONOTONIC
+    struct timespec ts;
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) == 0) return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#endif
+    return (double)clock() / CLOCKS_PER_SEC;
+}
+
+static int interrupt_poll(void *ctx)
+{
+    signal_poll *p = (signal_poll *)ctx;
+    double now = monotonic_seconds();
+    if (now - p->last < POLL_SECONDS) return 0;
+    p->last = now;
+    PyEval_RestoreThread(p->ts);
+    p->raised = PyErr_CheckSignals() != 0;
+    p->ts = PyEval_SaveThread();
+    return p->raised;
+}
+
+/* tf_solve without the GIL, polled for signals in the main thread. */
+static tf_status solve_released(const tf_ode *ode, tf_solver_options *opt, const double *t_out, long n_out,
+                                double *y, tf_emit_fn emit, void *ctx, tf_solver_stats *st, tf_error *err,
+                                int *raised)
+{
+    signal_poll poll = {NULL, monotonic_seconds(), 0};
+    if (PyThread_get_thread_ident() == main_thread_ident) {
+        opt->interrupt = interrupt_poll;
+        opt->interrupt_ctx = &poll;
+    }
+    poll.ts = PyEval_SaveThread();
+    tf_status status = tf_solve(ode, opt, t_out, n_out, y, emit, ctx, st, err);
+    PyEval_RestoreThread(poll.ts);
+    *raised = poll.raised;
+    return status;
+}
+
+/* SolverError(message, status, t_fail, h_fail, state, stiff_suspected): the message is the error
+ * record's what (status.h: the status's sentence, or the argument refused) */
+static void raise_solver_error(const tf_error *err, const tf_solver_stats *st, const double *y, int n)
 {
     PyObject *state = PyTuple_New(n);
     for (int i = 0; i < n && state; i++) PyTuple_SET_ITEM(state, i, PyFloat_FromDouble(y[i]));
-    PyObject *exc_args = Py_BuildValue("(siddNi)", tf_status_message(status), status, st->t_fail, st->h_fail,
+    PyObject *exc_args = Py_BuildValue("(siddNi)", err->what, (int)err->code, err->t, st->h_fail,
                                        state, st->stiff_suspected);
     if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
 }
@@ -200,10 +255,10 @@ static void raise_solver_error(int status, const tf_solver_stats *st, const doub
  * reported as a SolverError with TF_ERR_BAD_ARGUMENT naming the field. */
 static int check_model(const tf_model *m)
 {
-    const char *what = 0;
-    if (tf_model_check(m, &what) == TF_OK) return 0;
+    tf_error e;
+    if (tf_model_check(m, &e) == TF_OK) return 0;
     char message[160];
-    snprintf(message, sizeof message, "the C core's model check refused '%s'", what ? what : "?");
+    snprintf(message, sizeof message, "the C core's model check refused '%s'", e.what);
     PyObject *exc_args = Py_BuildValue("(siddNi)", message, TF_ERR_BAD_ARGUMENT, 0.0, 0.0, PyTuple_New(0), 0);
     if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
     return -1;
@@ -273,15 +328,15 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     tf_ode ode = tf_model_ode(&m);
     double rtol_w[TF_MAX_STATES];
     tf_model_rtol_weights(&m, rtol_w);
-    tf_solver_options opt = {method, rtol, atol, h0, hmax, max_steps, rtol_w};
+    tf_solver_options opt = {.method = method, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
+                             .max_steps = max_steps, .rtol_weight = rtol_w};
     tf_solver_stats st;
     emit_ctx ec = {&m, (double *)outv.buf, nch, columns ? (long)n_out : 0};
-    int status;
-    Py_BEGIN_ALLOW_THREADS
-    status = tf_solve(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st);
-    Py_END_ALLOW_THREADS
+    int raised;
+    tf_error e;
+    tf_status status = solve_released(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st, &e, &raised);
     if (status != TF_OK) {
-        raise_solver_error(status, &st, y, n);
+        if (!raised) raise_solver_error(&e, &st, y, n);
         goto done;
     }
     result = Py_BuildValue("{s:l,s:l,s:l,s:l,s:l,s:i,s:d,s:l}", "steps", st.steps, "rejected", st.rejected,
@@ -373,15 +428,15 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
             Y[n + tf_model_temperature_index(&m) * np + k] = 1.0;
     tf_sensitivity_system sys = {&m, np, targets};
     tf_ode ode = tf_sensitivity_ode(&sys);
-    tf_solver_options opt = {TF_METHOD_DOPRI5, rtol, atol, h0, hmax, max_steps};
+    tf_solver_options opt = {.method = TF_METHOD_DOPRI5, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
+                             .max_steps = max_steps};
     tf_solver_stats st;
     sens_emit_ctx ec = {&m, (double *)outv.buf, (double *)sensv.buf, nch, n, np};
-    int status;
-    Py_BEGIN_ALLOW_THREADS
-    status = tf_solve(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st);
-    Py_END_ALLOW_THREADS
+    int raised;
+    tf_error e;
+    tf_status status = solve_released(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st, &e, &raised);
     if (status != TF_OK) {
-        raise_solver_error(status, &st, Y, n);
+        if (!raised) raise_solver_error(&e, &st, Y, n);
         goto done;
     }
     result = Py_BuildValue("{s:l,s:l,s:l}", "steps", st.steps, "rejected", st.rejected, "rhs_evals", st.rhs_evals);
@@ -555,11 +610,17 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
 {
     PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *outs[3];
     double T_plant, T_comp, gain, mass, kp, ki, kd, tau_d, dt;
-    int compensation, substeps;
-    if (!PyArg_ParseTuple(args, "OdOdidd(dddd)diOOOOO", &plant_spec, &T_plant, &comp_spec, &T_comp, &compensation,
-                          &gain, &mass, &kp, &ki, &kd, &tau_d, &dt, &substeps, &xr_obj, &vr_obj, &outs[0], &outs[1],
+    int compensation;
+    long substeps_in;
+    if (!PyArg_ParseTuple(args, "OdOdidd(dddd)dlOOOOO", &plant_spec, &T_plant, &comp_spec, &T_comp, &compensation,
+                          &gain, &mass, &kp, &ki, &kd, &tau_d, &dt, &substeps_in, &xr_obj, &vr_obj, &outs[0], &outs[1],
                           &outs[2]))
         return NULL;
+    if (substeps_in > TF_LOOP_MAX_SUBSTEPS) { /* beyond an int: the core's own bound, in its words */
+        PyErr_SetString(PyExc_ValueError, "loop: n x substeps (at most 1e8 plant substeps in one run)");
+        return NULL;
+    }
+    int substeps = (int)(substeps_in < 0 ? 0 : substeps_in);
     arena a = {0}, b = {0};
     tf_model pm, cm;
     tf_rt_friction *rt = PyMem_Malloc(2 * sizeof(tf_rt_friction)); /* ~3 kB each: not on the stack */
@@ -582,23 +643,25 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
         if (views[k].len != 8 * n) { PyErr_SetString(PyExc_ValueError, "outputs: one float64 per period"); goto done; }
         out[k] = (double *)views[k].buf;
     }
-    if (tf_rt_from_model(&rt[0], &pm) || (comp_spec != Py_None && tf_rt_from_model(&rt[1], &cm))) {
-        PyErr_Format(PyExc_ValueError, "%s friction model: %s", rt[0].status ? "plant" : "compensation",
-                     rt[0].status ? rt[0].what : rt[1].what);
+    tf_error e;
+    int plant_bad = 0;
+    if ((plant_bad = tf_rt_from_model(&rt[0], &pm, &e) != TF_OK) ||
+        (comp_spec != Py_None && tf_rt_from_model(&rt[1], &cm, &e))) {
+        PyErr_Format(PyExc_ValueError, "%s friction model: %s", plant_bad ? "plant" : "compensation", e.what);
         goto done;
     }
     /* the PID at rest, as tf_pid_init leaves it (bad gains: tf_loop_run refuses them) */
     tf_loop loop = {mass, &rt[0], T_plant, {kp, ki, kd, tau_d}, comp_spec == Py_None ? TF_COMP_NONE : compensation,
                     &rt[1], T_comp, gain, dt, substeps};
-    int status;
+    tf_status status;
     Py_BEGIN_ALLOW_THREADS
-    status = tf_loop_run(&loop, (long)n, x_ref, v_ref, out[0], out[1], out[2]);
+    status = tf_loop_run(&loop, (long)n, x_ref, v_ref, out[0], out[1], out[2], &e);
     Py_END_ALLOW_THREADS
     /* a refusal (ValueError) names the part, the argument and the period; other statuses are returned */
-    if (status == TF_ERR_BAD_ARGUMENT && loop.period >= 0)
-        PyErr_Format(PyExc_ValueError, "%s: %s (period %ld)", loop.where, loop.what, loop.period);
+    if (status == TF_ERR_BAD_ARGUMENT && e.index >= 0)
+        PyErr_Format(PyExc_ValueError, "%s: %s (period %ld)", e.where, e.what, e.index);
     else if (status == TF_ERR_BAD_ARGUMENT)
-        PyErr_Format(PyExc_ValueError, "%s: %s", loop.where, loop.what);
+        PyErr_Format(PyExc_ValueError, "%s: %s", e.where, e.what);
     else
         result = PyLong_FromLong(status);
 done:
@@ -640,20 +703,21 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
         if (PyErr_Occurred()) goto done;
         if (nT != n) { PyErr_SetString(PyExc_ValueError, "T: a number or one per velocity"); goto done; }
     }
-    if (tf_rt_from_model(f, &m)) { PyErr_Format(PyExc_ValueError, "friction model: %s", f->what); goto done; }
+    tf_error e;
+    if (tf_rt_from_model(f, &m, &e)) { PyErr_Format(PyExc_ValueError, "friction model: %s", e.what); goto done; }
     double *F = (double *)Fv.buf;
     struct timespec t0, t1;
     Py_ssize_t i = 0;
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (; i < n; i++)
-        if (tf_rt_step_status(f, v[i], T ? T[i] : T_const, dt, &F[i])) break;
+    for (; i < n; i++) /* no record while timing: a refused step changes nothing, so it is repeated for it */
+        if (tf_rt_step(f, v[i], T ? T[i] : T_const, dt, &F[i], NULL)) break;
     clock_gettime(CLOCK_MONOTONIC, &t1);
     Py_END_ALLOW_THREADS
     /* a refused step: ValueError (an argument or parameter), FloatingPointError (an overflow) */
-    if (i < n)
-        PyErr_Format(f->status == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "step %zd: %s",
-                     i, f->what);
+    if (i < n && tf_rt_step(f, v[i], T ? T[i] : T_const, dt, &F[i], &e) != TF_OK)
+        PyErr_Format(e.code == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "step %zd: %s",
+                     i, e.what);
     else
         result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
 done:
@@ -694,6 +758,7 @@ static const tf_constant constants[] = {
     C("status", "ok", TF_OK), C("status", "nonfinite", TF_ERR_NONFINITE),
     C("status", "step_underflow", TF_ERR_STEP_UNDERFLOW), C("status", "max_steps", TF_ERR_MAX_STEPS),
     C("status", "bad_argument", TF_ERR_BAD_ARGUMENT), C("status", "no_memory", TF_ERR_NO_MEMORY),
+    C("status", "interrupted", TF_ERR_INTERRUPTED), C("status", "singular", TF_ERR_SINGULAR),
     C("output", "time", TF_OUT_TIME), C("output", "input", TF_OUT_INPUT),
     C("output", "stage_displacement", TF_OUT_STAGE_DISPLACEMENT), C("output", "stage_velocity", TF_OUT_STAGE_VELOCITY),
     C("output", "displacement", TF_OUT_DISPLACEMENT), C("output", "velocity", TF_OUT_VELOCITY),
@@ -782,5 +847,14 @@ PyMODINIT_FUNC PyInit__core(void)
     if (PyModule_AddObject(mod, "SolverError", SolverError) < 0) return NULL;
     Py_INCREF(SolverError);
     if (add_constants(mod) < 0) return NULL;
+    main_thread_ident = PyThread_get_thread_ident(); /* Python imports extension modules ... */
+    PyObject *threading = PyImport_ImportModule("threading"); /* ... but ask, in case this is not the main thread */
+    PyObject *main = threading ? PyObject_CallMethod(threading, "main_thread", NULL) : NULL;
+    PyObject *ident = main ? PyObject_GetAttrString(main, "ident") : NULL;
+    if (ident && PyLong_Check(ident)) main_thread_ident = PyLong_AsUnsignedLong(ident);
+    Py_XDECREF(ident);
+    Py_XDECREF(main);
+    Py_XDECREF(threading);
+    PyErr_Clear(); /* no answer: the importing thread it is */
     return mod;
 }

@@ -39,7 +39,7 @@ from .errors import InputError, shorten
 from .models import MassPlant, Model, PrescribedMotion, StickSlipPlant, load_model
 
 #: The resource file's format version (core/fmu/fmi2_cs.c, FMU_FORMAT).
-FORMAT = 1
+FORMAT = 2
 #: The binary's limits (fmi2_cs.c: MAX_VR value references, MAX_POINTS points of one law).
 MAX_VALUE_REFERENCE = 2048
 MAX_POINTS = 256
@@ -365,6 +365,7 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     variables = _variables(model, spec, temperature, step)
     tfm = _resource_text(model, spec, variables, integrator)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
+    tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
     xml = _xml(model, variables, identifier, guid, source, step)
     so = binary.read_bytes()
     target = path if isinstance(path, Target) else Path(os.fspath(path))

@@ -26,16 +26,16 @@ typedef struct {
     int started;
 } tf_pid;
 
-/* Checks, as in realtime.h: every function validates its arguments and returns a status (TF_OK =
- * 0, TF_ERR_BAD_ARGUMENT, TF_ERR_NONFINITE), and a refused call changes nothing. */
+/* Checks, as in realtime.h: every function validates its arguments and returns a tf_status (TF_OK,
+ * TF_ERR_BAD_ARGUMENT, TF_ERR_NONFINITE), fills the error record *err (status.h; may be NULL), and a
+ * refused call changes nothing. */
 
 /* Gains finite, tau_d finite and >= 0. */
-int tf_pid_init(tf_pid *c, double kp, double ki, double kd, double tau_d);
+tf_status tf_pid_init(tf_pid *c, double kp, double ki, double kd, double tau_d, tf_error *err);
 /* One control period of dt > 0 [s] with error e: the control u into *u (NaN on a refusal: a
- * non-finite e, dt <= 0 or not finite, non-finite gains, or a u that would not be finite). */
-int tf_pid_step_status(tf_pid *c, double e, double dt, double *u);
-/* The same, returning u: NaN when refused (the controller's state is then unchanged). */
-double tf_pid_step(tf_pid *c, double e, double dt);
+ * non-finite e, dt <= 0 or not finite, non-finite gains, or a u that would not be finite; the
+ * controller's state is then unchanged). */
+tf_status tf_pid_step(tf_pid *c, double e, double dt, double *u, tf_error *err);
 
 /* Observer-based compensation: advances z^ (in f->z) by dt and writes F^ [N] to *F.
  * v: measured velocity [m/s]; e = x - x_ref [m]; k: observer gain [1/s], finite and >= 0 (k = 0:
@@ -43,10 +43,9 @@ double tf_pid_step(tf_pid *c, double e, double dt);
  * deflection: it is defined for the models with one (LuGre, Dahl, elasto-plastic) and refused
  * (TF_ERR_BAD_ARGUMENT) for the others -- Coulomb and Stribeck have no state to observe (use
  * feed-forward, tf_rt_step), GMS has one per element and no published observer. Refusals as
- * tf_rt_step_status's, recorded in f->status and f->what. */
-int tf_observer_step_status(tf_rt_friction *f, double v, double e, double k, double T, double dt, double *F);
-/* The same, returning F^: NaN when refused. */
-double tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double dt);
+ * tf_rt_step's (where "observer" for its own arguments). */
+tf_status tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double dt, double *F,
+                           tf_error *err);
 
 typedef enum {
     TF_COMP_NONE = 0,
@@ -69,23 +68,24 @@ typedef struct {
     double observer_gain;
     double dt;
     int substeps;
-    /* Set by tf_loop_run when it stops short: which part refused (a static string: "loop",
-       "reference", "pid", "plant", "compensation"), why (`what`, a static string: the argument or
-       parameter), and the period (-1: before the first). */
-    const char *where, *what;
-    long period;
 } tf_loop;
+
+/* The most plant substeps (n x substeps) one tf_loop_run takes (~10 s of work): more is refused. */
+#define TF_LOOP_MAX_SUBSTEPS 100000000.0
 
 /* Runs n >= 1 control periods from rest at x = x_ref[0]. x_ref, v_ref: the reference at each
  * period start (v_ref may be NULL without feed-forward). Writes, when not NULL, per period: x
  * (position at the period start), u (the control held over it, compensation included), F_comp
  * (the compensation in it). Returns TF_OK; TF_ERR_BAD_ARGUMENT, before writing anything, for a
- * NULL or non-finite argument (mass, dt > 0, substeps >= 1, gains, a reference sample), an
+ * NULL or non-finite argument (mass, dt > 0, substeps >= 1, n x substeps <= TF_LOOP_MAX_SUBSTEPS,
+ * gains, a reference sample), an
  * unknown compensation, an observer on a model without a bristle state, or a plant or
  * compensation model refused at its temperature; or TF_ERR_NONFINITE if the loop goes unstable
- * (outputs written up to that period). */
-int tf_loop_run(tf_loop *loop, long n, const double *x_ref, const double *v_ref, double *x, double *u,
-                double *F_comp);
+ * (outputs written up to that period). When it stops short, *err (may be NULL) says which part
+ * refused (where: "loop", "reference", "pid", "plant", "compensation"), why (what: the argument or
+ * parameter) and the period (index; -1: before the first). */
+tf_status tf_loop_run(tf_loop *loop, long n, const double *x_ref, const double *v_ref, double *x, double *u,
+                      double *F_comp, tf_error *err);
 
 #ifdef __cplusplus
 }

@@ -4,6 +4,8 @@
 #ifndef THERMOFRICTION_INTEGRATOR_H
 #define THERMOFRICTION_INTEGRATOR_H
 
+#include "status.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -11,8 +13,8 @@ extern "C" {
 typedef struct {
     int n;
     void *ctx;
-    int (*rhs)(double t, const double *y, double *dy, void *ctx);
-    int (*jac)(double t, const double *y, double *J, void *ctx); /* row-major n x n */
+    tf_status (*rhs)(double t, const double *y, double *dy, void *ctx); /* TF_OK, or the step fails */
+    tf_status (*jac)(double t, const double *y, double *J, void *ctx); /* row-major n x n */
     double (*next_corner)(double t, void *ctx);                  /* may be NULL */
     /* Discrete modes (may be 0/NULL): nevent event functions g(t, y) that cross zero upwards
      * where a mode must change. After every accepted step the driver locates the earliest
@@ -40,25 +42,22 @@ typedef struct {
     /* n weights of the relative tolerance in the error norm, atol_i + rtol_weight_i rtol |y_i|; NULL: all 1.
      * A state whose value is relative to an arbitrary origin (a position) gets 0: see tf_model_rtol_weights */
     const double *rtol_weight;
+    /* Polled every TF_POLL_STEPS attempted steps (NULL: never): a nonzero return stops the integration
+     * with TF_ERR_INTERRUPTED, y0 holding the state at the last accepted step (the error record: t). For a
+     * caller that must react to a signal (Ctrl-C) during one long integration. */
+    int (*interrupt)(void *ctx);
+    void *interrupt_ctx;
 } tf_solver_options;
 
-typedef enum {
-    TF_OK = 0,
-    TF_ERR_NONFINITE = 1,      /* NaN or infinite state or derivative */
-    TF_ERR_STEP_UNDERFLOW = 2,
-    TF_ERR_MAX_STEPS = 3,
-    TF_ERR_BAD_ARGUMENT = 4,
-    TF_ERR_NO_MEMORY = 5
-} tf_status;
+#define TF_POLL_STEPS 64
+
 
 typedef struct {
     long steps, rejected, rhs_evals, jac_evals, decompositions, events;
     int method_used;     /* the method at the end (AUTO may switch) */
     double switch_time;  /* when AUTO switched to Rodas4; -1 if it did not */
     int stiff_suspected; /* explicit method saw stiffness */
-    /* on failure: */
-    int status;
-    double t_fail, h_fail;
+    double h_fail;       /* on failure: the step size (the time is in the error record) */
 } tf_solver_stats;
 
 /* Writes one output sample: index into the grid, its time and the state there. */
@@ -66,15 +65,15 @@ typedef void (*tf_emit_fn)(long i, double t, const double *y, void *ctx);
 
 /* Integrates from (t_out[0], y0) through t_out[n_out-1]; y0 is overwritten by the final
  * state (or the state at failure). t_out must be non-decreasing, finite and within +-1e12 s
- * (else TF_ERR_BAD_ARGUMENT). Returns a tf_status. */
-int tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
-             double *y0, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *stats);
+ * (else TF_ERR_BAD_ARGUMENT). Returns a tf_status and fills *err (status.h; may be NULL): where
+ * "solver", what the status's message or the argument refused, t the time of the failure, index
+ * the output sample for a failure there (else -1). */
+tf_status tf_solve(const tf_ode *ode, const tf_solver_options *opt, const double *t_out, long n_out,
+                   double *y0, tf_emit_fn emit, void *emit_ctx, tf_solver_stats *stats, tf_error *err);
 
-const char *tf_status_message(int status);
-
-/* Dense LU with partial pivoting (row-major n x n, in place) and the matching solve; used by
- * Rodas4's stages. tf_lu_factor returns nonzero for a singular matrix. */
-int tf_lu_factor(double *A, int n, int *piv);
+/* Dense LU with partial pivoting (row-major n x n, in place) and the matching solve.
+ * tf_lu_factor returns TF_ERR_SINGULAR for a singular (or non-finite) matrix. */
+tf_status tf_lu_factor(double *A, int n, int *piv);
 void tf_lu_solve(const double *A, int n, const int *piv, double *b);
 
 #ifdef __cplusplus

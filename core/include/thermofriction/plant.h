@@ -88,19 +88,19 @@ void tf_model_prepare(tf_model *model);
  * fc/sigma0; 1..64 GMS elements with k_i, w_i > 0 summing to one; Model I parameters and Model
  * II's lambda checked at the constant temperature or over the sampled one; periodic inputs with a
  * positive frequency; for prescribed motion a continuous input). Returns TF_OK, or
- * TF_ERR_BAD_ARGUMENT with the offending field's name in *what (a static string; may be NULL).
- * tf_solve does not call it: callers that build models from user data must (the Python package
- * checks the same rules, with messages). */
-int tf_model_check(const tf_model *model, const char **what);
+ * TF_ERR_BAD_ARGUMENT with the offending field's name in err->what (where "model"; err may be
+ * NULL). tf_solve does not call it: callers that build models from user data must (the Python
+ * package checks the same rules, with messages). */
+tf_status tf_model_check(const tf_model *model, tf_error *err);
 /* The same rules for the friction model and its thermal extension alone (the plant, input and
  * temperature signal are not looked at: the real-time API, realtime.h, holds no more): the kind,
  * GMS elements, the laws' structure, and the parameters -- always for a model without a thermal
  * extension, at temperature T for one with it (not at all when T is not finite). */
-int tf_model_check_friction(const tf_model *model, double T, const char **what);
+tf_status tf_model_check_friction(const tf_model *model, double T, tf_error *err);
 /* The same rules for parameters already evaluated at one temperature: p (TF_NPARAM values), Model
  * II's lambda and offset there (as tf_model_params_cached gives them). */
-int tf_model_check_params(const tf_model *model, const double *p, double lambda, double dF_offset,
-                          const char **what);
+tf_status tf_model_check_params(const tf_model *model, const double *p, double lambda, double dF_offset,
+                                tf_error *err);
 
 int tf_model_nstate(const tf_model *model);
 int tf_model_noutput(const tf_model *model);
@@ -155,15 +155,15 @@ typedef struct {
 
 /* Right-hand side, and, where the pointers are not NULL, its Jacobian (n x n, row-major) and
  * its derivatives with respect to the np targets (n x np, row-major). */
-int tf_model_derivatives(tf_model *model, double t, const double *y, double *dy, double *J,
-                         const tf_target *targets, int np, double *fp);
+tf_status tf_model_derivatives(tf_model *model, double t, const double *y, double *dy, double *J,
+                               const tf_target *targets, int np, double *fp);
 
 /* Characteristic magnitude of each state, for default absolute tolerances. */
 void tf_model_state_scale(const tf_model *model, double *scale);
 
-int tf_model_rhs(double t, const double *y, double *dy, void *model);
+tf_status tf_model_rhs(double t, const double *y, double *dy, void *model);
 /* Jacobian d(rhs)/dy, row-major n x n. */
-int tf_model_jac(double t, const double *y, double *J, void *model);
+tf_status tf_model_jac(double t, const double *y, double *J, void *model);
 /* Earliest time after t where the input or the temperature signal has a corner. */
 double tf_model_next_corner(double t, void *model);
 /* Discrete modes of the friction model (GMS): event functions and the update at restarts. */

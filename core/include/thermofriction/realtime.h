@@ -3,11 +3,13 @@
  * Model II, behind four calls:
  *
  *     tf_rt_friction f;
- *     tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL);          // parameters p[TF_NPARAM]
- *     tf_rt_set_model_i(&f, TF_P_FC, &fc_law);             // optional: a law of temperature
- *     double F = tf_rt_step(&f, v, T, dt);                 // every control period (NaN: refused)
- *     tf_rt_set_param(&f, TF_P_SIGMA1, 3.0);               // at run time
- *     tf_rt_reset(&f);                                     // internal states to rest
+ *     tf_error err;                                        // status.h: why a call was refused
+ *     tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &err);    // parameters p[TF_NPARAM]
+ *     tf_rt_set_model_i(&f, TF_P_FC, &fc_law, &err);       // optional: a law of temperature
+ *     double F;
+ *     if (tf_rt_step(&f, v, T, dt, &F, &err) != TF_OK) ... // every control period
+ *     tf_rt_set_param(&f, TF_P_SIGMA1, 3.0, NULL);         // at run time (err may be NULL)
+ *     tf_rt_reset(&f, NULL);                               // internal states to rest
  *
  * Discretisation: exponential (Rosenbrock-)Euler. Over one step the state equation
  * z' = f(v, z) is linearised in z at the start, z' ~ a - b (z - z_n), and that linear equation is
@@ -29,6 +31,7 @@
 
 #include "friction.h"
 #include "plant.h"
+#include "status.h"
 #include "thermal.h"
 
 #ifdef __cplusplus
@@ -40,14 +43,11 @@ typedef struct {
        plant fields are unused), with its per-temperature parameter cache */
     tf_model model;
     double z[TF_MAX_FRICTION_STATES]; /* internal states */
-    /* The outcome of the last call on this object: TF_OK, or a tf_status (integrator.h) with `what`
-       naming the argument or parameter refused (a static string; NULL on TF_OK). */
-    int status;
-    const char *what;
 } tf_rt_friction;
 
-/* Checks. Every function validates its arguments and returns a status (TF_OK = 0), or reports a
- * failure as documented for the three that return a number. A refused call changes nothing: the
+/* Checks. Every function validates its arguments and returns a tf_status (status.h), filling the
+ * error record *err when err is not NULL: `what` names the argument (where "realtime") or the model
+ * field (where "model") refused. A refused call changes nothing: the
  * internal states, the parameters and the laws stay as they were, so that a controller can skip a
  * bad sample and go on. The model is checked with the simulator's rules (tf_model_check_friction,
  * plant.h: sigma0, fc > 0, fs >= fc, ...; 1..64 GMS elements; laws with n >= 2 strictly increasing
@@ -62,43 +62,44 @@ typedef struct {
  * TF_FRICTION_GMS (else NULL). fs = fc when p[TF_P_FS] is not finite (no Stribeck effect). The
  * parameters must be valid as given (they are the model's while no law is set): give a
  * parameter that will follow a law its value at some temperature, not 0. */
-int tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_elements *gms);
+tf_status tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_elements *gms, tf_error *err);
 /* Model I: parameter `param` follows `law` (copied; its arrays must outlive f). Not with Model II. */
-int tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law);
+tf_status tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law, tf_error *err);
 /* Model II: dF(T) [N] applied in `form` (TF_DF_SCALE: F (1 + dF / fc); TF_DF_OFFSET: + dF tanh(v / v_smooth)).
  * Not with Model I. */
-int tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form);
+tf_status tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form, tf_error *err);
 /* Changes parameter `param` at run time (its law, if any, is dropped). With a thermal extension
  * the new value is checked at the last temperature stepped at (if any), else at the next step. */
-int tf_rt_set_param(tf_rt_friction *f, int param, double value);
+tf_status tf_rt_set_param(tf_rt_friction *f, int param, double value, tf_error *err);
 /* Internal states to rest (z = 0, GMS elements stuck). */
-int tf_rt_reset(tf_rt_friction *f);
+tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err);
 /* Parameters at temperature T [degC] into p[TF_NPARAM]; *lambda, *dF_offset (may be NULL).
  * Nothing is written if T or the parameters there are refused. */
-int tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset);
+tf_status tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset,
+                          tf_error *err);
 /* Advances the internal states by dt [s] at sliding velocity v [m/s] and temperature T [degC]
  * (ignored without a thermal model) and writes the friction force F [N] to *F (the sign convention
  * of docs/models.md#conventions: the force resisting sliding, with v's sign in steady sliding).
  * dt <= 0 gives the force without advancing. On a refusal *F is NaN and the state is unchanged. */
-int tf_rt_step_status(tf_rt_friction *f, double v, double T, double dt, double *F);
-/* The same, returning F: NaN when the step is refused (f->status says why; NULL f: NaN only). */
-double tf_rt_step(tf_rt_friction *f, double v, double T, double dt);
+tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double dt, double *F, tf_error *err);
 
 /* The friction model and thermal extension of a simulation model (plant.h's tf_model), for
  * callers that already configure one; its laws' arrays must outlive f. */
-int tf_rt_from_model(tf_rt_friction *f, const tf_model *model);
+tf_status tf_rt_from_model(tf_rt_friction *f, const tf_model *model, tf_error *err);
 /* F' from the base model's force: Model II's scale factor and offset (docs/models.md#model-ii) as
- * tf_rt_params_at gives them, at sliding velocity v with parameters p (tf_thermal_force, thermal.h).
- * NaN when p is NULL. */
-double tf_rt_thermal_force(double F_base, double v, const double *p, double lambda, double dF_offset);
+ * tf_rt_params_at gives them, at sliding velocity v with parameters p (tf_thermal_force, thermal.h),
+ * into *F. */
+tf_status tf_rt_thermal_force(double F_base, double v, const double *p, double lambda, double dF_offset, double *F,
+                              tf_error *err);
 
 /* The core of tf_rt_step for callers that add terms to the state equation (observers): advances
  * z by one exponential-Euler step of z' = f(v, z) + extra[j] (extra: NULL, or one value per
  * internal state) with parameters p (already checked), writes the rates at the new state to dz
- * (with extra added) and returns the base force. gms: the elements for TF_FRICTION_GMS (else may
- * be NULL). Returns NaN, changing nothing, for NULL p, z or dz, an unknown kind or bad GMS elements. */
-double tf_rt_advance(int kind, const double *p, tf_gms_elements *gms, double *z, double v, double dt,
-                     const double *extra, double *dz);
+ * (with extra added) and the base force to *F. gms: the elements for TF_FRICTION_GMS (else may be
+ * NULL). Refuses (TF_ERR_BAD_ARGUMENT, *F NaN, nothing changed) NULL p, z, dz or F, an unknown kind or
+ * bad GMS elements. */
+tf_status tf_rt_advance(int kind, const double *p, tf_gms_elements *gms, double *z, double v, double dt,
+                        const double *extra, double *dz, double *F, tf_error *err);
 
 #ifdef __cplusplus
 }

@@ -22,7 +22,7 @@ typedef struct {
 } tf_sensitivity_system;
 
 /* Augmented right-hand side: Y = [y (n), S (n x np, row-major)]. */
-int tf_sensitivity_rhs(double t, const double *Y, double *dY, void *system);
+tf_status tf_sensitivity_rhs(double t, const double *Y, double *dY, void *system);
 double tf_sensitivity_next_corner(double t, void *system);
 /* An ODE over the augmented state, for tf_solve with the explicit method (no Jacobian). */
 tf_ode tf_sensitivity_ode(tf_sensitivity_system *system);

@@ -32,7 +32,7 @@ from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 MAX_SAMPLES = 10_000_000
 
 
-#: Output times must lie within +-MAX_TIME s: the C core refuses others (integrator.c, tf_solve),
+#: Output times must lie within +-MAX_TIME s: the C core refuses others (solve.c, tf_solve),
 #: as beyond it a double resolves time only to ~1e-4 s and periodic inputs lose their phase.
 MAX_TIME = 1e12
 
