@@ -21,7 +21,8 @@ from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
 from .plant import PlantFit, fit_plant, step_response
 from .problem import Problem, make_traces
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
-from .result import FitResult, stamped
+from .provenance import stamped
+from .result import FitResult
 from .start import force_start, lugre_start, with_friction_model
 from .uncertainty import uncertainty
 

@@ -18,7 +18,8 @@ from .optimiser import one_blas_thread
 from .parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
-from .result import FitResult, stamped
+from .provenance import stamped
+from .result import FitResult
 from .setup import SETUP
 from ..validate import validate
 
