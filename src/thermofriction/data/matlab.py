@@ -56,6 +56,8 @@ def _load(path: Path) -> dict:
         raise InputError(f"{path}: is a folder, not a MATLAB file") from None
     except OSError as e:
         raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    if not head:  # an interrupted copy, a file created and never written
+        raise InputError(f"{path}: empty file (0 bytes): not a MATLAB file (an interrupted copy?)")
     if head[512:].startswith(_HDF5_MAGIC) or head.startswith(_HDF5_MAGIC):
         raise InputError(f"{path}: a MATLAB v7.3 (HDF5) file, which thermofriction does not read: save it with "
                          f"save('{path.name}', ..., '-v7') in MATLAB, or write the run as CSV "
@@ -65,9 +67,10 @@ def _load(path: Path) -> dict:
     except NotImplementedError as e:  # SciPy's word for v7.3
         raise InputError(f"{path}: not readable as a MATLAB file up to v7 ({e}); save it with '-v7' in MATLAB "
                          f"or write the run as CSV") from None
-    except (ValueError, TypeError, OSError, EOFError, IndexError, KeyError, UnicodeDecodeError, OverflowError,
-            MemoryError, AssertionError) as e:
-        raise InputError(f"{path}: not a readable MATLAB file ({shorten(str(e) or type(e).__name__)})") from None
+    except Exception as e:  # noqa: BLE001 - whatever SciPy's reader meets in damaged bytes (MatReadError,
+        # zlib.error from a corrupted compressed v7 stream, ValueError, ...), the file is what is wrong
+        raise InputError(f"{path}: not a readable MATLAB file, damaged or truncated? "
+                         f"({shorten(str(e) or type(e).__name__)})") from None
 
 
 def _vector(path, label, value) -> np.ndarray:
