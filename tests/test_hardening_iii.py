@@ -78,3 +78,106 @@ def test_remove_empty_keeps_a_folder_that_holds_anything(tmp_path):
     (target / "user-file").write_text("mine")
     _remove_empty(missing)
     assert not (target / "data").exists() and (target / "user-file").read_text() == "mine"
+
+
+# -- implausible voltages ----------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def small_dataset(tmp_path_factory):
+    data = tf.synthesize(tf.load_model("li2009-model-i"), [35.0], duration=0.1, sample_rate=2000, seed=3)
+    return tf.save_dataset(data, tmp_path_factory.mktemp("small") / "ds")
+
+
+def _copy(folder, to):
+    import shutil
+    shutil.copytree(folder, to)
+    return to
+
+
+def test_a_voltage_of_9e18_in_a_dataset_is_refused_naming_file_sample_and_value(small_dataset, tmp_path):
+    """Before: 9.2e18 V passed every check (the values are limited to 1e100 only) and identify ran."""
+    ds = _copy(small_dataset, tmp_path / "ds")
+    f = next(ds.glob("*.csv"))
+    lines = f.read_text().splitlines()
+    head = lines[0].split(",")
+    k = next(i for i, h in enumerate(head) if h.startswith("voltage"))
+    cells = lines[21].split(",")
+    cells[k] = "9.2e18"
+    lines[21] = ",".join(cells)
+    f.write_text("\n".join(lines) + "\n")
+    with pytest.raises(tf.InputError) as info:
+        tf.load_dataset(ds)
+    msg = str(info.value)
+    for text in (f.name, "voltage", "sample 21", "9.2e+18 V", "not a plausible actuator voltage", "10000 V"):
+        assert text in msg, (text, msg)
+    r = run_cli("identify", ds, "--method", "base", "-q")
+    assert r.returncode == 2 and "9.2e+18 V" in _one_line(r.stderr)
+
+
+def test_a_plausible_high_voltage_and_a_millivolt_record_still_load(small_dataset, tmp_path):
+    """The bound is physical, not tight: 1 kV (a high-voltage piezo stack) and 9.2e6 mV = 9.2 kV load."""
+    ds = _copy(small_dataset, tmp_path / "ds")
+    f = next(ds.glob("*.csv"))
+    text = f.read_text()
+    head, *rows = text.splitlines()
+    k = next(i for i, h in enumerate(head.split(",")) if h.startswith("voltage"))
+    new = []
+    for j, row in enumerate(rows):
+        cells = row.split(",")
+        cells[k] = repr(9.2e6 if j == 5 else 1000.0 * (j % 2))
+        new.append(",".join(cells))
+    hcells = head.split(",")
+    hcells[k] = "voltage[mV]"
+    f.write_text(",".join(hcells) + "\n" + "\n".join(new) + "\n")
+    data = tf.load_dataset(ds)
+    assert np.max(data.experiments[0].voltage) == pytest.approx(9200.0)
+
+
+def test_manifest_and_synth_inputs_of_9e18_volts_are_refused(small_dataset, tmp_path):
+    ds = _copy(small_dataset, tmp_path / "ds")
+    man = ds / "dataset.toml"
+    man.write_text(man.read_text().replace("amplitude=30.0", "amplitude=9.2e18"))
+    assert "9.2e18" in man.read_text()
+    with pytest.raises(tf.InputError, match=r"\[\[experiment\]\] 1: 'input': 9.2e\+18 V \(its peak\)"):
+        tf.load_dataset(ds)
+    with pytest.raises(tf.InputError, match="9.2e\\+18 V"):
+        tf.synthesize(tf.load_model("li2009-model-i"), [35.0], input=tf.Sine(amplitude=9.2e18, frequency=5.0))
+    r = run_cli("synth", "li2009-model-i", "--temperatures", "35", "--input", "sine:amplitude=9.2e18,frequency=5",
+                "-o", tmp_path / "out")
+    assert r.returncode == 2 and "9.2e+18 V" in _one_line(r.stderr) and not (tmp_path / "out").exists()
+
+
+# -- synth: a limit and progress ---------------------------------------------------------------
+
+def test_synth_refuses_30000_temperatures_before_any_work(tmp_path):
+    """Before: accepted, and ran for hours with no progress shown."""
+    from thermofriction.data.synth import MAX_EXPERIMENTS
+    temps = ",".join(str(30 + k % 12) for k in range(30000))  # (one argument is at most 128 KiB)
+    t0 = time.perf_counter()
+    r = run_cli("synth", "li2009-model-i", "--temperatures", temps, "-o", tmp_path / "out")
+    assert r.returncode == 2 and time.perf_counter() - t0 < 30
+    err = _one_line(r.stderr)
+    assert "30000 temperatures" in err and f"limit of {MAX_EXPERIMENTS}" in err and "docs/limits.md" in err
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(tf.InputError, match="30000 temperatures"):
+        tf.synthesize(tf.load_model("li2009-model-i"), np.linspace(30, 40, 30000))
+
+
+def test_synthesize_reports_progress_after_each_experiment():
+    seen = []
+    tf.synthesize(tf.load_model("li2009-model-i"), [33.0, 35.0], validate=[34.0], duration=0.05,
+                  sample_rate=1000, progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(1, 3), (2, 3), (3, 3)]
+
+
+def test_synth_prints_progress_lines_on_a_pipe_during_a_long_run(tmp_path, monkeypatch):
+    from thermofriction.data import synth
+    monkeypatch.setattr(synth, "PROGRESS_INTERVAL", 0.0)  # every experiment counts as "long"
+    import io
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    update, stop = synth._progress(3)
+    for k in (1, 2, 3):
+        update(k, 3)
+    stop()
+    assert err.getvalue().splitlines() == ["  synth: 1 of 3 experiments, 0 s", "  synth: 2 of 3 experiments, 0 s"]

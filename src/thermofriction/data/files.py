@@ -17,7 +17,7 @@ from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
 from .force import ForceExperiment, force_experiment, is_force_data, is_force_file, units_of
-from ..plausible import displacement_problem, kelvin_hint
+from ..plausible import displacement_problem, input_voltage_problem, kelvin_hint, voltage_problem
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "experiment")
@@ -147,6 +147,9 @@ def load_dataset(path) -> Dataset:
                 inp = parse_waveform(e["input"])
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
+            problem = input_voltage_problem(inp)
+            if problem:
+                raise InputError(f"{where}: 'input': {problem}")
         if is_force_file(folder / f):  # measured motion and friction force (torque): data/force.py
             if inp is not None:
                 raise InputError(f"{where}: 'input' does not apply to a force experiment (its motion is measured)")
@@ -160,6 +163,9 @@ def load_dataset(path) -> Dataset:
                 problem = displacement_problem(cols[column], unit)
                 if problem:
                     raise InputError(f"{folder / f}: {label}: {problem}")
+        problem = voltage_problem(cols["voltage"])
+        if problem:
+            raise InputError(f"{folder / f}: {headers['voltage'][0]}: {problem}")
         cols["time"], inp = _from_zero(cols["time"], inp)
         sig = cols.get("temperature")
         if T is None:
