@@ -181,3 +181,36 @@ def test_synth_prints_progress_lines_on_a_pipe_during_a_long_run(tmp_path, monke
         update(k, 3)
     stop()
     assert err.getvalue().splitlines() == ["  synth: 1 of 3 experiments, 0 s", "  synth: 2 of 3 experiments, 0 s"]
+
+
+# -- force data from a stuck load cell ------------------------------------------------------------
+
+def _force_dataset(folder, force, header="friction_force[N]", position="position[m]"):
+    folder.mkdir()
+    t = np.arange(2000) / 1000.0
+    x = 1e-5 * np.sin(2 * np.pi * 2 * t)
+    f = np.broadcast_to(np.asarray(force, float), t.shape)
+    rows = "".join(f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), x.tolist(), f.tolist()))
+    (folder / "run.csv").write_text(f"time[s],{position},{header}\n" + rows)
+    (folder / "dataset.toml").write_text('name = "stuck"\n[[experiment]]\nfile = "run.csv"\ntemperature = 35.0\n')
+    return folder
+
+
+@pytest.mark.parametrize("force,header", [(1.0, "friction_force[N]"), (0.0, "friction_force[N]"),
+                                          (-2.5e-3, "friction_torque[N*m]")], ids=["1 N", "0 N", "torque"])
+def test_a_constant_force_is_refused_when_the_data_are_loaded(tmp_path, force, header):
+    """Before: identify ended in SciPy's `ValueError: Residuals are not finite in the initial point`
+    (the noise estimated from a constant record is 0), a traceback with exit 1."""
+    ds = _force_dataset(tmp_path / "ds", force, header, "position[rad]" if "torque" in header else "position[m]")
+    with pytest.raises(tf.InputError) as info:
+        tf.load_dataset(ds)
+    msg = str(info.value)
+    assert "run.csv" in msg and "does not vary" in msg and "stuck load cell" in msg, msg
+    r = run_cli("identify", ds, "--method", "base")
+    assert r.returncode == 2 and "does not vary" in _one_line(r.stderr)
+
+
+def test_a_varying_force_still_loads(tmp_path):
+    t = np.arange(2000) / 1000.0
+    ds = _force_dataset(tmp_path / "ds", np.sign(np.cos(2 * np.pi * 2 * t)))
+    assert np.ptp(tf.load_dataset(ds).experiments[0].force) == 2.0

@@ -269,6 +269,10 @@ def force_experiment(path, name, *, temperature, role, description, from_zero) -
     """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it); ``temperature``
     is the manifest's (None: the column's mean); ``from_zero`` moves a clock time to start at zero."""
     cols = read_force_csv(path)
+    force = cols["force"]
+    if np.ptp(force) <= 1e-12 * np.max(np.abs(force)):  # its noise estimate would be 0: nothing to weigh a fit by
+        raise InputError(f"{path}: column {cols['headers']['force']}: the force does not vary (every sample is "
+                         f"{force[0]:g}): a stuck load cell? A constant record has no friction to identify")
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
     if temperature is None:
