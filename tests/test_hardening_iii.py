@@ -214,3 +214,109 @@ def test_a_varying_force_still_loads(tmp_path):
     t = np.arange(2000) / 1000.0
     ds = _force_dataset(tmp_path / "ds", np.sign(np.cos(2 * np.pi * 2 * t)))
     assert np.ptp(tf.load_dataset(ds).experiments[0].force) == 2.0
+
+
+# -- Dask: damaged scheduler files, something else at the address, repeated axes, a fleet over its input --
+
+SWEEP = ["sweep", "li2009-model-i", "--grid", "temperature=30,35", "--duration", "0.05", "--sample-rate", "1000"]
+
+
+@pytest.mark.parametrize("content,words", [
+    (bytes(range(256)) * 2, ["not a Dask scheduler file", "not UTF-8"]),
+    (b"", ["not a Dask scheduler file"]),
+    (b"hello", ["not a Dask scheduler file"]),
+    (b'{"foo": 1}', ["no \"address\""]),
+    (b"[1, 2]", ["no \"address\""]),
+    (b'{"address": 42}', ["no \"address\""]),
+], ids=["binary", "empty", "text", "no address", "a list", "a number"])
+def test_a_damaged_scheduler_file_is_one_message(tmp_path, content, words):
+    """Before: an AssertionError (or KeyError, TypeError) traceback from inside Dask."""
+    f = tmp_path / "scheduler.json"
+    f.write_bytes(content)
+    r = run_cli(*SWEEP, "--scheduler", f, "-o", tmp_path / "x.csv")
+    err = _one_line(r.stderr)
+    assert r.returncode == 2 and "scheduler.json" in err, err
+    for w in words:
+        assert w in err, (w, err)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def _server(reply, tmp_path):
+    """A TCP server on a free port that answers every connection with ``reply`` (b"": says nothing)."""
+    code = ("import socket, sys, time\n"
+            "s = socket.socket(); s.bind(('127.0.0.1', 0)); s.listen(8)\n"
+            "print(s.getsockname()[1], flush=True)\n"
+            "conns = []\n"
+            "while True:\n"
+            "    c, _ = s.accept(); conns.append(c)\n"
+            f"    c.sendall({reply!r}) if {reply!r} else None\n")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    port = int(proc.stdout.readline())
+    return proc, port
+
+
+@pytest.mark.parametrize("reply", [b"SSH-2.0-OpenSSH_9.6\r\n", b"HTTP/1.0 400 Bad Request\r\n\r\n", b""],
+                         ids=["ssh banner", "http reply", "silent"])
+def test_something_else_than_a_scheduler_at_the_address_is_named(tmp_path, reply):
+    """Before: Dask read the first 8 bytes of the text as a message length (3 EiB) and the command said
+    "out of memory" (exit 1); a silent server made it wait for ever."""
+    proc, port = _server(reply, tmp_path)
+    try:
+        env = dict(os.environ, DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT="2s")
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "thermofriction", *SWEEP, "--scheduler", f"tcp://127.0.0.1:{port}",
+                            "-o", tmp_path / "x.csv"], capture_output=True, text=True, env=env, timeout=120)
+        took = time.perf_counter() - t0
+    finally:
+        proc.kill()
+        proc.wait()
+    err = _one_line(r.stderr)
+    assert r.returncode == 2 and f"tcp://127.0.0.1:{port}: not a Dask scheduler" in err, err
+    assert "out of memory" not in err and took < 60
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_scheduler_file_is_read_and_its_address_probed(tmp_path):
+    from thermofriction.scale.cluster import read_scheduler_file
+    f = tmp_path / "s.json"
+    f.write_text('{"type": "Scheduler", "address": " tcp://10.0.0.1:8786 ", "id": "x"}')
+    assert read_scheduler_file(f) == "tcp://10.0.0.1:8786"
+    proc, port = _server(b"SSH-2.0-x\r\n", tmp_path)
+    try:
+        f.write_text(f'{{"address": "tcp://127.0.0.1:{port}"}}')
+        with pytest.raises(tf.InputError, match="not a Dask scheduler"):
+            tf.sweep("li2009-model-i", {"temperature": [35.0]}, duration=0.05, scheduler=str(f))
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_a_repeated_grid_axis_is_refused(tmp_path):
+    """Before: the first `--grid temperature=...` was dropped without a word (exit 0, one row)."""
+    r = run_cli("sweep", "li2009-model-i", "--grid", "temperature=30,35", "--grid", "temperature=40",
+                "--duration", "0.05", "--scheduler", "sequential", "-o", tmp_path / "x.csv")
+    err = _one_line(r.stderr)
+    assert r.returncode == 2 and "'temperature' is given twice" in err and "temperature=30,35" in err, err
+    assert not (tmp_path / "x.csv").exists()
+    with pytest.raises(tf.InputError, match="given twice"):
+        tf.sweep("li2009-model-i", ["temperature=30", "amplitude=20", "temperature=31"], duration=0.05,
+                 scheduler="sequential")
+
+
+def test_a_fleet_writing_over_its_input_is_refused_before_any_identification(tmp_path, monkeypatch):
+    """A dataset folder named `dataset` and `-o` that folder: the fleet's `dataset.toml` output is the
+    dataset's manifest. Before: refused only when writing, after every identification ran (16 s)."""
+    from thermofriction.cli import main
+    from thermofriction.scale import fleet
+    data = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05, sample_rate=1000, seed=1)
+    a = tf.save_dataset(data, tmp_path / "dataset")
+    b = tf.save_dataset(data, tmp_path / "unit-2")
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+
+    def never(*args, **kwargs):
+        raise AssertionError("identification started")
+    monkeypatch.setattr(fleet, "identify_fleet", never)
+    assert main(["identify", str(a), str(b), "--method", "base", "-q", "-o", str(a)]) == 2
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+    assert set(fleet.output_files(a, [a, b])) >= {str(a / "dataset.toml"), str(a / "fleet.json")}
+    assert str(a / "T35C.csv") in fleet.input_files([a, b])

@@ -171,6 +171,8 @@ def cmd_identify_fleet(args) -> int:
     if args.json:
         raise InputError("--json applies to one dataset; with several, each dataset's results JSON goes into -o DIR")
     laws, params = _identify_options(args)
+    from ..scale.fleet import refuse_overwriting_inputs
+    refuse_overwriting_inputs(args.output, paths)  # before any identification, not after all of them
     update, stop = progress_bar(len(paths), "identify", enabled=not args.quiet)
     try:
         fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,

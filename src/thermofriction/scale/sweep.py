@@ -255,7 +255,16 @@ class SweepResult:
 
 def _grid(grid):
     if isinstance(grid, (list, tuple)):  # ["temperature=30:42:0.25", ...] as on the command line
-        grid = dict(parse_axis(g) for g in grid)
+        axes = [parse_axis(g) if isinstance(g, str) else g for g in grid]
+        if not all(isinstance(a, tuple) and len(a) == 2 for a in axes):
+            raise InputError(f"grid: a list holds axes 'NAME=VALUES' (as --grid does), got {shorten(grid)}")
+        seen = {}
+        for g, (name, _) in zip(grid, axes):
+            if name in seen:  # a dict would keep the last one: the first was dropped without a word
+                raise InputError(f"--grid {shorten(g)}: the axis '{name}' is given twice (first as --grid "
+                                 f"{shorten(seen[name])}): give each axis once, all its values in one --grid")
+            seen[name] = g
+        grid = dict(axes)
     if not isinstance(grid, dict) or not grid:
         raise InputError(f"grid must be a non-empty dict of name -> values, got {shorten(grid)}")
     axes = {str(k): _as_axis(k, v) for k, v in grid.items()}
