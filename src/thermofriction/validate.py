@@ -11,6 +11,8 @@ import numpy as np
 
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
+from . import _args
+from .data.experiments import Dataset
 from .drive import drive
 from .identify.quality import fit_quality
 from .models import Model, require_actuator
@@ -225,6 +227,9 @@ class ValidationResult:
 def validate(model: Model, data, experiments=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics). Temperatures outside a law's calibrated range are reported as warnings."""
+    _args.model(model, Model)
+    _args.dataset(data, Dataset, experiments=True)
+    _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")

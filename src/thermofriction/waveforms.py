@@ -338,8 +338,8 @@ def parse_waveform(spec: str) -> Waveform:
     """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
     ``sampled:file=u.csv``."""
     if not isinstance(spec, str):
-        raise InputError(f"a waveform spec must be a string such as 'sawtooth:amplitude=30,frequency=5', "
-                         f"got {shorten(spec)}")
+        raise InputError(f"spec must be a waveform spec (a string) such as 'sawtooth:amplitude=30,frequency=5', "
+                         f"got {type(spec).__name__} {shorten(spec)}")
     where = f"--input {shorten(spec, 100)}"
     if not spec.isprintable():  # so that every message below, which quotes parts of it, is one line
         raise InputError(f"{where}: contains a control character (a line break, tab or NUL)")

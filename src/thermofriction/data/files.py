@@ -13,6 +13,7 @@ import tomli_w
 
 from .._io import atomic_write
 from .._reading import read_text
+from .. import _args
 from ..errors import InputError, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
@@ -67,6 +68,7 @@ def load_dataset(path) -> Dataset:
     """Reads a dataset folder (docs/formats.md): ``dataset.toml`` and the experiment files it lists,
     all checked; any problem is one InputError naming the file (and its line, column or
     ``[[experiment]] N`` entry)."""
+    _args.path(path, "path")
     folder = Path(path)
     if folder.is_dir():
         manifest = folder / "dataset.toml"
@@ -256,6 +258,9 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     leaves a folder without ``dataset.toml``, which :func:`load_dataset` refuses, naming the
     temporary files left; on an error nothing is changed and folders created for it are removed."""
     from .._io import publish_together
+    _args.instance(dataset, Dataset, "dataset", "a Dataset")
+    _args.path(folder, "folder")
+    _args.flag(overwrite, "overwrite")
     folder = Path(folder)
     files = [e.file for e in dataset.experiments]
     if not files:

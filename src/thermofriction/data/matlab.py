@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, shorten
+from .. import _args
 from .experiments import _SI, _UNITS, MIN_SAMPLES, REQUIRED, max_rows, MAX_ROWS_ENV
 
 #: longest first, so that stage_displacement_um is not read as a "displacement" with unit "stage..."
@@ -98,6 +99,10 @@ def read_experiment_mat(path, struct: str | None = None, units: dict | None = No
     with_headers: also return, per column, (where it is, its unit) for a dataset's checks."""
     from .csv import check_columns
 
+    _args.path(path, "path")
+    _args.text(struct, "struct", none=True)
+    _args.instance(units, dict, "units", "a dict (column -> unit)", none=True)
+    _args.flag(with_headers, "with_headers")
     path = Path(path)
     variables = {k: v for k, v in _load(path).items() if not k.startswith("__")}
     origin = "variable"

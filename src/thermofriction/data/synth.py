@@ -10,10 +10,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .. import _args
 from ..models import PRESETS, Model, load_model, require_actuator
 from ..plausible import input_voltage_problem, parse_length
 from ..simulate import StepSizeController, simulate
-from ..waveforms import Sampled, parse_waveform
+from ..waveforms import Sampled, Waveform, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
 from .._io import publish_together
 from .files import _check_temperature, check_dataset_folder, save_dataset
@@ -62,6 +63,19 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
 
     At most :data:`MAX_EXPERIMENTS` temperatures in all. ``progress(done, total)`` is called after each
     experiment."""
+    _args.model(model, Model)  # the argument types (_args.py): before any work
+    for label, v in (("temperatures", temperatures), ("validate", validate)):
+        if not (v is None or _args.is_number(v) or (isinstance(v, (list, tuple, np.ndarray)) and
+                                                     all(_args.is_number(T) for T in v))):
+            _args.refuse(label, "a number or a list of numbers [C]", v)
+    for label, v in (("duration", duration), ("sample_rate", sample_rate), ("noise", noise),
+                     ("quantization", quantization), ("temperature_noise", temperature_noise), ("drift", drift)):
+        _args.number(v, label)
+    _args.instance(input, Waveform, "input", "a Waveform", none=True)
+    if record_temperature is not None:
+        _args.flag(record_temperature, "record_temperature")
+    _args.flag(record_stage, "record_stage")
+    _args.text(name, "name", none=True)
     require_actuator(model, "synthesize")
     waveform = input if input is not None else model.input
     if waveform is None:
@@ -73,7 +87,7 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
     fit_T = _temperatures(temperatures, "temperatures")
     val_T = _temperatures(validate, "validate")
     if not fit_T and not val_T:
-        raise InputError("give at least one temperature")
+        raise InputError("give at least one temperature (temperatures, or validate)")
     if len(fit_T) + len(val_T) > MAX_EXPERIMENTS:
         raise InputError(f"{len(fit_T) + len(val_T)} temperatures, more than the limit of {MAX_EXPERIMENTS} "
                          f"experiments per synthesised dataset: synthesise several datasets")

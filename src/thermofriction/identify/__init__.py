@@ -8,6 +8,10 @@ from __future__ import annotations
 
 import dataclasses
 import numbers
+import os
+
+from .. import _args
+from ..data.experiments import Dataset
 
 from ..errors import InputError, shorten
 from ..models import Model, StickSlipPlant, load_model
@@ -109,6 +113,20 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     offset: force data only (docs/force-data.md): fit the force sensor's offset, one for all experiments
         (default), or hold it at the initial model's ``[plant] sensor_offset``.
     """
+    _args.dataset(data, Dataset, experiments=True)  # the argument types (_args.py): before any work
+    _args.text(method, "method")
+    if not (init is None or isinstance(init, (Model, str, os.PathLike))):
+        _args.refuse("init", "a Model, a model file or a preset name, or None", init)
+    _args.text(friction, "friction", none=True)
+    parameters = _args.names(parameters, "parameters", allow=Parameters)  # 'sigma0' is one name, not 5 letters
+    free = free if isinstance(free, str) else (_args.names(free, "free") or ())  # (a string: "m_e,m")
+    _args.text(procedure, "procedure")
+    _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
+    _args.flag(refine, "refine")
+    _args.number(reference_temperature, "reference_temperature", "degC", none=True)
+    _args.number(rtol, "rtol")
+    _args.function(progress, "progress")
+    _args.flag(offset, "offset")
     if method not in METHODS:
         raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
     _check_arguments(method, reference_temperature, rtol, starts, seed)

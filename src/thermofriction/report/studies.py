@@ -7,6 +7,7 @@ import html
 
 import numpy as np
 
+from .. import _args
 from .page import Figures, _fmt, _plt, _table, _write_page
 
 def heating_report(runs, path, *, figures_dir=None, title=None, command=None) -> str:
@@ -15,6 +16,12 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
     full simulation on the same grid) and ``constant`` (the displacement predicted at the start
     temperature, on the same grid). Figures: temperature rise, step-size drift, and the error of
     the constant-temperature prediction; a table of the figures that matter."""
+    if not isinstance(runs, (list, tuple)) or not runs or not all(isinstance(r, dict) for r in runs):
+        _args.refuse("runs", "a non-empty list of dicts", runs)
+    _args.path(path, "path")
+    _args.path(figures_dir, "figures_dir", none=True)
+    _args.text(title, "title", none=True)
+    _args.text(command, "command", none=True)
     plt = _plt()
     figs = Figures(figures_dir)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
@@ -78,6 +85,12 @@ def control_report(rows, path, *, figures_dir=None, title=None, command=None) ->
     """Writes an HTML report of thermofriction.control.compare_compensation's rows: the table of RMS
     and maximum tracking errors per reference, stage temperature and compensation, and for each
     reference the tracking error over time at the hottest temperature."""
+    if not isinstance(rows, (list, tuple)) or not rows or not all(isinstance(r, dict) for r in rows):
+        _args.refuse("rows", "a non-empty list of row dicts (compare_compensation)", rows)
+    _args.path(path, "path")
+    _args.path(figures_dir, "figures_dir", none=True)
+    _args.text(title, "title", none=True)
+    _args.text(command, "command", none=True)
     plt = _plt()
     figs = Figures(figures_dir)
     table = [[r["reference"], _fmt(r["temperature"], "{:.1f}"), r["compensation"], _fmt(r["rms_error"] * 1e6, "{:.3g}"),

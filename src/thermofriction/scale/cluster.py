@@ -40,7 +40,7 @@ def is_client(obj) -> bool:
 
 def check_scheduler(scheduler):
     """None, "sequential", an address (tcp://HOST:PORT, a host:port, a scheduler file) or a Client."""
-    if scheduler is None or scheduler == SEQUENTIAL or is_client(scheduler):
+    if scheduler is None or (isinstance(scheduler, str) and scheduler == SEQUENTIAL) or is_client(scheduler):
         return scheduler
     if isinstance(scheduler, (str, os.PathLike)) and str(scheduler).strip():
         return str(scheduler).strip()

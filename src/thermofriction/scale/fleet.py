@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _io
+from .. import _args
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import PRESETS, Model, load_model
 from .cluster import Runner
@@ -259,6 +260,13 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
 
     from ..data import Dataset, load_dataset
 
+    if not isinstance(datasets, (str, os.PathLike, list, tuple)) or (
+            isinstance(datasets, (list, tuple)) and not all(isinstance(d, (str, os.PathLike, Dataset)) for d in datasets)):
+        _args.refuse("datasets", "a list of dataset folders or Datasets, or a folder of dataset folders", datasets)
+    _args.text(method, "method")
+    if not (init is None or isinstance(init, (Model, str, os.PathLike))):
+        _args.refuse("init", "a Model, a model file or a preset name, or None", init)
+    _args.function(progress, "progress")
     if isinstance(datasets, (str, os.PathLike)):
         datasets = fleet_datasets(datasets) or [datasets]
     datasets = list(datasets)
