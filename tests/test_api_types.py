@@ -84,6 +84,8 @@ TAKES = {
     "reference": lambda v: isinstance(v, control.Reference),
     "pid": lambda v: isinstance(v, control.PID),
     "compensation?": lambda v: v is None or isinstance(v, (control.FeedForward, control.Observer)),
+    "law": lambda v: isinstance(v, tf.Law),
+    "laws": lambda v: isinstance(v, dict) and all(isinstance(k, str) and isinstance(x, tf.Law) for k, x in v.items()),
     "array": lambda v: isinstance(v, (list, tuple, np.ndarray)) and len(v) > 0 and all(_number(x) for x in v),
 }
 
@@ -183,7 +185,43 @@ def calls(t):
         "compare_compensation": (control.compare_compensation, dict(stage=t["stage"], references=[t["ref"]]),
                                  {"stage": "model", "references": "sequence", "temperatures": "numbers",
                                   "calibration": "number", "observer_gain": "number", "pid": "pid"}),
+        # constructors of the objects a user builds a model and a run from
+        "LuGre": (tf.LuGre, dict(sigma0=1e5, sigma1=300.0, fc=1.0), _numbers("sigma0", "sigma1", "fc", "sigma2",
+                                                                            "fs", "vs", "vd", kind="number?")),
+        "Coulomb": (tf.Coulomb, dict(fc=1.0), _numbers("fc", "sigma2", "v_smooth", kind="number?")),
+        "Stribeck": (tf.Stribeck, dict(fc=1.0, fs=1.5, vs=1e-3), _numbers("fc", "fs", "vs", "delta", "sigma2",
+                                                                           kind="number?")),
+        "Dahl": (tf.Dahl, dict(sigma0=1e5, fc=1.0), _numbers("sigma0", "fc", "v_smooth", kind="number?")),
+        "ElastoPlastic": (tf.ElastoPlastic, dict(sigma0=1e5, sigma1=300.0, fc=1.0, z_ba=1e-6),
+                          _numbers("sigma0", "sigma1", "fc", "z_ba", "sigma2", kind="number?")),
+        "Const": (tf.Const, dict(value=1.0), _numbers("value")),
+        "Linear": (tf.Linear, dict(a=1.0, b=0.0), _numbers("a", "b")),
+        "Exp": (tf.Exp, dict(a=1.0, b=0.0), _numbers("a", "b")),
+        "ModelI": (tf.ModelI, dict(laws={"fc": tf.Const(1.0)}), {"laws": "laws"}),
+        "ModelII": (tf.ModelII, dict(dF=tf.Const(0.0)), {"dF": "law", "form": "text"}),
+        "Heat": (tf.Heat, dict(heat_capacity=1.0, thermal_resistance=1.0),
+                 _numbers("heat_capacity", "thermal_resistance", "heat_fraction")),
+        "MassPlant": (tf.MassPlant, dict(mass=1.0), _numbers("mass", "spring_stiffness", "pull_velocity")),
+        "Sine": (tf.Sine, dict(amplitude=1.0, frequency=1.0), _numbers("amplitude", "frequency", "offset")),
+        "Sawtooth": (tf.Sawtooth, dict(amplitude=1.0, frequency=1.0),
+                     {**_numbers("amplitude", "frequency", "rise", "offset"), "direction": "whole"}),
+        "Square": (tf.Square, dict(amplitude=1.0, frequency=1.0, slew=0.01),
+                   _numbers("amplitude", "frequency", "slew", "offset", "duty")),
+        "Step": (tf.Step, dict(amplitude=1.0), _numbers("amplitude", "time", "slew", "offset")),
+        "Sampled": (tf.Sampled, dict(time=np.array([0.0, 1.0]), value=np.array([0.0, 1.0])),
+                    {"time": "array", "value": "array"}),
+        "StepSizeController": (tf.StepSizeController, dict(), {"rtol": "number", "atol": "numbers?",
+                                                               "max_steps": "whole"}),
     }
+
+
+#: a model object's field named by its model-file key (docs/models.md) in the message: [plant] 'm', [heat] 'C_th'
+FILE_KEYS = {"mass": "m", "spring_stiffness": "k_s", "pull_velocity": "v_0", "heat_capacity": "C_th",
+             "thermal_resistance": "R_th", "heat_fraction": "eta"}
+
+
+def _numbers(*names, kind="number"):
+    return {n: kind for n in names}
 
 
 def test_every_public_function_of_the_package_is_covered(things):
@@ -199,9 +237,11 @@ FUNCTIONS = ["load_model", "simulate", "parse_waveform", "identify", "load_datas
              "read_experiment_mat", "parse_axis", "simulate_heating", "cycle_table", "heating_report",
              "control_report", "sine_reference", "point_to_point", "simulate_loop", "friction_steps",
              "compare_compensation"]
+CONSTRUCTORS = ["LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "Const", "Linear", "Exp", "ModelI", "ModelII",
+                "Heat", "MassPlant", "Sine", "Sawtooth", "Square", "Step", "Sampled", "StepSizeController"]
 
 
-@pytest.mark.parametrize("name", FUNCTIONS)
+@pytest.mark.parametrize("name", FUNCTIONS + CONSTRUCTORS)
 def test_wrong_types_are_input_errors_naming_the_argument(things, name):
     fn, valid, kinds = calls(things)[name]
 
@@ -215,7 +255,8 @@ def test_wrong_types_are_input_errors_naming_the_argument(things, name):
         try:
             fn(**{**valid, arg: wrong})
         except tf.InputError as e:
-            assert arg in str(e), f"{name}({arg}={wrong!r}): the message does not name {arg!r}: {e}"
+            named = arg in str(e) or f"'{FILE_KEYS.get(arg)}'" in str(e)
+            assert named, f"{name}({arg}={wrong!r}): the message does not name {arg!r}: {e}"
         except Exception as e:  # noqa: BLE001 - the property: nothing else
             raise AssertionError(f"{name}({arg}={wrong!r}) raised {type(e).__name__}: {e}") from e
         else:
