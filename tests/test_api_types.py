@@ -73,6 +73,8 @@ TAKES = {
                                         all(_number(x) for x in v)),
     "numbers?": lambda v: v is None or _number(v) or (isinstance(v, (list, tuple, np.ndarray)) and len(v) and
                                                       all(_number(x) for x in v)),
+    "numbers*": lambda v: v is None or _number(v) or (isinstance(v, (list, tuple, np.ndarray)) and
+                                                      all(_number(x) for x in v)),  # may be empty
     "dict?": lambda v: v is None or isinstance(v, dict),
     "solver?": lambda v: v is None or isinstance(v, (tf.Dopri5, tf.Rodas4, tf.AutoSwitch, str)),
     "controller?": lambda v: v is None or isinstance(v, tf.StepSizeController),
@@ -129,7 +131,7 @@ def calls(t):
         "save_dataset": (tf.save_dataset, dict(dataset=d, folder=out), {"dataset": "dataset", "folder": "path",
                                                                         "overwrite": "flag"}),
         "synthesize": (tf.synthesize, dict(model=m, temperatures=[35.0], duration=0.02, sample_rate=1000.0),
-                       {"model": "model", "temperatures": "numbers", "validate": "numbers?", "duration": "number",
+                       {"model": "model", "temperatures": "numbers", "validate": "numbers*", "duration": "number",
                         "sample_rate": "number", "input": "waveform?", "noise": "number", "quantization": "number",
                         "temperature_noise": "number", "drift": "number", "record_temperature": "flag?",
                         "record_stage": "flag", "seed": "whole", "name": "text?", "progress": "function?"}),

@@ -270,7 +270,7 @@ def friction_steps(model: Model, velocity, dt: float, temperature: float | None 
     returns (forces, seconds spent in C)."""
     where = "friction_steps"
     _model(where, "model", model)
-    if not isinstance(velocity, (list, tuple, np.ndarray)) or np.asarray(velocity).dtype.kind not in "iuf":
+    if not isinstance(velocity, (list, tuple, np.ndarray)) or not len(velocity) or np.asarray(velocity).dtype.kind not in "iuf":
         raise InputError(f"{where}: velocity must be an array of numbers [m/s], one per step, got "
                          f"{type(velocity).__name__} {shorten(velocity)}")
     v = _samples(where, "velocity", velocity)
@@ -314,12 +314,13 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
     and observer, for each reference and stage temperature. Returns a list of row dicts."""
     where = "compare_compensation"
     _model(where, "stage", stage)
-    if not (isinstance(references, (list, tuple)) and all(isinstance(r, Reference) for r in references)):
-        raise InputError(f"{where}: references must be a list of References (sine_reference, point_to_point), "
+    if not (isinstance(references, (list, tuple)) and references and all(isinstance(r, Reference) for r in references)):
+        raise InputError(f"{where}: references must be a non-empty list of References (sine_reference, point_to_point), "
                          f"got {type(references).__name__} {shorten(references)}")
     if _args.is_number(temperatures):
         temperatures = [temperatures]
-    if not (isinstance(temperatures, (list, tuple, np.ndarray)) and all(_args.is_number(T) for T in temperatures)):
+    if not (isinstance(temperatures, (list, tuple, np.ndarray)) and len(temperatures)
+            and all(_args.is_number(T) for T in temperatures)):
         raise InputError(f"{where}: temperatures must be a number or a list of numbers [C], got "
                          f"{type(temperatures).__name__} {shorten(temperatures)}")
     _number(where, "calibration", calibration)

@@ -97,7 +97,7 @@ class Sawtooth(Waveform):
         if not 0 < rise < 1:
             raise InputError(f"sawtooth: 'rise' must be between 0 and 1 (exclusive), got {rise!r}")
         object.__setattr__(self, "rise", rise)
-        if isinstance(self.direction, (bool, np.bool_)) or self.direction not in (1, -1):
+        if isinstance(self.direction, (bool, np.bool_)) or not isinstance(self.direction, (int, float, np.integer, np.floating)) or self.direction not in (1, -1):
             raise InputError(f"sawtooth: 'direction' must be +1 or -1, got {self.direction!r}")
         object.__setattr__(self, "direction", int(self.direction))
 

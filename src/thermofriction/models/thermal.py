@@ -45,7 +45,7 @@ class ModelII:
     def __post_init__(self):
         if not isinstance(self.dF, Law):
             raise InputError(f"dF must be a Law (e.g. tf.Linear(a, b)), got {type(self.dF).__name__} {shorten(self.dF)}")
-        if self.form not in ("scale", "offset"):
+        if not isinstance(self.form, str) or self.form not in ("scale", "offset"):
             raise InputError(f"[thermal]: 'form' must be \"scale\" or \"offset\", got {self.form!r}")
 
     def to_dict(self):

@@ -263,6 +263,9 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
     if not isinstance(datasets, (str, os.PathLike, list, tuple)) or (
             isinstance(datasets, (list, tuple)) and not all(isinstance(d, (str, os.PathLike, Dataset)) for d in datasets)):
         _args.refuse("datasets", "a list of dataset folders or Datasets, or a folder of dataset folders", datasets)
+    for d in [datasets] if isinstance(datasets, (str, os.PathLike)) else datasets:
+        if not isinstance(d, Dataset):
+            _args.path(d, "datasets")  # an empty name is not the current folder
     _args.text(method, "method")
     if not (init is None or isinstance(init, (Model, str, os.PathLike))):
         _args.refuse("init", "a Model, a model file or a preset name, or None", init)

@@ -197,8 +197,10 @@ def _check_types(duration, temperature, sample_rate, solver, friction_work):
     """No coercion (_args.py): duration='2', temperature='35', sample_rate=True are refused."""
     _args.number(duration, "duration", "s", none=True)
     _args.number(sample_rate, "sample_rate", "Hz")
-    if not (temperature is None or _args.is_number(temperature) or isinstance(temperature, (Sampled, tuple, list))):
-        _args.refuse("temperature", "a number [degC], a Sampled signal or (times, values)", temperature)
+    pair = isinstance(temperature, (tuple, list)) and len(temperature) == 2 and all(
+        isinstance(x, (list, tuple, np.ndarray)) and np.ndim(x) == 1 for x in temperature)
+    if not (temperature is None or _args.is_number(temperature) or isinstance(temperature, Sampled) or pair):
+        _args.refuse("temperature", "a number [degC], a Sampled signal or (times, values), two arrays", temperature)
     if solver is not None and not isinstance(solver, str) and not isinstance(solver, tuple(SOLVERS.values())):
         _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
     _args.flag(friction_work, "friction_work")
