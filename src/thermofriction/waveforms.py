@@ -342,7 +342,7 @@ def parse_waveform(spec: str) -> Waveform:
     """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
     ``sampled:file=u.csv``."""
     if not isinstance(spec, str):
-        raise InputError(f"spec must be a waveform spec (a string) such as 'sawtooth:amplitude=30,frequency=5', "
+        raise InputError(f"spec must be a string, a waveform spec such as 'sawtooth:amplitude=30,frequency=5', "
                          f"got {type(spec).__name__} {shorten(spec)}")
     where = f"--input {shorten(spec, 100)}"
     if not spec.isprintable():  # so that every message below, which quotes parts of it, is one line

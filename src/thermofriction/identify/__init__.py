@@ -113,8 +113,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     offset: force data only (docs/force-data.md): fit the force sensor's offset, one for all experiments
         (default), or hold it at the initial model's ``[plant] sensor_offset``.
     """
-    _args.dataset(data, Dataset, experiments=True)  # the argument types (_args.py): before any work
-    _args.text(method, "method")
+    _args.text(method, "method")  # the argument types (_args.py): before any work
     if not (init is None or isinstance(init, (Model, str, os.PathLike))):
         _args.refuse("init", "a Model, a model file or a preset name, or None", init)
     _args.text(friction, "friction", none=True)
@@ -130,6 +129,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     if method not in METHODS:
         raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
     _check_arguments(method, reference_temperature, rtol, starts, seed)
+    _args.dataset(data, Dataset, experiments=True)
     from ..data.force import is_force_data
     if is_force_data(getattr(data, "experiments", data)):  # measured force under measured motion
         from .force import identify_force

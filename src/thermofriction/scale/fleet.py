@@ -274,7 +274,7 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
         datasets = fleet_datasets(datasets) or [datasets]
     datasets = list(datasets)
     if not datasets:
-        raise InputError("give at least one dataset")
+        raise InputError("datasets: give at least one dataset")
     if "progress" in identify_options:
         raise InputError("progress= is the fleet's (datasets done); identify's own progress is not shown")
     paths = [d.path if isinstance(d, Dataset) else d for d in datasets]
