@@ -83,7 +83,8 @@ def test_position_only_drives_by_its_gradient(tmp_path):
     t = np.sort(rng.uniform(0, 1, 40))
     t[0] = 0.0
     x = 0.3 * t ** 2 - 0.1 * t
-    _write(tmp_path / "p.csv", "time[s],position[m],friction_force[N]", np.column_stack([t, x, np.ones_like(t)]))
+    _write(tmp_path / "p.csv", "time[s],position[m],friction_force[N]",
+           np.column_stack([t, x, 1.0 + 0.1 * t]))  # (a force that varies: a constant one is refused)
     data = tf.load_dataset(_dataset(tmp_path, ["p.csv"]))
     exp = data.experiments[0]
     assert isinstance(exp, ForceExperiment) and exp.velocity is None

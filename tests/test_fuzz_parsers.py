@@ -639,6 +639,9 @@ def manifests(draw):
             e["description"] = draw(st.text(st.characters(blacklist_categories=("Cs",)), max_size=30))
         if draw(st.booleans()):
             kind, p = draw(waveform_params())
+            for k in ("amplitude", "offset"):  # a manifest's input is a voltage: at most +-10 kV (plausible.py)
+                if k in p:
+                    p[k] = p[k] / 200.0
             e["input"] = f"{kind}:" + ",".join(f"{k}={v!r}" for k, v in p.items())
         exps.append(e)
     d["experiment"] = exps

@@ -190,7 +190,7 @@ def test_validate_predicts_every_experiment_and_lists_the_ones_it_cannot(tmp_pat
     out = run_cli("validate", tmp_path / "m.toml", tmp_path / "ds", "--json", tmp_path / "v.json")
     assert out.returncode == 1, out.stderr
     assert "not predicted" in out.stderr and "Traceback" not in out.stderr
-    assert json.loads((tmp_path / "v.json").read_text())["failed"]
+    assert "v.json not written" in out.stderr and not (tmp_path / "v.json").exists()  # a failed run publishes nothing
 
 
 # -- plausible data -----------------------------------------------------------------------------

@@ -384,7 +384,7 @@ API_CASES = {
     "solver='fast'": (lambda m: tf.simulate(m, 0.01, temperature=35, solver="fast"), "unknown solver"),
     "solver=5": (lambda m: tf.simulate(m, 0.01, temperature=35, solver=5), "solver must be"),
     "max_samples=2.5": (lambda m: tf.simulate(m, 0.01, temperature=35, max_samples=2.5), "max_samples must be"),
-    "duration='1'x": (lambda m: tf.simulate(m, "one", temperature=35), "duration and sample_rate must be numbers"),
+    "duration='1'x": (lambda m: tf.simulate(m, "one", temperature=35), "duration must be a number"),
     "t_eval beyond 1e12 s": (lambda m: tf.simulate(m, temperature=35, t_eval=[0.0, 1e13]), "limit of 1e\\+12 s"),
     "model.save('/tmp')": (_save_to_tmp, "is a folder"),
     "identify seed=-5": (lambda m: tf.identify([object()], "base", seed=-5), "seed must be"),

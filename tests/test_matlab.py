@@ -136,8 +136,21 @@ def v73(path):
                      + b"\0" * (512 - 132) + b"\x89HDF\r\n\x1a\n" + b"\0" * 200)
 
 
+def corrupted_compressed(path):
+    # a v7 file (compressed variables) whose zlib stream is damaged half-way: SciPy raises zlib.error
+    scipy.io.savemat(path, good(), do_compression=True)
+    raw = bytearray(path.read_bytes())
+    for i in range(200, len(raw) - 20, 7):
+        raw[i] ^= 0x5A
+    path.write_bytes(bytes(raw))
+
+
 BAD = [
     ("v7.3 file", v73, None, ["run.mat", "v7.3", "-v7", "CSV"]),
+    ("empty file", lambda p: p.write_bytes(b""), None, ["run.mat", "empty file (0 bytes)", "interrupted copy"]),
+    ("truncated header", lambda p: p.write_bytes(b"MATLAB 5.0 MAT-file"), None,
+     ["run.mat", "not a readable MATLAB file"]),
+    ("corrupted compressed stream", corrupted_compressed, None, ["run.mat", "not a readable MATLAB file"]),
     ("not a MATLAB file", lambda p: p.write_bytes(os.urandom(300)), None, ["run.mat", "not a readable MATLAB file"]),
     ("matrix", good(displacement_um=np.ones((N, 2))), None, ["run.mat", "'displacement_um'", f"{N}x2", "vector"]),
     ("text", good(voltage="thirty volts"), None, ["run.mat", "'voltage'", "text"]),
@@ -181,7 +194,7 @@ def test_bad_mat_input_is_one_clear_message(tmp_path, content, extra, expected):
         assert text in err, (text, err)
 
 
-@pytest.mark.parametrize("case", ["v7.3 file", "matrix"])
+@pytest.mark.parametrize("case", ["v7.3 file", "matrix", "empty file", "corrupted compressed stream"])
 def test_bad_mat_input_exits_2_on_the_command_line(tmp_path, case):
     _, content, extra, expected = next(b for b in BAD if b[0] == case)
     _write(tmp_path, content, extra)

@@ -23,7 +23,8 @@ import numpy as np
 
 from . import _bridge
 from ._bridge import model_spec
-from .errors import InputError, SolverError
+from . import _args
+from .errors import InputError, SolverError, shorten
 from .models import MassPlant, Model
 from .results import Result
 
@@ -148,8 +149,22 @@ class Reference:
     velocity: np.ndarray
 
 
+#: the most samples of a reference (10 million: ~240 MB for its three arrays)
+MAX_REFERENCE_SAMPLES = 10_000_000
+
+
+def _check_length(where, duration, dt):
+    if duration / dt > MAX_REFERENCE_SAMPLES:
+        raise InputError(f"{where}: duration / dt = {duration / dt:.3g} samples, more than the limit of "
+                         f"{MAX_REFERENCE_SAMPLES}: lengthen dt or shorten the reference")
+
+
 def sine_reference(amplitude: float, frequency: float, duration: float, dt: float = 1e-4) -> Reference:
     """x_ref = amplitude (1 - cos(2 pi f t)): starts at rest at 0, reverses every half period."""
+    where = "sine_reference"
+    amplitude, frequency = _number(where, "amplitude", amplitude), _number(where, "frequency", frequency, positive=True)
+    duration, dt = _number(where, "duration", duration, positive=True), _number(where, "dt", dt, positive=True)
+    _check_length(where, duration, dt)
     t = np.arange(int(round(duration / dt)) + 1) * dt
     w = 2 * math.pi * frequency
     return Reference(f"sine {amplitude * 1e3:g} mm, {frequency:g} Hz", t, amplitude * (1 - np.cos(w * t)),
@@ -158,6 +173,10 @@ def sine_reference(amplitude: float, frequency: float, duration: float, dt: floa
 
 def point_to_point(distance: float, move_time: float, dwell: float, dt: float = 1e-4) -> Reference:
     """A quintic (minimum-jerk) move of ``distance`` in ``move_time``, a dwell, and back the same way."""
+    where = "point_to_point"
+    distance, move_time = _number(where, "distance", distance), _number(where, "move_time", move_time, positive=True)
+    dwell, dt = _number(where, "dwell", dwell, minimum=0.0), _number(where, "dt", dt, positive=True)
+    _check_length(where, 2 * (move_time + dwell), dt)
     n = int(round((2 * (move_time + dwell)) / dt)) + 1
     t = np.arange(n) * dt
     period = move_time + dwell
@@ -271,6 +290,9 @@ def friction_steps(model: Model, velocity, dt: float, temperature: float | None 
     returns (forces, seconds spent in C)."""
     where = "friction_steps"
     _model(where, "model", model)
+    if not isinstance(velocity, (list, tuple, np.ndarray)) or not len(velocity) or np.asarray(velocity).dtype.kind not in "iuf":
+        raise InputError(f"{where}: velocity must be an array of numbers [m/s], one per step, got "
+                         f"{type(velocity).__name__} {shorten(velocity)}")
     v = _samples(where, "velocity", velocity)
     dt = _number(where, "dt", dt, positive=True)
     F = np.empty_like(v)
@@ -310,6 +332,21 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
     """Tracking errors with no compensation, temperature-blind compensation (the model told
     ``calibration``) and temperature-aware compensation (told the stage's temperature), feed-forward
     and observer, for each reference and stage temperature. Returns a list of row dicts."""
+    where = "compare_compensation"
+    _model(where, "stage", stage)
+    if not (isinstance(references, (list, tuple)) and references and all(isinstance(r, Reference) for r in references)):
+        raise InputError(f"{where}: references must be a non-empty list of References (sine_reference, point_to_point), "
+                         f"got {type(references).__name__} {shorten(references)}")
+    if _args.is_number(temperatures):
+        temperatures = [temperatures]
+    if not (isinstance(temperatures, (list, tuple, np.ndarray)) and len(temperatures)
+            and all(_args.is_number(T) for T in temperatures)):
+        raise InputError(f"{where}: temperatures must be a number or a list of numbers [C], got "
+                         f"{type(temperatures).__name__} {shorten(temperatures)}")
+    _number(where, "calibration", calibration)
+    _number(where, "observer_gain", observer_gain)
+    if not isinstance(pid, PID):
+        raise InputError(f"{where}: pid must be a PID, got {type(pid).__name__}")
     rows = []
     for ref in references:
         for T in temperatures:

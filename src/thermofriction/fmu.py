@@ -36,6 +36,7 @@ from . import _bridge
 from ._io import Target, atomic_write
 from ._version import __version__
 from .errors import InputError, shorten
+from . import _args
 from .models import MassPlant, Model, PrescribedMotion, StickSlipPlant, load_model
 
 #: The resource file's format version (core/fmu/fmi2_cs.c, FMU_FORMAT).
@@ -330,6 +331,12 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     ``integrator``: "adaptive" (default: the core's error-controlled integrator between communication
     points) or "realtime" (fixed steps of ``step`` seconds: the core's real-time friction step and
     semi-implicit Euler for the plant; docs/fmu.md#integrators)."""
+    _args.path(path, "path")
+    _args.number(temperature, "temperature", "degC", none=True)
+    _args.text(model_identifier, "model_identifier", none=True)
+    _args.text(source, "source", none=True)
+    _args.text(integrator, "integrator")
+    _args.number(step, "step", "s", none=True)
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)
         model = load_model(model)

@@ -28,6 +28,7 @@ import numpy as np
 
 from ._lazy import lazy
 from .errors import InputError, SolverError, TemperatureRangeWarning
+from . import _args
 from .models import Model
 from .results import Result
 from .drive import input_of
@@ -141,6 +142,18 @@ def cycle_table(model: Model, input: Waveform, temperatures, warmup_cycles: int 
     fixed temperature: simulated from rest for warmup + measure cycles, averaged over the last
     ``measure_cycles``. ``startup`` is the extra displacement of the first warmup cycles from rest
     over the periodic steps (one value per temperature)."""
+    _args.model(model, Model)
+    _args.instance(input, Waveform, "input", "a periodic Waveform")
+    if isinstance(temperatures, (str, bytes)) or not (_args.is_number(temperatures) or (
+            isinstance(temperatures, (list, tuple, np.ndarray)) and len(temperatures)
+            and all(_args.is_number(t) for t in temperatures))):
+        _args.refuse("temperatures", "a number or a non-empty list of numbers [C]", temperatures)
+    temperatures = np.atleast_1d(np.asarray(temperatures, float))
+    warmup_cycles = _args.whole(warmup_cycles, "warmup_cycles")
+    measure_cycles = _args.whole(measure_cycles, "measure_cycles")
+    if warmup_cycles < 0 or measure_cycles < 1:
+        raise InputError(f"warmup_cycles must be 0 or more and measure_cycles 1 or more, got {warmup_cycles} and "
+                         f"{measure_cycles}")
     fast = dataclasses.replace(model, heat=None)
     period = input.period
     n = warmup_cycles + measure_cycles
@@ -166,6 +179,12 @@ def simulate_heating(model: Model, duration: float, *, input: Waveform | None = 
     method: ``TwoTimeScale()`` (default) or ``Full()``.
     samples: the result holds about this many cycle starts, evenly spread.
     """
+    _args.model(model, Model)
+    _args.number(duration, "duration", "s")
+    _args.instance(input, Waveform, "input", "a periodic Waveform", none=True)
+    _args.number(temperature, "temperature", "degC", none=True)
+    _args.instance(method, (TwoTimeScale, Full), "method", "TwoTimeScale() or Full()", none=True)
+    _args.whole(samples, "samples")
     if model.heat is None:
         raise InputError("simulate_heating needs a model with a [heat] section (docs/models.md#self-heating)")
     method = method or TwoTimeScale()

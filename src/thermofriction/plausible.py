@@ -17,6 +17,10 @@ TEMPERATURE_RANGE = (-100.0, 300.0)
 #: (capacitive sensors resolve ~1e-10 m): its values are most likely in another unit than the header's
 MIN_DISPLACEMENT_SPAN = 1e-11
 
+#: [V] the largest plausible actuator drive voltage in recorded data: piezo stick-slip actuators are driven
+#: at up to ~150 V, high-voltage stacks at up to ~1 kV; beyond 10 kV a value is in another unit or corrupt
+VOLTAGE_LIMIT = 1e4
+
 _LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9, "pm": 1e-12}
 
 
@@ -59,6 +63,29 @@ def displacement_problem(x, unit: str) -> str | None:
     return None
 
 
+def voltage_problem(v) -> str | None:
+    """Why a voltage record [V] (or one value) is not an actuator's drive voltage, or None: where its
+    largest magnitude exceeds :data:`VOLTAGE_LIMIT`, that value and its 1-based sample number."""
+    v = np.atleast_1d(np.asarray(v, float))
+    if not v.size:
+        return None
+    i = int(np.argmax(np.abs(v)))
+    if abs(v[i]) <= VOLTAGE_LIMIT:
+        return None
+    where = f"sample {i + 1}: " if v.size > 1 else ""
+    return (f"{where}{v[i]:g} V is not a plausible actuator voltage (expected within +-{VOLTAGE_LIMIT:g} V: "
+            f"values in another unit, e.g. mV (give voltage[mV]), or a corrupt record?)")
+
+
+def input_voltage_problem(waveform) -> str | None:
+    """:func:`voltage_problem` of a waveform's peak (|offset| + |amplitude|, or a sampled input's values)."""
+    values = getattr(waveform, "value", None)
+    if values is None:
+        values = abs(float(getattr(waveform, "offset", 0.0))) + abs(float(getattr(waveform, "amplitude", 0.0)))
+    problem = voltage_problem(values)
+    return problem and problem.replace(" V is not", " V (its peak) is not") if values is not None else None
+
+
 def parse_length(text: str, what: str) -> float:
     """A length from the command line: a number in metres, or a number with a unit (``20nm``, ``5 um``)."""
     m = re.fullmatch(r"\s*([-+0-9.eE]+)\s*([a-zµμ]*)\s*", str(text))
@@ -75,5 +102,5 @@ def parse_length(text: str, what: str) -> float:
     return value
 
 
-__all__ = ["kelvin_hint", "TEMPERATURE_RANGE", "MIN_DISPLACEMENT_SPAN", "temperature_problem", "check_temperature",
+__all__ = ["kelvin_hint", "TEMPERATURE_RANGE", "VOLTAGE_LIMIT", "voltage_problem", "input_voltage_problem", "MIN_DISPLACEMENT_SPAN", "temperature_problem", "check_temperature",
            "displacement_problem", "parse_length"]

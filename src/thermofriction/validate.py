@@ -9,6 +9,8 @@ import warnings
 
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
+from . import _args
+from .data.experiments import Dataset
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .results import Result
@@ -151,6 +153,9 @@ def validate(model: Model, data, experiments=None, *, offset=None) -> Validation
     errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
     zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
     it, held-out runs included). Temperatures outside a law's calibrated range are reported as warnings."""
+    _args.model(model, Model)
+    _args.dataset(data, Dataset, experiments=True)
+    _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")

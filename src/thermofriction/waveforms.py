@@ -19,7 +19,7 @@ from ._reading import read_bytes, strict_float
 from .errors import InputError, shorten, unknown_keys
 
 def _finite(name, value, where):
-    if isinstance(value, (str, bytes, bool)):  # float("1e5") would pass: a number is asked for
+    if isinstance(value, (str, bytes, bool, np.bool_)):  # float("1e5") would pass: a number is asked for
         raise InputError(f"{where}: '{name}' must be a number, got {shorten(value)}")
     try:
         value = float(value)
@@ -97,7 +97,7 @@ class Sawtooth(Waveform):
         if not 0 < rise < 1:
             raise InputError(f"sawtooth: 'rise' must be between 0 and 1 (exclusive), got {rise!r}")
         object.__setattr__(self, "rise", rise)
-        if self.direction not in (1, -1):
+        if isinstance(self.direction, (bool, np.bool_)) or not isinstance(self.direction, (int, float, np.integer, np.floating)) or self.direction not in (1, -1):
             raise InputError(f"sawtooth: 'direction' must be +1 or -1, got {self.direction!r}")
         object.__setattr__(self, "direction", int(self.direction))
 
@@ -203,9 +203,13 @@ class Sampled(Waveform):
     kind = "sampled"
 
     def __post_init__(self):
+        where = f"sampled waveform{f' {self.file}' if self.file else ''}"
+        for name in ("time", "value"):  # arrays of numbers only: no text, no booleans read as 0/1
+            a = getattr(self, name)
+            if not isinstance(a, (list, tuple, np.ndarray)) or np.asarray(a).dtype.kind not in "iuf":
+                raise InputError(f"{where}: {name} must be an array of numbers, got {type(a).__name__} {shorten(a)}")
         t = np.ascontiguousarray(self.time, dtype=float)
         v = np.ascontiguousarray(self.value, dtype=float)
-        where = f"sampled waveform{f' {self.file}' if self.file else ''}"
         if t.ndim != 1 or t.shape != v.shape or t.size < 2:
             raise InputError(f"{where}: needs at least two (time, value) pairs of equal length")
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
@@ -338,8 +342,8 @@ def parse_waveform(spec: str) -> Waveform:
     """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
     ``sampled:file=u.csv``."""
     if not isinstance(spec, str):
-        raise InputError(f"a waveform spec must be a string such as 'sawtooth:amplitude=30,frequency=5', "
-                         f"got {shorten(spec)}")
+        raise InputError(f"spec must be a string, a waveform spec such as 'sawtooth:amplitude=30,frequency=5', "
+                         f"got {type(spec).__name__} {shorten(spec)}")
     where = f"--input {shorten(spec, 100)}"
     if not spec.isprintable():  # so that every message below, which quotes parts of it, is one line
         raise InputError(f"{where}: contains a control character (a line break, tab or NUL)")

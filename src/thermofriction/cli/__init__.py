@@ -27,6 +27,7 @@ def main(argv=None) -> int:
     # NumPy's "overflow encountered in ..." says nothing a user can act on: results are checked
     # (non-finite outputs and values are refused with a message of their own)
     warnings.filterwarnings("ignore", message=".* encountered in ", category=RuntimeWarning)
+    _tolerant_streams()
     parser = build_parser()
     args = parser.parse_args(argv)
     caught = []
@@ -69,6 +70,19 @@ def main(argv=None) -> int:
         return 1
     finally:
         _io.restore_signal_handlers(handlers)
+
+
+def _tolerant_streams():
+    """Standard output and error that cannot encode a character (PYTHONIOENCODING=ascii, a latin-1
+    terminal, the C locale) write it as an escape (``\\xb0`` for a degree sign in a model's name) instead of stopping the
+    command with a UnicodeEncodeError after its work is done."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)  # a TextIOWrapper; tests may swap in others
+        if reconfigure is not None and getattr(stream, "errors", "strict") in ("strict", "surrogateescape"):
+            try:
+                reconfigure(errors="backslashreplace")
+            except (ValueError, OSError):  # a closed or detached stream: nothing to write to anyway
+                pass
 
 
 def _after_signal():

@@ -171,6 +171,8 @@ def cmd_identify_fleet(args) -> int:
     if args.json:
         raise InputError("--json applies to one dataset; with several, each dataset's results JSON goes into -o DIR")
     laws, params = _identify_options(args)
+    from ..scale.fleet import refuse_overwriting_inputs
+    refuse_overwriting_inputs(args.output, paths)  # before any identification, not after all of them
     update, stop = progress_bar(len(paths), "identify", enabled=not args.quiet)
     try:
         fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,
@@ -198,14 +200,17 @@ def cmd_validate(args) -> int:
     data = load_dataset(args.dataset)
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
     res = validate(model, data)
-    if args.json:  # a .mat name writes the same metrics for MATLAB
+    if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
     for w in res.warnings:
         print(f"thermofriction: warning: {w}", file=sys.stderr)
     for f in res.failures:  # the others were still predicted; the exit status says some were not
         print(f"thermofriction: {f.file}: not predicted: {f.reason}", file=sys.stderr)
-    if args.json:
+    if args.json and res.failures:  # a failed run (exit 1) publishes nothing: its metrics are incomplete
+        print(f"thermofriction: {args.json} not written: {len(res.failures)} of {len(res.failures) + len(res.predictions)} "
+              f"experiments were not predicted", file=sys.stderr)
+    elif args.json:
         print(f"wrote {args.json}")
     return 1 if res.failures else 0
 
@@ -256,9 +261,13 @@ def cmd_demo(args) -> int:
     from ..demo import run_demo
 
     update, status = _progress(False)
+    new_folders = _missing_folders(args.output, "data")  # run_demo creates them; a failed run removes them
     try:
         with _io.publish_together():  # every file of the demo appears at the end, or none
             out = run_demo(args.output, progress=update)
+    except BaseException:  # an error, Ctrl-C, SIGTERM: the temporaries are gone, so are the folders
+        _remove_empty(new_folders)
+        raise
     finally:
         if status is not None:
             status.stop()
@@ -272,6 +281,29 @@ def cmd_demo(args) -> int:
     print(f"  Model I against the truth the data were made from: {out['recovery']['model-i']['summary']}")
     print(f"  report: {out['report']}")
     return 0
+
+
+def _missing_folders(folder, *subfolders) -> list:
+    """The folders on the way to ``folder`` (and its ``subfolders``) that do not exist yet, deepest first."""
+    import os
+    from pathlib import Path
+
+    folder = Path(os.path.abspath(folder))
+    missing = [folder / s for s in subfolders if not (folder / s).exists()]
+    for p in (folder, *folder.parents):
+        if p.exists():
+            break
+        missing.append(p)
+    return missing
+
+
+def _remove_empty(folders):
+    """Removes each folder that is still empty (deepest first); one that holds anything stays."""
+    import contextlib
+    import os
+    for f in folders:
+        with contextlib.suppress(OSError):
+            os.rmdir(f)
 
 
 def cmd_sweep(args) -> int:

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .._reading import read_input_file, strict_float
+from .. import _args
 from ..errors import InputError, shorten
 from ..plausible import kelvin_hint
 from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
@@ -114,6 +115,8 @@ def read_experiment_csv(path, with_headers: bool = False) -> dict:
 
     The format is strict; any problem is one InputError naming the file and, where it applies, the
     line (the header is line 1) and the column."""
+    _args.path(path, "path")
+    _args.flag(with_headers, "with_headers")
     path = Path(path)
     raw = read_experiment_bytes(path)
     try:

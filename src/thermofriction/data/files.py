@@ -14,13 +14,14 @@ import tomli_w
 
 from .._io import atomic_write
 from .._reading import read_text
+from .. import _args
 from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
 from .command import check_torque_constant
 from .force import ForceExperiment, check_motion_option, force_experiment, is_force_data, is_force_file, units_of
 from .matlab import force_mat_variables, is_matlab, read_force_mat
-from ..plausible import displacement_problem, kelvin_hint
+from ..plausible import displacement_problem, input_voltage_problem, kelvin_hint, voltage_problem
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "torque_constant", "experiment")
@@ -93,6 +94,7 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
     motion: what drives the models of force experiments, "auto", "position" or "velocity"
         (docs/force-data.md#the-motion-that-drives-the-model); given, it overrides the manifest's ``motion``
         keys; None: the manifest's, else "auto"."""
+    _args.path(path, "path")
     if motion is not None:
         check_motion_option(motion, "motion")
     folder = Path(path)
@@ -176,6 +178,9 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
                 inp = parse_waveform(e["input"])
             except InputError as err:
                 raise InputError(f"{where}: {err}") from None
+            problem = input_voltage_problem(inp)
+            if problem:
+                raise InputError(f"{where}: 'input': {problem}")
         opts = _force_options(e, where, options)
         if motion is not None:
             opts["motion"] = motion
@@ -205,6 +210,9 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
                 problem = displacement_problem(cols[column], unit)
                 if problem:
                     raise InputError(f"{folder / f}: {label}: {problem}")
+        problem = voltage_problem(cols["voltage"])
+        if problem:
+            raise InputError(f"{folder / f}: {headers['voltage'][0]}: {problem}")
         cols["time"], inp = _from_zero(cols["time"], inp)
         sig = cols.get("temperature")
         if T is None:
@@ -315,6 +323,9 @@ def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     leaves a folder without ``dataset.toml``, which :func:`load_dataset` refuses, naming the
     temporary files left; on an error nothing is changed and folders created for it are removed."""
     from .._io import publish_together
+    _args.instance(dataset, Dataset, "dataset", "a Dataset")
+    _args.path(folder, "folder")
+    _args.flag(overwrite, "overwrite")
     folder = Path(folder)
     files = [e.file for e in dataset.experiments]
     if not files:

@@ -341,6 +341,10 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
     data/matlab.py: read_force_mat); None reads ``path`` as a CSV file. A drive's command (or a current times
     ``torque_constant``) in place of the friction is read by data/command.py: measured_force."""
     cols = read_force_csv(path) if columns is None else columns
+    force = np.asarray(cols["force"], float)
+    if force.size and np.ptp(force) <= 1e-12 * np.max(np.abs(force)):  # its noise estimate would be 0
+        raise InputError(f"{path}: column {cols['headers']['force']}: the force does not vary (every sample is "
+                         f"{force[0]:g}): a stuck load cell? A constant record has no friction to identify")
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
     if temperature is None:

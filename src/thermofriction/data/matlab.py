@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, shorten
+from .. import _args
 from .experiments import _SI, _UNITS, MIN_SAMPLES, REQUIRED, max_rows, MAX_ROWS_ENV
 from . import force
 from .force import EXAMPLE, check_force_columns_present, check_force_values, column_key, units_kind
@@ -58,6 +59,8 @@ def _load(path: Path) -> dict:
         raise InputError(f"{path}: is a folder, not a MATLAB file") from None
     except OSError as e:
         raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
+    if not head:  # an interrupted copy, a file created and never written
+        raise InputError(f"{path}: empty file (0 bytes): not a MATLAB file (an interrupted copy?)")
     if head[512:].startswith(_HDF5_MAGIC) or head.startswith(_HDF5_MAGIC):
         raise InputError(f"{path}: a MATLAB v7.3 (HDF5) file, which thermofriction does not read: save it with "
                          f"save('{path.name}', ..., '-v7') in MATLAB, or write the run as CSV "
@@ -67,9 +70,10 @@ def _load(path: Path) -> dict:
     except NotImplementedError as e:  # SciPy's word for v7.3
         raise InputError(f"{path}: not readable as a MATLAB file up to v7 ({e}); save it with '-v7' in MATLAB "
                          f"or write the run as CSV") from None
-    except (ValueError, TypeError, OSError, EOFError, IndexError, KeyError, UnicodeDecodeError, OverflowError,
-            MemoryError, AssertionError) as e:
-        raise InputError(f"{path}: not a readable MATLAB file ({shorten(str(e) or type(e).__name__)})") from None
+    except Exception as e:  # noqa: BLE001 - whatever SciPy's reader meets in damaged bytes (MatReadError,
+        # zlib.error from a corrupted compressed v7 stream, ValueError, ...), the file is what is wrong
+        raise InputError(f"{path}: not a readable MATLAB file, damaged or truncated? "
+                         f"({shorten(str(e) or type(e).__name__)})") from None
 
 
 def _vector(path, label, value) -> np.ndarray:
@@ -97,6 +101,10 @@ def read_experiment_mat(path, struct: str | None = None, units: dict | None = No
     with_headers: also return, per column, (where it is, its unit) for a dataset's checks."""
     from .csv import check_columns
 
+    _args.path(path, "path")
+    _args.text(struct, "struct", none=True)
+    _args.instance(units, dict, "units", "a dict (column -> unit)", none=True)
+    _args.flag(with_headers, "with_headers")
     path = Path(path)
     variables = {k: v for k, v in _load(path).items() if not k.startswith("__")}
     origin = "variable"

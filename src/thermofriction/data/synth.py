@@ -10,13 +10,20 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .. import _args
 from ..models import PRESETS, Model, load_model, require_actuator
-from ..plausible import parse_length
+from ..plausible import input_voltage_problem, parse_length
 from ..simulate import StepSizeController, simulate
-from ..waveforms import Sampled, parse_waveform
+from ..waveforms import Sampled, Waveform, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
 from .._io import publish_together
 from .files import _check_temperature, check_dataset_folder, save_dataset
+
+#: the most experiments (fit and validate temperatures together) of one synthesised dataset: each is a
+#: simulation (~0.1-1 s for the default 2 s at 10 kHz) and a file; a longer list is most likely a mistake
+#: (a range typed as a list), and a real one is better split into several datasets
+MAX_EXPERIMENTS = 1000
+
 
 def _nonneg(label, v):
     try:
@@ -38,7 +45,7 @@ def _temperatures(values, label):
 
 def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_rate=10_000.0, input=None,
                noise=20e-9, quantization=0.0, temperature_noise=0.0, drift=0.0, record_temperature=None,
-               record_stage=False, seed=0, name=None) -> Dataset:
+               record_stage=False, seed=0, name=None, progress=None) -> Dataset:
     """A dataset simulated from ``model`` at each temperature (role "fit") and at each ``validate``
     temperature (role "validate"), with realistic sensor effects:
 
@@ -52,16 +59,40 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
     The manifest's temperature is the true one. ``input`` defaults to the model's ``[input]``.
     Seeded and reproducible: each experiment draws from its own stream
     (``default_rng([seed, i])`` for the i-th fit temperature, ``[seed, j, 1]`` for the j-th
-    validate one), so adding an experiment changes no other."""
+    validate one), so adding an experiment changes no other.
+
+    At most :data:`MAX_EXPERIMENTS` temperatures in all. ``progress(done, total)`` is called after each
+    experiment."""
+    _args.model(model, Model)  # the argument types (_args.py): before any work
+    for label, v in (("temperatures", temperatures), ("validate", validate)):
+        if not (v is None or _args.is_number(v) or (isinstance(v, (list, tuple, np.ndarray)) and
+                                                     all(_args.is_number(T) for T in v))):
+            _args.refuse(label, "a number or a list of numbers [C]", v)
+    for label, v in (("duration", duration), ("sample_rate", sample_rate), ("noise", noise),
+                     ("quantization", quantization), ("temperature_noise", temperature_noise), ("drift", drift)):
+        _args.number(v, label)
+    _args.instance(input, Waveform, "input", "a Waveform", none=True)
+    if record_temperature is not None:
+        _args.flag(record_temperature, "record_temperature")
+    _args.flag(record_stage, "record_stage")
+    _args.text(name, "name", none=True)
     require_actuator(model, "synthesize")
     waveform = input if input is not None else model.input
     if waveform is None:
         raise InputError(f"{'model ' + repr(model.name) if model.name else 'the model'} has no [input] "
                          f"waveform: give input= (e.g. tf.Sawtooth(amplitude=30, frequency=5))")
+    problem = input_voltage_problem(waveform)  # the dataset would be refused when it is loaded
+    if problem:
+        raise InputError(f"input: {problem}")
     fit_T = _temperatures(temperatures, "temperatures")
     val_T = _temperatures(validate, "validate")
     if not fit_T and not val_T:
-        raise InputError("give at least one temperature")
+        raise InputError("give at least one temperature (temperatures, or validate)")
+    if len(fit_T) + len(val_T) > MAX_EXPERIMENTS:
+        raise InputError(f"{len(fit_T) + len(val_T)} temperatures, more than the limit of {MAX_EXPERIMENTS} "
+                         f"experiments per synthesised dataset: synthesise several datasets")
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress must be a function (done, total) or None, got {type(progress).__name__}")
     noise = _nonneg("noise", noise)
     quantization = _nonneg("quantization", quantization)
     temperature_noise = _nonneg("temperature_noise", temperature_noise)
@@ -132,6 +163,8 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
         exps.append(Experiment(file=file, time=res.time, voltage=res.input, displacement=x, temperature=T,
                                temperature_signal=sig, stage_displacement=stage, role=role, description=desc,
                                input=None if isinstance(waveform, Sampled) else waveform))
+        if progress is not None:
+            progress(len(exps), len(runs))
     return Dataset(path=None, name=name or f"synthetic-{label}",
                    description=f"synthesised by thermofriction from {label}", experiments=exps)
 
@@ -216,20 +249,27 @@ def cmd_synth(args) -> int:
     if not fit_T:
         raise InputError("--temperatures: give at least one temperature, e.g. --temperatures 30.8,35.7,41.5")
     val_T = _float_list(args.validate or "", "--validate")
+    if len(fit_T) + len(val_T) > MAX_EXPERIMENTS:  # before the model is read, the folder checked
+        raise InputError(f"--temperatures, --validate: {len(fit_T) + len(val_T)} temperatures, more than the limit "
+                         f"of {MAX_EXPERIMENTS} experiments per synthesised dataset (docs/limits.md): synthesise "
+                         f"several datasets")
     check_dataset_folder(args.output, args.force, hint="--force")  # before the work, not after it
     model = load_model(args.model)
     waveform = parse_waveform(args.input) if args.input else None
     if waveform is None and model.input is None:
         raise InputError(f"{args.model}: the model has no [input] waveform: give --input, "
                          f"e.g. --input sawtooth:amplitude=30,frequency=5")
+    update, stop = _progress(len(fit_T) + len(val_T))
     try:
         data = synthesize(model, fit_T, validate=val_T, duration=args.duration, sample_rate=args.sample_rate,
                           input=waveform, noise=args.noise, quantization=args.quantization,
                           temperature_noise=args.temperature_noise, drift=args.drift,
                           record_temperature=args.record_temperature, record_stage=args.record_stage,
-                          seed=args.seed)
+                          seed=args.seed, progress=update)
     except InputError as e:
         raise InputError(f"synth: {e}") from None
+    finally:
+        stop()
     inputs = [] if args.model in PRESETS else [args.model]
     for w in (waveform, model.input):
         if isinstance(w, Sampled) and w.file:
@@ -242,4 +282,31 @@ def cmd_synth(args) -> int:
     return 0
 
 
-__all__ = ["synthesize", "add_synth_command", "cmd_synth"]
+#: [s] on a pipe or a file (a CI log), a progress line at most this often; a shorter run prints none
+PROGRESS_INTERVAL = 5.0
+
+
+def _progress(total):
+    """(update(done, total), stop()) for synth's progress: a bar on a terminal (a run of several
+    experiments); elsewhere a line on stderr every PROGRESS_INTERVAL seconds of a long run."""
+    import sys
+    import time
+
+    if total < 2:
+        return None, (lambda: None)
+    if sys.stderr.isatty():
+        from ..scale.cluster import progress_bar  # rich, loaded only here
+        bar, stop = progress_bar(total, "synth")
+        return (lambda done, _total: bar(done)), stop
+    t0 = last = time.monotonic()
+
+    def line(done, total):
+        nonlocal last
+        now = time.monotonic()
+        if now - last >= PROGRESS_INTERVAL and done < total:
+            last = now
+            print(f"  synth: {done} of {total} experiments, {now - t0:.0f} s", file=sys.stderr, flush=True)
+    return line, (lambda: None)
+
+
+__all__ = ["synthesize", "add_synth_command", "cmd_synth", "MAX_EXPERIMENTS"]

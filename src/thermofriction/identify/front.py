@@ -6,15 +6,18 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import os
 
 import numpy as np
 
-from ..data.experiments import TEMPERATURE_RANGE
+from .. import _args
+from ..data.experiments import TEMPERATURE_RANGE, Dataset
 from ..errors import InputError, ThermofrictionError, shorten
 from ..measurements import amount, measurement_of
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
+from ..models import Model
 from .parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
@@ -81,6 +84,21 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
     it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
     """
+    _args.text(method, "method")  # the argument types (_args.py): before any work
+    if not (init is None or isinstance(init, (Model, str, os.PathLike))):
+        _args.refuse("init", "a Model, a model file or a preset name, or None", init)
+    _args.text(friction, "friction", none=True)
+    parameters = _args.names(parameters, "parameters", allow=Parameters)  # 'sigma0' is one name, not 5 letters
+    free = free if isinstance(free, str) else (_args.names(free, "free") or ())  # (a string: "m_e,m")
+    _args.text(procedure, "procedure")
+    _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
+    _args.flag(refine, "refine")
+    _args.number(reference_temperature, "reference_temperature", "degC", none=True)
+    _args.number(rtol, "rtol")
+    _args.function(progress, "progress")
+    if not isinstance(offset, (bool, str)):
+        _args.refuse("offset", "\"shared\", \"per-experiment\", \"none\", True or False", offset)
+    _args.dataset(data, Dataset, experiments=True)
     if method not in METHODS:
         raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
     _check_arguments(method, reference_temperature, rtol, starts, seed)

@@ -16,6 +16,7 @@ import tomli_w
 
 from .._io import Target, atomic_write
 from .._reading import read_text
+from .. import _args
 from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
 from .friction import (FRICTION_MODELS, GMS, PARAMETER_DOMAIN, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,
@@ -318,7 +319,11 @@ def preset_path(name: str):
 def load_model(source, friction_from=None) -> Model:
     """Loads a model file, or a shipped preset by name (see ``PRESETS``). ``friction_from``: see
     :func:`model_from_dict`."""
+    _args.path(source, "source")
+    _args.function(friction_from, "friction_from")
     source = os.fspath(source)
+    if isinstance(source, bytes):
+        source = os.fsdecode(source)
     p = Path(source)
     try:
         exists = p.exists()

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-from ..errors import InputError
+from ..errors import InputError, shorten
 from ..waveforms import Waveform, waveform_from_dict
 from ._parse import by_symbol, num
 from .laws import Law
@@ -17,6 +17,12 @@ class ModelI:
 
     laws: dict = field(default_factory=dict)
     model = "I"
+
+    def __post_init__(self):
+        if not (isinstance(self.laws, dict) and all(isinstance(k, str) and isinstance(v, Law)
+                                                    for k, v in self.laws.items())):
+            raise InputError(f"laws must be a dict of parameter name -> Law (e.g. {{'fc': tf.Linear(...)}}), got "
+                             f"{type(self.laws).__name__} {shorten(self.laws)}")
 
     def to_dict(self):
         d = {"model": "I"}
@@ -37,7 +43,9 @@ class ModelII:
     model = "II"
 
     def __post_init__(self):
-        if self.form not in ("scale", "offset"):
+        if not isinstance(self.dF, Law):
+            raise InputError(f"dF must be a Law (e.g. tf.Linear(a, b)), got {type(self.dF).__name__} {shorten(self.dF)}")
+        if not isinstance(self.form, str) or self.form not in ("scale", "offset"):
             raise InputError(f"[thermal]: 'form' must be \"scale\" or \"offset\", got {self.form!r}")
 
     def to_dict(self):

@@ -13,10 +13,32 @@ from ..models import Model
 from .displacement import render, truth_section
 from .entries import Entry, akaike, entry_label, law_at, reference_temperature
 from .force import render_force
+from .. import _args
+from ..data.experiments import Dataset
 from .studies import control_report, heating_report
 
 #: measurement name -> the page that shows it
 PAGES = {"displacement": render, "force": render_force, "command": render_force}
+
+
+def _check_report_arguments(models, data, path, figures_dir, command, title, truth) -> list:
+    """The types of report()'s arguments (_args.py); one model or fit is a list of one."""
+    if isinstance(models, (Model, Entry)) or (hasattr(models, "to_dict") and hasattr(models, "model")):
+        models = [models]
+    if not isinstance(models, (list, tuple)) or not models:
+        _args.refuse("models", "a non-empty list of Models, FitResults or (label, Model, fit dict) entries", models)
+    for m in models:
+        if not (isinstance(m, (Model, Entry)) or (hasattr(m, "to_dict") and isinstance(getattr(m, "model", None), Model))
+                or (isinstance(m, tuple) and len(m) == 3 and isinstance(m[0], str) and isinstance(m[1], Model)
+                    and (m[2] is None or isinstance(m[2], dict)))):
+            _args.refuse("models", "a list of Models, FitResults or (label, Model, fit dict) entries; one entry is", m)
+    _args.dataset(data, Dataset, experiments=True)
+    _args.path(path, "path")
+    _args.path(figures_dir, "figures_dir", none=True)
+    _args.text(command, "command", none=True)
+    _args.text(title, "title", none=True)
+    _args.instance(truth, dict, "truth", "a dict (label -> FitResult.recovery summary)", none=True)
+    return list(models)
 
 
 def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
@@ -24,6 +46,7 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
     entries) on ``data``; returns the HTML. ``truth`` (label -> FitResult.recovery summary, for data
     made from a known model) adds a section saying whether the fits recover it; ``bands`` (what
     ``tf.propagate`` returns) a section with the prediction bands."""
+    models = _check_report_arguments(models, data, path, figures_dir, command, title, truth)
     entries = []
     for m in models:
         if isinstance(m, Entry):

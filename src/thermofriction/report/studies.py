@@ -7,6 +7,7 @@ import html
 
 import numpy as np
 
+from .. import _args
 from .._lazy import lazy
 from .page import Figures, fmt_number, html_table, page_styled, subplots, write_page
 
@@ -20,6 +21,12 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
     full simulation on the same grid) and ``constant`` (the displacement predicted at the start
     temperature, on the same grid). Figures: temperature rise, step-size drift, and the error of
     the constant-temperature prediction; a table of the figures that matter."""
+    if not isinstance(runs, (list, tuple)) or not runs or not all(isinstance(r, dict) for r in runs):
+        _args.refuse("runs", "a non-empty list of dicts", runs)
+    _args.path(path, "path")
+    _args.path(figures_dir, "figures_dir", none=True)
+    _args.text(title, "title", none=True)
+    _args.text(command, "command", none=True)
     figs = Figures(figures_dir)
     colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     parts = []
@@ -83,6 +90,12 @@ def control_report(rows, path, *, figures_dir=None, title=None, command=None) ->
     """Writes an HTML report of thermofriction.control.compare_compensation's rows: the table of RMS
     and maximum tracking errors per reference, stage temperature and compensation, and for each
     reference the tracking error over time at the hottest temperature."""
+    if not isinstance(rows, (list, tuple)) or not rows or not all(isinstance(r, dict) for r in rows):
+        _args.refuse("rows", "a non-empty list of row dicts (compare_compensation)", rows)
+    _args.path(path, "path")
+    _args.path(figures_dir, "figures_dir", none=True)
+    _args.text(title, "title", none=True)
+    _args.text(command, "command", none=True)
     figs = Figures(figures_dir)
     table = [[r["reference"], fmt_number(r["temperature"], "{:.1f}"), r["compensation"], fmt_number(r["rms_error"] * 1e6, "{:.3g}"),
               fmt_number(r["max_error"] * 1e6, "{:.3g}")] for r in rows]

@@ -40,12 +40,92 @@ def is_client(obj) -> bool:
 
 def check_scheduler(scheduler):
     """None, "sequential", an address (tcp://HOST:PORT, a host:port, a scheduler file) or a Client."""
-    if scheduler is None or scheduler == SEQUENTIAL or is_client(scheduler):
+    if scheduler is None or (isinstance(scheduler, str) and scheduler == SEQUENTIAL) or is_client(scheduler):
         return scheduler
     if isinstance(scheduler, (str, os.PathLike)) and str(scheduler).strip():
         return str(scheduler).strip()
     raise InputError(f"scheduler must be None (a local cluster), 'sequential', an address such as "
                      f"tcp://HOST:8786, or a distributed.Client; got {shorten(scheduler)}")
+
+
+#: a Dask scheduler file is a few hundred bytes of JSON (dask scheduler --scheduler-file)
+_SCHEDULER_FILE_LIMIT = 1 << 20
+#: a Dask message's 8-byte length prefix beyond this is not a greeting (text read as a length: ~1e18)
+_GREETING_LIMIT = 1 << 26
+
+
+def read_scheduler_file(path) -> str:
+    """The address in a scheduler file (JSON with an ``address``, as ``dask scheduler --scheduler-file``
+    writes it), or one InputError naming the file: Dask's own reader fails on a damaged file with an
+    AssertionError or a KeyError."""
+    from .._reading import read_text
+
+    what = "a Dask scheduler file (JSON with an \"address\", as 'dask scheduler --scheduler-file' writes)"
+    try:
+        if os.path.getsize(path) > _SCHEDULER_FILE_LIMIT:
+            raise InputError(f"scheduler {path}: not {what}: {os.path.getsize(path)} bytes")
+        text = read_text(path, "scheduler file")
+    except OSError as e:
+        raise InputError(f"scheduler {path}: cannot read ({e.strerror or e})") from None
+    except UnicodeDecodeError:
+        raise InputError(f"scheduler {path}: not {what}: not UTF-8 text") from None
+    import json
+    try:
+        info = json.loads(text)
+    except ValueError as e:
+        raise InputError(f"scheduler {path}: not {what}: {e}") from None
+    address = info.get("address") if isinstance(info, dict) else None
+    if not isinstance(address, str) or not address.strip():
+        raise InputError(f"scheduler {path}: not {what}: no \"address\" in it")
+    return address.strip()
+
+
+def _probe(address):
+    """For a TCP address: when something answers there, that it greets as a Dask scheduler does (at once,
+    with a message of a plausible length), so that an HTTP or SSH server is named as not a scheduler instead
+    of Dask waiting forever or reading its text as a 3 EiB message ("out of memory"). Nothing listening, or
+    another protocol (tls://, ucx://): left to Dask, which retries until its connect timeout."""
+    import re
+    import socket
+    import struct
+
+    m = re.fullmatch(r"(?:tcp://)?\[?([^\[\]/]+?)\]?:(\d+)/?", address)
+    if m is None:
+        return
+    host, port = m.group(1), int(m.group(2))
+    timeout = _connect_timeout()
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except OSError:
+        return  # Dask tries again until its timeout and then says so
+    with sock:
+        head = b""
+        try:
+            while len(head) < 8:
+                chunk = sock.recv(8 - len(head))
+                if not chunk:
+                    break
+                head += chunk
+        except OSError:  # socket.timeout included
+            pass
+    if len(head) < 8:
+        said = f"it sent {head!r} and closed the connection" if head else f"it said nothing within {timeout:g} s"
+        raise InputError(f"scheduler {address}: not a Dask scheduler ({said}; a scheduler greets a client at once); "
+                         f"start one with 'dask scheduler' (docs/scale.md)")
+    (length,) = struct.unpack("<Q", head)
+    if not 0 < length <= _GREETING_LIMIT:
+        raise InputError(f"scheduler {address}: not a Dask scheduler (it answered {head!r}...); start one with "
+                         f"'dask scheduler' (docs/scale.md)")
+
+
+def _connect_timeout() -> float:
+    """Dask's connect timeout [s] (distributed.comm.timeouts.connect), 30 s where it cannot be read."""
+    try:
+        import dask.config
+        from dask.utils import parse_timedelta
+        return float(parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s"))
+    except Exception:  # noqa: BLE001 - a hint only
+        return 30.0
 
 
 class Runner:
@@ -94,13 +174,19 @@ class Runner:
             self.client = self._stack.enter_context(distributed.Client(self._cluster))
             return
         address = self.scheduler
-        kw = {"scheduler_file": address} if os.path.isfile(address) else {"address": address}
+        if os.path.exists(address):  # a scheduler file: read here, so that a damaged one is one message
+            address = read_scheduler_file(address)
+        _probe(address)
         try:
             # the wait is Dask's own (distributed.comm.timeouts.connect, 30 s unless configured)
-            self.client = self._stack.enter_context(distributed.Client(**kw))
-        except (OSError, TimeoutError, ValueError) as e:
-            raise InputError(f"scheduler {address}: cannot connect ({e}); start one with 'dask scheduler' and "
-                             f"'dask worker ADDRESS' (docs/scale.md)") from None
+            self.client = self._stack.enter_context(distributed.Client(address=address))
+        except MemoryError:  # a reply whose first bytes, read as a length, ask for exabytes
+            raise InputError(f"scheduler {address}: cannot connect (its reply is not Dask's protocol): not a Dask "
+                             f"scheduler; start one with 'dask scheduler' (docs/scale.md)") from None
+        except Exception as e:  # noqa: BLE001 - OSError, TimeoutError, and whatever Dask raises on a reply it
+            # cannot read (an AssertionError): all mean that no scheduler can be used there
+            raise InputError(f"scheduler {address}: cannot connect ({shorten(str(e) or type(e).__name__, 200)}); "
+                             f"start one with 'dask scheduler' and 'dask worker ADDRESS' (docs/scale.md)") from None
 
     def __exit__(self, *exc):
         self._stack.close()
@@ -200,4 +286,4 @@ def progress_bar(total, label, enabled=True):
     return (lambda done: bar.update(task, completed=done)), bar.stop
 
 
-__all__ = ["Runner", "SEQUENTIAL", "check_scheduler", "batches", "auto_batch_size", "progress_bar", "is_client"]
+__all__ = ["Runner", "SEQUENTIAL", "check_scheduler", "read_scheduler_file", "batches", "auto_batch_size", "progress_bar", "is_client"]

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _io
+from .. import _args
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import PRESETS, Model, load_model
 from .cluster import Runner
@@ -67,6 +68,48 @@ def _names(paths) -> list[str]:
         used.add(name)
         names.append(name)
     return names
+
+
+def output_files(folder, datasets) -> list[str]:
+    """The files :meth:`FleetResult.write` may write into ``folder`` for these datasets (folders or
+    Dataset objects): NAME.toml and NAME.json per dataset, fleet.json and fleet.csv."""
+    paths = [getattr(d, "path", d) for d in datasets]
+    names = _names([p if p is not None else (getattr(d, "name", None) or "dataset") for p, d in zip(paths, datasets)])
+    return ([os.path.join(folder, f"{n}{ext}") for n in names for ext in (".toml", ".json")]
+            + [os.path.join(folder, f) for f in SUMMARY_FILES])
+
+
+def input_files(datasets) -> list[str]:
+    """Every file the fleet reads: each dataset folder's manifest and the experiment files it lists (read
+    from the manifest only; a manifest that cannot be read has no other files to protect)."""
+    import tomllib
+
+    files = []
+    for d in datasets:
+        folder = getattr(d, "path", d)
+        if folder is None:
+            continue
+        manifest = os.path.join(folder, "dataset.toml")
+        files.append(manifest)
+        try:
+            with open(manifest, "rb") as fh:
+                entries = tomllib.load(fh).get("experiment", [])
+        except (OSError, ValueError, RecursionError):  # (the dataset's own error is reported when it is read)
+            continue
+        for e in entries if isinstance(entries, list) else []:
+            f = e.get("file") if isinstance(e, dict) else None
+            if isinstance(f, str) and f:
+                files.append(os.path.join(folder, f))
+    return files
+
+
+def refuse_overwriting_inputs(folder, datasets, option="-o"):
+    """Exit 2 before any identification when an output in ``folder`` would be one of the fleet's input
+    files (a dataset folder named ``dataset`` with ``-o`` that folder: its ``dataset.toml``), the same file
+    by device and inode."""
+    targets = [_io.Target(f, label=f"{option} {folder}: {os.path.basename(f)}") for f in output_files(folder, datasets)
+               if os.path.isdir(folder)]
+    _io.refuse_inputs(targets, input_files(datasets))
 
 
 def _identify_one(data, method, init, kw):
@@ -217,11 +260,21 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
 
     from ..data import Dataset, load_dataset
 
+    if not isinstance(datasets, (str, os.PathLike, list, tuple)) or (
+            isinstance(datasets, (list, tuple)) and not all(isinstance(d, (str, os.PathLike, Dataset)) for d in datasets)):
+        _args.refuse("datasets", "a list of dataset folders or Datasets, or a folder of dataset folders", datasets)
+    for d in [datasets] if isinstance(datasets, (str, os.PathLike)) else datasets:
+        if not isinstance(d, Dataset):
+            _args.path(d, "datasets")  # an empty name is not the current folder
+    _args.text(method, "method")
+    if not (init is None or isinstance(init, (Model, str, os.PathLike))):
+        _args.refuse("init", "a Model, a model file or a preset name, or None", init)
+    _args.function(progress, "progress")
     if isinstance(datasets, (str, os.PathLike)):
         datasets = fleet_datasets(datasets) or [datasets]
     datasets = list(datasets)
     if not datasets:
-        raise InputError("give at least one dataset")
+        raise InputError("datasets: give at least one dataset")
     if "progress" in identify_options:
         raise InputError("progress= is the fleet's (datasets done); identify's own progress is not shown")
     paths = [d.path if isinstance(d, Dataset) else d for d in datasets]
@@ -264,4 +317,5 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
                        failures, time.perf_counter() - t0, where)
 
 
-__all__ = ["identify_fleet", "FleetResult", "fleet_datasets", "OUTLIER_Z"]
+__all__ = ["identify_fleet", "FleetResult", "fleet_datasets", "OUTLIER_Z", "output_files", "input_files",
+           "refuse_overwriting_inputs"]

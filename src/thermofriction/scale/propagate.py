@@ -23,8 +23,11 @@ import numbers
 import numpy as np
 
 from .. import _io
+from .. import _args
+from ..simulate import AutoSwitch, Dopri5, Rodas4, StepSizeController
+from ..waveforms import Waveform
 from ..errors import InputError, ThermofrictionError, shorten
-from .cluster import Runner, auto_batch_size, batches
+from .cluster import Runner, auto_batch_size, batches, check_scheduler
 
 MAX_DRAWS = 1_000_000
 
@@ -168,6 +171,23 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
 
     from ..simulate import simulate
 
+    if input is not None and not isinstance(input, Waveform):
+        _args.refuse("input", "a Waveform or None", input)
+    _args.number(duration, "duration", "s")
+    _args.number(sample_rate, "sample_rate", "Hz")
+    if solver is not None and not isinstance(solver, (str, Dopri5, Rodas4, AutoSwitch)):
+        _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
+    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
+    check_scheduler(scheduler)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        _args.refuse("workers", "a positive whole number or None", workers)
+    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, numbers.Integral)
+                                   or batch_size < 1):
+        _args.refuse("batch_size", "a positive whole number or None", batch_size)
+    _args.function(progress, "progress")
+    if isinstance(temperatures, (str, bytes)) or not (_args.is_number(temperatures) or (
+            isinstance(temperatures, (list, tuple, np.ndarray)) and all(_args.is_number(t) for t in temperatures))):
+        _args.refuse("temperatures", "a number or a list of numbers [C]", temperatures)
     model = getattr(result, "model", None)
     if model is None or not hasattr(result, "parameters"):
         raise InputError(f"result must be a fit (tf.identify's FitResult), got {shorten(result)}")

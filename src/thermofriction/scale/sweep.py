@@ -22,11 +22,13 @@ import warnings
 import numpy as np
 
 from .. import _io
+from .. import _args
+from ..simulate import AutoSwitch, Dopri5, Rodas4, StepSizeController
 from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
 from ..waveforms import Sampled, Waveform
-from .cluster import Runner, auto_batch_size, batches
+from .cluster import Runner, auto_batch_size, batches, check_scheduler
 
 #: the most points of one sweep (their coordinates and metrics are held in memory: ~100 bytes each)
 MAX_POINTS = 50_000_000
@@ -59,6 +61,7 @@ _WAVEFORM_UNITS = {"frequency": "Hz", "rise": "", "duty": "", "slew": "s", "time
 def parse_axis(text: str):
     """``NAME=START:STOP:STEP`` (STOP included when the steps reach it), ``NAME=V1,V2,...`` or
     ``NAME=V``: (name, values)."""
+    _args.text(text, "text")
     name, eq, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
     where = f"--grid {shorten(text)}"
@@ -255,9 +258,18 @@ class SweepResult:
 
 def _grid(grid):
     if isinstance(grid, (list, tuple)):  # ["temperature=30:42:0.25", ...] as on the command line
-        grid = dict(parse_axis(g) for g in grid)
+        axes = [parse_axis(g) if isinstance(g, str) else g for g in grid]
+        if not all(isinstance(a, tuple) and len(a) == 2 for a in axes):
+            raise InputError(f"grid: a list holds axes 'NAME=VALUES' (as --grid does), got {shorten(grid)}")
+        seen = {}
+        for g, (name, _) in zip(grid, axes):
+            if name in seen:  # a dict would keep the last one: the first was dropped without a word
+                raise InputError(f"--grid {shorten(g)}: the axis '{name}' is given twice (first as --grid "
+                                 f"{shorten(seen[name])}): give each axis once, all its values in one --grid")
+            seen[name] = g
+        grid = dict(axes)
     if not isinstance(grid, dict) or not grid:
-        raise InputError(f"grid must be a non-empty dict of name -> values, got {shorten(grid)}")
+        raise InputError(f"grid must be a non-empty dict of name -> values, got {type(grid).__name__} {shorten(grid)}")
     axes = {str(k): _as_axis(k, v) for k, v in grid.items()}
     n = math.prod(a.size for a in axes.values())
     if n > MAX_POINTS:
@@ -291,10 +303,19 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     """
     import time
 
-    if isinstance(model, str):
-        model = load_model(model)
-    if not isinstance(model, Model):
-        raise InputError(f"model must be a Model (or a model file / preset name), got {shorten(model)}")
+    model = _args.model(model, Model, loader=load_model)  # the argument types (_args.py): before any work
+    _args.number(duration, "duration", "s")
+    _args.number(temperature, "temperature", "degC", none=True)
+    _args.number(sample_rate, "sample_rate", "Hz")
+    if solver is not None and not isinstance(solver, (str, Dopri5, Rodas4, AutoSwitch)):
+        _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
+    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
+    check_scheduler(scheduler)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        _args.refuse("workers", "a positive whole number or None", workers)
+    _args.function(progress, "progress")
+    if not isinstance(metrics, str):
+        metrics = _args.names(metrics, "metrics", none=False)
     waveform = input if input is not None else model.input
     if waveform is None:
         raise InputError("the model has no [input]: give input= (e.g. tf.Sawtooth(amplitude=30, frequency=5))")

@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import _bridge
 from ..drive import input_of
+from .. import _args
 from ..errors import InputError, SolverError, shorten
 from ..models import Model, PrescribedMotion, StickSlipPlant
 from ..waveforms import Sampled, Waveform
@@ -192,6 +193,19 @@ def _check_arguments(model, input, controller, max_samples):
         raise InputError(f"max_samples must be a positive whole number or None, got {shorten(max_samples)}")
 
 
+def _check_types(duration, temperature, sample_rate, solver, friction_work):
+    """No coercion (_args.py): duration='2', temperature='35', sample_rate=True are refused."""
+    _args.number(duration, "duration", "s", none=True)
+    _args.number(sample_rate, "sample_rate", "Hz")
+    pair = isinstance(temperature, (tuple, list)) and len(temperature) == 2 and all(
+        isinstance(x, (list, tuple, np.ndarray)) and np.ndim(x) == 1 for x in temperature)
+    if not (temperature is None or _args.is_number(temperature) or isinstance(temperature, Sampled) or pair):
+        _args.refuse("temperature", "a number [degC], a Sampled signal or (times, values), two arrays", temperature)
+    if solver is not None and not isinstance(solver, str) and not isinstance(solver, tuple(SOLVERS.values())):
+        _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
+    _args.flag(friction_work, "friction_work")
+
+
 def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
              sample_rate: float = 10_000.0, t_eval=None, solver=None,
              controller: StepSizeController | None = None, max_samples: int | None = MAX_SAMPLES,
@@ -211,6 +225,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         heat model), returned as ``friction_work``.
     """
     _check_arguments(model, input, controller, max_samples)
+    _check_types(duration, temperature, sample_rate, solver, friction_work)
     solver = solver or AutoSwitch()
     if isinstance(solver, str):
         if solver not in SOLVERS:

@@ -75,6 +75,11 @@ class StepSizeController:
                 or self.max_steps < 1):
             raise InputError(f"max_steps must be a positive whole number, got {shorten(self.max_steps)}")
         if self.atol is not None:
+            if isinstance(self.atol, (str, bytes, bool, np.bool_)) or (
+                    isinstance(self.atol, (list, tuple)) and not all(isinstance(a, (int, float)) and not isinstance(a, bool)
+                                                                     for a in self.atol)):
+                raise InputError(f"atol must be a positive finite number (or one per state), got "
+                                 f"{type(self.atol).__name__} {shorten(self.atol)}")
             try:
                 atol = np.asarray(self.atol, dtype=float)
             except (TypeError, ValueError):

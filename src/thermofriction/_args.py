@@ -1,0 +1,156 @@
+"""Argument checks for the public Python API: one rule, one wording (docs/hardening.md#python-api-argument-types).
+
+The rule:
+
+- **An argument takes the types its documentation names, nothing else.** Anything else is an
+  :class:`~thermofriction.errors.InputError` naming the argument, what it takes and what it got
+  (``duration must be a number [s], got str '2'``), raised before any work: no ``TypeError`` or
+  ``AttributeError`` from deep inside, and no half-done run.
+- **Nothing is coerced.** A string is never read as a number (``duration='2'``), a boolean is never a
+  number (``sample_rate=True`` is not 1 Hz), a number is never a flag, a string is never a list of its
+  letters: one name where names are expected is that one name (``parameters='sigma0'`` is
+  ``['sigma0']``).
+- **Paths and names stand for objects only where the documentation says so**: a model file or preset
+  name where a function documents "a model, a model file or a preset name" (``load_model``,
+  ``identify(init=...)``, ``sweep``, ``identify_fleet``, ``export_fmu``), a solver's name (``simulate(solver='rodas4')``,
+  as ``--method rodas4``), dataset folders for ``identify_fleet``. Elsewhere a path given for a model or a
+  dataset is refused with the call that loads it (``tf.identify('/path/to/data')``: ``data must be a
+  Dataset ..., got str '/path/to/data': load the folder with tf.load_dataset('/path/to/data')``).
+"""
+
+from __future__ import annotations
+
+import numbers
+import os
+
+import numpy as np
+
+from ._io import Target
+from .errors import InputError, shorten
+
+
+def got(value) -> str:
+    """``str '2'``, ``int 42``, ``NoneType None``: the type and the value, shortened."""
+    return f"{type(value).__name__} {shorten(value)}"
+
+
+def refuse(name: str, what: str, value, hint: str = ""):
+    raise InputError(f"{name} must be {what}, got {got(value)}{': ' + hint if hint else ''}")
+
+
+def is_number(value) -> bool:
+    """A real number (int, float, NumPy's), not a boolean and not a string."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def number(value, name: str, unit: str = "", *, none: bool = False):
+    """``value`` as a float when it is a real number (None passes with ``none``); else InputError."""
+    if value is None and none:
+        return None
+    if not is_number(value):
+        refuse(name, f"a number{f' [{unit}]' if unit else ''}" + (" or None" if none else ""), value)
+    return float(value)
+
+
+def whole(value, name: str, *, none: bool = False):
+    """``value`` as an int when it is a whole number (an Integral, not a boolean); else InputError."""
+    if value is None and none:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        refuse(name, "a whole number" + (" or None" if none else ""), value)
+    return int(value)
+
+
+def flag(value, name: str) -> bool:
+    """True or False (NumPy's booleans too); a number or a string is not a flag."""
+    if not isinstance(value, (bool, np.bool_)):
+        refuse(name, "True or False", value)
+    return bool(value)
+
+
+def text(value, name: str, *, none: bool = False):
+    if value is None and none:
+        return None
+    if not isinstance(value, str):
+        refuse(name, "a string" + (" or None" if none else ""), value)
+    return value
+
+
+def function(value, name: str, *, none: bool = True):
+    if value is None and none:
+        return None
+    if not callable(value):
+        refuse(name, "a function" + (" or None" if none else ""), value)
+    return value
+
+
+def path(value, name: str, *, none: bool = False):
+    """A file or folder name: a non-empty str or os.PathLike (a bytes path is decoded)."""
+    if value is None and none:
+        return None
+    if isinstance(value, Target):  # an output the command line has checked already
+        return value
+    if isinstance(value, (str, os.PathLike)):
+        p = os.fspath(value)
+        if isinstance(p, bytes):
+            p = os.fsdecode(p)
+        if not p.strip():
+            refuse(name, "a file name", value)
+        return value
+    refuse(name, "a file name (str or pathlib.Path)" + (" or None" if none else ""), value)
+
+
+def names(value, name: str, *, none: bool = True, allow=()):
+    """A list of names: one string is one name (never its letters); a list or tuple of strings; None with
+    ``none``; objects of the types ``allow`` pass as they are (a Parameters object)."""
+    if value is None and none:
+        return None
+    if allow and isinstance(value, allow):
+        return value
+    if isinstance(value, str):
+        return [value]
+    if isinstance(value, (list, tuple, set, frozenset)) and all(isinstance(v, str) for v in value):
+        return list(value)
+    refuse(name, "a name or a list of names" + (" or None" if none else ""), value)
+
+
+def instance(value, cls, name: str, what: str, *, none: bool = False, hint: str = ""):
+    if value is None and none:
+        return None
+    if not isinstance(value, cls):
+        refuse(name, what + (" or None" if none else ""), value, hint)
+    return value
+
+
+def model(value, cls, name: str = "model", *, loader=None, none: bool = False):
+    """A model (an instance of ``cls``, :class:`~thermofriction.Model`); with a ``loader`` (``load_model``), a
+    model file or preset name is loaded. Otherwise a path is refused naming ``tf.load_model``."""
+    if value is None and none:
+        return None
+    if isinstance(value, cls):
+        return value
+    if loader is not None and isinstance(value, (str, os.PathLike)):
+        return loader(value)
+    hint = (f"load it with tf.load_model({shorten(os.fspath(value))})" if isinstance(value, (str, os.PathLike))
+            else "")
+    refuse(name, "a Model" + (", a model file or a preset name" if loader else "") + (" or None" if none else ""),
+           value, hint)
+
+
+def dataset(value, cls, name: str = "data", *, experiments: bool = False, none: bool = False):
+    """A dataset (an instance of ``cls``, :class:`~thermofriction.Dataset`; with ``experiments``, also a
+    non-empty list of experiments); a path is refused naming ``tf.load_dataset``."""
+    if value is None and none:
+        return None
+    if isinstance(value, cls):
+        return value
+    if experiments and isinstance(value, (list, tuple)) and value and all(hasattr(e, "time") for e in value):
+        return value
+    hint = (f"load the folder with tf.load_dataset({shorten(os.fspath(value))})"
+            if isinstance(value, (str, os.PathLike)) else "")
+    refuse(name, "a Dataset" + (" or a list of experiments" if experiments else "") + (" or None" if none else ""),
+           value, hint)
+
+
+__all__ = ["got", "refuse", "is_number", "number", "whole", "flag", "text", "function", "path", "names",
+           "instance", "model", "dataset"]
