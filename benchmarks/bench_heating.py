@@ -36,10 +36,10 @@ def main(argv=None):
     best = np.inf
     for _ in range(3):
         t0 = time.perf_counter()
-        avg = simulate_heating(model, duration, method=TwoTimeScale(), **kw)
+        avg = simulate_heating(model, duration, solver=TwoTimeScale(), **kw)
         best = min(best, time.perf_counter() - t0)
     t0 = time.perf_counter()
-    full = simulate_heating(model, duration, method=Full(), **kw)
+    full = simulate_heating(model, duration, solver=Full(), **kw)
     t_full = time.perf_counter() - t0
 
     n_cycles = full.stats["cycles_simulated"]

@@ -26,8 +26,8 @@ def run(frequency, duration, full=True, model=None):
     prediction (start-up from rest plus the periodic step at 30 C per cycle), on one grid."""
     model = model or tf.load_model("li2009-self-heating")
     saw = tf.Sawtooth(amplitude=30, frequency=frequency, rise=0.999)
-    avg = simulate_heating(model, duration, input=saw, temperature=T_START, method=TwoTimeScale())
-    ref = simulate_heating(model, duration, input=saw, temperature=T_START, method=Full()) if full else None
+    avg = simulate_heating(model, duration, input=saw, temperature=T_START, solver=TwoTimeScale())
+    ref = simulate_heating(model, duration, input=saw, temperature=T_START, solver=Full()) if full else None
     table = tf.heating.cycle_table(model, saw, [T_START])
     cycles = np.round(avg.time * frequency)
     warm = 6  # cycle_table's warm-up: its start-up excess applies from then on

@@ -198,7 +198,7 @@ ROWS = [
         ["t = ", "maximum number of steps", "state x_p = ", "--max-steps, now 20"]),
     Row("stiff problem, explicit method", ["simulate", "{model}", "-o", "{out}", "--duration", "5", "--sample-rate",
                                            "100", "--method", "dopri5", "--max-steps", "20000"], 1,
-        ["t = ", "(step", "dopri5", "state x = ", "looks stiff", "--method rodas4", "--method auto"], model=STIFF),
+        ["t = ", "(step", "dopri5", "state x = ", "looks stiff", "--solver rodas4", "--solver auto"], model=STIFF),
 ]
 
 

@@ -228,7 +228,7 @@ def test_two_time_scale_on_prescribed_sawtooth_sliding_is_the_exact_exponential(
     saw = tf.Sawtooth(amplitude=A, frequency=f, rise=0.5)
     heat = dataclasses.replace(HEAT, thermal_resistance=2000.0, heat_capacity=0.002)
     model = Model(PrescribedMotion(), Coulomb(fc=FC, v_smooth=1e-9), heat=heat, input=saw)
-    res = simulate_heating(model, 20.0, method=TwoTimeScale(points=5))
+    res = simulate_heating(model, 20.0, solver=TwoTimeScale(points=5))
     v = 2 * A * f  # the slope on each flank: A / (rise / f) with rise 0.5
     F = FC * math.tanh(v / 1e-9)
     np.testing.assert_allclose(res.table.cycle_work, 2 * A * F, rtol=1e-9)
@@ -246,7 +246,7 @@ def test_two_time_scale_against_the_full_simulation():
     model = tf.load_model("li2009-self-heating")
     saw = tf.Sawtooth(amplitude=30, frequency=500, rise=0.999)
     avg = simulate_heating(model, 20.0, input=saw)
-    full = simulate_heating(model, 20.0, input=saw, method=Full())
+    full = simulate_heating(model, 20.0, input=saw, solver=Full())
     np.testing.assert_array_equal(avg.time, full.time)
     assert full.temperature[-1] - 30.0 > 3.0  # it heats a lot in 20 s
     assert np.max(np.abs(avg.temperature - full.temperature)) < 5e-3

@@ -13,7 +13,7 @@ The rule:
 - **Paths and names stand for objects only where the documentation says so**: a model file or preset
   name where a function documents "a model, a model file or a preset name" (``load_model``,
   ``identify(init=...)``, ``sweep``, ``identify_fleet``, ``export_fmu``), a solver's name (``simulate(solver='rodas4')``,
-  as ``--method rodas4``), dataset folders for ``identify_fleet``. Elsewhere a path given for a model or a
+  as ``--solver rodas4``), dataset folders for ``identify_fleet``. Elsewhere a path given for a model or a
   dataset is refused with the call that loads it (``tf.identify('/path/to/data')``: ``data must be a
   Dataset ..., got str '/path/to/data': load the folder with tf.load_dataset('/path/to/data')``).
 """

@@ -1,4 +1,4 @@
-"""Self-heating over long runs (docs/models.md#self-heating): ``simulate_heating(model, duration, method=...)``.
+"""Self-heating over long runs (docs/models.md#self-heating): ``simulate_heating(model, duration, solver=...)``.
 
 Minutes of stepping at hundreds of hertz are 10^4-10^6 cycles of fast, stiff contact dynamics
 under a thermal time constant of seconds to minutes. Two methods behind one entry point:
@@ -42,18 +42,29 @@ integrate, interpolate = lazy("scipy.integrate"), lazy("scipy.interpolate")
 class TwoTimeScale:
     """Tabulate s(T), E(T) from the fast model at ``points`` temperatures (``warmup_cycles`` to reach
     the periodic state, then the mean over ``measure_cycles``), then integrate the slow heat
-    balance alone (``rtol``). The table spans the start and ambient temperatures and the steady
-    state the heat balance predicts; it grows by itself if the temperature leaves it."""
+    balance alone (at ``controller``'s relative tolerance, default 1e-8). The table spans the start and ambient
+    temperatures and the steady state the heat balance predicts; it grows by itself if the temperature leaves
+    it. (``rtol=``, the earlier way to give the tolerance, still works with a DeprecationWarning: tolerances are
+    given by a StepSizeController everywhere.)"""
 
     points: int = 17
     warmup_cycles: int = 6
     measure_cycles: int = 4
-    rtol: float = 1e-8
+    controller: StepSizeController | None = None
+    rtol: float | None = None
     name = "two-time-scale"
 
     def __post_init__(self):
         if self.points < 4 or self.warmup_cycles < 1 or self.measure_cycles < 1:
             raise InputError("TwoTimeScale: points >= 4, warmup_cycles >= 1 and measure_cycles >= 1")
+        if self.rtol is not None:
+            warnings.warn("TwoTimeScale(rtol=...) is now TwoTimeScale(controller=StepSizeController(rtol=...))",
+                          DeprecationWarning, stacklevel=3)
+
+    @property
+    def tolerance(self) -> float:
+        """The slow heat balance's relative tolerance."""
+        return self.controller.rtol if self.controller is not None else self.rtol if self.rtol is not None else 1e-8
 
 
 @dataclass(frozen=True)
@@ -172,18 +183,26 @@ def cycle_table(model: Model, input: Waveform, temperatures, warmup_cycles: int 
 
 
 def simulate_heating(model: Model, duration: float, *, input: Waveform | None = None, temperature=None,
-                     method=None, samples: int = 1000) -> HeatingResult:
+                     solver=None, samples: int = 1000, method=None) -> HeatingResult:
     """Simulates ``duration`` seconds of periodic operation of a model with a [heat] section.
 
     temperature: the ambient temperature [degC] (default: the model's T_amb).
-    method: ``TwoTimeScale()`` (default) or ``Full()``.
+    solver: ``TwoTimeScale()`` (default) or ``Full()``. (``method=``, its earlier name, still works with a
+        DeprecationWarning: ``method`` names the identification method only.)
     samples: the result holds about this many cycle starts, evenly spread.
     """
+    if method is not None:
+        warnings.warn("simulate_heating(method=...) is now simulate_heating(solver=...)", DeprecationWarning,
+                      stacklevel=2)
+        if solver is not None:
+            raise InputError("give solver= (method= is its earlier name), not both")
+        solver = method
+    method = solver
     _args.model(model, Model)
     _args.number(duration, "duration", "s")
     _args.instance(input, Waveform, "input", "a periodic Waveform", none=True)
     _args.number(temperature, "temperature", "degC", none=True)
-    _args.instance(method, (TwoTimeScale, Full), "method", "TwoTimeScale() or Full()", none=True)
+    _args.instance(method, (TwoTimeScale, Full), "solver", "TwoTimeScale() or Full()", none=True)
     _args.whole(samples, "samples")
     if model.heat is None:
         raise InputError("simulate_heating needs a model with a [heat] section (docs/models.md#self-heating)")
@@ -202,7 +221,7 @@ def simulate_heating(model: Model, duration: float, *, input: Waveform | None = 
         return _full(model, heat, waveform, n_cycles, idx, method)
     if isinstance(method, TwoTimeScale):
         return _two_time_scale(model, heat, waveform, t_samples, method)
-    raise InputError(f"method must be TwoTimeScale() or Full(), got {method!r}")
+    raise InputError(f"solver must be TwoTimeScale() or Full(), got {method!r}")
 
 
 def _full(model, heat, waveform, n_cycles, idx, method: Full) -> HeatingResult:
@@ -262,7 +281,7 @@ def _two_time_scale(model, heat, waveform, t_samples, method: TwoTimeScale) -> H
         for a, b in zip(bounds[:-1], bounds[1:]):
             if b <= a:
                 continue
-            sol = integrate.solve_ivp(rates, (a, b), y, method="LSODA", rtol=method.rtol, atol=[1e-9, 1e-15, 1e-15],
+            sol = integrate.solve_ivp(rates, (a, b), y, method="LSODA", rtol=method.tolerance, atol=[1e-9, 1e-15, 1e-15],
                             events=leaves, dense_output=True)
             if sol.status < 0:
                 raise SolverError(f"two-time-scale: the slow heat balance failed at t = {sol.t[-1]:.6g} s: "

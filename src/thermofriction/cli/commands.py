@@ -31,7 +31,7 @@ def cmd_simulate(args) -> int:
     _refuse_inputs(args, _model_inputs(args.model, model), args.temperature_file, _waveform_inputs(waveform))
     t0 = time.perf_counter()
     res = simulate(model, args.duration, temperature=temperature, input=waveform, sample_rate=args.sample_rate,
-                   solver=SOLVERS[args.method](), controller=controller, max_samples=args.max_samples)
+                   solver=SOLVERS[solver_of(args)](), controller=controller, max_samples=args.max_samples)
     elapsed = time.perf_counter() - t0
     if args.output == "-":
         import io
@@ -109,6 +109,27 @@ def _identify_options(args):
     return laws, params
 
 
+def solver_of(args) -> str:
+    """--solver; --method, its earlier name for simulate and sweep, is still read, with a note (one meaning per
+    option name: --method is identification's)."""
+    if getattr(args, "solver_old", None):
+        if args.solver not in (None, args.solver_old):
+            raise InputError(f"--method {args.solver_old} and --solver {args.solver} contradict each other")
+        print("thermofriction: note: --method is now --solver for simulate and sweep (--method names the "
+              "identification method)", file=sys.stderr)
+        return args.solver_old
+    return args.solver or "auto"
+
+
+def _offset(args):
+    """--offset, or --no-offset (its earlier spelling of "none"); None: the measurement's default."""
+    if getattr(args, "no_offset", False):
+        if args.offset not in (None, "none"):
+            raise InputError(f"--no-offset and --offset {args.offset} contradict each other")
+        return "none"
+    return args.offset
+
+
 def cmd_identify(args) -> int:
     from ..data import load_dataset
     from ..identify import identify
@@ -120,7 +141,7 @@ def cmd_identify(args) -> int:
     if getattr(args, "scheduler", None) or getattr(args, "workers", None):
         raise InputError("--scheduler and --workers apply to fleet identification (several datasets, or a folder "
                          "of datasets); one dataset is identified in this process")
-    data = load_dataset(args.dataset)
+    data = load_dataset(args.dataset, motion=args.motion)
     laws, params = _identify_options(args)
     init = args.init if args.init and args.init not in PRESETS else None
     _refuse_inputs(args, _dataset_inputs(data), init, *_model_inputs(init, None))
@@ -130,8 +151,9 @@ def cmd_identify(args) -> int:
                        free=args.free or (),
                        procedure=args.procedure,
                        laws=laws or None, refine=not args.no_refine,
-                       reference_temperature=args.reference_temperature, rtol=args.rtol, starts=args.starts,
-                       seed=args.seed, progress=update, offset=not getattr(args, "no_offset", False))
+                       reference_temperature=args.reference_temperature,
+                       controller=StepSizeController(rtol=args.rtol), starts=args.starts,
+                       seed=args.seed, progress=update, offset=_offset(args), max_evaluations=args.max_evaluations)
     finally:
         if status is not None:
             status.stop()
@@ -178,7 +200,8 @@ def cmd_identify_fleet(args) -> int:
         fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,
                                free=args.free or (), procedure=args.procedure, laws=laws or None,
                                refine=not args.no_refine, reference_temperature=args.reference_temperature,
-                               rtol=args.rtol, starts=args.starts, seed=args.seed, scheduler=args.scheduler,
+                               controller=StepSizeController(rtol=args.rtol), starts=args.starts, seed=args.seed,
+                               scheduler=args.scheduler,
                                workers=args.workers, progress=update)
     finally:
         stop()
@@ -197,9 +220,9 @@ def cmd_validate(args) -> int:
     from ..validate import validate
 
     model = load_model(args.model)
-    data = load_dataset(args.dataset)
+    data = load_dataset(args.dataset, motion=args.motion)
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
-    res = validate(model, data)
+    res = validate(model, data, offset=args.offset)
     if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
@@ -328,7 +351,7 @@ def cmd_sweep(args) -> int:
     update, stop = progress_bar(n_points, "sweep", enabled=not args.quiet)
     try:
         res = sweep(model, args.grid, input=waveform, duration=args.duration, temperature=args.temperature,
-                    metrics=args.metrics, sample_rate=args.sample_rate, solver=SOLVERS[args.method](),
+                    metrics=args.metrics, sample_rate=args.sample_rate, solver=SOLVERS[solver_of(args)](),
                     controller=StepSizeController(rtol=args.rtol), scheduler=args.scheduler, workers=args.workers,
                     batch_size=args.batch_size, progress=update)
     finally:

@@ -63,6 +63,23 @@ def _temperature(text):
     return v
 
 
+def _solver_option(p, help_text):
+    """--solver (the integrator); --method, its earlier name, still read (commands.solver_of says it is old)."""
+    p.add_argument("--solver", choices=sorted(SOLVERS), default=None, help=help_text)
+    p.add_argument("--method", dest="solver_old", choices=sorted(SOLVERS), help=argparse.SUPPRESS)
+
+
+def _force_options(p):
+    """The options of force (torque) data (docs/force-data.md) for commands that read a dataset."""
+    p.add_argument("--offset", choices=("shared", "per-experiment", "none"),
+                   help="force data: the sensor offset, one fitted for all experiments (shared, the default), one "
+                        "per experiment (a sensor re-zeroed between runs; in validate, estimated on every "
+                        "experiment, held-out ones included), or none (the model's own)")
+    p.add_argument("--motion", choices=("auto", "position", "velocity"),
+                   help="force data: what drives the model, overriding the dataset's 'motion' (default: auto, the "
+                        "velocity column where it is the position's derivative, else the position)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="thermofriction",
@@ -98,9 +115,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--sample-rate", type=_positive_float, default=10_000.0, metavar="HZ",
                    help="output sample rate [Hz] (default: 10000)")
     s.add_argument("-o", "--output", metavar="OUT.csv", help="CSV output file ('-' for standard output)")
-    s.add_argument("--method", choices=sorted(SOLVERS), default="auto",
-                   help="integrator: dopri5 (explicit), rodas4 (stiff), auto (default: dopri5, trying rodas4 "
-                        "when it detects stiffness and keeping it only where it is cheaper)")
+    _solver_option(s, "integrator: dopri5 (explicit), rodas4 (stiff), auto (default: dopri5, trying rodas4 when it "
+                      "detects stiffness and keeping it only where it is cheaper)")
     s.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
     s.add_argument("--atol", type=_positive_float, default=None,
                    help="absolute tolerance for every state (default: rtol times each state's scale)")
@@ -150,10 +166,12 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--rtol", type=_positive_float, default=1e-8,
                    help="simulation tolerance during the fit (default: 1e-8)")
     i.add_argument("--seed", type=_int_in(0), default=0, help="seed of the multi-start sample, 0 or more (default: 0)")
+    i.add_argument("--max-evaluations", type=_int_in(1, 100_000), metavar="N",
+                   help="the most model evaluations of each least-squares stage (default: the stages' own limits)")
     # force (torque) data (docs/force-data.md)
+    _force_options(i)
     i.add_argument("--no-offset", action="store_true",
-                   help="force data: do not fit the force sensor's offset (one for all experiments, fitted by "
-                        "default); hold it at the initial model's [plant] sensor_offset (default 0)")
+                   help="force data: the same as --offset none (hold the initial model's [plant] sensor_offset)")
     i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
     i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
@@ -167,6 +185,7 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("model", metavar="MODEL.toml", help="model file or preset")
     v.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
     v.add_argument("--json", metavar="METRICS.json", help="metrics as JSON (docs/formats.md#validation-metrics)")
+    _force_options(v)
     v.set_defaults(run=cmd_validate)
 
     r = sub.add_parser("report", help="an HTML report comparing models on a dataset",
@@ -262,7 +281,7 @@ def _add_sweep_command(sub):
                    help="output sample rate [Hz] the metrics are taken from (default: 10000)")
     w.add_argument("--metrics", default=",".join(DEFAULT_METRICS), metavar="NAMES",
                    help=f"comma-separated metrics (default: {','.join(DEFAULT_METRICS)})")
-    w.add_argument("--method", choices=sorted(SOLVERS), default="auto", help="integrator (default: auto)")
+    _solver_option(w, "integrator (default: auto)")
     w.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
     _scheduler_options(w)
     w.add_argument("--batch-size", type=_positive_int, metavar="N",

@@ -7,6 +7,7 @@ import dataclasses
 import math
 import numbers
 import os
+import warnings
 
 import numpy as np
 
@@ -18,6 +19,7 @@ from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
 from ..models import Model
+from ..simulate import StepSizeController
 from .parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
@@ -53,11 +55,11 @@ def _check_arguments(method, reference_temperature, rtol, starts, seed):
                              f"got {shorten(reference_temperature)}")
 
 
-@stamped  # the fitted model's name and provenance (result.py)
-@one_blas_thread  # (engine.py) for the whole procedure, whose fits run side by side
+@stamped  # the fitted model's name and provenance (provenance.py)
+@one_blas_thread  # (optimiser.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
-             refine=True, reference_temperature=None, rtol=1e-8, starts=8, seed=0, progress=None, offset=True,
-             max_evaluations=None) -> FitResult:
+             refine=True, reference_temperature=None, controller=None, starts=8, seed=0, progress=None, offset=True,
+             max_evaluations=None, rtol=None) -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
@@ -75,7 +77,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         "m_e", "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a
         plant given in its physical form).
     laws: Model I law kinds per parameter, e.g. {"sigma0": "exp"}; default: chosen by AICc.
-    rtol: the simulations' relative tolerance during the fit; starts: the multi-start size.
+    controller: a StepSizeController whose relative tolerance the fit's simulations keep (default: rtol 1e-8);
+        ``rtol=``, the earlier way to give it, still works with a DeprecationWarning. starts: the multi-start size.
     offset: force data only (docs/force-data.md): "shared" (default: one sensor offset fitted for all
         experiments), "per-experiment" (one per run: a sensor re-zeroed between runs) or "none" (or False: the
         initial model's ``[plant] sensor_offset`` held).
@@ -94,7 +97,15 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
     _args.flag(refine, "refine")
     _args.number(reference_temperature, "reference_temperature", "degC", none=True)
-    _args.number(rtol, "rtol")
+    if rtol is not None:  # the earlier spelling: tolerances are given by a StepSizeController everywhere
+        warnings.warn("identify(rtol=...) is now identify(controller=StepSizeController(rtol=...))",
+                      DeprecationWarning, stacklevel=4)  # (the user, past the two decorators)
+        _args.number(rtol, "rtol")
+        if controller is not None:
+            raise InputError("give controller= (rtol= is its earlier spelling), not both")
+        controller = StepSizeController(rtol=rtol)
+    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
+    rtol = 1e-8 if controller is None else controller.rtol
     _args.function(progress, "progress")
     if not isinstance(offset, (bool, str)):
         _args.refuse("offset", "\"shared\", \"per-experiment\", \"none\", True or False", offset)

@@ -151,12 +151,12 @@ def _explain(e: _bridge.CoreFailure, model: Model, solver, controller, waveform,
     except Exception:  # noqa: BLE001 - the input value is a courtesy, never a second error
         pass
     stiff_hint = ("the problem looks stiff: use the stiff solver, Rodas4() or AutoSwitch() "
-                  "(--method rodas4 or --method auto)")
+                  "(--solver rodas4 or --solver auto)")
     explicit = isinstance(solver, Dopri5)
     if e.status == "max_steps":
         hint = (f"{stiff_hint}; or " if e.stiff else
                 "the run is long for its time scales: " if not explicit else
-                "the run is long for its time scales or stiff (try --method rodas4 or auto): ")
+                "the run is long for its time scales or stiff (try --solver rodas4 or auto): ")
         hint += f"raise max_steps (--max-steps, now {controller.max_steps}) or shorten the duration"
     elif e.status == "nonfinite":
         hint = ("likely cause: extreme parameter or input values (an overflow) or a model that is "
