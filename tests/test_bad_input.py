@@ -197,7 +197,7 @@ ROWS = [
     Row("too many steps", [*PRESET_I, "--max-steps", "20"], 1,
         ["t = ", "maximum number of steps", "state x_p = ", "--max-steps, now 20"]),
     Row("stiff problem, explicit method", ["simulate", "{model}", "-o", "{out}", "--duration", "5", "--sample-rate",
-                                           "100", "--method", "dopri5", "--max-steps", "20000"], 1,
+                                           "100", "--solver", "dopri5", "--max-steps", "20000"], 1,
         ["t = ", "(step", "dopri5", "state x = ", "looks stiff", "--solver rodas4", "--solver auto"], model=STIFF),
 ]
 

@@ -11,7 +11,7 @@ def test_help_lists_every_simulate_option():
     out = run_cli("simulate", "--help")
     assert out.returncode == 0
     for opt in ("--temperature", "--temperature-file", "--input", "--duration", "--sample-rate", "-o",
-                "--method", "--rtol", "--atol", "--max-steps", "li2009-model-i", "sawtooth:amplitude"):
+                "--solver", "--rtol", "--atol", "--max-steps", "li2009-model-i", "sawtooth:amplitude"):
         assert opt in out.stdout
 
 

@@ -341,10 +341,6 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
     data/matlab.py: read_force_mat); None reads ``path`` as a CSV file. A drive's command (or a current times
     ``torque_constant``) in place of the friction is read by data/command.py: measured_force."""
     cols = read_force_csv(path) if columns is None else columns
-    force = np.asarray(cols["force"], float)
-    if force.size and np.ptp(force) <= 1e-12 * np.max(np.abs(force)):  # its noise estimate would be 0
-        raise InputError(f"{path}: column {cols['headers']['force']}: the force does not vary (every sample is "
-                         f"{force[0]:g}): a stuck load cell? A constant record has no friction to identify")
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
     if temperature is None:
@@ -353,6 +349,10 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
         temperature = float(np.mean(sig))
     v = cols.get("velocity")
     F, quantity, column = measured_force(path, cols, torque_constant)
+    F = np.asarray(F, float)
+    if F.size and np.ptp(F) <= 1e-12 * np.max(np.abs(F)):  # its noise estimate would be 0: nothing to weigh a fit by
+        raise InputError(f"{path}: column {column or 'friction'}: the force does not vary (every sample is "
+                         f"{F[0]:g}): a stuck load cell? A constant record has no friction to identify")
     F = -F if flip_sign else F
     source, check = choose_motion(path, t, cols["position"], v, motion, cols.get("headers"))
     drive_v = velocity_of(t, cols["position"], v if source == "velocity" else None)

@@ -16,18 +16,16 @@ from .front import MAX_STARTS, METHODS, identify
 from .laws import fit_law, segmented_fit
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
-from .optimiser import fit, one_blas_thread
-from .parameters import PLANT_UNITS, Parameter, Parameters, target_of
+from .optimiser import fit
+from .parameters import Parameter, Parameters
 from .plant import PlantFit, fit_plant, step_response
-from .problem import Problem, make_traces
-from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
-from .provenance import stamped
+from .problem import make_traces
+from .procedures import base_model, fit_friction, identify_heat
 from .result import FitResult
-from .start import force_start, lugre_start, with_friction_model
+from .start import force_start, with_friction_model
 from .uncertainty import uncertainty
 
 __all__ = ["with_friction_model", "fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter",
            "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit", "identify_model_i", "identify_model_ii",
            "identify_heat", "base_model", "make_traces", "uncertainty", "compare_friction_models", "force_start",
-           "METHODS", "MAX_STARTS", "one_blas_thread", "PLANT_UNITS", "target_of", "Problem", "default_fit_parameters",
-           "stamped", "lugre_start"]
+           "METHODS", "MAX_STARTS"]

@@ -107,7 +107,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
     rtol = 1e-8 if controller is None else controller.rtol
     _args.function(progress, "progress")
-    if not isinstance(offset, (bool, str)):
+    if not (offset is None or isinstance(offset, (bool, str))):
         _args.refuse("offset", "\"shared\", \"per-experiment\", \"none\", True or False", offset)
     _args.dataset(data, Dataset, experiments=True)
     if method not in METHODS:

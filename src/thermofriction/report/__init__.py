@@ -69,5 +69,4 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
     return text
 
 
-__all__ = ["report", "render", "render_force", "Entry", "akaike", "truth_section", "law_at", "reference_temperature",
-           "heating_report", "control_report", "PAGES"]
+__all__ = ["report", "render", "render_force", "PAGES", "Entry", "heating_report", "control_report"]
