@@ -146,8 +146,8 @@ def dataset(value, cls, name: str = "data", *, experiments: bool = False, none: 
         return value
     if experiments and isinstance(value, (list, tuple)) and value and all(hasattr(e, "time") for e in value):
         return value
-    inner = getattr(value, "experiments", None)  # a dataset-like object (a namespace with .experiments, .fit)
-    if isinstance(inner, (list, tuple)) and all(hasattr(e, "time") for e in inner) and not isinstance(value, str):
+    held = getattr(value, "experiments", None)  # a dataset-like object (its experiments), as the tests build them
+    if experiments and isinstance(held, (list, tuple)) and all(hasattr(e, "time") for e in held):
         return value
     hint = (f"load the folder with tf.load_dataset({shorten(os.fspath(value))})"
             if isinstance(value, (str, os.PathLike)) else "")

@@ -336,7 +336,6 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     _args.text(model_identifier, "model_identifier", none=True)
     _args.text(source, "source", none=True)
     _args.text(integrator, "integrator")
-    _args.number(step, "step", "s", none=True)
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)
         model = load_model(model)
