@@ -18,7 +18,7 @@ from .optimiser import fit
 from .parameters import Parameters, get_value, unit_of, with_values
 from .problem import make_traces
 from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
-                         friction_parameters, temperature_groups)
+                         friction_parameters, temperature_groups, unrefined_result)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
@@ -241,14 +241,10 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     if free:  # one plant for all temperatures: the median of the per-temperature estimates
         model = with_values(model, {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free})
     if not refine:
-        params = Parameters()
-        for n, law in new_laws.items():
-            for cname, v in zip(law.coefficient_names(), law.coefficients()):
-                params.add(f"{n}.{cname}", v, unit=unit_of(model, f"{n}.{cname}"))
-        return FitResult("model-i", model, params, np.full((0, 0), np.nan), math.nan, math.nan, 0,
-                         sum(r.nfev for _, r in per_T), sum(r.njev for _, r in per_T), 0,
-                         time.perf_counter() - t0, True, "per-temperature fits and laws (no joint refinement)",
-                         warnings=warns, details=details)
+        params = _law_parameters(new_laws, held, free, model)
+        return unrefined_result("model-i", model, params, experiments, measurement, t0, [r for _, r in per_T],
+                                "per-temperature fits and laws (no joint refinement)", warns, details,
+                                rtol=opts.get("rtol", 1e-8))
     if progress:
         progress("Model I: joint refinement of the law coefficients on all experiments")
     params = _law_parameters(new_laws, held, free, model)

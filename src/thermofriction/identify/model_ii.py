@@ -19,7 +19,7 @@ from .problem import Problem, make_traces, pool
 from .laws import aicc, segmented_fit
 from .parameters import Parameters, get_value, unit_of
 from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
-                         temperature_groups)
+                         temperature_groups, unrefined_result)
 from .result import FitResult
 
 
@@ -42,6 +42,10 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     groups = temperature_groups(experiments)
     if len(groups) < 2:
         raise InputError("Model II needs fit experiments at two or more temperatures")
+    if procedure != "direct" and len(groups) < 4:
+        raise InputError(f"Model II's paper procedure needs fit experiments at four or more temperatures (it fits "
+                         f"two straight segments to the displacement against temperature); these are at "
+                         f"{len(groups)}: use procedure 'direct'")
     if reference_temperature is None:
         ref_group = groups[0]
     else:
@@ -252,9 +256,9 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     for i, v in enumerate(law.values):
         params.add(f"dF.values[{i}]", float(v), unit="N")
     if not refine:
-        return FitResult("model-ii (direct)", model, params, np.full((len(params),) * 2, np.nan), math.nan,
-                         math.nan, 0, sum(r.nfev for _, r in per_T), 0, 0, time.perf_counter() - t0, True,
-                         "per-temperature dF and law (no joint refinement)", details=details)
+        return unrefined_result("model-ii (direct)", model, params, experiments, measurement, t0,
+                                [r for _, r in per_T], "per-temperature dF and law (no joint refinement)",
+                                details=details, rtol=opts.get("rtol", 1e-8))
     if progress:
         progress("Model II (direct): joint refinement of dF(T) and the base parameters on all experiments")
     model, params, traces, warns = _refinement(model, law, params, base, T_ref, free, experiments, measurement)

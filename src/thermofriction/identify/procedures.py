@@ -12,14 +12,14 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..models import Model, ModelI
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
-from .optimiser import fit
+from .optimiser import FitOutcome, fit
 from .parameters import Parameters, get_value, unit_of, with_values
-from .problem import make_traces
+from .problem import Problem, make_traces
 from .result import FitResult
 from .uncertainty import uncertainty
 
@@ -81,6 +81,31 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                      warnings=first + list(extra_warnings) + warns, statistics=stats, details=details or {},
                      fit_quality=overall, unit=unit, measurement=measurement.name,
                      removed=measurement.removed)
+
+
+def unrefined_result(method, model, params, experiments, measurement, t0, per_fits, message, warns=(), details=None,
+                     rtol=1e-8) -> FitResult:
+    """The result of a procedure that stops before its joint refinement (``refine=False``): the model it built
+    (laws through per-temperature fits) held against all the experiments, with the residuals, the noise check
+    and the Jacobian there, so that its RMSE, adequacy and intervals (linearized where it stopped, not at an
+    optimum) are the data's, as a refined fit's are. ``per_fits``: the fits it was built from (their
+    evaluations, and its success: every one of them converged)."""
+    traces = make_traces(experiments, model, measurement)
+    names = [p.name for p in params.varying]
+    theta = np.array([p.value for p in params.varying], float)
+    r, J = Problem(model, names, traces, rtol=rtol, parallel=len(traces) > 1).evaluate(theta, jac=True)
+    if r is None:
+        raise ComputationError(f"{method}: the model built without the joint refinement cannot be simulated on "
+                               f"the fit experiments; run with the refinement")
+    failed = [f.method for f in per_fits if not f.success]
+    success = not failed
+    if failed:
+        message = f"{message}; not converged: {', '.join(failed)}"
+    outcome = FitOutcome(theta, r, J, sum(f.nfev for f in per_fits) + 1, sum(f.njev for f in per_fits) + 1,
+                         success, message, 0, time.perf_counter() - t0)
+    return fit_result(method, model, params, outcome, traces, t0, list(warns) + [
+        "no joint refinement (refine=False): the laws pass through the per-temperature estimates; the intervals "
+        "are linearized there, not at an optimum of all the data"], details)
 
 
 def friction_parameters(model: Model, names, fixed=()) -> Parameters:
@@ -234,6 +259,6 @@ def temperature_groups(experiments):
     return groups
 
 
-__all__ = ["fit_friction", "fit_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes",
+__all__ = ["fit_friction", "fit_result", "unrefined_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes",
            "identify_heat", "temperature_groups", "FRICTION_FIT_PARAMETERS", "DEFAULT_FRICTION_PARAMETERS",
            "DEFAULT_HEAT_PARAMETERS"]

@@ -234,6 +234,8 @@ class FitResult(Result):
         for r in rows:
             lines.append("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)))
         names = [p.name for p in self.parameters.varying]
+        if np.shape(self.correlation) != (len(names), len(names)):  # no joint fit, no correlations
+            names = []
         pairs = [(names[i], names[j], self.correlation[i, j]) for i in range(len(names))
                  for j in range(i + 1, len(names)) if np.isfinite(self.correlation[i, j])
                  and abs(self.correlation[i, j]) > 0.5]
