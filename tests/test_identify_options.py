@@ -62,7 +62,8 @@ def test_model_i_with_each_option_ends_cleanly(model_i_data, options):
     res = tf.identify(model_i_data, "model-i", **options)
     # the truth's fc falls by 5x over the 10 C: a straight line cannot follow it, and the fit must say so
     wrong_law = options.get("laws", {}).get("fc") == "linear"
-    d = _check_result(res, right_model=not wrong_law)
+    # an elasto-plastic start holds z_ba at a value the LuGre truth (z_ba = 0) does not have: not the right model
+    d = _check_result(res, right_model=not wrong_law and "friction" not in options)
     if wrong_law:
         assert res.adequate is False
     if options.get("refine") is False:
@@ -85,7 +86,7 @@ def test_model_ii_with_each_option_ends_cleanly(model_ii_data, options):
         assert res.n_points == 0 and "no trajectory fit" in res.report()
         assert res.fit_quality is None
         return
-    _check_result(res)
+    _check_result(res, right_model="friction" not in options)
     assert res.success, res.message
     if options.get("procedure") == "both":
         assert "paper" in res.alternatives and res.alternatives["paper"].report()
