@@ -126,7 +126,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
                                 refine=refine, progress=progress, free=free, measurement=measurement,
                                 parameters=parameters, **opts)
     res = finish(res, experiments, init, measurement)
-    #HELD res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
+    res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
     held = list(getattr(data, "validate", None) or [])
     return _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
 

@@ -202,9 +202,9 @@ class FitResult(Result):
         lines = [f"[[Fit: {self.method}]]"]
         held = [h for h in (self.fit_quality or {}).get("held") or [] if h["contradicted"]]
         if self.adequate is False:  # first, in plain words
-            lines.append(f"    NOT ADEQUATE: " + (f"{len(held)} held value(s) contradicted by the data (see the first "
-                         f"warnings)" if held else f"residuals {self.fit_quality['ratio']:.3g} x the measurement "
-                         f"noise (see the first warning)"))
+            lines.append(f"    NOT ADEQUATE: residuals {self.fit_quality['ratio']:.3g} x the measurement noise"
+                         + (f", {len(held)} held value(s) contradicted by the data" if held else "")
+                         + " (see the first warnings)")
         if self.n_points == 0 and "paper" in self.details:  # no trajectory fit: say what was done instead
             lines += [f"    {'done' if self.success else 'REFUSED'}: {self.message}"] + self._paper_lines()
         else:
