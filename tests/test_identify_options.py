@@ -63,7 +63,9 @@ def test_model_i_with_each_option_ends_cleanly(model_i_data, options):
     # the truth's fc falls by 5x over the 10 C: a straight line cannot follow it, and the fit must say so
     wrong_law = options.get("laws", {}).get("fc") == "linear"
     # an elasto-plastic start holds z_ba at a value the LuGre truth (z_ba = 0) does not have: not the right model
-    d = _check_result(res, right_model=not wrong_law and "friction" not in options)
+    # (without the refinement the laws pass through per-temperature fits, not an optimum of all the data: its
+    # verdict is its own, checked for consistency only)
+    d = _check_result(res, right_model=not wrong_law and "friction" not in options and options.get("refine", True))
     if wrong_law:
         assert res.adequate is False
     if options.get("refine") is False:

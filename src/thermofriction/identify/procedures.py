@@ -70,7 +70,9 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
         bad = [p["file"] for p, q in zip(per, qualities) if q["adequate"] is False]
         first.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
                         f"noise estimated from the data ({amount(overall['rmse'], unit)} against "
-                        f"{amount(overall['noise'], unit)}; not adequate in {len(bad)} of {len(per)} experiments): "
+                        f"{amount(overall['noise'], unit)}, where a right model gives at most "
+                        f"{overall['threshold']:.3g} times on these samples; not adequate in {len(bad)} of "
+                        f"{len(per)} experiments): "
                         f"the model misses what the data show. Try: {measurement.advice(model)}")
     cost = float(outcome.r @ outcome.r)
     warns += _unsupported_excess(params, corr, unit)
