@@ -153,7 +153,7 @@ def held_tests(res, experiments, measurement, rtol=1e-8) -> list:
         if df:
             out.append({"name": label, "value": value, "statistic": stat, "dof": df,
                         "p_value": float(special.chdtrc(df, stat)) * (0.5 if floor and stat > 0 else 1.0),
-                        "misfit_share": stat * s2tau / max(float(r @ r), 1e-300)})
+                        "misfit_share": stat * s2tau / max(float(r @ r), 1e-300), "_columns": cols, "_J": J[:, :p]})
     for i, t in enumerate(out):  # held values that move the data the same way (m and m_e on a modal plant): one
         t["same_as"] = next((u["name"] for u in out[:i] if u["dof"] == t["dof"]
                              and abs(u["statistic"] - t["statistic"]) <= 1e-6 * max(t["statistic"], 1e-300)), None)
@@ -172,6 +172,49 @@ def held_tests(res, experiments, measurement, rtol=1e-8) -> list:
     return sorted(out, key=lambda t: (t["same_as"] is not None, t["p_value"], order[t["name"]]))
 
 
+#: the stated prior range of a law held for lack of information: its level within a factor PRIOR_FACTOR either way
+#: (95 %), as a normal prior on the law's log scale
+PRIOR_FACTOR = 3.0
+
+
+def _consider(res, tests):
+    """The fitted parameters' covariance with the uncertainty of the laws held for lack of information added (a
+    consider covariance): each held law's level, within a factor PRIOR_FACTOR either way (95 %), shifts the fitted
+    parameters by G = -J^+ j (j: the sensitivity to the law's log scale), so cov += G G^T sd^2. Intervals,
+    standard errors and correlations are updated; the report says what was included."""
+    varying = res.parameters.varying
+    se = np.array([p.stderr for p in varying], float)
+    if not varying or not np.all(np.isfinite(se)) or res.correlation.shape != (len(varying),) * 2:
+        return
+    cov = np.nan_to_num(res.correlation) * np.outer(se, se)
+    sd = math.log(PRIOR_FACTOR) / 1.959964
+    for t in tests:
+        law = res.model.laws[t["name"]]
+        c = np.array(law.coefficients(), float)
+        scale = np.r_[c[0], np.zeros(len(c) - 1)] if law.kind == "exp" else c
+        j = t["_columns"] @ scale
+        G = -np.linalg.lstsq(t["_J"], j, rcond=None)[0]
+        cov = cov + np.outer(G, G) * sd ** 2
+    se_new = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    tq = float(special.stdtrit(max(res.statistics.get("effective_samples", 1e6) - len(varying), 1.0), 0.975))
+    for par, s in zip(varying, se_new):
+        par.stderr = float(s)
+        if par.positive and par.value > 0:
+            f = math.exp(min(tq * s / par.value, 700.0))
+            par.ci95 = (par.value / f, par.value * f)
+        else:
+            par.ci95 = (par.value - tq * s, par.value + tq * s)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        res.correlation = cov / np.outer(se_new, se_new)
+    names = ", ".join(t["name"] for t in tests)
+    grown = max(se_new / np.where(se > 0, se, np.inf))
+    res.warnings.append(f"{names} could not be determined and {'is' if len(tests) == 1 else 'are'} held at the initial "
+                        f"model's law; the intervals include {'its' if len(tests) == 1 else 'their'} level within a "
+                        f"stated factor {PRIOR_FACTOR:g} either way (95 %): standard errors up to {grown:.3g} times "
+                        f"those with it held exactly")
+    res.details["considered"] = {"parameters": [t["name"] for t in tests], "prior_factor": PRIOR_FACTOR}
+
+
 def with_held_tests(res, experiments, measurement, rtol=1e-8):
     """``res`` with ``fit_quality["held"]``; a contradicted held value makes the fit not adequate and is said
     first in its warnings (second, after the residuals' own "not adequate", where they are far above the noise)."""
@@ -184,6 +227,9 @@ def with_held_tests(res, experiments, measurement, rtol=1e-8):
     res.fit_quality["held"] = [{k: t[k] for k in ("name", "value", "statistic", "dof", "p_value", "misfit_share",
                                                   "contradicted")} for t in tests]
     bad = [t for t in tests if t["contradicted"] and t["same_as"] is None]
+    lack = [t for t in tests if t["name"] in (res.details.get("held_for_lack_of_information") or ())]
+    if lack:
+        _consider(res, lack)
     if bad:
         # after the residuals' own verdict where that already says not adequate (a model far off: the held
         # directions then share out a misfit they do not all cause), else first

@@ -285,7 +285,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     per_temperature = _PerTemperature(init, names, free, opts, measurement, progress)
     per_T = per_temperature.run(groups)
     held, warns = per_temperature.held, per_temperature.warnings
-    details = {"per_temperature": [
+    details = {"held_for_lack_of_information": list(held), "per_temperature": [
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
          "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
     new_laws, details["laws"] = _laws_through(per_T, names, held, init, laws)

@@ -74,6 +74,9 @@ class FitResult(Result):
         value = np.asarray(law_of(self.model)(T), float)
         names = [p.name for p in self.parameters.varying]
         own = [i for i, n in enumerate(names) if n.startswith(name + ".")]
+        considered = self.details.get("considered") or {}
+        if not own and name in considered.get("parameters", ()):  # held for lack of information: its stated range
+            return value, value / considered["prior_factor"], value * considered["prior_factor"]
         if not own:
             return value, value.copy(), value.copy()
         theta = np.array([self.parameters[names[i]].value for i in own])
