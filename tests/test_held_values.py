@@ -90,3 +90,37 @@ def test_at_the_truth_the_score_statistic_is_chi_squared__analytic():
         p = len(fitted)
         stats += [_score(r, J[:, :p], J[:, p + i:p + i + 1], s2)[0] for i in range(len(held))]
     assert 0.18 < np.mean(stats) < 2.3, stats
+
+
+def test_a_law_held_for_lack_of_information_reaches_the_other_intervals__reference_truth():
+    """A Stribeck truth whose sigma1 the data cannot determine at the first temperature (random levels, seed 1 of
+    tests/coverage_study.py): sigma1 is held at the start's law (2x the truth's), and with the held law's level given
+    a stated factor-3 range its interval covers the truth, the others' intervals widen (consider covariance), and
+    every fitted law's interval covers the truth at every fit temperature."""
+    from coverage_study import stribeck
+    row = stribeck(1)
+    assert row["held"] == ["sigma1"], row
+    assert row["covered"] == row["points"], row["missed"]
+
+
+def test_the_consider_covariance_widens_by_the_held_directions_share__analytic():
+    """G G^T sd^2 with G = -J^+ j: for J = [e1] and j = e1 + e2 (half of j along the fitted direction), the fitted
+    parameter moves by -1 per unit of the held one: its variance grows by sd^2 exactly."""
+    from types import SimpleNamespace
+
+    from thermofriction.identify.held import PRIOR_FACTOR, _consider
+    from thermofriction.identify.parameters import Parameters
+    from thermofriction.models import Linear
+
+    params = Parameters()
+    params.add("fc.b", 1.0)
+    params["fc.b"].stderr = 0.1
+    res = SimpleNamespace(parameters=params, correlation=np.eye(1), statistics={"effective_samples": 1e6},
+                          model=SimpleNamespace(laws={"sigma1": Linear(0.0, 2.0)}), warnings=[], details={})
+    J = np.array([[1.0], [0.0]])
+    cols = np.array([[0.0, 0.5], [0.0, 0.5]])  # d r / d (a, b) of sigma1's law; its log scale: b * column b
+    _consider(res, [{"name": "sigma1", "_columns": cols, "_J": J}])
+    sd = np.log(PRIOR_FACTOR) / 1.959964
+    assert params["fc.b"].stderr == pytest.approx(np.sqrt(0.1 ** 2 + sd ** 2), rel=1e-9)
+    assert res.details["considered"] == {"parameters": ["sigma1"], "prior_factor": PRIOR_FACTOR}
+    assert "stated factor 3" in res.warnings[0]
