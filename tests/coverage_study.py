@@ -25,24 +25,38 @@ def masses_freed(seed) -> dict:
         fit = tf.identify(data, "model-i", init=plant_only_file(truth, d), free=["m_e"])
     rows = fit.recovery(truth, TEMPERATURES)
     lo, hi = fit.parameters["m_e"].ci95
-    return {"scenario": "masses freed", "seed": seed, "covered": sum(r["covered"] for r in rows)
+    return {"scenario": "masses freed", "seed": seed, "fc_error": _level_error(fit, truth, TEMPERATURES),
+            "covered": sum(r["covered"] for r in rows)
             + int(lo <= truth.plant.end_effector_mass <= hi), "points": len(rows) + 1,
             "held": fit.details.get("held_for_lack_of_information"), "adequate": fit.adequate,
             "missed": [(r["parameter"], r["temperature"]) for r in rows if not r["covered"]]}
 
 
-def stribeck(seed) -> dict:
+def _level_error(fit, truth, temperatures, name="fc") -> float:
+    return max(abs(fit.model.parameters_at(T)[name] / truth.parameters_at(T)[name] - 1) for T in temperatures)
+
+
+def stribeck(seed, heavy=False) -> dict:
+    """``heavy``: the truth's end-effector mass twice the start's (0.1 kg against 0.05), freed."""
     rng = np.random.default_rng(seed)
-    base = stribeck_truth()
+    base = stribeck_truth(end_effector_mass=0.1 if heavy else None)
     level = {n: float(rng.uniform(0.8, 1.25)) for n in base.laws}
     level["fs"] = level["fc"]
     laws = {n: Linear(l.a * level[n], l.b * level[n], range=l.range) for n, l in base.laws.items()}
     truth = tf.Model(base.plant, base.friction, ModelI(laws), base.input)
     data = reference_experiments(truth, seed=seed)
-    fit = tf.identify(data, "model-i", init=start_from(truth, {"sigma0": 2.5, "sigma1": 2.0, "fc": 0.45, "fs": 0.45}),
-                      parameters=["sigma0", "sigma1", "fc", "fs"])
+    start = start_from(truth, {"sigma0": 2.5, "sigma1": 2.0, "fc": 0.45, "fs": 0.45},
+                       plant=tf.load_model("li2009-model-i").plant if heavy else None)
+    fit = tf.identify(data, "model-i", init=start, parameters=["sigma0", "sigma1", "fc", "fs"],
+                      free=["m_e"] if heavy else ())
     rows = fit.recovery(truth, FIT_T)
-    return {"scenario": "stribeck", "seed": seed, "covered": sum(r["covered"] for r in rows), "points": len(rows),
+    extra = {}
+    if heavy:
+        lo, hi = fit.parameters["m_e"].ci95
+        extra = {"m_e_error": fit.parameters["m_e"].value / 0.1 - 1, "m_e_covered": bool(lo <= 0.1 <= hi)}
+    return {"scenario": "stribeck" + (", m_e 2x freed" if heavy else ""), "seed": seed,
+            "fc_error": _level_error(fit, truth, FIT_T), "fs_error": _level_error(fit, truth, FIT_T, "fs"), **extra,
+            "covered": sum(r["covered"] for r in rows), "points": len(rows),
             "held": fit.details.get("held_for_lack_of_information"), "adequate": fit.adequate,
             "missed": [(r["parameter"], r["temperature"]) for r in rows if not r["covered"]]}
 
@@ -50,7 +64,7 @@ def stribeck(seed) -> dict:
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 6
     table = {}
-    for make in (masses_freed, stribeck):
+    for make in (masses_freed, stribeck, lambda s: stribeck(s, heavy=True)):
         for seed in range(n):
             r = make(seed)
             print(r, flush=True)
