@@ -63,6 +63,20 @@ def test_a_missing_stribeck_effect_is_contradicted__reference_truth():
     assert any("no Stribeck effect" in w and "fs,vs" in w for w in res.warnings[:3])
 
 
+def test_a_missing_stribeck_effect_under_model_i_is_contradicted__reference_truth():
+    """Issue 30's case: the Stribeck truth fitted by Model I from a plain LuGre start 2-3x off was called adequate
+    (rmse/noise 1.08). fs held at fc (following fc's law) is now tested along fc's law at three vs: contradicted,
+    said first, the fit not adequate."""
+    truth = stribeck_truth()
+    data = reference_experiments(truth, seed=3)
+    res = tf.identify(data, "model-i", init=start_from(truth, {"sigma0": 2.5, "sigma1": 2.0, "fc": 0.45}))
+    fs = _held(res, "fs")
+    assert fs["contradicted"] and fs["p_value"] < 1e-12, fs
+    assert res.adequate is False
+    first = 0 if res.fit_quality["ratio"] <= res.fit_quality["threshold"] else 1
+    assert res.warnings[first].startswith("fs held at fc (no Stribeck effect) is contradicted by the data")
+
+
 def test_the_right_model_is_not_flagged__reference_truth():
     """The Stribeck truth fitted with fs and its laws (vs, delta, sigma2 and the masses held at the truth's): no
     held value contradicted, the fit adequate."""
