@@ -81,6 +81,9 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         initial model's ``[plant] sensor_offset`` held).
     max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
 
+    After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
+    (identify/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
+
     What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
     it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
     """
