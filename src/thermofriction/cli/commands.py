@@ -100,8 +100,8 @@ def _identify_options(args):
             raise InputError(f"--law '{item}': expected PARAM=linear|exp|const")
         laws[name.strip()] = kind
     params = [p.strip() for p in args.parameters.split(",")] if args.parameters else None
-    if params and args.method != "base":
-        raise InputError("--parameters applies to --method base only")
+    if params and args.method == "plant":
+        raise InputError("--parameters applies to the friction methods; --method plant fits xi, wn and K")
     if args.reference_temperature is not None and args.method != "model-ii":
         raise InputError("--reference-temperature applies to --method model-ii only")
     if args.rtol >= 1:

@@ -148,8 +148,9 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--init", metavar="MODEL.toml",
                    help="initial model: file or preset (default: the paper's preset for the method)")
     i.add_argument("--parameters", metavar="NAMES",
-                   help="comma-separated parameters to fit with --method base (default: the friction model's, "
-                        "LuGre's sigma0,sigma1,fc)")
+                   help="comma-separated friction parameters to fit (default: the friction model's, LuGre's "
+                        "sigma0,sigma1,fc), any of the model's: e.g. sigma0,sigma1,fc,fs,vs; with --method model-i "
+                        "each gets its own temperature law, with model-ii they are the base parameters")
     i.add_argument("--free", metavar="NAMES",
                    help="plant parameters to fit too, one value shared by all experiments, comma-separated: m_e, m "
                         "(the masses), xi, wn, K (c, k, T_em for a plant in physical form); e.g. --free m_e,m")

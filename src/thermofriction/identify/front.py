@@ -15,6 +15,7 @@ from .. import _args
 from ..data.experiments import TEMPERATURE_RANGE, Dataset
 from ..errors import InputError, ThermofrictionError, shorten
 from ..measurements import amount, measurement_of
+from .held import with_held_tests
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
@@ -70,8 +71,11 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     friction: the friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb);
         default the initial model's. When it differs, the initial friction model is built from the
         initial model's values (:func:`with_friction_model`).
-    parameters: names (or a Parameters object) to fit for "base"; default the friction model's
-        (procedures.FRICTION_FIT_PARAMETERS; LuGre: sigma0, sigma1, fc).
+    parameters: the friction parameters to fit (any of the friction model's: fs, vs, sigma2, delta, z_ba, ...);
+        default the friction model's (procedures.FRICTION_FIT_PARAMETERS; LuGre: sigma0, sigma1, fc). "base" also
+        takes a Parameters object; Model I fits each named one with its own law (any other with a law in the
+        initial model keeps it, held); Model II fits them as its base parameters. fs is fitted as its excess
+        over fc, in log space, so that fs >= fc holds by construction.
     procedure: Model II's "direct" (default), "paper" or "both".
     free: plant parameters fitted too, in any method but "plant", one value shared by all experiments:
         "m_e", "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a
@@ -83,6 +87,9 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         experiments), "per-experiment" (one per run: a sensor re-zeroed between runs) or "none" (or False: the
         initial model's ``[plant] sensor_offset`` held).
     max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
+
+    After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
+    (identify/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
 
     What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
     it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
@@ -146,11 +153,13 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         if init.thermal is not None and not hasattr(init.thermal, "laws"):
             init = base_model(init)
         res = identify_model_i(experiments, init, laws=laws, refine=refine, progress=progress, free=free,
-                               measurement=measurement, **opts)
+                               measurement=measurement, parameters=parameters, **opts)
     else:
         res = identify_model_ii(experiments, init, procedure=procedure, reference_temperature=reference_temperature,
-                                refine=refine, progress=progress, free=free, measurement=measurement, **opts)
+                                refine=refine, progress=progress, free=free, measurement=measurement,
+                                parameters=parameters, **opts)
     res = finish(res, experiments, init, measurement)
+    res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
     held = list(getattr(data, "validate", None) or [])
     return _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
 

@@ -10,15 +10,15 @@ import time
 import numpy as np
 
 from .._lazy import lazy
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
 from ..models.friction import in_domain
 from .laws import fit_law
 from .optimiser import fit
-from .parameters import Parameters, get_value, unit_of, with_values
+from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
 from .problem import make_traces
 from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
-                         friction_parameters, temperature_groups)
+                         fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
@@ -131,10 +131,14 @@ class _PerTemperature:
             shifts = {n: float(init.laws[n](T) / init.laws[n](T_prev)) for n in names
                       if n in init.laws and n not in held}
             shifts = {n: f for n, f in shifts.items() if math.isfinite(f) and f > 0}
-            if shifts:
-                values = base.friction.values()
-                base = base.with_friction(**{n: values[n] * f for n, f in shifts.items()})
-        base = dataclasses.replace(base, thermal=None)
+            values = base.friction.values()
+            new = {n: values[n] * f for n, f in shifts.items()}
+            # a parameter held with a law follows it (not carried from the neighbour); fs carries its excess over fc
+            new.update({n: float(init.laws[n](T)) for n in init.laws if n not in names})
+            if "fs" in names and "fs" not in new and (values.get("fs") or 0.0) > (values.get("fc") or math.inf):
+                new["fs"] = new.get("fc", values["fc"]) + values["fs"] - values["fc"]
+            base = base.with_friction(**new) if new else base
+        base = stribeck_start(dataclasses.replace(base, thermal=None), names)
         if held:  # parameters the data cannot determine follow the initial model's law
             base = base.with_friction(**{n: base_model(init, T).friction.values()[n] for n in held})
         return base
@@ -151,28 +155,60 @@ class _PerTemperature:
         first = dict(self.opts)
         if previous is not None and neighbour:  # continuation from the neighbouring temperature
             first["starts"] = 1
-        res = fit_friction(group, base, friction_parameters(base, names + free, fixed=self.held),
-                           method=f"base at {T:.4g} C", measurement=self.measurement, **first)
+        res = self.fit_one(group, T, base, self.held, first)
         if first_of_all:
-            undetermined = [n for n in names if not math.isfinite(res.parameters[n].stderr)
-                            or res.parameters[n].stderr > abs(res.parameters[n].value)]
+            undetermined = [n for n in names if not math.isfinite(_fitted(res, n).stderr)
+                            or _fitted(res, n).stderr > abs(_fitted(res, n).value)]
             if undetermined and len(undetermined) < len(names):
                 self.held = undetermined
                 self.warnings.append(f"{', '.join(undetermined)} cannot be determined from these data (standard "
                                      f"error above 100 % at {T:.4g} C): held at the initial model's law")
-                res = fit_friction(group, base.with_friction(**{n: base_model(init, T).friction.values()[n]
-                                                                for n in undetermined}),
-                                   friction_parameters(base, names + free, fixed=undetermined),
-                                   method=f"base at {T:.4g} C", measurement=self.measurement, **self.opts)
+                res = self.fit_one(group, T, base.with_friction(**{n: base_model(init, T).friction.values()[n]
+                                                                   for n in undetermined}), undetermined, self.opts)
         # continuation carries only what this temperature determined: a parameter the data leave open
         # (standard error above its value, e.g. sigma1 run to its bound) restarts from the initial model,
         # or the next fit spends most of its evaluations walking back from a bound
-        open_ = [n for n in names if n in res.parameters and n not in self.held
-                 and not (res.parameters[n].stderr is not None and math.isfinite(res.parameters[n].stderr)
-                          and res.parameters[n].stderr < abs(res.parameters[n].value))]
+        open_ = [n for n in names if n not in self.held and not (
+            _fitted(res, n).stderr is not None and math.isfinite(_fitted(res, n).stderr)
+            and _fitted(res, n).stderr < abs(_fitted(res, n).value))]
         at_T = base_model(init, T).friction.values()
-        following = res.model.with_friction(**{n: at_T[n] for n in open_ if n in at_T}) if open_ else res.model
+        reset = {n: at_T[n] for n in open_ if n in at_T and n != "fs"}
+        if "fs" in open_ and "fs" in at_T:  # fs by its excess over fc (fs >= fc)
+            fc = reset.get("fc", res.model.friction.values()["fc"])
+            reset["fs"] = fc + max(at_T["fs"] - at_T["fc"], 0.0)
+        following = res.model.with_friction(**reset) if reset else res.model
         return T, res, (T, following)
+
+    def fit_one(self, group, T, base, fixed, opts):
+        """One temperature's fit (fs as its excess over fc); a fit that fails names the temperature, the
+        parameters and where it started, as a failed computation (never as an error of the user's file)."""
+        names = self.names + self.free
+        try:
+            return fit_friction(group, base, friction_parameters(base, names, fixed=fixed, excess=True),
+                                method=f"base at {T:.4g} C", measurement=self.measurement, **opts)
+        except (InputError, ComputationError) as e:
+            start = ", ".join(f"{n} = {get_value(base, n):.4g}" for n in names)
+            raise ComputationError(f"Model I: the fit at {T:.4g} C of {', '.join(n for n in names if n not in fixed)} "
+                                   f"failed, from {start} (continued from the neighbouring temperature's fit along the "
+                                   f"initial model's laws, with {opts.get('starts', 8)} start(s)): {e}") from e
+
+
+def _fitted(res, name):
+    """The fitted Parameter of ``name`` (fs: its excess over fc, where it was fitted as one)."""
+    return res.parameters[EXCESS] if name == "fs" and EXCESS in res.parameters else res.parameters[name]
+
+
+def _estimate(res, name):
+    """(value, standard error) of ``name`` at one temperature; fs from fc and the excess (delta method)."""
+    if not (name == "fs" and EXCESS in res.parameters):
+        return res.parameters[name].value, res.parameters[name].stderr
+    x, fc = res.parameters[EXCESS], res.parameters["fc"]
+    se_x, se_fc = x.stderr or 0.0, (fc.stderr or 0.0) if fc.vary else 0.0
+    varying = [p.name for p in res.parameters.varying]
+    rho = 0.0
+    if fc.vary and res.correlation.shape == (len(varying),) * 2:
+        rho = float(np.nan_to_num(res.correlation[varying.index(EXCESS), varying.index("fc")]))
+    return x.value + fc.value, math.sqrt(max(se_x ** 2 + se_fc ** 2 + 2 * rho * se_x * se_fc, 0.0))
 
 
 def _laws_through(per_T, names, held, init, laws):
@@ -185,8 +221,8 @@ def _laws_through(per_T, names, held, init, laws):
             new_laws[n] = init.laws[n] if n in init.laws else Const(init.friction.values()[n])
             law_tables[n] = {"chosen": "held at the initial model", "law": new_laws[n].to_dict()}
             continue
-        vals = np.array([r.parameters[n].value for _, r in per_T])
-        ses = np.array([r.parameters[n].stderr for _, r in per_T])
+        vals = np.array([_estimate(r, n)[0] for _, r in per_T])
+        ses = np.array([_estimate(r, n)[1] for _, r in per_T])
         kinds = (laws or {}).get(n)
         kinds = (kinds,) if isinstance(kinds, str) else (kinds or ("linear", "exp"))
         prefer = init.laws[n].kind if n in init.laws else None
@@ -216,39 +252,58 @@ def _law_parameters(new_laws, held, free, model) -> Parameters:
     return params
 
 
+def _above_fc(new_laws, per_T, Ts):
+    """fs's law kept at or above fc's over the fit temperatures: where the laws through the estimates cross, fs's
+    becomes fc's scaled by the estimates' median ratio fs/fc (at least 1). Returns a warning, or None."""
+    if "fs" not in new_laws or "fc" not in new_laws:
+        return None
+    grid = np.linspace(float(Ts.min()), float(Ts.max()), 41)
+    fs, fc = new_laws["fs"], new_laws["fc"]
+    if np.all(np.asarray(fs(grid)) >= np.asarray(fc(grid))) or not fc.coefficient_names():
+        return None
+    ratio = max(float(np.median([_estimate(r, "fs")[0] / r.parameters["fc"].value for _, r in per_T])), 1.0)
+    c = np.array(fc.coefficients(), float)
+    c = np.r_[c[0] * ratio, c[1:]] if fc.kind == "exp" else c * ratio
+    new_laws["fs"] = fc.with_coefficients(c)
+    return (f"fs's law through the per-temperature estimates fell below fc's: fs follows fc's law times their median "
+            f"ratio {ratio:.4g} instead, as the joint refinement's start")
+
+
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
-                     **opts) -> FitResult:
+                     parameters=None, **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
     ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
-    ``free``: plant parameters (e.g. m_e) fitted too, one value shared by all experiments (per
-    temperature first; their median starts the joint refinement)."""
+    ``parameters``: the friction parameters fitted (default :func:`default_fit_parameters`), each with its
+    own law; any other with a law in ``init`` keeps it, held. ``free``: plant parameters (e.g. m_e) fitted
+    too, one value shared by all experiments (per temperature first; their median starts the joint refinement)."""
     free = list(free)
     t0 = time.perf_counter()
     groups = temperature_groups(experiments)
     if len(groups) < 2:
         raise InputError("Model I needs fit experiments at two or more temperatures")
-    names = default_fit_parameters(init)
+    names = fitted_names(init, parameters)
     per_temperature = _PerTemperature(init, names, free, opts, measurement, progress)
     per_T = per_temperature.run(groups)
     held, warns = per_temperature.held, per_temperature.warnings
-    details = {"per_temperature": [
+    details = {"held_for_lack_of_information": list(held), "per_temperature": [
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
          "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
     new_laws, details["laws"] = _laws_through(per_T, names, held, init, laws)
     Ts = np.array([T for T, _ in per_T])
-    friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in names})
+    crossed = _above_fc(new_laws, per_T, Ts)
+    warns += [crossed] if crossed else []
+    kept = {n: law for n, law in init.laws.items() if n not in names}  # held with their laws
+    held = held + list(kept)
+    new_laws = {**new_laws, **kept}
+    friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in new_laws})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
     if free:  # one plant for all temperatures: the median of the per-temperature estimates
         model = with_values(model, {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free})
     if not refine:
-        params = Parameters()
-        for n, law in new_laws.items():
-            for cname, v in zip(law.coefficient_names(), law.coefficients()):
-                params.add(f"{n}.{cname}", v, unit=unit_of(model, f"{n}.{cname}"))
-        return FitResult("model-i", model, params, np.full((0, 0), np.nan), math.nan, math.nan, 0,
-                         sum(r.nfev for _, r in per_T), sum(r.njev for _, r in per_T), 0,
-                         time.perf_counter() - t0, True, "per-temperature fits and laws (no joint refinement)",
-                         warnings=warns, details=details)
+        params = _law_parameters(new_laws, held, free, model)
+        return unrefined_result("model-i", model, params, experiments, measurement, t0, [r for _, r in per_T],
+                                "per-temperature fits and laws (no joint refinement)", warns, details,
+                                rtol=opts.get("rtol", 1e-8))
     if progress:
         progress("Model I: joint refinement of the law coefficients on all experiments")
     params = _law_parameters(new_laws, held, free, model)

@@ -11,15 +11,15 @@ import time
 import numpy as np
 
 from ..drive import experiment_waveform
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..models import PWL, Const, Model, ModelII
 from ..simulate import simulate
 from .optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
 from .problem import Problem, make_traces, pool
 from .laws import aicc, segmented_fit
-from .parameters import Parameters, get_value, unit_of
+from .parameters import Parameters
 from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
-                         temperature_groups)
+                         fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 
@@ -30,7 +30,7 @@ def _final_displacement(exp):
 
 
 def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True, free=(),
-                      progress=None, measurement=None, **opts) -> FitResult:
+                      progress=None, measurement=None, parameters=None, **opts) -> FitResult:
     """Model II. ``procedure="paper"``: base model at the reference temperature; displacement
     against temperature by a segmented linear fit with an estimated breakpoint; displacement
     against dF by simulation; composed dF(T). ``"direct"``: dF fitted per temperature on the
@@ -42,6 +42,10 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     groups = temperature_groups(experiments)
     if len(groups) < 2:
         raise InputError("Model II needs fit experiments at two or more temperatures")
+    if procedure != "direct" and len(groups) < 4:
+        raise InputError(f"Model II's paper procedure needs fit experiments at four or more temperatures (it fits "
+                         f"two straight segments to the displacement against temperature); these are at "
+                         f"{len(groups)}: use procedure 'direct'")
     if reference_temperature is None:
         ref_group = groups[0]
     else:
@@ -49,7 +53,8 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     T_ref = float(np.mean([e.temperature for e in ref_group]))
     if progress:
         progress(f"Model II: base model at the reference temperature {T_ref:.4g} C")
-    base_init = base_model(init, T_ref)
+    names = fitted_names(base_model(init, T_ref), parameters)
+    base_init = stribeck_start(base_model(init, T_ref), names)
     # The direct procedure's first fits (the base model here, dF at each temperature) only start its joint
     # refinement, which ends at the requested tolerance and step: they run at rtol 1e-6 (whose integration
     # error moves a Gauss-Newton step by ~0.1-0.2 standard errors on data like the paper's) and stop as
@@ -58,8 +63,12 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     first_opts = opts
     if refine and procedure == "direct":
         first_opts = dict(opts, rtol=max(opts.get("rtol", 1e-8), COARSE_RTOL), small_step=COARSE_STEP)
-    base_fit = fit_friction(ref_group, base_init, default_fit_parameters(base_init) + list(free),
-                            method=f"base at {T_ref:.4g} C", measurement=measurement, **first_opts)
+    try:
+        base_fit = fit_friction(ref_group, base_init, friction_parameters(base_init, names + list(free), excess=True),
+                                method=f"base at {T_ref:.4g} C", measurement=measurement, **first_opts)
+    except (InputError, ComputationError) as e:
+        raise ComputationError(f"Model II: the base fit at the reference temperature {T_ref:.4g} C of "
+                               f"{', '.join(names + list(free))} failed: {e}") from e
     base = base_fit.model
     details = {"reference_temperature": T_ref, "base": base_fit.to_dict()}
     results = {}
@@ -67,7 +76,7 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
         results["paper"] = _model_ii_paper(groups, base, T_ref, details, t0, progress)
     if procedure in ("direct", "both"):
         results["direct"] = _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts,
-                                             free, first_opts, measurement)
+                                             free, first_opts, measurement, names)
     main = results["direct" if procedure != "paper" else "paper"]
     if procedure == "both":
         main.alternatives["paper"] = results["paper"]
@@ -241,7 +250,7 @@ def _dF_law(per_T):
 
 
 def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, progress, opts, free=(), first_opts=None,
-                     measurement=None):
+                     measurement=None, names=None):
     popts = dict(first_opts or opts)  # the per-temperature fits (first_opts: see identify_model_ii)
     popts["starts"] = 1
     per_T, scans = _dF_per_temperature(groups, base, T_ref, popts, measurement, progress)
@@ -252,19 +261,20 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     for i, v in enumerate(law.values):
         params.add(f"dF.values[{i}]", float(v), unit="N")
     if not refine:
-        return FitResult("model-ii (direct)", model, params, np.full((len(params),) * 2, np.nan), math.nan,
-                         math.nan, 0, sum(r.nfev for _, r in per_T), 0, 0, time.perf_counter() - t0, True,
-                         "per-temperature dF and law (no joint refinement)", details=details)
+        return unrefined_result("model-ii (direct)", model, params, experiments, measurement, t0,
+                                [r for _, r in per_T], "per-temperature dF and law (no joint refinement)",
+                                details=details, rtol=opts.get("rtol", 1e-8))
     if progress:
         progress("Model II (direct): joint refinement of dF(T) and the base parameters on all experiments")
-    model, params, traces, warns = _refinement(model, law, params, base, T_ref, free, experiments, measurement)
+    model, params, traces, warns = _refinement(model, law, params, base, T_ref, free, experiments, measurement,
+                                               names or default_fit_parameters(base))
     outcome = fit(model, params, traces, **dict(opts, starts=1))
     res = fit_result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
     res.nfev += sum(r.nfev for _, r in per_T)
     return res
 
 
-def _refinement(model, law, params, base, T_ref, free, experiments, measurement):
+def _refinement(model, law, params, base, T_ref, free, experiments, measurement, names):
     """What the joint refinement fits. The base parameters are refined with dF, so that dF's intervals carry
     their uncertainty. Scaling sigma0, sigma1, fc by 1/c and shifting dF by fc (1 - 1/c) leaves the scale form
     unchanged, so dF is pinned to zero at the reference temperature (its definition: the base model holds
@@ -280,8 +290,8 @@ def _refinement(model, law, params, base, T_ref, free, experiments, measurement)
         [0.0 if j == k else v for j, v in enumerate(law.values)])))
     params[f"dF.values[{k}]"].value = params[f"dF.values[{k}]"].init_value = 0.0
     params[f"dF.values[{k}]"].vary = False
-    for name in default_fit_parameters(base) + list(free):
-        params.add(name, get_value(model, name), min=0.0, unit=unit_of(model, name))
+    for p in friction_parameters(model, list(names) + list(free), excess=True).values():
+        params.add(p.name, p.value, min=p.min, unit=p.unit)
     # the breakpoint is fitted with the values: held where the per-temperature estimates put it,
     # its error would bias dF between the measured temperatures and leave it out of the intervals
     traces = make_traces(experiments, model, measurement)

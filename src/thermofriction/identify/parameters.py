@@ -19,6 +19,9 @@ TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
 #: Not a C core target: a breakpoint temperature of a piecewise-linear dF. Its sensitivity is the chain
 #: rule on the knot values' sensitivities (identify/engine.py), exact on constant-temperature runs.
 KNOT = -1
+#: Not a parameter of the model: the Stribeck excess fs - fc, fitted in place of fs (in log space, so that fs >= fc
+#: holds by construction, never as a refused step); setting it sets fs = fc + excess.
+EXCESS = "fs_excess"
 #: The plant's fittable parameters by their model-file symbols, with units: one value shared by all
 #: experiments (the masses above all, which the paper does not give).
 PLANT_UNITS = {"m": "kg", "m_e": "kg", "xi": "", "wn": "rad/s", "K": "m/V", "c": "N s/m", "k": "N/m", "T_em": "N/V",
@@ -139,6 +142,10 @@ def target_of(model: Model, name: str):
         if coef not in names:
             raise InputError(f"'{name}': dF ({model.thermal.dF.kind}) has coefficients {', '.join(names) or 'none'}")
         return (TARGET_DF, 0, names.index(coef))
+    if name == EXCESS:  # fs - fc: its sensitivity is fs's (fc held); fc's column gains it (Problem.in_names)
+        if "fs" in model.laws:
+            raise InputError(f"'{name}': 'fs' follows a law in this model: fit its coefficients")
+        return (TARGET_PARAM, PARAMETERS.index("fs"), 0)
     if base not in PARAMETERS:
         raise InputError(f"'{name}' is not a parameter ({', '.join(PARAMETERS)}, 'dF', or 'p.coefficient')")
     idx = PARAMETERS.index(base)
@@ -156,6 +163,8 @@ def target_of(model: Model, name: str):
 
 
 def get_value(model: Model, name: str) -> float:
+    if name == EXCESS:
+        return get_value(model, "fs") - get_value(model, "fc")
     kind, idx, coef = target_of(model, name)
     if kind == TARGET_HEAT:
         return float(getattr(model.heat, HEAT_PARAMETERS[name][0]))
@@ -190,6 +199,8 @@ def with_values(model: Model, values: dict) -> Model:
             plant[_plant_field(model, name)] = float(v)
         elif kind == TARGET_HEAT:
             heat[HEAT_PARAMETERS[name][0]] = float(v)
+        elif name == EXCESS:
+            friction["fs"] = float(values.get("fc", get_value(model, "fc"))) + float(v)
         elif kind == TARGET_PARAM:
             friction[PARAMETERS[idx]] = float(v)
         elif kind == TARGET_LAW:
@@ -222,7 +233,7 @@ def unit_of(model: Model, name: str) -> str:
         return HEAT_PARAMETERS[base][1]
     if coef is None and base not in PARAMETERS and base in PLANT_UNITS:
         return PLANT_UNITS[base]
-    unit = "N" if base == "dF" else PARAMETER_UNITS.get(base, "")
+    unit = "N" if base in ("dF", EXCESS) else PARAMETER_UNITS.get(base, "")
     if base == "dF" and coef and coef.startswith("T["):
         return "C"
     if coef is None:
@@ -231,4 +242,4 @@ def unit_of(model: Model, name: str) -> str:
     return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]
+__all__ = ["EXCESS", "KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]

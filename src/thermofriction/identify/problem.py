@@ -18,7 +18,7 @@ from .. import _bridge
 from ..errors import InputError
 from ..models import Const, Model, ModelII
 from ..measurements import Trace, measurement_of
-from .parameters import KNOT, TARGET_DF, TARGET_LAW, get_value, split_name, target_of, with_values
+from .parameters import EXCESS, KNOT, TARGET_DF, TARGET_LAW, get_value, split_name, target_of, with_values
 
 #: the most integration steps of one run during a fit
 MAX_STEPS = 2_000_000
@@ -160,7 +160,12 @@ class Problem:
     def in_names(self, S, model: Model, trace: Trace):
         """Sensitivities ``S`` of one output to what the run was simulated with, as sensitivities to the
         fitted names (the chain rule through the laws at the trace's temperature, where it applies)."""
-        return S if self.chain is None else S @ self.chain_matrix(model, float(trace.temperature))
+        if self.chain is not None:
+            return S @ self.chain_matrix(model, float(trace.temperature))
+        if EXCESS in self.names and "fc" in self.names:  # fs = fc + excess: moving fc (excess held) moves fs too
+            S = S.copy()
+            S[..., self.names.index("fc")] += S[..., self.names.index(EXCESS)]
+        return S
 
     def chain_matrix(self, model: Model, T: float) -> np.ndarray:
         """d(the simulated values)/d(the fitted names) at temperature T: a law's derivative in a

@@ -12,14 +12,14 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..models import Model, ModelI
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
-from .optimiser import fit
-from .parameters import Parameters, get_value, unit_of, with_values
-from .problem import make_traces
+from .optimiser import FitOutcome, fit
+from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
+from .problem import Problem, make_traces
 from .result import FitResult
 from .uncertainty import uncertainty
 
@@ -70,7 +70,9 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
         bad = [p["file"] for p, q in zip(per, qualities) if q["adequate"] is False]
         first.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
                         f"noise estimated from the data ({amount(overall['rmse'], unit)} against "
-                        f"{amount(overall['noise'], unit)}; not adequate in {len(bad)} of {len(per)} experiments): "
+                        f"{amount(overall['noise'], unit)}, where a right model gives at most "
+                        f"{overall['threshold']:.3g} times on these samples; not adequate in {len(bad)} of "
+                        f"{len(per)} experiments): "
                         f"the model misses what the data show. Try: {measurement.advice(model)}")
     cost = float(outcome.r @ outcome.r)
     warns += _unsupported_excess(params, corr, unit)
@@ -83,15 +85,76 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                      removed=measurement.removed)
 
 
-def friction_parameters(model: Model, names, fixed=()) -> Parameters:
-    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term or a law's coefficient."""
+def unrefined_result(method, model, params, experiments, measurement, t0, per_fits, message, warns=(), details=None,
+                     rtol=1e-8) -> FitResult:
+    """The result of a procedure that stops before its joint refinement (``refine=False``): the model it built
+    (laws through per-temperature fits) held against all the experiments, with the residuals, the noise check
+    and the Jacobian there, so that its RMSE, adequacy and intervals (linearized where it stopped, not at an
+    optimum) are the data's, as a refined fit's are. ``per_fits``: the fits it was built from (their
+    evaluations, and its success: every one of them converged)."""
+    traces = make_traces(experiments, model, measurement)
+    names = [p.name for p in params.varying]
+    theta = np.array([p.value for p in params.varying], float)
+    r, J = Problem(model, names, traces, rtol=rtol, parallel=len(traces) > 1).evaluate(theta, jac=True)
+    if r is None:
+        raise ComputationError(f"{method}: the model built without the joint refinement cannot be simulated on "
+                               f"the fit experiments; run with the refinement")
+    failed = [f.method for f in per_fits if not f.success]
+    success = not failed
+    if failed:
+        message = f"{message}; not converged: {', '.join(failed)}"
+    outcome = FitOutcome(theta, r, J, sum(f.nfev for f in per_fits) + 1, sum(f.njev for f in per_fits) + 1,
+                         success, message, 0, time.perf_counter() - t0)
+    return fit_result(method, model, params, outcome, traces, t0, list(warns) + [
+        "no joint refinement (refine=False): the laws pass through the per-temperature estimates; the intervals "
+        "are linearized there, not at an optimum of all the data, and the held values are not tested"],
+        dict(details or {}, refined=False))
+
+
+def friction_parameters(model: Model, names, fixed=(), excess=False) -> Parameters:
+    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term or a law's
+    coefficient. ``excess``: fs fitted as the excess fs - fc (EXCESS, in log space: fs >= fc by construction)
+    where the start has one (:func:`stribeck_start`)."""
     params = Parameters()
     for name in names:
+        if name == "fs" and excess and get_value(model, EXCESS) > 0:
+            name = EXCESS
         v = get_value(model, name)
         positive = not name.startswith("dF") and "." not in name
         params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
                    unit=unit_of(model, name))
     return params
+
+
+def fitted_names(init: Model, parameters) -> list:
+    """The friction parameters Model I or II fits: ``parameters`` (names of the initial model's friction
+    parameters, with a law or not), default :func:`default_fit_parameters`."""
+    if parameters is None:
+        return default_fit_parameters(init)
+    if isinstance(parameters, Parameters) or isinstance(parameters, str):
+        raise InputError("parameters= for Model I and II takes a list of friction parameter names, e.g. "
+                         "['sigma0', 'sigma1', 'fc', 'fs', 'vs']")
+    known = [f.name for f in dataclasses.fields(init.friction) if f.name != "v_smooth"]
+    names = list(dict.fromkeys(parameters))
+    for n in names:
+        if n not in known:
+            raise InputError(f"parameters: '{n}' is not a parameter of the {init.friction.model} friction model "
+                             f"(one of: {', '.join(known)})")
+    if not names:
+        raise InputError("parameters: name at least one friction parameter")
+    return names
+
+
+def stribeck_start(model: Model, names) -> Model:
+    """``model`` with a Stribeck excess to start from where ``names`` fit fs and it has none (fs = fc): fs a
+    tenth above fc, vs 1 mm/s where it has none (a fit cannot start an excess from zero in log space)."""
+    values = model.friction.values()
+    if "fs" not in names or "fs" in model.laws or (values.get("fs") or 0.0) > (values.get("fc") or math.inf):
+        return model
+    if values.get("fc") is None:
+        raise InputError("fs can be fitted with fc: give fc a value (or a law)")
+    vs = values.get("vs")
+    return model.with_friction(fs=1.1 * values["fc"], vs=vs if vs and vs > 0 else 1e-3)
 
 
 def base_model(model: Model, temperature=None) -> Model:
@@ -123,6 +186,12 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", m
 def _unsupported_excess(params: Parameters, corr, unit) -> list:
     """A fitted Stribeck excess fs - fc the data do not support (within two standard errors of zero): said."""
     names = [p.name for p in params.varying]
+    if EXCESS in names:
+        x = params[EXCESS]
+        if x.stderr is not None and math.isfinite(x.stderr) and x.value < 2 * x.stderr:
+            return [f"the data show no Stribeck excess: fs - fc = {x.value:.3g} +- {x.stderr:.3g} {x.unit}, within two "
+                    f"standard errors of zero; the fitted map is Coulomb-viscous, and vs says nothing"]
+        return []
     if "fs" not in names or "fc" not in params:
         return []
     fs, fc = params["fs"], params["fc"]
@@ -234,6 +303,6 @@ def temperature_groups(experiments):
     return groups
 
 
-__all__ = ["fit_friction", "fit_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes",
+__all__ = ["fit_friction", "fit_result", "unrefined_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes", "stribeck_start", "fitted_names",
            "identify_heat", "temperature_groups", "FRICTION_FIT_PARAMETERS", "DEFAULT_FRICTION_PARAMETERS",
            "DEFAULT_HEAT_PARAMETERS"]

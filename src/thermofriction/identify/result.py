@@ -73,6 +73,9 @@ class FitResult(Result):
         value = np.asarray(law_of(self.model)(T), float)
         names = [p.name for p in self.parameters.varying]
         own = [i for i, n in enumerate(names) if n.startswith(name + ".")]
+        considered = self.details.get("considered") or {}
+        if not own and name in considered.get("parameters", ()):  # held for lack of information: its stated range
+            return value, value / considered["prior_factor"], value * considered["prior_factor"]
         if not own:
             return value, value.copy(), value.copy()
         theta = np.array([self.parameters[names[i]].value for i in own])
@@ -199,9 +202,11 @@ class FitResult(Result):
     def report(self) -> str:
         """A table like lmfit's fit report."""
         lines = [f"[[Fit: {self.method}]]"]
+        held = [h for h in (self.fit_quality or {}).get("held") or [] if h["contradicted"]]
         if self.adequate is False:  # first, in plain words
-            lines.append(f"    NOT ADEQUATE: residuals {self.fit_quality['ratio']:.3g} x the measurement noise "
-                         f"(see the first warning)")
+            lines.append(f"    NOT ADEQUATE: residuals {self.fit_quality['ratio']:.3g} x the measurement noise"
+                         + (f", {len(held)} held value(s) contradicted by the data" if held else "")
+                         + " (see the first warnings)")
         if self.n_points == 0 and "paper" in self.details:  # no trajectory fit: say what was done instead
             lines += [f"    {'done' if self.success else 'REFUSED'}: {self.message}"] + self._paper_lines()
         else:
@@ -234,6 +239,8 @@ class FitResult(Result):
         for r in rows:
             lines.append("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)))
         names = [p.name for p in self.parameters.varying]
+        if np.shape(self.correlation) != (len(names), len(names)):  # no joint fit, no correlations
+            names = []
         pairs = [(names[i], names[j], self.correlation[i, j]) for i in range(len(names))
                  for j in range(i + 1, len(names)) if np.isfinite(self.correlation[i, j])
                  and abs(self.correlation[i, j]) > 0.5]

@@ -1,0 +1,252 @@
+"""Held values checked against the data (a procedure-layer step after a fit): for every parameter the fit holds --
+the plant's masses and stiffness, the friction model's fs, vs, sigma2, delta, a law held at the initial model's --
+a score (Lagrange-multiplier) test from the sensitivities at the optimum says whether the data contradict it.
+
+At the optimum the residuals r are orthogonal to the fitted directions J. A held parameter whose column j (its
+sensitivity, offsets profiled out as the measurement does) leaves a part j' = (I - J J^+) j that r still projects on
+is one the data would move: LM = (j'^T r)^2 / (s^2 tau j'^T j') is chi-squared with one degree of freedom if the held
+value is right (a law's coefficients together: as many as it has), with s^2 the residual variance and tau the
+residuals' integrated autocorrelation time (their variance inflation: correlated residuals carry less information).
+A held value is contradicted where p < LEVEL / (the number of tests) and freeing it would remove at least MATERIAL
+of the misfit. fs held at fc (no Stribeck effect) is tested in the directions of an excess at three vs together.
+The held columns are the Problem's own sensitivities (one more simulation with them as extra targets)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .._lazy import lazy
+from ..models import ModelI
+from .parameters import EXCESS, PLANT_UNITS, get_value
+from .problem import Problem, make_traces
+
+special = lazy("scipy.special")
+
+#: the family-wise level at which held values are said to be contradicted (Bonferroni over the tests): strict, as
+#: a right model's small misfits (integration error, a law's shape) must not raise false alarms, while a wrong
+#: mass or a missing Stribeck effect gives p < 1e-12
+LEVEL = 1e-3
+#: held friction parameters tested where the model has them; plant parameters tested by form
+FRICTION_HELD = ("fs", "vs", "sigma2", "delta", "z_ba")
+PLANT_HELD = {True: ("m_e", "m", "wn"), False: ("m_e", "m", "k")}  # modal form: wn for the stiffness
+_FIELDS = {"m_e": "end_effector_mass", "m": "mass", "wn": "natural_frequency", "k": "stiffness"}
+#: ... and only where freeing it would remove at least this fraction of the misfit (linearized: the statistic over
+#: the cost in units of s^2 tau): at 10^4-10^5 samples a right model's small misfits (a law's shape exp where the
+#: truth's is linear) are significant in some held direction, and yet not what the held value is (a 2x wrong mass
+#: removes ~20 %, a missing Stribeck effect fs = 1.5 fc ~3 %, a law shape ~0.2 %)
+MATERIAL = 0.01
+#: Stribeck velocities at which a missing Stribeck effect (fs = fc) is looked for [m/s]
+STRIBECK_VS = (3e-4, 3e-3, 3e-2)
+
+
+def _candidates(model, varying) -> list:
+    """[(label, [names])]: the held quantities of ``model`` that can be tested (fs without a Stribeck excess: apart,
+    :func:`_stribeck_columns`)."""
+    out = []
+    plant = model.plant
+    if hasattr(plant, "modal"):
+        for name in PLANT_HELD[bool(plant.modal)]:
+            if name not in varying and getattr(plant, _FIELDS.get(name, ""), None) is not None:
+                out.append((name, [name]))
+    values = model.friction.values()
+    laws = model.laws if isinstance(model.thermal, ModelI) else {}
+    for name in FRICTION_HELD:
+        if name in laws:
+            continue  # below, with the other laws held whole
+        if values.get(name) is None or name in varying or name == "fs" and EXCESS in varying:
+            continue
+        if name in ("fs", "vs") and not _has_excess(model):
+            continue  # no Stribeck excess: vs does nothing, and fs is tested apart
+        out.append((name, [name]))
+    for name, law in laws.items():  # a law held whole (e.g. at the initial model's, for lack of information)
+        coefs = [f"{name}.{c}" for c in law.coefficient_names()]
+        if coefs and not any(c in varying for c in coefs):
+            out.append((name, coefs))
+    return out
+
+
+def _has_excess(model) -> bool:
+    if isinstance(model.thermal, ModelI) and "fs" in model.laws:
+        return True
+    values = model.friction.values()
+    return values.get("fs") is not None and values.get("fc") is not None and values["fs"] > values["fc"]
+
+
+def _score(r, J, cols, s2tau, floor=False):
+    """(statistic, degrees of freedom) of the score test of the held columns ``cols`` given the fitted ``J``.
+    ``floor``: the one held value is at the lower end of its domain (sigma2 = 0): only a move up contradicts it,
+    so a score pointing down counts as none (and one pointing up as half the two-sided p, by the caller)."""
+    if J.shape[1]:
+        scale = np.linalg.norm(J, axis=0)
+        scale[scale == 0] = 1.0
+        Q, _ = np.linalg.qr(J / scale)
+        cols = cols - Q @ (Q.T @ cols)
+    norms = np.linalg.norm(cols, axis=0)
+    keep = norms > 1e-9 * max(float(np.max(norms, initial=0.0)), 1e-300)
+    if not keep.any():
+        return 0.0, 0
+    if floor and cols.shape[1] == 1 and float(cols[:, 0] @ r) > 0:  # the data would move it below its floor
+        return 0.0, 1
+    U, S, _ = np.linalg.svd(cols[:, keep] / norms[keep], full_matrices=False)
+    U = U[:, S > 1e-8 * S[0]]
+    g = U.T @ r
+    return float(g @ g) / s2tau, U.shape[1]
+
+
+def _advice(label, dof) -> str:
+    if label in PLANT_UNITS:
+        return f"try --free {label} (free=[\"{label}\"])"
+    if label == "fs":
+        return "fit a Stribeck effect (add fs,vs to --parameters, from a start with fs > fc)"
+    return f"fit it (add {label} to --parameters{', with fs' if label == 'vs' else ''})"
+
+
+def _stribeck_columns(res, varying, traces, rtol):
+    """The sensitivities to fs at fs = fc (a Stribeck effect the model does not have) at each of STRIBECK_VS: the
+    model's output is the same at any vs there, the direction in which fs would move it is not."""
+    model = res.model
+    values = model.friction.values()
+    fc_law = model.laws.get("fc") if isinstance(model.thermal, ModelI) else None
+    if not hasattr(model.friction, "vs") or _has_excess(model) or "fs" in varying or EXCESS in varying \
+            or values.get("fc") is None and fc_law is None:
+        return None
+    cols = []
+    for vs in STRIBECK_VS:
+        if fc_law is None:
+            m, names, scale = model.with_friction(fs=values["fc"], vs=vs), ["fs"], np.ones(1)
+        else:  # fs following fc's law (fs = fc at every temperature): the direction of its level
+            m = dataclasses.replace(model, friction=dataclasses.replace(model.friction, fs=None, vs=vs),
+                                    thermal=ModelI({**model.laws, "fs": fc_law}))
+            names = [f"fs.{c}" for c in fc_law.coefficient_names()]
+            c = np.array(fc_law.coefficients(), float)
+            scale = np.r_[c[0], np.zeros(len(c) - 1)] if fc_law.kind == "exp" else c
+        theta = np.array([get_value(m, n) for n in varying + names], float)
+        _, J = Problem(m, varying + names, traces, rtol=rtol, parallel=len(traces) > 1).evaluate(theta, jac=True)
+        if J is None:
+            return None
+        cols.append(J[:, len(varying):] @ scale)
+    return np.column_stack(cols)
+
+
+def held_tests(res, experiments, measurement, rtol=1e-8) -> list:
+    """The score test of every held value of the fit ``res``: [{name, value, statistic, dof, p_value,
+    contradicted, message}], most contradicted first. Empty where the model cannot be evaluated there."""
+    varying = [p.name for p in res.parameters.varying]
+    if not res.n_points:
+        return []
+    candidates = _candidates(res.model, set(varying))
+    held_names = [n for _, names in candidates for n in names]
+    traces = make_traces(experiments, res.model, measurement)
+    theta = np.array([get_value(res.model, n) for n in varying + held_names], float)
+    problem = Problem(res.model, varying + held_names, traces, rtol=rtol, parallel=len(traces) > 1)
+    r, J = problem.evaluate(theta, jac=True)
+    if r is None:
+        return []
+    n, p = J.shape[0], len(varying)
+    dof = max(n - p - measurement.offsets_in(traces), 1)
+    s2tau = float(r @ r) / dof * float(res.statistics.get("variance_inflation", 1.0))
+    groups, k = [], p
+    for label, names in candidates:
+        groups.append((label, J[:, k:k + len(names)], get_value(res.model, names[0]) if len(names) == 1 else None))
+        k += len(names)
+    stribeck = _stribeck_columns(res, varying, traces, rtol)
+    if stribeck is not None:
+        groups.append(("fs", stribeck, res.model.friction.values().get("fc")))
+    out = []
+    for label, cols, value in groups:
+        floor = value == 0.0 and cols.shape[1] == 1  # at the lower end of its domain: one-sided
+        stat, df = _score(r, J[:, :p], cols, s2tau, floor)
+        if df:
+            out.append({"name": label, "value": value, "statistic": stat, "dof": df,
+                        "p_value": float(special.chdtrc(df, stat)) * (0.5 if floor and stat > 0 else 1.0),
+                        "misfit_share": stat * s2tau / max(float(r @ r), 1e-300), "_columns": cols, "_J": J[:, :p]})
+    for i, t in enumerate(out):  # held values that move the data the same way (m and m_e on a modal plant): one
+        t["same_as"] = next((u["name"] for u in out[:i] if u["dof"] == t["dof"]
+                             and abs(u["statistic"] - t["statistic"]) <= 1e-6 * max(t["statistic"], 1e-300)), None)
+    for t in out:
+        t["contradicted"] = bool(t["p_value"] < LEVEL / len(out) and t["misfit_share"] >= MATERIAL)
+        what = f"{t['name']} held at {t['value']:.4g}" if t["value"] is not None else f"{t['name']}'s law held"
+        if t["name"] == "fs" and stribeck is not None:
+            what = "fs held at fc (no Stribeck effect)"
+        p_text = ("p < 1e-12" if t["p_value"] < 1e-12 else f"p = {t['p_value']:.2g}") + \
+            f", {100 * t['misfit_share']:.2g} % of the misfit"
+        also = [u["name"] for u in out if u["same_as"] == t["name"]]
+        also = f" (or {', '.join(also)}: the same direction in these data)" if also else ""
+        t["message"] = (f"{what} is contradicted by the data ({p_text}){also}: {_advice(t['name'], t['dof'])}"
+                        if t["contradicted"] else f"{what}: not contradicted by the data ({p_text}){also}")
+    order = {t["name"]: i for i, t in enumerate(out)}
+    return sorted(out, key=lambda t: (t["same_as"] is not None, t["p_value"], order[t["name"]]))
+
+
+#: the stated prior range of a law held for lack of information: its level within a factor PRIOR_FACTOR either way
+#: (95 %), as a normal prior on the law's log scale
+PRIOR_FACTOR = 3.0
+
+
+def _consider(res, tests):
+    """The fitted parameters' covariance with the uncertainty of the laws held for lack of information added (a
+    consider covariance): each held law's level, within a factor PRIOR_FACTOR either way (95 %), shifts the fitted
+    parameters by G = -J^+ j (j: the sensitivity to the law's log scale), so cov += G G^T sd^2. Intervals,
+    standard errors and correlations are updated; the report says what was included."""
+    varying = res.parameters.varying
+    se = np.array([p.stderr for p in varying], float)
+    if not varying or not np.all(np.isfinite(se)) or res.correlation.shape != (len(varying),) * 2:
+        return
+    cov = np.nan_to_num(res.correlation) * np.outer(se, se)
+    sd = math.log(PRIOR_FACTOR) / 1.959964
+    for t in tests:
+        law = res.model.laws[t["name"]]
+        c = np.array(law.coefficients(), float)
+        scale = np.r_[c[0], np.zeros(len(c) - 1)] if law.kind == "exp" else c
+        j = t["_columns"] @ scale
+        G = -np.linalg.lstsq(t["_J"], j, rcond=None)[0]
+        cov = cov + np.outer(G, G) * sd ** 2
+    se_new = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    tq = float(special.stdtrit(max(res.statistics.get("effective_samples", 1e6) - len(varying), 1.0), 0.975))
+    for par, s in zip(varying, se_new):
+        par.stderr = float(s)
+        if par.positive and par.value > 0:
+            f = math.exp(min(tq * s / par.value, 700.0))
+            par.ci95 = (par.value / f, par.value * f)
+        else:
+            par.ci95 = (par.value - tq * s, par.value + tq * s)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        res.correlation = cov / np.outer(se_new, se_new)
+    names = ", ".join(t["name"] for t in tests)
+    grown = max(se_new / np.where(se > 0, se, np.inf))
+    res.warnings.append(f"{names} could not be determined and {'is' if len(tests) == 1 else 'are'} held at the initial "
+                        f"model's law; the intervals include {'its' if len(tests) == 1 else 'their'} level within a "
+                        f"stated factor {PRIOR_FACTOR:g} either way (95 %): standard errors up to {grown:.3g} times "
+                        f"those with it held exactly")
+    res.details["considered"] = {"parameters": [t["name"] for t in tests], "prior_factor": PRIOR_FACTOR}
+
+
+def with_held_tests(res, experiments, measurement, rtol=1e-8):
+    """``res`` with ``fit_quality["held"]``; a contradicted held value makes the fit not adequate and is said
+    first in its warnings (second, after the residuals' own "not adequate", where they are far above the noise)."""
+    if res.fit_quality is None:
+        return res
+    if res.details.get("refined") is False:  # not at an optimum: the residuals are not orthogonal to the fit's
+        res.fit_quality["held"] = None
+        return res
+    tests = held_tests(res, experiments, measurement, rtol)
+    res.fit_quality["held"] = [{k: t[k] for k in ("name", "value", "statistic", "dof", "p_value", "misfit_share",
+                                                  "contradicted")} for t in tests]
+    bad = [t for t in tests if t["contradicted"] and t["same_as"] is None]
+    lack = [t for t in tests if t["name"] in (res.details.get("held_for_lack_of_information") or ())]
+    if lack:
+        _consider(res, lack)
+    if bad:
+        # after the residuals' own verdict where that already says not adequate (a model far off: the held
+        # directions then share out a misfit they do not all cause), else first
+        at = 1 if res.fit_quality["adequate"] is False and res.warnings and \
+            res.warnings[0].startswith("the fit is not adequate") else 0
+        res.fit_quality["adequate"] = False
+        res.warnings[at:at] = [t["message"] for t in bad]
+    return res
+
+
+__all__ = ["held_tests", "with_held_tests", "LEVEL"]
