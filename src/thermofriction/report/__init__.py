@@ -11,7 +11,7 @@ from ..errors import InputError
 from ..measurements import measurement_of
 from ..models import Model
 from .displacement import render, truth_section
-from .entries import Entry, akaike, entry_label, law_at, reference_temperature
+from .entries import Entry, akaike, entry_label, law_at, reference_temperature  # (akaike, law_at, ...: for callers)
 from .force import render_force
 from .. import _args
 from ..data.experiments import Dataset

@@ -37,6 +37,13 @@ def entry_label(model: Model, fit: dict | None = None) -> str:
 
 
 def akaike(entries):
+    """(difference, weight) of each entry's fit or None, and the number of groups: :func:`akaike_scaled` without
+    the divisor c."""
+    scaled, groups = akaike_scaled(entries)
+    return [None if a is None else a[:2] for a in scaled], groups
+
+
+def akaike_scaled(entries):
     """AICc difference to the best and Akaike weight of each entry's fit, or None: only between fits
     of the same data (the same experiments and points), where AICc is comparable; the weights sum to
     one over such a group. Correlated residuals carry less information than their count: the differences
@@ -89,7 +96,7 @@ EXPERIMENT_COLUMNS = ["model", "file", "T [°C]", "role", "max error [%]", "RMSE
 
 def comparison_rows(entries):
     rows = []
-    aic, _ = akaike(entries)
+    aic, _ = akaike_scaled(entries)
     for e, a in zip(entries, aic):
         s = e.validation.summary()
         v = s.get("validate", s.get("fit", {}))
@@ -263,5 +270,5 @@ def parameter_section(entries, fit_T) -> str:
     return ("<section><h2>Identified parameters</h2>" + "".join(out) + "</section>") if out else ""
 
 
-__all__ = ["Entry", "entry_label", "akaike", "inflation_of_most_general", "comparison_rows", "law_at", "reference_temperature", "law_rows",
+__all__ = ["Entry", "entry_label", "akaike", "akaike_scaled", "inflation_of_most_general", "comparison_rows", "law_at", "reference_temperature", "law_rows",
            "breakpoint_rows", "parameter_section"]

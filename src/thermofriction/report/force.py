@@ -15,7 +15,7 @@ from ..measurements import steady_state_curve
 from ..measurements.command import implied_friction
 from ..models import ModelI, ModelII
 from ..validate import validate
-from .entries import akaike
+from .entries import akaike_scaled
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
 from .plots import thin as _thin
 
@@ -153,7 +153,7 @@ def fig_loops(figs, entries, unit, xunit, what):
 
 
 def _akaike(entries):
-    return akaike(entries)[0]
+    return akaike_scaled(entries)[0]
 
 
 def render_force(entries, data, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
