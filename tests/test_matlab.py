@@ -249,7 +249,7 @@ def test_identify_and_validate_results_round_trip_through_mat_files(csv_folder, 
 
 def test_results_to_mat_turns_json_shapes_into_matlab_shapes():
     """Independent of any fit: the documented mapping on a hand-made document."""
-    from thermofriction.data.matlab import results_to_mat
+    from thermofriction.data.matlab_results import results_to_mat
     m = results_to_mat({"a.b": {"value": 1.0, "unit": "N"}, "c": {"value": "nan", "unit": ""}})
     assert list(m["name"]) == ["a.b", "c"] and np.isnan(m["value"][1]) and m["value"][0] == 1.0
     t = results_to_mat([{"file": "x.csv", "T": 30.0}, {"file": "y.csv", "T": "inf"}])

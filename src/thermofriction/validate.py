@@ -91,7 +91,7 @@ class ValidationResult(Result):
 
     def to_mat(self, path):
         """The same metrics as a MATLAB file (docs/formats.md#results-in-matlab-files)."""
-        from .data.matlab import save_results_mat
+        from .data.matlab_results import save_results_mat
         save_results_mat(jsonable(self.to_dict()), path)
 
     def rows(self):

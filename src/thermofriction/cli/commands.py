@@ -43,7 +43,8 @@ def cmd_simulate(args) -> int:
         sys.stdout.flush()  # a write error (a full disk) is reported here, as one line (main)
         return 0
     if args.output:
-        from ..data.matlab import is_matlab, simulation_to_mat
+        from ..data.matlab import is_matlab
+        from ..data.matlab_results import simulation_to_mat
         if is_matlab(args.output):  # docs/formats.md#matlab-files
             simulation_to_mat(res, _target(args, "output"))
         else:

@@ -10,7 +10,8 @@ a ``dataset.toml`` manifest, and synthetic datasets with realistic sensor effect
 from .csv import read_experiment_csv
 from .experiments import (MAX_ROWS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, ROLES, SAMPLING_TOLERANCE, TEMPERATURE_RANGE,
                           TEMPERATURE_VARIES, Dataset, Experiment, max_rows)
-from .files import load_dataset, save_dataset
+from .files import load_dataset
+from .save import save_dataset
 from .matlab import read_experiment_mat
 from .synth import add_synth_command, cmd_synth, synthesize
 

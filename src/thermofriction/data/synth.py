@@ -17,7 +17,8 @@ from ..simulate import StepSizeController, simulate
 from ..waveforms import Sampled, Waveform, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
 from .._io import publish_together
-from .files import _check_temperature, check_dataset_folder, save_dataset
+from .files import check_temperature
+from .save import check_dataset_folder, save_dataset
 
 #: the most experiments (fit and validate temperatures together) of one synthesised dataset: each is a
 #: simulation (~0.1-1 s for the default 2 s at 10 kHz) and a file; a longer list is most likely a mistake
@@ -40,7 +41,25 @@ def _temperatures(values, label):
         return []
     if isinstance(values, (int, float, np.number)):
         values = [values]
-    return [_check_temperature(float(T) if isinstance(T, np.number) else T, label) for T in values]
+    return [check_temperature(float(T) if isinstance(T, np.number) else T, label) for T in values]
+
+
+def _check_types(model, temperatures, validate, duration, sample_rate, noise, quantization, temperature_noise,
+                 drift, input, record_temperature, record_stage, name):
+    """synthesize's argument types (_args.py), before any work."""
+    _args.model(model, Model)  # the argument types (_args.py): before any work
+    for label, v in (("temperatures", temperatures), ("validate", validate)):
+        if not (v is None or _args.is_number(v) or (isinstance(v, (list, tuple, np.ndarray)) and
+                                                     all(_args.is_number(T) for T in v))):
+            _args.refuse(label, "a number or a list of numbers [C]", v)
+    for label, v in (("duration", duration), ("sample_rate", sample_rate), ("noise", noise),
+                     ("quantization", quantization), ("temperature_noise", temperature_noise), ("drift", drift)):
+        _args.number(v, label)
+    _args.instance(input, Waveform, "input", "a Waveform", none=True)
+    if record_temperature is not None:
+        _args.flag(record_temperature, "record_temperature")
+    _args.flag(record_stage, "record_stage")
+    _args.text(name, "name", none=True)
 
 
 def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_rate=10_000.0, input=None,
@@ -63,19 +82,8 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
 
     At most :data:`MAX_EXPERIMENTS` temperatures in all. ``progress(done, total)`` is called after each
     experiment."""
-    _args.model(model, Model)  # the argument types (_args.py): before any work
-    for label, v in (("temperatures", temperatures), ("validate", validate)):
-        if not (v is None or _args.is_number(v) or (isinstance(v, (list, tuple, np.ndarray)) and
-                                                     all(_args.is_number(T) for T in v))):
-            _args.refuse(label, "a number or a list of numbers [C]", v)
-    for label, v in (("duration", duration), ("sample_rate", sample_rate), ("noise", noise),
-                     ("quantization", quantization), ("temperature_noise", temperature_noise), ("drift", drift)):
-        _args.number(v, label)
-    _args.instance(input, Waveform, "input", "a Waveform", none=True)
-    if record_temperature is not None:
-        _args.flag(record_temperature, "record_temperature")
-    _args.flag(record_stage, "record_stage")
-    _args.text(name, "name", none=True)
+    _check_types(model, temperatures, validate, duration, sample_rate, noise, quantization, temperature_noise, drift,
+                 input, record_temperature, record_stage, name)
     require_actuator(model, "synthesize")
     waveform = input if input is not None else model.input
     if waveform is None:
@@ -121,52 +129,62 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
     exps = []
     used = set()
     for T, role, stream in runs:
-        rng = np.random.default_rng(stream)
-        res = simulate(model, duration, temperature=T, input=waveform, sample_rate=sample_rate,
-                       controller=StepSizeController(rtol=1e-10))
-        span = float(np.ptp(res.displacement))
-        if record_stage and res.stage_displacement is not None:  # a plant test: the stage moves
-            span = max(span, float(np.ptp(res.stage_displacement)))
-        for what, v in (("noise", noise), ("quantization", quantization)):
-            if v > span > 0:  # 20 meant as nanometres but given in metres
-                raise InputError(f"{what} {v:g} m exceeds the simulated displacement range ({span:.3g} m) at "
-                                 f"{T:g} C: give it with a unit, e.g. 20nm")
-        x = res.displacement + noise * rng.standard_normal(res.time.size)
-        sign = 0
-        if drift:
-            sign = 1 if rng.random() < 0.5 else -1
-            x = x + sign * drift * (res.time - res.time[0])
-        if quantization > 0:
-            x = np.round(x / quantization) * quantization
-        stage = None
-        if record_stage:
-            stage = res.stage_displacement + noise * rng.standard_normal(res.time.size)
-            if quantization > 0:
-                stage = np.round(stage / quantization) * quantization
-        T_true = res.temperature if model.heat is not None else T  # with [heat], T is the ambient one
-        sig = T_true + temperature_noise * rng.standard_normal(res.time.size) if record_temperature else None
-        effects = [f"noise {noise:g} m"]
-        if quantization:
-            effects.append(f"quantisation {quantization:g} m")
-        if drift:
-            effects.append(f"drift {sign * drift:+g} m/s")
-        if record_temperature:
-            effects.append(f"temperature noise {temperature_noise:g} C")
-        desc = (f"synthesised from {label} at {T:g} C: input {spec}, {duration:g} s at {sample_rate:g} Hz, "
-                f"{', '.join(effects)}, seed {seed}")
-        stem = f"T{T:.10g}C{'-validate' if role == 'validate' else ''}"
-        file, k = f"{stem}.csv", 1
-        while file in used:
-            k += 1
-            file = f"{stem}-{k}.csv"
-        used.add(file)
-        exps.append(Experiment(file=file, time=res.time, voltage=res.input, displacement=x, temperature=T,
-                               temperature_signal=sig, stage_displacement=stage, role=role, description=desc,
-                               input=None if isinstance(waveform, Sampled) else waveform))
+        exps.append(_one_run(model, waveform, T, role, stream, used, duration=duration, sample_rate=sample_rate,
+                             noise=noise, quantization=quantization, drift=drift, record_stage=record_stage,
+                             record_temperature=record_temperature, temperature_noise=temperature_noise,
+                             label=label, spec=spec, seed=seed))
         if progress is not None:
             progress(len(exps), len(runs))
     return Dataset(path=None, name=name or f"synthetic-{label}",
                    description=f"synthesised by thermofriction from {label}", experiments=exps)
+
+
+def _one_run(model, waveform, T, role, stream, used, *, duration, sample_rate, noise, quantization, drift,
+             record_stage, record_temperature, temperature_noise, label, spec, seed) -> Experiment:
+    """One synthesised experiment at temperature ``T``: simulated, then the sensor's effects drawn from its own
+    random stream; its file name is added to ``used``."""
+    rng = np.random.default_rng(stream)
+    res = simulate(model, duration, temperature=T, input=waveform, sample_rate=sample_rate,
+                   controller=StepSizeController(rtol=1e-10))
+    span = float(np.ptp(res.displacement))
+    if record_stage and res.stage_displacement is not None:  # a plant test: the stage moves
+        span = max(span, float(np.ptp(res.stage_displacement)))
+    for what, v in (("noise", noise), ("quantization", quantization)):
+        if v > span > 0:  # 20 meant as nanometres but given in metres
+            raise InputError(f"{what} {v:g} m exceeds the simulated displacement range ({span:.3g} m) at "
+                             f"{T:g} C: give it with a unit, e.g. 20nm")
+    x = res.displacement + noise * rng.standard_normal(res.time.size)
+    sign = 0
+    if drift:
+        sign = 1 if rng.random() < 0.5 else -1
+        x = x + sign * drift * (res.time - res.time[0])
+    if quantization > 0:
+        x = np.round(x / quantization) * quantization
+    stage = None
+    if record_stage:
+        stage = res.stage_displacement + noise * rng.standard_normal(res.time.size)
+        if quantization > 0:
+            stage = np.round(stage / quantization) * quantization
+    T_true = res.temperature if model.heat is not None else T  # with [heat], T is the ambient one
+    sig = T_true + temperature_noise * rng.standard_normal(res.time.size) if record_temperature else None
+    effects = [f"noise {noise:g} m"]
+    if quantization:
+        effects.append(f"quantisation {quantization:g} m")
+    if drift:
+        effects.append(f"drift {sign * drift:+g} m/s")
+    if record_temperature:
+        effects.append(f"temperature noise {temperature_noise:g} C")
+    desc = (f"synthesised from {label} at {T:g} C: input {spec}, {duration:g} s at {sample_rate:g} Hz, "
+            f"{', '.join(effects)}, seed {seed}")
+    stem = f"T{T:.10g}C{'-validate' if role == 'validate' else ''}"
+    file, k = f"{stem}.csv", 1
+    while file in used:
+        k += 1
+        file = f"{stem}-{k}.csv"
+    used.add(file)
+    return Experiment(file=file, time=res.time, voltage=res.input, displacement=x, temperature=T,
+                      temperature_signal=sig, stage_displacement=stage, role=role, description=desc,
+                      input=None if isinstance(waveform, Sampled) else waveform)
 
 
 # -- command line -----------------------------------------------------------------------------

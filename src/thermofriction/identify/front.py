@@ -56,6 +56,42 @@ def _check_arguments(method, reference_temperature, rtol, starts, seed):
                              f"got {shorten(reference_temperature)}")
 
 
+def _evaluation_limit(max_evaluations) -> int:
+    if isinstance(max_evaluations, bool) or not isinstance(max_evaluations, numbers.Integral) \
+            or not 1 <= max_evaluations <= 100_000:
+        raise InputError(f"max_evaluations must be a whole number from 1 to 100000, got {shorten(max_evaluations)}")
+    return int(max_evaluations)
+
+
+def _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine, reference_temperature,
+                   controller, rtol, progress, offset):
+    """The argument types (_args.py), before any work; returns (parameters, free, rtol) as identify uses them."""
+    _args.text(method, "method")  # the argument types (_args.py): before any work
+    if not (init is None or isinstance(init, (Model, str, os.PathLike))):
+        _args.refuse("init", "a Model, a model file or a preset name, or None", init)
+    _args.text(friction, "friction", none=True)
+    parameters = _args.names(parameters, "parameters", allow=Parameters)  # 'sigma0' is one name, not 5 letters
+    free = free if isinstance(free, str) else (_args.names(free, "free") or ())  # (a string: "m_e,m")
+    _args.text(procedure, "procedure")
+    _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
+    _args.flag(refine, "refine")
+    _args.number(reference_temperature, "reference_temperature", "degC", none=True)
+    if rtol is not None:  # the earlier spelling: tolerances are given by a StepSizeController everywhere
+        warnings.warn("identify(rtol=...) is now identify(controller=StepSizeController(rtol=...))",
+                      DeprecationWarning, stacklevel=5)  # (the user, past this and the two decorators)
+        _args.number(rtol, "rtol")
+        if controller is not None:
+            raise InputError("give controller= (rtol= is its earlier spelling), not both")
+        controller = StepSizeController(rtol=rtol)
+    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
+    rtol = 1e-8 if controller is None else controller.rtol
+    _args.function(progress, "progress")
+    if not (offset is None or isinstance(offset, (bool, str))):
+        _args.refuse("offset", "\"shared\", \"per-experiment\", \"none\", True or False", offset)
+    _args.dataset(data, Dataset, experiments=True)
+    return parameters, free, rtol
+
+
 @stamped  # the fitted model's name and provenance (provenance.py)
 @one_blas_thread  # (optimiser.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
@@ -94,29 +130,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
     it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
     """
-    _args.text(method, "method")  # the argument types (_args.py): before any work
-    if not (init is None or isinstance(init, (Model, str, os.PathLike))):
-        _args.refuse("init", "a Model, a model file or a preset name, or None", init)
-    _args.text(friction, "friction", none=True)
-    parameters = _args.names(parameters, "parameters", allow=Parameters)  # 'sigma0' is one name, not 5 letters
-    free = free if isinstance(free, str) else (_args.names(free, "free") or ())  # (a string: "m_e,m")
-    _args.text(procedure, "procedure")
-    _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
-    _args.flag(refine, "refine")
-    _args.number(reference_temperature, "reference_temperature", "degC", none=True)
-    if rtol is not None:  # the earlier spelling: tolerances are given by a StepSizeController everywhere
-        warnings.warn("identify(rtol=...) is now identify(controller=StepSizeController(rtol=...))",
-                      DeprecationWarning, stacklevel=4)  # (the user, past the two decorators)
-        _args.number(rtol, "rtol")
-        if controller is not None:
-            raise InputError("give controller= (rtol= is its earlier spelling), not both")
-        controller = StepSizeController(rtol=rtol)
-    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
-    rtol = 1e-8 if controller is None else controller.rtol
-    _args.function(progress, "progress")
-    if not (offset is None or isinstance(offset, (bool, str))):
-        _args.refuse("offset", "\"shared\", \"per-experiment\", \"none\", True or False", offset)
-    _args.dataset(data, Dataset, experiments=True)
+    parameters, free, rtol = _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine,
+                                            reference_temperature, controller, rtol, progress, offset)
     if method not in METHODS:
         raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
     _check_arguments(method, reference_temperature, rtol, starts, seed)
@@ -131,10 +146,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
     if max_evaluations is not None:
-        if isinstance(max_evaluations, bool) or not isinstance(max_evaluations, numbers.Integral) \
-                or not 1 <= max_evaluations <= 100_000:
-            raise InputError(f"max_evaluations must be a whole number from 1 to 100000, got {shorten(max_evaluations)}")
-        opts["max_nfev"] = int(max_evaluations)
+        opts["max_nfev"] = _evaluation_limit(max_evaluations)
     free = _plant_parameters(init, free, method)
     if method == "plant":
         return _identify_plant(getattr(data, "experiments", data), init)

@@ -183,7 +183,7 @@ class FitResult(Result):
 
     def to_mat(self, path):
         """The same results as a MATLAB file (docs/formats.md#results-in-matlab-files)."""
-        from ..data.matlab import save_results_mat
+        from ..data.matlab_results import save_results_mat
         save_results_mat(self.to_dict(), path)
 
     def _rows(self):

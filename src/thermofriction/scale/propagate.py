@@ -158,19 +158,9 @@ class PropagationResult:
         from .figures import bands_figure
         return bands_figure(self)
 
-def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=None, duration: float = 1.0,
-              sample_rate: float = 1000.0, level: float = 0.95, solver=None, controller=None, scheduler=None,
-              workers=None, batch_size=None, progress=None) -> PropagationResult:
-    """Draws ``draws`` parameter sets from ``result``'s covariance (a ``FitResult``), simulates each
-    at every temperature [C] (``duration`` s of ``input``, default the model's), and returns the
-    central ``level`` bands of the displacement and of the mean step per cycle.
-
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: a local Dask cluster).
-    batch_size: draws per task. progress: called with the number of draws done."""
-    import time
-
-    from ..simulate import simulate
-
+def _checked(result, temperatures, draws, seed, input, duration, sample_rate, level, solver, controller, scheduler,
+             workers, batch_size, progress):
+    """propagate's arguments checked before any work; returns (the fitted model, the temperatures as an array)."""
     if input is not None and not isinstance(input, Waveform):
         _args.refuse("input", "a Waveform or None", input)
     _args.number(duration, "duration", "s")
@@ -203,6 +193,24 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
         raise InputError(f"temperatures must be numbers [C], got {shorten(temperatures)}") from None
     if temps.ndim != 1 or temps.size == 0 or not np.all(np.isfinite(temps)):
         raise InputError(f"temperatures must be a non-empty list of finite numbers [C], got {shorten(temperatures)}")
+    return model, temps
+
+
+def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=None, duration: float = 1.0,
+              sample_rate: float = 1000.0, level: float = 0.95, solver=None, controller=None, scheduler=None,
+              workers=None, batch_size=None, progress=None) -> PropagationResult:
+    """Draws ``draws`` parameter sets from ``result``'s covariance (a ``FitResult``), simulates each
+    at every temperature [C] (``duration`` s of ``input``, default the model's), and returns the
+    central ``level`` bands of the displacement and of the mean step per cycle.
+
+    scheduler, workers: as for :func:`thermofriction.sweep` (None: a local Dask cluster).
+    batch_size: draws per task. progress: called with the number of draws done."""
+    import time
+
+    from ..simulate import simulate
+
+    model, temps = _checked(result, temperatures, draws, seed, input, duration, sample_rate, level, solver, controller,
+                            scheduler, workers, batch_size, progress)
     waveform = input if input is not None else model.input
     if waveform is None:
         raise InputError("the fitted model has no [input]: give input= (e.g. tf.Sawtooth(amplitude=30, frequency=5))")
