@@ -154,6 +154,14 @@ static double output(run_state *s, double *dF)
     return F;
 }
 
+/* The sampled position's slope on the segment after its k-th knot (k knots at or before the time), zero
+ * before the first knot and after the last (where tf_waveform_slope holds it): the segment is known, no search. */
+static double slope_after(const tf_waveform *w, int k)
+{
+    if (k <= 0 || k >= w->n) return 0.0;
+    return (w->v[k] - w->v[k - 1]) / (w->t[k] - w->t[k - 1]);
+}
+
 tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out, double *F, int np,
                               const int *params, double *dF, tf_error *err)
 {
@@ -182,7 +190,7 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
     double t = t_out[0];
     while (k < w->n && w->t[k] <= t) k++;
     s->v = NAN; /* forces the first segment's coefficients */
-    start_segment(s, tf_waveform_slope(w, t));
+    start_segment(s, slope_after(w, k));
     for (long i = 0; i < n_out; i++) {
         while (t < t_out[i]) {
             double end = k < w->n ? w->t[k] : INFINITY;
@@ -191,7 +199,7 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
             t = t1;
             if (t == end) {
                 k++;
-                start_segment(s, tf_waveform_slope(w, t));
+                start_segment(s, slope_after(w, k));
             }
         }
         double *d = np ? dF + (size_t)i * (size_t)np : 0;
