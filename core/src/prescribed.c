@@ -50,7 +50,7 @@ static void coefficients(run_state *s)
         one[i] = 1.0;
     }
     if (!s->np) return;
-    tf_friction_eval(s->kind, s->p, &s->gms, s->v, one, dz, &jac, &dp1);
+    tf_friction_eval(s->kind, s->p, &s->gms, s->v, one, dz, 0, &dp1);
     for (int i = 0; i < s->nz; i++)
         for (int j = 0; j < s->np; j++) {
             s->da[i][j] = pd(s, dp0.ddz_dp[i], j);
@@ -63,11 +63,11 @@ static void phis(double b, double h, double *E, double *phi, double *psi)
 {
     double x = b * h;
     *E = exp(x);
-    if (fabs(x) < 1e-3) { /* Taylor series: the first omitted terms are below 1e-14 relative */
-        *phi = h * (1.0 + x * (0.5 + x * (1.0 / 6.0 + x / 24.0)));
-        *psi = h * h * (0.5 + x * (1.0 / 3.0 + x * (1.0 / 8.0 + x / 30.0)));
-    } else {
-        *phi = expm1(x) / b;
+    if (fabs(x) < 1e-2) { /* Taylor series: the first omitted terms are below 2e-13 relative */
+        *phi = h * (1.0 + x * (0.5 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x / 120.0))));
+        *psi = h * h * (0.5 + x * (1.0 / 3.0 + x * (1.0 / 8.0 + x * (1.0 / 30.0 + x / 144.0))));
+    } else { /* E - 1 loses at most 2e-14 relative here (|x| >= 1e-2): one exponential, not two */
+        *phi = (*E - 1.0) / b;
         *psi = (h * *E - *phi) / b;
     }
 }
