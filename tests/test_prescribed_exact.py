@@ -1,5 +1,5 @@
 """The exact stepping of friction under a prescribed motion (core/src/prescribed.c, ``_bridge.prescribed_force``)
-that force-data fits use for the force and its Jacobian (docs/force-data.md#the-jacobian).
+that force-data fits use for the force and its Jacobian (docs/force-data.md#3-identification).
 
 Oracles: the closed-form LuGre response to a constant velocity from rest (analytic); the adaptive integrator of
 the C core at rtol 1e-11 (an independent algorithm: Dormand-Prince/Rodas4 with restarts at every knot and GMS's

@@ -1,4 +1,4 @@
-/* Friction under a prescribed motion, stepped exactly (docs/force-data.md#the-jacobian).
+/* Friction under a prescribed motion, stepped exactly (docs/force-data.md#3-identification).
  *
  * A prescribed motion given as a sampled position (tf_waveform TF_WAVE_SAMPLED: straight lines between
  * knots) has a constant velocity on each segment between knots. There, and at a constant temperature,
