@@ -58,7 +58,7 @@ def main(argv=None):
                 old_seconds, old = fit(data)
             worst = max(abs(p.value - old.parameters[name].value) / p.stderr
                         for name, p in new.parameters.items() if p.vary)
-            line += f"  {old_seconds:.1f} s ({old_seconds / seconds:.0f}x); max |difference| {worst:.3f} standard errors"
+            line += f"  {old_seconds:.1f} s ({old_seconds / seconds:.0f}x); max |difference| {worst:.2g} standard errors"
         print(line, flush=True)
 
 
