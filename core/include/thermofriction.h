@@ -11,4 +11,5 @@
 #include "thermofriction/sensitivity.h"
 #include "thermofriction/realtime.h"
 #include "thermofriction/control.h"
+#include "thermofriction/prescribed.h"
 #endif

@@ -517,6 +517,52 @@ static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
     }
 }
 
+static void test_prescribed_exact_stepping_gms_and_its_record(void)
+{
+    /* tf_prescribed_force on the analytic GMS case above, the motion as a sampled position (up at 1e-4 m/s
+     * for 0.6 s, down at -1.5e-4 m/s for 0.4 s): F = k v t until the capacity fc at t* = 0.2 s, then fc, then
+     * fc + k v' (t - 0.6) after the reversal; dF/dfc = 0 before t* and 1 after (the capacity w g = fc moves
+     * the force once the element has slipped), dF/dC = 0 throughout (it slips at its fixed point). Then the
+     * one error record: a decreasing grid, a model it does not apply to. */
+    tf_model m;
+    memset(&m, 0, sizeof m);
+    m.plant = TF_PLANT_PRESCRIBED;
+    m.friction = TF_FRICTION_GMS;
+    m.p[TF_P_FC] = m.p[TF_P_FS] = 2.0;
+    m.p[TF_P_VS] = 1e-3;
+    m.p[TF_P_DELTA] = 2.0;
+    m.p[TF_P_C] = 50.0;
+    m.p[TF_P_VSMOOTH] = 1e-6;
+    m.gms.n = 1;
+    m.gms.k[0] = 1e5;
+    m.gms.w[0] = 1.0;
+    m.fs_follows_fc = 1;
+    m.T_const = 25.0;
+    static const double kt[3] = {0.0, 0.6, 1.0}, kx[3] = {0.0, 6e-5, 0.0};
+    m.input = (tf_waveform){TF_WAVE_SAMPLED, 0, 0, 0, 0, 1.0, 0, 0, kt, kx, 3};
+    double k = 1e5, fc = 2.0, v = 1e-4, vdown = -1.5e-4;
+    double t[6] = {0.0, 0.1, 0.25, 0.4, 0.6, 0.7}, F[6], dF[12];
+    double exact[6] = {0.0, k * v * 0.1, fc, fc, fc, fc + k * vdown * 0.1};
+    double dfc[6] = {0, 0, 1, 1, 1, 1};
+    int params[2] = {TF_P_FC, TF_P_C};
+    tf_status s = tf_prescribed_force(&m, 6, t, F, 2, params, dF, &E);
+    double worst = 0.0, worst_d = 0.0;
+    for (int i = 0; i < 6; i++) {
+        worst = fmax(worst, fabs(F[i] - exact[i]));
+        worst_d = fmax(worst_d, fmax(fabs(dF[2 * i] - dfc[i]), fabs(dF[2 * i + 1])));
+    }
+    CHECK(s == TF_OK && E.code == TF_OK && worst < 1e-12 * fc && worst_d < 1e-12,
+          "prescribed GMS: status %d, worst force error %g N, worst derivative error %g", s, worst, worst_d);
+    t[3] = 0.2;
+    s = tf_prescribed_force(&m, 6, t, F, 0, NULL, NULL, &E);
+    CHECK(s == TF_ERR_BAD_ARGUMENT && E.code == s && !strcmp(E.where, "prescribed") && strstr(E.what, "t_out") &&
+              E.index == 3, "prescribed: a decreasing grid named at its sample (%s / %s / %ld)", E.where, E.what, E.index);
+    t[3] = 0.4;
+    m.friction = TF_FRICTION_ELASTOPLASTIC;
+    CHECK(!tf_prescribed_applies(&m) && tf_prescribed_force(&m, 6, t, F, 0, NULL, NULL, &E) == TF_ERR_BAD_ARGUMENT &&
+              strstr(E.what, "model"), "prescribed: the elasto-plastic model is refused (%s)", E.what);
+}
+
 /* Real-time API (realtime.h, control.h). */
 static void rt_lugre(tf_rt_friction *f)
 {
@@ -979,6 +1025,7 @@ int main(void)
     test_jacobian_vs_finite_differences();
     test_frictionless_step_response();
     test_gms_element_breaks_loose_exactly_at_its_capacity();
+    test_prescribed_exact_stepping_gms_and_its_record();
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

@@ -232,6 +232,28 @@ def run_sensitivities(spec: dict, targets: np.ndarray, t: np.ndarray, out: np.nd
         raise _failure(e) from None
 
 
+def prescribed_applies(spec: dict) -> bool:
+    """Whether :func:`prescribed_force` applies to the model ``spec`` (prescribed.h): a prescribed plant
+    driven by a sampled position at a constant temperature, no Model II, no self-heating, and a friction
+    model whose state rate is affine in its state (all but the elasto-plastic one)."""
+    return bool(_core.prescribed_applies(spec))
+
+
+def prescribed_force(spec: dict, t: np.ndarray, names=()) -> tuple:
+    """The friction force at times ``t`` under the prescribed motion of ``spec``, stepped exactly segment by
+    segment (prescribed.h: no integrator, no tolerance), and its derivatives with respect to the friction
+    parameters ``names`` (at the run's temperature): (F, dF of shape (len(t), len(names))). Raises
+    CoreFailure."""
+    t = np.ascontiguousarray(t, float)
+    F = np.empty(t.size)
+    dF = np.empty((t.size, len(names)))
+    try:
+        _core.prescribed_force(spec, t, F, tuple(PARAMETERS.index(n) for n in names), dF)
+    except _core.SolverError as e:
+        raise _failure(e) from None
+    return F, dF
+
+
 def target(kind: str, index: int = 0, coefficient: int = 0) -> tuple:
     """A sensitivity target: ``kind`` one of ``param``, ``law``, ``dF``, ``heat``."""
     return (TARGET_CODES[kind], int(index), int(coefficient))
@@ -253,6 +275,6 @@ def rt_steps(spec, T, v, dt, F_out) -> float:
 
 
 __all__ = ["PARAMETERS", "PLANT_CODES", "FRICTION_CODES", "LAW_CODES", "OUTPUTS", "OUTPUT_COLUMN", "MECHANICAL_STATES",
-           "model_spec", "law_tuple", "waveform_tuple", "run", "run_sensitivities", "CoreFailure", "target", "loop",
+           "model_spec", "law_tuple", "waveform_tuple", "run", "run_sensitivities", "prescribed_force", "prescribed_applies", "CoreFailure", "target", "loop",
            "rt_steps", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
            "n_outputs", "state_index"]

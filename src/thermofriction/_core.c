@@ -824,7 +824,84 @@ fail:
     return -1;
 }
 
+/* prescribed_force(spec, t_out, F_out, params, dF_out|None): the friction force under a prescribed
+ * motion stepped exactly (prescribed.h) into F_out (n_out float64), its derivatives with respect to
+ * the parameters `params` (a tuple of tf_param indices) into dF_out (n_out x np, C order). Raises
+ * SolverError with the core's status and record. */
+static PyObject *py_prescribed_force(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *t_obj, *F_obj, *p_obj, *dF_obj;
+    if (!PyArg_ParseTuple(args, "OOOOO", &spec, &t_obj, &F_obj, &p_obj, &dF_obj)) return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    Py_buffer Fv = {0}, dFv = {0};
+    int have_F = 0, have_dF = 0, params[TF_NPARAM];
+    if (parse_model(&a, spec, &m)) goto done;
+    Py_ssize_t n_out;
+    const double *t_out = get_array(&a, t_obj, &n_out, "t_out");
+    if (PyErr_Occurred()) goto done;
+    if (!PyTuple_Check(p_obj) || PyTuple_GET_SIZE(p_obj) > TF_NPARAM) {
+        PyErr_SetString(PyExc_ValueError, "params must be a tuple of at most TF_NPARAM indices");
+        goto done;
+    }
+    int np = (int)PyTuple_GET_SIZE(p_obj);
+    for (int j = 0; j < np; j++) {
+        params[j] = (int)PyLong_AsLong(PyTuple_GET_ITEM(p_obj, j));
+        if (PyErr_Occurred()) goto done;
+    }
+    if (PyObject_GetBuffer(F_obj, &Fv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
+    have_F = 1;
+    if (Fv.itemsize != 8 || strcmp(Fv.format, "d") != 0 || Fv.len != 8 * n_out) {
+        PyErr_SetString(PyExc_ValueError, "F_out: one float64 per output time");
+        goto done;
+    }
+    double *dF = NULL;
+    if (np > 0) {
+        if (PyObject_GetBuffer(dF_obj, &dFv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
+        have_dF = 1;
+        if (dFv.itemsize != 8 || strcmp(dFv.format, "d") != 0 || dFv.len != 8 * n_out * np) {
+            PyErr_SetString(PyExc_ValueError, "dF_out: a C-ordered float64 array of shape (n_out, np)");
+            goto done;
+        }
+        dF = (double *)dFv.buf;
+    }
+    if (check_model(&m)) goto done;
+    tf_error e;
+    tf_status status;
+    Py_BEGIN_ALLOW_THREADS
+    status = tf_prescribed_force(&m, (long)n_out, t_out, (double *)Fv.buf, np, params, dF, &e);
+    Py_END_ALLOW_THREADS
+    if (status != TF_OK) {
+        PyObject *exc_args = Py_BuildValue("(siddNi)", e.what, (int)e.code, e.t, 0.0, PyTuple_New(0), 0);
+        if (exc_args) { PyErr_SetObject(SolverError, exc_args); Py_DECREF(exc_args); }
+        goto done;
+    }
+    result = Py_BuildValue("i", tf_prescribed_applies(&m));
+done:
+    if (have_F) PyBuffer_Release(&Fv);
+    if (have_dF) PyBuffer_Release(&dFv);
+    arena_free(&a);
+    return result;
+}
+
+/* prescribed_applies(spec): whether prescribed_force applies to the model (tf_prescribed_applies). */
+static PyObject *py_prescribed_applies(PyObject *self, PyObject *args)
+{
+    PyObject *spec;
+    if (!PyArg_ParseTuple(args, "O", &spec)) return NULL;
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    if (!parse_model(&a, spec, &m)) result = PyBool_FromLong(tf_prescribed_applies(&m));
+    arena_free(&a);
+    return result;
+}
+
 static PyMethodDef methods[] = {
+    {"prescribed_force", py_prescribed_force, METH_VARARGS,
+     "Friction force (and parameter derivatives) under a prescribed motion, stepped exactly."},
+    {"prescribed_applies", py_prescribed_applies, METH_VARARGS, "Whether prescribed_force applies to a model."},
     {"rt_steps", py_rt_steps, METH_VARARGS, "tf_rt_step over an array of velocities; returns seconds (timed in C)."},
     {"loop", py_loop, METH_VARARGS, "The closed-loop stage simulation of control.h (fixed step)."},
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},

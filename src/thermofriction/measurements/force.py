@@ -9,9 +9,14 @@ sensor_offset``, where validation uses it as it is, never re-fitting it on held-
 ("per-experiment": nuisance parameters, each run's mean residual removed, estimated on every run, held-out ones
 included, for a sensor re-zeroed between runs), or none fitted ("none": the model's own is used).
 
-The Jacobian is by forward differences of whole runs at a tighter tolerance (a prescribed-motion model has only
-the friction states, so a run costs little): the C core's sensitivities are those of the states, and the friction
-force is an output of them.
+The simulated force and its Jacobian come from the C core's exact stepping of the prescribed motion
+(core/src/prescribed.c, ``_bridge.prescribed_force``) wherever it applies: the measured motion is a piecewise-linear
+position, so the velocity is constant between its knots, and at a constant temperature the friction state's rate
+(LuGre, Dahl, each GMS element) is affine in the state there, with a closed-form step and closed-form sensitivities
+to the friction parameters; static maps have no state. Model I's laws act at a run's temperature through their
+values there (the chain rule of ``Problem.chain_matrix``). Elsewhere -- Model II, a temperature signal, the
+elasto-plastic model, a fitted name that is not a friction parameter -- the runs are integrated and the Jacobian is
+by forward differences of whole runs at a tighter tolerance.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ from .. import _bridge
 from ..drive import drive
 from ..errors import InputError
 from ..data.force import ForceExperiment
-from ..models import Model
+from ..models import Model, ModelI
 from ..simulate import StepSizeController, simulate
 from ..waveforms import Sampled
 from .base import OFFSETS, Measurement, Trace, center, center_each
@@ -115,13 +120,58 @@ class Force(Measurement):
         forces = problem.run_all(run, False)
         return None if any(f is None for f in forces) else np.concatenate(forces)
 
+    @staticmethod
+    def exact_names(problem, model):
+        """The friction parameters the exact stepping differentiates for this problem (the values at a run's
+        temperature, ``problem.chain``, where laws are fitted), or None where it does not apply: a thermal model
+        other than Model I, a temperature signal, a fitted name that is not a friction parameter, or a model the
+        core does not step exactly (``_bridge.prescribed_applies``)."""
+        if model.thermal is not None and not isinstance(model.thermal, ModelI):
+            return None
+        names = problem.chain if problem.chain is not None else problem.names
+        if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
+            return None  # a law's base value fitted as such: not a value at the temperature
+        arrays = getattr(model.friction, "arrays", ())
+        if any(n not in _bridge.PARAMETERS or n in arrays for n in names):
+            return None
+        for tr in problem.traces:
+            if not isinstance(tr.temperature, (int, float)):
+                return None
+        if not problem.traces or not _bridge.prescribed_applies(
+                _bridge.model_spec(model, problem.traces[0].temperature, problem.traces[0].waveform)):
+            return None
+        return list(names)
+
+    def _exact(self, problem, model, names, jac):
+        """(force, Jacobian in the fitted names or None) of every trace, concatenated, by the exact stepping;
+        (None, None) when a run fails."""
+        def run(i):
+            tr = problem.traces[i]
+            T = float(tr.temperature)
+            try:  # Model I's laws evaluated at T by the core; derivatives in the values there
+                F, dF = _bridge.prescribed_force(_bridge.model_spec(model, T, tr.waveform), tr.time,
+                                                 names if jac else ())
+            except _bridge.CoreFailure:
+                return None
+            if not jac:
+                return F, None
+            return F, (dF @ problem.chain_matrix(model, T) if problem.chain is not None else dF)
+        out = problem.run_all(run, jac)
+        if any(o is None for o in out):
+            return None, None
+        return np.concatenate([o[0] for o in out]), (np.vstack([o[1] for o in out]) if jac else None)
+
     def residuals(self, problem, model, theta, jac):
+        measured = np.concatenate([tr.measured - (tr.held_offset if self.offset == "none" else 0.0)
+                                   for tr in problem.traces])
+        names = self.exact_names(problem, model)
+        if names is not None:
+            F, J = self._exact(problem, model, names, jac)
+            return (None, None) if F is None else self.profiled(problem.traces, F - measured, J)
         rtol = min(problem.rtol, FD_RTOL) if jac else problem.rtol
         F = self._forces(problem, model, rtol)
         if F is None:
             return None, None
-        measured = np.concatenate([tr.measured - (tr.held_offset if self.offset == "none" else 0.0)
-                                   for tr in problem.traces])
         r = F - measured
         J = None
         if jac:
