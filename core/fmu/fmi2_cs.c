@@ -17,9 +17,7 @@ const char *fmi2GetVersion(void) { return fmi2Version; }
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cats[])
 {
-    if (!c) return fmi2Error;
-    fmu_set_debug_logging(c, on);
-    return fmi2OK;
+    return (fmi2Status)fmu_set_debug_logging(c, on);
 }
 
 fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,

@@ -32,9 +32,7 @@ const char *fmi3GetVersion(void) { return fmi3Version; }
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean on, size_t n, const fmi3String categories[])
 {
-    if (!c) return fmi3Error;
-    fmu_set_debug_logging(c, on);
-    return fmi3OK;
+    return (fmi3Status)fmu_set_debug_logging(c, on);
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,

@@ -453,7 +453,12 @@ static double output(instance *c, int vr)
 
 /* ---- the FMI functions ---- */
 
-void fmu_set_debug_logging(fmu_instance *c, int on) { c->logging = on; }
+fmu_status fmu_set_debug_logging(fmu_instance *c, int on)
+{
+    if (!c) return FMU_ERROR;
+    c->logging = on;
+    return FMU_OK;
+}
 
 fmu_instance *fmu_instantiate(const char *name, const char *guid, const char *resources, int resources_is_uri,
                               const fmu_callbacks *cb, int logging)

@@ -32,7 +32,7 @@ typedef struct fmu_instance fmu_instance;
 fmu_instance *fmu_instantiate(const char *name, const char *guid, const char *resources, int resources_is_uri,
                               const fmu_callbacks *cb, int logging);
 void fmu_free_instance(fmu_instance *c);
-void fmu_set_debug_logging(fmu_instance *c, int on);
+fmu_status fmu_set_debug_logging(fmu_instance *c, int on);
 fmu_status fmu_setup_experiment(fmu_instance *c, int tol_defined, double tol, double start, int stop_defined,
                                 double stop);
 fmu_status fmu_enter_initialization(fmu_instance *c);

@@ -284,20 +284,13 @@ def _default_experiment_xml(model: Model, step: float | None) -> str:
 
 
 def _xml(model: Model, variables, identifier: str, guid: str, source: str | None, step: float | None = None) -> str:
-    name, description = _names(model, identifier, source, step)
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(name)} guid="{guid}"',
-           f'  description={quoteattr(description)} generationTool="thermofriction {__version__}"',
-           f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"',
+    out = [*_head(model, identifier, f'fmiVersion="2.0" guid="{guid}"', source, step),
            '  variableNamingConvention="structured" numberOfEventIndicators="0">',
            f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
            '    canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"',
            '    canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
            *_units_xml(variables)]
-    out += ['  <LogCategories>',
-            '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
-            '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
-            '  </LogCategories>',
+    out += [*_LOG_CATEGORIES,
             _default_experiment_xml(model, step),
             '  <ModelVariables>']
     outputs = []
@@ -354,12 +347,23 @@ def default_experiment(model: Model, step: float | None = None) -> tuple[float, 
     return stop, h, why
 
 
-def _names(model: Model, identifier: str, source: str | None, step: float | None) -> tuple[str, str]:
-    """The model description's modelName and description (the model's own and where it came from)."""
+_LOG_CATEGORIES = ['  <LogCategories>',
+                   '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
+                   '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
+                   '  </LogCategories>']
+
+
+def _head(model: Model, identifier: str, version: str, source: str | None, step: float | None) -> list[str]:
+    """The model description's first lines: the version attributes, modelName, description (the model's
+    own and where it came from), the tool and the date."""
     provenance = f"exported by thermofriction {__version__}" + (f" from {source}" if source else "")
     provenance += (f"; fixed-step real-time integrator, step {step:g} s" if step is not None
                    else "; adaptive integrator")
-    return model.name or identifier, ((model.description + " -- ") if model.description else "") + provenance
+    description = ((model.description + " -- ") if model.description else "") + provenance
+    return ['<?xml version="1.0" encoding="UTF-8"?>',
+            f'<fmiModelDescription {version} modelName={quoteattr(model.name or identifier)}',
+            f'  description={quoteattr(description)} generationTool="thermofriction {__version__}"',
+            f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"']
 
 
 def _units_xml(variables, extra=()) -> list[str]:
@@ -377,20 +381,13 @@ def _units_xml(variables, extra=()) -> list[str]:
 
 def _xml3(model: Model, variables, identifier: str, guid: str, source: str | None, step: float | None = None) -> str:
     """modelDescription.xml of an FMI 3.0 co-simulation FMU: the FMI 2 export's variables as Float64, and time."""
-    name, description = _names(model, identifier, source, step)
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(name)} instantiationToken="{guid}"',
-           f'  description={quoteattr(description)} generationTool="thermofriction {__version__}"',
-           f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"',
+    out = [*_head(model, identifier, f'fmiVersion="3.0" instantiationToken="{guid}"', source, step),
            '  variableNamingConvention="structured">',
            f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
            '    canGetAndSetFMUState="true" canSerializeFMUState="false" providesDirectionalDerivatives="false"',
            '    providesAdjointDerivatives="false" hasEventMode="false" maxOutputDerivativeOrder="0"/>',
            *_units_xml(variables, extra=("s",)),  # time's
-           '  <LogCategories>',
-           '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
-           '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
-           '  </LogCategories>',
+           *_LOG_CATEGORIES,
            _default_experiment_xml(model, step),
            '  <ModelVariables>',
            f'    <Float64 name="time" valueReference="{VR_TIME}" causality="independent" variability="continuous"'
