@@ -1,8 +1,10 @@
-"""FMI 2.0 co-simulation FMUs of any model (docs/fmu.md): ``export_fmu(model, path)``.
+"""FMI 2.0 and 3.0 co-simulation FMUs of any model (docs/fmu.md): ``export_fmu(model, path, fmi=2|3)``.
 
-One prebuilt binary serves every model: the C core with an FMI wrapper (core/fmu/fmi2_cs.c), built
-when the package is installed. Exporting a model zips that binary as
-``binaries/linux64/<modelIdentifier>.so`` with a generated ``modelDescription.xml`` and
+One prebuilt binary serves every model and both standards: the C core with the shared FMU logic
+(core/fmu/fmu_common.c) and the FMI 2 and FMI 3 wrappers (fmi2_cs.c, fmi3_cs.c), built when the package
+is installed, for Linux x86-64 and, when the MinGW-w64 cross compiler is there, Windows x86-64.
+Exporting a model zips the binaries as ``binaries/linux64/<modelIdentifier>.so`` and
+``binaries/win64/<modelIdentifier>.dll`` (FMI 3: ``x86_64-linux``, ``x86_64-windows``) with a generated ``modelDescription.xml`` and
 ``resources/model.tfm``, the model description the binary reads when it is instantiated (its plant,
 friction model, thermal extension, laws and every tunable parameter with its value reference). So an
 export needs no compiler.
@@ -41,9 +43,9 @@ from ._version import __version__
 from .errors import InputError, shorten
 from .models import MassPlant, Model, PrescribedMotion, StickSlipPlant, load_model
 
-#: The resource file's format version (core/fmu/fmi2_cs.c, FMU_FORMAT).
+#: The resource file's format version (core/fmu/fmu_common.c, FMU_FORMAT).
 FORMAT = 2
-#: The binary's limits (fmi2_cs.c: MAX_VR value references, MAX_POINTS points of one law).
+#: The binary's limits (fmu_common.c: MAX_VR value references, MAX_POINTS points of one law).
 MAX_VALUE_REFERENCE = 2048
 MAX_POINTS = 256
 FIRST_PARAMETER = 16
@@ -51,7 +53,7 @@ FIRST_PARAMETER = 16
 #: The integrators an FMU can carry (docs/fmu.md#integrators).
 INTEGRATORS = ("adaptive", "realtime")
 
-#: Fixed value references of the inputs and outputs (fmi2_cs.c).
+#: Fixed value references of the inputs and outputs (fmu_common.c).
 VR_DRIVE, VR_TEMPERATURE, VR_DISPLACEMENT, VR_VELOCITY, VR_FRICTION_FORCE, VR_TEMPERATURE_OUT, VR_STAGE = range(7)
 
 #: The FMI versions an export can follow (docs/fmu.md).
@@ -250,7 +252,7 @@ def _variables(model: Model, spec: dict, temperature: float | None, step: float 
 
 
 def _resource_text(model: Model, spec: dict, variables, integrator: str = "adaptive") -> str:
-    """resources/model.tfm: the structure and the parameters' roles (read by fmi2_cs.c)."""
+    """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
              f"plant {spec['plant']} {int(isinstance(model.plant, StickSlipPlant) and model.plant.modal)}",
@@ -432,7 +434,7 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         if temperature != temperature or abs(temperature) == float("inf"):
             raise InputError(f"export_fmu: temperature must be a finite number of degrees C, got {temperature!r}")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
-        raise InputError(f"FMUs are exported for Linux x86-64 only; this is {platform.system()} {platform.machine()}")
+        raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); this is {platform.system()} {platform.machine()}")
     if fmi not in FMI_VERSIONS:
         raise InputError(f"export_fmu: fmi = {shorten(fmi)}: the FMI version is 2 or 3")
     binary = binary_path()
