@@ -494,4 +494,5 @@ def _headers_licence(fmi: int = 2) -> str:
             f"{years} Modelica Association Project \"FMI\", under the 2-Clause BSD License.\n")
 
 
-__all__ = ["export_fmu", "binary_path", "default_experiment", "INTEGRATORS", "FMI_VERSIONS"]
+__all__ = ["export_fmu", "binary_path", "default_experiment", "INTEGRATORS", "FMI_VERSIONS",
+           "NoWindowsBinaryWarning"]
