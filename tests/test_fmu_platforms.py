@@ -166,8 +166,8 @@ def test_dll_imports_windows_system_libraries_only(tmp_path):
 def test_dll_runs_under_wine_as_the_linux_binary(tmp_path):
     """The win64 DLL, loaded by a Windows program (core/fmu/harness) under Wine, runs a co-simulation
     of the paper's actuator through a sawtooth fall (held inputs, 20 us steps) and gives the outputs
-    fmpy gets from the Linux binary of the same FMU, to 1e-10 of each output's range (seen: 7e-15; two compilers and
-    C libraries: the adaptive integrator's rounding differs, not its tolerance)."""
+    fmpy gets from the Linux binary of the same FMU, to 1e-10 of each output's range (seen: 7e-15, the
+    rounding of two compilers and C libraries)."""
     wine = shutil.which("wine") or shutil.which("wine64")
     if not wine and not os.environ.get("CI"):
         pytest.skip("Wine is not installed (Debian: apt-get install wine64 wine; CI installs it)")
