@@ -4,7 +4,8 @@ One prebuilt binary serves every model and both standards: the C core with the s
 (core/fmu/fmu_common.c) and the FMI 2 and FMI 3 wrappers (fmi2_cs.c, fmi3_cs.c), built when the package
 is installed, for Linux x86-64 and, when the MinGW-w64 cross compiler is there, Windows x86-64.
 Exporting a model zips the binaries as ``binaries/linux64/<modelIdentifier>.so`` and
-``binaries/win64/<modelIdentifier>.dll`` (FMI 3: ``x86_64-linux``, ``x86_64-windows``) with a generated ``modelDescription.xml`` and
+``binaries/win64/<modelIdentifier>.dll`` (FMI 3: ``x86_64-linux``, ``x86_64-windows``) with a
+generated ``modelDescription.xml`` and
 ``resources/model.tfm``, the model description the binary reads when it is instantiated (its plant,
 friction model, thermal extension, laws and every tunable parameter with its value reference). So an
 export needs no compiler.
@@ -349,10 +350,11 @@ def default_experiment(model: Model, step: float | None = None) -> tuple[float, 
     return stop, h, why
 
 
-_LOG_CATEGORIES = ['  <LogCategories>',
-                   '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
-                   '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
-                   '  </LogCategories>']
+_LOG_CATEGORIES = [
+    '  <LogCategories>',
+    '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
+    '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
+    '  </LogCategories>']
 
 
 def _head(model: Model, identifier: str, version: str, source: str | None, step: float | None) -> list[str]:
@@ -416,8 +418,9 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
                source: str | None = None, integrator: str = "adaptive", step: float | None = None,
                fmi: int = 2) -> Path | Target:
     """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 (``fmi=2``, the default) or
-    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md), with the linux64 binary and, when the
-    package was built with the MinGW-w64 cross compiler, the win64 one (else a NoWindowsBinaryWarning says so). ``temperature``: the start value of the temperature input [degC] (with a
+    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md), with the linux64 binary and, when
+    the package was built with the MinGW-w64 cross compiler, the win64 one (else a NoWindowsBinaryWarning
+    says so). ``temperature``: the start value of the temperature input [degC] (with a
     heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
     ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
     ``source``: where the model came from (a file or preset name), for the FMU's description.
@@ -434,7 +437,8 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         if temperature != temperature or abs(temperature) == float("inf"):
             raise InputError(f"export_fmu: temperature must be a finite number of degrees C, got {temperature!r}")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
-        raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); this is {platform.system()} {platform.machine()}")
+        raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); "
+                         f"this is {platform.system()} {platform.machine()}")
     if fmi not in FMI_VERSIONS:
         raise InputError(f"export_fmu: fmi = {shorten(fmi)}: the FMI version is 2 or 3")
     binary = binary_path()
