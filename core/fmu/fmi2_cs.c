@@ -1,453 +1,23 @@
-/* An FMI 2.0 co-simulation wrapper around the C core (docs/fmu.md): one binary for every model.
- *
- * The model is not compiled in: fmi2Instantiate reads it from resources/model.tfm, a text file the
- * Python exporter writes (thermofriction/fmu.py). That file gives the structure (plant, friction
- * model, thermal extension, the laws' kinds and sizes) and, for every tunable parameter, its value
- * reference, its role in a tf_model and its start value. So one prebuilt shared object serves any
- * model and no compiler is needed where the FMU is made.
- *
- * Between two communication points the model is integrated by tf_solve (the adaptive
- * Dormand-Prince / Rodas4 switch of integrator.h), the inputs being held (or, after
- * fmi2SetRealInputDerivatives, followed along their first derivative) through the step. The drive
- * and the temperature reach the core as two-point sampled signals over the step, so the core's own
- * corner handling and parameter cache apply unchanged.
- *
- * Never a crash on bad input: non-finite inputs or parameters, parameters out of their domain at
- * the temperature, a failed integration give fmi2Error with a logged message and leave the state as
- * it was before the call; a temperature outside the laws' calibrated range gives fmi2Warning. */
-#include <ctype.h>
-#include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
+/* The FMI 2.0 co-simulation functions (docs/fmu.md): the standard's calling conventions around the
+ * shared model and step logic of fmu_common.c. */
 #include <stdlib.h>
-#include <string.h>
 
 #include "fmi2Functions.h"
-#include "thermofriction.h"
+#include "fmu_common.h"
 
-#define FMU_FORMAT 2 /* 2: the "guid" line */
-#define MAX_VR 2048     /* value references 0 .. MAX_VR-1 */
-#define MAX_POINTS 256  /* points (or coefficients) of one law */
-#define NLAW (TF_NPARAM + 1) /* the parameters' laws, then Model II's dF */
-/* The work of one communication step is bounded (a fuzzer builds with smaller bounds): */
-#ifndef MAX_FIXED_STEPS
-#define MAX_FIXED_STEPS 100000000L /* fixed steps (~10 s of work): more is refused */
-#endif
-#ifndef MAX_ADAPTIVE_STEPS
-#define MAX_ADAPTIVE_STEPS 10000000L /* the adaptive integrator's steps: more fails */
-#endif
-#define T_MIN (-100.0)  /* [degC] the temperatures a sensor on an actuator can read: the package's range */
-#define T_MAX 300.0     /* (thermofriction.plausible.TEMPERATURE_RANGE); outside it an input is refused */
-#define TIME_LIMIT 1e12 /* [s] the core's time limit (integrator.h: beyond it a double resolves time poorly) */
-
-/* Fixed value references of the inputs and outputs; parameters come from the resource file. */
-enum {
-    VR_DRIVE = 0,          /* input: voltage, force or displacement */
-    VR_TEMPERATURE = 1,    /* input: temperature (the ambient temperature with a heat model) [degC] */
-    VR_DISPLACEMENT = 2,
-    VR_VELOCITY = 3,
-    VR_FRICTION_FORCE = 4,
-    VR_TEMPERATURE_OUT = 5,
-    VR_STAGE_DISPLACEMENT = 6,
-    VR_FIRST_PARAMETER = 16
-};
-
-/* What a parameter's value reference sets in the tf_model. */
-typedef enum {
-    ROLE_NONE = 0, ROLE_M, ROLE_M_E, ROLE_C, ROLE_K, ROLE_T_EM, ROLE_XI, ROLE_WN, ROLE_GAIN, ROLE_K_S, ROLE_V_0,
-    ROLE_PARAM, ROLE_LAW_A, ROLE_LAW_B, ROLE_LAW_X, ROLE_LAW_Y, ROLE_GMS_K, ROLE_GMS_W,
-    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0, ROLE_STEP
-} role_kind;
-
-static const char *const ROLE_NAMES[] = {"", "m", "m_e", "c", "k", "T_em", "xi", "wn", "K", "k_s", "v_0",
-                                         "p", "law_a", "law_b", "law_x", "law_y", "gms_k", "gms_w",
-                                         "C_th", "R_th", "eta", "T_0", "step"};
-
-typedef struct {
-    unsigned char role, fixed; /* fixed: settable before initialisation only (law breakpoints, T_0) */
-    short i, j;                /* parameter / law index, element or point index */
-} role_t;
-
-typedef struct {
-    int kind, n;
-    double x[MAX_POINTS], y[MAX_POINTS], d[MAX_POINTS];
-} law_store;
-
-typedef struct {
-    fmi2CallbackFunctions cb;
-    char *name;
-    int logging;
-    enum { S_INSTANTIATED, S_INIT, S_STEP, S_TERMINATED, S_ERROR } mode;
-
-    /* structure (resources) */
-    int plant, modal, friction, n_gms, thermal, df_form, fs_follows_fc, heat, temperature_input;
-    double range_lo, range_hi; /* the laws' calibrated range; NaN: none */
-    tf_waveform p_ext;
-    law_store law[NLAW];
-    role_t role[MAX_VR];
-    int max_vr;
-    char guid[64];           /* the model description's GUID (resources: "guid" line) */
-
-    /* values: parameters and inputs by value reference, their start values for fmi2Reset */
-    double r[MAX_VR], r_start[MAX_VR];
-    double du, dT;           /* input derivatives for the next step (0: held) */
-    int du_set;              /* du given for the next step */
-    double u_prev;           /* prescribed motion: where the last step left the motion */
-    double last_du;          /* prescribed motion: its slope over the last step (the velocity reported after it) */
-
-    /* the model and its state */
-    tf_model model;
-    double wave_t[2], wave_v[2], temp_t[2], temp_v[2];
-    double t, y[TF_MAX_STATES];
-    double rtol;
-    double fixed_step;       /* > 0: the fixed-step real-time integrator at this step [s]; 0: adaptive */
-    int out_of_range;        /* the last temperature was outside the range (warn once per excursion) */
-} instance;
-
-/* ---- logging ---- */
-
-static void logv(instance *c, fmi2Status status, const char *category, const char *fmt, va_list ap)
+/* The importer's printf-like logger; the message is already its own format ('%' doubled). */
+static void log_fmi2(const fmu_callbacks *cb, const char *name, fmu_status status, const char *category,
+                 const char *message)
 {
-    if (!c || !c->cb.logger) return;
-    if (status == fmi2OK && !c->logging) return;
-    char msg[512], esc[1024];
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    /* The logger takes a printf format; many importers (fmpy among them) show the format without
-     * formatting it. So the message itself is the format, its '%' doubled. */
-    size_t k = 0;
-    for (const char *s = msg; *s && k + 2 < sizeof esc; s++) {
-        if (*s == '%') esc[k++] = '%';
-        esc[k++] = *s;
-    }
-    esc[k] = 0;
-    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "thermofriction", status, category, esc);
+    ((fmi2CallbackLogger)cb->host_logger)(cb->env, name, (fmi2Status)status, category, message);
 }
-
-#if defined(__GNUC__)
-#define PRINTF_LIKE __attribute__((format(printf, 2, 3)))
-#else
-#define PRINTF_LIKE
-#endif
-
-static void warn(instance *c, const char *fmt, ...) PRINTF_LIKE;
-static void warn(instance *c, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    logv(c, fmi2Warning, "logStatusWarning", fmt, ap);
-    va_end(ap);
-}
-
-/* Logs an error and returns fmi2Error. */
-static fmi2Status fail(instance *c, const char *fmt, ...) PRINTF_LIKE;
-static fmi2Status fail(instance *c, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    logv(c, fmi2Error, "logStatusError", fmt, ap);
-    va_end(ap);
-    return fmi2Error;
-}
-
-/* A temperature [degC] the package would take (thermofriction.plausible: -100 to 300 C). */
-static int plausible_temperature(double T) { return T >= T_MIN && T <= T_MAX; }
-
-/* ---- the resource file ---- */
-
-/* file:///a/b%20c/resources -> /a/b c/resources (the forms FMI importers pass). */
-static int uri_to_path(const char *uri, char *path, size_t size)
-{
-    const char *s = uri;
-    if (strncmp(s, "file://", 7) == 0) {
-        s += 7;
-        if (strncmp(s, "localhost/", 10) == 0) s += 9;
-    } else if (strncmp(s, "file:", 5) == 0) {
-        s += 5;
-    }
-    size_t k = 0;
-    for (; *s && k + 1 < size; s++) {
-        if (s[0] == '%' && isxdigit((unsigned char)s[1]) && isxdigit((unsigned char)s[2])) {
-            char hex[3] = {s[1], s[2], 0};
-            path[k++] = (char)strtol(hex, 0, 16);
-            s += 2;
-        } else {
-            path[k++] = *s;
-        }
-    }
-    path[k] = 0;
-    return *s == 0;
-}
-
-static int role_by_name(const char *name)
-{
-    for (int i = 1; i < (int)(sizeof ROLE_NAMES / sizeof *ROLE_NAMES); i++)
-        if (strcmp(name, ROLE_NAMES[i]) == 0) return i;
-    return -1;
-}
-
-/* Reads the model's structure and parameters; 0 on success, else logs the line and returns -1. */
-static int read_resources(instance *c, const char *dir)
-{
-    char path[4096];
-    if (!uri_to_path(dir, path, sizeof path - 16)) return (fail(c, "resource location too long"), -1);
-    size_t len = strlen(path);
-    while (len > 0 && path[len - 1] == '/') path[--len] = 0;
-    strcat(path, "/model.tfm");
-    FILE *f = fopen(path, "r");
-    if (!f) return (fail(c, "cannot open %s (the FMU's model description)", path), -1);
-    char line[1024];
-    int lineno = 0, ok = 1, have_header = 0;
-    c->range_lo = c->range_hi = NAN;
-    while (ok && fgets(line, sizeof line, f)) {
-        lineno++;
-        char key[32];
-        int used = 0;
-        if (line[0] == '#' || sscanf(line, "%31s%n", key, &used) != 1) continue;
-        const char *rest = line + used;
-        if (strcmp(key, "thermofriction-fmu") == 0) {
-            int version;
-            ok = sscanf(rest, "%d", &version) == 1 && version == FMU_FORMAT;
-            have_header = ok;
-        } else if (strcmp(key, "guid") == 0) {
-            ok = sscanf(rest, "%63s", c->guid) == 1;
-        } else if (strcmp(key, "plant") == 0) {
-            ok = sscanf(rest, "%d %d", &c->plant, &c->modal) == 2;
-        } else if (strcmp(key, "friction") == 0) {
-            ok = sscanf(rest, "%d %d", &c->friction, &c->n_gms) == 2 && c->n_gms >= 0 &&
-                 c->n_gms <= TF_MAX_FRICTION_STATES && tf_friction_nstate(c->friction, c->n_gms) >= 0;
-        } else if (strcmp(key, "thermal") == 0) {
-            ok = sscanf(rest, "%d %d %d", &c->thermal, &c->df_form, &c->fs_follows_fc) == 3;
-        } else if (strcmp(key, "heat") == 0) {
-            ok = sscanf(rest, "%d", &c->heat) == 1;
-        } else if (strcmp(key, "temperature_input") == 0) {
-            ok = sscanf(rest, "%d", &c->temperature_input) == 1;
-        } else if (strcmp(key, "range") == 0) {
-            ok = sscanf(rest, "%lf %lf", &c->range_lo, &c->range_hi) == 2;
-        } else if (strcmp(key, "p_ext") == 0) { /* kind amplitude frequency rise offset direction slew t0 */
-            tf_waveform *w = &c->p_ext;
-            ok = sscanf(rest, "%d %lf %lf %lf %lf %lf %lf %lf", &w->kind, &w->amplitude, &w->frequency, &w->rise,
-                        &w->offset, &w->direction, &w->slew, &w->t0) == 8 && w->kind != TF_WAVE_SAMPLED;
-        } else if (strcmp(key, "law") == 0) { /* index (TF_NPARAM: dF) kind n */
-            int i, kind, n;
-            ok = sscanf(rest, "%d %d %d", &i, &kind, &n) == 3 && i >= 0 && i < NLAW && n >= 0 && n <= MAX_POINTS;
-            if (ok) c->law[i].kind = kind, c->law[i].n = n;
-        } else if (strcmp(key, "var") == 0) { /* vr role i j fixed start */
-            unsigned vr;
-            char rname[16];
-            int i, j, fixed;
-            double start;
-            ok = sscanf(rest, "%u %15s %d %d %d %lf", &vr, rname, &i, &j, &fixed, &start) == 6 &&
-                 vr >= VR_FIRST_PARAMETER && vr < MAX_VR && role_by_name(rname) > 0 && isfinite(start);
-            if (ok) {
-                c->role[vr] = (role_t){(unsigned char)role_by_name(rname), (unsigned char)fixed, (short)i, (short)j};
-                c->r[vr] = c->r_start[vr] = start;
-                if ((int)vr > c->max_vr) c->max_vr = (int)vr;
-            }
-        } else if (strcmp(key, "integrator") == 0) { /* adaptive | realtime (its step: the "step" variable) */
-            char kind[16];
-            ok = sscanf(rest, "%15s", kind) == 1 && (strcmp(kind, "adaptive") == 0 || strcmp(kind, "realtime") == 0);
-            if (ok) c->fixed_step = strcmp(kind, "realtime") == 0 ? NAN : 0.0; /* NaN until its variable is read */
-        } else if (strcmp(key, "input") == 0) { /* start values of the inputs */
-            ok = sscanf(rest, "%lf %lf", &c->r_start[VR_DRIVE], &c->r_start[VR_TEMPERATURE]) == 2;
-            c->r[VR_DRIVE] = c->r_start[VR_DRIVE];
-            c->r[VR_TEMPERATURE] = c->r_start[VR_TEMPERATURE];
-        } else {
-            ok = 0;
-        }
-    }
-    fclose(f);
-    if (!ok) return (fail(c, "%s, line %d: not understood (an FMU made by another version?)", path, lineno), -1);
-    if (!have_header) return (fail(c, "%s: not a thermofriction FMU model description", path), -1);
-    if (!c->guid[0]) return (fail(c, "%s: no guid line (the model description's GUID)", path), -1);
-    if (isnan(c->fixed_step)) {
-        int has_step = 0;
-        for (int vr = VR_FIRST_PARAMETER; vr <= c->max_vr; vr++) has_step |= c->role[vr].role == ROLE_STEP;
-        if (!has_step) return (fail(c, "%s: the realtime integrator without its step variable", path), -1);
-    }
-    return 0;
-}
-
-/* ---- the model from the parameter values ---- */
-
-/* Builds c->model from the structure and the values; 0, or logs why not and returns -1. */
-static int build_model(instance *c, tf_model *m)
-{
-    tf_gms_elements keep = m->gms; /* GMS modes are state: kept across a rebuild */
-    memset(m, 0, sizeof *m);
-    m->plant = c->plant;
-    m->friction = c->friction;
-    m->thermal = c->thermal;
-    m->dF_form = c->df_form;
-    m->fs_follows_fc = c->fs_follows_fc;
-    m->gms.n = c->n_gms;
-    memcpy(m->gms.mode, keep.mode, sizeof keep.mode);
-    m->m = 1.0;
-    double xi = 0, wn = 0, gain = 0;
-    for (int vr = VR_FIRST_PARAMETER; vr <= c->max_vr; vr++) {
-        role_t r = c->role[vr];
-        double v = c->r[vr];
-        switch (r.role) {
-        case ROLE_M: m->m = v; break;
-        case ROLE_M_E: m->m_e = v; break;
-        case ROLE_C: m->c = v; break;
-        case ROLE_K: m->k = v; break;
-        case ROLE_T_EM: m->T_em = v; break;
-        case ROLE_XI: xi = v; break;
-        case ROLE_WN: wn = v; break;
-        case ROLE_GAIN: gain = v; break;
-        case ROLE_K_S: m->k_s = v; break;
-        case ROLE_V_0: m->v_0 = v; break;
-        case ROLE_PARAM: if (r.i >= 0 && r.i < TF_NPARAM) m->p[r.i] = v; break;
-        case ROLE_LAW_A: if (r.i >= 0 && r.i < NLAW) c->law[r.i].x[0] = v; break; /* a, b kept in x[0], y[0] */
-        case ROLE_LAW_B: if (r.i >= 0 && r.i < NLAW) c->law[r.i].y[0] = v; break;
-        case ROLE_LAW_X: if (r.i >= 0 && r.i < NLAW && r.j >= 0 && r.j < MAX_POINTS) c->law[r.i].x[r.j] = v; break;
-        case ROLE_LAW_Y: if (r.i >= 0 && r.i < NLAW && r.j >= 0 && r.j < MAX_POINTS) c->law[r.i].y[r.j] = v; break;
-        case ROLE_GMS_K: if (r.i >= 0 && r.i < TF_MAX_FRICTION_STATES) m->gms.k[r.i] = v; break;
-        case ROLE_GMS_W: if (r.i >= 0 && r.i < TF_MAX_FRICTION_STATES) m->gms.w[r.i] = v; break;
-        case ROLE_C_TH: m->heat.C_th = v; break;
-        case ROLE_R_TH: m->heat.R_th = v; break;
-        case ROLE_ETA: m->heat.eta = v; break;
-        case ROLE_T_0: m->heat.T_0 = v; break;
-        case ROLE_STEP:
-            if (!(v > 0 && isfinite(v))) return (fail(c, "integrator.step = %g s: the fixed step must be positive", v), -1);
-            c->fixed_step = v;
-            break;
-        default: break;
-        }
-        if (r.role && !isfinite(v)) return (fail(c, "parameter (value reference %d) is not finite", vr), -1);
-    }
-    if (c->plant == TF_PLANT_STICK_SLIP && c->modal) { /* k = m wn^2, c = 2 xi wn m, T_em = K k */
-        m->k = m->m * wn * wn;
-        m->c = 2.0 * xi * wn * m->m;
-        m->T_em = gain * m->k;
-    }
-    if (c->fs_follows_fc) m->p[TF_P_FS] = m->p[TF_P_FC];
-    for (int i = 0; i < NLAW; i++) {
-        law_store *s = &c->law[i];
-        tf_law *law = i < TF_NPARAM ? &m->law[i] : &m->dF;
-        if (s->kind == TF_LAW_NONE) continue;
-        law->kind = s->kind;
-        if (s->kind == TF_LAW_CONST || s->kind == TF_LAW_LINEAR || s->kind == TF_LAW_EXP) {
-            law->a = s->x[0];
-            law->b = s->y[0];
-        } else {
-            law->n = s->n;
-            law->x = s->x;
-            law->y = s->y;
-            if (s->kind == TF_LAW_TABLE) {
-                for (int k = 1; k < s->n; k++)
-                    if (!(s->x[k] > s->x[k - 1])) return (fail(c, "law breakpoints must increase strictly"), -1);
-                tf_pchip_slopes(s->n, s->x, s->y, s->d);
-                law->d = s->d;
-            }
-        }
-    }
-    if (c->heat) {
-        m->heat.on = 1;
-        m->heat.T_amb = c->r[VR_TEMPERATURE];
-        m->heat.P_ext = c->p_ext;
-    }
-    m->input.kind = TF_WAVE_SAMPLED;
-    m->input.n = 2;
-    m->input.t = c->wave_t;
-    m->input.v = c->wave_v;
-    tf_model_prepare(m);
-    return 0;
-}
-
-/* The drive and temperature of model m over [t, t + h]: lines from their values at t along their
- * derivatives (h = 0: at t only). */
-static void set_signals(instance *c, tf_model *m, double t, double h)
-{
-    double u = c->r[VR_DRIVE], du = c->du;
-    if (c->plant == TF_PLANT_PRESCRIBED && !c->du_set) { /* no derivative: the motion ramps to u over the step */
-        du = h > 0 ? (u - c->u_prev) / h : 0.0;
-        u = c->u_prev;
-    }
-    double dT = c->dT;
-    if (!(h > 0)) { /* at a communication point: the values at t; a prescribed motion's velocity that of the last step */
-        h = 1.0, dT = 0.0;
-        du = c->plant == TF_PLANT_PRESCRIBED ? c->last_du : 0.0;
-        u = c->plant == TF_PLANT_PRESCRIBED ? c->u_prev : c->r[VR_DRIVE];
-        c->wave_t[0] = t - h, c->wave_t[1] = t + h; /* a segment through (t, u) with slope du */
-        c->wave_v[0] = u - du * h, c->wave_v[1] = u + du * h;
-        goto temperature;
-    }
-    c->wave_t[0] = t, c->wave_t[1] = t + h;
-    c->wave_v[0] = u, c->wave_v[1] = u + du * h;
-temperature:
-    m->input.kind = TF_WAVE_SAMPLED;
-    m->input.n = 2;
-    m->input.t = c->wave_t;
-    m->input.v = c->wave_v;
-    if (c->heat) {
-        m->heat.T_amb = c->r[VR_TEMPERATURE];
-    } else if (c->temperature_input) {
-        c->temp_t[0] = t, c->temp_t[1] = t + h;
-        c->temp_v[0] = c->r[VR_TEMPERATURE], c->temp_v[1] = c->r[VR_TEMPERATURE] + dT * h;
-        m->T_n = 2;
-        m->T_t = c->temp_t;
-        m->T_v = c->temp_v;
-    } else {
-        m->T_const = NAN;
-    }
-}
-
-static int check_model(instance *c, const tf_model *m)
-{
-    tf_error e;
-    if (tf_model_check(m, &e) == TF_OK) return 0;
-    if (c->temperature_input || c->heat)
-        fail(c, "at time %g s, temperature %g C: the model is outside its domain ('%s')", c->t,
-             c->r[VR_TEMPERATURE], e.what);
-    else
-        fail(c, "at time %g s: the model is outside its domain ('%s')", c->t, e.what);
-    return -1;
-}
-
-/* fmi2Warning (logged) when temperature T leaves the laws' calibrated range, once per excursion. */
-static fmi2Status check_range(instance *c, double T)
-{
-    if (isnan(c->range_lo)) return fmi2OK;
-    int out = !(T >= c->range_lo - 1e-9 && T <= c->range_hi + 1e-9);
-    fmi2Status s = fmi2OK;
-    if (out && !c->out_of_range) {
-        warn(c, "at time %g s the temperature %g C is outside the laws' calibrated range [%g, %g] C: extrapolated",
-              c->t, T, c->range_lo, c->range_hi);
-        s = fmi2Warning;
-    }
-    c->out_of_range = out;
-    return s;
-}
-
-/* ---- outputs ---- */
-
-static double output(instance *c, int vr)
-{
-    double out[TF_OUT_NFIXED + TF_MAX_FRICTION_STATES + 2];
-    set_signals(c, &c->model, c->t, 0.0);
-    tf_model_outputs(&c->model, c->t, c->y, out);
-    switch (vr) {
-    case VR_DISPLACEMENT: return out[TF_OUT_DISPLACEMENT];
-    case VR_VELOCITY: return out[TF_OUT_VELOCITY];
-    case VR_FRICTION_FORCE: return out[TF_OUT_FRICTION_FORCE];
-    case VR_TEMPERATURE_OUT: return out[TF_OUT_TEMPERATURE];
-    case VR_STAGE_DISPLACEMENT: return out[TF_OUT_STAGE_DISPLACEMENT];
-    default: return NAN;
-    }
-}
-
-/* ---- the FMI functions ---- */
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char *fmi2GetVersion(void) { return fmi2Version; }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component comp, fmi2Boolean on, size_t n, const fmi2String cats[])
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cats[])
 {
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    c->logging = on;
-    return fmi2OK;
+    return (fmi2Status)fmu_set_debug_logging(c, on);
 }
 
 fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
@@ -459,476 +29,121 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
                                    "this FMU supports co-simulation only");
         return NULL;
     }
-    instance *c = cb->allocateMemory(1, sizeof *c);
-    if (!c) return NULL;
-    memset(c, 0, sizeof *c);
-    c->cb = *cb;
-    c->logging = logging;
-    size_t len = strlen(name ? name : "") + 1;
-    c->name = cb->allocateMemory(len, 1);
-    if (c->name) memcpy(c->name, name ? name : "", len);
-    c->rtol = 1e-6;
-    int bad_guid = 0;
-    if (!resources || read_resources(c, resources) != 0 ||
-        (bad_guid = !guid || strcmp(guid, c->guid) != 0) || build_model(c, &c->model) != 0) {
-        if (!resources) fail(c, "no resource location given");
-        if (bad_guid)
-            fail(c, "fmi2Instantiate: GUID %s is not this FMU's %s (a model description of another FMU?)",
-                 guid ? guid : "(NULL)", c->guid);
-        if (c->name) cb->freeMemory(c->name);
-        cb->freeMemory(c);
-        return NULL;
-    }
-    c->mode = S_INSTANTIATED;
-    return c;
+    fmu_callbacks f = {cb->logger ? log_fmi2 : NULL, (fmu_host_function)cb->logger, cb->componentEnvironment, 1, NULL,
+                       cb->allocateMemory, cb->freeMemory};
+    return fmu_instantiate(name, guid, resources, 1, &f, logging);
 }
 
-void fmi2FreeInstance(fmi2Component comp)
-{
-    instance *c = comp;
-    if (!c) return;
-    fmi2CallbackFreeMemory freeMemory = c->cb.freeMemory;
-    if (c->name) freeMemory(c->name);
-    freeMemory(c);
-}
+void fmi2FreeInstance(fmi2Component c) { fmu_free_instance(c); }
 
-fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tol_defined, fmi2Real tol, fmi2Real start,
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Real tol, fmi2Real start,
                                fmi2Boolean stop_defined, fmi2Real stop)
 {
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (c->mode != S_INSTANTIATED) return fail(c, "fmi2SetupExperiment: only after fmi2Instantiate");
-    if (tol_defined) {
-        if (!(tol > 0 && tol < 1)) return fail(c, "fmi2SetupExperiment: tolerance %g must be between 0 and 1", tol);
-        c->rtol = tol;
-    }
-    if (!(fabs(start) <= TIME_LIMIT))
-        return fail(c, "fmi2SetupExperiment: start time %g s: must be finite and within +-%g s (the integrator's "
-                    "time limit)", start, TIME_LIMIT);
-    c->t = start;
-    return fmi2OK;
+    return (fmi2Status)fmu_setup_experiment(c, tol_defined, tol, start, stop_defined, stop);
 }
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return (fmi2Status)fmu_enter_initialization(c); }
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return (fmi2Status)fmu_exit_initialization(c); }
+fmi2Status fmi2Terminate(fmi2Component c) { return (fmi2Status)fmu_terminate(c); }
+fmi2Status fmi2Reset(fmi2Component c) { return (fmi2Status)fmu_reset(c); }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component comp)
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
 {
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (c->mode != S_INSTANTIATED) return fail(c, "fmi2EnterInitializationMode: only after fmi2Instantiate");
-    c->mode = S_INIT;
-    return fmi2OK;
+    return (fmi2Status)fmu_get_real(c, vr, n, value);
 }
-
-fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
 {
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (c->mode != S_INIT) return fail(c, "fmi2ExitInitializationMode: only in initialization mode");
-    if (!isfinite(c->r[VR_DRIVE]) || !isfinite(c->r[VR_TEMPERATURE]))
-        return fail(c, "the inputs at the start are not finite (drive %g, temperature %g)", c->r[VR_DRIVE],
-                     c->r[VR_TEMPERATURE]);
-    if ((c->temperature_input || c->heat) && !plausible_temperature(c->r[VR_TEMPERATURE]))
-        return fail(c, "the temperature at the start %g C is not a plausible temperature (expected %g to %g C)",
-                    c->r[VR_TEMPERATURE], T_MIN, T_MAX);
-    if (build_model(c, &c->model) != 0) return fmi2Error;
-    c->u_prev = c->r[VR_DRIVE];
-    set_signals(c, &c->model, c->t, 0.0);
-    if (check_model(c, &c->model) != 0) return fmi2Error;
-    tf_model_initial_state(&c->model, c->y);
-    tf_model_on_restart(c->t, c->y, &c->model); /* GMS modes consistent with the start */
-    c->mode = S_STEP;
-    if (c->temperature_input || c->heat) return check_range(c, output(c, VR_TEMPERATURE_OUT));
-    return fmi2OK;
+    return (fmi2Status)fmu_set_real(c, vr, n, value);
 }
-
-fmi2Status fmi2Terminate(fmi2Component comp)
-{
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    c->mode = S_TERMINATED;
-    return fmi2OK;
-}
-
-fmi2Status fmi2Reset(fmi2Component comp)
-{
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    memcpy(c->r, c->r_start, sizeof c->r);
-    c->du = c->dT = 0;
-    c->du_set = 0;
-    c->t = 0;
-    c->out_of_range = 0;
-    memset(c->y, 0, sizeof c->y);
-    memset(c->model.gms.mode, 0, sizeof c->model.gms.mode);
-    c->mode = S_INSTANTIATED;
-    return build_model(c, &c->model) == 0 ? fmi2OK : fmi2Error;
-}
-
-static int is_output(fmi2ValueReference vr)
-{
-    return vr >= VR_DISPLACEMENT && vr <= VR_STAGE_DISPLACEMENT;
-}
-
-/* The value references the model description declares (fmu.py's _variables): the drive, the
- * temperature input with a thermal extension or a heat model, the outputs of this plant, and the
- * parameters the resource file gives a role. Every other one is refused. */
-static int declared(const instance *c, fmi2ValueReference vr)
-{
-    switch (vr) {
-    case VR_DRIVE: case VR_DISPLACEMENT: case VR_VELOCITY: case VR_FRICTION_FORCE: return 1;
-    case VR_TEMPERATURE: return c->temperature_input || c->heat;
-    case VR_TEMPERATURE_OUT: return c->heat;
-    case VR_STAGE_DISPLACEMENT: return c->plant == TF_PLANT_STICK_SLIP;
-    default: return vr >= VR_FIRST_PARAMETER && vr < MAX_VR && c->role[vr].role != ROLE_NONE;
-    }
-}
-
-fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
-{
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (n > 0 && (!vr || !value)) return fail(c, "fmi2GetReal: NULL argument");
-    for (size_t k = 0; k < n; k++) {
-        if (!declared(c, vr[k])) return fail(c, "fmi2GetReal: value reference %u is not a variable of this FMU", vr[k]);
-        value[k] = is_output(vr[k]) ? output(c, (int)vr[k]) : c->r[vr[k]];
-    }
-    return fmi2OK;
-}
-
-fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
-{
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (n > 0 && (!vr || !value)) return fail(c, "fmi2SetReal: NULL argument");
-    if (c->mode == S_TERMINATED || c->mode == S_ERROR) return fail(c, "fmi2SetReal: the instance is terminated");
-    int changed = 0;
-    double before[MAX_VR];
-    memcpy(before, c->r, sizeof before);
-    for (size_t k = 0; k < n; k++) {
-        fmi2ValueReference v = vr[k];
-        if (!declared(c, v) || is_output(v)) {
-            memcpy(c->r, before, sizeof before);
-            return fail(c, "fmi2SetReal: value reference %u cannot be set", v);
-        }
-        if (!isfinite(value[k])) {
-            memcpy(c->r, before, sizeof before);
-            return fail(c, "fmi2SetReal: %s (value reference %u) is not finite (%g): refused",
-                         v == VR_DRIVE ? "the drive input" : v == VR_TEMPERATURE ? "the temperature input"
-                                                                                  : "a parameter", v, value[k]);
-        }
-        if ((v == VR_TEMPERATURE || c->role[v].role == ROLE_T_0) && !plausible_temperature(value[k])) {
-            memcpy(c->r, before, sizeof before);
-            return fail(c, "fmi2SetReal: %s %g C is not a plausible temperature (expected %g to %g C): refused",
-                        v == VR_TEMPERATURE ? (c->heat ? "the ambient temperature" : "the temperature input")
-                                            : "the start temperature T_0", value[k], T_MIN, T_MAX);
-        }
-        if (v >= VR_FIRST_PARAMETER && c->role[v].role == ROLE_STEP && !(value[k] > 0)) {
-            memcpy(c->r, before, sizeof before);
-            return fail(c, "fmi2SetReal: integrator.step = %g s refused: the fixed step must be positive", value[k]);
-        }
-        if (v >= VR_FIRST_PARAMETER) {
-            if (c->mode == S_STEP && c->role[v].fixed) {
-                memcpy(c->r, before, sizeof before);
-                return fail(c, "fmi2SetReal: parameter %u is fixed: set it before initialization", v);
-            }
-            changed = 1;
-        }
-        if (v == VR_DRIVE) c->du_set = 0, c->du = 0.0; /* a new value without a derivative is held */
-        if (v == VR_TEMPERATURE) c->dT = 0.0;
-        c->r[v] = value[k];
-    }
-    if (changed && c->mode == S_STEP) { /* a tunable parameter: the model must stay valid */
-        tf_model m = c->model;
-        int bad = build_model(c, &m) != 0;
-        if (!bad) set_signals(c, &m, c->t, 0.0);
-        if (bad || check_model(c, &m) != 0) {
-            memcpy(c->r, before, sizeof before);
-            build_model(c, &c->model); /* the laws' stores back to the old values */
-            return fmi2Error;
-        }
-        c->model = m;
-    }
-    return fmi2OK;
-}
-
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t n,
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                        const fmi2Integer order[], const fmi2Real value[])
 {
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (n > 0 && (!vr || !order || !value)) return fail(c, "fmi2SetRealInputDerivatives: NULL argument");
-    if (c->mode == S_TERMINATED || c->mode == S_ERROR)
-        return fail(c, "fmi2SetRealInputDerivatives: the instance is terminated");
-    double du = c->du, dT = c->dT; /* a refusal changes nothing */
-    int du_set = c->du_set;
-    for (size_t k = 0; k < n; k++) {
-        if (order[k] != 1) return fail(c, "fmi2SetRealInputDerivatives: only first derivatives (order 1)");
-        if (!isfinite(value[k])) return fail(c, "fmi2SetRealInputDerivatives: derivative is not finite (%g)", value[k]);
-        if (vr[k] == VR_DRIVE) du = value[k], du_set = 1;
-        else if (vr[k] == VR_TEMPERATURE && c->temperature_input) dT = value[k];
-        else return fail(c, "fmi2SetRealInputDerivatives: value reference %u is no continuous input", vr[k]);
-    }
-    c->du = du, c->dT = dT, c->du_set = du_set;
-    return fmi2OK;
+    return (fmi2Status)fmu_set_input_derivatives(c, vr, n, order, value);
 }
-
-fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t n,
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                         const fmi2Integer order[], fmi2Real value[])
 {
-    return fail((instance *)comp, "fmi2GetRealOutputDerivatives: not provided");
+    return (fmi2Status)fmu_fail(c, "fmi2GetRealOutputDerivatives: not provided");
 }
 
-static void no_emit(long i, double t, const double *y, void *ctx) {}
-static fmi2Status step_done(instance *c, double h, const double *y, int n, fmi2Status status);
-
-/* Relative sliding velocity at (t, y): the friction's input (plant.c's states: x_p, v_p, x_e, v_e
- * for the stick-slip actuator, x, v for a mass; prescribed motion: the input's slope). */
-static double sliding_velocity(const tf_model *m, double t, const double *y)
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean no_prior)
 {
-    switch (m->plant) {
-    case TF_PLANT_STICK_SLIP: return y[3] - y[1];
-    case TF_PLANT_MASS: return y[1];
-    default: return tf_waveform_slope(&m->input, t);
-    }
+    return (fmi2Status)fmu_do_step(c, t, h, no_prior);
 }
-
-/* The fixed-step real-time integrator over [c->t, c->t + h] into y: as many steps of c->fixed_step
- * as fit, the last one shortened to end on the communication point (docs/fmu.md). Each step:
- * the friction states by the core's real-time step (realtime.h: exponential Euler at the sliding
- * velocity held over the step), then the plant by semi-implicit Euler with that force (velocities,
- * then positions with the new velocities, as tf_loop_run does), the heat balance and frictional
- * work by explicit Euler; the drive and temperature held at their values at the step's start.
- * The plant's equations are the simulator's own (tf_model_rhs). 0, or logs why not and returns -1
- * (y and the model's GMS modes may then be changed: the caller restores them). */
-static int realtime_steps(instance *c, double h, double *y)
+fmi2Status fmi2CancelStep(fmi2Component c)
 {
-    tf_model *m = &c->model;
-    tf_rt_friction rt;
-    tf_error e;
-    if (tf_rt_from_model(&rt, m, &e) != TF_OK)
-        return (fail(c, "the real-time friction model refused the model ('%s')", e.what), -1);
-    int n = tf_model_nstate(m);
-    int nz = tf_friction_nstate(m->friction, m->gms.n);
-    int nm = m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
-    memcpy(rt.z, y + nm, sizeof(double) * nz);
-    memcpy(rt.model.gms.mode, m->gms.mode, sizeof m->gms.mode);
-    double dt = c->fixed_step;
-    /* whole steps, a communication step within 1e-9 of a whole number of steps counting as one */
-    double ratio = h / dt;
-    if (!(ratio <= MAX_FIXED_STEPS)) /* (long)floor(ratio) would overflow, or the step would not end */
-        return (fail(c, "fmi2DoStep: a communication step of %g s is %.3g fixed steps of integrator.step = %g s; "
-                     "at most %ld are taken in one communication step: refused", h, ratio, dt, MAX_FIXED_STEPS), -1);
-    long whole = (long)floor(ratio * (1.0 + 1e-9));
-    double last = h - whole * dt;
-    if (last <= 1e-9 * dt) last = 0.0;
-    long steps = whole + (last > 0.0);
-    double dy[TF_MAX_STATES];
-    for (long s = 0; s < steps; s++) {
-        double ts = c->t + s * dt, hs = s < whole ? dt : last;
-        if (s == whole - 1 && last == 0.0) hs = h - s * dt; /* end exactly on the communication point */
-        double v = sliding_velocity(m, ts, y), T = tf_model_temperature(m, ts, y), F;
-        tf_status st = tf_rt_step(&rt, v, T, hs, &F, &e);
-        if (st != TF_OK)
-            return (fail(c, "the fixed step at %g s (temperature %g C) was refused: %s ('%s')", ts, T,
-                         tf_status_message(st), e.what), -1);
-        memcpy(y + nm, rt.z, sizeof(double) * nz);
-        memcpy(m->gms.mode, rt.model.gms.mode, sizeof m->gms.mode);
-        tf_model_rhs(ts, y, dy, m); /* at the new friction states: the force the real-time step gave */
-        for (int i = 1; i < nm; i += 2) y[i] += dy[i] * hs;
-        for (int i = 0; i < nm; i += 2) y[i] += y[i + 1] * hs;
-        for (int i = nm + nz; i < n; i++) y[i] += dy[i] * hs;
-        for (int i = 0; i < n; i++)
-            if (!isfinite(y[i]))
-                return (fail(c, "the fixed step of %g s diverged at %g s (the state is not finite): lower "
-                             "integrator.step below the plant's and the friction's time constants", dt, ts), -1);
-    }
-    return 0;
+    return (fmi2Status)fmu_fail(c, "fmi2CancelStep: steps are never asynchronous");
 }
 
-fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no_prior)
+/* ---- FMU state: a copy of the instance ---- */
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) { return (fmi2Status)fmu_get_state(c, state); }
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) { return (fmi2Status)fmu_set_state(c, state); }
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) { return (fmi2Status)fmu_free_state(c, state); }
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size)
 {
-    instance *c = comp;
-    if (!c) return fmi2Error;
-    if (c->mode != S_STEP) return fail(c, "fmi2DoStep: only after initialization");
-    if (!(h > 0) || !isfinite(h) || !isfinite(t)) return fail(c, "fmi2DoStep: bad step (t = %g, h = %g)", t, h);
-    if (fabs(t - c->t) > 1e-9 * fmax(1.0, fabs(t))) /* the importer's clock and ours must agree */
-        return fail(c, "fmi2DoStep: communication point %.17g s is not the FMU's time %.17g s", t, c->t);
-    if (!isfinite(c->r[VR_DRIVE]) || !isfinite(c->r[VR_TEMPERATURE]))
-        return fail(c, "at time %g s the inputs are not finite (drive %g, temperature %g)", t, c->r[VR_DRIVE],
-                     c->r[VR_TEMPERATURE]);
-    if (!(fabs(t + h) <= TIME_LIMIT))
-        return fail(c, "fmi2DoStep: the step ends at %g s, beyond +-%g s (the integrator's time limit)", t + h,
-                    TIME_LIMIT);
-    if (c->temperature_input || c->heat) {
-        double T0 = c->r[VR_TEMPERATURE], T1 = T0 + (c->heat ? 0.0 : c->dT * h);
-        if (!plausible_temperature(T0) || !plausible_temperature(T1))
-            return fail(c, "fmi2DoStep: the %s reaches %g C over the step, not a plausible temperature (expected "
-                        "%g to %g C)", c->heat ? "ambient temperature" : "temperature input",
-                        plausible_temperature(T0) ? T1 : T0, T_MIN, T_MAX);
-    }
-    fmi2Status status = fmi2OK;
-    if (c->temperature_input && !c->heat) {
-        status = check_range(c, c->r[VR_TEMPERATURE]);
-        double T1 = c->r[VR_TEMPERATURE] + c->dT * h;
-        if (status == fmi2OK && c->dT != 0.0) status = check_range(c, T1);
-    }
-    set_signals(c, &c->model, c->t, h);
-    if (check_model(c, &c->model) != 0) return fmi2Error;
-
-    int n = tf_model_nstate(&c->model);
-    double y[TF_MAX_STATES], atol[TF_MAX_STATES];
-    memcpy(y, c->y, sizeof(double) * n);
-    tf_gms_elements modes = c->model.gms;
-    if (c->fixed_step > 0) {
-        if (realtime_steps(c, h, y) != 0) {
-            c->model.gms = modes;
-            tf_model_prepare(&c->model);
-            return fmi2Error;
-        }
-        return step_done(c, h, y, n, status);
-    }
-    tf_model_state_scale(&c->model, atol);
-    for (int i = 0; i < n; i++) atol[i] *= c->rtol;
-    tf_ode ode = tf_model_ode(&c->model);
-    double rtol_w[TF_MAX_STATES];
-    tf_model_rtol_weights(&c->model, rtol_w);
-    tf_solver_options opt = {.method = TF_METHOD_AUTO, .rtol = c->rtol, .atol = atol, .max_steps = MAX_ADAPTIVE_STEPS,
-                             .rtol_weight = rtol_w};
-    double t_out[2] = {c->t, c->t + h};
-    tf_solver_stats st;
-    tf_error e;
-    tf_status s = tf_solve(&ode, &opt, t_out, 2, y, no_emit, 0, &st, &e);
-    for (int i = 0; s == TF_OK && i < n; i++)
-        if (!isfinite(y[i])) s = TF_ERR_NONFINITE, e.t = c->t + h, snprintf(e.what, sizeof e.what, "%s", "state");
-    if (s != TF_OK) {
-        c->model.gms = modes;
-        return fail(c, "the integration from %g s over %g s failed at %g s: %s (%s)", c->t, h, e.t,
-                    tf_status_message(s), e.what);
-    }
-    return step_done(c, h, y, n, status);
+    return (fmi2Status)fmu_fail(c, "FMU states cannot be serialized (canSerializeFMUstate is false)");
 }
-
-/* After a successful step of h: the new state and time, the inputs advanced along their derivatives. */
-static fmi2Status step_done(instance *c, double h, const double *y, int n, fmi2Status status)
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size)
 {
-    memcpy(c->y, y, sizeof(double) * n);
-    c->t += h;
-    c->u_prev = c->wave_v[1];
-    c->last_du = (c->wave_v[1] - c->wave_v[0]) / h;
-    if (c->temperature_input && !c->heat) c->r[VR_TEMPERATURE] += c->dT * h;
-    if (c->du_set || c->plant != TF_PLANT_PRESCRIBED) c->r[VR_DRIVE] = c->wave_v[1];
-    c->du = c->dT = 0.0; /* derivatives hold for one step */
-    c->du_set = 0;
-    if (c->heat) {
-        fmi2Status r = check_range(c, output(c, VR_TEMPERATURE_OUT));
-        if (r > status) status = r;
-    }
-    return status;
+    return (fmi2Status)fmu_fail(c, "FMU states cannot be serialized (canSerializeFMUstate is false)");
 }
-
-fmi2Status fmi2CancelStep(fmi2Component comp) { return fail((instance *)comp, "fmi2CancelStep: steps are never asynchronous"); }
-
-/* ---- FMU state: a copy of the instance (its laws' pointers are rebuilt on restore) ---- */
-
-fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate *state)
 {
-    instance *c = comp;
-    if (!c || !state) return fmi2Error;
-    instance *s = *state ? *state : c->cb.allocateMemory(1, sizeof *s);
-    if (!s) return fail(c, "fmi2GetFMUstate: out of memory");
-    memcpy(s, c, sizeof *s);
-    *state = s;
-    return fmi2OK;
+    return (fmi2Status)fmu_fail(c, "FMU states cannot be serialized (canSerializeFMUstate is false)");
 }
-
-fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state)
-{
-    instance *c = comp;
-    if (!c || !state) return fmi2Error;
-    char *name = c->name;
-    fmi2CallbackFunctions cb = c->cb;
-    int logging = c->logging;
-    memcpy(c, state, sizeof *c);
-    c->name = name, c->cb = cb, c->logging = logging;
-    tf_gms_elements modes = c->model.gms;
-    if (build_model(c, &c->model) != 0) return fmi2Error;
-    c->model.gms = modes;
-    return fmi2OK;
-}
-
-fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
-{
-    instance *c = comp;
-    if (!c || !state) return fmi2Error;
-    if (*state) c->cb.freeMemory(*state);
-    *state = NULL;
-    return fmi2OK;
-}
-
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size)
-{
-    return fail((instance *)comp, "FMU states cannot be serialized (canSerializeFMUstate is false)");
-}
-fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byte bytes[], size_t size)
-{
-    return fail((instance *)comp, "FMU states cannot be serialized (canSerializeFMUstate is false)");
-}
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte bytes[], size_t size, fmi2FMUstate *state)
-{
-    return fail((instance *)comp, "FMU states cannot be serialized (canSerializeFMUstate is false)");
-}
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueReference u[], size_t nu,
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
                                         const fmi2ValueReference z[], size_t nz, const fmi2Real du[], fmi2Real dz[])
 {
-    return fail((instance *)comp, "fmi2GetDirectionalDerivative: not provided");
+    return (fmi2Status)fmu_fail(c, "fmi2GetDirectionalDerivative: not provided");
 }
 
 /* ---- the types this FMU has no variables of ---- */
 
-fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2Integer value[])
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer value[])
 {
-    return n == 0 ? fmi2OK : fail((instance *)comp, "fmi2GetInteger: this FMU has no integer variables");
+    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetInteger: this FMU has no integer variables");
 }
-fmi2Status fmi2GetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2Boolean value[])
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean value[])
 {
-    return n == 0 ? fmi2OK : fail((instance *)comp, "fmi2GetBoolean: this FMU has no boolean variables");
+    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetBoolean: this FMU has no boolean variables");
 }
-fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2String value[])
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String value[])
 {
-    return n == 0 ? fmi2OK : fail((instance *)comp, "fmi2GetString: this FMU has no string variables");
+    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetString: this FMU has no string variables");
 }
-fmi2Status fmi2SetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t n, const fmi2Integer value[])
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer value[])
 {
-    return n == 0 ? fmi2OK : fail((instance *)comp, "fmi2SetInteger: this FMU has no integer variables");
+    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetInteger: this FMU has no integer variables");
 }
-fmi2Status fmi2SetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t n, const fmi2Boolean value[])
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean value[])
 {
-    return n == 0 ? fmi2OK : fail((instance *)comp, "fmi2SetBoolean: this FMU has no boolean variables");
+    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetBoolean: this FMU has no boolean variables");
 }
-fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size_t n, const fmi2String value[])
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String value[])
 {
-    return n == 0 ? fmi2OK : fail((instance *)comp, "fmi2SetString: this FMU has no string variables");
+    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetString: this FMU has no string variables");
 }
 
-fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Status *value)
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
-    return fail((instance *)comp, "fmi2GetStatus: steps are never asynchronous");
+    return (fmi2Status)fmu_fail(c, "fmi2GetStatus: steps are never asynchronous");
 }
-fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Real *value)
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
 {
-    instance *c = comp;
     if (!c || !value) return fmi2Error;
-    if (s == fmi2LastSuccessfulTime) { *value = c->t; return fmi2OK; }
-    return fail(c, "fmi2GetRealStatus: only fmi2LastSuccessfulTime");
+    if (s == fmi2LastSuccessfulTime) { *value = fmu_time(c); return fmi2OK; }
+    return (fmi2Status)fmu_fail(c, "fmi2GetRealStatus: only fmi2LastSuccessfulTime");
 }
-fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Integer *value)
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
-    return fail((instance *)comp, "fmi2GetIntegerStatus: not provided");
+    return (fmi2Status)fmu_fail(c, "fmi2GetIntegerStatus: not provided");
 }
-fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Boolean *value)
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
 {
-    return fail((instance *)comp, "fmi2GetBooleanStatus: not provided");
+    return (fmi2Status)fmu_fail(c, "fmi2GetBooleanStatus: not provided");
 }
-fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusKind s, fmi2String *value)
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
 {
-    return fail((instance *)comp, "fmi2GetStringStatus: not provided");
+    return (fmi2Status)fmu_fail(c, "fmi2GetStringStatus: not provided");
 }

@@ -1,4 +1,5 @@
-/* Coverage-guided fuzz target (libFuzzer) for the FMI 2.0 co-simulation wrapper (core/fmu/fmi2_cs.c):
+/* Coverage-guided fuzz target (libFuzzer) for the FMI 2.0 co-simulation wrapper (core/fmu/fmi2_cs.c
+ * around fmu_common.c, the logic the FMI 3.0 wrapper shares):
  * its resource file and every entry point. The fuzzer's bytes are
  *   - the model description the FMU loads (resources/model.tfm: a two-byte length, then that much text;
  *     the seeds are files the Python exporter wrote), written to a temporary folder, and

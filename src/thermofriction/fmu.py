@@ -1,8 +1,11 @@
-"""FMI 2.0 co-simulation FMUs of any model (docs/fmu.md): ``export_fmu(model, path)``.
+"""FMI 2.0 and 3.0 co-simulation FMUs of any model (docs/fmu.md): ``export_fmu(model, path, fmi=2|3)``.
 
-One prebuilt binary serves every model: the C core with an FMI wrapper (core/fmu/fmi2_cs.c), built
-when the package is installed. Exporting a model zips that binary as
-``binaries/linux64/<modelIdentifier>.so`` with a generated ``modelDescription.xml`` and
+One prebuilt binary serves every model and both standards: the C core with the shared FMU logic
+(core/fmu/fmu_common.c) and the FMI 2 and FMI 3 wrappers (fmi2_cs.c, fmi3_cs.c), built when the package
+is installed, for Linux x86-64 and, when the MinGW-w64 cross compiler is there, Windows x86-64.
+Exporting a model zips the binaries as ``binaries/linux64/<modelIdentifier>.so`` and
+``binaries/win64/<modelIdentifier>.dll`` (FMI 3: ``x86_64-linux``, ``x86_64-windows``) with a
+generated ``modelDescription.xml`` and
 ``resources/model.tfm``, the model description the binary reads when it is instantiated (its plant,
 friction model, thermal extension, laws and every tunable parameter with its value reference). So an
 export needs no compiler.
@@ -27,10 +30,13 @@ import os
 import platform
 import re
 import uuid
+import warnings
 import zipfile
 from importlib import resources
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
+
+import numpy as np
 
 from . import _bridge
 from ._io import Target, atomic_write
@@ -39,9 +45,9 @@ from .errors import InputError, shorten
 from . import _args
 from .models import MassPlant, Model, PrescribedMotion, StickSlipPlant, load_model
 
-#: The resource file's format version (core/fmu/fmi2_cs.c, FMU_FORMAT).
+#: The resource file's format version (core/fmu/fmu_common.c, FMU_FORMAT).
 FORMAT = 2
-#: The binary's limits (fmi2_cs.c: MAX_VR value references, MAX_POINTS points of one law).
+#: The binary's limits (fmu_common.c: MAX_VR value references, MAX_POINTS points of one law).
 MAX_VALUE_REFERENCE = 2048
 MAX_POINTS = 256
 FIRST_PARAMETER = 16
@@ -49,10 +55,18 @@ FIRST_PARAMETER = 16
 #: The integrators an FMU can carry (docs/fmu.md#integrators).
 INTEGRATORS = ("adaptive", "realtime")
 
-#: Fixed value references of the inputs and outputs (fmi2_cs.c).
+#: Fixed value references of the inputs and outputs (fmu_common.c).
 VR_DRIVE, VR_TEMPERATURE, VR_DISPLACEMENT, VR_VELOCITY, VR_FRICTION_FORCE, VR_TEMPERATURE_OUT, VR_STAGE = range(7)
 
-_BINARY = "thermofriction_fmi2.so"
+#: The FMI versions an export can follow (docs/fmu.md).
+FMI_VERSIONS = (2, 3)
+#: Value reference of FMI 3's independent variable time (fmi3_cs.c, VR_TIME).
+VR_TIME = 15
+
+_BINARY = "thermofriction_fmi.so"
+_DLL = "thermofriction_fmi.dll"
+# where each platform's binary goes in an FMU of each version
+_PLATFORMS = {2: {"so": "linux64", "dll": "win64"}, 3: {"so": "x86_64-linux", "dll": "x86_64-windows"}}
 
 # SI base units of the units the FMU declares (FMI 2.0 UnitDefinitions); others are declared by name.
 _BASE_UNITS = {
@@ -63,6 +77,10 @@ _BASE_UNITS = {
 }
 
 
+class NoWindowsBinaryWarning(UserWarning):
+    """An exported FMU carries the Linux binary only (the package was built without MinGW-w64)."""
+
+
 class _Variable:
     def __init__(self, name, vr, unit, description, start=None, causality="parameter", variability="tunable",
                  role=None, i=0, j=0):
@@ -70,9 +88,10 @@ class _Variable:
         self.causality, self.variability, self.role, self.i, self.j = causality, variability, role, i, j
 
 
-def binary_path() -> Path:
-    """The installed FMI binary (built with the package on Linux)."""
-    return Path(str(resources.files("thermofriction"))) / "_fmu" / _BINARY
+def binary_path(platform_name: str = "linux64") -> Path:
+    """The installed FMI binary (FMI 2 and 3 in one): ``"linux64"``, built with the package on Linux, or
+    ``"win64"``, the DLL cross-compiled with MinGW-w64 when the package was built where it is installed."""
+    return Path(str(resources.files("thermofriction"))) / "_fmu" / (_DLL if platform_name == "win64" else _BINARY)
 
 
 def _identifier(text: str) -> str:
@@ -235,7 +254,7 @@ def _variables(model: Model, spec: dict, temperature: float | None, step: float 
 
 
 def _resource_text(model: Model, spec: dict, variables, integrator: str = "adaptive") -> str:
-    """resources/model.tfm: the structure and the parameters' roles (read by fmi2_cs.c)."""
+    """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
              f"plant {spec['plant']} {int(isinstance(model.plant, StickSlipPlant) and model.plant.modal)}",
@@ -263,36 +282,20 @@ def _resource_text(model: Model, spec: dict, variables, integrator: str = "adapt
     return "\n".join(lines) + "\n"
 
 
+def _default_experiment_xml(model: Model, step: float | None) -> str:
+    stop, h, _ = default_experiment(model, step)
+    return f'  <DefaultExperiment startTime="0" stopTime="{stop!r}" stepSize="{h!r}" tolerance="1e-06"/>'
+
+
 def _xml(model: Model, variables, identifier: str, guid: str, source: str | None, step: float | None = None) -> str:
-    name = model.name or identifier
-    provenance = f"exported by thermofriction {__version__}" + (f" from {source}" if source else "")
-    provenance += (f"; fixed-step real-time integrator, step {step:g} s" if step is not None
-                   else "; adaptive integrator")
-    description = ((model.description + " -- ") if model.description else "") + provenance
-    units = sorted({v.unit for v in variables if v.unit})
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(name)} guid="{guid}"',
-           f'  description={quoteattr(description)} generationTool="thermofriction {__version__}"',
-           f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"',
+    out = [*_head(model, identifier, f'fmiVersion="2.0" guid="{guid}"', source, step),
            '  variableNamingConvention="structured" numberOfEventIndicators="0">',
            f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
            '    canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"',
            '    canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
-           '  <UnitDefinitions>']
-    for u in units:
-        if u == "degC":
-            out.append('    <Unit name="degC"><BaseUnit K="1" offset="273.15"/></Unit>')
-        elif u in _BASE_UNITS:
-            attrs = " ".join(f'{k}="{e}"' for k, e in _BASE_UNITS[u].items())
-            out.append(f'    <Unit name={quoteattr(u)}><BaseUnit {attrs}/></Unit>')
-        else:
-            out.append(f'    <Unit name={quoteattr(u)}/>')
-    out += ['  </UnitDefinitions>',
-            '  <LogCategories>',
-            '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
-            '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
-            '  </LogCategories>',
-            f'  <DefaultExperiment startTime="0" stopTime="1" stepSize="{_default_step(step)!r}" tolerance="1e-06"/>',
+           *_units_xml(variables)]
+    out += [*_LOG_CATEGORIES,
+            _default_experiment_xml(model, step),
             '  <ModelVariables>']
     outputs = []
     for index, v in enumerate(variables, start=1):
@@ -316,15 +319,109 @@ def _xml(model: Model, variables, identifier: str, guid: str, source: str | None
     return "\n".join(out)
 
 
-def _default_step(step: float | None) -> float:
-    """The default communication step: 0.1 ms, with the realtime integrator a whole number of its steps."""
-    return 1e-4 if step is None else step * max(1, round(1e-4 / step))
+def default_experiment(model: Model, step: float | None = None) -> tuple[float, float, str]:
+    """The FMU's default experiment (stop time [s], communication step [s], why): a step that resolves the
+    model's ``[input]``: 1/200 of its period and 1/20 of its shortest ramp (a sawtooth's fall or rise, a
+    square's or step's slew, the closest samples), over two periods (a step: until ten slews after it; no
+    periodic input: 1 s). Without an ``[input]``: 0.1 ms over 1 s. With the realtime integrator the step is
+    a whole number of its fixed steps (at least one). docs/fmu.md#the-default-experiment says why."""
+    w = model.input
+    stop, why = 1.0, "no [input] in the model: 0.1 ms"
+    candidates = []
+    period = getattr(w, "period", None)
+    if period:
+        candidates.append((period / 200, f"1/200 of the input's period {period:g} s"))
+        stop = 2 * period
+    if w is not None and w.kind == "sawtooth":
+        ramp = min(w.rise, 1 - w.rise) * period
+        candidates.append((ramp / 20, f"1/20 of the sawtooth's {'fall' if w.rise > 0.5 else 'rise'} {ramp:g} s"))
+    elif w is not None and w.kind in ("square", "step") and w.slew > 0:
+        candidates.append((w.slew / 20, f"1/20 of the {w.kind}'s slew {w.slew:g} s"))
+        if w.kind == "step":
+            stop = max(w.time + 10 * w.slew, 10 * w.slew)
+    elif w is not None and w.kind == "sampled":
+        dt = float(np.min(np.diff(w.time)))
+        candidates.append((dt, f"the input's closest samples, {dt:g} s apart"))
+        stop = float(w.time[-1])
+    h, why = min(candidates) if candidates else (1e-4, why)
+    h = float(f"{h:.2g}")  # a round number
+    if step is not None:
+        n = max(1, round(h / step))
+        h, why = step * n, why + f", as {n} fixed step{'s' if n > 1 else ''} of {step:g} s"
+    return stop, h, why
+
+
+_LOG_CATEGORIES = [
+    '  <LogCategories>',
+    '    <Category name="logStatusWarning" description="a temperature outside the laws\' calibrated range"/>',
+    '    <Category name="logStatusError" description="refused inputs or parameters, failed integrations"/>',
+    '  </LogCategories>']
+
+
+def _head(model: Model, identifier: str, version: str, source: str | None, step: float | None) -> list[str]:
+    """The model description's first lines: the version attributes, modelName, description (the model's
+    own and where it came from), the tool and the date."""
+    provenance = f"exported by thermofriction {__version__}" + (f" from {source}" if source else "")
+    provenance += (f"; fixed-step real-time integrator, step {step:g} s" if step is not None
+                   else "; adaptive integrator")
+    description = ((model.description + " -- ") if model.description else "") + provenance
+    return ['<?xml version="1.0" encoding="UTF-8"?>',
+            f'<fmiModelDescription {version} modelName={quoteattr(model.name or identifier)}',
+            f'  description={quoteattr(description)} generationTool="thermofriction {__version__}"',
+            f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"']
+
+
+def _units_xml(variables, extra=()) -> list[str]:
+    out = ['  <UnitDefinitions>']
+    for u in sorted({v.unit for v in variables if v.unit} | set(extra)):
+        if u == "degC":
+            out.append('    <Unit name="degC"><BaseUnit K="1" offset="273.15"/></Unit>')
+        elif u in _BASE_UNITS:
+            attrs = " ".join(f'{k}="{e}"' for k, e in _BASE_UNITS[u].items())
+            out.append(f'    <Unit name={quoteattr(u)}><BaseUnit {attrs}/></Unit>')
+        else:
+            out.append(f'    <Unit name={quoteattr(u)}/>')
+    return out + ['  </UnitDefinitions>']
+
+
+def _xml3(model: Model, variables, identifier: str, guid: str, source: str | None, step: float | None = None) -> str:
+    """modelDescription.xml of an FMI 3.0 co-simulation FMU: the FMI 2 export's variables as Float64, and time."""
+    out = [*_head(model, identifier, f'fmiVersion="3.0" instantiationToken="{guid}"', source, step),
+           '  variableNamingConvention="structured">',
+           f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
+           '    canGetAndSetFMUState="true" canSerializeFMUState="false" providesDirectionalDerivatives="false"',
+           '    providesAdjointDerivatives="false" hasEventMode="false" maxOutputDerivativeOrder="0"/>',
+           *_units_xml(variables, extra=("s",)),  # time's
+           *_LOG_CATEGORIES,
+           _default_experiment_xml(model, step),
+           '  <ModelVariables>',
+           f'    <Float64 name="time" valueReference="{VR_TIME}" causality="independent" variability="continuous"'
+           ' description="the simulation time" unit="s"/>']
+    outputs = []
+    for v in variables:
+        attrs = [f"name={quoteattr(v.name)}", f'valueReference="{v.vr}"', f"description={quoteattr(v.description)}",
+                 f'causality="{v.causality}"', f'variability="{v.variability}"']
+        if v.unit:
+            attrs.append(f"unit={quoteattr(v.unit)}")
+        if v.causality in ("parameter", "input"):
+            attrs.append(f'start="{v.start!r}"')
+        else:
+            outputs.append(v.vr)
+        out.append(f'    <Float64 {" ".join(attrs)}/>')
+    out += ['  </ModelVariables>', '  <ModelStructure>']
+    out += [f'    <Output valueReference="{vr}"/>' for vr in outputs]
+    out += [f'    <InitialUnknown valueReference="{vr}"/>' for vr in outputs]
+    out += ['  </ModelStructure>', '</fmiModelDescription>', '']
+    return "\n".join(out)
 
 
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
-               source: str | None = None, integrator: str = "adaptive", step: float | None = None) -> Path | Target:
-    """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 co-simulation FMU to
-    ``path`` (docs/fmu.md). ``temperature``: the start value of the temperature input [degC] (with a
+               source: str | None = None, integrator: str = "adaptive", step: float | None = None,
+               fmi: int = 2) -> Path | Target:
+    """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 (``fmi=2``, the default) or
+    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md), with the linux64 binary and, when
+    the package was built with the MinGW-w64 cross compiler, the win64 one (else a NoWindowsBinaryWarning
+    says so). ``temperature``: the start value of the temperature input [degC] (with a
     heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
     ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
     ``source``: where the model came from (a file or preset name), for the FMU's description.
@@ -346,7 +443,10 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         if temperature != temperature or abs(temperature) == float("inf"):
             raise InputError(f"export_fmu: temperature must be a finite number of degrees C, got {temperature!r}")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
-        raise InputError(f"FMUs are exported for Linux x86-64 only; this is {platform.system()} {platform.machine()}")
+        raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); "
+                         f"this is {platform.system()} {platform.machine()}")
+    if fmi not in FMI_VERSIONS:
+        raise InputError(f"export_fmu: fmi = {shorten(fmi)}: the FMI version is 2 or 3")
     binary = binary_path()
     if not binary.is_file():
         raise InputError(f"this installation has no FMU binary ({binary}): reinstall thermofriction on Linux x86-64 "
@@ -372,27 +472,37 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     tfm = _resource_text(model, spec, variables, integrator)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
     tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
-    xml = _xml(model, variables, identifier, guid, source, step)
-    so = binary.read_bytes()
+    xml = (_xml if fmi == 2 else _xml3)(model, variables, identifier, guid, source, step)
+    binaries = {"so": binary.read_bytes()}
+    if binary_path("win64").is_file():
+        binaries["dll"] = binary_path("win64").read_bytes()
+    else:
+        warnings.warn("this installation has no Windows binary (the package was built without the MinGW-w64 cross "
+                      "compiler x86_64-w64-mingw32-gcc): the FMU carries linux64 only", NoWindowsBinaryWarning,
+                      stacklevel=2)
     target = path if isinstance(path, Target) else Path(os.fspath(path))
     if isinstance(target, Path) and target.is_dir():
         raise InputError(f"{target}: is a folder; give a file name for the FMU (e.g. {target / (identifier + '.fmu')})")
     with atomic_write(target, "wb") as fh:
         with zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", xml)
-            info = zipfile.ZipInfo(f"binaries/linux64/{identifier}.so", date_time=(2020, 1, 1, 0, 0, 0))
-            info.external_attr = 0o755 << 16
-            info.compress_type = zipfile.ZIP_DEFLATED
-            z.writestr(info, so)
+            for ext, data in binaries.items():
+                info = zipfile.ZipInfo(f"binaries/{_PLATFORMS[fmi][ext]}/{identifier}.{ext}",
+                                       date_time=(2020, 1, 1, 0, 0, 0))
+                info.external_attr = 0o755 << 16
+                info.compress_type = zipfile.ZIP_DEFLATED
+                z.writestr(info, data)
             z.writestr("resources/model.tfm", tfm)
             z.writestr("resources/model.toml", model.to_toml())
-            z.writestr("documentation/licenses/fmi2-headers.txt", _headers_licence())
+            z.writestr(f"documentation/licenses/fmi{fmi}-headers.txt", _headers_licence(fmi))
     return target
 
 
-def _headers_licence() -> str:
-    return ("The binary was built with the official FMI 2.0.1 headers, (C) 2008-2011 MODELISAR consortium, "
-            "2012-2019 Modelica Association Project \"FMI\", under the 2-Clause BSD License.\n")
+def _headers_licence(fmi: int = 2) -> str:
+    version, years = ("2.0.1", "2012-2019") if fmi == 2 else ("3.0.2", "2012-2024")
+    return (f"The binary was built with the official FMI {version} headers, (C) 2008-2011 MODELISAR consortium, "
+            f"{years} Modelica Association Project \"FMI\", under the 2-Clause BSD License.\n")
 
 
-__all__ = ["export_fmu", "binary_path", "INTEGRATORS"]
+__all__ = ["export_fmu", "binary_path", "default_experiment", "INTEGRATORS", "FMI_VERSIONS",
+           "NoWindowsBinaryWarning"]

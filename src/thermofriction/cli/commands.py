@@ -385,13 +385,14 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_fmu(args) -> int:
-    """Export a model as an FMI 2.0 co-simulation FMU (docs/fmu.md)."""
-    from ..fmu import export_fmu  # zipfile and the binary only when asked for
+    """Export a model as an FMI 2.0 or 3.0 co-simulation FMU (docs/fmu.md)."""
+    from ..fmu import binary_path, export_fmu  # zipfile and the binary only when asked for
 
     model = load_model(args.model)
     _refuse_inputs(args, _model_inputs(args.model, model))
     export_fmu(model, _target(args, "output"), temperature=args.temperature, model_identifier=args.model_identifier,
-               source=args.model, integrator=args.integrator, step=args.step)
+               source=args.model, integrator=args.integrator, step=args.step, fmi=args.fmi)
     how = f"fixed step {args.step:g} s" if args.integrator == "realtime" else "adaptive integrator"
-    print(f"{model.name or args.model}: wrote {args.output} (FMI 2.0 co-simulation, linux64, {how})")
+    where = "linux64, win64" if binary_path("win64").is_file() else "linux64"
+    print(f"{model.name or args.model}: wrote {args.output} (FMI {args.fmi}.0 co-simulation, {where}, {how})")
     return 0

@@ -222,8 +222,9 @@ def _add_fmu_command(sub):
     """`thermofriction fmu`: export a model as an FMI 2.0 co-simulation FMU (docs/fmu.md)."""
     f = sub.add_parser(
         "fmu", help="export a model as an FMI 2.0 co-simulation FMU for Simulink, OpenModelica, fmpy, ... (docs/fmu.md)",
-        description="Write MODEL as an FMI 2.0 co-simulation FMU for Linux x86-64 (the C core inside, libc and libm "
-                    "its only dependencies). Inputs: the plant's drive (voltage, force or motion) and, for Model I "
+        description="Write MODEL as an FMI 2.0 (or, with --fmi 3, FMI 3.0) co-simulation FMU for Linux x86-64 and, "
+                    "when the package was built with the MinGW-w64 cross compiler, Windows x86-64 (the C core "
+                    "inside, the C library its only dependency). Inputs: the plant's drive (voltage, force or motion) and, for Model I "
                     "and II, the temperature [C] (with a [heat] section, the ambient temperature). Outputs: "
                     "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
@@ -242,6 +243,7 @@ def _add_fmu_command(sub):
     f.add_argument("--step", type=_finite_float, metavar="SECONDS",
                    help="the realtime integrator's fixed step [s], e.g. 1e-5 (a tenth of the fastest time "
                         "constant or less)")
+    f.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version: 2 (default) or 3")
     from .commands import cmd_fmu
     f.set_defaults(run=cmd_fmu)
 
