@@ -41,10 +41,24 @@ int tf_model_work_index(const tf_model *model)
  * (no temperature signal, no heat or work state). Its parameters, lambda and dF are then the
  * run's, and tf_model_ode gives it a right-hand side (rhs_lugre_constant_T) that dispatches on
  * nothing per call: a third of the general path's cost on the paper's workload. */
+/* Whether a parameter is given (a number or a law): the direction-dependent ones are NaN when not,
+ * the ripple's period <= 0. */
+static int given(const tf_model *m, int i)
+{
+    return m->law[i].kind != TF_LAW_NONE || (i == TF_P_RIPPLE_PERIOD ? m->p[i] > 0.0 : tf_side_given(m->p[i]));
+}
+
+/* Direction-dependent friction or a position ripple: the general path handles them. */
+static int sided_or_ripple(const tf_model *m)
+{
+    return given(m, TF_P_FC_NEG) || given(m, TF_P_FS_NEG) || given(m, TF_P_VS_NEG) || given(m, TF_P_SIGMA2_NEG) ||
+           given(m, TF_P_RIPPLE_PERIOD);
+}
+
 static int lugre_constant_T(const tf_model *m)
 {
     return m->friction == TF_FRICTION_LUGRE && m->T_n == 0 && !has_work(m) &&
-           (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS);
+           (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS) && !sided_or_ripple(m);
 }
 
 /* Relative sliding velocity v_r of the driven body on its driving surface. */
@@ -54,6 +68,16 @@ static double relative_velocity(const tf_model *m, double t, const double *y)
     case TF_PLANT_STICK_SLIP: return y[VE] - y[VP];
     case TF_PLANT_MASS: return y[V];
     default: return tf_waveform_slope(&m->input, t);
+    }
+}
+
+/* Relative position x_r of the same bodies (the position ripple's argument). */
+static double relative_position(const tf_model *m, double t, const double *y)
+{
+    switch (m->plant) {
+    case TF_PLANT_STICK_SLIP: return y[XE] - y[XP];
+    case TF_PLANT_MASS: return y[X];
+    default: return tf_waveform_value(&m->input, t);
     }
 }
 
@@ -104,6 +128,8 @@ static double friction_at(tf_model *m, double T, double t, const double *y, doub
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
     double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+    if (p[TF_P_RIPPLE_PERIOD] > 0.0) /* on the base force: Model II scales it with the rest */
+        F += tf_friction_ripple(p, relative_position(m, t, y), jac ? &jac->dF_dx : 0, dp ? dp->dF_dp : 0);
     if (F_base) *F_base = F;
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, nz, jac);
 }
@@ -330,6 +356,10 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
         J_(XE, VE) = 1.0;
         J_(VE, VP) = d->dF_dv / m->m_e;
         J_(VE, VE) = -d->dF_dv / m->m_e;
+        if (d->dF_dx != 0.0) { /* the ripple, in x_e - x_p */
+            J_(VP, XE) += d->dF_dx / m->m, J_(VP, XP) -= d->dF_dx / m->m;
+            J_(VE, XE) -= d->dF_dx / m->m_e, J_(VE, XP) += d->dF_dx / m->m_e;
+        }
         for (int j = 0; j < nz; j++) {
             J_(VP, nm + j) = d->dF_dz[j] / m->m;
             J_(VE, nm + j) = -d->dF_dz[j] / m->m_e;
@@ -340,6 +370,7 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
         J_(X, V) = 1.0;
         J_(V, X) = -m->k_s / m->m;
         J_(V, V) = -d->dF_dv / m->m;
+        J_(V, X) -= d->dF_dx / m->m;
         for (int j = 0; j < nz; j++) {
             J_(V, nm + j) = -d->dF_dz[j] / m->m;
             J_(nm + j, V) = d->ddz_dv[j];

@@ -62,6 +62,7 @@ static inline double tf_thermal_force(double F_base, double v, double v_smooth, 
     double F = lambda * F_base;
     if (jac && lambda != 1.0) {
         jac->dF_dv *= lambda;
+        jac->dF_dx *= lambda;
         for (int j = 0; j < nz; j++) jac->dF_dz[j] *= lambda;
     }
     if (dF_offset != 0.0) { /* offset form: dF along a smoothed sign of v */

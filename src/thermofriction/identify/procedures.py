@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import Model, ModelI
+from ..models.friction import SIGNED
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
@@ -84,11 +85,12 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
 
 
 def friction_parameters(model: Model, names, fixed=()) -> Parameters:
-    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term or a law's coefficient."""
+    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term, a law's
+    coefficient or a ripple amplitude."""
     params = Parameters()
     for name in names:
         v = get_value(model, name)
-        positive = not name.startswith("dF") and "." not in name
+        positive = not name.startswith("dF") and "." not in name and name not in SIGNED
         params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
                    unit=unit_of(model, name))
     return params

@@ -17,6 +17,49 @@ from ._parse import num, num_array
 # from the core's parameter list (friction.h, TF_PARAMETERS).
 
 
+#: The negative side's parameters (docs/models.md#direction-and-position), each with its positive one.
+NEGATIVE_SIDE = {"fc_neg": "fc", "fs_neg": "fs", "vs_neg": "vs", "sigma2_neg": "sigma2"}
+#: The ripple's harmonics (friction.h, TF_RIPPLE_ORDER) and its amplitudes' names, in N or N m.
+RIPPLE_ORDER = 3
+RIPPLE_AMPLITUDES = tuple(f"ripple_{f}{k}" for k in range(1, RIPPLE_ORDER + 1) for f in ("cos", "sin"))
+#: Parameters that may take either sign (fitted as they are, not in log space).
+SIGNED = frozenset(RIPPLE_AMPLITUDES)
+
+
+def ripple_keys(table, where="[friction]") -> dict:
+    """``ripple = { period = P, cos = [a1, ...], sin = [b1, ...] }`` as the flat parameters
+    ``ripple_period``, ``ripple_cos1`` ... (up to RIPPLE_ORDER harmonics)."""
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: 'ripple' must be a table {{ period = ..., cos = [...], sin = [...] }}, "
+                         f"got {shorten(table)}")
+    unknown = set(table) - {"period", "cos", "sin"}
+    if unknown:
+        raise InputError(f"{where}: 'ripple' has unknown keys {sorted(unknown)} (period, cos, sin)")
+    if "period" not in table:
+        raise InputError(f"{where}: 'ripple' needs its 'period' (one revolution, a screw pitch, ... in m or rad)")
+    out = {"ripple_period": num(table["period"], where, "ripple.period")}
+    for f in ("cos", "sin"):
+        amps = list(num_array(table.get(f, []), where, f"ripple.{f}"))
+        if len(amps) > RIPPLE_ORDER:
+            raise InputError(f"{where}: 'ripple.{f}' has {len(amps)} amplitudes; at most {RIPPLE_ORDER} harmonics")
+        out.update({f"ripple_{f}{k + 1}": float(a) for k, a in enumerate(amps)})
+    return out
+
+
+def side_values(values: dict) -> dict:
+    """The parameter values that act in negative sliding: each given ``*_neg`` in its positive
+    slot (fs_neg absent: fs, or fc_neg where fs = fc)."""
+    out = dict(values)
+    fc, fs = values.get("fc"), values.get("fs")
+    no_stribeck = fs is None or fs == fc
+    for neg, pos in NEGATIVE_SIDE.items():
+        if values.get(neg) is not None:
+            out[pos] = values[neg]
+    if values.get("fs_neg") is None and values.get("fc_neg") is not None and no_stribeck:
+        out["fs"] = out["fc"]
+    return out
+
+
 class _Friction:
     """What every friction model shares: parameters as dataclass fields (None where a Model I law
     gives the value), ``values()``, the file form, and the state layout."""
@@ -56,6 +99,8 @@ class _Friction:
     def from_dict(cls, d: dict, where="[friction]"):
         d = dict(d)
         d.pop("model", None)
+        if "ripple" in d:
+            d.update(ripple_keys(d.pop("ripple"), where))
         allowed = [f.name for f in fields(cls)]
         unknown = set(d) - set(allowed)
         if unknown:
@@ -91,6 +136,17 @@ class LuGre(_Friction):
     delta: float | None = 2.0
     vd: float | None = None
     v_smooth: float = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
     model = "lugre"
     nstate = 1
@@ -108,6 +164,15 @@ class Coulomb(_Friction):
     fc: float | None
     sigma2: float | None = 0.0
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    sigma2_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
     model = "coulomb"
     required = ("fc",)
@@ -124,6 +189,17 @@ class Stribeck(_Friction):
     delta: float | None = 2.0
     sigma2: float | None = 0.0
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
     model = "stribeck"
     required = ("fc",)
@@ -137,6 +213,14 @@ class Dahl(_Friction):
     sigma0: float | None
     fc: float | None
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
     model = "dahl"
     nstate = 1
@@ -162,6 +246,17 @@ class ElastoPlastic(_Friction):
     delta: float | None = 2.0
     vd: float | None = None
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
     model = "elastoplastic"
     nstate = 1
@@ -191,6 +286,17 @@ class GMS(_Friction):
     delta: float | None = 2.0
     sigma2: float | None = 0.0
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
     model = "gms"
     required = ("k", "w", "C", "fc")
@@ -231,7 +337,8 @@ FRICTION_MODELS = {cls.model: cls for cls in (LuGre, Coulomb, Stribeck, Dahl, El
 #: Where each parameter is physical (fs, vs: relative to fc, checked below).
 PARAMETER_DOMAIN = {"sigma0": "positive", "sigma1": "non-negative", "sigma2": "non-negative", "fc": "positive",
                     "delta": "positive", "vd": "positive", "v_smooth": "positive", "C": "positive",
-                    "z_ba": "non-negative"}
+                    "z_ba": "non-negative", "fc_neg": "positive", "vs_neg": "positive",
+                    "sigma2_neg": "non-negative", "ripple_period": "positive"}
 
 
 def in_domain(name: str, values) -> np.ndarray:
@@ -246,7 +353,29 @@ def in_domain(name: str, values) -> np.ndarray:
 
 
 def check_friction_values(values: dict, where: str):
-    """Physical checks on a full set of parameter values (numbers and laws evaluated)."""
+    """Physical checks on a full set of parameter values (numbers and laws evaluated), on both
+    sides of a direction-dependent model, and on the ripple."""
+    _check_side(values, where, "")
+    if any(values.get(n) is not None for n in NEGATIVE_SIDE):
+        for name in ("fs_neg", *RIPPLE_AMPLITUDES):
+            v = values.get(name)
+            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
+        neg = side_values(values)
+        if neg.get("fs") is not None and neg.get("fc") is not None and neg["fs"] < neg["fc"]:
+            raise InputError(f"{where}: the negative side's static level fs_neg ({neg['fs']!r}; fs where not given) "
+                             f"must be at least its Coulomb level fc_neg ({neg['fc']!r})")
+        _check_side(neg, where, " (negative side: fc_neg, fs_neg, vs_neg, sigma2_neg)")
+    amps = [n for n in RIPPLE_AMPLITUDES if values.get(n) is not None]
+    for name in amps:
+        if not (isinstance(values[name], (int, float)) and math.isfinite(values[name])):
+            raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(values[name])}")
+    if amps and values.get("ripple_period") is None:
+        raise InputError(f"{where}: ripple amplitudes ({', '.join(amps)}) need the ripple's period "
+                         f"(ripple = {{ period = ..., cos = [...], sin = [...] }})")
+
+
+def _check_side(values: dict, where: str, side: str):
     for name, domain in PARAMETER_DOMAIN.items():
         v = values.get(name)
         # finite first: a law that overflows (a exp(b T) with b = 100) gives inf, which is "positive"
@@ -262,11 +391,11 @@ def check_friction_values(values: dict, where: str):
         if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
             raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
     if fs is not None and fc is not None and fs < fc:
-        raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r})")
+        raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r}){side}")
     if fs is not None and fc is not None and fs != fc:
         vs = values.get("vs")
         if vs is None or not vs > 0:
-            raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}")
+            raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}{side}")
 
 
 def stribeck_curve(values: dict, v):
@@ -293,6 +422,10 @@ def dissipativity_violation(model_name: str, values: dict):
     lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
     if model_name not in ("lugre", "elastoplastic"):
         return None
+    if any(values.get(n) is not None for n in NEGATIVE_SIDE):  # each side on its own, the positive first
+        return dissipativity_violation(model_name, {k: v for k, v in values.items() if k not in NEGATIVE_SIDE}) or \
+            dissipativity_violation(model_name, {k: v for k, v in side_values(values).items()
+                                                 if k not in NEGATIVE_SIDE})
     # extreme but finite values (sigma0 = 1e300) overflow the products below; the condition is
     # then decided by the terms that remain finite, and NumPy's warnings are not the user's business
     # the same values come back for every run of a model (simulate checks before each): decide once
@@ -330,5 +463,6 @@ def _dissipativity_violation(values: dict):
 
 
 
-__all__ = ["PARAMETERS", "PARAMETER_UNITS", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
+__all__ = ["PARAMETERS", "PARAMETER_UNITS", "NEGATIVE_SIDE", "RIPPLE_AMPLITUDES", "RIPPLE_ORDER", "SIGNED",
+           "ripple_keys", "side_values", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
            "FRICTION_MODELS", "check_friction_values", "stribeck_curve", "dissipativity_violation"]
