@@ -22,12 +22,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference as R  # noqa: E402
 import lookalike as L  # noqa: E402
 from test_differential_friction import (_spec, _times, _velocity_bands, core_eval, fd_jacobian,  # noqa: E402
-                                        random_case_state, term_magnitudes)
+                                        random_case_state, sensitivity_model, term_magnitudes, x_e,
+                                        x_e_and_sensitivities)
 
 import thermofriction as tf  # noqa: E402
-from thermofriction import _bridge  # noqa: E402
 from thermofriction.control import friction_steps  # noqa: E402
-from thermofriction.identify.parameters import get_value, target_of, with_values  # noqa: E402
 from thermofriction.models import ModelI, ModelII  # noqa: E402
 
 RIPPLE = dict(ripple_period=2e-3, ripple_cos1=0.05, ripple_sin1=-0.03, ripple_sin3=0.02)
@@ -150,54 +149,41 @@ def test_jacobian_matches_finite_differences_of_reference(case):
 @pytest.mark.parametrize("kind", ["stribeck", "lugre", "dahl"])
 def test_simulation_matches_reference(kind):
     """Oracle: the reference simulation (SciPy, rtol 1e-10) of a spring-pulled mass with each side's levels
-    and the ripple, 4 s (stick-slip in both directions: the pull reverses). x agrees to 1e-5 of its range."""
+    and the ripple, 4 s (stick-slip in both directions: the pull reverses). x agrees to 1e-5 of its range (the C
+    solver at rtol 1e-9)."""
     model = tf.Model(tf.MassPlant(mass=1.0, spring_stiffness=2.0), sided(kind), input=tf.Sine(3.0, 0.5))
     t = np.linspace(0.0, 4.0, 801)
-    res = tf.simulate(model, 4.0, sample_rate=200.0, rtol=1e-10)
-    ref = R.reference_simulate_system(model, None, t, rtol=1e-10,
-                                      method="LSODA" if kind == "stribeck" else "DOP853")
-    x_c = np.interp(t, res.time, res.displacement)
-    x_r = ref.y[0]
+    res = tf.simulate(model, 4.0, sample_rate=200.0, controller=tf.StepSizeController(rtol=1e-9))
+    ref = R.reference_simulate_system(model, t, rtol=1e-10, method="LSODA" if kind == "stribeck" else "DOP853")
+    x_c, x_r = res.displacement, ref.displacement
     assert np.max(np.abs(x_c - x_r)) <= 1e-5 * np.ptp(x_r), np.max(np.abs(x_c - x_r)) / np.ptp(x_r)
-    v = ref.y[1]
-    assert v.min() < -1e-3 and v.max() > 1e-3  # both sides slid
-
-
-def _sensitivities(model, names, t, rtol=1e-10):
-    """dx/dtheta of the mass by the core's forward sensitivities (as identification runs them)."""
-    spec = _bridge.model_spec(model, None, model.input)
-    theta = np.array([get_value(model, n) for n in names], float)
-    targets = np.array([target_of(model, n) for n in names], dtype=np.int32).reshape(-1, 3)
-    atol_y = rtol * _bridge.state_scale(spec)
-    atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 0.05)[None, :]
-    out = np.empty((len(t), _bridge.n_outputs(model, False)))
-    sens = np.empty((len(t), len(atol_y), len(names)))
-    _bridge.run_sensitivities(spec, targets, t, out, sens, rtol=rtol, atol=np.concatenate([atol_y, atol_s.ravel()]),
-                              max_steps=10_000_000)
-    return sens[:, _bridge.state_index(model, "x"), :]
+    assert ref.velocity.min() < -1e-3 and ref.velocity.max() > 1e-3  # both sides slid
 
 
 def test_sensitivities_match_finite_differences():
-    """Oracle: central differences of whole simulations (rtol 1e-12). The forward sensitivities of x_e to the
-    negative side's levels and to the ripple's amplitudes agree to 1e-4 of their scale."""
-    model = tf.Model(tf.MassPlant(mass=1.0, spring_stiffness=2.0),
-                     tf.LuGre(sigma0=1e5, sigma1=300.0, fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4, fc_neg=1.3,
-                              fs_neg=1.8, sigma2_neg=0.7, **RIPPLE), input=tf.Sine(3.0, 0.5))
-    names = ["fc_neg", "fs_neg", "sigma2_neg", "ripple_cos1", "ripple_sin1", "fc"]
-    t = np.linspace(0.2, 3.0, 15)
-    S = _sensitivities(model, names, t)
+    """Oracle: central differences (relative step 1e-3) of x_e(t) simulated at rtol 1e-12, as
+    tests/test_differential_friction.py checks the other parameters: the LuGre actuator through the sawtooth's
+    flyback (the end effector slips backwards: the negative side acts) with each side's levels and a ripple.
+    The forward sensitivities to the negative side's levels and the ripple's amplitudes agree to 1e-3 of the
+    largest sensitivity, and each moves x_e measurably."""
+    m = sensitivity_model("lugre")
+    fc = m.friction.fc
+    model = m.with_friction(fc_neg=1.2 * fc, fs_neg=1.5 * fc, vs_neg=2e-3, sigma2_neg=30.0, ripple_period=2e-6,
+                            ripple_cos1=0.05 * fc, ripple_sin1=-0.03 * fc)
+    names = ("fc_neg", "fs_neg", "vs_neg", "sigma2_neg", "ripple_cos1", "ripple_sin1", "fc")
+    t = np.linspace(0.0, 0.21, 1051)
+    x, S, _ = x_e_and_sensitivities(model, names, t)
+    x_ref, _ = x_e(model, t)
+    np.testing.assert_allclose(x, x_ref, atol=1e-6 * np.ptp(x_ref))
     for j, name in enumerate(names):
-        v0 = get_value(model, name)
-        h = 1e-5 * max(abs(v0), 0.05)
-        xs = []
-        for s in (1, -1):
-            m = with_values(model, {name: v0 + s * h})
-            r = tf.simulate(m, 3.0, sample_rate=1000.0, rtol=1e-12)
-            xs.append(np.interp(t, r.time, r.displacement))
-        fd = (xs[0] - xs[1]) / (2 * h)
-        scale = np.max(np.abs(fd)) + 1e-12
-        assert np.max(np.abs(S[:, j] - fd)) <= 1e-4 * scale, (name, S[:, j], fd)
-        assert scale > 1e-6, name  # the parameter acts
+        v = model.friction.values()[name]
+        h = 1e-3 * abs(v)
+        xp, _ = x_e(model.with_friction(**{name: v + h}), t)
+        xm, _ = x_e(model.with_friction(**{name: v - h}), t)
+        fd = (xp - xm) / (2 * h)
+        scale = np.max(np.abs(S[:, j])) + np.max(np.abs(fd))
+        assert scale * abs(v) > 1e-6 * np.ptp(x_ref), f"{name} moves nothing here: the test would not see an error"
+        assert np.max(np.abs(S[:, j] - fd)) / scale < 1e-3, name
 
 
 def test_real_time_step_sides_and_ripple():
