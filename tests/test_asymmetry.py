@@ -257,19 +257,24 @@ def test_identify_lookalike_asymmetry_and_ripple():
 
 def test_fmu_with_asymmetry_and_ripple(tmp_path):
     """Oracle: tf.simulate of the same model (itself tested against the reference above). The exported
-    FMU of an asymmetric LuGre mass with a ripple, run by fmpy, gives the same displacement to 1e-6 of its
-    range, and its parameters include fc_neg and the ripple's amplitudes."""
+    FMU of an asymmetric LuGre mass with a ripple, run by fmpy, gives the same displacement to 2e-3 of its
+    range (fmpy holds the input over each step), ten times closer than the symmetric model's, and its
+    parameters include fc_neg and the ripple's amplitudes."""
     fmpy = pytest.importorskip("fmpy")
     model = tf.Model(tf.MassPlant(mass=1.0, spring_stiffness=2.0),
-                     tf.LuGre(sigma0=1e5, sigma1=300.0, fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4, fc_neg=1.3,
+                     tf.LuGre(sigma0=1e5, sigma1=300.0, fc=1.0, fs=1.5, vs=1e-3, sigma2=0.4, vd=5e-3, fc_neg=1.3,
                               sigma2_neg=0.7, ripple_period=2e-3, ripple_cos1=0.05), input=tf.Sine(3.0, 0.5))
     path = tmp_path / "m.fmu"
     tf.export_fmu(model, path)
     names = {v.name for v in fmpy.read_model_description(str(path)).modelVariables}
-    assert {"fc_neg", "sigma2_neg", "ripple_cos1", "ripple_period"} <= names, sorted(names)
+    assert {f"friction.{n}" for n in ("fc_neg", "sigma2_neg", "ripple_cos1", "ripple_period")} <= names, sorted(names)
     t = np.arange(4001) * 5e-4
     signal = np.array(list(zip(t, model.input(t))), dtype=[("time", float), ("force", float)])
     out = fmpy.simulate_fmu(str(path), stop_time=2.0, output_interval=5e-4, input=signal, output=["displacement"])
     res = tf.simulate(model, input=tf.Sampled(t, model.input(t)), t_eval=out["time"])
     x = res.displacement
-    assert np.max(np.abs(out["displacement"] - x)) <= 1e-6 * np.ptp(x) + 1e-9
+    err = np.max(np.abs(out["displacement"] - x))
+    assert err <= 2e-3 * np.ptp(x), err / np.ptp(x)  # the master holds the input over each 0.5 ms step
+    symmetric = model.with_friction(fc_neg=None, sigma2_neg=None, ripple_period=None, ripple_cos1=None)
+    x_sym = tf.simulate(symmetric, input=tf.Sampled(t, model.input(t)), t_eval=out["time"]).displacement
+    assert np.max(np.abs(out["displacement"] - x_sym)) > 10 * err  # the FMU ran the asymmetric model
