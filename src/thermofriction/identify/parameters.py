@@ -13,7 +13,7 @@ import re
 from .. import _bridge
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
-from ..models.friction import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, side_values
+from ..models.sides import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, side_values
 
 TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import Model, ModelI
-from ..models.friction import SIGNED
+from ..models.sides import SIGNED
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled

@@ -5,62 +5,34 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import KW_ONLY, dataclass, fields, replace
 
 import numpy as np
 
 from .._bridge import PARAMETER_UNITS, PARAMETERS
 from ..errors import InputError, shorten, unknown_keys
 from ._parse import num, num_array
+from .sides import NEGATIVE_SIDE, check_sides, ripple_keys, side_values
 
 # PARAMETERS and PARAMETER_UNITS (the one table of units: files, reports and fit results use it) come
 # from the core's parameter list (friction.h, TF_PARAMETERS).
 
 
-#: The negative side's parameters (docs/models.md#direction-and-position), each with its positive one.
-NEGATIVE_SIDE = {"fc_neg": "fc", "fs_neg": "fs", "vs_neg": "vs", "sigma2_neg": "sigma2"}
-#: The ripple's harmonics (friction.h, TF_RIPPLE_ORDER) and its amplitudes' names, in N or N m.
-RIPPLE_ORDER = 3
-RIPPLE_AMPLITUDES = tuple(f"ripple_{f}{k}" for k in range(1, RIPPLE_ORDER + 1) for f in ("cos", "sin"))
-#: Parameters that may take either sign (fitted as they are, not in log space).
-SIGNED = frozenset(RIPPLE_AMPLITUDES)
+@dataclass(frozen=True)
+class _Ripple:
+    """The position ripple every model takes (docs/models.md#direction-and-position), keyword-only."""
+
+    _: KW_ONLY
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
 
 
-def ripple_keys(table, where="[friction]") -> dict:
-    """``ripple = { period = P, cos = [a1, ...], sin = [b1, ...] }`` as the flat parameters
-    ``ripple_period``, ``ripple_cos1`` ... (up to RIPPLE_ORDER harmonics)."""
-    if not isinstance(table, dict):
-        raise InputError(f"{where}: 'ripple' must be a table {{ period = ..., cos = [...], sin = [...] }}, "
-                         f"got {shorten(table)}")
-    unknown = set(table) - {"period", "cos", "sin"}
-    if unknown:
-        raise InputError(f"{where}: 'ripple' has unknown keys {sorted(unknown)} (period, cos, sin)")
-    if "period" not in table:
-        raise InputError(f"{where}: 'ripple' needs its 'period' (one revolution, a screw pitch, ... in m or rad)")
-    out = {"ripple_period": num(table["period"], where, "ripple.period")}
-    for f in ("cos", "sin"):
-        amps = list(num_array(table.get(f, []), where, f"ripple.{f}"))
-        if len(amps) > RIPPLE_ORDER:
-            raise InputError(f"{where}: 'ripple.{f}' has {len(amps)} amplitudes; at most {RIPPLE_ORDER} harmonics")
-        out.update({f"ripple_{f}{k + 1}": float(a) for k, a in enumerate(amps)})
-    return out
-
-
-def side_values(values: dict) -> dict:
-    """The parameter values that act in negative sliding: each given ``*_neg`` in its positive
-    slot (fs_neg absent: fs, or fc_neg where fs = fc)."""
-    out = dict(values)
-    fc, fs = values.get("fc"), values.get("fs")
-    no_stribeck = fs is None or fs == fc
-    for neg, pos in NEGATIVE_SIDE.items():
-        if values.get(neg) is not None:
-            out[pos] = values[neg]
-    if values.get("fs_neg") is None and values.get("fc_neg") is not None and no_stribeck:
-        out["fs"] = out["fc"]
-    return out
-
-
-class _Friction:
+class _Friction(_Ripple):
     """What every friction model shares: parameters as dataclass fields (None where a Model I law
     gives the value), ``values()``, the file form, and the state layout."""
 
@@ -84,7 +56,8 @@ class _Friction:
 
     def values(self) -> dict:
         """Parameters given as numbers (None-valued ones omitted)."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+        return {f.name: getattr(self, f.name) for f in sorted(fields(self), key=lambda f: f.name.startswith("ripple_"))
+                if getattr(self, f.name) is not None}
 
     def to_dict(self) -> dict:
         d = {"model": self.model}
@@ -140,13 +113,6 @@ class LuGre(_Friction):
     fs_neg: float | None = None
     vs_neg: float | None = None
     sigma2_neg: float | None = None
-    ripple_period: float | None = None
-    ripple_cos1: float | None = None
-    ripple_sin1: float | None = None
-    ripple_cos2: float | None = None
-    ripple_sin2: float | None = None
-    ripple_cos3: float | None = None
-    ripple_sin3: float | None = None
 
     model = "lugre"
     nstate = 1
@@ -166,13 +132,6 @@ class Coulomb(_Friction):
     v_smooth: float | None = 1e-6
     fc_neg: float | None = None
     sigma2_neg: float | None = None
-    ripple_period: float | None = None
-    ripple_cos1: float | None = None
-    ripple_sin1: float | None = None
-    ripple_cos2: float | None = None
-    ripple_sin2: float | None = None
-    ripple_cos3: float | None = None
-    ripple_sin3: float | None = None
 
     model = "coulomb"
     required = ("fc",)
@@ -193,13 +152,6 @@ class Stribeck(_Friction):
     fs_neg: float | None = None
     vs_neg: float | None = None
     sigma2_neg: float | None = None
-    ripple_period: float | None = None
-    ripple_cos1: float | None = None
-    ripple_sin1: float | None = None
-    ripple_cos2: float | None = None
-    ripple_sin2: float | None = None
-    ripple_cos3: float | None = None
-    ripple_sin3: float | None = None
 
     model = "stribeck"
     required = ("fc",)
@@ -214,13 +166,6 @@ class Dahl(_Friction):
     fc: float | None
     v_smooth: float | None = 1e-6
     fc_neg: float | None = None
-    ripple_period: float | None = None
-    ripple_cos1: float | None = None
-    ripple_sin1: float | None = None
-    ripple_cos2: float | None = None
-    ripple_sin2: float | None = None
-    ripple_cos3: float | None = None
-    ripple_sin3: float | None = None
 
     model = "dahl"
     nstate = 1
@@ -250,13 +195,6 @@ class ElastoPlastic(_Friction):
     fs_neg: float | None = None
     vs_neg: float | None = None
     sigma2_neg: float | None = None
-    ripple_period: float | None = None
-    ripple_cos1: float | None = None
-    ripple_sin1: float | None = None
-    ripple_cos2: float | None = None
-    ripple_sin2: float | None = None
-    ripple_cos3: float | None = None
-    ripple_sin3: float | None = None
 
     model = "elastoplastic"
     nstate = 1
@@ -290,13 +228,6 @@ class GMS(_Friction):
     fs_neg: float | None = None
     vs_neg: float | None = None
     sigma2_neg: float | None = None
-    ripple_period: float | None = None
-    ripple_cos1: float | None = None
-    ripple_sin1: float | None = None
-    ripple_cos2: float | None = None
-    ripple_sin2: float | None = None
-    ripple_cos3: float | None = None
-    ripple_sin3: float | None = None
 
     model = "gms"
     required = ("k", "w", "C", "fc")
@@ -356,23 +287,7 @@ def check_friction_values(values: dict, where: str):
     """Physical checks on a full set of parameter values (numbers and laws evaluated), on both
     sides of a direction-dependent model, and on the ripple."""
     _check_side(values, where, "")
-    if any(values.get(n) is not None for n in NEGATIVE_SIDE):
-        for name in ("fs_neg", *RIPPLE_AMPLITUDES):
-            v = values.get(name)
-            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
-                raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
-        neg = side_values(values)
-        if neg.get("fs") is not None and neg.get("fc") is not None and neg["fs"] < neg["fc"]:
-            raise InputError(f"{where}: the negative side's static level fs_neg ({neg['fs']!r}; fs where not given) "
-                             f"must be at least its Coulomb level fc_neg ({neg['fc']!r})")
-        _check_side(neg, where, " (negative side: fc_neg, fs_neg, vs_neg, sigma2_neg)")
-    amps = [n for n in RIPPLE_AMPLITUDES if values.get(n) is not None]
-    for name in amps:
-        if not (isinstance(values[name], (int, float)) and math.isfinite(values[name])):
-            raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(values[name])}")
-    if amps and values.get("ripple_period") is None:
-        raise InputError(f"{where}: ripple amplitudes ({', '.join(amps)}) need the ripple's period "
-                         f"(ripple = {{ period = ..., cos = [...], sin = [...] }})")
+    check_sides(values, where, _check_side)
 
 
 def _check_side(values: dict, where: str, side: str):
@@ -460,9 +375,5 @@ def _dissipativity_violation(values: dict):
                    f"can create energy; give vd (sigma1(v) = sigma1 exp(-(v/vd)^2)), or raise sigma2")
 
 
-
-
-
-__all__ = ["PARAMETERS", "PARAMETER_UNITS", "NEGATIVE_SIDE", "RIPPLE_AMPLITUDES", "RIPPLE_ORDER", "SIGNED",
-           "ripple_keys", "side_values", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
+__all__ = ["PARAMETERS", "PARAMETER_UNITS", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",
            "FRICTION_MODELS", "check_friction_values", "stribeck_curve", "dissipativity_violation"]
