@@ -279,6 +279,11 @@ static void to_negative_side(const double *p, double *d)
         if (tf_side_given(p[sided_neg[i]])) d[sided_neg[i]] = d[sided_pos[i]], d[sided_pos[i]] = 0.0;
 }
 
+void tf_friction_side_partials(const double *p, double v, double *d)
+{
+    if (v < 0.0 && tf_friction_asymmetric(p)) to_negative_side(p, d);
+}
+
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
 {

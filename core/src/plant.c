@@ -552,6 +552,13 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
     tf_stribeck(p, v, &dg_dv);
     tf_stribeck_param_partials(p, v, dg_p);
     if (m->fs_follows_fc) dg_p[TF_P_FC] += dg_p[TF_P_FS];
+    /* the negative capacity -w_i g_-(v) (direction-dependent levels: friction.h, tf_friction_side) */
+    double q[TF_NPARAM], dgn_dv, dgn_p[TF_NPARAM];
+    const double *pn = tf_friction_side(p, -1.0, q);
+    tf_stribeck(pn, v, &dgn_dv);
+    tf_stribeck_param_partials(pn, v, dgn_p);
+    tf_friction_side_partials(p, -1.0, dgn_p);
+    if (m->fs_follows_fc) dgn_p[TF_P_FC] += dgn_p[TF_P_FS];
     /* dv/dt along the trajectory before the switch; under prescribed motion v(t) is the input's
        slope, whose change is left out (it moves an event only through the Stribeck curve's slope) */
     double vdot = velocity_along(m, fm);
@@ -560,9 +567,11 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
         int a = old[i], b = m->gms.mode[i], row = nm + i;
         if (a == b) continue;
         double jump = fm[row] - fpl[row], w = m->gms.w[i];
+        const double *dgs_p = a == 0 && b < 0 ? dgn_p : dg_p; /* the capacity of the side it broke loose to */
+        double dgs_dv = a == 0 && b < 0 ? dgn_dv : dg_dv;
         /* the event function that fired: a stuck element reaching its capacity, b z_i - w_i g(v);
            a slipping one whose motion reversed, -a v */
-        double rate = a == 0 ? b * fm[row] - w * dg_dv * vdot : -a * vdot;
+        double rate = a == 0 ? b * fm[row] - w * dgs_dv * vdot : -a * vdot;
         if (!(fabs(rate) > 0.0) || jump == 0.0) continue;
         for (int k = 0; k < np; k++) {
             const tf_target *tg = &targets[k];
@@ -571,11 +580,11 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
             double dv = velocity_along(m, col);
             if (a == 0) {
                 double dcap = 0.0; /* d(capacity g)/dtheta, directly */
-                if (tg->kind == TF_TARGET_PARAM) dcap = dg_p[tg->param];
+                if (tg->kind == TF_TARGET_PARAM) dcap = dgs_p[tg->param];
                 else if (tg->kind == TF_TARGET_LAW) dcap = tf_law_coef_derivative(&m->law[tg->param], tg->coef,
                                                                                   tf_model_temperature(m, t, Y)) *
-                                                           dg_p[tg->param];
-                num = b * col[row] - w * (dcap + dg_dv * dv);
+                                                           dgs_p[tg->param];
+                num = b * col[row] - w * (dcap + dgs_dv * dv);
             } else {
                 num = -a * dv;
             }

@@ -74,6 +74,10 @@ static inline int tf_friction_asymmetric(const double *p)
  * dependent, else q filled with the negative side's values in the positive slots (so that every
  * model's equations serve both sides). */
 const double *tf_friction_side(const double *p, double v, double *q);
+/* Partials d[TF_NPARAM] computed with tf_friction_side's values moved, in place, to the negative-side
+ * parameters they came from (nothing where v >= 0 or the model is symmetric). tf_friction_eval does
+ * this for its own partials; callers that differentiate g(v) themselves use it. */
+void tf_friction_side_partials(const double *p, double v, double *d);
 /* The position ripple R(x) = sum_k a_k cos(2 pi k x / P) + b_k sin(2 pi k x / P) (zero when
  * P <= 0), added to the friction force of any model by the plant (which knows the position x).
  * dR/dx into *dR_dx when not NULL; dR/d(amplitude) added into dR_dp[TF_NPARAM] when not NULL
