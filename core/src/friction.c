@@ -229,9 +229,10 @@ static double gms(const double *p, const tf_gms_elements *el, double v, const do
     return F;
 }
 
-static double eval_side(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
-                        double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
+double tf_friction_eval_side(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
+                             double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
 {
+    if (jac) jac->dF_dx = 0.0;
     if (kind == TF_FRICTION_LUGRE) return lugre(p, v, z, dz, jac, dp);
     if (dp) { /* each model writes the entries its equations have; the rest stay zero */
         int nz = kind == TF_FRICTION_GMS && el ? el->n : 1;
@@ -287,11 +288,10 @@ void tf_friction_side_partials(const double *p, double v, double *d)
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
 {
-    if (jac) jac->dF_dx = 0.0;
-    if (!(v < 0.0) || !tf_friction_asymmetric(p)) return eval_side(kind, p, el, v, z, dz, jac, dp);
+    if (!(v < 0.0) || !tf_friction_asymmetric(p)) return tf_friction_eval_side(kind, p, el, v, z, dz, jac, dp);
     double q[TF_NPARAM];
     tf_friction_side(p, v, q);
-    double F = eval_side(kind, q, el, v, z, dz, jac, dp);
+    double F = tf_friction_eval_side(kind, q, el, v, z, dz, jac, dp);
     if (dp) {
         int nz = tf_friction_nstate(kind, el ? el->n : 0);
         to_negative_side(p, dp->dF_dp);

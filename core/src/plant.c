@@ -106,9 +106,11 @@ const double *tf_model_params_cached(tf_model *m, double T, double *lambda, doub
 {
     /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
     if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
-        tf_model_params_at(m, T, m->cache_p);
+        if (!m->cache_valid) m->cache_laws = tf_thermal_law_mask(m->law); /* after a prepare: laws may have changed */
+        tf_thermal_params_masked(m->thermal, m->p, m->law, m->cache_laws, m->fs_follows_fc, T, m->cache_p);
         m->cache_lambda = tf_model_lambda(m, T);
         m->cache_dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
+        m->cache_plain = !tf_friction_asymmetric(m->cache_p) && !(m->cache_p[TF_P_RIPPLE_PERIOD] > 0.0);
         m->cache_T = T;
         m->cache_valid = 1;
     }
@@ -127,9 +129,14 @@ static double friction_at(tf_model *m, double T, double t, const double *y, doub
     const double *p = tf_model_params_cached(m, T, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
-    double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
-    if (p[TF_P_RIPPLE_PERIOD] > 0.0) /* on the base force: Model II scales it with the rest */
-        F += tf_friction_ripple(p, relative_position(m, t, y), jac ? &jac->dF_dx : 0, dp ? dp->dF_dp : 0);
+    double F;
+    if (m->cache_plain) { /* symmetric, no ripple (cached with p): the models' equations alone */
+        F = tf_friction_eval_side(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+    } else {
+        F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+        if (p[TF_P_RIPPLE_PERIOD] > 0.0) /* on the base force: Model II scales it with the rest */
+            F += tf_friction_ripple(p, relative_position(m, t, y), jac ? &jac->dF_dx : 0, dp ? dp->dF_dp : 0);
+    }
     if (F_base) *F_base = F;
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, nz, jac);
 }

@@ -156,6 +156,12 @@ static inline double tf_lugre_value(const double *p, double v, double z, double 
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
 
+/* tf_friction_eval with p's values on both sides (no direction-dependent substitution): for callers
+ * that know their parameters are symmetric (the plant caches that per temperature) or that have
+ * already taken tf_friction_side's values. */
+double tf_friction_eval_side(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
+                             double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
+
 /* Discrete modes (GMS). Event functions (two per element) cross zero upwards where a mode must
  * change: a stuck element when F_i reaches +w_i g(v) or -w_i g(v), a slipping one when v
  * reverses. tf_friction_update_modes
