@@ -229,9 +229,10 @@ static double gms(const double *p, const tf_gms_elements *el, double v, const do
     return F;
 }
 
-double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
-                        double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
+double tf_friction_eval_side(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
+                             double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
 {
+    if (jac) jac->dF_dx = 0.0;
     if (kind == TF_FRICTION_LUGRE) return lugre(p, v, z, dz, jac, dp);
     if (dp) { /* each model writes the entries its equations have; the rest stay zero */
         int nz = kind == TF_FRICTION_GMS && el ? el->n : 1;
@@ -248,6 +249,74 @@ double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, do
     }
 }
 
+/* ---- direction-dependent friction and the position ripple ---- */
+
+static const int sided_pos[] = {TF_P_FC, TF_P_FS, TF_P_VS, TF_P_SIGMA2};
+static const int sided_neg[] = {TF_P_FC_NEG, TF_P_FS_NEG, TF_P_VS_NEG, TF_P_SIGMA2_NEG};
+#define NSIDED 4
+
+/* fs_neg absent, fc_neg given and fs = fc: no Stribeck effect on the negative side either */
+static int fs_neg_follows_fc_neg(const double *p)
+{
+    return !tf_side_given(p[TF_P_FS_NEG]) && tf_side_given(p[TF_P_FC_NEG]) && p[TF_P_FS] == p[TF_P_FC];
+}
+
+const double *tf_friction_side(const double *p, double v, double *q)
+{
+    if (!(v < 0.0) || !tf_friction_asymmetric(p)) return p;
+    memcpy(q, p, sizeof(double) * TF_NPARAM);
+    for (int i = 0; i < NSIDED; i++)
+        if (tf_side_given(p[sided_neg[i]])) q[sided_pos[i]] = p[sided_neg[i]];
+    if (fs_neg_follows_fc_neg(p)) q[TF_P_FS] = q[TF_P_FC];
+    return q;
+}
+
+/* Partials computed on the negative side's values (in the positive slots) moved to the negative
+ * parameters they came from: the same expressions, on the negative side. */
+static void to_negative_side(const double *p, double *d)
+{
+    if (fs_neg_follows_fc_neg(p)) d[TF_P_FC] += d[TF_P_FS], d[TF_P_FS] = 0.0;
+    for (int i = 0; i < NSIDED; i++)
+        if (tf_side_given(p[sided_neg[i]])) d[sided_neg[i]] = d[sided_pos[i]], d[sided_pos[i]] = 0.0;
+}
+
+void tf_friction_side_partials(const double *p, double v, double *d)
+{
+    if (v < 0.0 && tf_friction_asymmetric(p)) to_negative_side(p, d);
+}
+
+double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, double v, const double *z,
+                        double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp)
+{
+    if (!(v < 0.0) || !tf_friction_asymmetric(p)) return tf_friction_eval_side(kind, p, el, v, z, dz, jac, dp);
+    double q[TF_NPARAM];
+    tf_friction_side(p, v, q);
+    double F = tf_friction_eval_side(kind, q, el, v, z, dz, jac, dp);
+    if (dp) {
+        int nz = tf_friction_nstate(kind, el ? el->n : 0);
+        to_negative_side(p, dp->dF_dp);
+        for (int j = 0; j < nz; j++) to_negative_side(p, dp->ddz_dp[j]);
+    }
+    return F;
+}
+
+double tf_friction_ripple(const double *p, double x, double *dR_dx, double *dR_dp)
+{
+    double P = p[TF_P_RIPPLE_PERIOD], R = 0.0, dx = 0.0;
+    if (P > 0.0 && isfinite(P)) {
+        double w = 2.0 * M_PI / P;
+        for (int k = 1; k <= TF_RIPPLE_ORDER; k++) {
+            int ic = TF_P_RIPPLE_COS1 + 2 * (k - 1), is = ic + 1;
+            double c = cos(k * w * x), s = sin(k * w * x);
+            R += p[ic] * c + p[is] * s;
+            dx += k * w * (p[is] * c - p[ic] * s);
+            if (dR_dp) dR_dp[ic] += c, dR_dp[is] += s;
+        }
+    }
+    if (dR_dx) *dR_dx = dx;
+    return R;
+}
+
 int tf_friction_nevent(int kind, const tf_gms_elements *el)
 {
     return kind == TF_FRICTION_GMS && el ? 2 * el->n : 0;
@@ -257,7 +326,9 @@ void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, do
                         double *g_out)
 {
     if (kind != TF_FRICTION_GMS) return;
-    double g = tf_stribeck(p, v, 0);
+    double q[TF_NPARAM];
+    const double *pn = tf_friction_side(p, -1.0, q); /* the negative capacity's parameters */
+    double g = tf_stribeck(p, v, 0), gn = tf_stribeck(pn, v, 0);
     /* A stuck element has one function per capacity, F_i - w_i g and -F_i - w_i g, rather than
      * |F_i| - w_i g: an element that sticks again at its capacity (a reversal) starts that
      * function at zero, where no upward crossing can be seen, but must still be caught at the
@@ -268,10 +339,10 @@ void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, do
      * bit), so no error estimate would stop a step from carrying v across the whole band. */
     double band = (p[TF_P_FS] != p[TF_P_FC] && p[TF_P_VS] > 0.0) ? 3.0 * p[TF_P_VS] : -1.0;
     for (int i = 0; i < el->n; i++) {
-        double cap = el->w[i] * g;
+        double cap = el->w[i] * g, cap_n = el->w[i] * gn;
         if (el->mode[i] == 0) {
             g_out[2 * i] = z[i] - cap;
-            g_out[2 * i + 1] = -z[i] - cap;
+            g_out[2 * i + 1] = -z[i] - cap_n;
         } else {
             g_out[2 * i] = -el->mode[i] * v;
             g_out[2 * i + 1] = band > 0.0 ? band - fabs(v) : -1.0;
@@ -282,7 +353,8 @@ void tf_friction_events(int kind, const double *p, const tf_gms_elements *el, do
 void tf_friction_update_modes(int kind, const double *p, tf_gms_elements *el, double v, const double *z)
 {
     if (kind != TF_FRICTION_GMS) return;
-    double g = tf_stribeck(p, v, 0);
+    double q[TF_NPARAM];
+    double g = tf_stribeck(tf_friction_side(p, v, q), v, 0); /* the capacity on the side of v */
     for (int i = 0; i < el->n; i++) {
         if (el->mode[i] == 0) {
             /* at capacity and pushed further: it breaks loose (a rounding margin, so that the
@@ -313,7 +385,39 @@ const char *tf_friction_structure_problem(int kind, const tf_gms_elements *gms)
 }
 
 /* The friction parameters the model uses, at one temperature. */
+static const char *side_problem(int k, const double *p, int offset_form);
+
+/* The negative side's parameter named for a problem found on its values. */
+static const char *negative_name(const char *name)
+{
+    static const char *const pos[] = {"fc", "fs", "vs", "sigma2", "delta", "z_ba"};
+    static const char *const neg[] = {"fc_neg", "fs_neg", "vs_neg", "sigma2_neg", "delta (negative side)",
+                                      "z_ba (below fc_neg/sigma0)"};
+    for (int i = 0; i < 6; i++)
+        if (name && strcmp(name, pos[i]) == 0) return neg[i];
+    return name;
+}
+
 const char *tf_friction_params_problem(int k, const double *p, int offset_form)
+{
+    const char *problem = side_problem(k, p, offset_form);
+    if (problem) return problem;
+    static const char *const neg_names[] = {"fc_neg", "fs_neg", "vs_neg", "sigma2_neg"};
+    for (int i = 0; i < NSIDED; i++) /* NaN: the positive value; +-inf never */
+        if (isinf(p[sided_neg[i]])) return neg_names[i];
+    if (tf_friction_asymmetric(p)) {
+        double q[TF_NPARAM];
+        problem = side_problem(k, tf_friction_side(p, -1.0, q), offset_form);
+        if (problem) return negative_name(problem);
+    }
+    double P = p[TF_P_RIPPLE_PERIOD];
+    if (isnan(P) || isinf(P)) return "ripple_period";
+    for (int i = TF_P_RIPPLE_COS1; i <= TF_P_RIPPLE_SIN3; i++)
+        if (!isfinite(p[i])) return "ripple amplitudes (ripple_cos1 ... ripple_sin3)";
+    return 0;
+}
+
+static const char *side_problem(int k, const double *p, int offset_form)
 {
     int stribeck = k == TF_FRICTION_STRIBECK || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC ||
                    k == TF_FRICTION_GMS;

@@ -41,10 +41,24 @@ int tf_model_work_index(const tf_model *model)
  * (no temperature signal, no heat or work state). Its parameters, lambda and dF are then the
  * run's, and tf_model_ode gives it a right-hand side (rhs_lugre_constant_T) that dispatches on
  * nothing per call: a third of the general path's cost on the paper's workload. */
+/* Whether a parameter is given (a number or a law): the direction-dependent ones are NaN when not,
+ * the ripple's period <= 0. */
+static int given(const tf_model *m, int i)
+{
+    return m->law[i].kind != TF_LAW_NONE || (i == TF_P_RIPPLE_PERIOD ? m->p[i] > 0.0 : tf_side_given(m->p[i]));
+}
+
+/* Direction-dependent friction or a position ripple: the general path handles them. */
+static int sided_or_ripple(const tf_model *m)
+{
+    return given(m, TF_P_FC_NEG) || given(m, TF_P_FS_NEG) || given(m, TF_P_VS_NEG) || given(m, TF_P_SIGMA2_NEG) ||
+           given(m, TF_P_RIPPLE_PERIOD);
+}
+
 static int lugre_constant_T(const tf_model *m)
 {
     return m->friction == TF_FRICTION_LUGRE && m->T_n == 0 && !has_work(m) &&
-           (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS);
+           (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS) && !sided_or_ripple(m);
 }
 
 /* Relative sliding velocity v_r of the driven body on its driving surface. */
@@ -54,6 +68,16 @@ static double relative_velocity(const tf_model *m, double t, const double *y)
     case TF_PLANT_STICK_SLIP: return y[VE] - y[VP];
     case TF_PLANT_MASS: return y[V];
     default: return tf_waveform_slope(&m->input, t);
+    }
+}
+
+/* Relative position x_r of the same bodies (the position ripple's argument). */
+static double relative_position(const tf_model *m, double t, const double *y)
+{
+    switch (m->plant) {
+    case TF_PLANT_STICK_SLIP: return y[XE] - y[XP];
+    case TF_PLANT_MASS: return y[X];
+    default: return tf_waveform_value(&m->input, t);
     }
 }
 
@@ -82,9 +106,11 @@ const double *tf_model_params_cached(tf_model *m, double T, double *lambda, doub
 {
     /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
     if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
-        tf_model_params_at(m, T, m->cache_p);
+        if (!m->cache_valid) m->cache_laws = tf_thermal_law_mask(m->law); /* after a prepare: laws may have changed */
+        tf_thermal_params_masked(m->thermal, m->p, m->law, m->cache_laws, m->fs_follows_fc, T, m->cache_p);
         m->cache_lambda = tf_model_lambda(m, T);
         m->cache_dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
+        m->cache_plain = !tf_friction_asymmetric(m->cache_p) && !(m->cache_p[TF_P_RIPPLE_PERIOD] > 0.0);
         m->cache_T = T;
         m->cache_valid = 1;
     }
@@ -103,7 +129,14 @@ static double friction_at(tf_model *m, double T, double t, const double *y, doub
     const double *p = tf_model_params_cached(m, T, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
-    double F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+    double F;
+    if (m->cache_plain) { /* symmetric, no ripple (cached with p): the models' equations alone */
+        F = tf_friction_eval_side(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+    } else {
+        F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+        if (p[TF_P_RIPPLE_PERIOD] > 0.0) /* on the base force: Model II scales it with the rest */
+            F += tf_friction_ripple(p, relative_position(m, t, y), jac ? &jac->dF_dx : 0, dp ? dp->dF_dp : 0);
+    }
     if (F_base) *F_base = F;
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, nz, jac);
 }
@@ -330,6 +363,10 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
         J_(XE, VE) = 1.0;
         J_(VE, VP) = d->dF_dv / m->m_e;
         J_(VE, VE) = -d->dF_dv / m->m_e;
+        if (d->dF_dx != 0.0) { /* the ripple, in x_e - x_p */
+            J_(VP, XE) += d->dF_dx / m->m, J_(VP, XP) -= d->dF_dx / m->m;
+            J_(VE, XE) -= d->dF_dx / m->m_e, J_(VE, XP) += d->dF_dx / m->m_e;
+        }
         for (int j = 0; j < nz; j++) {
             J_(VP, nm + j) = d->dF_dz[j] / m->m;
             J_(VE, nm + j) = -d->dF_dz[j] / m->m_e;
@@ -340,6 +377,7 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
         J_(X, V) = 1.0;
         J_(V, X) = -m->k_s / m->m;
         J_(V, V) = -d->dF_dv / m->m;
+        J_(V, X) -= d->dF_dx / m->m;
         for (int j = 0; j < nz; j++) {
             J_(V, nm + j) = -d->dF_dz[j] / m->m;
             J_(nm + j, V) = d->ddz_dv[j];
@@ -521,6 +559,13 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
     tf_stribeck(p, v, &dg_dv);
     tf_stribeck_param_partials(p, v, dg_p);
     if (m->fs_follows_fc) dg_p[TF_P_FC] += dg_p[TF_P_FS];
+    /* the negative capacity -w_i g_-(v) (direction-dependent levels: friction.h, tf_friction_side) */
+    double q[TF_NPARAM], dgn_dv, dgn_p[TF_NPARAM];
+    const double *pn = tf_friction_side(p, -1.0, q);
+    tf_stribeck(pn, v, &dgn_dv);
+    tf_stribeck_param_partials(pn, v, dgn_p);
+    tf_friction_side_partials(p, -1.0, dgn_p);
+    if (m->fs_follows_fc) dgn_p[TF_P_FC] += dgn_p[TF_P_FS];
     /* dv/dt along the trajectory before the switch; under prescribed motion v(t) is the input's
        slope, whose change is left out (it moves an event only through the Stribeck curve's slope) */
     double vdot = velocity_along(m, fm);
@@ -529,9 +574,11 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
         int a = old[i], b = m->gms.mode[i], row = nm + i;
         if (a == b) continue;
         double jump = fm[row] - fpl[row], w = m->gms.w[i];
+        const double *dgs_p = a == 0 && b < 0 ? dgn_p : dg_p; /* the capacity of the side it broke loose to */
+        double dgs_dv = a == 0 && b < 0 ? dgn_dv : dg_dv;
         /* the event function that fired: a stuck element reaching its capacity, b z_i - w_i g(v);
            a slipping one whose motion reversed, -a v */
-        double rate = a == 0 ? b * fm[row] - w * dg_dv * vdot : -a * vdot;
+        double rate = a == 0 ? b * fm[row] - w * dgs_dv * vdot : -a * vdot;
         if (!(fabs(rate) > 0.0) || jump == 0.0) continue;
         for (int k = 0; k < np; k++) {
             const tf_target *tg = &targets[k];
@@ -540,11 +587,11 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
             double dv = velocity_along(m, col);
             if (a == 0) {
                 double dcap = 0.0; /* d(capacity g)/dtheta, directly */
-                if (tg->kind == TF_TARGET_PARAM) dcap = dg_p[tg->param];
+                if (tg->kind == TF_TARGET_PARAM) dcap = dgs_p[tg->param];
                 else if (tg->kind == TF_TARGET_LAW) dcap = tf_law_coef_derivative(&m->law[tg->param], tg->coef,
                                                                                   tf_model_temperature(m, t, Y)) *
-                                                           dg_p[tg->param];
-                num = b * col[row] - w * (dcap + dg_dv * dv);
+                                                           dgs_p[tg->param];
+                num = b * col[row] - w * (dcap + dgs_dv * dv);
             } else {
                 num = -a * dv;
             }

@@ -237,6 +237,8 @@ static tf_status rt_step(tf_rt_friction *f, double v, double T, double dt, doubl
     if (gms)
         for (int j = 0; j < nz; j++) mode0[j] = m->gms.mode[j];
     double F = advance(m->friction, nz, p, &m->gms, f->z, v, dt, 0, dz);
+    double x = dt > 0.0 ? f->x + v * dt : f->x;
+    if (p[TF_P_RIPPLE_PERIOD] > 0.0) F += tf_friction_ripple(p, x, 0, 0);
     F = tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 0, 0);
     /* F' is finite only if every state is: each model's force sums its states with positive
        weights (sigma0 z, the GMS element forces), and lambda > 0 */
@@ -246,8 +248,17 @@ static tf_status rt_step(tf_rt_friction *f, double v, double T, double dt, doubl
             for (int j = 0; j < nz; j++) m->gms.mode[j] = mode0[j];
         return rt_done(err, TF_ERR_NONFINITE, "force or state not finite (v or dt too large)");
     }
+    f->x = x;
     *F_out = F;
     return err ? rt_done(err, TF_OK, 0) : TF_OK;
+}
+
+tf_status tf_rt_set_position(tf_rt_friction *f, double x, tf_error *err)
+{
+    if (!f) return rt_done(err, TF_ERR_BAD_ARGUMENT, "f (NULL)");
+    if (!isfinite(x)) return rt_done(err, TF_ERR_BAD_ARGUMENT, "x (not finite)");
+    f->x = x;
+    return rt_done(err, TF_OK, 0);
 }
 
 tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double dt, double *F, tf_error *err)

@@ -16,6 +16,24 @@ void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, in
     if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
 }
 
+unsigned long tf_thermal_law_mask(const tf_law *laws)
+{
+    unsigned long mask = 0;
+    for (int i = 0; i < TF_NPARAM; i++)
+        if (laws[i].kind != TF_LAW_NONE) mask |= 1UL << i;
+    return mask;
+}
+
+void tf_thermal_params_masked(int thermal, const double *p_base, const tf_law *laws, unsigned long mask,
+                              int fs_follows_fc, double T, double *p)
+{
+    memcpy(p, p_base, sizeof(double) * TF_NPARAM);
+    if (thermal == TF_THERMAL_MODEL_I)
+        for (int i = 0; mask; i++, mask >>= 1)
+            if (mask & 1UL) p[i] = tf_law_eval(&laws[i], T, 0);
+    if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
+}
+
 double tf_thermal_df_coef_partial(int form, const tf_law *dF, int coef, double T, double F_base, double F_ref,
                                   double v, double v_smooth)
 {

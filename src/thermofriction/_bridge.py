@@ -38,6 +38,8 @@ def _ordered(group: str) -> tuple:
 #: Friction parameters in the core's order, and their units (friction.h, TF_PARAMETERS).
 PARAMETERS = _ordered("parameter")
 PARAMETER_UNITS = {name: _core.PARAMETER_UNITS[name] for name in PARAMETERS}
+#: A negative side without any viscous term (sigma2_neg = 0) in the core, where 0 means "sigma2"
+_SMALLEST = 5e-324
 PLANT_CODES = dict(_GROUPS["plant"])
 FRICTION_CODES = dict(_GROUPS["friction"])
 LAW_CODES = dict(_GROUPS["law"])
@@ -115,6 +117,8 @@ def model_spec(model, temperature=None, input=None, friction_work: bool = False)
     values = {name: v for name, v in friction.values().items() if name not in friction.arrays}
     values.setdefault("fs", values.get("fc", 0.0))
     values.setdefault("vs", 1e-3)
+    if values.get("sigma2_neg") == 0.0:  # 0 is "not given" in the core (friction.h, tf_side_given)
+        values["sigma2_neg"] = _SMALLEST
     params = np.array([0.0 if values.get(name) is None else values[name] for name in PARAMETERS], float)
     thermal = _thermal_kind(model)
     laws = None

@@ -10,7 +10,8 @@ them (no ``Law.__call__``/``evaluate``, no ``Waveform.__call__``/``corners``, no
     waveforms   waveform_value, waveform_corners, waveform_slope          inputs
     laws        law_value, law_slope, temperature_value                   temperature laws
     friction    friction_params, stribeck_g, elastoplastic_alpha,         every friction model and the
-                base_friction, thermal_friction                           thermal extensions (the only copy)
+                base_friction, thermal_friction, on_side, ripple          thermal extensions (the only copy),
+                                                                          direction and position
     plants      ReferenceSystem (any plant), ReferenceModel (LuGre on     right-hand sides
                 the stick-slip actuator, with the C core's (X, V, Z) scales)
     solve       friction_force, rhs, default_atol, reference_simulate,    solve_ivp, restarted at corners;
@@ -22,8 +23,8 @@ them (no ``Law.__call__``/``evaluate``, no ``Waveform.__call__``/``corners``, no
 """
 
 from .control import reference_closed_loop
-from .friction import (FrictionParams, base_friction, elastoplastic_alpha, friction_params, stribeck_g,
-                       thermal_friction)
+from .friction import (FrictionParams, base_friction, elastoplastic_alpha, friction_params, on_side, ripple,
+                       stribeck_g, thermal_friction)
 from .laws import law_slope, law_value, temperature_value
 from .plants import ReferenceModel, ReferenceSystem
 from .solve import (ReferenceResult, ReferenceSystemResult, default_atol, friction_force, reference_simulate,
@@ -32,7 +33,7 @@ from .thermal import ReferenceHeatedSystem, reference_simulate_heated
 from .waveforms import waveform_corners, waveform_slope, waveform_value
 
 __all__ = ["waveform_value", "waveform_corners", "waveform_slope", "law_value", "law_slope", "temperature_value",
-           "FrictionParams", "friction_params", "stribeck_g", "elastoplastic_alpha", "base_friction",
+           "FrictionParams", "friction_params", "stribeck_g", "elastoplastic_alpha", "base_friction", "on_side", "ripple",
            "thermal_friction", "ReferenceSystem", "ReferenceModel", "friction_force", "rhs", "default_atol",
            "ReferenceResult", "reference_simulate", "ReferenceSystemResult", "reference_simulate_system",
            "ReferenceHeatedSystem", "reference_simulate_heated", "reference_closed_loop"]

@@ -6,11 +6,13 @@ of the C core's first differential tests (ReferenceModel) evaluate them here.
     FrictionParams, friction_params(model, T)      parameters at T (Model I laws applied)
     stribeck_g, elastoplastic_alpha                the Stribeck curve, the elasto-plastic alpha
     base_friction(kind, p, v, z, modes)            (F, [z_i']) of the friction model alone
-    thermal_friction(kind, p, v, z, modes)         (F', [z_i']) with Model II's scale or offset
+    thermal_friction(kind, p, v, z, modes, x)      (F', [z_i']) with the position ripple and Model II
+    on_side(p, direction), ripple(p, x)            direction-dependent levels, the position ripple
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -42,6 +44,14 @@ class FrictionParams:
     w: tuple
     lam: float
     dF_offset: float
+    #: the negative side's levels (None: the positive one) and the position ripple
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
+    ripple_period: float | None = None
+    ripple_cos: tuple = ()
+    ripple_sin: tuple = ()
 
 
 def friction_params(model, T) -> FrictionParams:
@@ -69,7 +79,46 @@ def friction_params(model, T) -> FrictionParams:
     f = {n: (None if p[n] is None else float(p[n])) for n in _ALL_PARAMS}
     k = tuple(float(x) for x in getattr(fr, "k", ()))
     w = tuple(float(x) for x in getattr(fr, "w", ()))
-    return FrictionParams(**f, k=k, w=w, lam=lam, dF_offset=off)
+    # direction and position (written here from docs/models.md#direction-and-position, by name)
+    extra = {}
+    for n in ("fc_neg", "fs_neg", "vs_neg", "sigma2_neg", "ripple_period"):
+        value = law_value(laws[n], T) if n in laws else getattr(fr, n, None)
+        extra[n] = None if value is None else float(value)
+    for f_ in ("cos", "sin"):
+        amps = []
+        for h in (1, 2, 3):
+            n = f"ripple_{f_}{h}"
+            value = law_value(laws[n], T) if n in laws else getattr(fr, n, None)
+            amps.append(0.0 if value is None else float(value))
+        extra[f"ripple_{f_}"] = tuple(amps)
+    return FrictionParams(**f, k=k, w=w, lam=lam, dF_offset=off, **extra)
+
+
+def on_side(p: FrictionParams, direction) -> FrictionParams:
+    """The parameters acting in sliding direction ``direction`` (< 0: negative): each given
+    negative-side level in place of its positive one; fs_neg not given is fs, except where the
+    positive side has no Stribeck effect (fs = fc) and fc_neg is given: then fc_neg."""
+    if not direction < 0:
+        return p
+    fc = p.fc if p.fc_neg is None else p.fc_neg
+    if p.fs_neg is not None:
+        fs = p.fs_neg
+    elif p.fc_neg is not None and p.fs == p.fc:
+        fs = fc
+    else:
+        fs = p.fs
+    vs = p.vs if p.vs_neg is None else p.vs_neg
+    sigma2 = p.sigma2 if p.sigma2_neg is None else p.sigma2_neg
+    return dataclasses.replace(p, fc=fc, fs=fs, vs=vs, sigma2=sigma2)
+
+
+def ripple(p: FrictionParams, x):
+    """sum_k a_k cos(2 pi k x / P) + b_k sin(2 pi k x / P), k = 1, 2, ... (0 without a period)."""
+    if not p.ripple_period:
+        return 0.0
+    q = 2.0 * math.pi * x / p.ripple_period
+    return sum(a * math.cos((k + 1) * q) for k, a in enumerate(p.ripple_cos)) + \
+        sum(b * math.sin((k + 1) * q) for k, b in enumerate(p.ripple_sin))
 
 
 def stribeck_g(p: FrictionParams, v):
@@ -96,7 +145,9 @@ def elastoplastic_alpha(p: FrictionParams, z, v, g):
 
 def base_friction(kind, p: FrictionParams, v, z, modes=()):
     """(F, [z_i']) of the friction model alone (no thermal extension) at sliding velocity v and
-    internal states z. GMS ``modes``: 0 stuck, +1/-1 slipping in that direction."""
+    internal states z. GMS ``modes``: 0 stuck, +1/-1 slipping in that direction. Direction-
+    dependent levels: the side of v's sign (on_side)."""
+    p = on_side(p, v)
     if kind == "coulomb":
         return p.fc * math.tanh(v / p.v_smooth) + p.sigma2 * v, []
     if kind == "stribeck":
@@ -122,11 +173,13 @@ def base_friction(kind, p: FrictionParams, v, z, modes=()):
 
 
 
-def thermal_friction(kind, p: FrictionParams, v, z, modes=()):
-    """(F', [z_i']): the friction model with Model II's thermal term (docs/models.md#model-ii):
-    the base force scaled by lam = 1 + dF(T)/fc, or dF(T) tanh(v/v_smooth) added (the offset
-    form). Model I needs nothing here: its laws are in p already."""
+def thermal_friction(kind, p: FrictionParams, v, z, modes=(), x=0.0):
+    """(F', [z_i']): the friction model, the position ripple at sliding position x added to the
+    base force, and Model II's thermal term (docs/models.md#model-ii): the base force scaled by
+    lam = 1 + dF(T)/fc, or dF(T) tanh(v/v_smooth) added (the offset form). Model I needs nothing
+    here: its laws are in p already."""
     F, zd = base_friction(kind, p, v, z, modes)
+    F += ripple(p, x)
     F = p.lam * F
     if p.dF_offset != 0.0:
         F += p.dF_offset * math.tanh(v / p.v_smooth)

@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 from thermofriction.models import ModelII
 from thermofriction.waveforms import Sampled, Sine, Zero
 
-from .friction import FrictionParams, friction_params, stribeck_g, thermal_friction
+from .friction import FrictionParams, friction_params, on_side, stribeck_g, thermal_friction
 from .waveforms import interp_scalar, scalar_waveform, scalar_waveform_slope, waveform_corners
 
 _NSTATE = {"coulomb": 0, "stribeck": 0, "dahl": 1, "lugre": 1, "elastoplastic": 1}
@@ -109,10 +109,18 @@ class ReferenceSystem:
             return y[1]
         return self.input_slope(t)
 
+    def position(self, t, y):
+        """x_r, the driven body's position relative to its driving surface (the ripple's argument)."""
+        if self.plant == "stick-slip":
+            return y[2] - y[0]
+        if self.plant == "mass":
+            return y[0]
+        return self.input_value(t)
+
     # -- friction and the right-hand side --------------------------------------------------------
     def friction_and_rates(self, t, y):
         p = self.params_at_time(t)
-        return thermal_friction(self.kind, p, self.velocity(t, y), y[self.nm:], self.modes)
+        return thermal_friction(self.kind, p, self.velocity(t, y), y[self.nm:], self.modes, self.position(t, y))
 
     def friction(self, t, y):
         y = [float(v) for v in y]
@@ -150,7 +158,7 @@ class ReferenceSystem:
                     sign = -1.0 if kind == "rearm" else 1.0
 
                     def cap(t, y, i=i, s=s, sign=sign):
-                        p = self.params_at_time(t)
+                        p = on_side(self.params_at_time(t), s)  # the capacity in direction s
                         return sign * (p.w[i] * stribeck_g(p, self.velocity(t, y)) - s * y[self.nm + i])
                     funcs.append(cap)
                     what.append((kind, i, s))
@@ -188,7 +196,7 @@ class ReferenceSystem:
             return
         p = self.params_at_time(t)
         v = self.velocity(t, y)
-        g = stribeck_g(p, v)
+        g = stribeck_g(on_side(p, v), v)
         for i, mode in enumerate(self.modes):
             Fi = y[self.nm + i]
             if mode != 0 and mode * v <= 0.0:

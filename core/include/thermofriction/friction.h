@@ -26,7 +26,18 @@ extern "C" {
     X(VD, "vd", "m/s", "sigma1 velocity scale; <= 0: sigma1 constant")                                  \
     X(VSMOOTH, "v_smooth", "m/s", "velocity band of smoothed signs")                                    \
     X(ZBA, "z_ba", "m", "elasto-plastic break-away deflection")                                         \
-    X(C, "C", "N/s", "GMS: rate at which a slipping element's force approaches its capacity")
+    X(C, "C", "N/s", "GMS: rate at which a slipping element's force approaches its capacity")             \
+    X(FC_NEG, "fc_neg", "N", "Coulomb level for negative sliding; NaN or 0: fc")                            \
+    X(FS_NEG, "fs_neg", "N", "static level for negative sliding; NaN or 0: fs")      \
+    X(VS_NEG, "vs_neg", "m/s", "Stribeck velocity for negative sliding; NaN or 0: vs")                      \
+    X(SIGMA2_NEG, "sigma2_neg", "N s/m", "viscous friction for negative sliding; NaN or 0: sigma2")         \
+    X(RIPPLE_PERIOD, "ripple_period", "m", "period P of the position ripple; <= 0: no ripple")         \
+    X(RIPPLE_COS1, "ripple_cos1", "N", "ripple amplitude of cos(2 pi x / P)")                          \
+    X(RIPPLE_SIN1, "ripple_sin1", "N", "ripple amplitude of sin(2 pi x / P)")                          \
+    X(RIPPLE_COS2, "ripple_cos2", "N", "ripple amplitude of cos(4 pi x / P)")                          \
+    X(RIPPLE_SIN2, "ripple_sin2", "N", "ripple amplitude of sin(4 pi x / P)")                          \
+    X(RIPPLE_COS3, "ripple_cos3", "N", "ripple amplitude of cos(6 pi x / P)")                          \
+    X(RIPPLE_SIN3, "ripple_sin3", "N", "ripple amplitude of sin(6 pi x / P)")
 
 #define TF_PARAMETER_ENUM_(symbol, name, unit, meaning) TF_P_##symbol,
 typedef enum { TF_PARAMETERS(TF_PARAMETER_ENUM_) TF_NPARAM } tf_param;
@@ -42,6 +53,36 @@ typedef enum {
 } tf_friction_kind;
 
 #define TF_MAX_FRICTION_STATES 64
+/* Harmonics of the position ripple (TF_P_RIPPLE_COS1 ... TF_P_RIPPLE_SIN3, interleaved cos, sin). */
+#define TF_RIPPLE_ORDER 3
+
+/* Direction-dependent friction: the parameters that take their own value for negative sliding
+ * (v < 0), each paired with its positive-side parameter. A negative value not given (NaN or 0,
+ * tf_side_given) means "the positive value" (fs_neg: fc_neg where fs = fc, i.e. no Stribeck effect
+ * on either side). */
+/* Whether a negative-side value is given: NaN and 0 mean "the positive value" (so that a
+ * zero-initialised parameter array stays symmetric; a negative side without any viscous term is
+ * sigma2_neg = the smallest positive double, which the Python package writes for sigma2_neg = 0). */
+static inline int tf_side_given(double x) { return x != 0.0 && x == x; }
+/* Whether any negative-side value is given (the symmetric case: four tests). */
+static inline int tf_friction_asymmetric(const double *p)
+{
+    return tf_side_given(p[TF_P_FC_NEG]) || tf_side_given(p[TF_P_FS_NEG]) || tf_side_given(p[TF_P_VS_NEG]) ||
+           tf_side_given(p[TF_P_SIGMA2_NEG]);
+}
+/* The parameters acting at sliding velocity v: p itself where v >= 0 or nothing is direction-
+ * dependent, else q filled with the negative side's values in the positive slots (so that every
+ * model's equations serve both sides). */
+const double *tf_friction_side(const double *p, double v, double *q);
+/* Partials d[TF_NPARAM] computed with tf_friction_side's values moved, in place, to the negative-side
+ * parameters they came from (nothing where v >= 0 or the model is symmetric). tf_friction_eval does
+ * this for its own partials; callers that differentiate g(v) themselves use it. */
+void tf_friction_side_partials(const double *p, double v, double *d);
+/* The position ripple R(x) = sum_k a_k cos(2 pi k x / P) + b_k sin(2 pi k x / P) (zero when
+ * P <= 0), added to the friction force of any model by the plant (which knows the position x).
+ * dR/dx into *dR_dx when not NULL; dR/d(amplitude) added into dR_dp[TF_NPARAM] when not NULL
+ * (the period is given, not fitted: its partial is left out). */
+double tf_friction_ripple(const double *p, double x, double *dR_dx, double *dR_dp);
 
 /* The elements of a Generalized Maxwell-slip model: stiffness k_i [N/m], capacity fraction w_i
  * (sum 1) and mode: 0 stuck (F_i' = k_i v), +1 or -1 slipping that way
@@ -61,6 +102,7 @@ typedef struct {
     double dF_dz[TF_MAX_FRICTION_STATES];
     double ddz_dv[TF_MAX_FRICTION_STATES];
     double ddz_dz[TF_MAX_FRICTION_STATES];
+    double dF_dx; /* the position ripple's dR/dx: 0 from tf_friction_eval, set by the plant */
 } tf_friction_partials;
 
 /* Partial derivatives with respect to the parameters, for forward sensitivities. */
@@ -113,6 +155,12 @@ static inline double tf_lugre_value(const double *p, double v, double z, double 
  * the current modes; where a mode switches, the sensitivities jump (tf_model_sensitivity_jump). */
 double tf_friction_eval(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
                         double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
+
+/* tf_friction_eval with p's values on both sides (no direction-dependent substitution): for callers
+ * that know their parameters are symmetric (the plant caches that per temperature) or that have
+ * already taken tf_friction_side's values. */
+double tf_friction_eval_side(int kind, const double *p, const tf_gms_elements *gms, double v, const double *z,
+                             double *dz, tf_friction_partials *jac, tf_friction_param_partials *dp);
 
 /* Discrete modes (GMS). Event functions (two per element) cross zero upwards where a mode must
  * change: a stuck element when F_i reaches +w_i g(v) or -w_i g(v), a slipping one when v

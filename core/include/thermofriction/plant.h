@@ -76,6 +76,8 @@ typedef struct {
      * evaluations per step. Zero-initialise the struct (or call tf_model_prepare). */
     int cache_valid;
     double cache_T, cache_p[TF_NPARAM], cache_lambda, cache_dF;
+    int cache_plain; /* cache_p symmetric and without a position ripple: the plant's plain evaluation */
+    unsigned long cache_laws; /* tf_thermal_law_mask of law, taken when the cache is filled after a prepare */
 } tf_model;
 
 /* Invalidate the cached parameters after changing a model's fields. */

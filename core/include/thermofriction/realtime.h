@@ -43,6 +43,7 @@ typedef struct {
        plant fields are unused), with its per-temperature parameter cache */
     tf_model model;
     double z[TF_MAX_FRICTION_STATES]; /* internal states */
+    double x; /* the sliding position (the ripple's argument): v dt summed per step, or set */
 } tf_rt_friction;
 
 /* Checks. Every function validates its arguments and returns a tf_status (status.h), filling the
@@ -71,14 +72,18 @@ tf_status tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form, tf_e
 /* Changes parameter `param` at run time (its law, if any, is dropped). With a thermal extension
  * the new value is checked at the last temperature stepped at (if any), else at the next step. */
 tf_status tf_rt_set_param(tf_rt_friction *f, int param, double value, tf_error *err);
-/* Internal states to rest (z = 0, GMS elements stuck). */
+/* The sliding position x [m] (a measured one, e.g. the encoder's), the argument of the position
+ * ripple (docs/models.md#direction-and-position); each step adds v dt to it. Refuses a non-finite x. */
+tf_status tf_rt_set_position(tf_rt_friction *f, double x, tf_error *err);
+/* Internal states to rest (z = 0, GMS elements stuck); the position is kept. */
 tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err);
 /* Parameters at temperature T [degC] into p[TF_NPARAM]; *lambda, *dF_offset (may be NULL).
  * Nothing is written if T or the parameters there are refused. */
 tf_status tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset,
                           tf_error *err);
 /* Advances the internal states by dt [s] at sliding velocity v [m/s] and temperature T [degC]
- * (ignored without a thermal model) and writes the friction force F [N] to *F (the sign convention
+ * (ignored without a thermal model), the position by v dt, and writes the friction force F [N]
+ * (with the position ripple at the new position, if the model has one) to *F (the sign convention
  * of docs/models.md#conventions: the force resisting sliding, with v's sign in steady sliding).
  * dt <= 0 gives the force without advancing. On a refusal *F is NaN and the state is unchanged. */
 tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double dt, double *F, tf_error *err);

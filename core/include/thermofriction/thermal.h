@@ -36,6 +36,12 @@ typedef enum {
  * set (kind != TF_LAW_NONE) when thermal is TF_THERMAL_MODEL_I; fs = fc when fs_follows_fc. */
 void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, int fs_follows_fc, double T,
                        double *p);
+/* The parameters that follow a law: bit i set where laws[i].kind != TF_LAW_NONE (TF_NPARAM <= 32). */
+unsigned long tf_thermal_law_mask(const tf_law *laws);
+/* tf_thermal_params with the laws of `mask` only (tf_thermal_law_mask): the plant's per-temperature path,
+ * which then visits only the parameters that have a law. */
+void tf_thermal_params_masked(int thermal, const double *p_base, const tf_law *laws, unsigned long mask,
+                              int fs_follows_fc, double T, double *p);
 
 /* ---- Model II: F' = lambda(T) F_base + dF_offset(T) s(v), s(v) = tanh(v / v_smooth) ---- */
 
@@ -62,6 +68,7 @@ static inline double tf_thermal_force(double F_base, double v, double v_smooth, 
     double F = lambda * F_base;
     if (jac && lambda != 1.0) {
         jac->dF_dv *= lambda;
+        jac->dF_dx *= lambda;
         for (int j = 0; j < nz; j++) jac->dF_dz[j] *= lambda;
     }
     if (dF_offset != 0.0) { /* offset form: dF along a smoothed sign of v */

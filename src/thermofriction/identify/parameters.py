@@ -13,6 +13,7 @@ import re
 from .. import _bridge
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
+from ..models.sides import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, side_values
 
 TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
@@ -180,6 +181,10 @@ def get_value(model: Model, name: str) -> float:
     base = PARAMETERS[idx]
     if base == "fs" and "fs" not in values:
         return float(values["fc"])
+    if base in NEGATIVE_SIDE and base not in values:  # a negative side starts from the positive one's value
+        return float(side_values({**values, "fs": values.get("fs", values.get("fc"))})[NEGATIVE_SIDE[base]])
+    if base in RIPPLE_AMPLITUDES and base not in values:
+        return 0.0
     if base not in values:
         raise InputError(f"'{name}' has no value in this model")
     return float(values[base])

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import ComputationError, InputError
 from ..models import Model, ModelI
+from ..models.sides import SIGNED
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
@@ -112,15 +113,15 @@ def unrefined_result(method, model, params, experiments, measurement, t0, per_fi
 
 
 def friction_parameters(model: Model, names, fixed=(), excess=False) -> Parameters:
-    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term or a law's
-    coefficient. ``excess``: fs fitted as the excess fs - fc (EXCESS, in log space: fs >= fc by construction)
-    where the start has one (:func:`stribeck_start`)."""
+    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term, a law's
+    coefficient or a ripple amplitude. ``excess``: fs fitted as the excess fs - fc (EXCESS, in log space: fs >= fc
+    by construction) where the start has one (:func:`stribeck_start`)."""
     params = Parameters()
     for name in names:
         if name == "fs" and excess and get_value(model, EXCESS) > 0:
             name = EXCESS
         v = get_value(model, name)
-        positive = not name.startswith("dF") and "." not in name
+        positive = not name.startswith("dF") and "." not in name and name not in SIGNED
         params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
                    unit=unit_of(model, name))
     return params

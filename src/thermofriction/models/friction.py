@@ -5,19 +5,34 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import KW_ONLY, dataclass, fields, replace
 
 import numpy as np
 
 from .._bridge import PARAMETER_UNITS, PARAMETERS
 from ..errors import InputError, shorten, unknown_keys
 from ._parse import num, num_array
+from .sides import NEGATIVE_SIDE, check_sides, ripple_keys, side_values
 
 # PARAMETERS and PARAMETER_UNITS (the one table of units: files, reports and fit results use it) come
 # from the core's parameter list (friction.h, TF_PARAMETERS).
 
 
-class _Friction:
+@dataclass(frozen=True)
+class _Ripple:
+    """The position ripple every model takes (docs/models.md#direction-and-position), keyword-only."""
+
+    _: KW_ONLY
+    ripple_period: float | None = None
+    ripple_cos1: float | None = None
+    ripple_sin1: float | None = None
+    ripple_cos2: float | None = None
+    ripple_sin2: float | None = None
+    ripple_cos3: float | None = None
+    ripple_sin3: float | None = None
+
+
+class _Friction(_Ripple):
     """What every friction model shares: parameters as dataclass fields (None where a Model I law
     gives the value), ``values()``, the file form, and the state layout."""
 
@@ -41,7 +56,8 @@ class _Friction:
 
     def values(self) -> dict:
         """Parameters given as numbers (None-valued ones omitted)."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
+        return {f.name: getattr(self, f.name) for f in sorted(fields(self), key=lambda f: f.name.startswith("ripple_"))
+                if getattr(self, f.name) is not None}
 
     def to_dict(self) -> dict:
         d = {"model": self.model}
@@ -56,6 +72,8 @@ class _Friction:
     def from_dict(cls, d: dict, where="[friction]"):
         d = dict(d)
         d.pop("model", None)
+        if "ripple" in d:
+            d.update(ripple_keys(d.pop("ripple"), where))
         allowed = [f.name for f in fields(cls)]
         unknown = set(d) - set(allowed)
         if unknown:
@@ -91,6 +109,10 @@ class LuGre(_Friction):
     delta: float | None = 2.0
     vd: float | None = None
     v_smooth: float = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
 
     model = "lugre"
     nstate = 1
@@ -108,6 +130,8 @@ class Coulomb(_Friction):
     fc: float | None
     sigma2: float | None = 0.0
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    sigma2_neg: float | None = None
 
     model = "coulomb"
     required = ("fc",)
@@ -124,6 +148,10 @@ class Stribeck(_Friction):
     delta: float | None = 2.0
     sigma2: float | None = 0.0
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
 
     model = "stribeck"
     required = ("fc",)
@@ -137,6 +165,7 @@ class Dahl(_Friction):
     sigma0: float | None
     fc: float | None
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
 
     model = "dahl"
     nstate = 1
@@ -162,6 +191,10 @@ class ElastoPlastic(_Friction):
     delta: float | None = 2.0
     vd: float | None = None
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
 
     model = "elastoplastic"
     nstate = 1
@@ -191,6 +224,10 @@ class GMS(_Friction):
     delta: float | None = 2.0
     sigma2: float | None = 0.0
     v_smooth: float | None = 1e-6
+    fc_neg: float | None = None
+    fs_neg: float | None = None
+    vs_neg: float | None = None
+    sigma2_neg: float | None = None
 
     model = "gms"
     required = ("k", "w", "C", "fc")
@@ -231,7 +268,8 @@ FRICTION_MODELS = {cls.model: cls for cls in (LuGre, Coulomb, Stribeck, Dahl, El
 #: Where each parameter is physical (fs, vs: relative to fc, checked below).
 PARAMETER_DOMAIN = {"sigma0": "positive", "sigma1": "non-negative", "sigma2": "non-negative", "fc": "positive",
                     "delta": "positive", "vd": "positive", "v_smooth": "positive", "C": "positive",
-                    "z_ba": "non-negative"}
+                    "z_ba": "non-negative", "fc_neg": "positive", "vs_neg": "positive",
+                    "sigma2_neg": "non-negative", "ripple_period": "positive"}
 
 
 def in_domain(name: str, values) -> np.ndarray:
@@ -246,7 +284,13 @@ def in_domain(name: str, values) -> np.ndarray:
 
 
 def check_friction_values(values: dict, where: str):
-    """Physical checks on a full set of parameter values (numbers and laws evaluated)."""
+    """Physical checks on a full set of parameter values (numbers and laws evaluated), on both
+    sides of a direction-dependent model, and on the ripple."""
+    _check_side(values, where, "")
+    check_sides(values, where, _check_side)
+
+
+def _check_side(values: dict, where: str, side: str):
     for name, domain in PARAMETER_DOMAIN.items():
         v = values.get(name)
         # finite first: a law that overflows (a exp(b T) with b = 100) gives inf, which is "positive"
@@ -262,11 +306,11 @@ def check_friction_values(values: dict, where: str):
         if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
             raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
     if fs is not None and fc is not None and fs < fc:
-        raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r})")
+        raise InputError(f"{where}: 'fs' ({fs!r}) must be at least 'fc' ({fc!r}){side}")
     if fs is not None and fc is not None and fs != fc:
         vs = values.get("vs")
         if vs is None or not vs > 0:
-            raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}")
+            raise InputError(f"{where}: 'vs' must be positive when fs != fc (the Stribeck velocity), got {vs!r}{side}")
 
 
 def stribeck_curve(values: dict, v):
@@ -293,6 +337,10 @@ def dissipativity_violation(model_name: str, values: dict):
     lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
     if model_name not in ("lugre", "elastoplastic"):
         return None
+    if any(values.get(n) is not None for n in NEGATIVE_SIDE):  # each side on its own, the positive first
+        return dissipativity_violation(model_name, {k: v for k, v in values.items() if k not in NEGATIVE_SIDE}) or \
+            dissipativity_violation(model_name, {k: v for k, v in side_values(values).items()
+                                                 if k not in NEGATIVE_SIDE})
     # extreme but finite values (sigma0 = 1e300) overflow the products below; the condition is
     # then decided by the terms that remain finite, and NumPy's warnings are not the user's business
     # the same values come back for every run of a model (simulate checks before each): decide once
@@ -325,9 +373,6 @@ def _dissipativity_violation(values: dict):
                    f"|z| <= fs/sigma0; at high speed sigma1 <= sigma2 fc/(fs - fc) = "
                    f"{(s2 * fc / (fs - fc)) if fs > fc else float('inf'):.3g} N s/m, sigma1 = {s1:.3g}): the model "
                    f"can create energy; give vd (sigma1(v) = sigma1 exp(-(v/vd)^2)), or raise sigma2")
-
-
-
 
 
 __all__ = ["PARAMETERS", "PARAMETER_UNITS", "LuGre", "Coulomb", "Stribeck", "Dahl", "ElastoPlastic", "GMS",

@@ -1,0 +1,74 @@
+"""Direction-dependent friction levels and the position ripple (docs/models.md#direction-and-position):
+the names, the model file's ripple table, the values that act in negative sliding, and their checks. Every
+friction model of models/friction.py takes them."""
+
+from __future__ import annotations
+
+import math
+
+from ..errors import InputError, shorten
+from ._parse import num, num_array
+
+#: The negative side's parameters (docs/models.md#direction-and-position), each with its positive one.
+NEGATIVE_SIDE = {"fc_neg": "fc", "fs_neg": "fs", "vs_neg": "vs", "sigma2_neg": "sigma2"}
+#: The ripple's harmonics (friction.h, TF_RIPPLE_ORDER) and its amplitudes' names, in N or N m.
+RIPPLE_ORDER = 3
+RIPPLE_AMPLITUDES = tuple(f"ripple_{f}{k}" for k in range(1, RIPPLE_ORDER + 1) for f in ("cos", "sin"))
+#: Parameters that may take either sign (fitted as they are, not in log space).
+SIGNED = frozenset(RIPPLE_AMPLITUDES)
+
+
+def ripple_keys(table, where="[friction]") -> dict:
+    """``ripple = { period = P, cos = [a1, ...], sin = [b1, ...] }`` as the flat parameters
+    ``ripple_period``, ``ripple_cos1`` ... (up to RIPPLE_ORDER harmonics)."""
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: 'ripple' must be a table {{ period = ..., cos = [...], sin = [...] }}, "
+                         f"got {shorten(table)}")
+    unknown = set(table) - {"period", "cos", "sin"}
+    if unknown:
+        raise InputError(f"{where}: 'ripple' has unknown keys {sorted(unknown)} (period, cos, sin)")
+    if "period" not in table:
+        raise InputError(f"{where}: 'ripple' needs its 'period' (one revolution, a screw pitch, ... in m or rad)")
+    out = {"ripple_period": num(table["period"], where, "ripple.period")}
+    for f in ("cos", "sin"):
+        amps = list(num_array(table.get(f, []), where, f"ripple.{f}"))
+        if len(amps) > RIPPLE_ORDER:
+            raise InputError(f"{where}: 'ripple.{f}' has {len(amps)} amplitudes; at most {RIPPLE_ORDER} harmonics")
+        out.update({f"ripple_{f}{k + 1}": float(a) for k, a in enumerate(amps)})
+    return out
+
+
+def side_values(values: dict) -> dict:
+    """The parameter values that act in negative sliding: each given ``*_neg`` in its positive
+    slot (fs_neg absent: fs, or fc_neg where fs = fc)."""
+    out = dict(values)
+    fc, fs = values.get("fc"), values.get("fs")
+    no_stribeck = fs is None or fs == fc
+    for neg, pos in NEGATIVE_SIDE.items():
+        if values.get(neg) is not None:
+            out[pos] = values[neg]
+    if values.get("fs_neg") is None and values.get("fc_neg") is not None and no_stribeck:
+        out["fs"] = out["fc"]
+    return out
+
+
+def check_sides(values: dict, where: str, check_side):
+    """The negative side's values checked as the positive ones are (``check_side(values, where, note)``), fs_neg
+    against fc_neg, and the ripple: finite amplitudes, none without a period."""
+    if any(values.get(n) is not None for n in NEGATIVE_SIDE):
+        for name in ("fs_neg", *RIPPLE_AMPLITUDES):
+            v = values.get(name)
+            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
+        neg = side_values(values)
+        if neg.get("fs") is not None and neg.get("fc") is not None and neg["fs"] < neg["fc"]:
+            raise InputError(f"{where}: the negative side's static level fs_neg ({neg['fs']!r}; fs where not given) "
+                             f"must be at least its Coulomb level fc_neg ({neg['fc']!r})")
+        check_side(neg, where, " (negative side: fc_neg, fs_neg, vs_neg, sigma2_neg)")
+    amps = [n for n in RIPPLE_AMPLITUDES if values.get(n) is not None]
+    for name in amps:
+        if not (isinstance(values[name], (int, float)) and math.isfinite(values[name])):
+            raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(values[name])}")
+    if amps and values.get("ripple_period") is None:
+        raise InputError(f"{where}: ripple amplitudes ({', '.join(amps)}) need the ripple's period "
+                         f"(ripple = {{ period = ..., cos = [...], sin = [...] }})")
