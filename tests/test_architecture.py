@@ -150,7 +150,8 @@ def _named_in(doc: str):
 
 
 def _exists(path: str) -> bool:
-    roots = [ROOT, ROOT / "core", ROOT / "core" / "src", ROOT / "core" / "include" / "thermofriction", ROOT / "docs",
+    roots = [ROOT, ROOT / "core", ROOT / "core" / "src", ROOT / "core" / "include" / "thermofriction",
+             ROOT / "core" / "fmu", ROOT / "docs",
              ROOT / "tests", PACKAGE] + [d for d in PACKAGE.iterdir() if d.is_dir()]
     return any((r / path.rstrip("/")).exists() for r in roots)
 
@@ -164,7 +165,8 @@ def test_architecture_document_names_only_what_exists():
     doc = DOC.read_text(encoding="utf-8")
     paths, python, c = _named_in(doc)
     defined, c_text = _defined_names(), _c_text()
-    missing = [p for p in sorted(paths) if not _exists(p)]
+    # build products (the FMU binaries the package build installs under _fmu/) are not in the tree
+    missing = [p for p in sorted(paths) if not _exists(p) and not p.startswith("_fmu/")]
     missing += [n for n in sorted(python) if not NOT_CODE.match(n) and n.split(".")[-1] not in defined
                 and not re.search(rf"\b{n.split('.')[-1]}\b", c_text)]  # a C function or a binding's export
     missing += [s for s in sorted(c) if not NOT_CODE.match(s) and not re.search(rf"\b{s}\b", c_text)]

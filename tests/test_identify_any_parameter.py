@@ -92,8 +92,9 @@ def test_the_excess_column_of_the_jacobian_matches_finite_differences__independe
 def test_unknown_parameters_are_refused_by_name(truth, data):
     with pytest.raises(tf.InputError, match="'mu' is not a parameter of the lugre"):
         tf.identify(data, "model-i", init=start_from(truth, FAR), parameters=["sigma0", "mu"])
+    # (a single string is one name, the API's rule: _args.py; a Parameters object is base's only)
     with pytest.raises(tf.InputError, match="list of friction parameter names"):
-        tf.identify(data, "model-ii", init=start_from(truth, FAR), parameters="sigma0")
+        tf.identify(data, "model-ii", init=start_from(truth, FAR), parameters=tf.Parameters())
 
 
 def test_a_failed_per_temperature_fit_names_the_temperature_and_parameters(truth, data, monkeypatch):

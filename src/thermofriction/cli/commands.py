@@ -123,12 +123,12 @@ def solver_of(args) -> str:
 
 
 def _offset(args):
-    """--offset, or --no-offset (its earlier spelling of "none"); None: the measurement's default."""
+    """--offset, or --no-offset (its earlier spelling of "none"); True: the measurement's default."""
     if getattr(args, "no_offset", False):
         if args.offset not in (None, "none"):
             raise InputError(f"--no-offset and --offset {args.offset} contradict each other")
         return "none"
-    return args.offset
+    return True if args.offset is None else args.offset
 
 
 def cmd_identify(args) -> int:

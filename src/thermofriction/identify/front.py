@@ -37,6 +37,9 @@ MAX_STARTS = 10_000
 
 
 def _check_arguments(method, reference_temperature, rtol, starts, seed):
+    if method not in METHODS:
+        raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
+
     def whole(v):
         return isinstance(v, numbers.Integral) and not isinstance(v, bool)
 
@@ -86,9 +89,8 @@ def _checked_types(data, method, init, friction, parameters, free, procedure, la
     _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
     rtol = 1e-8 if controller is None else controller.rtol
     _args.function(progress, "progress")
-    if not (offset is None or isinstance(offset, (bool, str))):
+    if not isinstance(offset, (bool, str)):
         _args.refuse("offset", "\"shared\", \"per-experiment\", \"none\", True or False", offset)
-    _args.dataset(data, Dataset, experiments=True)
     return parameters, free, rtol
 
 
@@ -132,9 +134,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     """
     parameters, free, rtol = _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine,
                                             reference_temperature, controller, rtol, progress, offset)
-    if method not in METHODS:
-        raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
     _check_arguments(method, reference_temperature, rtol, starts, seed)
+    _args.dataset(data, Dataset, experiments=True)  # after the options, whose messages name them first
     measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
     if method not in measurement.methods:
         *most, last = measurement.methods
