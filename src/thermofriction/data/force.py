@@ -2,22 +2,12 @@
 produced, read from CSV files whose headers give the units, linear (m, N) or rotary (rad, N m), or from MATLAB
 files (data/matlab.py: read_force_mat) with the same columns.
 
-**The motion that drives the model** (``motion = "auto" | "position" | "velocity"``, the dataset's option): with
-"auto" (the default) a ``velocity`` column drives the model when it is the position's derivative -- the lag
-between them (cross-correlation, sub-sample) at most LAG_LIMIT samples, their scales within SCALE_TOLERANCE, their
-correlation at least MIN_CORRELATION (:func:`check_motion`); otherwise, and without a velocity column, the
-position's derivative does (``numpy.gradient``, second order on irregular samples), with a MotionWarning giving
-the numbers. Either way the driving waveform is a piecewise-linear position whose slope is the sample's own
-velocity within half an interval of each sample (:func:`motion_waveform`), so that the model sees at each sample
-time exactly the velocity used there, with no half-sample lag.
+**The motion that drives the model** (``motion = "auto" | "position" | "velocity"``, the dataset's option) is
+chosen, checked and turned into the driving waveform by data/motion.py.
 
 **Sign convention**: the friction column has the sign of the velocity in sliding (the force or torque that the
 drive spends against friction). A column that opposes the motion (a reaction-torque sensor) is refused at loading
 (:func:`check_sign`); ``flip_sign = true`` in the manifest reads it negated.
-
-**Velocity resolution**: a quantised velocity (a firmware's fixed steps) makes static friction models chatter at
-rest when their ``v_smooth`` is far below a step; :func:`velocity_resolution` estimates the step and
-:func:`with_v_smooth` sets a model's ``v_smooth`` from it.
 """
 
 from __future__ import annotations

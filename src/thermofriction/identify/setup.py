@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from .._lazy import lazy
+from ..data.force import units_of
 from ..data.motion import with_v_smooth
 from ..errors import InputError
 from ..models import LuGre, Model, PrescribedMotion, StickSlipPlant, load_model
@@ -61,7 +62,7 @@ def force_initial(init, method, data, experiments, *, friction=None, free=(), pr
         raise InputError("Model II's paper procedure reads stick-slip displacements; force data use the direct one")
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
-    rotary = _rotary(getattr(data, "experiments", experiments))
+    rotary = units_of(getattr(data, "experiments", experiments))
     init = _from_plant_only(init, experiments, rotary)
     if init.plant.type != "prescribed":
         raise InputError(f"force data are fitted with a prescribed-motion model ([plant] type = \"prescribed\"); "
@@ -84,18 +85,6 @@ def _v_smooth_from_data(init, experiments):
     if default is None or getattr(init.friction, "v_smooth", None) != default:
         return init
     return with_v_smooth(init, experiments)
-
-
-def _rotary(experiments) -> bool:
-    """True for rotary experiments (rad, N m), False for linear ones; a mix is an error."""
-    exps = list(experiments)
-    kinds = {e.rotary for e in exps}
-    if len(kinds) > 1:
-        rot = next(e.file for e in exps if e.rotary)
-        lin = next(e.file for e in exps if not e.rotary)
-        raise InputError(f"the dataset mixes rotary ({rot}) and linear ({lin}) experiments: one joint or one "
-                         f"stage per dataset")
-    return kinds == {True}
 
 
 def _from_plant_only(init, experiments, rotary):
