@@ -28,7 +28,7 @@ import numpy as np
 
 from .. import _bridge
 from ..drive import drive
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from ..data.force import ForceExperiment
 from ..models import Model, ModelI
 from ..simulate import StepSizeController, simulate
@@ -239,10 +239,20 @@ class Force(Measurement):
                 ("max error [%]", "max_error_pct", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
 
     def friction_of(self, model, exp, rtol=1e-8) -> np.ndarray:
-        """The friction force (torque) ``model`` predicts along one experiment's measured motion, on its samples."""
+        """The friction force (torque) ``model`` predicts along one experiment's measured motion, on its samples:
+        simulated (with the simulation's checks and warnings); where the integrator cannot finish (bristles so
+        stiff that a fit driven by the exact stepping put them there), by the exact stepping itself, which
+        needs no step size."""
         d = drive(exp, model, start="model")
-        res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
-                       controller=StepSizeController(rtol=rtol))
+        try:
+            res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
+                           controller=StepSizeController(rtol=rtol))
+        except SolverError:
+            spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform) \
+                if isinstance(d.temperature, (int, float)) else None
+            if spec is None or not _bridge.prescribed_applies(spec):
+                raise
+            return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
         return res.friction_force
 
     def predicted(self, model, exp, rtol=1e-8):
