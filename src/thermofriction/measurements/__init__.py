@@ -10,8 +10,8 @@ implements :class:`Measurement` and an entry in :data:`REGISTRY`.
 from __future__ import annotations
 
 from ..errors import InputError, shorten
-from .base import OFFSETS, Measurement, MetricWarning, Trace, amount, center
-from .displacement import Displacement, Prediction, step_sizes
+from .base import OFFSETS, Measurement, MetricWarning, Trace, amount, center  # (MetricWarning: validate's)
+from .displacement import Displacement, Prediction, step_sizes  # (Prediction, step_sizes: validate's)
 from .force import Force, ForcePrediction, steady_state_curve
 from .command import Command
 
@@ -46,5 +46,5 @@ def measurement_of(data, *, offset=None) -> Measurement:
     return cls(offset)
 
 
-__all__ = ["Measurement", "MetricWarning", "Trace", "OFFSETS", "Displacement", "Force", "Command", "Prediction", "ForcePrediction",
-           "REGISTRY", "measurement_of", "kind_of", "amount", "center", "step_sizes", "steady_state_curve"]
+__all__ = ["Measurement", "Trace", "OFFSETS", "Displacement", "Force", "Command", "ForcePrediction", "REGISTRY",
+           "measurement_of", "kind_of", "amount", "center", "steady_state_curve"]
