@@ -202,7 +202,8 @@ def _unsupported_excess(params: Parameters, corr, unit) -> list:
     se = math.sqrt(max(se_fs ** 2 + se_fc ** 2 - 2 * rho * se_fs * se_fc, 0.0))
     excess = fs.value - fc.value
     if math.isfinite(se) and excess < 2 * se:
-        return [f"the data show no Stribeck excess: fs - fc = {excess:.3g} +- {se:.3g} {fs.unit}, within two standard "
+        where = unit if unit != "m" else fs.unit  # force data: the residuals' unit (N or N m); else fs's own
+        return [f"the data show no Stribeck excess: fs - fc = {excess:.3g} +- {se:.3g} {where}, within two standard "
                 f"errors of zero; the fitted map is Coulomb-viscous, and vs says nothing"]
     return []
 

@@ -271,8 +271,8 @@ class Force(Measurement):
         err = pred - meas
         span = float(np.ptp(meas))
         bias = float(np.mean(err))
-        if self.offset == "per-experiment":  # this run's own offset, estimated on it
-            err = err - bias
+        if self.offset == "per-experiment":  # this run's own offset, estimated on it (and in what is shown)
+            err, pred = err - bias, pred - bias
         quality = fit_quality(err, meas)
         rmse = float(np.sqrt(np.mean(err ** 2)))
         return ForcePrediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time),

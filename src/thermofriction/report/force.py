@@ -164,9 +164,11 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
         raise InputError("the dataset has no experiment with role 'validate': a report compares predictions on "
                          "experiments the models were not identified on")
     unit, vunit, xunit, what = _units(exps)
+    # fits with an offset per experiment are compared as they were made: each experiment's own offset removed
+    per_run = any(((e.fit or {}).get("sensor_offset") or {}).get("policy") == "per-experiment" for e in entries)
     for e in entries:
         if e.validation is None:
-            e.validation = validate(e.model, data)
+            e.validation = validate(e.model, data, offset="per-experiment" if per_run else None)
         # the default labels name the thermal model only (and the command line adds the file's stem to tell
         # them apart): here the friction model is what differs
         if e.label.startswith(("no thermal model", "Model I", "base")):
@@ -241,9 +243,12 @@ def _comparison_section(entries, unit, what) -> str:
          "max error, held out [%]", f"sensor offset [{unit}]"], rows) +
         "<p style='font-size:13px;color:#4a5266'>" + basis + "ΔAICc is each fit's AICc minus the lowest among fits of the same "
         "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
-        "to one. The held-out RMSE compares the models on experiments none was fitted to; the sensor offset was "
-        "fitted once, on the fit experiments, and is used there as it is. Max error is "
-        "max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
+        "to one. The held-out RMSE compares the models on experiments none was fitted to; " + (
+            "each experiment's own offset was removed (the fits estimated one per experiment; on held-out "
+            "experiments it is estimated on them), so the errors are of the friction's shape. "
+            if entries and entries[0].validation.measurement.offset == "per-experiment" else
+            "the sensor offset was fitted once, on the fit experiments, and is used there as it is. ") +
+        "Max error is max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
 
 
 def _parameters_section(entries, unit) -> str:
