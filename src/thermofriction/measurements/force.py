@@ -31,6 +31,7 @@ from ..drive import drive
 from ..errors import InputError, SolverError
 from ..data.force import ForceExperiment
 from ..models import Model, ModelI
+from ..models.sides import RIPPLE_AMPLITUDES
 from ..simulate import StepSizeController, simulate
 from ..waveforms import Sampled
 from .base import OFFSETS, Measurement, Trace, center, center_each
@@ -55,6 +56,12 @@ FIT_PARAMETERS = {
     "stribeck": ("fc", "fs", "vs", "sigma2"),
     "gms": ("C", "fc", "fs", "vs", "sigma2"),
 }
+
+
+def _has_ripple(model) -> bool:
+    """Whether the model has a position ripple: the plant's term, which the exact stepping (friction only) lacks."""
+    return bool(getattr(model.friction, "ripple_period", None)) and any(
+        getattr(model.friction, n, 0.0) for n in RIPPLE_AMPLITUDES)
 
 
 def _steps(model, names, theta):
@@ -129,6 +136,8 @@ class Force(Measurement):
         if model.thermal is not None and not isinstance(model.thermal, ModelI):
             return None
         names = problem.chain if problem.chain is not None else problem.names
+        if _has_ripple(model) or any(n in RIPPLE_AMPLITUDES for n in names):
+            return None
         if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
             return None  # a law's base value fitted as such: not a value at the temperature
         arrays = getattr(model.friction, "arrays", ())
@@ -250,7 +259,7 @@ class Force(Measurement):
         except SolverError:
             spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform) \
                 if isinstance(d.temperature, (int, float)) else None
-            if spec is None or not _bridge.prescribed_applies(spec):
+            if spec is None or not _bridge.prescribed_applies(spec) or _has_ripple(model):
                 raise
             return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
         return res.friction_force
