@@ -273,6 +273,7 @@ tf_status tf_rt_from_model(tf_rt_friction *f, const tf_model *m, tf_error *err)
     if (!f) return rt_done(err, TF_ERR_BAD_ARGUMENT, "f (NULL)");
     if (!m) return rt_done(err, TF_ERR_BAD_ARGUMENT, "model (NULL)");
     if (tf_model_check_friction(m, NAN, err)) return TF_ERR_BAD_ARGUMENT;
+    memset(f, 0, sizeof *f); /* every field from a known state: the position (the ripple's argument) at 0 */
     f->model = *m;
     tf_model_prepare(&f->model);
     return tf_rt_reset(f, err);
