@@ -135,6 +135,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     parameters, free, rtol = _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine,
                                             reference_temperature, controller, rtol, progress, offset)
     _check_arguments(method, reference_temperature, rtol, starts, seed)
+    max_nfev = None if max_evaluations is None else _evaluation_limit(max_evaluations)
     _args.dataset(data, Dataset, experiments=True)  # after the options, whose messages name them first
     measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
     if method not in measurement.methods:
@@ -146,8 +147,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
-    if max_evaluations is not None:
-        opts["max_nfev"] = _evaluation_limit(max_evaluations)
+    if max_nfev is not None:
+        opts["max_nfev"] = max_nfev
     free = _plant_parameters(init, free, method)
     if method == "plant":
         return _identify_plant(getattr(data, "experiments", data), init)
