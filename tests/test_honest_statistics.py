@@ -24,22 +24,29 @@ from thermofriction.measurements.quality import fit_quality, noise_check, noise_
 TRUE = dict(fc=0.4, fs=0.55, vs=0.1, sigma2=0.12)
 
 
-def stribeck_data(seed, rho, n=800, noise=0.02, offset=0.03):
-    """Two runs of a joint under sine motions; torque from the Stribeck map in closed form (independent of the
-    package's models) plus an offset and AR(1) noise of stationary standard deviation ``noise``."""
+def joint_data(friction, seed, n=800, noise=lambda n, rng: np.zeros(n), offset=0.0, name="joint"):
+    """Two runs of a joint under sine motions; torque ``friction(v)`` in closed form (independent of the
+    package's models) plus an offset and ``noise(n, rng)``."""
     rng = np.random.default_rng(seed)
     exps = []
     for k in range(2):
         t = np.linspace(0.0, 8.0, n)
         A, f = 0.6 * (1 + 0.2 * k), 0.25 * (1 + 0.1 * k)
         x, v = A * np.sin(2 * np.pi * f * t), A * 2 * np.pi * f * np.cos(2 * np.pi * f * t)
-        F = np.sign(v) * (TRUE["fc"] + (TRUE["fs"] - TRUE["fc"]) * np.exp(-(v / TRUE["vs"]) ** 2)) + TRUE["sigma2"] * v
-        cols = {"time": t, "position": x, "velocity": v, "force": F + offset + ar1(n, rho, noise, rng), "rotary": True,
-                "headers": {"time": "time[s]", "position": "position[rad]", "velocity": "velocity[rad/s]",
-                            "force": "friction_torque[N*m]"}}
+        cols = {"time": t, "position": x, "velocity": v, "force": friction(v) + offset + noise(n, rng),
+                "rotary": True, "headers": {"time": "time[s]", "position": "position[rad]",
+                                            "velocity": "velocity[rad/s]", "force": "friction_torque[N*m]"}}
         exps.append(force_experiment(f"run{k}", f"run{k}.csv", temperature=25.0, role="fit", description="",
                                      from_zero=lambda t, i: (t, i), motion="velocity", flip_sign=False, columns=cols))
-    return Dataset(name="stribeck", experiments=exps)
+    return Dataset(name=name, experiments=exps)
+
+
+def stribeck_data(seed, rho, n=800, noise=0.02, offset=0.03):
+    """The Stribeck map of TRUE, an offset and AR(1) noise of stationary standard deviation ``noise``."""
+    def stribeck(v):
+        return np.sign(v) * (TRUE["fc"] + (TRUE["fs"] - TRUE["fc"]) * np.exp(-(v / TRUE["vs"]) ** 2)) + \
+            TRUE["sigma2"] * v
+    return joint_data(stribeck, seed, n, lambda m, rng: ar1(m, rho, noise, rng), offset, "stribeck")
 
 
 def start():
@@ -133,20 +140,9 @@ def test_presliding_reversals_are_real_reversals_not_velocity_noise():
 
 
 def coulomb_data(seed=0, n=800):
-    """As stribeck_data, from a Coulomb-viscous map (no Stribeck excess), white noise."""
-    rng = np.random.default_rng(seed)
-    exps = []
-    for k in range(2):
-        t = np.linspace(0.0, 8.0, n)
-        A, f = 0.6 * (1 + 0.2 * k), 0.25 * (1 + 0.1 * k)
-        x, v = A * np.sin(2 * np.pi * f * t), A * 2 * np.pi * f * np.cos(2 * np.pi * f * t)
-        F = 0.4 * np.sign(v) + 0.12 * v + 0.02 * rng.standard_normal(n)
-        cols = {"time": t, "position": x, "velocity": v, "force": F, "rotary": True,
-                "headers": {"time": "time[s]", "position": "position[rad]", "velocity": "velocity[rad/s]",
-                            "force": "friction_torque[N*m]"}}
-        exps.append(force_experiment(f"run{k}", f"run{k}.csv", temperature=25.0, role="fit", description="",
-                                     from_zero=lambda t, i: (t, i), motion="velocity", flip_sign=False, columns=cols))
-    return Dataset(name="coulomb", experiments=exps)
+    """A Coulomb-viscous map (no Stribeck excess), white noise."""
+    return joint_data(lambda v: 0.4 * np.sign(v) + 0.12 * v, seed, n, lambda m, rng: 0.02 * rng.standard_normal(m),
+                      name="coulomb")
 
 
 def test_a_stribeck_excess_the_data_do_not_show_is_said():

@@ -123,6 +123,14 @@ class Measurement:
     def summary(self, predictions) -> dict:
         raise NotImplementedError
 
+    @staticmethod
+    def by_role(predictions):
+        """(role, its predictions) for "fit" and "validate", where there are any: what summaries are taken over."""
+        for role in ("fit", "validate"):
+            ps = [p for p in predictions if p.role == role]
+            if ps:
+                yield role, ps
+
 
 #: the offset policies, by the names the API, the command line (--offset) and the JSON use
 OFFSETS = ("shared", "per-experiment", "none")

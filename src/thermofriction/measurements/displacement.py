@@ -159,15 +159,13 @@ class Displacement(Measurement):
 
     def summary(self, predictions) -> dict:
         out = {}
-        for role in ("fit", "validate"):
-            ps = [p for p in predictions if p.role == role]
-            if ps:
-                # an undefined (NaN) percentage, warned about, does not hide the others
-                pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
-                out[role] = {"max_error_pct": max(pcts) if pcts else math.nan,
-                             "mean_max_error_pct": float(np.mean(pcts)) if pcts else math.nan,
-                             "rmse_offset_removed": float(np.sqrt(np.mean([p.rmse ** 2 for p in ps]))),
-                             "n": len(ps)}
+        for role, ps in self.by_role(predictions):
+            # an undefined (NaN) percentage, warned about, does not hide the others
+            pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
+            out[role] = {"max_error_pct": max(pcts) if pcts else math.nan,
+                         "mean_max_error_pct": float(np.mean(pcts)) if pcts else math.nan,
+                         "rmse_offset_removed": float(np.sqrt(np.mean([p.rmse ** 2 for p in ps]))),
+                         "n": len(ps)}
         return out
 
 

@@ -292,13 +292,11 @@ class Force(Measurement):
 
     def summary(self, predictions) -> dict:
         out = {}
-        for role in ("fit", "validate"):
-            ps = [p for p in predictions if p.role == role]
-            if ps:
-                pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
-                rmse = float(np.sqrt(np.mean([p.rmse ** 2 for p in ps])))
-                out[role] = {"max_error_pct": max(pcts) if pcts else math.nan, "rmse": rmse,
-                             "rmse_offset_removed": rmse, "unit": ps[0].unit, "n": len(ps)}
+        for role, ps in self.by_role(predictions):
+            pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
+            rmse = float(np.sqrt(np.mean([p.rmse ** 2 for p in ps])))
+            out[role] = {"max_error_pct": max(pcts) if pcts else math.nan, "rmse": rmse,
+                         "rmse_offset_removed": rmse, "unit": ps[0].unit, "n": len(ps)}
         return out
 
 
