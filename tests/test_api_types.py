@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 import thermofriction as tf
 from thermofriction import control, heating
 from thermofriction.data import read_experiment_csv, read_experiment_mat
-from thermofriction.report import control_report, heating_report
+from thermofriction.reporting import control_report, heating_report
 from thermofriction.scale import parse_axis
 
 
@@ -160,7 +160,7 @@ def calls(t):
                        "workers": "whole?", "batch_size": "whole?", "progress": "function?"}),
         "export_fmu": (tf.export_fmu, dict(model=m, path=out + ".fmu"),
                        {"model": "model|path", "path": "path", "temperature": "number?", "model_identifier": "text?",
-                        "source": "text?", "integrator": "text", "step": "number?"}),
+                        "source": "text?", "solver": "text", "step": "number?", "integrator": "text?"}),
         "read_experiment_csv": (read_experiment_csv, dict(path=t["csv"]), {"path": "path", "with_headers": "flag"}),
         "read_experiment_mat": (read_experiment_mat, dict(path=out + ".mat"), {"path": "path", "struct": "text?",
                                                                                "units": "dict?"}),
@@ -318,7 +318,7 @@ def test_a_solver_by_name_is_the_documented_exception(things):
 def test_one_parameter_name_is_one_parameter(things, monkeypatch):
     """Before: parameters='sigma0' was read letter by letter ("'s' is not a parameter")."""
     import sys
-    identify_module = sys.modules["thermofriction.identify.front"]  # where identify() calls the procedures
+    identify_module = sys.modules["thermofriction.identification.front"]  # where identify() calls the procedures
     seen = {}
 
     def capture(experiments, model, parameters, **kwargs):

@@ -175,6 +175,6 @@ def test_architecture_document_names_only_what_exists():
 
 
 def test_the_document_check_catches_a_missing_name():
-    paths, python, c = _named_in("the `identify/nowhere.py` module's `no_such_function()` and `tf_no_such`")
-    assert paths == {"identify/nowhere.py"} and python == {"no_such_function"} and c == {"tf_no_such"}
-    assert not _exists("identify/nowhere.py") and "no_such_function" not in _defined_names()
+    paths, python, c = _named_in("the `identification/nowhere.py` module's `no_such_function()` and `tf_no_such`")
+    assert paths == {"identification/nowhere.py"} and python == {"no_such_function"} and c == {"tf_no_such"}
+    assert not _exists("identification/nowhere.py") and "no_such_function" not in _defined_names()

@@ -12,7 +12,7 @@ import pytest
 
 import thermofriction as tf
 from thermofriction import _bridge, _core
-from thermofriction.simulate import SOLVERS
+from thermofriction.simulation import SOLVERS
 
 ROOT = Path(__file__).resolve().parents[1]
 HEADERS = sorted((ROOT / "core" / "include").rglob("*.h"))

@@ -14,7 +14,7 @@ import pytest
 
 import thermofriction as tf
 from thermofriction.cli import build_parser
-from thermofriction.identify import METHODS
+from thermofriction.identification import METHODS
 from thermofriction.models import FRICTION_MODELS
 
 ROOT = Path(__file__).resolve().parents[1]

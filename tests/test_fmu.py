@@ -305,7 +305,7 @@ def test_cli_exports_a_valid_fmu(tmp_path):
     assert causality["heat.C_th"] == "parameter"
 
 
-# ---- the fixed-step real-time integrator (export_fmu(..., integrator="realtime", step=...)) ----
+# ---- the fixed-step real-time integrator (export_fmu(..., solver="realtime", step=...)) ----
 #
 # Its tolerance: the method is first order (the friction's exponential Euler step with the sliding
 # velocity held over a step, the plant's semi-implicit Euler, the drive held at each step's start), so
@@ -318,7 +318,7 @@ def test_cli_exports_a_valid_fmu(tmp_path):
 
 def _realtime(model, tmp_path, name, step):
     path = tmp_path / f"{name}.fmu"
-    export_fmu(model, path, integrator="realtime", step=step)
+    export_fmu(model, path, solver="realtime", step=step)
     return path
 
 
@@ -422,32 +422,32 @@ def test_realtime_choice_in_the_model_description(tmp_path):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"integrator": "realtime", "step": 0.0}, "positive"),
-    ({"integrator": "realtime", "step": -1e-5}, "positive"),
-    ({"integrator": "realtime", "step": float("nan")}, "positive"),
-    ({"integrator": "realtime", "step": "fast"}, "number of seconds"),
-    ({"integrator": "realtime"}, "needs its fixed step"),
-    ({"integrator": "realtime", "step": 1e-3}, "unstable"),  # li2009: wn = 6686 rad/s, 2 / wn = 0.3 ms
-    ({"step": 1e-5}, "realtime integrator's fixed step"),
-    ({"integrator": "euler", "step": 1e-5}, "adaptive, realtime"),
+    ({"solver": "realtime", "step": 0.0}, "positive"),
+    ({"solver": "realtime", "step": -1e-5}, "positive"),
+    ({"solver": "realtime", "step": float("nan")}, "positive"),
+    ({"solver": "realtime", "step": "fast"}, "number of seconds"),
+    ({"solver": "realtime"}, "needs its fixed step"),
+    ({"solver": "realtime", "step": 1e-3}, "unstable"),  # li2009: wn = 6686 rad/s, 2 / wn = 0.3 ms
+    ({"step": 1e-5}, "realtime solver's fixed step"),
+    ({"solver": "euler", "step": 1e-5}, "adaptive, realtime"),
 ])
 def test_bad_step_refused_at_export(kwargs, message, tmp_path):
-    """Bad integrator or step values: an InputError naming them, no file written."""
+    """Bad solver or step values: an InputError naming them, no file written."""
     with pytest.raises(tf.InputError, match=message):
         export_fmu(tf.load_model("li2009-model-i"), tmp_path / "bad.fmu", **kwargs)
     assert not (tmp_path / "bad.fmu").exists()
 
 
 def test_cli_realtime_export_and_bad_steps(tmp_path):
-    """`thermofriction fmu ... --integrator realtime --step 1e-5` writes a valid FMU; bad steps (0, unstable,
+    """`thermofriction fmu ... --solver realtime --step 1e-5` writes a valid FMU; bad steps (0, unstable,
     --step without the realtime integrator) exit with status 2, one message, no file."""
     path = tmp_path / "rt.fmu"
     cmd = [sys.executable, "-m", "thermofriction", "fmu", "li2009-model-ii", "-o"]
-    out = subprocess.run(cmd + [str(path), "--integrator", "realtime", "--step", "1e-5"], capture_output=True,
+    out = subprocess.run(cmd + [str(path), "--solver", "realtime", "--step", "1e-5"], capture_output=True,
                          text=True)
     assert out.returncode == 0, out.stderr
     assert validate_fmu(str(path)) == [] and "fixed step 1e-05 s" in out.stdout
-    for extra in (["--integrator", "realtime", "--step", "0"], ["--integrator", "realtime", "--step", "1e-3"],
+    for extra in (["--solver", "realtime", "--step", "0"], ["--solver", "realtime", "--step", "1e-3"],
                   ["--step", "1e-5"]):
         bad = tmp_path / "bad.fmu"
         out = subprocess.run(cmd + [str(bad)] + extra, capture_output=True, text=True)

@@ -1,5 +1,5 @@
 """Held values checked against the data (issue 30, item 2): the score (Lagrange-multiplier) test of every held
-parameter from the sensitivities at the optimum (identify/held.py). Truths simulated by the independent SciPy
+parameter from the sensitivities at the optimum (identification/held.py). Truths simulated by the independent SciPy
 reference (tests/reference/): a wrong held mass and a missing Stribeck effect must be flagged (p < 1e-12), said
 first, and make the fit not adequate; the right model must not be; and at the truth itself the statistic is
 chi-squared (analytic: its mean over held directions and seeds is near its degrees of freedom)."""
@@ -12,9 +12,9 @@ import pytest
 
 import thermofriction as tf
 from stribeck_truths import reference_experiments, start_from, stribeck_truth
-from thermofriction.identify.held import _score
-from thermofriction.identify.parameters import get_value
-from thermofriction.identify.problem import Problem, make_traces
+from thermofriction.identification.held import _score
+from thermofriction.identification.parameters import get_value
+from thermofriction.identification.problem import Problem, make_traces
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -122,8 +122,8 @@ def test_the_consider_covariance_widens_by_the_held_directions_share__analytic()
     parameter moves by -1 per unit of the held one: its variance grows by sd^2 exactly."""
     from types import SimpleNamespace
 
-    from thermofriction.identify.held import PRIOR_FACTOR, _consider
-    from thermofriction.identify.parameters import Parameters
+    from thermofriction.identification.held import PRIOR_FACTOR, _consider
+    from thermofriction.identification.parameters import Parameters
     from thermofriction.models import Linear
 
     params = Parameters()

@@ -18,7 +18,7 @@ from lookalike import ar1  # noqa: E402
 import thermofriction as tf  # noqa: E402
 from thermofriction.data.experiments import Dataset  # noqa: E402
 from thermofriction.data.force import force_experiment  # noqa: E402
-from thermofriction.identify.uncertainty import integrated_autocorrelation  # noqa: E402
+from thermofriction.identification.uncertainty import integrated_autocorrelation  # noqa: E402
 from thermofriction.measurements.quality import fit_quality, noise_check, noise_level  # noqa: E402
 
 TRUE = dict(fc=0.4, fs=0.55, vs=0.1, sigma2=0.12)
@@ -129,7 +129,7 @@ def test_presliding_reversals_are_real_reversals_not_velocity_noise():
     """The report's presliding panels: turning points of the position by excursion. A sine's turning points are
     found where they are (analytic: t = 1, 3, 5, ... s at 0.25 Hz); a hold with velocity noise at rest (sign
     flips at every sample) adds none."""
-    from thermofriction.report.force import reversals
+    from thermofriction.reporting.force import reversals
     t = np.linspace(0, 10, 2001)
     x = np.sin(2 * np.pi * 0.25 * t)
     assert [round(float(t[i]), 2) for i in reversals(x, 10)] == [1.0, 3.0, 5.0, 7.0, 9.0]
@@ -161,7 +161,7 @@ def test_a_stribeck_excess_the_data_do_not_show_is_said():
 def test_a_parameter_at_its_bound_is_shown_at_bound_with_a_one_sided_interval():
     """fc held below its true value by a bound (max 0.3 N m, truth 0.4): it ends at the bound, shown "at upper
     bound" with a one-sided interval from the bound, not a two-sided one around it."""
-    from thermofriction.identify import Parameters, fit_friction
+    from thermofriction.identification import Parameters, fit_friction
     model = start()
     params = Parameters()
     params.add("fc", 0.25, min=0.0, max=0.3, unit="N m")

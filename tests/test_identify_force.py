@@ -6,7 +6,7 @@ to 30 % of the interval), with white noise of 1 % of the force's range and a sen
 from every preset and from the code's defaults (the rotary joint: sigma0 = 3000 N m/rad, sigma1 = 0.3 N m s/rad,
 fc = 0.9 N m, fs = 1.4 N m, vs = 0.3 rad/s, sigma2 = 0.35 N m s/rad; the stage: sigma0 = 2e5 N/m, sigma1 = 20
 N s/m, fc = 3 N, fs = 4 N, vs = 5 mm/s, sigma2 = 100 N s/m). Fits start from values read off the data
-(identify/force.py: force_start), not from the truth.
+(identification/force.py: force_start), not from the truth.
 
 Tolerance: each fitted parameter, and the offset, within twice the half-width of its own 95 % interval (about
 four standard errors) of the truth: an honest interval passes, a biased fit or a falsely tight interval fails.
@@ -201,7 +201,7 @@ def test_model_ii_from_torque_at_several_temperatures(tmp_path):
 
 def test_friction_models_compared_by_aicc_and_held_out_error(tmp_path):
     """compare_friction_models: on LuGre data LuGre wins on AICc and on the held-out error."""
-    from thermofriction.identify.compare import compare_friction_models
+    from thermofriction.identification.compare import compare_friction_models
     truth = tf.Model(JOINT, tf.LuGre(**ROT))
     folder, sd = make_dataset(tmp_path, truth, validate=(35.0,), offset=OFFSET, **DATA)
     out = compare_friction_models(tf.load_dataset(folder), ("coulomb", "stribeck", "lugre"))

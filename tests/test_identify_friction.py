@@ -18,8 +18,8 @@ import math
 import pytest
 
 import thermofriction as tf
-from thermofriction.identify import with_friction_model
-from thermofriction.identify.procedures import default_fit_parameters
+from thermofriction.identification import with_friction_model
+from thermofriction.identification.procedures import default_fit_parameters
 
 BASE = tf.load_model("li2009-base")
 TRUTHS = {
@@ -124,7 +124,7 @@ def test_cli_friction_and_the_report_compares_friction_models_on_the_same_data(t
     import subprocess
     import sys
 
-    from thermofriction.report import Entry, akaike
+    from thermofriction.reporting import Entry, akaike
 
     truth = truth_model("dahl")
     data = data_of(truth, (35.0,), seed=2, validate=(35.0,))

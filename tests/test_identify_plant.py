@@ -12,7 +12,7 @@ import pytest
 from scipy import linalg
 
 import thermofriction as tf
-from thermofriction.identify.plant import PlantFit, fit_plant, step_response, unit_gain_response
+from thermofriction.identification.plant import PlantFit, fit_plant, step_response, unit_gain_response
 
 XI, WN, K = 0.2488, 6685.5, 0.096e-6   # the paper's plant
 TRUE = {"damping_ratio": XI, "natural_frequency": WN, "gain": K}

@@ -320,7 +320,7 @@ def test_a_late_start_that_cannot_move_is_kept_and_explained(dataset, tmp_path):
 
 def test_the_step_underflow_message_names_a_late_start():
     from thermofriction import _bridge
-    from thermofriction.simulate import _explain
+    from thermofriction.simulation import _explain
 
     model = tf.load_model("li2009-model-i")
     e = _bridge.CoreFailure("the step size fell below the resolution of the time variable", "step_underflow", 1e6,
@@ -472,7 +472,7 @@ def test_long_values_are_shortened_in_messages():
 
 def test_cli_max_starts_is_identify_max_starts():
     from thermofriction import cli
-    from thermofriction.identify import MAX_STARTS
+    from thermofriction.identification import MAX_STARTS
 
     assert cli.MAX_STARTS == MAX_STARTS
 

@@ -90,7 +90,7 @@ def test_report_accepts_the_json_beside_a_fitted_model(fitted, tmp_path):
 def test_changing_a_data_file_changes_the_hash(tmp_path):
     ds = tf.synthesize(tf.load_model("li2009-model-i"), [34.0], duration=0.1, sample_rate=1000, seed=2)
     tf.save_dataset(ds, tmp_path / "d")
-    from thermofriction.identify.provenance import data_sha256
+    from thermofriction.identification.provenance import data_sha256
     where, h1 = data_sha256(tf.load_dataset(tmp_path / "d"))
     f = tmp_path / "d" / ds.experiments[0].file
     f.write_text(f.read_text().replace("\n0.001,", "\n0.0010,", 1))  # the same numbers, another file

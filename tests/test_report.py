@@ -1,4 +1,4 @@
-"""The HTML report and the figures behind it (report/plots.py, shared with the results' .plot()):
+"""The HTML report and the figures behind it (reporting/plots.py, shared with the results' .plot()):
 size, the error-against-temperature figure, fit and held-out temperatures told apart, AICc
 differences and weights, every metric defined, the laws at a reference temperature, and the page
 as Chromium renders it (legible legends, figures at the card's width)."""
@@ -17,9 +17,9 @@ import pytest
 import thermofriction as tf
 from thermofriction.demo import FIT_TEMPERATURES, HELD_OUT
 from thermofriction.models import Exp, ModelI
-from thermofriction.report import Entry, report
-from thermofriction.report import plots
-from thermofriction.report.figures import DEFINITIONS
+from thermofriction.reporting import Entry, report
+from thermofriction.reporting import plots
+from thermofriction.reporting.figures import DEFINITIONS
 
 
 def _truth():
@@ -172,7 +172,7 @@ def test_every_metric_in_a_table_is_defined_on_the_page(demo_like):
 def test_laws_are_given_at_a_reference_temperature_with_the_delta_method_error__analytic(demo_like):
     """For an exponential law a exp(b T): the value at T_ref and its standard error from the
     coefficients' covariance, g = (exp(b T), a T exp(b T)), computed here by hand."""
-    from thermofriction.report import law_at, reference_temperature
+    from thermofriction.reporting import law_at, reference_temperature
     fit = demo_like.fit.to_dict()
     law = demo_like.fit.model.laws["sigma0"]
     Tr = reference_temperature(law, 0.0)
@@ -293,7 +293,7 @@ def test_report_in_chromium_is_legible_and_uses_the_card_width(demo_like):
 def test_truth_section_counts_covered_points_per_parameter_and_says_why_a_fit_cannot_be_compared():
     """A hand-made recovery (what FitResult.recovery returns): the section counts covered points per
     parameter, gives the largest error relative to the truth, and carries the reason verbatim."""
-    from thermofriction.report import truth_section
+    from thermofriction.reporting import truth_section
     rows = [{"parameter": "fc", "temperature": T, "truth": 1.0, "value": v, "lower": v - 0.01, "upper": v + 0.01,
              "covered": abs(v - 1.0) <= 0.01} for T, v in ((30.0, 1.005), (35.0, 1.02), (40.0, 0.995))]
     page = truth_section({"Model I": {"summary": "2 of 3 covered", "rows": rows},

@@ -10,7 +10,7 @@ import pytest
 
 import thermofriction as tf
 from thermofriction import _bridge
-from thermofriction.simulate import _Grid, _pack
+from thermofriction.simulation import _Grid, _pack
 
 T_C = 35.7
 

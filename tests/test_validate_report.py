@@ -10,8 +10,8 @@ import pytest
 
 import thermofriction as tf
 from conftest import synthetic_experiments
-from thermofriction.report import Entry, report
-from thermofriction.validate import step_sizes, validate
+from thermofriction.reporting import Entry, report
+from thermofriction.validation import step_sizes, validate
 
 
 def dataset(model, fit, held_out, **kw):
@@ -122,7 +122,7 @@ def test_report_in_a_real_browser_has_no_console_errors_and_every_figure_shows(w
 def test_a_fit_that_did_not_converge_says_so_in_the_report(model_i, tmp_path):
     """Never silently: an entry whose fit did not converge (success False in its JSON) is named,
     with the optimiser's message, in the report's warnings; a converged one is not."""
-    from thermofriction.report import Entry
+    from thermofriction.reporting import Entry
 
     data = dataset(model_i, [32.0, 38.0], [35.0], duration=0.2)
     fits = [Entry("stalled", model_i, {"success": False, "message": "maximum evaluations reached"}),

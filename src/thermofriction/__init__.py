@@ -17,13 +17,16 @@ from .errors import (ComputationError, ConditioningWarning, InputError, Passivit
 from .models import (GMS, PARAMETERS, PRESETS, PWL, Const, Coulomb, Dahl, ElastoPlastic, Exp, Heat, Law, Linear, LuGre,
                      MassPlant, Model, ModelI, ModelII, Poly, PrescribedMotion, StickSlipPlant, Stribeck, Table,
                      load_model)
-from .simulate import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
+from .simulation import AutoSwitch, Dopri5, Rodas4, SimulationResult, StepSizeController, simulate
 from .waveforms import Sampled, Sawtooth, Sine, Square, Step, Waveform, parse_waveform
-from .identify import FitResult, Parameter, Parameters, identify
+from .identification import FitResult, Parameter, Parameters, identify
 from .data import Dataset, Experiment, load_dataset, save_dataset, synthesize
-from .validate import validate
+from .validation import validate
 from . import control, heating
-from .report import report
+from .reporting import report
+from . import _renamed
+
+_renamed.install(__name__)
 
 #: scale-out (scale/, docs/scale.md): loaded on first use, so that Dask loads only when it is needed
 _SCALE = ("sweep", "SweepResult", "identify_fleet", "FleetResult", "propagate", "PropagationResult")

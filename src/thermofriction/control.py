@@ -70,7 +70,7 @@ def _samples(where: str, name: str, values, n=None) -> np.ndarray:
 def _check_at(where: str, model: Model, temperature: float):
     """The model's domain at one temperature (Model I parameters, Model II's lambda), with the
     simulator's messages; its warnings (calibrated range, passivity) are the simulator's business."""
-    from .simulate.checks import check_temperatures
+    from .simulation.checks import check_temperatures
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -228,7 +228,7 @@ class LoopResult(Result):
 
     def plot(self):
         """A matplotlib figure: reference and position, and the tracking error, against time."""
-        from .report.study_plots import loop_figure
+        from .reporting.study_plots import loop_figure
         return loop_figure(self)
 
 

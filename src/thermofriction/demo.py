@@ -17,9 +17,9 @@ def run_demo(folder="thermofriction-demo", progress=None, command=None) -> dict:
     """Writes ``folder``/data (the dataset), the fitted models and their JSON results,
     validation.json and report.html. Returns a summary with the paths and timings."""
     from .data import save_dataset, synthesize
-    from .identify import identify
-    from .report import Entry, report
-    from .validate import validate
+    from .identification import identify
+    from .reporting import Entry, report
+    from .validation import validate
 
     def say(msg):
         if progress:

@@ -16,7 +16,7 @@ with a ``[heat]`` section), and every plant, friction, law and heat parameter as
 The model file's own ``[input]`` is not part of the FMU: the importer drives it.
 
 Between communication points the FMU integrates with the core's adaptive integrator (the default), or
-with ``integrator="realtime"`` by fixed steps of ``step`` seconds: the friction by the core's real-time
+with ``solver="realtime"`` by fixed steps of ``step`` seconds: the friction by the core's real-time
 step (realtime.h) and the plant by semi-implicit Euler, for a deterministic cost per step. The choice is
 in ``resources/model.tfm`` and the step is the fixed parameter ``integrator.step``.
 """
@@ -43,8 +43,8 @@ from .fmu_description import (MAX_POINTS, default_experiment, description_xml2, 
                               variables_of)
 from .models import MassPlant, Model, StickSlipPlant, load_model
 
-#: The integrators an FMU can carry (docs/fmu.md#integrators).
-INTEGRATORS = ("adaptive", "realtime")
+#: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
+SOLVERS = ("adaptive", "realtime")
 #: The FMI versions an export can follow (docs/fmu.md).
 FMI_VERSIONS = (2, 3)
 
@@ -85,7 +85,7 @@ def _check_exportable(model: Model):
 
 
 def _check_step(model: Model, step) -> float:
-    """The realtime integrator's step [s]: a positive finite number, below the stability limit 2 / omega
+    """The realtime solver's step [s]: a positive finite number, below the stability limit 2 / omega
     of semi-implicit Euler on the plant's stiffest spring (the stage's natural frequency, the mass's
     pulling spring)."""
     try:
@@ -108,13 +108,26 @@ def _check_step(model: Model, step) -> float:
     return step
 
 
-def _checked(model, path, temperature, model_identifier, source, integrator, step, fmi):
+def _solver(solver, integrator):
+    """``solver``, or ``integrator``, its earlier name (one meaning per option name: the solver is ``solver``)."""
+    _args.text(integrator, "integrator", none=True)
+    if integrator is None:
+        return solver
+    warnings.warn("export_fmu: integrator= is now solver=; the old name will be removed", DeprecationWarning,
+                  stacklevel=3)
+    if solver not in ("adaptive", integrator):
+        raise InputError(f"export_fmu: integrator={shorten(integrator)} and solver={shorten(solver)} contradict "
+                         "each other (integrator is solver's earlier name)")
+    return integrator
+
+
+def _checked(model, path, temperature, model_identifier, source, solver, step, fmi):
     """export_fmu's arguments, checked before any work: (the model, its source, the temperature, the step)."""
     _args.path(path, "path")
     _args.number(temperature, "temperature", "degC", none=True)
     _args.text(model_identifier, "model_identifier", none=True)
     _args.text(source, "source", none=True)
-    _args.text(integrator, "integrator")
+    _args.text(solver, "solver")
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)
         model = load_model(model)
@@ -133,21 +146,21 @@ def _checked(model, path, temperature, model_identifier, source, integrator, ste
     if not binary.is_file():
         raise InputError(f"this installation has no FMU binary ({binary}): reinstall thermofriction on Linux x86-64 "
                          "(the package builds it with CMake)")
-    if integrator not in INTEGRATORS:
-        raise InputError(f"export_fmu: integrator {shorten(integrator)}: use one of {', '.join(INTEGRATORS)}")
-    if integrator == "realtime":
+    if solver not in SOLVERS:
+        raise InputError(f"export_fmu: solver {shorten(solver)}: use one of {', '.join(SOLVERS)}")
+    if solver == "realtime":
         if step is None:
-            raise InputError("export_fmu: the realtime integrator needs its fixed step (step=..., --step SECONDS)")
+            raise InputError("export_fmu: the realtime solver needs its fixed step (step=..., --step SECONDS)")
         step = _check_step(model, step)
     elif step is not None:
-        raise InputError("export_fmu: step is the realtime integrator's fixed step; the adaptive integrator chooses "
-                         "its own (give integrator='realtime', --integrator realtime)")
+        raise InputError("export_fmu: step is the realtime solver's fixed step; the adaptive solver chooses "
+                         "its own (give solver='realtime', --solver realtime)")
     return model, source, temperature, step
 
 
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
-               source: str | None = None, integrator: str = "adaptive", step: float | None = None,
-               fmi: int = 2) -> Path | Target:
+               source: str | None = None, solver: str = "adaptive", step: float | None = None,
+               fmi: int = 2, integrator: str | None = None) -> Path | Target:
     """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 (``fmi=2``, the default) or
     FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md), with the linux64 binary and, when
     the package was built with the MinGW-w64 cross compiler, the win64 one (else a NoWindowsBinaryWarning
@@ -155,11 +168,12 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
     ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
     ``source``: where the model came from (a file or preset name), for the FMU's description.
-    ``integrator``: "adaptive" (default: the core's error-controlled integrator between communication
+    ``solver``: "adaptive" (default: the core's error-controlled integrator between communication
     points) or "realtime" (fixed steps of ``step`` seconds: the core's real-time friction step and
-    semi-implicit Euler for the plant; docs/fmu.md#integrators)."""
-    model, source, temperature, step = _checked(model, path, temperature, model_identifier, source, integrator, step,
-                                                fmi)
+    semi-implicit Euler for the plant; docs/fmu.md#solvers). ``integrator``: ``solver``'s earlier name
+    (deprecated)."""
+    solver = _solver(solver, integrator)
+    model, source, temperature, step = _checked(model, path, temperature, model_identifier, source, solver, step, fmi)
     _check_exportable(model)
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
@@ -169,7 +183,7 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         temperature if temperature is not None else (model.heat.ambient_temperature or 20.0))
     spec = _bridge.model_spec(model, temperature=heat_temperature if model.heat is not None else None)
     variables = variables_of(model, spec, temperature, step)
-    tfm = resource_text(model, spec, variables, integrator)
+    tfm = resource_text(model, spec, variables, solver)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
     tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
     xml = (description_xml2 if fmi == 2 else description_xml3)(model, variables, identifier, guid, source, step)
@@ -210,5 +224,12 @@ def _headers_licence(fmi: int = 2) -> str:
             f"{years} Modelica Association Project \"FMI\", under the 2-Clause BSD License.\n")
 
 
-__all__ = ["export_fmu", "binary_path", "default_experiment", "INTEGRATORS", "FMI_VERSIONS",
+def __getattr__(name):
+    if name == "INTEGRATORS":  # SOLVERS' earlier name
+        warnings.warn("thermofriction.fmu.INTEGRATORS is now SOLVERS", DeprecationWarning, stacklevel=2)
+        return SOLVERS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["export_fmu", "binary_path", "default_experiment", "SOLVERS", "FMI_VERSIONS",
            "NoWindowsBinaryWarning"]

@@ -160,7 +160,7 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
     return variables
 
 
-def resource_text(model: Model, spec: dict, variables, integrator: str = "adaptive") -> str:
+def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive") -> str:
     """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
@@ -169,7 +169,7 @@ def resource_text(model: Model, spec: dict, variables, integrator: str = "adapti
              f"thermal {spec['thermal']} {spec['dF_form']} {spec['fs_follows_fc']}",
              f"heat {int(model.heat is not None)}",
              f"temperature_input {int(model.thermal is not None and model.heat is None)}",
-             f"integrator {integrator}"]
+             f"integrator {solver}"]
     rng = model.temperature_range()
     if rng is not None:
         lines.append(f"range {rng[0]!r} {rng[1]!r}")

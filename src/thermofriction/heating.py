@@ -32,7 +32,7 @@ from . import _args
 from .models import Model
 from .results import Result
 from .drive import input_of
-from .simulate import StepSizeController, check_heated_temperatures, simulate
+from .simulation import StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
 
 integrate, interpolate = lazy("scipy.integrate"), lazy("scipy.interpolate")
@@ -130,7 +130,7 @@ class HeatingResult(Result):
 
     def plot(self):
         """A matplotlib figure: the interface temperature and the step per cycle against time."""
-        from .report.study_plots import heating_figure
+        from .reporting.study_plots import heating_figure
         return heating_figure(self)
 
 

@@ -285,7 +285,7 @@ def read_two_column_csv(path: Path, first: str):
             if not math.isfinite(data[k - 2, j]):
                 raise InputError(f"{path}: line {i}, column '{header[j]}': not finite: {shorten(cell.strip())}")
     t = data[:, 0] * scale
-    far = np.nonzero(np.abs(t) > 1e12)[0]  # the C core's time limit (simulate.MAX_TIME)
+    far = np.nonzero(np.abs(t) > 1e12)[0]  # the C core's time limit (simulation.MAX_TIME)
     if far.size:
         raise InputError(f"{path}: line {lines[far[0] + 1]}: time {t[far[0]]:g} s is beyond the limit of 1e12 s")
     bad = np.nonzero(np.diff(t) <= 0)[0]  # after scaling: ms to s can merge neighbouring values

@@ -11,7 +11,7 @@ import numpy as np
 from .. import _io
 from ..errors import InputError
 from ..models import PRESETS, MassPlant, load_model
-from ..simulate import SOLVERS, StepSizeController, simulate
+from ..simulation import SOLVERS, StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
 from .outputs import _dataset_inputs, _model_inputs, _refuse_inputs, _target, _waveform_inputs
 
@@ -110,16 +110,15 @@ def _identify_options(args):
     return laws, params
 
 
-def solver_of(args) -> str:
-    """--solver; --method, its earlier name for simulate and sweep, is still read, with a note (one meaning per
-    option name: --method is identification's)."""
+def solver_of(args, default="auto", old="--method") -> str:
+    """--solver; its earlier names (--method for simulate and sweep, --integrator for fmu) are still read, with
+    a note (one meaning per option name: --method is identification's, the solver is --solver)."""
     if getattr(args, "solver_old", None):
         if args.solver not in (None, args.solver_old):
-            raise InputError(f"--method {args.solver_old} and --solver {args.solver} contradict each other")
-        print("thermofriction: note: --method is now --solver for simulate and sweep (--method names the "
-              "identification method)", file=sys.stderr)
+            raise InputError(f"{old} {args.solver_old} and --solver {args.solver} contradict each other")
+        print(f"thermofriction: note: {old} is now --solver", file=sys.stderr)
         return args.solver_old
-    return args.solver or "auto"
+    return args.solver or default
 
 
 def _offset(args):
@@ -133,7 +132,7 @@ def _offset(args):
 
 def cmd_identify(args) -> int:
     from ..data import load_dataset
-    from ..identify import identify
+    from ..identification import identify
 
     if _fleet_paths(args) is not None:  # many datasets: the fleet path (scale/fleet.py)
         return cmd_identify_fleet(args)
@@ -218,7 +217,7 @@ def cmd_identify_fleet(args) -> int:
 
 def cmd_validate(args) -> int:
     from ..data import load_dataset
-    from ..validate import validate
+    from ..validation import validate
 
     model = load_model(args.model)
     data = load_dataset(args.dataset, motion=args.motion)
@@ -244,7 +243,7 @@ def cmd_report(args) -> int:
     from pathlib import Path
 
     from ..data import load_dataset
-    from ..report import Entry, entry_label, report
+    from ..reporting import Entry, entry_label, report
 
     if len(args.paths) < 2:
         raise InputError("report needs at least one model and a dataset: MODEL.toml... DATASET")
@@ -388,11 +387,12 @@ def cmd_fmu(args) -> int:
     """Export a model as an FMI 2.0 or 3.0 co-simulation FMU (docs/fmu.md)."""
     from ..fmu import binary_path, export_fmu  # zipfile and the binary only when asked for
 
+    solver = solver_of(args, "adaptive", "--integrator")
     model = load_model(args.model)
     _refuse_inputs(args, _model_inputs(args.model, model))
     export_fmu(model, _target(args, "output"), temperature=args.temperature, model_identifier=args.model_identifier,
-               source=args.model, integrator=args.integrator, step=args.step, fmi=args.fmi)
-    how = f"fixed step {args.step:g} s" if args.integrator == "realtime" else "adaptive integrator"
+               source=args.model, solver=solver, step=args.step, fmi=args.fmi)
+    how = f"fixed step {args.step:g} s" if solver == "realtime" else "adaptive integrator"
     where = "linux64, win64" if binary_path("win64").is_file() else "linux64"
     print(f"{model.name or args.model}: wrote {args.output} (FMI {args.fmi}.0 co-simulation, {where}, {how})")
     return 0

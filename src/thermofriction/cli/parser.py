@@ -9,7 +9,7 @@ from .._reading import strict_float
 from .._version import __version__
 from ..errors import shorten
 from ..models import PRESETS
-from ..simulate import MAX_SAMPLES, SOLVERS
+from ..simulation import MAX_SAMPLES, SOLVERS
 from .commands import cmd_demo, cmd_identify, cmd_report, cmd_simulate, cmd_validate
 from .presets import add_presets_command
 
@@ -230,18 +230,19 @@ def _add_fmu_command(sub):
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
                     "The model's [input] is not part of the FMU: the importer drives it.",
         epilog="Examples: thermofriction fmu li2009-model-i -o li2009-model-i.fmu; "
-               "thermofriction fmu li2009-model-i -o rt.fmu --integrator realtime --step 1e-5")
+               "thermofriction fmu li2009-model-i -o rt.fmu --solver realtime --step 1e-5")
     f.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
     f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help="the FMU file to write")
     f.add_argument("--temperature", type=_finite_float, metavar="C",
                    help="start value of the temperature input [C] (with [heat]: of the ambient temperature)")
     f.add_argument("--model-identifier", metavar="NAME",
                    help="the FMU's model identifier, letters, digits and _ (default: from the model's name)")
-    f.add_argument("--integrator", choices=("adaptive", "realtime"), default="adaptive",
+    f.add_argument("--solver", choices=("adaptive", "realtime"), default=None,
                    help="between communication points: the adaptive error-controlled integrator (default; for "
                         "accuracy) or fixed real-time steps of --step seconds (a deterministic cost per step)")
+    f.add_argument("--integrator", dest="solver_old", choices=("adaptive", "realtime"), help=argparse.SUPPRESS)
     f.add_argument("--step", type=_finite_float, metavar="SECONDS",
-                   help="the realtime integrator's fixed step [s], e.g. 1e-5 (a tenth of the fastest time "
+                   help="the realtime solver's fixed step [s], e.g. 1e-5 (a tenth of the fastest time "
                         "constant or less)")
     f.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version: 2 (default) or 3")
     from .commands import cmd_fmu

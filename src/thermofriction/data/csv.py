@@ -16,7 +16,7 @@ from ..plausible import kelvin_hint
 from .experiments import _SI, _UNITS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, SAMPLING_TOLERANCE, TEMPERATURE_RANGE, max_rows
 
 #: Magnitude limits on an experiment's values in SI units: time within the simulator's +-1e12 s
-#: (simulate.MAX_TIME); other values within 1e100, so that squares and sums of squares over ten
+#: (simulation.MAX_TIME); other values within 1e100, so that squares and sums of squares over ten
 #: million rows (metrics, least squares) stay finite.
 TIME_LIMIT = 1e12
 VALUE_LIMIT = 1e100

@@ -13,7 +13,7 @@ from ..errors import InputError
 from .. import _args
 from ..models import PRESETS, Model, load_model, require_actuator
 from ..plausible import input_voltage_problem, parse_length
-from ..simulate import StepSizeController, simulate
+from ..simulation import StepSizeController, simulate
 from ..waveforms import Sampled, Waveform, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
 from .._io import publish_together

@@ -11,7 +11,7 @@ residuals are ``F + J a + offset - u(t - delay)``.
 - **J and the offset** enter linearly: they are profiled out, as the force sensor's offset is -- the residuals
   and the Jacobian's columns projected onto the complement of the columns ``[a, 1]`` (per-experiment offsets:
   one column of ones per run; none: ``[a]`` and the model's own offset) -- and estimated with their standard
-  errors at the optimum (identify/setup.py: command_finish). The fitted model keeps its prescribed motion and
+  errors at the optimum (identification/setup.py: command_finish). The fitted model keeps its prescribed motion and
   holds J, the offset and the delay in its ``[plant]`` (``inertia``, ``sensor_offset``, ``delay``), so that
   validation predicts a command from a model file alone.
 - **The acceleration** is a Savitzky-Golay derivative (SciPy's ``savgol_filter``: a quadratic fitted by least

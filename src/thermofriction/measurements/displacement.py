@@ -14,7 +14,7 @@ from .. import _bridge
 from ..drive import drive
 from ..errors import InputError
 from ..models import require_actuator
-from ..simulate import StepSizeController, simulate
+from ..simulation import StepSizeController, simulate
 from .base import Measurement, MetricWarning, Trace, center
 from .quality import fit_quality
 

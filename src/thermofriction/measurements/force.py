@@ -32,7 +32,7 @@ from ..errors import InputError, SolverError
 from ..data.force import ForceExperiment
 from ..models import Model, ModelI
 from ..models.sides import RIPPLE_AMPLITUDES
-from ..simulate import StepSizeController, simulate
+from ..simulation import StepSizeController, simulate
 from ..waveforms import Sampled
 from .base import OFFSETS, Measurement, Trace, center, center_each
 from .quality import fit_quality

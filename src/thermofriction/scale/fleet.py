@@ -114,7 +114,7 @@ def refuse_overwriting_inputs(folder, datasets, option="-o"):
 
 def _identify_one(data, method, init, kw):
     """Runs on a worker: ("ok", FitResult) or ("failed", reason). Never raises for a bad dataset."""
-    from ..identify import identify
+    from ..identification import identify
     try:
         return "ok", identify(data, method, init=init, **kw)
     except ThermofrictionError as e:

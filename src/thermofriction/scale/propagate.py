@@ -24,7 +24,7 @@ import numpy as np
 
 from .. import _io
 from .. import _args
-from ..simulate import AutoSwitch, Dopri5, Rodas4, StepSizeController
+from ..simulation import AutoSwitch, Dopri5, Rodas4, StepSizeController
 from ..waveforms import Waveform
 from ..errors import InputError, ThermofrictionError, shorten
 from .cluster import Runner, auto_batch_size, batches, check_scheduler
@@ -66,8 +66,8 @@ def draw_parameters(result, draws: int, seed: int = 0):
 def _run_draws(model, names, thetas, temperatures, waveform, sim):
     """Runs on a worker: displacement (draws, temperatures, samples), mean steps (draws,
     temperatures), and {row: reason} for draws that could not be simulated (all NaN)."""
-    from ..identify.parameters import with_values
-    from ..simulate import simulate
+    from ..identification.parameters import with_values
+    from ..simulation import simulate
 
     disp = steps = None
     errors = {}
@@ -207,7 +207,7 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
     batch_size: draws per task. progress: called with the number of draws done."""
     import time
 
-    from ..simulate import simulate
+    from ..simulation import simulate
 
     model, temps = _checked(result, temperatures, draws, seed, input, duration, sample_rate, level, solver, controller,
                             scheduler, workers, batch_size, progress)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import _io
 from .. import _args
-from ..simulate import AutoSwitch, Dopri5, Rodas4, StepSizeController
+from ..simulation import AutoSwitch, Dopri5, Rodas4, StepSizeController
 from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
@@ -105,7 +105,7 @@ def _as_axis(name, values):
 
 def _kinds(model: Model, waveform, names):
     """Each grid name's kind ("temperature", "input", "parameter") and unit, checked against the model."""
-    from ..identify.parameters import target_of, unit_of  # loads SciPy: only when a sweep runs
+    from ..identification.parameters import target_of, unit_of  # loads SciPy: only when a sweep runs
 
     fields = {f.name for f in dataclasses.fields(waveform)} if dataclasses.is_dataclass(waveform) else set()
     kinds, units = {}, {}
@@ -134,8 +134,8 @@ def _kinds(model: Model, waveform, names):
 def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim):
     """Simulates each row of ``coords``; returns (values (n, len(metrics)), errors {row: reason},
     warnings). A point that fails is NaN with its reason; the others go on."""
-    from ..identify.parameters import with_values
-    from ..simulate import simulate
+    from ..identification.parameters import with_values
+    from ..simulation import simulate
 
     values = np.full((coords.shape[0], len(metrics)), np.nan)
     errors, seen = {}, {}

@@ -24,7 +24,7 @@ import numpy as np
 from ..drive import experiment_waveform
 from ..errors import ComputationError, InputError
 from ..models import FRICTION_MODELS, Coulomb, LuGre, Model, ModelI, PrescribedMotion
-from ..simulate import simulate
+from ..simulation import simulate
 from .optimiser import fit
 from .parameters import Parameters
 from .problem import Problem, make_traces

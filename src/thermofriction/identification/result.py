@@ -277,10 +277,10 @@ class FitResult(Result):
         this model on it) measured against predicted displacement and the residuals' RMS; for Model
         I and II the laws with the per-temperature estimates and their 95 % intervals (``paper``:
         the paper's Eqs. (9)-(11) and (13) beside them)."""
-        from ..report.fit_plots import fit_figure
+        from ..reporting.fit_plots import fit_figure
         validation = data
         if data is not None and not hasattr(data, "predictions"):
-            from ..validate import validate
+            from ..validation import validate
             validation = validate(self.model, data)
         return fit_figure(self, validation, paper=paper)
 
@@ -303,7 +303,7 @@ class FitResult(Result):
 
 
 def _plant_lines(plant) -> list:
-    """A drive's inertia and delay (command data: identify/setup.py command_finish), as the report says them."""
+    """A drive's inertia and delay (command data: identification/setup.py command_finish), as the report says them."""
     if not plant:
         return []
     J, d = plant["inertia"], plant["delay"]

@@ -20,14 +20,14 @@ from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
 from ..models import Model
-from ..simulate import StepSizeController
+from ..simulation import StepSizeController
 from .parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
 from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
 from .provenance import stamped
 from .result import FitResult
 from .setup import SETUP
-from ..validate import validate
+from ..validation import validate
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
@@ -105,7 +105,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         (one friction model for all experiments, no thermal model), "model-i" or "model-ii".
     init: the initial model (its plant, masses and input are kept); a model, a file or a preset
         name. Default: the paper's preset for the method. A file with a [plant] and no [friction]
-        section starts LuGre from values taken from the data (identify/start.py).
+        section starts LuGre from values taken from the data (identification/start.py).
     friction: the friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb);
         default the initial model's. When it differs, the initial friction model is built from the
         initial model's values (:func:`with_friction_model`).
@@ -127,10 +127,10 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
 
     After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
-    (identify/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
+    (identification/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
 
     What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
-    it forms the residuals and their offsets; the steps particular to it are in identify/setup.py.
+    it forms the residuals and their offsets; the steps particular to it are in identification/setup.py.
     """
     parameters, free, rtol = _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine,
                                             reference_temperature, controller, rtol, progress, offset)

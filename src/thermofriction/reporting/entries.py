@@ -10,7 +10,7 @@ import re
 import numpy as np
 
 from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
-from ..validate import ValidationResult
+from ..validation import ValidationResult
 from .page import fmt_number, html_table
 from .fit_plots import as_float, law_outside_intervals, per_temperature_estimates
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import ModelI, ModelII
-from ..validate import validate
+from ..validation import validate
 from .entries import COMPARISON_COLUMNS, EXPERIMENT_COLUMNS, akaike, comparison_rows, parameter_section
 from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
                       fig_steps)

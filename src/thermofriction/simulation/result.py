@@ -88,7 +88,7 @@ class SimulationResult(Result):
         """A matplotlib figure against time: the input, displacement, friction force and (when it
         changes) the temperature; ``what`` names other fields, e.g. ``("velocity", "temperature")``.
         The figure is not pyplot's: a notebook shows it once, ``fig.savefig(path)`` writes it."""
-        from ..report.plots import simulation_figure
+        from ..reporting.plots import simulation_figure
         return simulation_figure(self, what)
 
     def summary(self) -> list:

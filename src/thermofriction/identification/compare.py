@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..errors import ThermofrictionError
-from ..validate import validate
+from ..validation import validate
 from .front import identify
 
 

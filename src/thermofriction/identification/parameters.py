@@ -18,7 +18,7 @@ from ..models.sides import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, side_values
 TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
 #: Not a C core target: a breakpoint temperature of a piecewise-linear dF. Its sensitivity is the chain
-#: rule on the knot values' sensitivities (identify/engine.py), exact on constant-temperature runs.
+#: rule on the knot values' sensitivities (identification/problem.py), exact on constant-temperature runs.
 KNOT = -1
 #: Not a parameter of the model: the Stribeck excess fs - fc, fitted in place of fs (in log space, so that fs >= fc
 #: holds by construction, never as a refused step); setting it sets fs = fc + excess.

@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..measurements import steady_state_curve
 from ..measurements.command import implied_friction
 from ..models import ModelI, ModelII
-from ..validate import validate
+from ..validation import validate
 from .entries import akaike_scaled
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
 from .plots import thin as _thin

@@ -131,7 +131,7 @@ class ValidationResult(Result):
         """A matplotlib figure of ``metric`` (max_error_pct, final_error_pct, step_error_pct, nrmse,
         rmse) against temperature: fit temperatures filled, held-out ones open on pale red bands,
         and for the max error the 7-8 % of Li et al. (2009). Draws into ``ax`` when given."""
-        from .report.plots import error_figure
+        from .reporting.plots import error_figure
         return error_figure([(label or self.model.name or "model", self)], metric, ax=ax)
 
     def _repr_html_(self):

@@ -13,7 +13,7 @@ import numpy as np
 from ..drive import experiment_waveform
 from ..errors import ComputationError, InputError
 from ..models import PWL, Const, Model, ModelII
-from ..simulate import simulate
+from ..simulation import simulate
 from .optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
 from .problem import Problem, make_traces, pool
 from .laws import aicc, segmented_fit
