@@ -30,7 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import reference  # noqa: E402  (the plain NumPy/SciPy implementation the tests use)
 
 import thermofriction as tf  # noqa: E402
-from thermofriction.identify import fit_friction, identify  # noqa: E402
+from thermofriction.identification import fit_friction, identify  # noqa: E402
 
 TEMPS = (30.8, 33.9, 35.7, 38.4, 41.5)
 #: end-to-end targets on this dataset (issue 18) [s]

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import thermofriction as tf
 from thermofriction import control as C
-from thermofriction.report import control_report
+from thermofriction.reporting import control_report
 
 
 def main(argv=None):

@@ -15,7 +15,7 @@ import numpy as np
 
 import thermofriction as tf
 from thermofriction.heating import Full, TwoTimeScale, simulate_heating
-from thermofriction.report import heating_report
+from thermofriction.reporting import heating_report
 
 FREQUENCIES = (5.0, 50.0, 500.0)
 T_START = 30.0
