@@ -24,7 +24,7 @@ import numpy as np
 STYLE = {"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10.5, "xtick.labelsize": 9.5,
          "ytick.labelsize": 9.5, "legend.fontsize": 9, "legend.title_fontsize": 9.5, "axes.grid": True,
          "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
-         "svg.fonttype": "none", "figure.dpi": 100}
+         "svg.fonttype": "none", "figure.dpi": 100, "axes.formatter.useoffset": False}
 WIDE = 11.0                      # a full-width figure [in]
 HALF = 5.6                       # one of two side by side [in]
 MODEL_COLOURS = ("#1f77b4", "#2ca02c", "#9467bd", "#8c6d31", "#17becf", "#7f7f7f")
@@ -325,36 +325,5 @@ def steps_figure(entries, width=HALF):
     return fig
 
 
-# -- thermal laws ------------------------------------------------------------------------------
-
-@styled
-def simulation_figure(result, what=None):
-    """A simulation result against time: input, displacement, friction force, and the temperature
-    when it changes (``what`` picks the panels by field name)."""
-    panels = list(what) if what else ["input", "displacement", "friction_force"]
-    if what is None and np.ptp(result.temperature) > 1e-9:
-        panels.append("temperature")
-    scales = {"input": (1.0, f"input [{result.input_unit}]"), "displacement": (1e6, "displacement [µm]"),
-              "velocity": (1e3, "velocity [mm/s]"), "friction_force": (1.0, "friction force [N]"),
-              "temperature": (1.0, "temperature [°C]"), "relative_displacement": (1e6, "x_e − x_p [µm]"),
-              "stage_displacement": (1e6, "stage displacement [µm]")}
-    for p in panels:
-        if p not in scales or getattr(result, p, None) is None:
-            raise ValueError(f"cannot plot {p!r}: choose from "
-                             f"{', '.join(k for k in scales if getattr(result, k, None) is not None)}")
-    fig, axes = new_figure(9.0, 1.9 * len(panels) + 0.5, nrows=len(panels), ncols=1, sharex=True)
-    for ax, p in zip(axes[:, 0], panels):
-        scale, label = scales[p]
-        ax.plot(*thin(result.time, getattr(result, p) * scale, 1500), lw=1.1, color=MODEL_COLOURS[0])
-        if p == "displacement" and result.stage_displacement is not None:
-            ax.plot(*thin(result.time, result.stage_displacement * 1e6, 1500), lw=0.9, color="0.55",
-                    label="stage")
-            ax.lines[0].set_label("end effector")
-            ax.legend(loc="best")
-        ax.set_ylabel(label)
-    axes[-1, 0].set_xlabel("time [s]")
-    return fig
-
-
-__all__ = ["STYLE", "displacement_figure", "residual_figure", "error_figure", "steps_figure", "simulation_figure",
+__all__ = ["STYLE", "displacement_figure", "residual_figure", "error_figure", "steps_figure",
            "temperature_styles", "window_rms"]
