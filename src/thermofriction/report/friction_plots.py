@@ -133,7 +133,7 @@ def force_units(predictions):
 
 
 @styled
-def force_hysteresis_figure(validation, files=None, max_panels=4, title=None):
+def force_hysteresis_figure(validation, files=None, max_panels=4, title=None, label=None):
     """Force data: measured (markers) and predicted (line) friction against the measured position, one panel
     per experiment (``files``, or held-out experiments first, at most ``max_panels``)."""
     preds = list(validation.predictions)
@@ -151,7 +151,8 @@ def force_hysteresis_figure(validation, files=None, max_panels=4, title=None):
     for ax in axes.flat[len(shown):]:
         ax.set_visible(False)
     axes.flat[0].legend(loc="best")
-    fig.suptitle(title or f"{getattr(validation.model, 'name', None) or 'model'}: friction {what} against position")
+    label = label or getattr(validation.model, "name", None) or "model"
+    fig.suptitle(title or f"{label}: friction {what} against position")
     return fig
 
 
@@ -166,5 +167,26 @@ def draw_force_hysteresis(ax, p, x_u, f_u, what="force"):
     ax.set_title(f"{p.file}, {p.temperature:.1f} °C" + (" (held out)" if p.role == "validate" else ""))
 
 
-__all__ = ["simulation_figure", "hysteresis_figure", "force_hysteresis_figure", "draw_force_hysteresis",
+def force_overview(fig, validation):
+    """Force data in one row of ``fig`` (a figure or subfigure): one experiment (the first held out, else the
+    first) measured and predicted over time, and against the position."""
+    preds = sorted(validation.predictions, key=lambda p: (p.role != "validate", p.temperature))
+    p = preds[0]
+    x_u, f_u = force_units(preds)
+    what = "torque" if f_u == "N m" else "force"
+    a = fig.subplots(1, 2)
+    k = scaled_axis(a[0], "y", np.concatenate([p.measured, p.predicted]), f"friction {what}", f_u)
+    tm, fm = _strided(p.time, p.measured, n=1500)
+    a[0].plot(tm, fm * k, "o", ms=2.2, mfc="none", color="0.45", mew=0.6, label="measured")
+    a[0].plot(*thin(p.time, p.predicted * k, 1500), "-", lw=1.1, color=MODEL_COLOURS[0], label="predicted")
+    a[0].set_xlabel("time [s]")
+    a[0].set_title("over time")
+    a[0].legend(loc="best")
+    draw_force_hysteresis(a[1], p, x_u, f_u, what)
+    a[1].set_title("against position")
+    fig.suptitle(f"{p.file}, {p.temperature:.1f} °C" + (" (held out)" if p.role == "validate" else ""))
+    return a
+
+
+__all__ = ["force_overview", "simulation_figure", "hysteresis_figure", "force_hysteresis_figure", "draw_force_hysteresis",
            "robust_ylim", "simulation_title", "ROBUST_PERCENTILES"]

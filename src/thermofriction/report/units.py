@@ -16,6 +16,9 @@ PREFIXES = {
     "N m": ((1.0, "N m"), (1e-3, "mN m"), (1e-6, "µN m")),
     "V": ((1.0, "V"), (1e-3, "mV")),
     "J": ((1.0, "J"), (1e-3, "mJ"), (1e-6, "µJ")),
+    "N/m": ((1e6, "N/µm"), (1e3, "N/mm"), (1.0, "N/m")),
+    "N s/m": ((1e6, "N s/µm"), (1e3, "N s/mm"), (1.0, "N s/m")),
+    "N m/rad": ((1e3, "N m/mrad"), (1.0, "N m/rad")),
 }
 
 
@@ -45,6 +48,19 @@ def scaled_axis(ax, axis, values, quantity, unit):
     return k
 
 
+def scaled_ticks(ax, axis, values, quantity, unit):
+    """As scaled_axis, with the data left in SI: the tick labels are scaled instead (for panels drawn by many
+    calls, e.g. error bars and laws). Returns the multiplier the labels use."""
+    from matplotlib.ticker import FuncFormatter
+    k, name = unit_scale(values, unit)
+    getattr(ax, f"set_{axis}label")(f"{quantity} [{name}]" if name else quantity)
+    if k != 1.0:
+        getattr(ax, f"{axis}axis").set_major_formatter(FuncFormatter(lambda v, _: f"{v * k:.6g}"))
+    else:
+        plain(ax, axis)
+    return k
+
+
 def plain(ax, axis="both"):
     """No offset or multiplier text on ``ax``'s axis (a linear axis; log axes have neither)."""
     for a in ((ax.xaxis, ax.yaxis) if axis == "both" else (getattr(ax, f"{axis}axis"),)):
@@ -54,4 +70,4 @@ def plain(ax, axis="both"):
             f.set_scientific(False)
 
 
-__all__ = ["PREFIXES", "unit_scale", "scaled_axis", "plain"]
+__all__ = ["PREFIXES", "unit_scale", "scaled_axis", "scaled_ticks", "plain"]
