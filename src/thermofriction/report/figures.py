@@ -48,7 +48,7 @@ def _held_out(entries):
 
 def fig_errors(figs, entries):
     fig = plots.error_figure(_pairs(entries))
-    band = any(p.get_label().startswith("Li et al.") for p in fig.axes[0].patches)
+    band = any(str(p.get_label()).startswith("Li et al.") for p in fig.axes[0].patches)
     return figs.render(fig, "error-vs-temperature",
                        "Max error against temperature for each model: filled circles at the temperatures it was "
                        "fitted to, open diamonds on pale red bands at the held-out ones (never used in "
