@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .plots import HALF, MODEL_COLOURS, WIDE, new_figure, styled, thin
 from .units import plain, scaled_axis
 
@@ -80,7 +81,7 @@ def simulation_figure(result, what=None, title=None):
     names = _panels(result)
     for p in panels:
         if p not in names or getattr(result, p, None) is None:
-            raise ValueError(f"cannot plot {p!r}: choose 'hysteresis' or from "
+            raise InputError(f"what: cannot plot {p!r}: choose 'hysteresis' or from "
                              f"{', '.join(k for k in names if getattr(result, k, None) is not None)}")
     fig, axes = new_figure(9.0, 1.9 * len(panels) + 0.8, nrows=len(panels), ncols=1, sharex=True)
     for ax, p in zip(axes[:, 0], panels):
@@ -138,7 +139,7 @@ def force_hysteresis_figure(validation, files=None, max_panels=4, title=None, la
     per experiment (``files``, or held-out experiments first, at most ``max_panels``)."""
     preds = list(validation.predictions)
     if not preds or not hasattr(preds[0], "position"):
-        raise ValueError("a hysteresis view needs force (torque) data: measured friction against position")
+        raise InputError("a hysteresis view needs force (torque) data: measured friction against position")
     shown = [p for p in preds if p.file in files] if files else \
         sorted(preds, key=lambda p: (p.role != "validate", p.temperature))[:max_panels]
     x_u, f_u = force_units(preds)
