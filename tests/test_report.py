@@ -222,7 +222,8 @@ def test_simulation_result_plot_draws_its_arrays():
     model = tf.load_model("li2009-model-i")
     res = tf.simulate(model, 0.4, temperature=([0, 0.4], [31, 39]), sample_rate=2000)
     fig = res.plot()
-    assert [ax.get_ylabel() for ax in fig.axes] == ["input [V]", "displacement [µm]", "friction force [N]",
+    # units from the data: µm of displacement, the friction's ~0.4 N flyback peaks in mN
+    assert [ax.get_ylabel() for ax in fig.axes] == ["input [V]", "displacement [µm]", "friction force [mN]",
                                                      "temperature [°C]"]
     line = fig.axes[1].get_lines()[0]
     np.testing.assert_allclose(line.get_ydata(), res.displacement * 1e6)
@@ -236,8 +237,9 @@ def test_fit_and_validation_plots_show_data_predictions_and_laws(demo_like):
     fig = fit.plot(demo_like.data)
     labels = [ax.get_ylabel() for ax in fig.axes if ax.get_visible()]
     assert labels[:2] == ["displacement [µm]", "RMS(predicted − measured) [nm]"]
-    assert {"sigma0 [N/m]", "sigma1 [N s/m]", "fc [N]"} <= set(labels)
-    law_ax = next(ax for ax in fig.axes if ax.get_ylabel() == "fc [N]")
+    # units from the data: sigma0 ~1e6 N/m in N/µm, fc ~0.5 N in mN (the data stay in SI, the ticks are scaled)
+    assert {"sigma0 [N/µm]", "sigma1 [N s/m]", "fc [mN]"} <= set(labels)
+    law_ax = next(ax for ax in fig.axes if ax.get_ylabel() == "fc [mN]")
     # the per-temperature estimates: one error bar per fit temperature, at those temperatures
     bars = [c for c in law_ax.containers if c.__class__.__name__ == "ErrorbarContainer"]
     assert len(bars) == 1

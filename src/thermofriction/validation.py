@@ -127,12 +127,24 @@ class ValidationResult(Result):
             console = Console(width=width)
         console.print(t)
 
-    def plot(self, metric="max_error_pct", ax=None, label=None):
+    def plot(self, metric="max_error_pct", ax=None, label=None, what="errors", paper=None):
         """A matplotlib figure of ``metric`` (max_error_pct, final_error_pct, step_error_pct, nrmse,
         rmse) against temperature: fit temperatures filled, held-out ones open on pale red bands,
-        and for the max error the 7-8 % of Li et al. (2009). Draws into ``ax`` when given."""
+        and for displacement data's max error the 7-8 % of Li et al. (2009) where the errors reach 1 %
+        (``paper=True``: always; False: never). Draws into ``ax`` when given. ``what="hysteresis"``
+        (force data): measured and predicted friction against the measured position per experiment."""
+        label = label or self.model.name or "model"
+        if what == "hysteresis":
+            from .reporting.friction_plots import force_hysteresis_figure
+            if self.measurement.name != "force":
+                raise InputError(f"what='hysteresis' needs force (torque) data; these are {self.measurement.name} data")
+            return force_hysteresis_figure(self, label=label)
+        if what != "errors":
+            raise InputError(f"what must be 'errors' or 'hysteresis', got {what!r}")
         from .reporting.plots import error_figure
-        return error_figure([(label or self.model.name or "model", self)], metric, ax=ax)
+        if paper is None and self.measurement.name != "displacement":
+            paper = False  # the paper's errors are of displacement
+        return error_figure([(label, self)], metric, ax=ax, paper=paper)
 
     def _repr_html_(self):
         head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)

@@ -8,6 +8,8 @@ import math
 import numpy as np
 
 from ..models import PARAMETER_UNITS, ModelII, load_model
+from .friction_plots import force_overview
+from .units import scaled_axis, scaled_ticks
 from .plots import (HALF, MODEL_COLOURS, PAPER, WIDE, draw_displacement, draw_residuals, hide_unused, is_held_out,
                     mark_held_out, new_figure, noise_handle, panel_grid, styled, temperature_key, temperature_styles)
 
@@ -99,7 +101,7 @@ def draw_law(ax, fit, model, name, held_out=(), paper=True):
         pad = 0.08 * (b - a if b > a else abs(a) or 1.0)
         ax.set_ylim(a - pad, b + pad)
     ax.set_xlabel("temperature [°C]")
-    ax.set_ylabel(f"{name} [{unit}]" if unit else name)
+    scaled_ticks(ax, "y", lims, name, unit)
     ax.set_title(name)
 
 
@@ -157,8 +159,8 @@ def draw_dF(ax, fit, model, label="fitted dF(T)", held_out=(), paper=True):
         ax.plot(grid, load_model("li2009-model-ii").thermal.dF(grid), label="paper, Eq. (13)", **PAPER)
     mark_held_out(ax, held_out)
     ax.set_xlabel("temperature [°C]")
-    ax.set_ylabel("dF [N]")
-    ax.set_title("thermal-induced friction dF(T)")
+    scaled_ticks(ax, "y", np.concatenate([np.asarray(ax.dataLim.intervaly)]), "dF", "N")
+    ax.set_title("dF(T)")
 
 
 @styled
@@ -177,26 +179,26 @@ def model_ii_figure(fit, model, held_out=(), paper=True):
         ax = axl.pop(0)
         T = np.array(procedure["temperatures"], float)
         D = np.array(procedure["displacement"], float)
-        ax.plot(T, D * 1e6, "ko", ms=5, label="measured")
+        k = scaled_axis(ax, "y", D, "net displacement", "m")
+        ax.plot(T, D * k, "ko", ms=5, label="measured")
         knots = np.array(procedure["displacement_law"]["T"], float)
         vals = np.array(procedure["displacement_law"]["values"], float)
-        ax.plot(knots, vals * 1e6, "-", color=MODEL_COLOURS[1],
+        ax.plot(knots, vals * k, "-", color=MODEL_COLOURS[1],
                 label=f"two segments,\nbreak at {procedure['breakpoint']:.1f} °C")
         mark_held_out(ax, held_out, label=False)
         ax.set_xlabel("temperature [°C]")
-        ax.set_ylabel("net displacement [µm]")
-        ax.set_title("displacement vs temperature (Fig. 6)")
+        ax.set_title("Fig. 6: against T")
         ax.legend(loc="best")
         ax = axl.pop(0)
         dFg = np.array(procedure["dF_grid"], float)
         Ds = np.array(procedure["displacement_vs_dF"], float)
         lf = procedure["linear_fit"]
-        ax.plot(dFg, Ds * 1e6, "ko", ms=5, label="simulated")
-        ax.plot(dFg, (lf["intercept"] + lf["slope"] * dFg) * 1e6, "-", color=MODEL_COLOURS[1],
+        k = scaled_axis(ax, "y", Ds, "net displacement", "m")
+        ax.plot(dFg, Ds * k, "ko", ms=5, label="simulated")
+        ax.plot(dFg, (lf["intercept"] + lf["slope"] * dFg) * k, "-", color=MODEL_COLOURS[1],
                 label=f"linear, R² = {lf['r2']:.4f}")
         ax.set_xlabel("dF [N]")
-        ax.set_ylabel("net displacement [µm]")
-        ax.set_title("displacement vs dF (Fig. 7)")
+        ax.set_title("Fig. 7: against dF")
         ax.legend(loc="best")
     ax = axl.pop(0)
     draw_dF(ax, fit, model, held_out=held_out, paper=paper)
@@ -236,6 +238,15 @@ def parameters_figure(fit: dict):
     return fig
 
 
+def _displacement_row(sub, preds, styles):
+    a = sub.subplots(1, 2)
+    draw_displacement(a[0], preds, styles)
+    a[0].set_title("measured (markers), predicted (lines)")
+    draw_residuals(a[1], preds, styles)
+    a[1].set_title("residual RMS, 2 % windows")
+    temperature_key(sub, styles, extra=[noise_handle()])
+
+
 @styled
 def fit_figure(fit, validation=None, paper=False):
     """An identification result (FitResult or its dict with ``model``): measured vs predicted and
@@ -261,12 +272,10 @@ def fit_figure(fit, validation=None, paper=False):
         styles = temperature_styles([(p.temperature, p.role) for p in preds])
         sub = subs[k]
         k += 1
-        a = sub.subplots(1, 2)
-        draw_displacement(a[0], preds, styles)
-        a[0].set_title("measured (markers) and predicted (lines)")
-        draw_residuals(a[1], preds, styles)
-        a[1].set_title("residual RMS over 2 % windows of the run")
-        temperature_key(sub, styles, extra=[noise_handle()])
+        if hasattr(preds[0], "position"):  # force (torque) data: the friction over time and against position
+            force_overview(sub, validation)
+        else:
+            _displacement_row(sub, preds, styles)
     if law_panels:
         sub = subs[k]
         a = sub.subplots(1, max(law_panels, 2) if rows > 1 else law_panels, squeeze=False)[0]
@@ -281,6 +290,9 @@ def fit_figure(fit, validation=None, paper=False):
             for h, lab in zip(*ax.get_legend_handles_labels()):
                 handles.setdefault(lab, h)
         sub.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
+    name = f"{model.name or 'fitted model'} ({d.get('method') or 'fit'})"
+    inner = fig.get_suptitle()  # a single row of force data names its experiment there
+    fig.suptitle(f"{name}: {inner}" if inner else name)
     return fig
 
 

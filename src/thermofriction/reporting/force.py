@@ -18,6 +18,7 @@ from ..validation import validate
 from .entries import akaike_scaled
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
 from .plots import thin as _thin
+from .units import scaled_axis
 
 
 def _colors(temps):
@@ -56,13 +57,13 @@ def fig_force_time(figs, entries, unit, what):
                              constrained_layout=True)
     for ax, p0 in zip(axes[:, 0], shown):
         stride = max(len(p0.time) // 400, 1)
-        ax.plot(p0.time[::stride], p0.measured[::stride], "o", ms=2.5, mfc="none", color="0.35", label="measured")
+        k = scaled_axis(ax, "y", p0.measured, what, unit)
+        ax.plot(p0.time[::stride], p0.measured[::stride] * k, "o", ms=2.5, mfc="none", color="0.35", label="measured")
         for e in entries:
             p = next(q for q in e.validation.predictions if q.file == p0.file)
-            ax.plot(*_thin(p.time, p.predicted), lw=1.1, label=e.label)
+            ax.plot(*_thin(p.time, p.predicted * k), lw=1.1, label=e.label)
         ax.set_title(f"{p0.file}, {p0.temperature:.1f} °C" + (" (held out)" if p0.role == "validate" else ""),
                      fontsize=9)
-        ax.set_ylabel(f"{what} [{unit}]")
     axes[-1, 0].set_xlabel("time [s]")
     fig.legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, frameon=False, loc="outside lower center",
                ncol=len(entries) + 1)
@@ -76,10 +77,12 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
     temps = sorted({e.temperature for e in exps})
     col = _colors(temps)
     top = max(float(np.max(np.abs(e.drive_velocity))) for e in exps)
-    for k, e in enumerate(exps):
+    measured = [implied_friction(entries[0].model, e) for e in exps]  # a drive's command: less the first model's J a
+    kv = scaled_axis(ax, "x", [top], "velocity", vunit)
+    kf = scaled_axis(ax, "y", np.concatenate([F for _, F in measured]), f"friction {what}", unit)
+    for k, (e, (v_e, F_e)) in enumerate(zip(exps, measured)):
         stride = max(len(e.time) // 1500, 1)
-        v_e, F_e = implied_friction(entries[0].model, e)  # a drive's command: less the first model's J a
-        ax.plot(v_e[::stride], F_e[::stride], ".", ms=2, alpha=0.35, color=col[e.temperature],
+        ax.plot(v_e[::stride] * kv, F_e[::stride] * kf, ".", ms=2, alpha=0.35, color=col[e.temperature],
                 label="measured" if k == 0 else None)
     v = np.concatenate([-np.geomspace(top, top * 1e-3, 40), np.geomspace(top * 1e-3, top, 40)])
     T_mid = float(np.median(temps))
@@ -88,9 +91,8 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
             F = steady_state_curve(e.model, v, T_mid) + e.model.plant.sensor_offset
         except Exception:  # noqa: BLE001 - a model that cannot run at this temperature: no curve, the rest stays
             continue
-        ax.plot(v, F, "-", lw=1.4, label=f"{e.label}, steady sliding at {T_mid:.1f} °C")
-    ax.set_xlabel(f"velocity [{vunit}]")
-    ax.set_ylabel(f"friction {what} [{unit}]")
+        ax.plot(v * kv, F * kf, "-", lw=1.4, label=f"{e.label}, steady sliding at {T_mid:.1f} °C")
+    ax.set_title(f"friction–velocity map at {T_mid:.1f} °C")
     ax.legend(fontsize=7, frameon=False, loc="lower right")
     return figs.render(fig, "velocity-map", f"The friction-velocity map: measured points (dots, coloured by "
                        f"temperature, {min(temps):.1f}–{max(temps):.1f} °C) and each model's steady-sliding "
@@ -129,7 +131,7 @@ def fig_loops(figs, entries, unit, xunit, what):
             break
     if not loops:
         return ""
-    fig, axes = subplots(1, len(loops), figsize=(3.2 * len(loops), 3.0), squeeze=False)
+    fig, axes = subplots(1, len(loops), figsize=(3.2 * len(loops), 3.2), squeeze=False, constrained_layout=True)
     for ax, (file, i) in zip(axes[0], loops):
         p0 = next(q for q in entries[0].validation.predictions if q.file == file)
         swing = abs(float(np.median(p0.measured[max(i - 20, 0):i])) - float(np.median(p0.measured[i + 1:i + 40])))
@@ -139,17 +141,50 @@ def fig_loops(figs, entries, unit, xunit, what):
             j += 1
         a, b = max(i - (j - i) // 2 - 2, 0), min(j + (j - i) // 2 + 2, len(p0.time))
         x = p0.position[a:b] - p0.position[i]
-        ax.plot(x, p0.measured[a:b], "o", ms=3, mfc="none", color="0.35", label="measured")
+        kx = scaled_axis(ax, "x", x, "position from the reversal", xunit)
+        kf = scaled_axis(ax, "y", p0.measured[a:b], f"friction {what}", unit)
+        ax.plot(x * kx, p0.measured[a:b] * kf, "o", ms=3, mfc="none", color="0.35", label="measured")
         for e in entries:
             p = next(q for q in e.validation.predictions if q.file == file)
-            ax.plot(x, p.predicted[a:b], "-", lw=1.2, label=e.label)
-        ax.set_title(f"{file}, t = {p0.time[i]:.3g} s", fontsize=8)
-        ax.set_xlabel(f"position from the reversal [{xunit}]")
-    axes[0][0].set_ylabel(f"friction {what} [{unit}]")
+            ax.plot(x * kx, p.predicted[a:b] * kf, "-", lw=1.2, label=e.label)
+        ax.set_title(f"{file}\nt = {p0.time[i]:.3g} s", fontsize=8)
+    for ax in axes[0][1:]:  # the y label once, unless a panel's unit differs
+        if ax.get_ylabel() == axes[0][0].get_ylabel():
+            ax.set_ylabel("")
     axes[0][0].legend(fontsize=7, frameon=False)
     return figs.render(fig, "presliding", f"Presliding: the {what} against the position around reversals of the "
                        f"motion, measured (markers) and predicted (lines); the loop's slope at the reversal is the "
                        f"bristle stiffness.")
+
+
+@page_styled
+def fig_hysteresis(figs, entries, unit, xunit, what):
+    """The friction against the measured position over whole runs, measured and predicted by each model; held-out
+    experiments first, at most MAX_PANELS."""
+    preds0 = entries[0].validation.predictions
+    shown = sorted(preds0, key=lambda p: (p.role != "validate", p.temperature))[:MAX_PANELS]
+    cols = min(len(shown), 2)
+    rows = -(-len(shown) // cols)
+    fig, axes = subplots(rows, cols, figsize=(4.3 * cols, 3.3 * rows + 0.4), squeeze=False, constrained_layout=True)
+    for ax, p0 in zip(axes.flat, shown):
+        kx = scaled_axis(ax, "x", p0.position, "position", xunit)
+        kf = scaled_axis(ax, "y", p0.measured, f"friction {what}", unit)
+        stride = max(len(p0.time) // 1500, 1)
+        ax.plot(p0.position[::stride] * kx, p0.measured[::stride] * kf, "o", ms=2, mfc="none", mew=0.6, color="0.45",
+                label="measured")
+        for e in entries:
+            p = next(q for q in e.validation.predictions if q.file == p0.file)
+            step = max(len(p.time) // 20_000, 1)
+            ax.plot(p.position[::step] * kx, p.predicted[::step] * kf, "-", lw=1.1, label=e.label)
+        ax.set_title(f"{p0.file}, {p0.temperature:.1f} °C" + (" (held out)" if p0.role == "validate" else ""),
+                     fontsize=9)
+    for ax in axes.flat[len(shown):]:
+        ax.set_visible(False)
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, frameon=False, loc="outside lower center",
+               ncol=len(entries) + 1)
+    return figs.render(fig, "hysteresis", f"The friction {what} against the measured position over each run: "
+                       f"measured (markers) and predicted by each model (lines), the sensor offset included; "
+                       f"held-out experiments first.")
 
 
 def _akaike(entries):
@@ -205,6 +240,7 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
                  + "</section>")
     parts.append("<section><h2>Friction–velocity map</h2>" + fig_velocity_map(figs, entries, exps, unit, vunit, what)
                  + "</section>")
+    parts.append("<section><h2>Hysteresis</h2>" + fig_hysteresis(figs, entries, unit, xunit, what) + "</section>")
     loops = fig_loops(figs, entries, unit, xunit, what)
     if loops:
         parts.append("<section><h2>Presliding hysteresis</h2>" + loops + "</section>")

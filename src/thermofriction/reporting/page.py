@@ -56,7 +56,7 @@ code{background:#eef0f5;padding:1px 4px;border-radius:3px}
 
 #: the look of the force and study pages' figures (the others': plots.STYLE)
 PAGE_STYLE = {"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False,
-              "axes.spines.right": False}
+              "axes.spines.right": False, "axes.formatter.useoffset": False}
 
 
 def page_styled(function):

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .plots import HALF, WIDE, new_figure, styled, thin
+from .units import scaled_axis
 
 
 @styled
@@ -18,9 +19,9 @@ def heating_figure(result):
     a.set_xlabel("time [s]")
     a.set_ylabel("temperature [°C]")
     a.set_title("interface temperature")
-    b.plot(*thin(result.time, np.asarray(result.step_size) * 1e6), color="#1f77b4")
+    k = scaled_axis(b, "y", result.step_size, "step per cycle", "m")
+    b.plot(*thin(result.time, np.asarray(result.step_size) * k), color="#1f77b4")
     b.set_xlabel("time [s]")
-    b.set_ylabel("step per cycle [µm]")
     b.set_title(f"step per cycle ({result.method})")
     return fig
 
@@ -30,16 +31,17 @@ def loop_figure(result):
     """Reference and position, and the tracking error, of a LoopResult against time."""
     fig, axes = new_figure(WIDE, HALF * 0.75, nrows=1, ncols=2)
     (a, b) = axes[0]
-    a.plot(*thin(result.time, result.reference * 1e3), color="0.5", ls="--", label="reference")
-    a.plot(*thin(result.time, result.position * 1e3), color="#1f77b4", label="position")
+    k = scaled_axis(a, "y", np.concatenate([result.reference, result.position]), "position", "m")
+    a.plot(*thin(result.time, result.reference * k), color="0.5", ls="--", label="reference")
+    a.plot(*thin(result.time, result.position * k), color="#1f77b4", label="position")
     a.set_xlabel("time [s]")
-    a.set_ylabel("position [mm]")
     a.set_title("tracking")
     a.legend(fontsize=8, frameon=False)
-    b.plot(*thin(result.time, result.error * 1e6), color="#d62728")
+    k = scaled_axis(b, "y", result.error, "error", "m")
+    b.plot(*thin(result.time, result.error * k), color="#d62728")
     b.set_xlabel("time [s]")
-    b.set_ylabel("error [µm]")
-    b.set_title(f"tracking error (RMS {result.rms_error * 1e6:.3g} µm)")
+    unit = b.get_ylabel().rsplit("[", 1)[-1].rstrip("]")
+    b.set_title(f"tracking error (RMS {result.rms_error * k:.3g} {unit})")
     return fig
 
 

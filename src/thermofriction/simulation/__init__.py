@@ -330,6 +330,8 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
         mean_velocity=float(steps.mean() / period) if steps.size else math.nan,
         input_unit={"stick-slip": "V", "mass": "N", "prescribed": "m"}[model.plant.type],
         stats=stats,
+        model_name=model.name,
+        rotary=bool(getattr(model.plant, "rotary", False)),
     )
 
 

@@ -43,6 +43,9 @@ class SimulationResult(Result):
     input_unit: str = "V"
     stats: dict = field(default_factory=dict)
     friction_work: np.ndarray | None = None
+    #: the simulated model's name (the figures' titles) and whether its motion is rotary (rad, N m)
+    model_name: str | None = None
+    rotary: bool = False
 
     def columns(self) -> dict:
         """The CSV columns (docs/formats.md#simulation-output), header -> array."""
@@ -84,12 +87,16 @@ class SimulationResult(Result):
             fh.write(",".join(cols) + "\n")
             np.savetxt(fh, table, delimiter=",", fmt="%.12g")
 
-    def plot(self, what=None):
+    def plot(self, what=None, title=None):
         """A matplotlib figure against time: the input, displacement, friction force and (when it
-        changes) the temperature; ``what`` names other fields, e.g. ``("velocity", "temperature")``.
-        The figure is not pyplot's: a notebook shows it once, ``fig.savefig(path)`` writes it."""
-        from ..reporting.plots import simulation_figure
-        return simulation_figure(self, what)
+        changes) the temperature; ``what`` names other fields, e.g. ``("velocity", "temperature")``,
+        or is ``"hysteresis"``: the friction force against the displacement (against x_e - x_p for
+        stick-slip plants). Titled with the model's name and the temperature (or ``title``); units
+        chosen from the data; a friction axis whose scale short flyback spikes would set is cut to
+        its 1-99 % percentiles, as the panel says. The figure is not pyplot's: a notebook shows it
+        once, ``fig.savefig(path)`` writes it."""
+        from ..reporting.friction_plots import simulation_figure
+        return simulation_figure(self, what, title)
 
     def summary(self) -> list:
         rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
