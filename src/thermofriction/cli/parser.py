@@ -13,6 +13,7 @@ from ..simulate import MAX_SAMPLES, SOLVERS
 from .commands import cmd_demo, cmd_identify, cmd_simulate, cmd_validate
 from .report_command import cmd_report
 from .outputs import formats_text
+from .init import add_init_command
 from .presets import add_presets_command
 from .propagate import add_propagate_command
 
@@ -234,6 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_synth_command(sub)
     _add_sweep_command(sub)
     add_presets_command(sub)
+    add_init_command(sub)
     add_propagate_command(sub, temperature=_temperature, positive_float=_positive_float, int_in=_int_in,
                           writes=_writes, scheduler_options=_scheduler_options)
     return p
