@@ -211,6 +211,41 @@ def test_report_bands_adds_the_section(fitted, tmp_path, capsys):
     assert "fit.json: not a propagation result" in err and not (tmp_path / "x.html").exists()
 
 
+def _damaged(fit, how):
+    d = json.loads(fit.read_text())
+    name = next(iter(d["parameters"]))
+    if how == "no model":
+        del d["model"]
+    elif how == "value null":
+        d["parameters"][name]["value"] = None
+    elif how == "value text":
+        d["parameters"][name]["value"] = "big"
+    elif how == "ci95 one number":
+        d["parameters"][name]["ci95"] = [1.0]
+    elif how == "correlation reordered":
+        d["correlation"]["names"] = d["correlation"]["names"][::-1]
+    elif how == "correlation ragged":
+        d["correlation"]["matrix"] = [[1.0]]
+    elif how == "n_points text":
+        d["n_points"] = "many"
+    elif how == "model without plant":
+        del d["model"]["plant"]
+    return d
+
+
+@pytest.mark.parametrize("how", ["no model", "value null", "value text", "ci95 one number", "correlation reordered",
+                                 "correlation ragged", "n_points text", "model without plant"])
+def test_a_damaged_results_json_is_one_message(how, fitted, tmp_path, capsys):
+    from thermofriction.cli.fits import load_fit
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(_damaged(fitted / "fit.json", how)))
+    with pytest.raises(tf.InputError, match=str(path).replace(".", r"\.")):
+        load_fit(path)
+    assert main(["propagate", str(path), "--temperatures", "36", "-o", str(tmp_path / "b.json")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("thermofriction: error: ") and not (tmp_path / "b.json").exists()
+
+
 def test_propagate_refuses_what_is_not_a_fit(fitted, tmp_path, capsys):
     bad = tmp_path / "metrics.json"
     bad.write_text(json.dumps({"experiments": []}))

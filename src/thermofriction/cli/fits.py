@@ -52,6 +52,8 @@ def _parameters(d, path):
         if not isinstance(p, dict) or "value" not in p:
             raise InputError(f"{where}: must be a table with 'value', 'stderr', 'ci95' and 'vary'")
         value = _number(p["value"], f"{where}: value")
+        if value is None:
+            raise InputError(f"{where}: value must be a number, got null")
         ci = p.get("ci95")
         if ci is not None and not (isinstance(ci, list) and len(ci) == 2):
             raise InputError(f"{where}: ci95 must be a pair of numbers, got {ci!r}")
@@ -83,6 +85,8 @@ def load_fit(path):
     naming the file and the key for anything else (a model file, a validation's metrics)."""
     from ..identify.result import FitResult
 
+    if os.fspath(path).lower().endswith(".mat"):
+        raise InputError(f"{path}: a MATLAB file; the fit is read from the results JSON (identify --json RESULTS.json)")
     try:
         d = json.loads(read_input_file(path, "results JSON").decode("utf-8"))
     except UnicodeDecodeError as e:
@@ -102,6 +106,15 @@ def load_fit(path):
     quality = d.get("fit_quality") if isinstance(d.get("fit_quality"), dict) else None
     if quality is not None:
         quality = {**quality, "noise": _number(quality.get("noise"), f"{path}: fit_quality: noise")}
+    try:
+        return _fit_result(FitResult, d, model, params, quality, path)
+    except (TypeError, ValueError) as e:  # (an InputError is a ValueError: it names its key already)
+        if isinstance(e, InputError):
+            raise
+        raise InputError(f"{path}: not an identification's results as identify --json writes them ({e})") from None
+
+
+def _fit_result(FitResult, d, model, params, quality, path):
     return FitResult(method=str(d["method"]), model=model, parameters=params,
                      correlation=_correlation(d["correlation"], params, path),
                      cost=_number(d.get("cost", "nan"), f"{path}: cost"),

@@ -116,6 +116,12 @@ def _ask(name: str) -> float:
             print(f"  not a plausible temperature [C]: {text!r}", file=sys.stderr)
 
 
+def _plausible(T) -> bool:
+    """A temperature a file name states that a dataset would take (not the 500 of a run's number, say)."""
+    from ..data.experiments import TEMPERATURE_RANGE
+    return T is not None and TEMPERATURE_RANGE[0] <= T <= TEMPERATURE_RANGE[1]
+
+
 def temperatures(folder: Path, files, explicit: dict, interactive: bool) -> dict:
     """{file: (temperature or None for the column's mean, where it came from)}; the files whose temperature is
     nowhere are asked for (``interactive``) or refused, all named in one message."""
@@ -125,7 +131,7 @@ def temperatures(folder: Path, files, explicit: dict, interactive: bool) -> dict
             out[f] = (explicit[f], "--temperature")
         elif has_temperature_column(folder / f):
             out[f] = (None, "column")
-        elif temperature_from_name(f) is not None:
+        elif _plausible(temperature_from_name(f)):
             out[f] = (temperature_from_name(f), "name")
     unknown = [f for f in files if f not in out]
     if unknown and not interactive:
@@ -222,7 +228,8 @@ def write_checked(folder: Path, text: str):
         else:
             with _io.atomic_write(manifest, "wb") as fh:
                 fh.write(old)
-        raise InputError(f"{e} (dataset.toml not written: leave the file out with --exclude, or fix it)") from None
+        raise InputError(f"{e} -- so {manifest} was not written (leave a file out with --exclude, give a temperature "
+                         f"with --temperature FILE=C, or fix the file)") from None
 
 
 def cmd_init(args) -> int:
