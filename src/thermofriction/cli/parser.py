@@ -187,8 +187,8 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--no-offset", action="store_true",
                    help="force data: the same as --offset none (hold the initial model's [plant] sensor_offset)")
     i.add_argument("-o", "--output", metavar="FITTED.toml", help=_writes(
-        "identify", "output", "the fitted model file, loadable by every command that takes a MODEL (several datasets: "
-                              "the folder DIR that receives NAME.toml and NAME.json per dataset)"))
+        "identify", "output", "the fitted model file, loadable by every command that takes a MODEL")
+        + "; with several datasets, the folder DIR that receives NAME.toml and NAME.json per dataset")
     i.add_argument("--json", metavar="RESULTS.json", help=_writes(
         "identify", "json", "the results (docs/formats.md#results-json), as JSON or as MATLAB structs"))
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
