@@ -230,7 +230,8 @@ def run_case(case, dataset, work):
         (work / name).write_text(text)
     if case.work is not None:
         case.work(work)
-    paths = {"data": data, "model": work / "m.toml", "work": work, "out": work / "out.file"}
+    out = {"simulate": "out.csv", "validate": "out.json", "identify": "out.toml"}.get(case.argv[0], "out.file")
+    paths = {"data": data, "model": work / "m.toml", "work": work, "out": work / out}  # names the command writes
     before = _digest(work)
     try:
         out = _run([a.format(**paths) for a in case.argv], work)

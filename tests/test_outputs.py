@@ -203,6 +203,10 @@ REFUSALS = {
                                       "-o", "link.toml"),
     "simulate -o model via hard link": ("simulate", "m.toml", "--temperature", "35", "--duration", "0.1",
                                         "-o", "hard.toml"),
+    "simulate -o temperature file via symlink": ("simulate", "m.toml", "--temperature-file", "T.csv", "--duration",
+                                                 "0.1", "-o", "link.csv"),
+    "simulate -o temperature file via hard link": ("simulate", "m.toml", "--temperature-file", "T.csv",
+                                                   "--duration", "0.1", "-o", "hard.csv"),
     "simulate -o temperature file": ("simulate", "m.toml", "--temperature-file", "T.csv", "--duration", "0.1",
                                      "-o", "T.csv"),
     "simulate -o sampled input": ("simulate", "m.toml", "--temperature", "35", "--input", "sampled:file=u.csv",
@@ -221,6 +225,14 @@ REFUSALS = {
 }
 
 
+#: the cases whose output name has an extension the command does not write (a model or manifest .toml, an
+#: experiment .csv for --json, X for both outputs): refused for that before any input is read (issue 33)
+NOT_WRITTEN_THERE = {"validate --json manifest", "validate --json experiment", "simulate -o model",
+                     "simulate -o model via symlink", "simulate -o model via hard link", "report -o model",
+                     "report -o manifest", "report -o results json", "identify -o X --json X",
+                     "identify --json experiment"}
+
+
 @pytest.mark.parametrize("case", sorted(REFUSALS))
 def test_an_output_that_is_an_input_is_refused(case, work):
     """Issue 17: `validate m.toml ds --json ds/dataset.toml` overwrote the manifest with exit 0,
@@ -228,6 +240,8 @@ def test_an_output_that_is_an_input_is_refused(case, work):
     (work / "link.toml").symlink_to("m.toml")
     os.link(work / "m.toml", work / "hard.toml")
     (work / "T.csv").write_text("time[s],temperature[C]\n0,30\n1,40\n")
+    (work / "link.csv").symlink_to("T.csv")
+    os.link(work / "T.csv", work / "hard.csv")
     (work / "u.csv").write_text("time[s],voltage[V]\n0,0\n1,30\n")
     (work / "m.json").write_text("{}\n")
     (work / "ds" / "T31C.csv").write_text("time[s],voltage[V]\n0,0\n1,30\n")  # an input synth would write
@@ -235,8 +249,11 @@ def test_an_output_that_is_an_input_is_refused(case, work):
     t0 = time.monotonic()
     out = run_cli(*REFUSALS[case], cwd=work)
     line = one_line_error(out, 2)
-    assert ("input of this run" in line or "the same file as" in line or "already holds a dataset" in line
-            or "not a dataset folder" in line), line
+    if case in NOT_WRITTEN_THERE:  # the name is no output of the command: refused for that, first
+        assert "unknown extension" in line or "no extension" in line, line
+    else:
+        assert ("input of this run" in line or "the same file as" in line or "already holds a dataset" in line
+                or "not a dataset folder" in line), line
     assert snapshot(work) == before
     assert time.monotonic() - t0 < 60  # refused before the work (identify would take longer)
 

@@ -12,7 +12,8 @@ import warnings
 
 from .. import _io
 from ..errors import ThermofrictionError
-from .commands import cmd_demo, cmd_identify, cmd_report, cmd_simulate, cmd_validate
+from .commands import cmd_demo, cmd_identify, cmd_simulate, cmd_validate
+from .report_command import cmd_report
 from .outputs import _check_outputs
 from .parser import MAX_STARTS, build_parser
 

@@ -10,8 +10,12 @@ from .._version import __version__
 from ..errors import shorten
 from ..models import PRESETS
 from ..simulation import MAX_SAMPLES, SOLVERS
-from .commands import cmd_demo, cmd_identify, cmd_report, cmd_simulate, cmd_validate
+from .commands import cmd_demo, cmd_identify, cmd_simulate, cmd_validate
+from .report_command import cmd_report
+from .outputs import formats_text
+from .init import add_init_command
 from .presets import add_presets_command
+from .propagate import add_propagate_command
 
 
 def _number(positive):
@@ -80,6 +84,13 @@ def _force_options(p):
                         "velocity column where it is the position's derivative, else the position)")
 
 
+def _writes(command, dest, what):
+    """An output option's help: what it writes and the extensions it takes (outputs.FORMATS, the one list)."""
+    how = "by the name's extension; other names are refused" if "or" in formats_text(command, dest) else \
+        "other names are refused"
+    return f"{what}; writes {formats_text(command, dest)} ({how})"
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="thermofriction",
@@ -114,7 +125,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated time [s] (default: 2)")
     s.add_argument("--sample-rate", type=_positive_float, default=10_000.0, metavar="HZ",
                    help="output sample rate [Hz] (default: 10000)")
-    s.add_argument("-o", "--output", metavar="OUT.csv", help="CSV output file ('-' for standard output)")
+    s.add_argument("-o", "--output", metavar="OUT.csv", help=_writes(
+        "simulate", "output", "the simulation: columns as CSV (docs/formats.md#simulation-output) or MATLAB "
+                              "vectors; '-' writes the CSV to standard output"))
     _solver_option(s, "integrator: dopri5 (explicit), rodas4 (stiff), auto (default: dopri5, trying rodas4 when it "
                       "detects stiffness and keeping it only where it is cheaper)")
     s.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
@@ -173,8 +186,11 @@ def build_parser() -> argparse.ArgumentParser:
     _force_options(i)
     i.add_argument("--no-offset", action="store_true",
                    help="force data: the same as --offset none (hold the initial model's [plant] sensor_offset)")
-    i.add_argument("-o", "--output", metavar="FITTED.toml", help="fitted model file")
-    i.add_argument("--json", metavar="RESULTS.json", help="results as JSON")
+    i.add_argument("-o", "--output", metavar="FITTED.toml", help=_writes(
+        "identify", "output", "the fitted model file, loadable by every command that takes a MODEL")
+        + "; with several datasets, the folder DIR that receives NAME.toml and NAME.json per dataset")
+    i.add_argument("--json", metavar="RESULTS.json", help=_writes(
+        "identify", "json", "the results (docs/formats.md#results-json), as JSON or as MATLAB structs"))
     i.add_argument("-q", "--quiet", action="store_true", help="no progress and no report")
     _scheduler_options(i, " (several datasets only)")
     i.set_defaults(run=cmd_identify)
@@ -185,7 +201,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "error, as a table and (with --json) as JSON.")
     v.add_argument("model", metavar="MODEL.toml", help="model file or preset")
     v.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
-    v.add_argument("--json", metavar="METRICS.json", help="metrics as JSON (docs/formats.md#validation-metrics)")
+    v.add_argument("--json", metavar="METRICS.json", help=_writes(
+        "validate", "json", "the metrics (docs/formats.md#validation-metrics), as JSON or as MATLAB structs"))
     _force_options(v)
     v.set_defaults(run=cmd_validate)
 
@@ -195,9 +212,13 @@ def build_parser() -> argparse.ArgumentParser:
                                    "from a JSON file beside each model file (same name, .json), when there is one.")
     r.add_argument("paths", nargs="+", metavar="MODEL.toml... DATASET",
                    help="one or more model files (or presets), then the dataset folder")
-    r.add_argument("-o", "--output", required=True, metavar="REPORT.html", help="the report")
+    r.add_argument("-o", "--output", required=True, metavar="REPORT.html", help=_writes(
+        "report", "output", "the report, one self-contained HTML file"))
     r.add_argument("--figures", metavar="DIR", help="also write every figure as SVG and PNG into DIR")
     r.add_argument("--title", help="the report's title")
+    r.add_argument("--bands", metavar="BANDS.json",
+                   help="add the prediction bands that 'thermofriction propagate -o BANDS.json' wrote (displacement "
+                        "data)")
     r.set_defaults(run=cmd_report)
 
     d = sub.add_parser("demo", help="the main job: synthesise the example dataset, identify, validate, report",
@@ -215,6 +236,9 @@ def build_parser() -> argparse.ArgumentParser:
     add_synth_command(sub)
     _add_sweep_command(sub)
     add_presets_command(sub)
+    add_init_command(sub)
+    add_propagate_command(sub, temperature=_temperature, positive_float=_positive_float, int_in=_int_in,
+                          writes=_writes, scheduler_options=_scheduler_options)
     return p
 
 
@@ -232,7 +256,7 @@ def _add_fmu_command(sub):
         epilog="Examples: thermofriction fmu li2009-model-i -o li2009-model-i.fmu; "
                "thermofriction fmu li2009-model-i -o rt.fmu --solver realtime --step 1e-5")
     f.add_argument("model", metavar="MODEL", help="model file (.toml) or preset name")
-    f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help="the FMU file to write")
+    f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help=_writes("fmu", "output", "the FMU file"))
     f.add_argument("--temperature", type=_finite_float, metavar="C",
                    help="start value of the temperature input [C] (with [heat]: of the ambient temperature)")
     f.add_argument("--model-identifier", metavar="NAME",
@@ -290,9 +314,9 @@ def _add_sweep_command(sub):
     _scheduler_options(w)
     w.add_argument("--batch-size", type=_positive_int, metavar="N",
                    help="points per task (default: about 8 tasks per worker, at most 500 points each)")
-    w.add_argument("-o", "--output", required=True, metavar="SWEEP.csv",
-                   help="the table: CSV ('-' for standard output), or Parquet when the name ends .parquet "
-                        "(needs pyarrow)")
+    w.add_argument("-o", "--output", required=True, metavar="SWEEP.csv", help=_writes(
+        "sweep", "output", "the table: CSV ('-' for standard output), MATLAB vectors (one per column), or "
+                           "Parquet (needs pyarrow)"))
     w.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     w.set_defaults(run=cmd_sweep)
 

@@ -139,6 +139,27 @@ class PropagationResult:
             fh.write(",".join(head) + "\n")
             np.savetxt(fh, np.column_stack(cols), delimiter=",", fmt="%.12g")
 
+    def to_dict(self) -> dict:
+        """Everything the result holds, as plain JSON types (arrays as nested lists, SI units; docs/cli.md#propagate);
+        :func:`load_propagation` reads it back."""
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        fields["failures"] = {str(k): v for k, v in self.failures.items()}
+        return _io.jsonable({"kind": "propagation", "draws": self.draws, **fields})
+
+    def to_json(self, path=None) -> str:
+        """The result as JSON (:meth:`to_dict`), written atomically to ``path`` when given."""
+        return _io.dump_json(self.to_dict(), path)
+
+    def to_mat(self, path):
+        """The result as a MATLAB file: one variable per key of :meth:`to_dict` (bands as temperatures x samples)."""
+        from ..data.matlab_results import save_results_mat
+        save_results_mat(self.to_dict(), path)
+
+    def save(self, path):
+        """By the name's extension: ``.csv`` (:meth:`to_csv`), ``.mat`` (:meth:`to_mat`), else JSON."""
+        name = str(getattr(path, "path", path)).lower()
+        return (self.to_csv if name.endswith(".csv") else self.to_mat if name.endswith(".mat") else self.to_json)(path)
+
     def report(self) -> str:
         lines = [f"[[Propagation]] {self.draws} draws ({len(self.failures)} failed), {100 * self.level:g} % bands"]
         for j, T in enumerate(self.temperatures):
@@ -157,6 +178,58 @@ class PropagationResult:
         """The bands as a matplotlib figure (the report's prediction-band figure)."""
         from .figures import bands_figure
         return bands_figure(self)
+
+def load_propagation(path) -> PropagationResult:
+    """A propagation result from the JSON that :meth:`PropagationResult.to_json` (``thermofriction propagate -o
+    X.json``) wrote; InputError naming the file and the key for anything else."""
+    import json
+    from .._reading import read_input_file
+
+    try:
+        d = json.loads(read_input_file(path, "propagation result (JSON)").decode("utf-8"))
+    except UnicodeDecodeError as e:
+        raise InputError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start})") from None
+    except InputError:
+        raise
+    except (ValueError, RecursionError) as e:
+        raise InputError(f"{path}: not JSON ({e})") from None
+    if not isinstance(d, dict) or d.get("kind") != "propagation":
+        raise InputError(f"{path}: not a propagation result (the JSON that 'thermofriction propagate -o X.json' "
+                         f"writes)")
+    values = {}
+    for f in dataclasses.fields(PropagationResult):
+        if f.name not in d and f.default is dataclasses.MISSING:
+            raise InputError(f"{path}: missing key '{f.name}'")
+        v = d.get(f.name, f.default)
+        try:
+            if f.name in ("names", "where"):
+                ok = isinstance(v, list) and all(isinstance(n, str) for n in v) if f.name == "names" else \
+                    isinstance(v, str)
+                if not ok:
+                    raise ValueError
+            elif f.name == "failures":
+                v = {int(k): str(r) for k, r in v.items()}
+            elif f.name in ("level", "noise", "wall_time"):
+                v = float(v)
+            else:
+                v = np.asarray(v, dtype=float)
+        except (TypeError, ValueError, AttributeError):
+            raise InputError(f"{path}: '{f.name}' is not what a propagation result holds there") from None
+        values[f.name] = v
+    res = PropagationResult(**values)
+    n_T, n_t = res.temperatures.size, res.time.size
+    for name in ("nominal", "median", "lower", "upper", "prediction_lower", "prediction_upper"):
+        if getattr(res, name).shape != (n_T, n_t):
+            raise InputError(f"{path}: '{name}' must have one row of {n_t} samples per temperature ({n_T})")
+    for name in ("nominal_step", "step_lower", "step_upper"):
+        if getattr(res, name).shape != (n_T,):
+            raise InputError(f"{path}: '{name}' must have one value per temperature ({n_T})")
+    if res.parameters.ndim != 2 or res.parameters.shape[1] != len(res.names):
+        raise InputError(f"{path}: 'parameters' must hold one row per draw, one column per name in 'names'")
+    if not 0 < res.level < 1:
+        raise InputError(f"{path}: 'level' must be between 0 and 1, got {res.level:g}")
+    return res
+
 
 def _checked(result, temperatures, draws, seed, input, duration, sample_rate, level, solver, controller, scheduler,
              workers, batch_size, progress):
@@ -257,4 +330,4 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
         wall_time=time.perf_counter() - t0, where=where)
 
 
-__all__ = ["propagate", "PropagationResult", "draw_parameters"]
+__all__ = ["propagate", "PropagationResult", "draw_parameters", "load_propagation"]

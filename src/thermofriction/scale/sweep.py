@@ -244,10 +244,21 @@ class SweepResult:
         with _io.atomic_write(path, "wb") as fh:
             pq.write_table(table, fh)
 
+    def to_mat(self, path):
+        """The table as a MATLAB file: one column vector per CSV column, named as the header with its unit as a
+        suffix (``temperature_C``), and ``error`` a cell array of text (empty where the point ran)."""
+        from ..data.matlab import matlab_name, save_mat
+        names = list(self.coordinates) + list(self.metrics)
+        variables = {matlab_name(self.header(n)): np.asarray(self.columns[n], float) for n in names}
+        variables["error"] = np.array([self.errors.get(i, "") for i in range(len(self))], dtype=object)
+        save_mat(path, variables)
+
     def save(self, path):
-        """``.parquet`` as Parquet (needs pyarrow), anything else as CSV."""
-        name = str(getattr(path, "path", path))
-        return self.to_parquet(path) if name.lower().endswith(".parquet") else self.to_csv(path)
+        """``.parquet`` as Parquet (needs pyarrow), ``.mat`` as a MATLAB file, anything else as CSV."""
+        name = str(getattr(path, "path", path)).lower()
+        if name.endswith(".parquet"):
+            return self.to_parquet(path)
+        return self.to_mat(path) if name.endswith(".mat") else self.to_csv(path)
 
     def __repr__(self):
         return (f"SweepResult({len(self)} points over {', '.join(self.coordinates)}; metrics "

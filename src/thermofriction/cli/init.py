@@ -1,0 +1,259 @@
+"""`thermofriction init DIR`: a dataset manifest (dataset.toml, docs/formats.md#datasets) written from a folder of
+experiment files (docs/cli.md#init)."""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+import re
+import sys
+from pathlib import Path
+
+from .. import _io
+from ..errors import InputError, shorten
+
+#: a temperature in a file name (docs/cli.md#init): a number with a Celsius unit after it (35.2C, 35.2degC,
+#: 35.2°C, 35p2C) or a T or temp before it (T35.2, T_35.2, temp35.2); "p" may stand for the decimal point
+_NUMBER = r"(\d+(?:[.p]\d+)?)"
+_NAME_PATTERNS = (re.compile(_NUMBER + r"\s*(?:°\s*C|deg_?C|C)(?![A-Za-z])", re.IGNORECASE),
+                  re.compile(r"(?<![A-Za-z])(?:T|temp|temperature)[_=-]?" + _NUMBER + r"(?![\d])", re.IGNORECASE))
+#: a file name that says the run is held out (synth's T33C-validate.csv)
+_HELD_OUT = re.compile(r"validat|hold-?out|held-?out", re.IGNORECASE)
+#: the experiment files init lists
+EXTENSIONS = (".csv", ".mat")
+
+
+def add_init_command(sub):
+    p = sub.add_parser(
+        "init", help="write a dataset.toml for a folder of experiment files (CSV, .mat)",
+        description="Write DIR/dataset.toml (docs/formats.md#datasets) listing every experiment file (.csv, .mat) "
+                    "in DIR, with its temperature and role, and check that the dataset loads. A file's temperature "
+                    "is, in this order: --temperature FILE=C; the mean of its temperature column "
+                    "(temperature[C], or temperature/temperature_C in a .mat); a temperature in its name (35.2C, "
+                    "35.2degC, 35p2C, T35.2, temp35.2); else asked for on a terminal. Roles: --validate; else the "
+                    "files whose names say so (validate, holdout, held-out) are held out for validation; else, "
+                    "with 4 or more experiments, about a quarter of them at interior temperatures; the others "
+                    "are fitted.",
+        epilog="example: thermofriction init measurements --temperature run7.csv=36.5 --validate run4.csv")
+    p.add_argument("folder", metavar="DIR", help="the folder of experiment files; dataset.toml is written there")
+    p.add_argument("--temperature", action="append", default=[], metavar="FILE=C",
+                   help="a file's temperature [C], over its column and its name; repeat for more files")
+    p.add_argument("--validate", metavar="FILE,FILE,...",
+                   help="the files held out for validation (role \"validate\"), comma-separated, or 'none' "
+                        "(default: about a quarter, at interior temperatures, with 4 or more experiments)")
+    p.add_argument("--exclude", action="append", default=[], metavar="PATTERN",
+                   help="leave out the files matching a shell pattern, e.g. --exclude 'calib*'; repeat for more")
+    p.add_argument("--name", help="the dataset's name (default: the folder's name)")
+    p.add_argument("--force", action="store_true", help="replace an existing dataset.toml")
+    p.set_defaults(run=cmd_init)
+    return p
+
+
+def experiment_files(folder: Path, exclude=()) -> list[str]:
+    """The experiment files directly in ``folder`` (.csv, .mat; not hidden, not ``exclude``d), sorted."""
+    names = [n for n in os.listdir(folder) if n.lower().endswith(EXTENSIONS) and not n.startswith(".")
+             and (folder / n).is_file() and not any(fnmatch.fnmatch(n, pat) for pat in exclude)]
+    return sorted(names)
+
+
+def temperature_from_name(name: str) -> float | None:
+    """The temperature [C] a file's name states (``run_35.2C.csv``, ``T35.2.csv``, ``35p2degC.mat``), or None
+    when it states none, or several different ones."""
+    stem = os.path.splitext(name)[0]
+    found = set()
+    for pattern in _NAME_PATTERNS:
+        found |= {float(m.group(1).replace("p", ".").replace("P", ".")) for m in pattern.finditer(stem)}
+    return found.pop() if len(found) == 1 else None
+
+
+def has_temperature_column(path: Path) -> bool:
+    """Whether an experiment file records a temperature: a CSV header cell temperature[...] (first line only),
+    or a .mat variable temperature / temperature_C."""
+    if path.suffix.lower() == ".mat":
+        import scipy.io
+        try:
+            names = [v[0] for v in scipy.io.whosmat(path)]
+        except Exception:  # noqa: BLE001 - not a readable MATLAB file: loading the dataset says why
+            return False
+        return any(n in ("temperature", "temperature_C") for n in names)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.readline(1 << 16).decode("utf-8-sig", errors="replace")
+    except OSError:
+        return False
+    return any(cell.partition("[")[0].strip().lower() == "temperature" for cell in head.split(","))
+
+
+def _explicit(items, files) -> dict:
+    """--temperature FILE=C, checked: {file: temperature}."""
+    from ..data.files import check_temperature
+    out = {}
+    for item in items:
+        name, eq, value = item.rpartition("=")
+        if not eq or not name:
+            raise InputError(f"--temperature {shorten(item)}: expected FILE=C, e.g. --temperature run3.csv=35.2")
+        if name not in files:
+            raise InputError(f"--temperature {shorten(item)}: {shorten(name)} is not one of the experiment files "
+                             f"({', '.join(files[:5])}{', ...' if len(files) > 5 else ''})")
+        try:
+            out[name] = check_temperature(float(value), f"--temperature {name}")
+        except ValueError:
+            raise InputError(f"--temperature {shorten(item)}: {shorten(value)} is not a number [C]") from None
+    return out
+
+
+def _ask(name: str) -> float:
+    """A file's temperature asked for on the terminal, until it is a plausible one."""
+    from ..data.files import check_temperature
+    while True:
+        try:
+            text = input(f"temperature of {name} [C]: ").strip()
+        except EOFError:
+            raise InputError(f"{name}: no temperature given") from None
+        try:
+            return check_temperature(float(text), name)
+        except ValueError:  # (an InputError is a ValueError too: the range)
+            print(f"  not a plausible temperature [C]: {text!r}", file=sys.stderr)
+
+
+def _plausible(T) -> bool:
+    """A temperature a file name states that a dataset would take (not the 500 of a run's number, say)."""
+    from ..data.experiments import TEMPERATURE_RANGE
+    return T is not None and TEMPERATURE_RANGE[0] <= T <= TEMPERATURE_RANGE[1]
+
+
+def temperatures(folder: Path, files, explicit: dict, interactive: bool) -> dict:
+    """{file: (temperature or None for the column's mean, where it came from)}; the files whose temperature is
+    nowhere are asked for (``interactive``) or refused, all named in one message."""
+    out = {}
+    for f in files:
+        if f in explicit:
+            out[f] = (explicit[f], "--temperature")
+        elif has_temperature_column(folder / f):
+            out[f] = (None, "column")
+        elif _plausible(temperature_from_name(f)):
+            out[f] = (temperature_from_name(f), "name")
+    unknown = [f for f in files if f not in out]
+    if unknown and not interactive:
+        listed = ", ".join(unknown[:8]) + (f", ... ({len(unknown)} files)" if len(unknown) > 8 else "")
+        raise InputError(f"{folder}: no temperature for {listed}: the file has no temperature column and its name "
+                         f"states none; give --temperature FILE=C (e.g. --temperature {unknown[0]}=35.2), name the "
+                         f"file with its temperature (run_35.2C.csv), or run init on a terminal to be asked")
+    for f in unknown:
+        out[f] = (_ask(f), "asked")
+    return out
+
+
+def default_validation(order) -> list:
+    """The files held out by default, from the files sorted by temperature: none with fewer than 4; else about a
+    quarter (at least one), evenly spread over the interior temperatures (validation inside the fitted range)."""
+    n = len(order)
+    if n < 4:
+        return []
+    k = max(1, round(n / 4))
+    return [order[round((i + 1) * (n - 1) / (k + 1))] for i in range(k)]
+
+
+def roles(files, temps: dict, validate, folder: Path) -> tuple[dict, str]:
+    """({file: "fit" | "validate"}, how the split was made)."""
+    if validate is not None:
+        chosen = [] if validate.strip().lower() == "none" else [v.strip() for v in validate.split(",") if v.strip()]
+        for v in chosen:
+            if v not in files:
+                raise InputError(f"--validate: {shorten(v)} is not one of the experiment files in {folder}")
+        how = "held out as you chose (--validate)" if chosen else "none held out (--validate none)"
+    elif any(_HELD_OUT.search(f) for f in files):
+        chosen = [f for f in files if _HELD_OUT.search(f)]
+        how = (f"{len(chosen)} of {len(files)} held out where the file name says so ('validat...', 'holdout', "
+               f"'held-out'; --validate chooses others)")
+    else:
+        mean = {f: _mean_temperature(folder / f) if T is None else T for f, (T, _) in temps.items()}
+        chosen = default_validation(sorted(files, key=lambda f: mean[f]))
+        how = (f"the default split: {len(chosen)} of {len(files)} held out at interior temperatures (--validate "
+               f"chooses others)" if chosen else
+               f"all fitted: with fewer than 4 experiments none is held out by default (report needs one: "
+               f"--validate FILE)")
+    return {f: "validate" if f in chosen else "fit" for f in files}, how
+
+
+def _mean_temperature(path: Path) -> float:
+    """The mean of an experiment file's temperature column (for ordering the files; the dataset's loading says
+    what is wrong with a file)."""
+    import numpy as np
+
+    from ..data import read_experiment_csv, read_experiment_mat
+    from ..data.force import is_force_file
+    try:
+        if path.suffix.lower() == ".mat":
+            from ..data.matlab import read_force_mat
+            cols = read_force_mat(path, struct=None, units=None) or read_experiment_mat(path)
+        elif is_force_file(path):
+            from ..data.force import read_force_csv
+            cols = read_force_csv(path)
+        else:
+            cols = read_experiment_csv(path)
+        return float(np.mean(cols["temperature"]))
+    except (InputError, KeyError, TypeError):
+        return float("nan")
+
+
+def manifest_text(name, files, temps, role_of) -> str:
+    import tomli_w
+    entries = []
+    for f in files:
+        entry = {"file": f}
+        if temps[f][0] is not None:
+            entry["temperature"] = temps[f][0]
+        entry["role"] = role_of[f]
+        entries.append(entry)
+    head = ("# written by 'thermofriction init' (docs/formats.md#datasets); an experiment without 'temperature' takes "
+            "the mean of its temperature column\n")
+    return head + tomli_w.dumps({"name": name}) + "".join("\n[[experiment]]\n" + tomli_w.dumps(e) for e in entries)
+
+
+def write_checked(folder: Path, text: str):
+    """Writes dataset.toml and loads the dataset; when it does not load, the folder is left as it was (the old
+    manifest back, or none) and the error names the file."""
+    from ..data import load_dataset
+
+    manifest = folder / "dataset.toml"
+    old = manifest.read_bytes() if manifest.is_file() else None
+    with _io.atomic_write(manifest, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    try:
+        return load_dataset(folder)
+    except InputError as e:
+        if old is None:
+            manifest.unlink()
+        else:
+            with _io.atomic_write(manifest, "wb") as fh:
+                fh.write(old)
+        raise InputError(f"{e} -- so {manifest} was not written (leave a file out with --exclude, give a temperature "
+                         f"with --temperature FILE=C, or fix the file)") from None
+
+
+def cmd_init(args) -> int:
+    folder = Path(args.folder)
+    if not folder.is_dir():
+        raise InputError(f"{args.folder}: {'not a folder' if folder.exists() else 'no such folder'}")
+    manifest = folder / "dataset.toml"
+    if (manifest.exists() or manifest.is_symlink()) and not args.force:
+        raise InputError(f"{manifest}: already exists; give --force to replace it")
+    files = experiment_files(folder, args.exclude)
+    if not files:
+        raise InputError(f"{args.folder}: no experiment files ({', '.join(EXTENSIONS)}) in this folder")
+    explicit = _explicit(args.temperature, files)
+    temps = temperatures(folder, files, explicit, interactive=sys.stdin is not None and sys.stdin.isatty())
+    role_of, how = roles(files, temps, args.validate, folder)
+    data = write_checked(folder, manifest_text(args.name or folder.resolve().name, files, temps, role_of))
+    width = max(map(len, files))
+    source = {"--temperature": "given", "column": "mean of its temperature column", "name": "from the file name",
+              "asked": "as you typed it"}
+    for e in data.experiments:
+        print(f"  {e.file:<{width}}  {e.temperature:8.4g} C  {e.role:<8}  ({source[temps[e.file][1]]})")
+    print(f"roles: {how}")
+    print(f"wrote {manifest} ({len(data.fit)} fit, {len(data.validate)} validate)")
+    return 0
+
+
+__all__ = ["add_init_command", "cmd_init", "temperature_from_name", "default_validation", "experiment_files"]
