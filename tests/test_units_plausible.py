@@ -5,6 +5,7 @@ warning must name it, the header and the unit that explains it, and a correct fi
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 import sys
@@ -15,6 +16,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from thermofriction.identify import front
 from thermofriction.data.force import write_force_csv
 from thermofriction.unit_scale import SUGGEST_WITHIN, TRUST_RATIO, suggestion, unit_warnings
 
@@ -86,13 +88,23 @@ def test_a_displacement_of_metres_beyond_any_actuator_travel_is_warned_at_loadin
     assert loading == []
 
 
-def test_identify_warns_before_the_fit_from_the_initial_model_and_carries_it(actuator):
-    """The fit is cut short (one start, 3 evaluations): the warning comes from the initial model, before it."""
+class _Stop(Exception):
+    pass
+
+
+def _stop(*args, **kwargs):
+    raise _Stop
+
+
+def test_identify_warns_before_the_fit_from_the_initial_model(actuator, monkeypatch):
+    """The warning comes from the initial model, before the fit, which is replaced here by a stop (a fit on values
+    1000x off takes seconds per simulation); the result carrying it is tested on force data."""
     data, _ = _load(actuator("mm"))
+    monkeypatch.setattr(front, "_fit", _stop)
     with pytest.warns(tf.UnitWarning, match=r"displacement\[mm\] are ~1,000× what the initial model produces"):
-        fit = tf.identify(data, "base", init=MODEL, starts=1, max_evaluations=3)
-    assert fit.warnings[0].startswith("suspicious unit: T32C.csv, T38C-validate.csv")
-    assert "µm" in fit.warnings[0] and fit.to_dict()["warnings"][0] == fit.warnings[0]
+        with pytest.raises(_Stop):
+            tf.identify(data, "base", init=MODEL, starts=1)
+    monkeypatch.undo()
     ok, _ = _load(actuator("um"))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -139,9 +151,24 @@ def test_millinewtons_under_a_newton_header_are_caught(tmp_path):
     assert raised[0].startswith("suspicious unit: run1.csv: the values under column friction_force[N] are ~1,000× "
                                 "what the model produces")
     assert "are they in mN (header friction_force[mN])?" in raised[0]
-    with pytest.warns(tf.UnitWarning, match=r"friction_force\[N\] are ~1,000× what the initial model"):
+    with pytest.warns(tf.UnitWarning, match=r"friction_force\[N\] are ~1,000× what the initial model") as caught:
         fit = tf.identify(wrong, "base", init=STAGE, starts=1, max_evaluations=3)
-    assert "are they in mN" in fit.warnings[0]
+    assert [w.filename for w in caught if issubclass(w.category, tf.UnitWarning)] == [__file__]  # the user's line
+    assert fit.warnings[0].startswith("suspicious unit: run1.csv") and "are they in mN" in fit.warnings[0]
+    assert fit.to_dict()["warnings"][0] == fit.warnings[0]  # in the results JSON too
+
+
+def test_cli_identify_prints_the_warning_and_exits_0(tmp_path):
+    _force_dataset(tmp_path / "mN", 1e3, "friction_force[N]")
+    STAGE.save(tmp_path / "stage.toml")
+    r = run_cli("identify", tmp_path / "mN", "--method", "base", "--init", tmp_path / "stage.toml", "--starts", "1",
+                "--max-evaluations", "3", "-o", tmp_path / "fit.toml", "--json", tmp_path / "fit.json")
+    assert r.returncode == 0, r.stderr
+    lines = [x for x in r.stderr.splitlines() if "suspicious unit" in x]
+    assert len(lines) == 1 and lines[0].startswith("thermofriction: warning: suspicious unit: run1.csv: the values "
+                                                   "under column friction_force[N] are ~1,000×")
+    assert "are they in mN" in r.stdout  # the report's [[Warnings]]
+    assert json.loads((tmp_path / "fit.json").read_text())["warnings"][0].startswith("suspicious unit: run1.csv")
 
 
 # -- the rule -------------------------------------------------------------------------------------------------------

@@ -133,10 +133,10 @@ def _problem(exp, measured, predicted):
     return ratio, label, unit, spans
 
 
-def unit_warnings(pairs, what="the model") -> list:
+def unit_warnings(pairs, what="the model", stacklevel=3) -> list:
     """The warnings over (experiment, measured, predicted) triples: one per column and suggested unit (a dataset
     whose every file has the same header says it once, naming the files), each issued as a :class:`UnitWarning`
-    too."""
+    too (``stacklevel``: 3 names the caller of the function that calls this one)."""
     groups = {}
     for exp, measured, predicted in pairs:
         found = _problem(exp, measured, predicted)
@@ -154,7 +154,7 @@ def unit_warnings(pairs, what="the model") -> list:
         out.append(f"{PREFIX}{files}: {where} are {_factor(ratio)} {what} produces for {these} ({detail})"
                    f"{_advice(label, unit, ratio)}")
     for m in out:
-        warnings.warn(m, UnitWarning, stacklevel=3)
+        warnings.warn(m, UnitWarning, stacklevel=stacklevel)
     return out
 
 
@@ -171,7 +171,7 @@ def model_unit_warnings(model, experiments, measurement, rtol=1e-6) -> list:
             except (ThermofrictionError, ArithmeticError):
                 continue
         pairs.append((exp, p.measured, p.predicted))
-    return unit_warnings(pairs, "the initial model")
+    return unit_warnings(pairs, "the initial model", stacklevel=6)  # identify's caller, past its two decorators
 
 
 __all__ = ["TRUST_RATIO", "SUGGEST_WITHIN", "PREFIX", "split_unit", "span_ratio", "suggestion",
