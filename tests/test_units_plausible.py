@@ -203,3 +203,16 @@ def test_a_model_that_does_not_move_is_no_evidence():
     with warnings.catch_warnings():
         warnings.simplefilter("error", tf.UnitWarning)
         assert unit_warnings([(_Exp(), np.array([0.0, 1e-3]), np.zeros(2))]) == []
+
+
+def test_the_reports_first_warning_is_the_suspicious_unit():
+    """docs/your-data.md, step 5: the unit explains every error after it, so it is said before the fit's."""
+    from types import SimpleNamespace
+
+    from thermofriction.report.displacement import _warnings
+    fit = {"fit_quality": {"adequate": False}, "warnings": ["the fit is not adequate: RMSE 1000 times the noise"]}
+    validation = SimpleNamespace(failures=[], warnings=["T20C.csv: temperature 20 C is outside the calibrated range",
+                                                        "suspicious unit: T20C.csv: the values under column ..."])
+    warns = _warnings([SimpleNamespace(label="Model I", fit=fit, validation=validation)])
+    assert warns[0] == "Model I: suspicious unit: T20C.csv: the values under column ..."
+    assert warns[1].startswith("Model I: the fit is not adequate") and len(warns) == 3
