@@ -216,3 +216,13 @@ def test_the_reports_first_warning_is_the_suspicious_unit():
     warns = _warnings([SimpleNamespace(label="Model I", fit=fit, validation=validation)])
     assert warns[0] == "Model I: suspicious unit: T20C.csv: the values under column ..."
     assert warns[1].startswith("Model I: the fit is not adequate") and len(warns) == 3
+
+
+def test_a_matlab_variable_is_named_by_its_name_and_suffix(actuator, tmp_path):
+    from thermofriction.data.matlab import save_mat
+    e = tf.load_dataset(actuator("um")).experiments[0]
+    save_mat(tmp_path / "run.mat", {"time": e.time, "voltage": e.voltage, "displacement_mm": e.displacement * 1e6})
+    (tmp_path / "dataset.toml").write_text('[[experiment]]\nfile = "run.mat"\ntemperature = 32.0\n')
+    _, raised = _validate(tf.load_model(MODEL), tf.load_dataset(tmp_path))
+    assert len(raised) == 1 and "run.mat: the values under variable 'displacement_mm' are ~1,000×" in raised[0]
+    assert "are they in µm (declare um: the variable's suffix, or the manifest's units table)?" in raised[0]

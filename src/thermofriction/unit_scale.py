@@ -108,17 +108,19 @@ def _advice(label: str, unit: str, ratio: float) -> str:
     """The unit that would explain ``ratio``, and how to declare it."""
     better = suggestion(unit, ratio)
     if better is None:
-        return (f": no unit explains a factor this far from a power of 1000; check the header's unit, the scale of "
-                f"the sensor, and whether the model is this plant's")
+        return (": no unit explains a factor this far from a power of 1000; check the header's unit, the sensor's "
+                "scale, and whether the model is this plant's")
     ascii_unit = better.replace("µ", "u")
     if ascii_unit not in _DECLARABLE:
-        how = f"; the file cannot declare {better}: convert the values to {split_unit(better)[1]}"
+        how = f" (the file cannot declare {better}: convert the values to {split_unit(better)[1]})"
     elif label.startswith("column "):
         how = f" (header {label[7:].partition('[')[0].strip()}[{ascii_unit}])"
+    elif label.startswith(("variable ", "struct ")):
+        how = f" (declare {ascii_unit}: the variable's suffix, or the manifest's units table)"
     else:
-        how = f" (declare {ascii_unit})"
-    other = " (or the torque_constant is)" if unit.endswith("A") else ""
-    return f": are they in {better}{how}? If they are not{other}, the model is far from this plant"
+        how = f" (an Experiment made in memory holds {split_unit(better)[1]})"
+    other = "the torque_constant is off or " if unit.endswith("A") else ""
+    return f": are they in {better}{how}? If they are not, {other}the model is far from this plant"
 
 
 def _problem(exp, measured, predicted):
@@ -149,7 +151,7 @@ def unit_warnings(pairs, what="the model", stacklevel=3) -> list:
         ratio = float(np.median([r for _, r, _ in runs]))
         these = "this experiment" if len(runs) == 1 else "these experiments"
         detail = runs[0][2] if len(runs) == 1 else f"the median ratio; {runs[0][0]}: {runs[0][2]}"
-        where = f"the values under {label}" if label.startswith(("column ", "variable ", "field ")) else \
+        where = f"the values under {label}" if label.startswith(("column ", "variable ", "struct ")) else \
             f"{label}'s values (in {unit})"
         out.append(f"{PREFIX}{files}: {where} are {_factor(ratio)} {what} produces for {these} ({detail})"
                    f"{_advice(label, unit, ratio)}")
