@@ -21,7 +21,7 @@ MIN_DISPLACEMENT_SPAN = 1e-11
 SUSPICIOUS = "suspicious unit: "
 
 #: [m] an actuator's displacement record spanning more than this is warned about at loading (UnitWarning):
-#: stick-slip positioners travel at most ~0.1 m, so a larger span is most likely µm or mm values under an [m]
+#: stick-slip positioners travel millimetres, at most some tenths of a metre, so a larger span is most likely µm or mm values under an [m]
 #: header (30 µm read as 30 m). Not refused: the model, where one meets the data, judges more finely
 #: (unit_scale.py)
 MAX_DISPLACEMENT_SPAN = 1.0
@@ -79,8 +79,8 @@ def displacement_doubt(x, unit: str) -> str | None:
     span = float(np.ptp(x)) if x.size else 0.0
     if not span > MAX_DISPLACEMENT_SPAN:
         return None
-    return (f"the displacement spans {span:.3g} m, more than an actuator's travel (up to ~0.1 m): are the values "
-            f"in um or mm under a [{unit}] header? (give the unit the numbers are in)")
+    return (f"the displacement spans {span:.3g} m, more than an actuator travels (millimetres, at most some tenths "
+            f"of a metre): are the values in um or mm under a [{unit}] header? (give the unit the numbers are in)")
 
 
 def voltage_problem(v) -> str | None:
