@@ -12,8 +12,7 @@ extensions (Li et al., Rev. Sci. Instrum. 80,
 
 from ._version import __version__
 from .errors import (ComputationError, ConditioningWarning, InputError, PassivityWarning, SolverError,
-                     TemperatureRangeWarning,
-                     ThermofrictionError)
+                     TemperatureRangeWarning, ThermofrictionError, UnitWarning)
 from .models import (GMS, PARAMETERS, PRESETS, PWL, Const, Coulomb, Dahl, ElastoPlastic, Exp, Heat, Law, Linear, LuGre,
                      MassPlant, Model, ModelI, ModelII, Poly, PrescribedMotion, StickSlipPlant, Stribeck, Table,
                      load_model)
@@ -44,7 +43,7 @@ def __getattr__(name):
 
 __all__ = [
     "ComputationError", "ConditioningWarning", "InputError", "PassivityWarning", "SolverError", "TemperatureRangeWarning",
-    "ThermofrictionError",
+    "ThermofrictionError", "UnitWarning",
     "PARAMETERS", "PRESETS", "PWL", "Const", "Exp", "Law", "Linear", "Model", "ModelI", "ModelII", "Poly", "Table",
     "Heat", "load_model",
     "StickSlipPlant", "MassPlant", "PrescribedMotion",

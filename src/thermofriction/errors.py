@@ -40,6 +40,11 @@ class ConditioningWarning(UserWarning):
     """The model is ill-conditioned where it will be simulated (default tolerances may not be enough)."""
 
 
+class UnitWarning(UserWarning):
+    """A record's values look like another unit than their header declares (docs/your-data.md#units): a scale
+    implausible for the plant, or a power of 1000 off what the model produces for the same experiment."""
+
+
 def shorten(value, limit: int = 60) -> str:
     """``repr(value)``, cut to about ``limit`` characters: a message quotes what it refuses, but a
     1 MB key or value is not echoed back whole."""

@@ -17,6 +17,15 @@ TEMPERATURE_RANGE = (-100.0, 300.0)
 #: (capacitive sensors resolve ~1e-10 m): its values are most likely in another unit than the header's
 MIN_DISPLACEMENT_SPAN = 1e-11
 
+#: what every warning of a suspected unit starts with (here and unit_scale.py; the report puts them first)
+SUSPICIOUS = "suspicious unit: "
+
+#: [m] an actuator's displacement record spanning more than this is warned about at loading (UnitWarning):
+#: stick-slip positioners travel millimetres, at most some tenths of a metre, so a larger span is most likely µm or mm values under an [m]
+#: header (30 µm read as 30 m). Not refused: the model, where one meets the data, judges more finely
+#: (unit_scale.py)
+MAX_DISPLACEMENT_SPAN = 1.0
+
 #: [V] the largest plausible actuator drive voltage in recorded data: piezo stick-slip actuators are driven
 #: at up to ~150 V, high-voltage stacks at up to ~1 kV; beyond 10 kV a value is in another unit or corrupt
 VOLTAGE_LIMIT = 1e4
@@ -63,6 +72,17 @@ def displacement_problem(x, unit: str) -> str | None:
     return None
 
 
+def displacement_doubt(x, unit: str) -> str | None:
+    """Why an actuator's displacement record (in metres, read under a ``[unit]`` header) looks like another
+    unit, though it may be one, or None: a span above :data:`MAX_DISPLACEMENT_SPAN`."""
+    x = np.asarray(x, float)
+    span = float(np.ptp(x)) if x.size else 0.0
+    if not span > MAX_DISPLACEMENT_SPAN:
+        return None
+    return (f"the displacement spans {span:.3g} m, more than an actuator travels (millimetres, at most some tenths "
+            f"of a metre): are the values in um or mm under a [{unit}] header? (give the unit the numbers are in)")
+
+
 def voltage_problem(v) -> str | None:
     """Why a voltage record [V] (or one value) is not an actuator's drive voltage, or None: where its
     largest magnitude exceeds :data:`VOLTAGE_LIMIT`, that value and its 1-based sample number."""
@@ -103,4 +123,4 @@ def parse_length(text: str, what: str) -> float:
 
 
 __all__ = ["kelvin_hint", "TEMPERATURE_RANGE", "VOLTAGE_LIMIT", "voltage_problem", "input_voltage_problem", "MIN_DISPLACEMENT_SPAN", "temperature_problem", "check_temperature",
-           "displacement_problem", "parse_length"]
+           "displacement_problem", "displacement_doubt", "MAX_DISPLACEMENT_SPAN", "SUSPICIOUS", "parse_length"]

@@ -14,6 +14,7 @@ from .data.experiments import Dataset
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .results import Result
+from .unit_scale import unit_warnings
 
 
 @dataclasses.dataclass
@@ -164,7 +165,8 @@ def validate(model: Model, data, experiments=None, *, offset=None) -> Validation
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
     zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
-    it, held-out runs included). Temperatures outside a law's calibrated range are reported as warnings."""
+    it, held-out runs included). Temperatures outside a law's calibrated range are reported as warnings, and so
+    is a record whose span is a power of 1000 off the prediction's (unit_scale.py; also a UnitWarning)."""
     _args.model(model, Model)
     _args.dataset(data, Dataset, experiments=True)
     _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)
@@ -173,17 +175,19 @@ def validate(model: Model, data, experiments=None, *, offset=None) -> Validation
         raise InputError("the dataset has no experiments")
     measurement = measurement_of(exps, offset=offset)  # asked once
     measurement.check_model(model, exps)
-    caught, preds, failures = [], [], []
+    caught, preds, failures, pairs = [], [], [], []
     for exp in exps:
         with warnings.catch_warnings(record=True) as w:
             warnings.simplefilter("always", TemperatureRangeWarning)
             warnings.simplefilter("always", MetricWarning)
             try:
                 preds.append(measurement.predict(model, exp))
+                pairs.append((exp, preds[-1].measured, preds[-1].predicted))
             except ThermofrictionError as e:  # one experiment the model cannot run: say why, go on
                 failures.append(Failure(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
         caught += [f"{exp.file}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
         caught += [str(x.message) for x in w if issubclass(x.category, MetricWarning)]
+    caught = unit_warnings(pairs) + caught  # (first: a unit off by 1000 explains every error after it)
     return ValidationResult(model, preds, caught, failures, measurement)
 
 

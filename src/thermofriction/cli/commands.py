@@ -5,11 +5,12 @@ from __future__ import annotations
 import math
 import sys
 import time
+import warnings
 
 import numpy as np
 
 from .. import _io
-from ..errors import InputError
+from ..errors import InputError, UnitWarning
 from ..models import PRESETS, MassPlant, load_model
 from ..simulation import SOLVERS, StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
@@ -222,7 +223,8 @@ def cmd_validate(args) -> int:
     model = load_model(args.model)
     data = load_dataset(args.dataset, motion=args.motion)
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
-    res = validate(model, data, offset=args.offset)
+    with warnings.catch_warnings(action="ignore", category=UnitWarning):  # in res.warnings, printed below
+        res = validate(model, data, offset=args.offset)
     if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")

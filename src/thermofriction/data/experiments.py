@@ -60,6 +60,9 @@ class Experiment:
     input: Waveform | None = None
     #: in a MATLAB file holding several runs, the struct holding this one (docs/formats.md#matlab-files)
     struct: str | None = None
+    #: per column read ("displacement", "force", ...): (where the file holds it, the unit its header declared),
+    #: what a unit warning names (unit_scale.py); None for an experiment made in memory
+    headers: dict | None = dataclasses.field(default=None, repr=False)
 
     @property
     def sample_rate(self) -> float:

@@ -7,19 +7,21 @@ import contextlib
 import dataclasses
 import math
 import tomllib
+import warnings
 from pathlib import Path, PurePosixPath
 
 import numpy as np
 
 from .._reading import read_text
 from .. import _args
-from ..errors import InputError, shorten, unknown_keys
+from ..errors import InputError, UnitWarning, shorten, unknown_keys
 from ..waveforms import parse_waveform
 from .csv import read_experiment_csv
 from .command import check_torque_constant
 from .force import check_motion_option, force_experiment, is_force_data, is_force_file, units_of
 from .matlab import is_matlab, read_force_mat
-from ..plausible import displacement_problem, input_voltage_problem, kelvin_hint, voltage_problem
+from ..plausible import (SUSPICIOUS, displacement_doubt, displacement_problem, input_voltage_problem, kelvin_hint,
+                         voltage_problem)
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "torque_constant", "experiment")
@@ -208,6 +210,9 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
                 problem = displacement_problem(cols[column], unit)
                 if problem:
                     raise InputError(f"{folder / f}: {label}: {problem}")
+                doubt = displacement_doubt(cols[column], unit)
+                if doubt:
+                    warnings.warn(f"{SUSPICIOUS}{folder / f}: {label}: {doubt}", UnitWarning, stacklevel=2)
         problem = voltage_problem(cols["voltage"])
         if problem:
             raise InputError(f"{folder / f}: {headers['voltage'][0]}: {problem}")
@@ -220,7 +225,7 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
         exps.append(Experiment(file=f, time=cols["time"], voltage=cols["voltage"], displacement=cols["displacement"],
                                temperature=T, temperature_signal=sig,
                                stage_displacement=cols.get("stage_displacement"), role=role, description=desc,
-                               input=inp, struct=e.get("struct")))
+                               input=inp, struct=e.get("struct"), headers=headers))
     try:  # one kind of experiment per dataset, and force data in one kind of units (data/force.py)
         if is_force_data(exps):
             units_of(exps)

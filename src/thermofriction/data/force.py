@@ -353,7 +353,18 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
                            temperature_signal=sig, role=role, description=description,
                            input=motion_waveform(t, drive_v), force=F, velocity=v, rotary=cols["rotary"],
                            struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
-                           column=column)
+                           column=column, headers=_headers(path, cols))
+
+
+def _headers(path, cols) -> dict:
+    """Per column read, (where the file holds it, the unit its header declared): what a unit warning names
+    (unit_scale.py). A MATLAB file's variables come with their units (``cols["units"]``), a CSV file's header
+    cells hold theirs."""
+    units = cols.get("units")
+    if units is not None:
+        return {k: (where, units[k]) for k, where in cols.get("headers", {}).items() if k in units}
+    return {k: (f"column {cell}", header_cell(path, 0, cell, _SI, EXAMPLE)[1]) for k, cell in
+            cols.get("headers", {}).items()}
 
 
 def write_force_csv(path, time, position, force, *, velocity=None, temperature=None, rotary=False, column=None):

@@ -238,8 +238,8 @@ def _run_variables(path, variables: dict, struct):
 def read_force_mat(path, struct: str | None = None, units: dict | None = None, *, variables=None) -> dict | None:
     """Reads one force (torque) experiment from a MATLAB file into SI arrays, as
     :func:`thermofriction.data.force.read_force_csv` does from a CSV file: a dict with ``time``, ``position``,
-    ``force``, ``rotary``, ``headers`` and, where present, ``velocity`` and ``temperature``. The vectors are
-    named as the CSV columns with the unit a suffix (``time``, ``position_rad``, ``velocity_deg_per_s``,
+    ``force``, ``rotary``, ``headers``, ``units`` (key -> the unit read) and, where present, ``velocity`` and
+    ``temperature``. The vectors are named as the CSV columns with the unit a suffix (``time``, ``position_rad``, ``velocity_deg_per_s``,
     ``friction_torque_N_m``, ``friction_force_mN``, ``temperature``; no suffix: SI), the file's variables or
     the fields of struct ``struct``; ``units`` gives units of variables without a suffix (the manifest's table).
 
@@ -307,6 +307,7 @@ def read_force_mat(path, struct: str | None = None, units: dict | None = None, *
                        lambda row: f"element {row + 1}")
     out["rotary"] = rotary
     out["headers"] = {key: f"{origin} '{var}'" for key, (var, _, _) in found.items()}
+    out["units"] = {key: unit for key, (_, _, unit) in found.items()}
     return out
 
 

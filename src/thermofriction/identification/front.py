@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import _args
 from ..data.experiments import TEMPERATURE_RANGE, Dataset
-from ..errors import InputError, ThermofrictionError, shorten
+from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
 from .held import with_held_tests
 from .model_i import identify_model_i
@@ -28,6 +28,7 @@ from .provenance import stamped
 from .result import FitResult
 from .setup import SETUP
 from ..validation import validate
+from ..unit_scale import model_unit_warnings
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
@@ -152,8 +153,25 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     free = _plant_parameters(init, free, method)
     if method == "plant":
         return _identify_plant(getattr(data, "experiments", data), init)
+    # every experiment's unit against the initial model's prediction, before the fit: said at once (unit_scale.py)
+    units = model_unit_warnings(init, getattr(data, "experiments", experiments), measurement)
     if method == "heat":
-        return identify_heat(experiments, init, parameters, free=free, progress=progress, **opts)
+        res = identify_heat(experiments, init, parameters, free=free, progress=progress, **opts)
+        res.warnings[:0] = units
+        return res
+    res = _fit(method, experiments, init, parameters, free, procedure, reference_temperature, laws, refine, progress,
+               measurement, opts)
+    res = finish(res, experiments, init, measurement)
+    res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
+    held = list(getattr(data, "validate", None) or [])
+    res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
+    res.warnings[:0] = units
+    return res
+
+
+def _fit(method, experiments, init, parameters, free, procedure, reference_temperature, laws, refine, progress,
+         measurement, opts):
+    """The procedure of method "base", "model-i" or "model-ii" from the initial model."""
     if method == "base":
         model = base_model(init)
         if free:
@@ -172,10 +190,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         res = identify_model_ii(experiments, init, procedure=procedure, reference_temperature=reference_temperature,
                                 refine=refine, progress=progress, free=free, measurement=measurement,
                                 parameters=parameters, **opts)
-    res = finish(res, experiments, init, measurement)
-    res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
-    held = list(getattr(data, "validate", None) or [])
-    return _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
+    return res
 
 
 #: held-out RMS over fit RMS above which a fit is said not to generalise
@@ -188,7 +203,9 @@ def _with_generalisation(res, data, held, measurement):
     ``fit_quality["generalisation"]``, and a warning where it is large. It says what the noise estimate
     cannot when the residuals are correlated."""
     try:
-        v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None)
+        with warnings.catch_warnings():  # (the units were checked against the initial model: identify)
+            warnings.simplefilter("ignore", UnitWarning)
+            v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None)
     except ThermofrictionError as e:
         res.warnings.append(f"the held-out experiments could not be predicted: {e}")
         return res

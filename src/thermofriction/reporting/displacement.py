@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..models import ModelI, ModelII
+from ..plausible import SUSPICIOUS
 from ..validation import validate
 from .entries import COMPARISON_COLUMNS, EXPERIMENT_COLUMNS, akaike, comparison_rows, parameter_section
 from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
@@ -87,7 +88,8 @@ def _cards(entries, exps) -> str:
 
 
 def _warnings(entries) -> list:
-    """Never silently: a fit that misses the data, or did not converge, first, and in every report."""
+    """Never silently, and in every report: a suspicious unit first, then a fit that misses the data or did not
+    converge."""
     fit_warnings = {e.label: list((e.fit or {}).get("warnings", [])) for e in entries}
     warns = []
     for e in entries:
@@ -99,7 +101,7 @@ def _warnings(entries) -> list:
               if (e.fit or {}).get("success") is False]
     warns += [f"{e.label}: {f.file} could not be predicted: {f.reason}" for e in entries for f in e.validation.failures]
     warns += [f"{e.label}: {w}" for e in entries for w in e.validation.warnings + fit_warnings[e.label]]
-    return warns
+    return sorted(warns, key=lambda w: SUSPICIOUS not in w)  # a unit 1000x off first: it explains the rest
 
 
 def _errors_section(entries) -> str:

@@ -14,6 +14,7 @@ from ..errors import InputError
 from ..measurements import steady_state_curve
 from ..measurements.command import implied_friction
 from ..models import ModelI, ModelII
+from ..plausible import SUSPICIOUS
 from ..validation import validate
 from .entries import akaike_scaled
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
@@ -232,6 +233,7 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
             warns.append(f"{e.label}: the fit did not converge: {f.get('message', '')}")
         warns += [f"{e.label}: {x.file} could not be predicted: {x.reason}" for x in e.validation.failures]
         warns += [f"{e.label}: {w}" for w in e.validation.warnings]
+    warns.sort(key=lambda w: SUSPICIOUS not in w)  # a unit 1000x off first: it explains the rest
     if warns:
         parts.append("<section><h2>Warnings</h2>" + "".join(f'<div class="warn">{html.escape(w)}</div>'
                                                            for w in dict.fromkeys(warns)) + "</section>")
