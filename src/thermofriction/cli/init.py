@@ -171,7 +171,7 @@ def roles(files, temps: dict, validate, folder: Path) -> tuple[dict, str]:
         chosen = default_validation(sorted(files, key=lambda f: mean[f]))
         how = (f"the default split: {len(chosen)} of {len(files)} held out at interior temperatures (--validate "
                f"chooses others)" if chosen else
-               f"all fitted: with fewer than 4 experiments none is held out by default (report needs one: "
+               "all fitted: with fewer than 4 experiments none is held out by default (report needs one: "
                f"--validate FILE)")
     return {f: "validate" if f in chosen else "fit" for f in files}, how
 

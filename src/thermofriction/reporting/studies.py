@@ -10,6 +10,7 @@ import numpy as np
 from .. import _args
 from .._lazy import lazy
 from .page import Figures, fmt_number, html_table, page_styled, subplots, write_page
+from .units import scaled_axis
 
 matplotlib = lazy("matplotlib")
 
@@ -38,18 +39,20 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
             ax.plot(r["reference"].time, r["reference"].temperature, ":", color="k", lw=1)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("interface temperature [°C]")
+    ax.set_title("interface temperature")
     ax.legend()
     temp_fig = figs.render(fig, "heating_temperature", "Temperature of the friction interface (lines: two-time-scale "
                            "method; dotted: the full simulation through every cycle).")
     fig, ax = subplots(figsize=(7, 3.4))
+    k = scaled_axis(ax, "y", np.concatenate([r["result"].step_size for r in runs]), "step per cycle", "m")
     for i, r in enumerate(runs):
         res = r["result"]
-        ax.plot(res.time, res.step_size * 1e6, color=colors[i % len(colors)], label=r["label"])
+        ax.plot(res.time, res.step_size * k, color=colors[i % len(colors)], label=r["label"])
         if r.get("reference") is not None:
             ref = r["reference"]
-            ax.plot(ref.time, ref.step_size * 1e6, ":", color="k", lw=1)
+            ax.plot(ref.time, ref.step_size * k, ":", color="k", lw=1)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("step per cycle [µm]")
+    ax.set_title("step per cycle as the interface heats")
     ax.legend()
     step_fig = figs.render(fig, "heating_step_size", "Step size drift as the interface heats (dotted: full simulation).")
     fig, ax = subplots(figsize=(7, 3.4))
@@ -106,13 +109,14 @@ def control_report(rows, path, *, figures_dir=None, title=None, command=None) ->
     hottest = max(r["temperature"] for r in rows)
     for i, name in enumerate(dict.fromkeys(r["reference"] for r in rows)):
         fig, ax = subplots(figsize=(7, 3.4))
+        shown = [r["result"] for r in rows if r["reference"] == name and r["temperature"] == hottest]
+        k = scaled_axis(ax, "y", np.concatenate([res.error for res in shown]), "tracking error", "m")
         for r in rows:
             if r["reference"] == name and r["temperature"] == hottest:
-                res = r["result"]
-                ax.plot(res.time, res.error * 1e6, label=r["compensation"], lw=1)
+                ax.plot(r["result"].time, r["result"].error * k, label=r["compensation"], lw=1)
         ax.set_xlabel("time [s]")
-        ax.set_ylabel("tracking error [µm]")
-        ax.set_yscale("symlog", linthresh=0.1)
+        ax.set_title(f"tracking error at {hottest:g} °C, {name}")
+        ax.set_yscale("symlog", linthresh=1e-7 * k)  # linear within 0.1 µm, where the errors cross zero
         ax.legend(fontsize=8)
         parts.append("<section><h2>" + html.escape(name) + "</h2>" + figs.render(
             fig, f"control_error_{i}", f"Tracking error at {hottest:g} °C, {name}: no compensation, and "
