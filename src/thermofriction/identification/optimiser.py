@@ -217,14 +217,24 @@ class FitOutcome:
     bounds: tuple = ()
 
 
+_BLAS = []  # the threadpoolctl controller, made once: finding the loaded BLAS libraries took 5-12 ms a call
+
+
+def _blas_controller():
+    if not _BLAS:
+        from threadpoolctl import ThreadpoolController
+        optimize.OptimizeResult  # noqa: B018  (SciPy's BLAS loaded first: the fits use it)
+        _BLAS.append(ThreadpoolController())
+    return _BLAS[0]
+
+
 def one_blas_thread(function):
     """Runs ``function`` with BLAS on one thread. The fits' linear algebra is on a few columns, and the
     cores belong to the simulations running beside it: OpenBLAS's threads, spinning between calls,
     took them (the benchmark's Model II: 1.7 s with them, 1.2 s without)."""
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        from threadpoolctl import threadpool_limits
-        with threadpool_limits(limits=1, user_api="blas"):
+        with _blas_controller().limit(limits=1, user_api="blas"):
             return function(*args, **kwargs)
     return wrapper
 
