@@ -3,6 +3,7 @@ parameter through the estimates, and a joint refinement of the law coefficients 
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import time
@@ -69,11 +70,16 @@ def _laws_on_information(Ts, per_T, laws: dict) -> dict:
             k += size
         return out
 
+    at = np.array([b[0] for b in blocks], float)
+
     def residuals(c):
+        # each law evaluated once at every temperature (the same values as one temperature at a time: 0.5 s of
+        # Python per Model I fit went to evaluating them one by one, in the thousands of calls this fit can take)
         trial = with_coefficients(c)
+        values = [np.asarray(trial[n](at), float) for n in names]
         out = []
-        for T, known, log, estimate, root in blocks:
-            predicted = np.array([float(trial[names[i]](T)) for i in known])
+        for k, (T, known, log, estimate, root) in enumerate(blocks):
+            predicted = np.array([values[i][k] for i in known])
             if np.any(~np.isfinite(predicted)) or np.any(predicted <= 0):
                 return np.full(sum(len(b[1]) for b in blocks), 1e6)
             out.append(root.T @ (np.where(log, np.log(predicted), predicted) - estimate))
@@ -211,6 +217,56 @@ def _estimate(res, name):
     return x.value + fc.value, math.sqrt(max(se_x ** 2 + se_fc ** 2 + 2 * rho * se_x * se_fc, 0.0))
 
 
+def _at_shared(per_T, free, shared):
+    """Each temperature's estimates where the freed plant parameters take their shared values (``shared``: the
+    median of the per-temperature estimates) instead of that temperature's own: the conditional mean and covariance
+    given them, from the fit's own covariance (each parameter in log space where its standard error is below
+    LOG_SPACE_BELOW of its value, as the fits were made, else in its own). The per-temperature estimates of sigma0
+    and fc move with that temperature's m_e; laws through them unmoved started the joint refinement far from its
+    optimum (8 temperatures from a start 2-3x off: 17 evaluations to a fit 1.2 times the noise, not adequate).
+    A temperature whose covariance is not usable is kept as it is."""
+    out = []
+    for T, res in per_T:
+        varying = [p.name for p in res.parameters.varying]
+        n = len(varying)
+        se = np.array([res.parameters[v].stderr for v in varying], float)
+        val = np.array([res.parameters[v].value for v in varying], float)
+        corr = np.asarray(res.correlation, float)
+        if corr.shape != (n, n) or not np.all(np.isfinite(se)) or not np.all(np.isfinite(corr)) \
+                or np.any(val <= 0) or not all(x in varying for x in free):
+            out.append((T, res))
+            continue
+        log = se < LOG_SPACE_BELOW * val
+        unit = np.where(log, val, 1.0)
+        cov = corr * np.outer(se / unit, se / unit)
+        y = np.where(log, np.log(val), val)
+        f = [varying.index(x) for x in free]
+        o = [i for i in range(n) if i not in f]
+        target = np.array([shared[x] for x in free])
+        try:
+            gain = cov[np.ix_(o, f)] @ np.linalg.inv(cov[np.ix_(f, f)])
+        except np.linalg.LinAlgError:
+            out.append((T, res))
+            continue
+        x = y[o] + gain @ (np.where(log[f], np.log(target), target) - y[f])
+        c = cov[np.ix_(o, o)] - gain @ cov[np.ix_(f, o)]
+        values = np.where(log[o], np.exp(np.minimum(x, 700.0)), x)
+        if np.any(values <= 0) or not np.all(np.isfinite(values)):
+            out.append((T, res))
+            continue
+        moved = copy.deepcopy(res)
+        sd = np.sqrt(np.maximum(np.diag(c), 0.0))
+        for k, i in enumerate(o):
+            moved.parameters[varying[i]].value = float(values[k])
+            moved.parameters[varying[i]].stderr = float(sd[k] * (values[k] if log[i] else 1.0))
+        for k, i in enumerate(f):
+            moved.parameters[varying[i]].value = float(target[k])
+        moved.correlation = np.eye(n)
+        moved.correlation[np.ix_(o, o)] = c / np.outer(np.where(sd > 0, sd, 1.0), np.where(sd > 0, sd, 1.0))
+        out.append((T, moved))
+    return out
+
+
 def _laws_through(per_T, names, held, init, laws):
     """A law per parameter through the per-temperature estimates (linear or exponential by AICc unless
     ``laws`` names one), refitted on the estimates' covariances; a held parameter keeps the initial model's."""
@@ -288,17 +344,21 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     details = {"held_for_lack_of_information": list(held), "per_temperature": [
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
          "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
-    new_laws, details["laws"] = _laws_through(per_T, names, held, init, laws)
+    # one plant for all temperatures: the median of the per-temperature estimates, each temperature's estimates
+    # moved to it before the laws are drawn through them
+    shared = {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free}
+    estimates = _at_shared(per_T, free, shared) if free else per_T
+    new_laws, details["laws"] = _laws_through(estimates, names, held, init, laws)
     Ts = np.array([T for T, _ in per_T])
-    crossed = _above_fc(new_laws, per_T, Ts)
+    crossed = _above_fc(new_laws, estimates, Ts)
     warns += [crossed] if crossed else []
     kept = {n: law for n, law in init.laws.items() if n not in names}  # held with their laws
     held = held + list(kept)
     new_laws = {**new_laws, **kept}
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in new_laws})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
-    if free:  # one plant for all temperatures: the median of the per-temperature estimates
-        model = with_values(model, {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free})
+    if free:
+        model = with_values(model, shared)
     if not refine:
         params = _law_parameters(new_laws, held, free, model)
         return unrefined_result("model-i", model, params, experiments, measurement, t0, [r for _, r in per_T],

@@ -217,14 +217,24 @@ class FitOutcome:
     bounds: tuple = ()
 
 
+_BLAS = []  # the threadpoolctl controller, made once: finding the loaded BLAS libraries took 5-12 ms a call
+
+
+def _blas_controller():
+    if not _BLAS:
+        from threadpoolctl import ThreadpoolController
+        optimize.OptimizeResult  # noqa: B018  (SciPy's BLAS loaded first: the fits use it)
+        _BLAS.append(ThreadpoolController())
+    return _BLAS[0]
+
+
 def one_blas_thread(function):
     """Runs ``function`` with BLAS on one thread. The fits' linear algebra is on a few columns, and the
     cores belong to the simulations running beside it: OpenBLAS's threads, spinning between calls,
     took them (the benchmark's Model II: 1.7 s with them, 1.2 s without)."""
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        from threadpoolctl import threadpool_limits
-        with threadpool_limits(limits=1, user_api="blas"):
+        with _blas_controller().limit(limits=1, user_api="blas"):
             return function(*args, **kwargs)
     return wrapper
 
@@ -263,7 +273,8 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     ``small_step``: the fit stops where the Gauss-Newton step is below this many standard errors at a
     misfit at the noise (COARSE_STEP for a fit that only starts another one). ``max_nfev``: the most
     evaluations of each least-squares stage (default: 40 for the coarse stage, 15 for the fine one, 60 for a
-    ``near`` or ``tight`` fit)."""
+    ``near`` or ``tight`` fit; a fit at rtol 1e-6 or looser has only the coarse stage, with its 40: with 15, a
+    start 2-3x off ran out of evaluations and went on to the multi-start, three times as many)."""
     t_start = time.perf_counter()
     varying = params.varying
     if not varying:
@@ -284,13 +295,14 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
         phi_first = phi_start
+        coarse_only = rtol >= COARSE_RTOL and not near  # at the coarse tolerance: its one stage is the coarse one
         if rtol < COARSE_RTOL and not near:
             coarse = Problem(model, names, traces, rtol=COARSE_RTOL, parallel=not one_trace)
             first = _least_squares(coarse, transform, phi_start, (lo, hi), 40 if max_nfev is None else max_nfev, False, scale,
                                    stall_step=COARSE_STEP)
             phi_start = first.x
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-        fine = max_nfev if max_nfev is not None else 60 if tight or near else 15
+        fine = max_nfev if max_nfev is not None else 60 if tight or near else 40 if coarse_only else 15
         res = _least_squares(problem, transform, phi_start, (lo, hi), fine, tight,
                              scale, small_step)
         res.moved = bool(np.any(res.x != phi_first))

@@ -22,6 +22,12 @@ from .parameters import EXCESS, KNOT, TARGET_DF, TARGET_LAW, get_value, split_na
 
 #: the most integration steps of one run during a fit
 MAX_STEPS = 2_000_000
+#: a run with sensitivities (a trial point of the trust region) may take at most this many times the steps of the
+#: trace's first such run in the same problem (and at least STEP_FLOOR): a trial step to a far stiffer model
+#: (sigma1 from 4 to 2e6 in one step from a start 2-3x off) otherwise ran to MAX_STEPS -- 2.1 s of CPU, 80 % of
+#: the whole fit at one temperature -- only to be refused, as a failed run is
+STEP_FACTOR = 20
+STEP_FLOOR = 100_000
 
 
 _POOL = None
@@ -69,6 +75,7 @@ class Problem:
         self.nfev = 0
         self.njev = 0
         self._seconds = {}  # (trace, with sensitivities): its last run's wall time, for run_all
+        self._steps = {}  # trace (by id) -> the steps of its first run with sensitivities: the budget's measure
 
     def model_at(self, theta):
         """The model at theta, or None where it must not be simulated: built and checked once per
@@ -151,8 +158,11 @@ class Problem:
             atol_y = rtol * scale
             atol_s = atol_y[:, None] / np.maximum(np.abs(theta), 1e-300)[None, :]
             sens = np.empty((n_out, len(scale), len(theta)))
-            _bridge.run_sensitivities(spec, targets, trace.time, out, sens, rtol=rtol,
-                                      atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=MAX_STEPS)
+            first = self._steps.get(id(trace))
+            budget = MAX_STEPS if first is None else min(MAX_STEPS, max(STEP_FLOOR, STEP_FACTOR * first))
+            stats = _bridge.run_sensitivities(spec, targets, trace.time, out, sens, rtol=rtol,
+                                              atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=budget)
+            self._steps.setdefault(id(trace), int(stats["steps"]))
         except _bridge.CoreFailure:
             return None, None
         return out, sens
@@ -222,4 +232,5 @@ def knot_derivative(law, k, T) -> float:
     return 0.0
 
 
-__all__ = ["Trace", "Problem", "make_traces", "pool", "at_temperature", "knot_derivative", "MAX_STEPS"]
+__all__ = ["Trace", "Problem", "make_traces", "pool", "at_temperature", "knot_derivative", "MAX_STEPS", "STEP_FACTOR",
+           "STEP_FLOOR"]
