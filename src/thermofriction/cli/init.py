@@ -172,7 +172,7 @@ def roles(files, temps: dict, validate, folder: Path) -> tuple[dict, str]:
         how = (f"the default split: {len(chosen)} of {len(files)} held out at interior temperatures (--validate "
                f"chooses others)" if chosen else
                "all fitted: with fewer than 4 experiments none is held out by default (report needs one: "
-               f"--validate FILE)")
+               "--validate FILE)")
     return {f: "validate" if f in chosen else "fit" for f in files}, how
 
 

@@ -153,7 +153,7 @@ class _PerTemperature:
         """The fit at one temperature, from the neighbouring temperature's model (continuation) or,
         without one, from the initial model's values there with the multi-start; returns (T, result,
         what the next temperature continues from)."""
-        init, names, free = self.init, self.names, self.free
+        init, names = self.init, self.names
         T = float(np.mean([e.temperature for e in group]))
         base = self.start_at(T, previous)
         if self.progress:
