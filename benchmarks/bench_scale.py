@@ -1,0 +1,190 @@
+"""Parallel efficiency of the scale-out workloads on the embedded default (threads in this process), in
+one run: each workload sequentially (``scheduler="sequential"``) and on the default, with
+
+    parallel efficiency = t_sequential / (workers x t_parallel)
+
+and the check that both give the same output to the last bit. Then, on a local Dask cluster of worker
+processes (``scheduler="processes"``'s), the scheduler's overhead per task (empty tasks) against the
+work of one chunk of the sweep: Dask's overhead share per chunk.
+
+    python benchmarks/bench_scale.py [--workers N] [--quick]
+
+- sweep: li2009-model-i, 1201 temperatures x 3 amplitudes = 3603 two-second runs at 10 kHz (the
+  issue's design sweep);
+- propagate: a fit's uncertainty, 600 draws x 2 temperatures = 1200 one-second runs at 1 kHz;
+- fleet: 8 identifications (li2009-base, 2 starts; an identification is seconds of hundreds of runs,
+  so the fleet has fewer, longer tasks). tf.identify runs some of its own simulations side by side on
+  a thread pool, so its "sequential" run already uses more than one core in part: the fleet's
+  efficiency against it understates what the fleet's own parallelism adds.
+
+The machine's load average (os.getloadavg) is printed before and after each measurement: on cores
+shared with other jobs the wall-clock efficiency is depressed by the time the others take; the CPU
+time of this process (sequential against parallel) is printed too, as the part of the overhead that
+does not depend on the load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import logging
+import os
+import time
+
+import numpy as np
+
+import thermofriction as tf
+
+
+def load() -> str:
+    return "/".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def timed(fn, one_core=False):
+    """(result, wall [s], CPU of this process [s], load average before, after). ``one_core``: this process
+    (all its threads) pinned to one core for the run."""
+    cores = os.sched_getaffinity(0) if one_core else None
+    if one_core:
+        os.sched_setaffinity(0, {min(cores)})
+    try:
+        before = load()
+        c0, t0 = time.process_time(), time.perf_counter()
+        out = fn()
+        return out, time.perf_counter() - t0, time.process_time() - c0, before, load()
+    finally:
+        if one_core:
+            os.sched_setaffinity(0, cores)
+
+
+def best(runs, seq, par, one_core=False):
+    """``runs`` alternating measurements of seq() and par(): the fastest of each (the machine's other jobs
+    only ever add time)."""
+    s = p = None
+    for _ in range(runs):
+        a = timed(seq, one_core)
+        s = a if s is None or a[1] < s[1] else s
+        b = timed(par)
+        p = b if p is None or b[1] < p[1] else p
+    return s, p
+
+
+def row(name, n, unit, seq, par, workers, same, baseline="sequential"):
+    _, t_s, c_s, l0, l1 = seq
+    _, t_p, c_p, l2, l3 = par
+    eff = t_s / (workers * t_p)
+    print(f"{name:10s} {n:5d} {unit:12s} {baseline:14s} {t_s:7.2f} s  CPU {c_s:6.2f} s ({c_s / t_s:.2f} cores)  "
+          f"load {l0} -> {l1}")
+    print(f"{'':29s} {str(workers) + ' threads':14s} {t_p:7.2f} s  CPU {c_p:6.2f} s ({c_p / t_p:.2f} cores)  "
+          f"load {l2} -> {l3}")
+    print(f"{'':29s} parallel efficiency {eff:.2f} (speed-up {t_s / t_p:.2f}x on {workers}); CPU parallel / "
+          f"sequential {c_p / c_s:.2f}; output identical: {same}")
+    return eff
+
+
+def same_sweep(a, b):
+    return (all(np.array_equal(a[k], b[k], equal_nan=True) for k in a.columns) and a.errors == b.errors
+            and a.warnings == b.warnings)
+
+
+def same_bands(a, b):
+    names = ("nominal", "median", "lower", "upper", "prediction_lower", "prediction_upper", "steps",
+             "final_displacement", "parameters", "step_lower", "step_upper")
+    return all(np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True) for k in names) and a.failures == b.failures
+
+
+def same_fleet(a, b):
+    return a.names == b.names and a.failures == b.failures and all(
+        a.fits[n].rmse == b.fits[n].rmse and all(a.fits[n].parameters[p].value == b.fits[n].parameters[p].value
+                                                 for p in a.fits[n].parameters) for n in a.fits)
+
+
+def _noop(x):
+    return x
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--quick", action="store_true", help="a tenth of the work (a smoke test, not a measurement)")
+    ap.add_argument("--no-dask", action="store_true", help="skip the local Dask cluster")
+    ap.add_argument("--runs", type=int, default=2, help="measurements of each, alternating; the fastest is shown")
+    args = ap.parse_args()
+    w = args.workers
+    scale = 0.1 if args.quick else 1.0
+    print(f"{os.cpu_count()} cores, {w} workers; best of {args.runs} alternating runs; load average (1/5/15 min) "
+          f"{load()}")
+
+    # -- sweep: the issue's 3603 two-second runs ---------------------------------------------------
+    model = tf.load_model("li2009-model-i")
+    grid = {"temperature": np.linspace(30.0, 42.0, max(int(1201 * scale), 2)), "amplitude": [10.0, 20.0, 30.0]}
+    n_sweep = grid["temperature"].size * 3
+    opts = dict(duration=2.0)
+    tf.sweep(model, {"temperature": [33.0, 36.0]}, scheduler="sequential", **opts)  # imports, caches: not timed
+    chunks = []
+
+    def par_sweep():
+        chunks.clear()
+        return tf.sweep(model, grid, workers=w, progress=chunks.append, **opts)
+    seq, par = best(args.runs, lambda: tf.sweep(model, grid, scheduler="sequential", **opts), par_sweep)
+    effs = {"sweep": row("sweep", n_sweep, "runs of 2 s", seq, par, w, same_sweep(seq[0], par[0]))}
+    print(f"{'':29s} {len(chunks)} chunks, {n_sweep / len(chunks):.0f} runs each on average")
+    t_sweep_seq, ref_sweep = seq[1], seq[0]
+
+    # -- propagate: 600 draws x 2 temperatures ------------------------------------------------------
+    base = tf.load_model("li2009-base")
+    truth = dataclasses.replace(base, friction=dataclasses.replace(base.friction, fc=base.friction.fc * 0.85))
+    data = tf.synthesize(truth, [35.0], duration=0.6, sample_rate=5000, noise=20e-9, seed=3)
+    fit = tf.identify(data, "base", init="li2009-base", starts=2, parameters=["sigma0", "fc"])
+    draws = max(int(600 * scale), 2)
+    popts = dict(temperatures=[33.0, 38.0], draws=draws, seed=1, duration=1.0)
+    tf.propagate(fit, [35.0], draws=4, duration=0.2, scheduler="sequential")  # imports (SciPy's stats): not timed
+    seq, par = best(args.runs, lambda: tf.propagate(fit, scheduler="sequential", **popts),
+                    lambda: tf.propagate(fit, workers=w, **popts))
+    effs["propagate"] = row("propagate", 2 * draws, "runs of 1 s", seq, par, w, same_bands(seq[0], par[0]))
+
+    # -- fleet: 8 identifications -------------------------------------------------------------------
+    n_fleet = max(int(8 * scale), 2)
+    fleet = []
+    for k in range(n_fleet):
+        fr = base.friction
+        m = dataclasses.replace(base, friction=dataclasses.replace(fr, fc=fr.fc * (0.8 + 0.03 * k),
+                                                                   sigma0=fr.sigma0 * (1.2 + 0.03 * k)))
+        fleet.append(tf.synthesize(m, [35.0, 38.0], duration=0.8, sample_rate=2500, noise=20e-9, seed=10 + k))
+    seq, par = best(args.runs, lambda: tf.identify_fleet(fleet, "base", scheduler="sequential", starts=2),
+                    lambda: tf.identify_fleet(fleet, "base", workers=w, starts=2))
+    row("fleet", n_fleet, "fits", seq, par, w, same_fleet(seq[0], par[0]))
+    # identify runs some simulations side by side on its own threads: its sequential run above used more
+    # than one core in part. The baseline of one core: the same run with this process pinned to one core
+    one, _ = best(1, lambda: tf.identify_fleet(fleet, "base", scheduler="sequential", starts=2), lambda: None,
+                  one_core=True)
+    effs["fleet"] = row("fleet", n_fleet, "fits", one, par, w, same_fleet(one[0], par[0]), baseline="one core")
+
+    if not args.no_dask:
+        # -- Dask: the overhead per task against a chunk's work ---------------------------------------
+        from distributed import Client, LocalCluster
+        t0 = time.perf_counter()
+        with LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None,
+                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+            client.wait_for_workers(w)
+            t_start = time.perf_counter() - t0
+            k = 400
+            before = load()
+            t0 = time.perf_counter()
+            client.gather(client.map(_noop, range(k), pure=False))
+            per_task = (time.perf_counter() - t0) / k
+            chunks = []
+            res, t_dask, _, l0, l1 = timed(lambda: tf.sweep(model, grid, scheduler=client, progress=chunks.append,
+                                                            **opts))
+            per_chunk = t_sweep_seq / len(chunks)
+            print(f"local Dask cluster ({w} worker processes; start-up {t_start:.1f} s, not counted): "
+                  f"{per_task * 1e3:.2f} ms per empty task (load {before})")
+            print(f"  sweep: {len(chunks)} chunks of {per_chunk * 1e3:.0f} ms of work on average: Dask's overhead "
+                  f"{100 * per_task / per_chunk:.1f} % of a chunk's work; {t_dask:.2f} s, parallel efficiency "
+                  f"{t_sweep_seq / (w * t_dask):.2f} (load {l0} -> {l1}); output identical: "
+                  f"{same_sweep(res, ref_sweep)}")
+    print("parallel efficiency (target >= 0.9): " + ", ".join(f"{k} {v:.2f}" for k, v in effs.items())
+          + f"; load average now {load()}")
+
+
+if __name__ == "__main__":
+    main()
