@@ -20,7 +20,8 @@ import pytest
 
 import thermofriction as tf
 from thermofriction.errors import InputError
-from thermofriction.scale.cluster import CHUNK_MAX_SECONDS, CHUNK_SECONDS, Runner, chunk_spans, recorded_warnings
+from thermofriction.scale.chunks import CHUNK_MAX_SECONDS, CHUNK_SECONDS, chunk_spans
+from thermofriction.scale.cluster import Runner, recorded_warnings
 
 
 def _same_sweep(a, b):

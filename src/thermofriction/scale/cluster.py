@@ -21,7 +21,6 @@ import asyncio
 import concurrent.futures
 import contextlib
 import logging
-import math
 import numbers
 import os
 import pickle
@@ -33,20 +32,14 @@ import warnings
 
 from .. import _args
 from ..errors import ComputationError, InputError, shorten
+from .chunks import CHUNK_SECONDS, chunk_spans
+from .connect import probe, read_scheduler_file
 
 SEQUENTIAL = "sequential"
 THREADS = "threads"
 PROCESSES = "processes"
 #: the scheduler=/--scheduler values that name a way of running here rather than a cluster's address
 LOCAL = (SEQUENTIAL, THREADS, PROCESSES)
-
-#: a chunk's work [s] aimed at, at least: Dask's overhead is ~2.5 ms per task (scheduler, pickles, the
-#: network), a thread pool's ~0.05 ms; both then stay below 3 % of the work (the target: < 10 %)
-CHUNK_SECONDS = {"dask": 0.1, "threads": 0.02, "sequential": 0.02}
-#: a chunk's work [s] at most: Ctrl-C waits for the running chunks of a thread pool, and a dead Dask
-#: worker's chunk is run again
-CHUNK_MAX_SECONDS = {"dask": 5.0, "threads": 1.0, "sequential": 1.0}
-
 
 def _distributed():
     try:
@@ -82,86 +75,6 @@ def check_options(scheduler=None, workers=None, batch_size=None, progress=None):
         if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
             _args.refuse(name, "a positive whole number or None", value)
     _args.function(progress, "progress")
-
-
-#: a Dask scheduler file is a few hundred bytes of JSON (dask scheduler --scheduler-file)
-_SCHEDULER_FILE_LIMIT = 1 << 20
-#: a Dask message's 8-byte length prefix beyond this is not a greeting (text read as a length: ~1e18)
-_GREETING_LIMIT = 1 << 26
-
-
-def read_scheduler_file(path) -> str:
-    """The address in a scheduler file (JSON with an ``address``, as ``dask scheduler --scheduler-file``
-    writes it), or one InputError naming the file: Dask's own reader fails on a damaged file with an
-    AssertionError or a KeyError."""
-    from .._reading import read_text
-
-    what = "a Dask scheduler file (JSON with an \"address\", as 'dask scheduler --scheduler-file' writes)"
-    try:
-        if os.path.getsize(path) > _SCHEDULER_FILE_LIMIT:
-            raise InputError(f"scheduler {path}: not {what}: {os.path.getsize(path)} bytes")
-        text = read_text(path, "scheduler file")
-    except OSError as e:
-        raise InputError(f"scheduler {path}: cannot read ({e.strerror or e})") from None
-    except UnicodeDecodeError:
-        raise InputError(f"scheduler {path}: not {what}: not UTF-8 text") from None
-    import json
-    try:
-        info = json.loads(text)
-    except ValueError as e:
-        raise InputError(f"scheduler {path}: not {what}: {e}") from None
-    address = info.get("address") if isinstance(info, dict) else None
-    if not isinstance(address, str) or not address.strip():
-        raise InputError(f"scheduler {path}: not {what}: no \"address\" in it")
-    return address.strip()
-
-
-def _probe(address):
-    """For a TCP address: when something answers there, that it greets as a Dask scheduler does (at once,
-    with a message of a plausible length), so that an HTTP or SSH server is named as not a scheduler instead
-    of Dask waiting forever or reading its text as a 3 EiB message ("out of memory"). Nothing listening, or
-    another protocol (tls://, ucx://): left to Dask, which retries until its connect timeout."""
-    import re
-    import socket
-    import struct
-
-    m = re.fullmatch(r"(?:tcp://)?\[?([^\[\]/]+?)\]?:(\d+)/?", address)
-    if m is None:
-        return
-    host, port = m.group(1), int(m.group(2))
-    timeout = _connect_timeout()
-    try:
-        sock = socket.create_connection((host, port), timeout=timeout)
-    except OSError:
-        return  # Dask tries again until its timeout and then says so
-    with sock:
-        head = b""
-        try:
-            while len(head) < 8:
-                chunk = sock.recv(8 - len(head))
-                if not chunk:
-                    break
-                head += chunk
-        except OSError:  # socket.timeout included
-            pass
-    if len(head) < 8:
-        said = f"it sent {head!r} and closed the connection" if head else f"it said nothing within {timeout:g} s"
-        raise InputError(f"scheduler {address}: not a Dask scheduler ({said}; a scheduler greets a client at once); "
-                         f"start one with 'dask scheduler' (docs/scale.md)")
-    (length,) = struct.unpack("<Q", head)
-    if not 0 < length <= _GREETING_LIMIT:
-        raise InputError(f"scheduler {address}: not a Dask scheduler (it answered {head!r}...); start one with "
-                         f"'dask scheduler' (docs/scale.md)")
-
-
-def _connect_timeout() -> float:
-    """Dask's connect timeout [s] (distributed.comm.timeouts.connect), 30 s where it cannot be read."""
-    try:
-        import dask.config
-        from dask.utils import parse_timedelta
-        return float(parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s"))
-    except Exception:  # noqa: BLE001 - a hint only
-        return 30.0
 
 
 #: per thread of a Runner's pool: where the warnings of the running task go (see recorded_warnings)
@@ -284,7 +197,7 @@ class Runner:
         address = self.scheduler
         if os.path.exists(address):  # a scheduler file: read here, so that a damaged one is one message
             address = read_scheduler_file(address)
-        _probe(address)
+        probe(address)
         try:
             # the wait is Dask's own (distributed.comm.timeouts.connect, 30 s unless configured)
             self.client = self._stack.enter_context(distributed.Client(address=address))
@@ -437,38 +350,6 @@ def _call(fn, payload: bytes) -> bytes:
     return pickle.dumps(fn(*pickle.loads(payload)), protocol=pickle.HIGHEST_PROTOCOL)
 
 
-def batches(n: int, size: int):
-    """(start, stop) of consecutive batches of ``size`` covering range(n)."""
-    return [(i, min(i + size, n)) for i in range(0, n, size)]
-
-
-def chunk_spans(n_items: int, n_workers: int, item_seconds=None, *, kind="dask", batch_size=None, largest=None,
-                per_worker: int = 4):
-    """(start, stop) of consecutive chunks covering range(n_items), in order.
-
-    ``batch_size``: that many items each. Else guided self-scheduling: each chunk holds 1/(per_worker x
-    workers) of the items still to hand out -- the first ones large (every worker gets ``per_worker``
-    chunks or more), the last ones small, so that the workers finish together -- but at least
-    CHUNK_SECONDS[kind] of work (so that a chunk's overhead stays a few per cent of it) and at most
-    CHUNK_MAX_SECONDS[kind] (and ``largest`` items)."""
-    if batch_size is not None:
-        return batches(n_items, int(batch_size))
-    if item_seconds is not None and item_seconds > 0 and math.isfinite(item_seconds):
-        smallest = max(1, math.ceil(CHUNK_SECONDS[kind] / item_seconds))
-        biggest = max(smallest, math.floor(CHUNK_MAX_SECONDS[kind] / item_seconds))
-    else:  # nothing known: small chunks
-        smallest, biggest = 1, n_items
-    if largest is not None:
-        smallest, biggest = min(smallest, largest), min(biggest, largest)
-    spans, a = [], 0
-    w = max(int(n_workers), 1)
-    while a < n_items:
-        size = min(max(math.ceil((n_items - a) / (per_worker * w)), smallest), biggest, n_items - a)
-        spans.append((a, a + size))
-        a += size
-    return spans
-
-
 def progress_bar(total, label, enabled=True):
     """A rich progress bar on stderr (on a terminal only): returns (update(done), stop())."""
     if not enabled or not sys.stderr.isatty():
@@ -483,4 +364,4 @@ def progress_bar(total, label, enabled=True):
 
 
 __all__ = ["Runner", "SEQUENTIAL", "THREADS", "PROCESSES", "check_scheduler", "check_options", "read_scheduler_file",
-           "batches", "chunk_spans", "progress_bar", "is_client", "recorded_warnings"]
+           "chunk_spans", "progress_bar", "is_client", "recorded_warnings"]
