@@ -102,6 +102,28 @@ def _noop(x):
     return x
 
 
+def cores_free(workers, n_evals=3_000_000):
+    """The machine's parallel efficiency right now for work that is perfectly parallel: the C core's
+    right-hand side (LuGre on a mass), timed in C without the GIL, n_evals on one thread against n_evals on
+    each of ``workers`` threads at once (1.0 on free cores; the other jobs' share of the cores lowers it)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from thermofriction import _bridge
+    model = tf.Model(tf.MassPlant(1.0, spring_stiffness=2.0, pull_velocity=0.1), tf.LuGre(sigma0=1e5, sigma1=300.0, sigma2=0.4, fc=1.0, fs=1.5, vs=0.001))
+    spec, y = _bridge.model_spec(model, None, None), np.array([0.0, 1e-3, 5e-6])
+
+    def one(_=None):
+        t0 = time.perf_counter()
+        _bridge.time_rhs(spec, 1.0, y, n_evals)
+        return time.perf_counter() - t0
+    t1 = one()
+    with ThreadPoolExecutor(workers) as pool:
+        t0 = time.perf_counter()
+        list(pool.map(one, range(workers)))
+        tw = time.perf_counter() - t0
+    return t1 / tw
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
@@ -112,7 +134,7 @@ def main():
     w = args.workers
     scale = 0.1 if args.quick else 1.0
     print(f"{os.cpu_count()} cores, {w} workers; best of {args.runs} alternating runs; load average (1/5/15 min) "
-          f"{load()}")
+          f"{load()}; GIL-free C work on {w} threads runs at parallel efficiency {cores_free(w):.2f} now")
 
     # -- sweep: the issue's 3603 two-second runs ---------------------------------------------------
     model = tf.load_model("li2009-model-i")
@@ -125,7 +147,9 @@ def main():
     def par_sweep():
         chunks.clear()
         return tf.sweep(model, grid, workers=w, progress=chunks.append, **opts)
+    free = [cores_free(w)]
     seq, par = best(args.runs, lambda: tf.sweep(model, grid, scheduler="sequential", **opts), par_sweep)
+    free.append(cores_free(w))
     effs = {"sweep": row("sweep", n_sweep, "runs of 2 s", seq, par, w, same_sweep(seq[0], par[0]))}
     print(f"{'':29s} {len(chunks)} chunks, {n_sweep / len(chunks):.0f} runs each on average")
     t_sweep_seq, ref_sweep = seq[1], seq[0]
@@ -140,6 +164,7 @@ def main():
     tf.propagate(fit, [35.0], draws=4, duration=0.2, scheduler="sequential")  # imports (SciPy's stats): not timed
     seq, par = best(args.runs, lambda: tf.propagate(fit, scheduler="sequential", **popts),
                     lambda: tf.propagate(fit, workers=w, **popts))
+    free.append(cores_free(w))
     effs["propagate"] = row("propagate", 2 * draws, "runs of 1 s", seq, par, w, same_bands(seq[0], par[0]))
 
     # -- fleet: 8 identifications -------------------------------------------------------------------
@@ -158,6 +183,7 @@ def main():
     one, _ = best(1, lambda: tf.identify_fleet(fleet, "base", scheduler="sequential", starts=2), lambda: None,
                   one_core=True)
     effs["fleet"] = row("fleet", n_fleet, "fits", one, par, w, same_fleet(one[0], par[0]), baseline="one core")
+    free.append(cores_free(w))
 
     if not args.no_dask:
         # -- Dask: the overhead per task against a chunk's work ---------------------------------------
@@ -184,6 +210,9 @@ def main():
                   f"{same_sweep(res, ref_sweep)}")
     print("parallel efficiency (target >= 0.9): " + ", ".join(f"{k} {v:.2f}" for k, v in effs.items())
           + f"; load average now {load()}")
+    print(f"the machine's own parallel efficiency for GIL-free C work on {w} threads, measured before the sweep "
+          f"and after each workload: " + ", ".join(f"{x:.2f}" for x in free)
+          + " (1.0 on free cores: what the other jobs leave of them)")
 
 
 if __name__ == "__main__":
