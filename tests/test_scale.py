@@ -12,6 +12,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 import warnings
 
@@ -132,6 +133,25 @@ def test_the_warnings_module_is_left_as_it_was_and_other_warnings_are_shown():
         out = runner.map(task, [(i,) for i in range(6)], records_warnings=True)
     assert out == [[f"recorded {i}"] for i in range(6)]
     assert sorted(str(w.message) for w in shown if w.category is RuntimeWarning) == [f"shown {i}" for i in range(6)]
+    assert (list(warnings.filters), warnings.showwarning) == before
+
+
+def test_two_threads_inside_their_blocks_at_once_record_their_own_warnings():
+    """Both tasks are inside recorded_warnings when both warn (a barrier): each gets its own warning. With
+    warnings.catch_warnings in each thread instead, both would land in the list of the block entered last."""
+    barrier = threading.Barrier(2)
+
+    def task(i):
+        with recorded_warnings() as caught:
+            barrier.wait(timeout=30)
+            warnings.warn(f"task {i}", UserWarning)
+            barrier.wait(timeout=30)
+        return [str(w.message) for w in caught]
+
+    before = (list(warnings.filters), warnings.showwarning)
+    with Runner(workers=2) as runner:
+        out = runner.map(task, [(0,), (1,)], records_warnings=True)
+    assert out == [["task 0"], ["task 1"]]
     assert (list(warnings.filters), warnings.showwarning) == before
 
 
