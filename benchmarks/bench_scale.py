@@ -34,6 +34,7 @@ import time
 import numpy as np
 
 import thermofriction as tf
+from _timing import core_timer  # noqa: E402  (benchmarks/ is the script's folder, first on sys.path)
 
 
 def load() -> str:
@@ -152,6 +153,15 @@ def main():
     free.append(cores_free(w))
     effs = {"sweep": row("sweep", n_sweep, "runs of 2 s", seq, par, w, same_sweep(seq[0], par[0]))}
     print(f"{'':29s} {len(chunks)} chunks, {n_sweep / len(chunks):.0f} runs each on average")
+    # the part of a run that holds the GIL (Python around the C core) runs one thread at a time
+    sub = {"temperature": grid["temperature"][::10], "amplitude": grid["amplitude"]}
+    with core_timer(time.thread_time) as in_core:
+        c0 = time.thread_time()
+        tf.sweep(model, sub, scheduler="sequential", **opts)
+        c_all = time.thread_time() - c0
+    gil = 1.0 - sum(in_core) / c_all
+    print(f"{'':29s} the GIL is held {100 * gil:.0f} % of a run's CPU time (outside the C core): on {w} free cores "
+          f"threads can reach at most {min(1.0, 1.0 / (w * gil)):.2f}")
     t_sweep_seq, ref_sweep = seq[1], seq[0]
 
     # -- propagate: 600 draws x 2 temperatures ------------------------------------------------------
