@@ -175,9 +175,9 @@ class Runner:
         if self.kind == "threads":
             # the C core releases the GIL while it integrates: threads of this process use every core,
             # with nothing to start, to pickle or to send
+            self._threads = self.workers or os.cpu_count() or 1
             self._pool = concurrent.futures.ThreadPoolExecutor(
-                max_workers=self.workers or os.cpu_count() or 1, thread_name_prefix="thermofriction-scale",
-                initializer=_route_this_thread)
+                max_workers=self._threads, thread_name_prefix="thermofriction-scale", initializer=_route_this_thread)
             self._stack.callback(self._stop_pool)
             return
         distributed = _distributed()
@@ -222,7 +222,7 @@ class Runner:
     def n_workers(self) -> int:
         """The workers available now (1 in sequential mode)."""
         if self._pool is not None:
-            return self._pool._max_workers
+            return self._threads
         if self.client is None:
             return 1
         try:
@@ -256,7 +256,7 @@ class Runner:
             t0, size = time.perf_counter(), 1
             limit = max(1, n_items // 50)
             while first < min(limit, n_items) and time.perf_counter() - t0 < CHUNK_SECONDS[self.kind]:
-                b = min(first + size, n_items, limit)
+                b = min(first + size, limit, first + (largest or size))
                 results.append(fn(*args_of(first, b)))
                 spans.append((first, b))
                 first, size = b, 2 * size
