@@ -193,7 +193,8 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
     central ``level`` bands of the displacement and of the mean step per cycle.
 
     scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process).
-    batch_size: draws per task (default: chunks of at least ~20 ms of work on threads, ~100 ms on Dask). progress: called with the number of draws done."""
+    batch_size: draws per task (default: chunks of at least ~20 ms of work on threads, ~100 ms on Dask).
+    progress: called with the number of draws done."""
     import time
 
     from ..simulate import simulate
