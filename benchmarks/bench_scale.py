@@ -110,7 +110,8 @@ def cores_free(workers, n_evals=3_000_000):
     from concurrent.futures import ThreadPoolExecutor
 
     from thermofriction import _bridge
-    model = tf.Model(tf.MassPlant(1.0, spring_stiffness=2.0, pull_velocity=0.1), tf.LuGre(sigma0=1e5, sigma1=300.0, sigma2=0.4, fc=1.0, fs=1.5, vs=0.001))
+    model = tf.Model(tf.MassPlant(1.0, spring_stiffness=2.0, pull_velocity=0.1),
+                     tf.LuGre(sigma0=1e5, sigma1=300.0, sigma2=0.4, fc=1.0, fs=1.5, vs=0.001))
     spec, y = _bridge.model_spec(model, None, None), np.array([0.0, 1e-3, 5e-6])
 
     def one(_=None):
