@@ -1,7 +1,8 @@
 """Design sweeps (tf.sweep, `thermofriction sweep`): the grid, the metrics against analytic results
 and against tf.simulate run point by point (an independent path through the library), failures
 per point, the table's files, Ctrl-C. The runs on a real multi-process Dask cluster are in
-test_dask_cluster.py; here most runs are sequential (the baseline), one uses the local cluster."""
+test_dask_cluster.py, those on the default's threads in test_scale.py; here most runs are sequential (the
+baseline), some use the local Dask cluster (--scheduler processes)."""
 
 from __future__ import annotations
 
@@ -138,8 +139,8 @@ def test_cli_sweep_on_the_local_cluster_equals_the_sequential_run(tmp_path):
     seq = run("sweep", "li2009-model-i", *grid, "--duration", "0.3", "--sample-rate", "1000", "--scheduler",
               "sequential", "-o", "seq.csv", cwd=tmp_path)
     assert seq.returncode == 0, seq.stderr
-    loc = run("sweep", "li2009-model-i", *grid, "--duration", "0.3", "--sample-rate", "1000", "--workers", "2",
-              "-o", "local.csv", cwd=tmp_path)
+    loc = run("sweep", "li2009-model-i", *grid, "--duration", "0.3", "--sample-rate", "1000", "--scheduler",
+              "processes", "--workers", "2", "-o", "local.csv", cwd=tmp_path)
     assert loc.returncode == 0, loc.stderr
     assert "a local Dask cluster (2 workers)" in loc.stdout and "24 points (0 failed)" in loc.stdout
     assert (tmp_path / "local.csv").read_text() == (tmp_path / "seq.csv").read_text()
@@ -198,7 +199,8 @@ def test_ctrl_c_stops_the_local_cluster_and_writes_nothing(tmp_path):
     """SIGINT while the local cluster works: exit 130, no table, no temporary file, no worker left."""
     psutil = pytest.importorskip("psutil")
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "sweep", "li2009-model-i", "--grid",
-                             "temperature=30:41.5:0.01", "--duration", "2", "--workers", "1", "--batch-size", "5",
+                             "temperature=30:41.5:0.01", "--duration", "2", "--scheduler", "processes", "--workers",
+                             "1", "--batch-size", "5",
                              "-o", "s.csv"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline, workers = time.monotonic() + 120, []
@@ -234,7 +236,7 @@ def test_a_task_that_kills_its_workers_is_recorded_and_the_rest_go_on():
 
     from thermofriction.scale.cluster import Runner
     # Dask retries a task whose worker died on other workers, by default up to 3 times: once here
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), Runner(None, workers=2) as runner:
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), Runner("processes", workers=2) as runner:
         out = runner.map(_exit_on_one, [(i,) for i in range(6)], on_error=lambda i, why: ("lost", why))
     assert out[1] == ("lost", "its worker died each time it ran (a crash or out of memory?)")
     # Dask also gives up on a task that shared a dying worker with it too often; all others ran

@@ -3,8 +3,8 @@ A design sweep: step size against temperature and drive amplitude
 ==================================================================
 
 ``tf.sweep`` simulates a model at every point of a grid — temperatures, input fields, any parameter
-by name — and returns one row of metrics per point. By default the points run on a local Dask cluster
-on this machine's cores (``scheduler=None``), or on an existing cluster (``scheduler="tcp://HOST:8786"``);
+by name — and returns one row of metrics per point. By default the points run on threads in this
+process, one per core (``scheduler=None``), or on a Dask cluster (``scheduler="tcp://HOST:8786"``);
 this page runs them in its own process (``scheduler="sequential"``), which gives the same numbers.
 The command line's ``thermofriction sweep`` does the same; fleets and uncertainty propagation are in
 :doc:`/scale`.

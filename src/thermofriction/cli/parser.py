@@ -276,10 +276,11 @@ def _add_fmu_command(sub):
 def _scheduler_options(parser, only=""):
     """Where the work runs (docs/scale.md): shared by sweep and fleet identification."""
     parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="an existing Dask cluster: tcp://HOST:8786 or a scheduler file; 'sequential' runs in "
-                             f"this process, in order (default: a local Dask cluster on this machine's cores){only}")
+                        help="an existing Dask cluster: tcp://HOST:8786 or a scheduler file; 'processes' starts a "
+                             "local Dask cluster of worker processes; 'sequential' runs in this process, in order "
+                             f"(default: threads in this process, one per core){only}")
     parser.add_argument("--workers", type=_positive_int, metavar="N",
-                        help=f"workers of the local cluster (default: one per core){only}")
+                        help=f"threads, or worker processes of the local Dask cluster (default: one per core){only}")
 
 
 def _add_sweep_command(sub):
@@ -290,8 +291,8 @@ def _add_sweep_command(sub):
         "sweep", help="a design map: simulate a model at every point of a grid, one row of metrics per point",
         description="Simulate MODEL at every point of the grid given by the --grid options (their Cartesian "
                     "product, the last varying fastest) and write one row per point: the point's coordinates, "
-                    "then the metrics. Runs on Dask: a local cluster on this machine's cores, or an existing "
-                    "cluster (--scheduler). A point that fails is written with empty metrics and its reason "
+                    "then the metrics. Runs on threads on this machine's cores, a local Dask cluster or an "
+                    "existing one (--scheduler). A point that fails is written with empty metrics and its reason "
                     "in the error column; the others go on (exit status 1 when any failed).",
         epilog="Grid names: temperature [C]; a field of the input waveform (amplitude, frequency, rise, offset, "
                "duty, slew); a model parameter (sigma0, sigma1, fc, fs, vs, sigma2, a law coefficient such as "
@@ -313,7 +314,8 @@ def _add_sweep_command(sub):
     w.add_argument("--rtol", type=_positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
     _scheduler_options(w)
     w.add_argument("--batch-size", type=_positive_int, metavar="N",
-                   help="points per task (default: about 8 tasks per worker, at most 500 points each)")
+                   help="points per task (default: sized from the first points' time, at least ~20 ms of work "
+                        "each on threads and ~100 ms on Dask, 4 or more per worker)")
     w.add_argument("-o", "--output", required=True, metavar="SWEEP.csv", help=_writes(
         "sweep", "output", "the table: CSV ('-' for standard output), MATLAB vectors (one per column), or "
                            "Parquet (needs pyarrow)"))

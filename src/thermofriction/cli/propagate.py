@@ -21,7 +21,7 @@ def add_propagate_command(sub, *, temperature, positive_float, int_in, writes, s
         description="Draw parameter sets from a fit's covariance (the standard errors and correlations that "
                     "identify --json wrote; positive parameters log-normally), simulate each at every temperature "
                     "and write the central bands of the displacement and of the mean step per cycle, with and "
-                    "without the measurement noise the fit estimated. Runs on Dask, as sweep does; the draws are "
+                    "without the measurement noise the fit estimated. Runs where sweep does (threads in this process by default, or Dask); the draws are "
                     "made from --seed before any task runs, so the bands do not depend on where they ran.",
         epilog="example: thermofriction identify data --json fit.json -o fit.toml; thermofriction propagate "
                "fit.json --temperatures 33,37,40 --draws 400 -o bands.json; thermofriction report fit.toml data "
@@ -42,8 +42,8 @@ def add_propagate_command(sub, *, temperature, positive_float, int_in, writes, s
     p.add_argument("--solver", choices=sorted(SOLVERS), default=None, help="integrator (default: auto)")
     p.add_argument("--rtol", type=positive_float, default=1e-6, help="relative tolerance (default: 1e-6)")
     scheduler_options(p)
-    p.add_argument("--batch-size", type=int_in(1), metavar="N", help="draws per task (default: about 8 tasks per "
-                                                                      "worker, at most 100 draws each)")
+    p.add_argument("--batch-size", type=int_in(1), metavar="N", help="draws per task (default: sized from the "
+                   "nominal runs' time, 4 or more per worker, at most 100 draws each)")
     p.add_argument("-o", "--output", metavar="BANDS.json", help=writes(
         "propagate", "output", "the bands: JSON (everything, for report --bands), CSV (one row per temperature "
                                "and time) or MATLAB structs"))

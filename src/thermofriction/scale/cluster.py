@@ -1,28 +1,45 @@
-"""Where the work runs: Dask's distributed scheduler (an embedded local cluster by default, or an
-existing one), or in order in this process (``scheduler="sequential"``, the baseline).
+"""Where the work runs: threads in this process (the default: the C core releases the GIL while it
+integrates), in order in this process (``scheduler="sequential"``, the baseline), an embedded local
+Dask cluster of worker processes (``scheduler="processes"``), or an existing Dask cluster (an
+address or a ``distributed.Client``).
 
 Dask is imported here only, and only when a cluster is used, so that ``import thermofriction``
-stays light. Every workload of this package is a list of independent tasks (a batch of sweep
-points, one dataset, a batch of draws) whose result depends only on its arguments: the scheduler
+stays light. Every workload of this package is a list of independent tasks (a chunk of sweep
+points, one dataset, a chunk of draws) whose result depends only on its arguments: the scheduler
 may run them anywhere, in any order, and run one again when the worker holding it dies; the
-results are put back in task order, so they equal a sequential run's.
+results are put back in task order, so they equal a sequential run's to the last bit.
+
+Chunks (:func:`chunk_spans`): consecutive items per task, sized from the measured time of one item
+so that a task's overhead (~2.5 ms on Dask, ~0.05 ms on threads) stays a small share of its work,
+largest first and shrinking towards the end, so that every worker gets several and the last ones
+finish together (guided self-scheduling).
 """
 
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import contextlib
 import logging
-import math
+import numbers
 import os
 import pickle
 import sys
+import threading
+import time
 import uuid
+import warnings
 
+from .. import _args
 from ..errors import ComputationError, InputError, shorten
+from .chunks import CHUNK_SECONDS, chunk_spans
+from .connect import probe, read_scheduler_file
 
 SEQUENTIAL = "sequential"
-
+THREADS = "threads"
+PROCESSES = "processes"
+#: the scheduler=/--scheduler values that name a way of running here rather than a cluster's address
+LOCAL = (SEQUENTIAL, THREADS, PROCESSES)
 
 def _distributed():
     try:
@@ -39,114 +56,110 @@ def is_client(obj) -> bool:
 
 
 def check_scheduler(scheduler):
-    """None, "sequential", an address (tcp://HOST:PORT, a host:port, a scheduler file) or a Client."""
-    if scheduler is None or (isinstance(scheduler, str) and scheduler == SEQUENTIAL) or is_client(scheduler):
+    """None (threads in this process), "sequential", "threads", "processes" (a local Dask cluster), an
+    address (tcp://HOST:PORT, a host:port, a scheduler file) or a Client."""
+    if scheduler is None or (isinstance(scheduler, str) and scheduler in LOCAL) or is_client(scheduler):
         return scheduler
     if isinstance(scheduler, (str, os.PathLike)) and str(scheduler).strip():
         return str(scheduler).strip()
-    raise InputError(f"scheduler must be None (a local cluster), 'sequential', an address such as "
-                     f"tcp://HOST:8786, or a distributed.Client; got {shorten(scheduler)}")
+    raise InputError(f"scheduler must be None (threads in this process), 'sequential', 'threads', 'processes' "
+                     f"(a local Dask cluster), an address such as tcp://HOST:8786, or a distributed.Client; "
+                     f"got {shorten(scheduler)}")
 
 
-#: a Dask scheduler file is a few hundred bytes of JSON (dask scheduler --scheduler-file)
-_SCHEDULER_FILE_LIMIT = 1 << 20
-#: a Dask message's 8-byte length prefix beyond this is not a greeting (text read as a length: ~1e18)
-_GREETING_LIMIT = 1 << 26
+def check_options(scheduler=None, workers=None, batch_size=None, progress=None):
+    """The options of where and how the work runs, as sweep, propagate and identify_fleet take them,
+    checked before any work: one InputError naming the argument."""
+    check_scheduler(scheduler)
+    for name, value in (("workers", workers), ("batch_size", batch_size)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
+            _args.refuse(name, "a positive whole number or None", value)
+    _args.function(progress, "progress")
 
 
-def read_scheduler_file(path) -> str:
-    """The address in a scheduler file (JSON with an ``address``, as ``dask scheduler --scheduler-file``
-    writes it), or one InputError naming the file: Dask's own reader fails on a damaged file with an
-    AssertionError or a KeyError."""
-    from .._reading import read_text
-
-    what = "a Dask scheduler file (JSON with an \"address\", as 'dask scheduler --scheduler-file' writes)"
-    try:
-        if os.path.getsize(path) > _SCHEDULER_FILE_LIMIT:
-            raise InputError(f"scheduler {path}: not {what}: {os.path.getsize(path)} bytes")
-        text = read_text(path, "scheduler file")
-    except OSError as e:
-        raise InputError(f"scheduler {path}: cannot read ({e.strerror or e})") from None
-    except UnicodeDecodeError:
-        raise InputError(f"scheduler {path}: not {what}: not UTF-8 text") from None
-    import json
-    try:
-        info = json.loads(text)
-    except ValueError as e:
-        raise InputError(f"scheduler {path}: not {what}: {e}") from None
-    address = info.get("address") if isinstance(info, dict) else None
-    if not isinstance(address, str) or not address.strip():
-        raise InputError(f"scheduler {path}: not {what}: no \"address\" in it")
-    return address.strip()
+#: per thread of a Runner's pool: where the warnings of the running task go (see recorded_warnings)
+_local = threading.local()
 
 
-def _probe(address):
-    """For a TCP address: when something answers there, that it greets as a Dask scheduler does (at once,
-    with a message of a plausible length), so that an HTTP or SSH server is named as not a scheduler instead
-    of Dask waiting forever or reading its text as a 3 EiB message ("out of memory"). Nothing listening, or
-    another protocol (tls://, ucx://): left to Dask, which retries until its connect timeout."""
-    import re
-    import socket
-    import struct
-
-    m = re.fullmatch(r"(?:tcp://)?\[?([^\[\]/]+?)\]?:(\d+)/?", address)
-    if m is None:
-        return
-    host, port = m.group(1), int(m.group(2))
-    timeout = _connect_timeout()
-    try:
-        sock = socket.create_connection((host, port), timeout=timeout)
-    except OSError:
-        return  # Dask tries again until its timeout and then says so
-    with sock:
-        head = b""
+@contextlib.contextmanager
+def recorded_warnings():
+    """The warnings raised in the block, every one (``simplefilter("always")``), as a list of
+    ``warnings.WarningMessage``, without showing them. In a thread of a Runner's pool the block's own
+    thread's warnings are routed here by the runner (``warnings.catch_warnings`` changes the warnings
+    module's global state: two threads that enter and leave it out of turn lose warnings)."""
+    if getattr(_local, "routed", False):
+        caught = []
+        _local.sink = caught
         try:
-            while len(head) < 8:
-                chunk = sock.recv(8 - len(head))
-                if not chunk:
-                    break
-                head += chunk
-        except OSError:  # socket.timeout included
-            pass
-    if len(head) < 8:
-        said = f"it sent {head!r} and closed the connection" if head else f"it said nothing within {timeout:g} s"
-        raise InputError(f"scheduler {address}: not a Dask scheduler ({said}; a scheduler greets a client at once); "
-                         f"start one with 'dask scheduler' (docs/scale.md)")
-    (length,) = struct.unpack("<Q", head)
-    if not 0 < length <= _GREETING_LIMIT:
-        raise InputError(f"scheduler {address}: not a Dask scheduler (it answered {head!r}...); start one with "
-                         f"'dask scheduler' (docs/scale.md)")
+            yield caught
+        finally:
+            _local.sink = None
+    else:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            yield caught
 
 
-def _connect_timeout() -> float:
-    """Dask's connect timeout [s] (distributed.comm.timeouts.connect), 30 s where it cannot be read."""
-    try:
-        import dask.config
-        from dask.utils import parse_timedelta
-        return float(parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s"))
-    except Exception:  # noqa: BLE001 - a hint only
-        return 30.0
+class _RoutedWarnings:
+    """While a thread pool works: a pool thread's warnings go into its task's list when the task records
+    them (recorded_warnings), elsewhere as before; with ``always``, every one is shown (as
+    recorded_warnings asks: the same list as in sequential mode). On leaving, the warnings module is as
+    it was, whatever the threads did to it."""
+
+    def __init__(self, always: bool):
+        self.always = always
+
+    def __enter__(self):
+        self._saved = warnings.catch_warnings()
+        self._saved.__enter__()
+        if self.always:
+            warnings.simplefilter("always")
+        self._show = warnings.showwarning
+        warnings.showwarning = self._route
+        return self
+
+    def _route(self, message, category, filename, lineno, file=None, line=None):
+        sink = getattr(_local, "sink", None)
+        if sink is None:
+            self._show(message, category, filename, lineno, file, line)
+        else:
+            sink.append(warnings.WarningMessage(message, category, filename, lineno, file, line))
+
+    def __exit__(self, *exc):
+        return self._saved.__exit__(*exc)
+
+
+def _route_this_thread():
+    _local.routed = True
 
 
 class Runner:
     """Runs tasks ``fn(*args)`` on the chosen scheduler and hands back their results in task order.
 
-    ``with Runner(scheduler, workers) as r: results = r.map(fn, arg_tuples, progress=...)``.
+    ``with Runner(scheduler, workers) as r: results = r.map(fn, arg_tuples, progress=...)``, or
+    ``spans, results = r.map_chunks(fn, n_items, args_of, ...)`` for items cut into chunks here.
     ``progress(done_weight)`` is called after each task with the sum of the finished tasks'
     weights. A task that raises stops the run (the task functions of this package catch the
     failures of single points and datasets themselves and return them as results)."""
 
     def __init__(self, scheduler=None, workers=None):
+        check_options(scheduler, workers)
         self.scheduler = check_scheduler(scheduler)
-        if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-            raise InputError(f"workers must be a positive whole number, got {shorten(workers)}")
         self.workers = workers
-        self.client = self._cluster = None
+        self.client = self._cluster = self._pool = None
+        self._failing = False
         self._stack = contextlib.ExitStack()
 
     @property
     def sequential(self) -> bool:
         return self.scheduler == SEQUENTIAL
+
+    @property
+    def kind(self) -> str:
+        """"sequential", "threads" or "dask"."""
+        if self.sequential:
+            return "sequential"
+        return "threads" if self.scheduler in (None, THREADS) else "dask"
 
     def __enter__(self):
         if self.sequential:
@@ -159,13 +172,21 @@ class Runner:
         return self
 
     def _start(self):
+        if self.kind == "threads":
+            # the C core releases the GIL while it integrates: threads of this process use every core,
+            # with nothing to start, to pickle or to send
+            self._threads = self.workers or os.cpu_count() or 1
+            self._pool = concurrent.futures.ThreadPoolExecutor(
+                max_workers=self._threads, thread_name_prefix="thermofriction-scale", initializer=_route_this_thread)
+            self._stack.callback(self._stop_pool)
+            return
         distributed = _distributed()
         if is_client(self.scheduler):
             self.client = self.scheduler  # the caller's: used, not closed
             return
-        if self.scheduler is None:
-            # processes, one thread each: the C core releases the GIL, but a crash or a leak in one
-            # worker must not take the others (or this process) with it
+        if self.scheduler == PROCESSES:
+            # processes, one thread each: a crash or a leak in one worker does not take the others (or
+            # this process) with it
             n = self.workers or os.cpu_count() or 1
             # the workers ignore Ctrl-C (scale/_worker.py): this process stops them
             self._cluster = self._stack.enter_context(distributed.LocalCluster(
@@ -176,7 +197,7 @@ class Runner:
         address = self.scheduler
         if os.path.exists(address):  # a scheduler file: read here, so that a damaged one is one message
             address = read_scheduler_file(address)
-        _probe(address)
+        probe(address)
         try:
             # the wait is Dask's own (distributed.comm.timeouts.connect, 30 s unless configured)
             self.client = self._stack.enter_context(distributed.Client(address=address))
@@ -188,33 +209,79 @@ class Runner:
             raise InputError(f"scheduler {address}: cannot connect ({shorten(str(e) or type(e).__name__, 200)}); "
                              f"start one with 'dask scheduler' and 'dask worker ADDRESS' (docs/scale.md)") from None
 
+    def _stop_pool(self):
+        # after Ctrl-C or a failed task: the chunks not started are dropped, the running ones end by
+        # themselves (a chunk is at most about CHUNK_MAX_SECONDS of work)
+        self._pool.shutdown(wait=not self._failing, cancel_futures=True)
+
     def __exit__(self, *exc):
+        self._failing = exc[0] is not None
         self._stack.close()
         return False
 
     def n_workers(self) -> int:
         """The workers available now (1 in sequential mode)."""
+        if self._pool is not None:
+            return self._threads
         if self.client is None:
             return 1
         try:
             return max(len(self.client.scheduler_info(n_workers=-1)["workers"]), 1)
         except TypeError:  # older distributed: no n_workers argument
             return max(len(self.client.scheduler_info()["workers"]), 1)
-        except Exception:  # noqa: BLE001 - a hint for batch sizes only
+        except Exception:  # noqa: BLE001 - a hint for chunk sizes only
             return 1
 
     def describe(self) -> str:
+        if self._pool is not None:
+            return f"{self.n_workers()} threads in this process"
         if self.client is None:
             return "in this process, in order"
-        where = "a local Dask cluster" if self._cluster is not None else f"Dask scheduler {self.client.scheduler.address}"
+        where = ("a local Dask cluster" if self._cluster is not None
+                 else f"Dask scheduler {self.client.scheduler.address}")
         return f"{where} ({self.n_workers()} workers)"
 
-    def map(self, fn, arg_tuples, weights=None, progress=None, on_error=None) -> list:
+    def map_chunks(self, fn, n_items: int, args_of, *, batch_size=None, item_seconds=None, largest=None,
+                   progress=None, on_error=None, records_warnings=False):
+        """``fn(*args_of(a, b))`` for consecutive chunks [a, b) covering range(n_items): (spans, results),
+        both in item order. Chunk sizes: ``batch_size`` items each when given; else from ``item_seconds``
+        (one item's time [s]), or, when it is not known, from timing the first items here (which are
+        then the first chunks: none runs twice) -- see :func:`chunk_spans`. ``largest``: items per chunk at
+        most. ``on_error(span, reason)``: the result of a chunk the cluster could not run.
+        ``records_warnings``: ``fn`` records its warnings (recorded_warnings), every one."""
+        spans, results = [], []
+        first = progress_offset = 0
+        if batch_size is None and item_seconds is None and n_items > 0:
+            # the first items here, one chunk of 1, 2, 4, ... until ~CHUNK_SECONDS of work: their time per item
+            t0, size = time.perf_counter(), 1
+            limit = max(1, n_items // 50)
+            while first < min(limit, n_items) and time.perf_counter() - t0 < CHUNK_SECONDS[self.kind]:
+                b = min(first + size, limit, first + (largest or size))
+                results.append(fn(*args_of(first, b)))
+                spans.append((first, b))
+                first, size = b, 2 * size
+                if progress:
+                    progress(first)
+            item_seconds = (time.perf_counter() - t0) / first
+            progress_offset = first
+        rest = chunk_spans(n_items - first, self.n_workers(), item_seconds, kind=self.kind, batch_size=batch_size,
+                           largest=largest)
+        rest = [(a + first, b + first) for a, b in rest]
+        report = (lambda done: progress(progress_offset + done)) if progress else None
+        lost = (lambda i, reason: on_error(rest[i], reason)) if on_error else None
+        results += self.map(fn, [args_of(a, b) for a, b in rest], weights=[b - a for a, b in rest], progress=report,
+                            on_error=lost, records_warnings=records_warnings)
+        return spans + rest, results
+
+    def map(self, fn, arg_tuples, weights=None, progress=None, on_error=None, records_warnings=False) -> list:
         """``on_error(i, reason)``: the result of task i when the cluster could not run it (its
-        worker died every time it ran it, e.g. a crash); without it such a task stops the run."""
+        worker died every time it ran it, e.g. a crash); without it such a task stops the run.
+        ``records_warnings``: the tasks record their warnings (recorded_warnings), every one."""
         arg_tuples = list(arg_tuples)
         weights = list(weights) if weights is not None else [1] * len(arg_tuples)
         done = 0
+        if self._pool is not None:
+            return self._map_threads(fn, arg_tuples, weights, progress, records_warnings)
         if self.client is None:
             results = []
             for args, w in zip(arg_tuples, weights):
@@ -254,23 +321,33 @@ class Runner:
             raise
         return results
 
+    def _map_threads(self, fn, arg_tuples, weights, progress, records_warnings) -> list:
+        """The tasks on the pool's threads, the arguments as they are (nothing is pickled: a task must not
+        change its arguments, and the package's task functions do not). A task that raises stops the run,
+        as in sequential mode."""
+        results = [None] * len(arg_tuples)
+        done = 0
+        with _RoutedWarnings(always=records_warnings):
+            futures = {self._pool.submit(fn, *args): i for i, args in enumerate(arg_tuples)}
+            try:
+                for fut in concurrent.futures.as_completed(futures):
+                    i = futures[fut]
+                    results[i] = fut.result()
+                    done += weights[i]
+                    if progress:
+                        progress(done)
+            except BaseException:  # Ctrl-C, a task that raised: drop the chunks not started
+                for fut in futures:
+                    fut.cancel()
+                raise
+        return results
+
 
 def _call(fn, payload: bytes) -> bytes:
     """A task as the workers run it: arguments and result travel as pickles of our own, because
     Dask hands NumPy arrays over as read-only views of its network buffers, which the C core's
     binding refuses as outputs (and a model or dataset must come out as it went in)."""
     return pickle.dumps(fn(*pickle.loads(payload)), protocol=pickle.HIGHEST_PROTOCOL)
-
-
-def batches(n: int, size: int):
-    """(start, stop) of consecutive batches of ``size`` covering range(n)."""
-    return [(i, min(i + size, n)) for i in range(0, n, size)]
-
-
-def auto_batch_size(n_items: int, n_workers: int, per_worker: int = 8, largest: int = 500) -> int:
-    """Enough tasks to keep every worker busy and to lose little when one dies (``per_worker``
-    batches each), but many items per task so that the scheduler's overhead stays small."""
-    return int(min(max(math.ceil(n_items / (per_worker * max(n_workers, 1))), 1), largest))
 
 
 def progress_bar(total, label, enabled=True):
@@ -286,4 +363,5 @@ def progress_bar(total, label, enabled=True):
     return (lambda done: bar.update(task, completed=done)), bar.stop
 
 
-__all__ = ["Runner", "SEQUENTIAL", "check_scheduler", "read_scheduler_file", "batches", "auto_batch_size", "progress_bar", "is_client"]
+__all__ = ["Runner", "SEQUENTIAL", "THREADS", "PROCESSES", "check_scheduler", "check_options", "read_scheduler_file",
+           "chunk_spans", "progress_bar", "is_client", "recorded_warnings"]

@@ -26,7 +26,7 @@ from .. import _io
 from .. import _args
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import PRESETS, Model, load_model
-from .cluster import Runner
+from .cluster import Runner, check_options
 
 #: modified z-score above which a value is an outlier (Iglewicz & Hoaglin 1993: 0.6745 (x - median) / MAD)
 OUTLIER_Z = 3.5
@@ -254,7 +254,8 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
     A dataset that cannot be read or identified is recorded with its reason; the others go on.
 
     datasets: a list of dataset folders or ``Dataset`` objects, or one folder of dataset folders.
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: a local Dask cluster).
+    scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process; an
+        identification is seconds of work, so each dataset is one task).
     progress: called with the number of datasets done."""
     import time
 
@@ -269,7 +270,7 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
     _args.text(method, "method")
     if not (init is None or isinstance(init, (Model, str, os.PathLike))):
         _args.refuse("init", "a Model, a model file or a preset name, or None", init)
-    _args.function(progress, "progress")
+    check_options(scheduler, workers, progress=progress)
     if isinstance(datasets, (str, os.PathLike)):
         datasets = fleet_datasets(datasets) or [datasets]
     datasets = list(datasets)

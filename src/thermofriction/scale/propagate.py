@@ -24,10 +24,10 @@ import numpy as np
 
 from .. import _io
 from .. import _args
-from ..simulation import AutoSwitch, Dopri5, Rodas4, StepSizeController
 from ..waveforms import Waveform
 from ..errors import InputError, ThermofrictionError, shorten
-from .cluster import Runner, auto_batch_size, batches, check_scheduler
+from .cluster import Runner
+from .sweep import check_run_options
 
 MAX_DRAWS = 1_000_000
 
@@ -236,18 +236,7 @@ def _checked(result, temperatures, draws, seed, input, duration, sample_rate, le
     """propagate's arguments checked before any work; returns (the fitted model, the temperatures as an array)."""
     if input is not None and not isinstance(input, Waveform):
         _args.refuse("input", "a Waveform or None", input)
-    _args.number(duration, "duration", "s")
-    _args.number(sample_rate, "sample_rate", "Hz")
-    if solver is not None and not isinstance(solver, (str, Dopri5, Rodas4, AutoSwitch)):
-        _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
-    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
-    check_scheduler(scheduler)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        _args.refuse("workers", "a positive whole number or None", workers)
-    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, numbers.Integral)
-                                   or batch_size < 1):
-        _args.refuse("batch_size", "a positive whole number or None", batch_size)
-    _args.function(progress, "progress")
+    check_run_options(duration, sample_rate, solver, controller, scheduler, workers, batch_size, progress)
     if isinstance(temperatures, (str, bytes)) or not (_args.is_number(temperatures) or (
             isinstance(temperatures, (list, tuple, np.ndarray)) and all(_args.is_number(t) for t in temperatures))):
         _args.refuse("temperatures", "a number or a list of numbers [C]", temperatures)
@@ -276,8 +265,9 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
     at every temperature [C] (``duration`` s of ``input``, default the model's), and returns the
     central ``level`` bands of the displacement and of the mean step per cycle.
 
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: a local Dask cluster).
-    batch_size: draws per task. progress: called with the number of draws done."""
+    scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process).
+    batch_size: draws per task (default: chunks of at least ~20 ms of work on threads, ~100 ms on Dask).
+    progress: called with the number of draws done."""
     import time
 
     from ..simulation import simulate
@@ -290,13 +280,14 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
     sim = dict(duration=duration, sample_rate=sample_rate, solver=solver, controller=controller)
     t0 = time.perf_counter()
     nominal = [simulate(model, temperature=float(T), input=waveform, **sim) for T in temps]  # checks the arguments
+    per_draw = time.perf_counter() - t0  # a draw's runs take about what the nominal ones took: the chunks' size
     names, thetas = draw_parameters(result, int(draws), int(seed))
     with Runner(scheduler, workers) as runner:
-        size = batch_size or auto_batch_size(int(draws), runner.n_workers(), largest=100)
-        spans = batches(int(draws), size)
-        outs = runner.map(_run_draws, [(model, names, thetas[a:b], temps, waveform, sim) for a, b in spans],
-                          weights=[b - a for a, b in spans], progress=progress,
-                          on_error=lambda i, reason: (None, None, {k: reason for k in range(spans[i][1] - spans[i][0])}))
+        # at most 100 draws per chunk: a chunk's displacements (draws x temperatures x samples) travel back whole
+        spans, outs = runner.map_chunks(
+            _run_draws, int(draws), lambda a, b: (model, names, thetas[a:b], temps, waveform, sim),
+            batch_size=batch_size, item_seconds=per_draw, largest=100, progress=progress,
+            on_error=lambda span, reason: (None, None, {k: reason for k in range(span[1] - span[0])}))
         where = runner.describe()
     n_t = nominal[0].time.size
     disp = np.full((int(draws), temps.size, n_t), np.nan)

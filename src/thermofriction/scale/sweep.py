@@ -16,8 +16,6 @@ from __future__ import annotations
 import csv
 import dataclasses
 import math
-import numbers
-import warnings
 
 import numpy as np
 
@@ -28,7 +26,7 @@ from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
 from ..waveforms import Sampled, Waveform
-from .cluster import Runner, auto_batch_size, batches, check_scheduler
+from .cluster import Runner, check_options, recorded_warnings
 
 #: the most points of one sweep (their coordinates and metrics are held in memory: ~100 bytes each)
 MAX_POINTS = 50_000_000
@@ -54,6 +52,17 @@ METRICS = {
 DEFAULT_METRICS = ("mean_step", "final_displacement", "peak_friction_force")
 _INPUT_UNITS = {"stick-slip": "V", "mass": "N", "prescribed": "m"}
 _WAVEFORM_UNITS = {"frequency": "Hz", "rise": "", "duty": "", "slew": "s", "time": "s", "direction": ""}
+
+
+def check_run_options(duration, sample_rate, solver, controller, scheduler, workers, batch_size, progress):
+    """The options sweep and propagate share -- each run's length and rate, its integrator, where the runs go --
+    checked before any work: one InputError naming the argument."""
+    _args.number(duration, "duration", "s")
+    _args.number(sample_rate, "sample_rate", "Hz")
+    if solver is not None and not isinstance(solver, (str, Dopri5, Rodas4, AutoSwitch)):
+        _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
+    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
+    check_options(scheduler, workers, batch_size, progress)
 
 
 # -- the grid ---------------------------------------------------------------------------------
@@ -141,8 +150,7 @@ def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim)
     errors, seen = {}, {}
     for i, row in enumerate(coords):
         point = dict(zip(names, (float(v) for v in row)))
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with recorded_warnings() as caught:
             try:
                 T = point.get("temperature", temperature)
                 inp = {n: v for n, v in point.items() if kinds[n] == "input"}
@@ -306,25 +314,19 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
         the points when the grid has no ``temperature`` axis.
     metrics: names from ``METRICS`` (default: mean step per cycle, final displacement, peak
         friction force).
-    scheduler: None (a local Dask cluster on this machine's cores; ``workers`` of them),
-        "sequential" (in this process, in order), an address (``tcp://HOST:8786``, a scheduler
+    scheduler: None or "threads" (threads in this process, one per core, or ``workers`` of them: the
+        C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded
+        local Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler
         file) or a ``distributed.Client``.
-    batch_size: points per task (default: about 8 tasks per worker, at most 500 points each).
+    batch_size: points per task (default: chunks sized from the first points' time, at least ~20 ms
+        of work each on threads and ~100 ms on Dask, at least 4 per worker; docs/scale.md).
     progress: called with the number of points done.
     """
     import time
 
     model = _args.model(model, Model, loader=load_model)  # the argument types (_args.py): before any work
-    _args.number(duration, "duration", "s")
     _args.number(temperature, "temperature", "degC", none=True)
-    _args.number(sample_rate, "sample_rate", "Hz")
-    if solver is not None and not isinstance(solver, (str, Dopri5, Rodas4, AutoSwitch)):
-        _args.refuse("solver", "Dopri5(), Rodas4(), AutoSwitch() or one of their names", solver)
-    _args.instance(controller, StepSizeController, "controller", "a StepSizeController", none=True)
-    check_scheduler(scheduler)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        _args.refuse("workers", "a positive whole number or None", workers)
-    _args.function(progress, "progress")
+    check_run_options(duration, sample_rate, solver, controller, scheduler, workers, batch_size, progress)
     if not isinstance(metrics, str):
         metrics = _args.names(metrics, "metrics", none=False)
     waveform = input if input is not None else model.input
@@ -339,9 +341,6 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     if unknown or not metrics:
         raise InputError(f"unknown metric {shorten(unknown[0]) if unknown else '(none given)'} "
                          f"(one of: {', '.join(METRICS)})")
-    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, numbers.Integral)
-                                   or batch_size < 1):
-        raise InputError(f"batch_size must be a positive whole number, got {shorten(batch_size)}")
     axes, n = _grid(grid)
     names = tuple(axes)
     kinds, units = _kinds(model, waveform, names)
@@ -352,13 +351,12 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     sim = dict(duration=duration, sample_rate=sample_rate, solver=solver, controller=controller)
     t0 = time.perf_counter()
     with Runner(scheduler, workers) as runner:
-        size = batch_size or auto_batch_size(n, runner.n_workers())
-        spans = batches(n, size)
-        args = [(model, waveform, temperature, names, kinds, coords[a:b], metrics, sim) for a, b in spans]
-        def lost(i, reason):  # every point of a batch the cluster could not run
-            a, b = spans[i]
+        def lost(span, reason):  # every point of a chunk the cluster could not run
+            a, b = span
             return np.full((b - a, len(metrics)), np.nan), {k: reason for k in range(b - a)}, []
-        outs = runner.map(_run_batch, args, weights=[b - a for a, b in spans], progress=progress, on_error=lost)
+        spans, outs = runner.map_chunks(
+            _run_batch, n, lambda a, b: (model, waveform, temperature, names, kinds, coords[a:b], metrics, sim),
+            batch_size=batch_size, progress=progress, on_error=lost, records_warnings=True)
         where = runner.describe()
     values = np.vstack([o[0] for o in outs]) if outs else np.empty((0, len(metrics)))
     errors, seen = {}, {}

@@ -5,6 +5,7 @@ Warnings for what may be wrong, InputError for what is."""
 from __future__ import annotations
 
 import math
+import threading
 import warnings
 import weakref
 
@@ -77,6 +78,9 @@ def check_temperature_coverage(temperature, t0: float, t1: float):
 # it is not hashable): a model run again and again at one temperature (identification, sweeps, a
 # benchmark) is checked once. The entry goes with its model (a weak reference's callback).
 _PASSED: dict = {}
+# catch_warnings changes the warnings module's global state: threads that simulate side by side (tf.sweep's)
+# take turns here, or one would restore the state another had set and the warnings after it would be lost
+_RECORDING = threading.RLock()
 
 
 def _passed(model) -> set:
@@ -91,7 +95,7 @@ def check_temperatures(model: Model, temperature):
     key = None if isinstance(temperature, Sampled) else temperature
     if key is not None and key in _passed(model):
         return
-    with warnings.catch_warnings(record=True) as caught:
+    with _RECORDING, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         _check_temperatures(model, temperature)
     for w in caught:  # passed on as they came (stacklevel as the checks set it)
