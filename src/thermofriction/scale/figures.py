@@ -13,13 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write
+from ..reporting.units import scaled_axis
 
 
 def bands_figure(result):
     """The bands drawn around the fitted model's prediction (their width is nanometres on
     micrometres of motion). Left: per temperature, the parameters' band minus the fitted model's
-    displacement [nm], over time (the band with the measurement noise is given in words). Right: the mean
-    step per cycle's band minus the fitted model's step [nm] against temperature, each point labelled
+    displacement, over time (the band with the measurement noise is given in words). Right: the mean
+    step per cycle's band minus the fitted model's step against temperature, each point labelled
     with the fitted model's step [um]."""
     import matplotlib
     from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
@@ -32,13 +33,15 @@ def bands_figure(result):
     ax, bx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.6, 1]})
     t = result.time
     level = f"{100 * result.level:g} %"
+    k = scaled_axis(ax, "y", np.concatenate([np.ravel(result.lower - result.nominal),
+                                             np.ravel(result.upper - result.nominal)]),
+                    "displacement − fitted model's", "m")
     for j, T in enumerate(temps):
         c, nom = colors[j], result.nominal[j]
-        ax.fill_between(t, (result.lower[j] - nom) * 1e9, (result.upper[j] - nom) * 1e9, color=c, alpha=0.45,
+        ax.fill_between(t, (result.lower[j] - nom) * k, (result.upper[j] - nom) * k, color=c, alpha=0.45,
                         linewidth=0.6, edgecolor=c, label=f"{T:g} °C")
     ax.axhline(0, color="#1d2433", linewidth=0.8)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("displacement − fitted model's [nm]")
     ax.set_title(f"{level} band of the prediction from the parameters' uncertainty", fontsize=9)
     if result.noise:  # far wider than the parameters' band as a rule: said, not drawn
         extra = float(np.max(result.prediction_upper - result.nominal)) * 1e9
@@ -50,14 +53,15 @@ def bands_figure(result):
     if ok.any():
         order = np.argsort(temps)
         T, nom = temps[order], result.nominal_step[order]
-        lo, hi = (result.step_lower[order] - nom) * 1e9, (result.step_upper[order] - nom) * 1e9
+        lo, hi = result.step_lower[order] - nom, result.step_upper[order] - nom
+        ks = scaled_axis(bx, "y", np.concatenate([lo, hi]), "step per cycle − fitted model's", "m")
+        lo, hi = lo * ks, hi * ks
         bx.fill_between(T, lo, hi, color="#f0a500", alpha=0.35, linewidth=0, label=f"{level} band")
         bx.plot(T, lo, T, hi, color="#f0a500", linewidth=0.8)
         bx.plot(T, np.zeros_like(T), "o-", color="#1d2433", markersize=4, linewidth=0.8, label="fitted model")
         for x, step in zip(T, nom):
             bx.annotate(f"{step * 1e6:.4g} µm", (x, 0), textcoords="offset points", xytext=(0, 6), ha="center",
                         fontsize=7, color="#4a5266")
-        bx.set_ylabel("step per cycle − fitted model's [nm]")
         bx.legend(fontsize=8, frameon=False, loc="lower right")
     else:
         bx.text(0.5, 0.5, "no periodic input: no steps per cycle", ha="center", va="center",
