@@ -38,6 +38,21 @@ def _level_error(fit, truth, temperatures, name="fc") -> float:
 
 def stribeck(seed, heavy=False) -> dict:
     """``heavy``: the truth's end-effector mass twice the start's (0.1 kg against 0.05), freed."""
+    fit, truth = stribeck_fit(seed, heavy)
+    rows = fit.recovery(truth, FIT_T)
+    extra = {}
+    if heavy:
+        lo, hi = fit.parameters["m_e"].ci95
+        extra = {"m_e_error": fit.parameters["m_e"].value / 0.1 - 1, "m_e_covered": bool(lo <= 0.1 <= hi)}
+    return {"scenario": "stribeck" + (", m_e 2x freed" if heavy else ""), "seed": seed,
+            "fc_error": _level_error(fit, truth, FIT_T), "fs_error": _level_error(fit, truth, FIT_T, "fs"), **extra,
+            "covered": sum(r["covered"] for r in rows), "points": len(rows),
+            "held": fit.details.get("held_for_lack_of_information"), "adequate": fit.adequate,
+            "missed": [(r["parameter"], r["temperature"]) for r in rows if not r["covered"]]}
+
+
+def stribeck_fit(seed, heavy=False):
+    """(fit, truth) of one Stribeck truth (see :func:`stribeck`)."""
     rng = np.random.default_rng(seed)
     base = stribeck_truth(end_effector_mass=0.1 if heavy else None)
     level = {n: float(rng.uniform(0.8, 1.25)) for n in base.laws}
@@ -49,16 +64,7 @@ def stribeck(seed, heavy=False) -> dict:
                        plant=tf.load_model("li2009-model-i").plant if heavy else None)
     fit = tf.identify(data, "model-i", init=start, parameters=["sigma0", "sigma1", "fc", "fs"],
                       free=["m_e"] if heavy else ())
-    rows = fit.recovery(truth, FIT_T)
-    extra = {}
-    if heavy:
-        lo, hi = fit.parameters["m_e"].ci95
-        extra = {"m_e_error": fit.parameters["m_e"].value / 0.1 - 1, "m_e_covered": bool(lo <= 0.1 <= hi)}
-    return {"scenario": "stribeck" + (", m_e 2x freed" if heavy else ""), "seed": seed,
-            "fc_error": _level_error(fit, truth, FIT_T), "fs_error": _level_error(fit, truth, FIT_T, "fs"), **extra,
-            "covered": sum(r["covered"] for r in rows), "points": len(rows),
-            "held": fit.details.get("held_for_lack_of_information"), "adequate": fit.adequate,
-            "missed": [(r["parameter"], r["temperature"]) for r in rows if not r["covered"]]}
+    return fit, truth
 
 
 if __name__ == "__main__":

@@ -19,10 +19,13 @@ def test_right_models_are_not_flagged_and_a_wrong_held_mass_is():
 def test_coverage_of_the_95_percent_intervals_on_random_truths():
     """tests/coverage_study.py over 8 truths each (measured: masses freed 69/80 = 0.86, 66/70 = 0.94 over the fits
     called adequate -- the one fit flagged not adequate ended in a wrong optimum; Stribeck with fs fitted from laws
-    2-3x off 121/128 = 0.95; before the held laws' range reached the intervals 0.83 and 0.79)."""
+    2-3x off 121/128 = 0.95; before the held laws' range reached the intervals 0.83 and 0.79; Stribeck with the
+    end-effector mass twice the start's, freed: 120/128 = 0.94, 0.83 before the freed mass was profiled)."""
     from coverage_study import masses_freed, stribeck
     rows = [masses_freed(s) for s in range(8)]
     good = [r for r in rows if r["adequate"]]
     assert sum(r["covered"] for r in good) >= 0.9 * sum(r["points"] for r in good), rows
     rows = [stribeck(s) for s in range(8)]
+    assert sum(r["covered"] for r in rows) >= 0.9 * sum(r["points"] for r in rows), rows
+    rows = [stribeck(s, heavy=True) for s in range(8)]
     assert sum(r["covered"] for r in rows) >= 0.9 * sum(r["points"] for r in rows), rows

@@ -18,6 +18,7 @@ from .laws import fit_law
 from .optimiser import fit
 from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
 from .problem import make_traces
+from .profile import Profiled, profiled, widened
 from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
                          fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
@@ -373,9 +374,14 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     ropts.setdefault("max_nfev", 30)
     # from laws through the per-temperature optima weighted by their covariances: near the optimum
     outcome = fit(model, params, traces, near=True, **ropts)
-    res = fit_result("model-i", model, params, outcome, traces, t0, warns, details)
-    res.nfev += sum(r.nfev for _, r in per_T)
-    res.njev += sum(r.njev for _, r in per_T)
+    prof = Profiled(model, params, outcome, traces)
+    if free:  # a plant parameter's step can be blocked where a law meets its domain's edge (profile.py)
+        prof = profiled(model, params, outcome, traces, experiments, measurement, free,
+                        lambda m, fr: _law_parameters(dict(m.thermal.laws), held, fr, m), ropts)
+    res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details)
+    widened(res, prof.widen)
+    res.nfev += sum(r.nfev for _, r in per_T) + prof.nfev
+    res.njev += sum(r.njev for _, r in per_T) + prof.njev
     return res
 
 

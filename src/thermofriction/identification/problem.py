@@ -163,8 +163,8 @@ class Problem:
             stats = _bridge.run_sensitivities(spec, targets, trace.time, out, sens, rtol=rtol,
                                               atol=np.concatenate([atol_y, atol_s.ravel()]), max_steps=budget)
             self._steps.setdefault(id(trace), int(stats["steps"]))
-        except _bridge.CoreFailure:
-            return None, None
+        except (_bridge.CoreFailure, InputError):  # InputError: at this run's temperature the laws break a
+            return None, None  # rule between parameters (fs below fc) that holds at the model's own checks
         return out, sens
 
     def in_names(self, S, model: Model, trace: Trace):
