@@ -27,6 +27,9 @@ PROFILE_STEP = 2.0
 #: refinement again: twice what a 95 % interval allows one parameter, far above what two fits of the same
 #: optimum differ by (their tolerances), small against the 150-200 seen when stuck
 MIN_GAIN = 8.0
+#: the evaluations of each held fit: enough to leave a blocked optimum (the gains of 75-100 came in the first few)
+#: and to see a flat profile's rise, at a fraction of the refinement's cost
+HELD_EVALUATIONS = 10
 #: the most a flat profile widens a standard error: beyond it the parameter is as good as undetermined, and the
 #: two held fits say no more
 MAX_WIDENING = 5.0
@@ -88,7 +91,8 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
         for side in (-PROFILE_STEP, PROFILE_STEP):
             held = with_values(optimum, {name: value + side * se})
             held_params = parameters_of(held, others)
-            trial = fit(held, held_params, make_traces(experiments, held, measurement), **once)
+            trial = fit(held, held_params, make_traces(experiments, held, measurement),
+                        **{**once, "max_nfev": HELD_EVALUATIONS})
             out.nfev, out.njev = out.nfev + trial.nfev, out.njev + trial.njev
             trial_cost = float(trial.r @ trial.r) / variance
             rises[name] = min(rises.get(name, np.inf), (trial_cost - cost) / inflation)
@@ -125,4 +129,4 @@ def widened(result, factors: dict) -> None:
             f"widened {factor:.2g}x, to [{par.ci95[0]:.4g}, {par.ci95[1]:.4g}]")
 
 
-__all__ = ["profiled", "Profiled", "widened", "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING"]
+__all__ = ["profiled", "Profiled", "widened", "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING", "HELD_EVALUATIONS"]
