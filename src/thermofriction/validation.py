@@ -37,6 +37,9 @@ def predict(model: Model, exp, rtol=1e-8):
 
 @dataclasses.dataclass
 class ValidationResult(Result):
+    """What :func:`validate` returns: the model, one Prediction per experiment with its metrics, the warnings,
+    and the experiments it could not be run on; a table in a notebook, ``to_json``, ``to_dataframe``, ``plot``."""
+
     model: Model
     predictions: list
     warnings: list
