@@ -43,7 +43,7 @@ static double pd(const run_state *s, const double *d, int j)
 static void ep_coefficients(run_state *s)
 {
     double dzss[TF_NPARAM], dzba[TF_NPARAM];
-    tf_ep_segment_set(&s->ep, s->p, s->v, dzss, dzba);
+    tf_ep_segment_set(&s->ep, s->p, s->v, s->np ? dzss : 0, dzba);
     for (int j = 0; j < s->np; j++) {
         s->ep.dzss[j] = pd(s, dzss, j);
         s->ep.dzba[j] = pd(s, dzba, j);
