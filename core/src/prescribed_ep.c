@@ -63,10 +63,10 @@ static const double A[7][6] = {
 static const double EC[7] = {71.0 / 57600, 0.0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200, 22.0 / 525,
                              -1.0 / 40};
 
-/* Y from s = 0 to s1 < = 1 (Y[1..3] from 1, 0, 0); the rate at s1 into R1; NaN in Y[0] if the error
- * estimate is not finite. The first step from the rate at the start: a relative change of rho of
+/* Y from s = 0 to s1 <= 1 (Y[1..3] from 1, 0, 0); the rate at s1 into R1; NaN in Y[0] (reported by
+ * prescribed.c as a non-finite force) if the error estimate is not finite or the step stops advancing. The first step from the rate at the start: a relative change of rho of
  * (TF_EP_TOL z_ss / w)^(1/5), the error allowed in y being w times rho's relative error. */
-static void transition(tf_ep_segment *e, double *Y, double s1, double *R1)
+static void transition(const tf_ep_segment *e, double *Y, double s1, double *R1)
 {
     double K[7][4], Z[4], s = 0.0, zss = e->zss;
     rate(e, 0.0, Y, K[0]);
@@ -76,6 +76,10 @@ static void transition(tf_ep_segment *e, double *Y, double s1, double *R1)
         double rest = s1 - s;
         int last = h >= rest;
         if (last) h = rest;
+        if (!(s + h > s)) { /* no progress: the step has fallen below s's resolution */
+            Y[0] = *R1 = NAN;
+            return;
+        }
         for (int i = 1; i < 7; i++) {
             for (int c = 0; c < 4; c++) {
                 double sum = 0.0;
@@ -97,17 +101,15 @@ static void transition(tf_ep_segment *e, double *Y, double s1, double *R1)
             memcpy(Y, Z, sizeof Z); /* the last stage is at the fifth-order solution */
             memcpy(K[0], K[6], sizeof K[0]);
             s = s_end;
-            e->steps++;
             h *= fmin(fac, 5.0);
         } else {
             h *= fmax(fac, 0.2);
-            e->rejected++;
         }
     }
     *R1 = K[0][0];
 }
 
-void tf_ep_advance(tf_ep_segment *e, double v, double *z, double *S, int np, double h)
+void tf_ep_advance(const tf_ep_segment *e, double v, double *z, double *S, int np, double h)
 {
     if (!(h > 0.0) || v == 0.0) return; /* at rest the bristle holds (z' = v) */
     double sg = v > 0.0 ? 1.0 : -1.0, y = sg * *z, X = e->av * h, zss = e->zss;

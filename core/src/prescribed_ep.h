@@ -26,7 +26,6 @@
 typedef struct {
     double av, zss, zba;   /* |v|, the steady and the break-away deflection on the side of v */
     double dzss[TF_NPARAM], dzba[TF_NPARAM]; /* their derivatives in the run's parameters (np of them) */
-    long steps, rejected;  /* the transition's steps, for tests */
 } tf_ep_segment;
 
 /* The segment's values at velocity v: z_ss and z_ba, and their derivatives in every friction parameter
@@ -35,6 +34,6 @@ void tf_ep_segment_set(tf_ep_segment *e, const double *p, double v, double *dzss
 
 /* The state z and its sensitivities S[np] over the time h at velocity v (that of tf_ep_segment_set),
  * e->dzss and e->dzba in the same np parameters. No allocation. */
-void tf_ep_advance(tf_ep_segment *e, double v, double *z, double *S, int np, double h);
+void tf_ep_advance(const tf_ep_segment *e, double v, double *z, double *S, int np, double h);
 
 #endif
