@@ -35,8 +35,9 @@ fit's 95 % half-width ("recovered" when every one is within 2 half-widths).
 
 Run: python benchmarks/bench_rough_start.py [--quick] [--full] [--rows model-i,force-lugre,...] [--seed N]
   default: the issue's sizes for Model I, Model II and Model I with m_e freed (2 s at 10 kHz), force records of
-  6,000 samples over 24 s (about 2 minutes on the 2-core machine at a load average of 2); --full: force records of 30,000 samples over 120 s (the issue's joint record); --quick: 0.4 s at
-  5 kHz and 1,500-sample force records.
+  6,000 samples over 24 s (about 2 minutes on the 2-core machine at a load average of 2); --full: force records
+  of 30,000 samples over 120 s (the issue's joint record); --quick: 0.4 s at 5 kHz and 1,500-sample force
+  records.
 """
 
 from __future__ import annotations

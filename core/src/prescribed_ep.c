@@ -64,7 +64,8 @@ static const double EC[7] = {71.0 / 57600, 0.0, -71.0 / 16695, 71.0 / 1920, -172
                              -1.0 / 40};
 
 /* Y from s = 0 to s1 <= 1 (Y[1..3] from 1, 0, 0); the rate at s1 into R1; NaN in Y[0] (reported by
- * prescribed.c as a non-finite force) if the error estimate is not finite or the step stops advancing. The first step from the rate at the start: a relative change of rho of
+ * prescribed.c as a non-finite force) if the error estimate is not finite or the step stops advancing. The
+ * first step from the rate at the start: a relative change of rho of
  * (TF_EP_TOL z_ss / w)^(1/5), the error allowed in y being w times rho's relative error. */
 static void transition(const tf_ep_segment *e, double *Y, double s1, double *R1)
 {
