@@ -4,7 +4,10 @@ that force-data fits use for the force and its Jacobian (docs/force-data.md#3-id
 Oracles: the closed-form LuGre response to a constant velocity from rest (analytic); the adaptive integrator of
 the C core at rtol 1e-11 (an independent algorithm: Dormand-Prince/Rodas4 with restarts at every knot and GMS's
 located events) on jittered samples with velocity reversals; central differences of the force for the
-sensitivities; and a fit's result on the earlier path (integrated runs, forward-difference Jacobian)."""
+sensitivities; and a fit's result on the earlier path (integrated runs, forward-difference Jacobian). The
+elasto-plastic bristle's transition band is stepped numerically (core/src/prescribed_ep.c, a local error of
+1e-11 per step on ln(z_ss - y)); the C core's own test checks it against a quadrature of the time to reach each
+deflection."""
 
 from __future__ import annotations
 
@@ -38,6 +41,15 @@ FRICTIONS = {
     "stribeck": (tf.Stribeck(fc=0.9, fs=1.4, vs=0.3, sigma2=0.35, v_smooth=0.05), ("fc", "fs", "vs", "sigma2")),
     "gms": (tf.GMS(k=(1500.0, 1000.0, 500.0), w=(0.25, 0.35, 0.4), C=20.0, fc=0.9, fs=1.4, vs=0.3, sigma2=0.35),
             ("C", "fc", "fs", "vs", "sigma2")),
+    "elastoplastic": (tf.ElastoPlastic(**ROT, vd=0.2, z_ba=1e-4),
+                      ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2", "vd", "z_ba")),
+    # both sides' values: z_ss on the negative side from fc_neg, fs_neg, vs_neg
+    "elastoplastic-asymmetric": (tf.ElastoPlastic(**ROT, z_ba=2e-4, fc_neg=0.75, fs_neg=1.2, vs_neg=0.2,
+                                                  sigma2_neg=0.3),
+                                 ("sigma0", "fc", "fs", "vs", "z_ba", "fc_neg", "fs_neg", "vs_neg", "sigma2_neg")),
+    # fs = fc (fs follows fc): no Stribeck effect, z_ss = fc / sigma0 at every velocity; z_ba = 0
+    "elastoplastic-fs-follows": (tf.ElastoPlastic(sigma0=3000.0, sigma1=0.3, fc=0.9, sigma2=0.35, z_ba=0.0),
+                                 ("sigma0", "sigma1", "fc", "sigma2")),
 }
 
 
@@ -114,6 +126,31 @@ def test_sensitivities_equal_central_differences(kind):
         assert np.max(np.abs(dF[:, j] - cd)) <= (1e-5 if kind == "gms" else 1e-6) * scale, name
 
 
+@pytest.mark.parametrize("kind", ["elastoplastic", "elastoplastic-asymmetric"])
+def test_elastoplastic_through_its_transition_band(kind):
+    """A slow motion (strokes of a few steady deflections g/sigma0, so that many samples fall in the band between
+    z_ba and z_ss that the core steps numerically): the force equals the integrator's at rtol 1e-11 to 1e-9 of the
+    range, and every sensitivity equals central differences (relative step 1e-5) to 1e-8 of the range per unit
+    relative change of the parameter."""
+    friction, names = FRICTIONS[kind]
+    model = tf.Model(JOINT, friction)
+    t, w = jittered_motion()
+    w = tf.Sampled(w.time, 0.005 * w.value)
+    F, dF = _bridge.prescribed_force(_bridge.model_spec(model, 30.0, w), t, names)
+    zss = friction.fc / friction.sigma0
+    assert 2 * zss < np.ptp(w.value) < 10 * zss  # the strokes: a few steady deflections
+    ref = integrated(model, t, w)
+    assert np.max(np.abs(F - ref)) <= 1e-9 * np.ptp(ref)
+    for j, name in enumerate(names):
+        value = getattr(friction, name)
+        h = 1e-5 * abs(value)
+        up, down = (_bridge.prescribed_force(_bridge.model_spec(
+            tf.Model(JOINT, dataclasses.replace(friction, **{name: value + s})), 30.0, w), t)[0] for s in (h, -h))
+        cd = (up - down) / (2 * h)
+        assert np.max(np.abs(cd)) > 0, name
+        assert np.max(np.abs(dF[:, j] - cd)) * abs(value) <= 1e-8 * np.ptp(F), name
+
+
 def test_refusals_name_the_argument():
     """Decreasing output times and a model it does not apply to are refused with the core's record."""
     model = tf.Model(JOINT, tf.LuGre(**ROT))
@@ -121,19 +158,20 @@ def test_refusals_name_the_argument():
     with pytest.raises(_bridge.CoreFailure, match="t_out") as e:
         _bridge.prescribed_force(_bridge.model_spec(model, 30.0, w), t[::-1])
     assert e.value.status == "bad_argument"
-    ep = tf.Model(JOINT, tf.ElastoPlastic(**ROT, z_ba=1e-4))
-    assert not _bridge.prescribed_applies(_bridge.model_spec(ep, 30.0, w))
-    with pytest.raises(_bridge.CoreFailure, match="model"):
-        _bridge.prescribed_force(_bridge.model_spec(ep, 30.0, w), t)
     m2 = tf.Model(JOINT, tf.LuGre(**ROT), ModelII(Linear(a=0.0, b=0.01)))
     assert not _bridge.prescribed_applies(_bridge.model_spec(m2, 30.0, w))
+    with pytest.raises(_bridge.CoreFailure, match="model"):
+        _bridge.prescribed_force(_bridge.model_spec(m2, 30.0, w), t)
+    ep = tf.Model(JOINT, tf.ElastoPlastic(**ROT, z_ba=1e-4))
+    assert _bridge.prescribed_applies(_bridge.model_spec(ep, 30.0, w))
     assert _bridge.prescribed_applies(_bridge.model_spec(model, 30.0, w))
 
 
-def test_fit_equals_the_forward_difference_path(tmp_path):
-    """A LuGre fit to reference-made joint torque: every parameter within 0.05 standard errors of the fit on the
-    earlier path (integrated runs at rtol 1e-9, forward-difference Jacobian), on the same data."""
-    truth = tf.Model(JOINT, tf.LuGre(**ROT))
+@pytest.mark.parametrize("kind", ["lugre", "elastoplastic"])
+def test_fit_equals_the_forward_difference_path(tmp_path, kind):
+    """A LuGre (elasto-plastic) fit to reference-made joint torque: every parameter within 0.05 standard errors of
+    the fit on the earlier path (integrated runs at rtol 1e-9, forward-difference Jacobian), on the same data."""
+    truth = tf.Model(JOINT, tf.LuGre(**ROT) if kind == "lugre" else tf.ElastoPlastic(**ROT, z_ba=1e-4))
     folder, _ = make_dataset(tmp_path, truth, offset=0.05, n=1500, duration=2.0)
     data = tf.load_dataset(folder)
     calls = []
@@ -143,10 +181,10 @@ def test_fit_equals_the_forward_difference_path(tmp_path):
         calls.append(1)
         return real(self, *a, **k)
     with mock.patch.object(Force, "_exact", counted):
-        new = tf.identify(data, "base", friction="lugre")
+        new = tf.identify(data, "base", friction=kind)
     assert calls  # the exact path ran
     with mock.patch.object(Force, "exact_names", staticmethod(lambda problem, model: None)):
-        old = tf.identify(data, "base", friction="lugre")
+        old = tf.identify(data, "base", friction=kind)
     for name, p in new.parameters.items():
         if p.vary:
             assert abs(p.value - old.parameters[name].value) <= 0.05 * p.stderr, (name, p.value,

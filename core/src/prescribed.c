@@ -1,6 +1,8 @@
-/* Friction under a prescribed motion, stepped exactly segment by segment (prescribed.h). */
+/* Friction under a prescribed motion, stepped exactly segment by segment (prescribed.h); the
+ * elasto-plastic bristle by prescribed_ep.c. */
 #include "thermofriction/prescribed.h"
 #include "thermofriction/thermal.h"
+#include "prescribed_ep.h"
 
 #include <math.h>
 #include <string.h>
@@ -8,7 +10,8 @@
 #define NZ TF_MAX_FRICTION_STATES
 
 /* The run's state: the friction states z, their sensitivities S (NZ x np), the GMS modes, and the
- * current segment's rates z' = a + b z with their parameter derivatives da, db (NZ x np). */
+ * current segment's rates z' = a + b z with their parameter derivatives da, db (NZ x np); the
+ * elasto-plastic model's segment instead (prescribed_ep.h). */
 typedef struct {
     int kind, nz, np, follows; /* follows: fs = fc at every temperature, so fc moves both */
     const int *params;
@@ -17,13 +20,14 @@ typedef struct {
     double v;
     double z[NZ], S[NZ][TF_NPARAM];
     double a[NZ], b[NZ], da[NZ][TF_NPARAM], db[NZ][TF_NPARAM];
+    tf_ep_segment ep;
 } run_state;
 
 int tf_prescribed_applies(const tf_model *m)
 {
     return m->plant == TF_PLANT_PRESCRIBED && m->input.kind == TF_WAVE_SAMPLED && m->input.n >= 2 &&
            !m->heat.on && m->T_n <= 1 && m->thermal != TF_THERMAL_MODEL_II &&
-           m->friction != TF_FRICTION_ELASTOPLASTIC && tf_friction_nstate(m->friction, m->gms.n) >= 0;
+           tf_friction_nstate(m->friction, m->gms.n) >= 0;
 }
 
 /* A parameter derivative from the friction model's list d[TF_NPARAM]: fc's carries fs's where fs follows fc
@@ -32,6 +36,18 @@ static double pd(const run_state *s, const double *d, int j)
 {
     int q = s->params[j];
     return d[q] + (s->follows && q == TF_P_FC ? d[TF_P_FS] : 0.0);
+}
+
+/* The elasto-plastic segment's z_ss and z_ba at the current velocity, their derivatives in the run's
+ * parameters. */
+static void ep_coefficients(run_state *s)
+{
+    double dzss[TF_NPARAM], dzba[TF_NPARAM];
+    tf_ep_segment_set(&s->ep, s->p, s->v, s->np ? dzss : 0, dzba);
+    for (int j = 0; j < s->np; j++) {
+        s->ep.dzss[j] = pd(s, dzss, j);
+        s->ep.dzba[j] = pd(s, dzba, j);
+    }
 }
 
 /* The rates' coefficients at the current velocity and modes, from the friction model's own evaluation
@@ -43,6 +59,10 @@ static void coefficients(run_state *s)
     tf_friction_partials jac;
     tf_friction_param_partials dp0, dp1;
     if (s->nz == 0) return;
+    if (s->kind == TF_FRICTION_ELASTOPLASTIC) {
+        ep_coefficients(s);
+        return;
+    }
     tf_friction_eval(s->kind, s->p, &s->gms, s->v, zero, dz, &jac, s->np ? &dp0 : 0);
     for (int i = 0; i < s->nz; i++) {
         s->a[i] = dz[i];
@@ -78,6 +98,10 @@ static void phis(double b, double h, double *E, double *phi, double *psi)
 static void advance(run_state *s, double h)
 {
     if (!(h > 0.0)) return;
+    if (s->kind == TF_FRICTION_ELASTOPLASTIC) {
+        tf_ep_advance(&s->ep, s->v, &s->z[0], s->S[0], s->np, h);
+        return;
+    }
     for (int i = 0; i < s->nz; i++) {
         double E, phi, psi, z0 = s->z[i];
         phis(s->b[i], h, &E, &phi, &psi);
@@ -168,7 +192,7 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
     static run_state zero_state;
     if (!m || !tf_prescribed_applies(m))
         return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "model (not a prescribed motion at a constant "
-                            "temperature with a sampled position and an affine friction state)", NAN, -1);
+                            "temperature with a sampled position)", NAN, -1);
     if (n_out < 1 || !t_out || !F || np < 0 || np > TF_NPARAM || (np > 0 && (!params || !dF)))
         return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "arguments", NAN, -1);
     for (int j = 0; j < np; j++)

@@ -558,9 +558,71 @@ static void test_prescribed_exact_stepping_gms_and_its_record(void)
     CHECK(s == TF_ERR_BAD_ARGUMENT && E.code == s && !strcmp(E.where, "prescribed") && strstr(E.what, "t_out") &&
               E.index == 3, "prescribed: a decreasing grid named at its sample (%s / %s / %ld)", E.where, E.what, E.index);
     t[3] = 0.4;
-    m.friction = TF_FRICTION_ELASTOPLASTIC;
+    m.thermal = TF_THERMAL_MODEL_II;
     CHECK(!tf_prescribed_applies(&m) && tf_prescribed_force(&m, 6, t, F, 0, NULL, NULL, &E) == TF_ERR_BAD_ARGUMENT &&
-              strstr(E.what, "model"), "prescribed: the elasto-plastic model is refused (%s)", E.what);
+              strstr(E.what, "model"), "prescribed: Model II is refused (%s)", E.what);
+}
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* The elasto-plastic transition's rate per unit displacement, dy/dx = 1 - alpha(y) y / z_ss with the half
+ * sine alpha = 1/2 + sin(pi (y - (z_ss + z_ba) / 2) / (z_ss - z_ba)) / 2 (docs/models.md). */
+static double ep_rate(double y, double zss, double zba)
+{
+    double alpha = 0.5 + 0.5 * sin(M_PI * (y - 0.5 * (zss + zba)) / (zss - zba));
+    return 1.0 - alpha * y / zss;
+}
+
+static void test_prescribed_exact_stepping_elastoplastic(void)
+{
+    /* tf_prescribed_force on the elasto-plastic bristle from rest at a constant velocity v (sigma1 = sigma2 = 0,
+     * fs = fc: F = sigma0 z, z_ss = fc / sigma0). Analytic: z = v t up to z_ba (elastic), then the time at which
+     * z reaches y in the band is t_ba + (1/v) integral_{z_ba}^{y} dy / (1 - alpha y / z_ss), a quadrature
+     * (composite Simpson, 200,000 panels) independent of the stepping; one sample far into the steady state
+     * (where F = fc to rounding). Both directions of motion. */
+    tf_model m;
+    memset(&m, 0, sizeof m);
+    m.plant = TF_PLANT_PRESCRIBED;
+    m.friction = TF_FRICTION_ELASTOPLASTIC;
+    double s0 = 2e4, fc = 1.5, zss = fc / s0, zba = 0.3 * zss, v = 2e-3;
+    m.p[TF_P_SIGMA0] = s0;
+    m.p[TF_P_FC] = m.p[TF_P_FS] = fc;
+    m.p[TF_P_VS] = 1e-3;
+    m.p[TF_P_DELTA] = 2.0;
+    m.p[TF_P_ZBA] = zba;
+    m.p[TF_P_VSMOOTH] = 1e-6;
+    m.fs_follows_fc = 1;
+    m.T_const = 25.0;
+    double ys[5] = {0.5 * zba, zba + 0.25 * (zss - zba), zba + 0.75 * (zss - zba), zss - 1e-4 * (zss - zba), 0.0};
+    double t[6] = {0.0}, F[6];
+    for (int k = 0; k < 4; k++) {
+        double y0 = k == 0 ? 0.0 : zba, y1 = ys[k], sum = 0.0;
+        int n = 200000;
+        if (k == 0) {
+            t[k + 1] = ys[0] / v;
+            continue;
+        }
+        double hq = (y1 - y0) / n;
+        for (int i = 0; i <= n; i++) {
+            double wgt = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+            sum += wgt / ep_rate(y0 + i * hq, zss, zba);
+        }
+        t[k + 1] = zba / v + sum * hq / 3.0 / v;
+    }
+    t[5] = t[4] + 60.0 * zss / v;
+    ys[4] = zss;
+    for (int dir = 1; dir >= -1; dir -= 2) {
+        static double kt[2] = {0.0, 10.0}, kx[2];
+        kx[1] = dir * v * 10.0;
+        m.input = (tf_waveform){TF_WAVE_SAMPLED, 0, 0, 0, 0, 1.0, 0, 0, kt, kx, 2};
+        tf_status s = tf_prescribed_force(&m, 6, t, F, 0, NULL, NULL, &E);
+        double worst = fabs(F[0]);
+        for (int k = 0; k < 5; k++) worst = fmax(worst, fabs(F[k + 1] - dir * s0 * ys[k]));
+        CHECK(s == TF_OK && tf_prescribed_applies(&m) && worst < 1e-9 * fc,
+              "prescribed elasto-plastic, direction %d: status %d, worst force error %g N", dir, s, worst);
+    }
 }
 
 /* Real-time API (realtime.h, control.h). */
@@ -1026,6 +1088,7 @@ int main(void)
     test_frictionless_step_response();
     test_gms_element_breaks_loose_exactly_at_its_capacity();
     test_prescribed_exact_stepping_gms_and_its_record();
+    test_prescribed_exact_stepping_elastoplastic();
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

@@ -238,16 +238,16 @@ def run_sensitivities(spec: dict, targets: np.ndarray, t: np.ndarray, out: np.nd
 
 def prescribed_applies(spec: dict) -> bool:
     """Whether :func:`prescribed_force` applies to the model ``spec`` (prescribed.h): a prescribed plant
-    driven by a sampled position at a constant temperature, no Model II, no self-heating, and a friction
-    model whose state rate is affine in its state (all but the elasto-plastic one)."""
+    driven by a sampled position at a constant temperature, no Model II, no self-heating (any friction
+    model)."""
     return bool(_core.prescribed_applies(spec))
 
 
 def prescribed_force(spec: dict, t: np.ndarray, names=()) -> tuple:
     """The friction force at times ``t`` under the prescribed motion of ``spec``, stepped exactly segment by
-    segment (prescribed.h: no integrator, no tolerance), and its derivatives with respect to the friction
-    parameters ``names`` (at the run's temperature): (F, dF of shape (len(t), len(names))). Raises
-    CoreFailure."""
+    segment (prescribed.h: no integrator and no tolerance, but in the elasto-plastic transition band), and its
+    derivatives with respect to the friction parameters ``names`` (at the run's temperature): (F, dF of shape
+    (len(t), len(names))). Raises CoreFailure."""
     t = np.ascontiguousarray(t, float)
     F = np.empty(t.size)
     dF = np.empty((t.size, len(names)))

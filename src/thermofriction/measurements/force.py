@@ -13,10 +13,11 @@ The simulated force and its Jacobian come from the C core's exact stepping of th
 (core/src/prescribed.c, ``_bridge.prescribed_force``) wherever it applies: the measured motion is a piecewise-linear
 position, so the velocity is constant between its knots, and at a constant temperature the friction state's rate
 (LuGre, Dahl, each GMS element) is affine in the state there, with a closed-form step and closed-form sensitivities
-to the friction parameters; static maps have no state. Model I's laws act at a run's temperature through their
-values there (the chain rule of ``Problem.chain_matrix``). Elsewhere -- Model II, a temperature signal, the
-elasto-plastic model, a fitted name that is not a friction parameter -- the runs are integrated and the Jacobian is
-by forward differences of whole runs at a tighter tolerance.
+to the friction parameters; static maps have no state; the elasto-plastic bristle is affine outside its transition
+band and integrated with its variational equations inside it (core/src/prescribed_ep.c). Model I's laws act at a
+run's temperature through their values there (the chain rule of ``Problem.chain_matrix``). Elsewhere -- Model II,
+a temperature signal, a fitted name that is not a friction parameter -- the runs are integrated and the Jacobian
+is by forward differences of whole runs at a tighter tolerance.
 """
 
 from __future__ import annotations
