@@ -169,10 +169,10 @@ def model_unit_warnings(model, experiments, measurement, rtol=1e-6) -> list:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
-                p = measurement.predict(model, exp, rtol)
+                measured, predicted = measurement.spans(model, exp, rtol)
             except (ThermofrictionError, ArithmeticError):
                 continue
-        pairs.append((exp, p.measured, p.predicted))
+        pairs.append((exp, measured, predicted))
     return unit_warnings(pairs, "the initial model", stacklevel=6)  # identify's caller, past its two decorators
 
 

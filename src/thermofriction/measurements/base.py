@@ -100,6 +100,12 @@ class Measurement:
         """One experiment predicted by ``model``, with its metrics (a Prediction)."""
         raise NotImplementedError
 
+    def spans(self, model, exp, rtol=1e-6):
+        """(measured, predicted) of one experiment for the unit check (unit_scale.py), which uses only their
+        spans: by default the prediction's."""
+        p = self.predict(model, exp, rtol)
+        return p.measured, p.predicted
+
     #: the validation table's columns: (header, metric key, format); headers may hold ``{unit}``
     columns: tuple = ()
     #: what the table's RMSE has had removed, for its footer and the JSON

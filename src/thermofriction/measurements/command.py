@@ -296,9 +296,9 @@ class Command(Force):
             raise InputError("a drive's command is predicted with the moving part's inertia ([plant] inertia), and "
                              "this model has none: fit the model to command data (identify), or give it")
 
-    def predicted(self, model, exp, rtol=1e-8):
+    def predicted(self, model, exp, rtol=1e-8, fast=False):
         """(predicted, measured): ``F + J a + offset`` at ``t + delay``, and the command as recorded."""
-        pred = self.friction_of(model, exp, rtol) + model.plant.inertia * acceleration(exp) + model.plant.sensor_offset
+        pred = self.friction_of(model, exp, rtol, fast) + model.plant.inertia * acceleration(exp) + model.plant.sensor_offset
         return shifted(exp.time, pred, -model.plant.delay), np.asarray(exp.force, float)
 
     def validation_extras(self, model) -> dict:

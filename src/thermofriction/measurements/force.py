@@ -248,12 +248,17 @@ class Force(Measurement):
                 (f"RMSE [{unit}]", "rmse_offset_removed", "{:.4g}"), ("NRMSE", "nrmse", "{:.3g}"),
                 ("max error [%]", "max_error_pct", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
 
-    def friction_of(self, model, exp, rtol=1e-8) -> np.ndarray:
+    def friction_of(self, model, exp, rtol=1e-8, fast=False) -> np.ndarray:
         """The friction force (torque) ``model`` predicts along one experiment's measured motion, on its samples:
         simulated (with the simulation's checks and warnings); where the integrator cannot finish (bristles so
         stiff that a fit driven by the exact stepping put them there), by the exact stepping itself, which
-        needs no step size."""
+        needs no step size. ``fast``: by the exact stepping wherever it applies (no simulation checks: for
+        what only needs the values, the unit check)."""
         d = drive(exp, model, start="model")
+        if fast and isinstance(d.temperature, (int, float)) and not _has_ripple(model):
+            spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform)
+            if _bridge.prescribed_applies(spec):
+                return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
         try:
             res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
                            controller=StepSizeController(rtol=rtol))
@@ -265,18 +270,19 @@ class Force(Measurement):
             return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
         return res.friction_force
 
-    def predicted(self, model, exp, rtol=1e-8):
+    def predicted(self, model, exp, rtol=1e-8, fast=False):
         """(predicted, measured) of one experiment: the friction plus the sensor offset, and the record."""
-        return self.friction_of(model, exp, rtol) + model.plant.sensor_offset, np.asarray(exp.force, float)
+        return self.friction_of(model, exp, rtol, fast) + model.plant.sensor_offset, np.asarray(exp.force, float)
+
+    def spans(self, model, exp, rtol=1e-6):
+        """(measured, predicted) for the unit check, by the exact stepping where it applies."""
+        self.check_model(model, [exp])
+        predicted, measured = self.predicted(model, exp, rtol, fast=True)
+        return measured, predicted
 
     def predict(self, model, exp, rtol=1e-8) -> "ForcePrediction":
         """Simulates one force experiment on its own samples and compares the force."""
-        if model.plant.type != "prescribed":
-            raise InputError(f"force data are predicted with a prescribed-motion model ([plant] type = "
-                             f"\"prescribed\"); this model's plant is '{model.plant.type}'")
-        if model.plant.rotary != exp.rotary:
-            raise InputError(f"{exp.file}: the data are {'rotary' if exp.rotary else 'linear'} but the model's "
-                             f"motion is {model.plant.motion}")
+        self.check_model(model, [exp])
         pred, meas = self.predicted(model, exp, rtol)
         err = pred - meas
         span = float(np.ptp(meas))
