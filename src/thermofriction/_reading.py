@@ -67,6 +67,20 @@ def read_input_file(path, what: str = "file") -> bytes:
         raise InputError(f"{str(path)!r}: not a usable file name ({e})") from None
 
 
+def read_input_json(path, what: str = "JSON file"):
+    """The JSON value in ``path``, every failure (the file, its encoding, its syntax) as one InputError naming it."""
+    import json
+
+    try:
+        return json.loads(read_input_file(path, what).decode("utf-8"))
+    except UnicodeDecodeError as e:
+        raise InputError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start})") from None
+    except InputError:
+        raise
+    except (ValueError, RecursionError) as e:
+        raise InputError(f"{path}: not JSON ({e})") from None
+
+
 def read_text(path, what: str = "file", encoding: str = "utf-8") -> str:
     """``read_bytes`` decoded (UnicodeDecodeError is left to the caller)."""
     return read_bytes(path, what).decode(encoding)

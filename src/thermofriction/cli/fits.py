@@ -3,13 +3,12 @@ commands that continue from a fit (``propagate``)."""
 
 from __future__ import annotations
 
-import json
 import math
 import os
 
 import numpy as np
 
-from .._reading import read_input_file
+from .._reading import read_input_json
 from ..errors import InputError
 from ..models.model import model_from_dict
 
@@ -87,14 +86,7 @@ def load_fit(path):
 
     if os.fspath(path).lower().endswith(".mat"):
         raise InputError(f"{path}: a MATLAB file; the fit is read from the results JSON (identify --json RESULTS.json)")
-    try:
-        d = json.loads(read_input_file(path, "results JSON").decode("utf-8"))
-    except UnicodeDecodeError as e:
-        raise InputError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start})") from None
-    except InputError:
-        raise
-    except (ValueError, RecursionError) as e:
-        raise InputError(f"{path}: not JSON ({e})") from None
+    d = read_input_json(path, "results JSON")
     missing = [k for k in _REQUIRED if not isinstance(d, dict) or k not in d]
     if missing:
         raise InputError(f"{path}: not an identification's results (no '{missing[0]}'): give the JSON that "

@@ -16,18 +16,23 @@ matplotlib = lazy("matplotlib")
 
 
 @page_styled
+def _check_arguments(name, items, what, path, figures_dir, title, command):
+    """A study page's arguments: ``items`` a non-empty list of dicts, the paths and texts of their types."""
+    if not isinstance(items, (list, tuple)) or not items or not all(isinstance(r, dict) for r in items):
+        _args.refuse(name, what, items)
+    _args.path(path, "path")
+    _args.path(figures_dir, "figures_dir", none=True)
+    _args.text(title, "title", none=True)
+    _args.text(command, "command", none=True)
+
+
 def heating_report(runs, path, *, figures_dir=None, title=None, command=None) -> str:
     """Writes an HTML report of long heated runs: ``runs`` is a list of dicts with ``label``,
     ``result`` (a HeatingResult, the prediction with self-heating), optionally ``reference`` (the
     full simulation on the same grid) and ``constant`` (the displacement predicted at the start
     temperature, on the same grid). Figures: temperature rise, step-size drift, and the error of
     the constant-temperature prediction; a table of the figures that matter."""
-    if not isinstance(runs, (list, tuple)) or not runs or not all(isinstance(r, dict) for r in runs):
-        _args.refuse("runs", "a non-empty list of dicts", runs)
-    _args.path(path, "path")
-    _args.path(figures_dir, "figures_dir", none=True)
-    _args.text(title, "title", none=True)
-    _args.text(command, "command", none=True)
+    _check_arguments("runs", runs, "a non-empty list of dicts", path, figures_dir, title, command)
     figs = Figures(figures_dir)
     colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     parts = []
@@ -93,12 +98,8 @@ def control_report(rows, path, *, figures_dir=None, title=None, command=None) ->
     """Writes an HTML report of thermofriction.control.compare_compensation's rows: the table of RMS
     and maximum tracking errors per reference, stage temperature and compensation, and for each
     reference the tracking error over time at the hottest temperature."""
-    if not isinstance(rows, (list, tuple)) or not rows or not all(isinstance(r, dict) for r in rows):
-        _args.refuse("rows", "a non-empty list of row dicts (compare_compensation)", rows)
-    _args.path(path, "path")
-    _args.path(figures_dir, "figures_dir", none=True)
-    _args.text(title, "title", none=True)
-    _args.text(command, "command", none=True)
+    _check_arguments("rows", rows, "a non-empty list of row dicts (compare_compensation)", path, figures_dir, title,
+                     command)
     figs = Figures(figures_dir)
     table = [[r["reference"], fmt_number(r["temperature"], "{:.1f}"), r["compensation"], fmt_number(r["rms_error"] * 1e6, "{:.3g}"),
               fmt_number(r["max_error"] * 1e6, "{:.3g}")] for r in rows]

@@ -182,17 +182,9 @@ class PropagationResult:
 def load_propagation(path) -> PropagationResult:
     """A propagation result from the JSON that :meth:`PropagationResult.to_json` (``thermofriction propagate -o
     X.json``) wrote; InputError naming the file and the key for anything else."""
-    import json
-    from .._reading import read_input_file
+    from .._reading import read_input_json
 
-    try:
-        d = json.loads(read_input_file(path, "propagation result (JSON)").decode("utf-8"))
-    except UnicodeDecodeError as e:
-        raise InputError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start})") from None
-    except InputError:
-        raise
-    except (ValueError, RecursionError) as e:
-        raise InputError(f"{path}: not JSON ({e})") from None
+    d = read_input_json(path, "propagation result (JSON)")
     if not isinstance(d, dict) or d.get("kind") != "propagation":
         raise InputError(f"{path}: not a propagation result (the JSON that 'thermofriction propagate -o X.json' "
                          f"writes)")
