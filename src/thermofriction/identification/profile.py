@@ -27,7 +27,7 @@ PROFILE_STEP = 2.0
 #: refinement again: twice what a 95 % interval allows one parameter, far above what two fits of the same
 #: optimum differ by (their tolerances), small against the 150-200 seen when stuck
 MIN_GAIN = 8.0
-#: the evaluations of each held fit: enough to leave a blocked optimum (the gains of 75-100 came in the first few)
+#: the evaluations of each held fit: enough to leave a blocked optimum (its gain of 150-200 came in the first few)
 #: and to see a flat profile's rise, at a fraction of the refinement's cost
 HELD_EVALUATIONS = 10
 #: the most a flat profile widens a standard error: beyond it the parameter is as good as undetermined, and the
