@@ -255,20 +255,28 @@ class Force(Measurement):
         needs no step size. ``fast``: by the exact stepping wherever it applies (no simulation checks: for
         what only needs the values, the unit check)."""
         d = drive(exp, model, start="model")
-        if fast and isinstance(d.temperature, (int, float)) and not _has_ripple(model):
-            spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform)
-            if _bridge.prescribed_applies(spec):
-                return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
+        stepped = self._stepped(d, model, exp) if fast else None
+        if stepped is not None:
+            return stepped
         try:
             res = simulate(d.model(model), t_eval=exp.time, temperature=d.temperature, input=d.waveform,
                            controller=StepSizeController(rtol=rtol))
         except SolverError:
-            spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform) \
-                if isinstance(d.temperature, (int, float)) else None
-            if spec is None or not _bridge.prescribed_applies(spec) or _has_ripple(model):
+            stepped = self._stepped(d, model, exp)
+            if stepped is None:
                 raise
-            return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
+            return stepped
         return res.friction_force
+
+    @staticmethod
+    def _stepped(d, model, exp):
+        """The exact stepping's friction along ``exp`` (driven as ``d``), or None where it does not apply."""
+        if not isinstance(d.temperature, (int, float)) or _has_ripple(model):
+            return None
+        spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform)
+        if not _bridge.prescribed_applies(spec):
+            return None
+        return _bridge.prescribed_force(spec, np.asarray(exp.time, float))[0]
 
     def predicted(self, model, exp, rtol=1e-8, fast=False):
         """(predicted, measured) of one experiment: the friction plus the sensor offset, and the record."""
