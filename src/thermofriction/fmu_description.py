@@ -189,7 +189,7 @@ def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive")
     return "\n".join(lines) + "\n"
 
 
-def _default_experimentdescription_xml2(model: Model, step: float | None) -> str:
+def _default_experiment_xml(model: Model, step: float | None) -> str:
     stop, h, _ = default_experiment(model, step)
     return f'  <DefaultExperiment startTime="0" stopTime="{stop!r}" stepSize="{h!r}" tolerance="1e-06"/>'
 
@@ -201,9 +201,9 @@ def description_xml2(model: Model, variables, identifier: str, guid: str, source
            f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
            '    canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"',
            '    canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
-           *_unitsdescription_xml2(variables)]
+           *_units_xml(variables)]
     out += [*_LOG_CATEGORIES,
-            _default_experimentdescription_xml2(model, step),
+            _default_experiment_xml(model, step),
             '  <ModelVariables>']
     outputs = []
     for index, v in enumerate(variables, start=1):
@@ -279,7 +279,7 @@ def _head(model: Model, identifier: str, version: str, source: str | None, step:
             f'  generationDateAndTime="{datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"']
 
 
-def _unitsdescription_xml2(variables, extra=()) -> list[str]:
+def _units_xml(variables, extra=()) -> list[str]:
     out = ['  <UnitDefinitions>']
     for u in sorted({v.unit for v in variables if v.unit} | set(extra)):
         if u == "degC":
@@ -300,9 +300,9 @@ def description_xml3(model: Model, variables, identifier: str, guid: str, source
            f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
            '    canGetAndSetFMUState="true" canSerializeFMUState="false" providesDirectionalDerivatives="false"',
            '    providesAdjointDerivatives="false" hasEventMode="false" maxOutputDerivativeOrder="0"/>',
-           *_unitsdescription_xml2(variables, extra=("s",)),  # time's
+           *_units_xml(variables, extra=("s",)),  # time's
            *_LOG_CATEGORIES,
-           _default_experimentdescription_xml2(model, step),
+           _default_experiment_xml(model, step),
            '  <ModelVariables>',
            f'    <Float64 name="time" valueReference="{VR_TIME}" causality="independent" variability="continuous"'
            ' description="the simulation time" unit="s"/>']
