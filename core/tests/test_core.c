@@ -469,6 +469,23 @@ static void emit_force(long i, double t, const double *y, void *ctx)
     r->F[i] = tf_model_friction(r->m, t, y);
 }
 
+/* One GMS element (k = 1e5 N/m, capacity fc = 2 N, C = 50 /s) under prescribed motion: the analytic case of the
+ * two tests below. */
+static void single_gms_element(tf_model *m)
+{
+    memset(m, 0, sizeof *m);
+    m->plant = TF_PLANT_PRESCRIBED;
+    m->friction = TF_FRICTION_GMS;
+    m->p[TF_P_FC] = m->p[TF_P_FS] = 2.0;
+    m->p[TF_P_VS] = 1e-3;
+    m->p[TF_P_DELTA] = 2.0;
+    m->p[TF_P_C] = 50.0;
+    m->p[TF_P_VSMOOTH] = 1e-6;
+    m->gms.n = 1;
+    m->gms.k[0] = 1e5;
+    m->gms.w[0] = 1.0;
+}
+
 static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
 {
     /* One GMS element under prescribed motion x = v t: it sticks (F = k v t) until F reaches its
@@ -476,17 +493,7 @@ static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
      * (F -> w fc at rate C) and, when the motion reverses at the sawtooth's corner, sticks again
      * (F falls at k v' from where it was). Analytic solution, every method. */
     tf_model m;
-    memset(&m, 0, sizeof m);
-    m.plant = TF_PLANT_PRESCRIBED;
-    m.friction = TF_FRICTION_GMS;
-    m.p[TF_P_FC] = m.p[TF_P_FS] = 2.0;
-    m.p[TF_P_VS] = 1e-3;
-    m.p[TF_P_DELTA] = 2.0;
-    m.p[TF_P_C] = 50.0;
-    m.p[TF_P_VSMOOTH] = 1e-6;
-    m.gms.n = 1;
-    m.gms.k[0] = 1e5;
-    m.gms.w[0] = 1.0;
+    single_gms_element(&m);
     m.T_const = NAN;
     /* up at 1e-4 m/s for 0.6 s, down for 0.4 s (sawtooth, amplitude 6e-5 m, 1 Hz, rise 0.6) */
     m.input = (tf_waveform){TF_WAVE_SAWTOOTH, 6e-5, 1.0, 0.6, 0.0, 1.0, 0, 0, 0, 0, 0};
@@ -525,17 +532,7 @@ static void test_prescribed_exact_stepping_gms_and_its_record(void)
      * the force once the element has slipped), dF/dC = 0 throughout (it slips at its fixed point). Then the
      * one error record: a decreasing grid, a model it does not apply to. */
     tf_model m;
-    memset(&m, 0, sizeof m);
-    m.plant = TF_PLANT_PRESCRIBED;
-    m.friction = TF_FRICTION_GMS;
-    m.p[TF_P_FC] = m.p[TF_P_FS] = 2.0;
-    m.p[TF_P_VS] = 1e-3;
-    m.p[TF_P_DELTA] = 2.0;
-    m.p[TF_P_C] = 50.0;
-    m.p[TF_P_VSMOOTH] = 1e-6;
-    m.gms.n = 1;
-    m.gms.k[0] = 1e5;
-    m.gms.w[0] = 1.0;
+    single_gms_element(&m);
     m.fs_follows_fc = 1;
     m.T_const = 25.0;
     static const double kt[3] = {0.0, 0.6, 1.0}, kx[3] = {0.0, 6e-5, 0.0};
