@@ -11,6 +11,7 @@ refinement starts again from there."""
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 
 import numpy as np
@@ -19,7 +20,7 @@ from ..models import Model
 from .optimiser import fit
 from .parameters import with_values
 from .problem import make_traces
-from .uncertainty import inflation_of
+from .uncertainty import inflation_of, uncertainty
 
 #: [standard errors] where each freed plant parameter is held
 PROFILE_STEP = 2.0
@@ -40,18 +41,12 @@ def _variance(outcome) -> float:
     return float(outcome.r @ outcome.r) / max(outcome.r.size - outcome.J.shape[1], 1)
 
 
-def _standard_error(outcome, inflation, names, name) -> float:
-    """``name``'s standard error as the fit reports it (uncertainty.py: the residuals' variance inflated by their
-    integrated autocorrelation time), here without the SVD's care for undetermined directions."""
-    col = np.linalg.norm(outcome.J, axis=0)
-    col[col == 0] = 1.0
-    J = outcome.J / col  # columns of one scale: law coefficients span 1e-3 to 1e6
-    try:
-        cov = np.linalg.pinv(J.T @ J) / np.outer(col, col)
-    except np.linalg.LinAlgError:
-        return float("nan")
-    i = names.index(name)
-    return float(np.sqrt(max(_variance(outcome) * inflation * cov[i, i], 0.0)))
+def _standard_errors(params, outcome, traces, model) -> dict:
+    """The standard errors the fit reports (uncertainty.py, on a copy of ``params``: the same variance,
+    autocorrelation inflation and undetermined directions)."""
+    copied = copy.deepcopy(params)
+    uncertainty(copied, outcome, traces, model)
+    return {p.name: p.stderr for p in copied.varying}
 
 
 @dataclasses.dataclass
@@ -79,11 +74,12 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
     optimum = with_values(model, dict(zip(names, outcome.theta)))
     variance = _variance(outcome)
     inflation, _ = inflation_of(outcome.r, [tr.n_residuals for tr in traces])
+    errors = _standard_errors(params, outcome, traces, model)
     cost = float(outcome.r @ outcome.r) / variance  # chi-square
     out = Profiled(model, params, outcome, traces)
     best, rises = None, {}
     for name in (n for n in free if n in names):
-        se = _standard_error(outcome, inflation, names, name)
+        se = errors[name]
         value = float(outcome.theta[names.index(name)])
         if not np.isfinite(se) or se <= 0 or value - PROFILE_STEP * se <= 0:
             continue
