@@ -668,7 +668,8 @@ fmu_status fmu_set_input_derivatives(fmu_instance *c, const fmu_vr vr[], size_t 
 }
 
 static void no_emit(long i, double t, const double *y, void *ctx) {}
-static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_status status);
+static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_status status,
+                             const tf_gms_elements *modes);
 
 /* Relative sliding velocity at (t, y): the friction's input (plant.c's states: x_p, v_p, x_e, v_e
  * for the stick-slip actuator, x, v for a mass; prescribed motion: the input's slope). */
@@ -773,7 +774,7 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
             tf_model_prepare(&c->model);
             return FMU_ERROR;
         }
-        return step_done(c, h, y, n, status);
+        return step_done(c, h, y, n, status, &modes);
     }
     tf_model_state_scale(&c->model, atol);
     for (int i = 0; i < n; i++) atol[i] *= c->rtol;
@@ -793,12 +794,20 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
         return fmu_fail(c, "the integration from %g s over %g s failed at %g s: %s (%s)", c->t, h, e.t,
                     tf_status_message(s), e.what);
     }
-    return step_done(c, h, y, n, status);
+    return step_done(c, h, y, n, status, &modes);
 }
 
-/* After a successful step of h: the new state and time, the inputs advanced along their derivatives. */
-static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_status status)
+/* After a successful step of h: the new state and time, the inputs advanced along their derivatives; refused,
+ * with nothing moved, where an output would not be finite (a finite state can still give an infinite velocity
+ * or force: the fuzzer found one that fmi2DoStep had answered OK). */
+static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_status status,
+                             const tf_gms_elements *modes)
 {
+    double y_before[TF_MAX_STATES];
+    memcpy(y_before, c->y, sizeof(double) * n);
+    double t = c->t, u_prev = c->u_prev, last_du = c->last_du, drive = c->r[VR_DRIVE], T = c->r[VR_TEMPERATURE];
+    double du = c->du, dT = c->dT;
+    int du_set = c->du_set;
     memcpy(c->y, y, sizeof(double) * n);
     c->t += h;
     c->u_prev = c->wave_v[1];
@@ -807,6 +816,16 @@ static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_s
     if (c->du_set || c->plant != TF_PLANT_PRESCRIBED) c->r[VR_DRIVE] = c->wave_v[1];
     c->du = c->dT = 0.0; /* derivatives hold for one step */
     c->du_set = 0;
+    for (int vr = VR_DISPLACEMENT; vr <= VR_STAGE_DISPLACEMENT; vr++) {
+        double v = declared(c, (fmu_vr)vr) ? output(c, vr) : 0.0;
+        if (isfinite(v)) continue;
+        memcpy(c->y, y_before, sizeof(double) * n);
+        c->t = t, c->u_prev = u_prev, c->last_du = last_du, c->r[VR_DRIVE] = drive, c->r[VR_TEMPERATURE] = T;
+        c->du = du, c->dT = dT, c->du_set = du_set;
+        c->model.gms = *modes;
+        return fmu_fail(c, "the step from %g s over %g s gives a non-finite output (value reference %d: %g)", t, h,
+                        vr, v);
+    }
     if (c->heat) {
         fmu_status r = check_range(c, output(c, VR_TEMPERATURE_OUT));
         if (r > status) status = r;
