@@ -1,6 +1,7 @@
 """Coverage of the 95 % intervals on random truths (issue 30, item 4), simulated by the independent SciPy reference:
 (a) random Model I truths (tests/truths.py; sigma1 often poorly determined) with the end-effector mass freed,
-(b) Stribeck truths (fs = 1.5 fc, rising sigma1) with random levels, fs fitted from laws 2-3x off.
+(b) Stribeck truths (fs = 1.5 fc, rising sigma1) with random levels, fs fitted from laws 2-3x off (with the mass
+2x and freed; or vs fitted too, from 2.5x off).
 ``python tests/coverage_study.py N`` prints each fit and the table; tests/test_adequacy_study.py runs a few (slow)."""
 
 from __future__ import annotations
@@ -51,6 +52,22 @@ def stribeck(seed, heavy=False) -> dict:
             "missed": [(r["parameter"], r["temperature"]) for r in rows if not r["covered"]]}
 
 
+def stribeck_vs(seed) -> dict:
+    """The Stribeck truth with vs named too, from 2.5x the truth's (the laws 2-3x off as in :func:`stribeck`): on
+    these 0.4 s records vs is not determined (fitted as one constant, then held where the joint refinement left it,
+    its stated range reaching the other intervals through refits at its ends)."""
+    truth = stribeck_truth()
+    data = reference_experiments(truth, seed=seed)
+    start = start_from(truth, {"sigma0": 2.5, "sigma1": 2.0, "fc": 0.45, "fs": 0.45}, vs=2.5 * truth.friction.vs)
+    fit = tf.identify(data, "model-i", init=start, parameters=["sigma0", "sigma1", "fc", "fs", "vs"])
+    rows = fit.recovery(truth, FIT_T)
+    return {"scenario": "stribeck, vs fitted", "seed": seed, "fc_error": _level_error(fit, truth, FIT_T),
+            "fs_error": _level_error(fit, truth, FIT_T, "fs"), "vs": fit.model.parameters_at(36.0)["vs"],
+            "covered": sum(r["covered"] for r in rows), "points": len(rows), "adequate": fit.adequate,
+            "held_where_reached": fit.details.get("held_where_reached"),
+            "missed": [(r["parameter"], r["temperature"]) for r in rows if not r["covered"]]}
+
+
 def stribeck_fit(seed, heavy=False):
     """(fit, truth) of one Stribeck truth (see :func:`stribeck`)."""
     rng = np.random.default_rng(seed)
@@ -70,7 +87,7 @@ def stribeck_fit(seed, heavy=False):
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 6
     table = {}
-    for make in (masses_freed, stribeck, lambda s: stribeck(s, heavy=True)):
+    for make in (masses_freed, stribeck, lambda s: stribeck(s, heavy=True), stribeck_vs):
         for seed in range(n):
             r = make(seed)
             print(r, flush=True)

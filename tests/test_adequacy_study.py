@@ -29,3 +29,13 @@ def test_coverage_of_the_95_percent_intervals_on_random_truths():
     assert sum(r["covered"] for r in rows) >= 0.9 * sum(r["points"] for r in rows), rows
     rows = [stribeck(s, heavy=True) for s in range(8)]
     assert sum(r["covered"] for r in rows) >= 0.9 * sum(r["points"] for r in rows), rows
+
+
+def test_coverage_with_vs_fitted_on_records_that_do_not_determine_it():
+    """tests/coverage_study.py's stribeck_vs over 6 data seeds (measured: 86/96 = 0.90 with vs's range reaching the
+    others through refits at its ends; 69/96 = 0.72 with the linearized sensitivities; every fit called adequate at
+    residuals 0.99-1.01 times the noise, vs 0.0066-0.0158 m/s against the truth's 0.006)."""
+    from coverage_study import stribeck_vs
+    rows = [stribeck_vs(s) for s in range(6)]
+    assert all(r["adequate"] for r in rows), rows
+    assert sum(r["covered"] for r in rows) >= 0.85 * sum(r["points"] for r in rows), rows

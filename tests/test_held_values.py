@@ -138,3 +138,11 @@ def test_the_consider_covariance_widens_by_the_held_directions_share__analytic()
     assert params["fc.b"].stderr == pytest.approx(np.sqrt(0.1 ** 2 + sd ** 2), rel=1e-9)
     assert res.details["considered"] == {"parameters": ["sigma1"], "prior_factor": PRIOR_FACTOR}
     assert "stated factor 3" in res.warnings[0]
+    # a constant left open by the joint refinement: the refits at the range's ends (shifts -0.3, +0.1 of fc.b)
+    # replace the linearization; each end is ln 3 from the optimum, the prior's sd ln 3 / 1.96: the variance added
+    # is the mean of the squared shifts over 1.96^2 (analytic)
+    params["fc.b"].stderr = 0.1
+    res.details, res.warnings, res.correlation = {}, [], np.eye(1)
+    _consider(res, [{"name": "sigma1", "_columns": cols, "_J": J}], {"sigma1": [[-0.3], [0.1]]})
+    assert params["fc.b"].stderr == pytest.approx(np.sqrt(0.1 ** 2 + (0.3 ** 2 + 0.1 ** 2) / 2 / 1.959964 ** 2),
+                                                  rel=1e-9)

@@ -9,7 +9,7 @@ import numpy as np
 
 import thermofriction as tf
 from thermofriction import _bridge
-from thermofriction.identification import model_i, optimiser, problem
+from thermofriction.identification import laws, optimiser, problem
 from thermofriction.identification.parameters import Parameters
 from thermofriction.identification.procedures import fit_friction
 
@@ -76,7 +76,7 @@ def test_estimates_moved_to_the_shared_mass_are_the_conditional_mean():
     corr = np.array([[1.0, 0.2, -0.6, 0.7], [0.2, 1.0, 0.1, 0.3], [-0.6, 0.1, 1.0, -0.5], [0.7, 0.3, -0.5, 1.0]])
     res = types.SimpleNamespace(parameters=params, correlation=corr)
     shared = {"m_e": 0.082}
-    (T, moved), = model_i._at_shared([(35.0, res)], ["m_e"], shared)
+    (T, moved), = laws.at_shared([(35.0, res)], ["m_e"], shared)
 
     log = np.array([True, False, True, True])
     v = np.array(list(values.values()))
@@ -95,5 +95,5 @@ def test_estimates_moved_to_the_shared_mass_are_the_conditional_mean():
     np.testing.assert_allclose([moved.parameters[n].stderr for n in ("sigma0", "sigma1", "fc")], se_expect, rtol=1e-10)
     # the original is untouched, and a mass already at the shared value moves nothing
     assert params["sigma0"].value == 2e6
-    (_, same), = model_i._at_shared([(35.0, res)], ["m_e"], {"m_e": 0.08})
+    (_, same), = laws.at_shared([(35.0, res)], ["m_e"], {"m_e": 0.08})
     assert all(math.isclose(same.parameters[n].value, values[n], rel_tol=1e-12) for n in values)

@@ -186,10 +186,12 @@ def held_tests(res, experiments, measurement, rtol=1e-8) -> list:
 PRIOR_FACTOR = 3.0
 
 
-def _consider(res, tests):
+def _consider(res, tests, secants=None):
     """The fitted parameters' covariance with the uncertainty of the laws held for lack of information added (a
     consider covariance): each held law's level, within a factor PRIOR_FACTOR either way (95 %), shifts the fitted
-    parameters by G = -J^+ j (j: the sensitivity to the law's log scale), so cov += G G^T sd^2. Intervals,
+    parameters by G = -J^+ j (j: the sensitivity to the law's log scale), so cov += G G^T sd^2 -- or, for a constant
+    the joint refinement left open (``secants``: name -> the shifts of refits with it held at the range's ends), by
+    those shifts over the log of the factor, averaged over both ends. Intervals,
     standard errors and correlations are updated; the report says what was included."""
     varying = res.parameters.varying
     se = np.array([p.stderr for p in varying], float)
@@ -198,6 +200,11 @@ def _consider(res, tests):
     cov = np.nan_to_num(res.correlation) * np.outer(se, se)
     sd = math.log(PRIOR_FACTOR) / 1.959964
     for t in tests:
+        if len((secants or {}).get(t["name"]) or ()) == 2:  # refits at the range's ends (model_i.py): G from their secants
+            for shift in secants[t["name"]]:
+                G = np.asarray(shift, float) / math.log(PRIOR_FACTOR)
+                cov = cov + np.outer(G, G) * sd ** 2 / 2
+            continue
         law = res.model.laws[t["name"]]
         c = np.array(law.coefficients(), float)
         scale = np.r_[c[0], np.zeros(len(c) - 1)] if law.kind == "exp" else c
@@ -217,8 +224,11 @@ def _consider(res, tests):
         res.correlation = cov / np.outer(se_new, se_new)
     names = ", ".join(t["name"] for t in tests)
     grown = max(se_new / np.where(se > 0, se, np.inf))
-    res.warnings.append(f"{names} could not be determined and {'is' if len(tests) == 1 else 'are'} held at the initial "
-                        f"model's law; the intervals include {'its' if len(tests) == 1 else 'their'} level within a "
+    reached = set(res.details.get("held_where_reached") or ())
+    where = ("where the joint refinement left " + ("it" if len(tests) == 1 else "them")
+             if reached >= {t["name"] for t in tests} else "at the initial model's law")
+    res.warnings.append(f"{names} could not be determined and {'is' if len(tests) == 1 else 'are'} held {where}; "
+                        f"the intervals include {'its' if len(tests) == 1 else 'their'} level within a "
                         f"stated factor {PRIOR_FACTOR:g} either way (95 %): standard errors up to {grown:.3g} times "
                         f"those with it held exactly")
     res.details["considered"] = {"parameters": [t["name"] for t in tests], "prior_factor": PRIOR_FACTOR}
@@ -227,6 +237,7 @@ def _consider(res, tests):
 def with_held_tests(res, experiments, measurement, rtol=1e-8):
     """``res`` with ``fit_quality["held"]``; a contradicted held value makes the fit not adequate and is said
     first in its warnings (second, after the residuals' own "not adequate", where they are far above the noise)."""
+    secants = res.details.pop("_secants", None)  # internal to the consider step below
     if res.fit_quality is None:
         return res
     if res.details.get("refined") is False:  # not at an optimum: the residuals are not orthogonal to the fit's
@@ -238,7 +249,7 @@ def with_held_tests(res, experiments, measurement, rtol=1e-8):
     bad = [t for t in tests if t["contradicted"] and t["same_as"] is None]
     lack = [t for t in tests if t["name"] in (res.details.get("held_for_lack_of_information") or ())]
     if lack:
-        _consider(res, lack)
+        _consider(res, lack, secants or {})
     if bad:
         # after the residuals' own verdict where that already says not adequate (a model far off: the held
         # directions then share out a misfit they do not all cause), else first

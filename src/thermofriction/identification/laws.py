@@ -3,6 +3,7 @@ weighted least squares with AICc to choose, and the two-segment (broken-line) fi
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -13,6 +14,9 @@ from ..models import PWL, Const, Exp, Linear
 from ..models.friction import in_domain
 
 optimize = lazy("scipy.optimize")
+
+LOG_SPACE_BELOW = 0.3  # relative standard error below which a parameter's misfit is taken as quadratic in its log
+
 
 def aicc(ssr, n, k):
     if ssr <= 0:
@@ -108,4 +112,123 @@ def segmented_fit(T, values, weights=None):
     return float(tb), PWL(knots, vals, range=(float(T[0]), float(T[-1]))), best[0]
 
 
-__all__ = ["fit_law", "segmented_fit", "aicc"]
+def laws_on_information(Ts, per_T, laws: dict) -> dict:
+    """The laws' coefficients refitted to the per-temperature estimates weighted by each temperature's
+    full covariance (in log space, where the fits were made), not by its standard errors alone: the
+    per-temperature estimates are strongly correlated (sigma0 with fc), and the joint refinement then
+    starts near its optimum instead of some standard errors away. The law kinds stay as chosen; a law
+    is kept as it was if this fails or leaves its parameter's physical domain."""
+    names = list(laws)
+    blocks = []
+    for T, res in per_T:
+        varying = [p.name for p in res.parameters.varying]
+        if not all(n in varying for n in names):
+            return laws
+        idx = [varying.index(n) for n in names]
+        value = np.array([res.parameters[n].value for n in names])
+        se = np.array([res.parameters[n].stderr for n in names], float)
+        if np.any(value <= 0) or res.correlation.shape != (len(varying), len(varying)):
+            return laws
+        known = np.isfinite(se) & (se > 0)  # a parameter this temperature leaves open adds nothing
+        corr = res.correlation[np.ix_(idx, idx)][np.ix_(known, known)]
+        if not known.any() or not np.all(np.isfinite(corr)):
+            continue
+        # well-determined parameters in log space (where the fits were made), a poorly determined one
+        # (sigma1, often) in its own: its misfit is nearer quadratic there
+        log = se[known] < LOG_SPACE_BELOW * value[known]
+        unit = np.where(log, value[known], 1.0)
+        cov = corr * np.outer(se[known] / unit, se[known] / unit)
+        try:
+            root = np.linalg.cholesky(np.linalg.inv(cov))  # W = root root^T
+        except np.linalg.LinAlgError:
+            continue
+        blocks.append((T, np.flatnonzero(known), log, np.where(log, np.log(value[known]), value[known]), root))
+    if not blocks:
+        return laws
+    sizes = [len(laws[n].coefficients()) for n in names]
+    c0 = np.concatenate([laws[n].coefficients() for n in names])
+
+    def with_coefficients(c):
+        out, k = {}, 0
+        for n, size in zip(names, sizes):
+            out[n] = laws[n].with_coefficients(c[k:k + size])
+            k += size
+        return out
+
+    at = np.array([b[0] for b in blocks], float)
+
+    def residuals(c):
+        # each law evaluated once at every temperature (the same values as one temperature at a time: 0.5 s of
+        # Python per Model I fit went to evaluating them one by one, in the thousands of calls this fit can take)
+        trial = with_coefficients(c)
+        values = [np.asarray(trial[n](at), float) for n in names]
+        out = []
+        for k, (T, known, log, estimate, root) in enumerate(blocks):
+            predicted = np.array([values[i][k] for i in known])
+            if np.any(~np.isfinite(predicted)) or np.any(predicted <= 0):
+                return np.full(sum(len(b[1]) for b in blocks), 1e6)
+            out.append(root.T @ (np.where(log, np.log(predicted), predicted) - estimate))
+        return np.concatenate(out)
+
+    try:
+        res = optimize.least_squares(residuals, c0, x_scale=np.where(c0 != 0, np.abs(c0), 1.0))
+    except (ValueError, np.linalg.LinAlgError):
+        return laws
+    if not res.success or 2 * res.cost >= float(np.sum(residuals(c0) ** 2)):
+        return laws
+    refined = with_coefficients(res.x)
+    grid = np.linspace(float(np.min(Ts)), float(np.max(Ts)), 41)
+    return {n: refined[n] if in_domain(n, refined[n](grid)).all() else laws[n] for n in names}
+
+
+def at_shared(per_T, free, shared):
+    """Each temperature's estimates where the freed plant parameters take their shared values (``shared``: the
+    median of the per-temperature estimates) instead of that temperature's own: the conditional mean and covariance
+    given them, from the fit's own covariance (each parameter in log space where its standard error is below
+    LOG_SPACE_BELOW of its value, as the fits were made, else in its own). The per-temperature estimates of sigma0
+    and fc move with that temperature's m_e; laws through them unmoved started the joint refinement far from its
+    optimum (8 temperatures from a start 2-3x off: 17 evaluations to a fit 1.2 times the noise, not adequate).
+    A temperature whose covariance is not usable is kept as it is."""
+    out = []
+    for T, res in per_T:
+        varying = [p.name for p in res.parameters.varying]
+        n = len(varying)
+        se = np.array([res.parameters[v].stderr for v in varying], float)
+        val = np.array([res.parameters[v].value for v in varying], float)
+        corr = np.asarray(res.correlation, float)
+        if corr.shape != (n, n) or not np.all(np.isfinite(se)) or not np.all(np.isfinite(corr)) \
+                or np.any(val <= 0) or not all(x in varying for x in free):
+            out.append((T, res))
+            continue
+        log = se < LOG_SPACE_BELOW * val
+        unit = np.where(log, val, 1.0)
+        cov = corr * np.outer(se / unit, se / unit)
+        y = np.where(log, np.log(val), val)
+        f = [varying.index(x) for x in free]
+        o = [i for i in range(n) if i not in f]
+        target = np.array([shared[x] for x in free])
+        try:
+            gain = cov[np.ix_(o, f)] @ np.linalg.inv(cov[np.ix_(f, f)])
+        except np.linalg.LinAlgError:
+            out.append((T, res))
+            continue
+        x = y[o] + gain @ (np.where(log[f], np.log(target), target) - y[f])
+        c = cov[np.ix_(o, o)] - gain @ cov[np.ix_(f, o)]
+        values = np.where(log[o], np.exp(np.minimum(x, 700.0)), x)
+        if np.any(values <= 0) or not np.all(np.isfinite(values)):
+            out.append((T, res))
+            continue
+        moved = copy.deepcopy(res)
+        sd = np.sqrt(np.maximum(np.diag(c), 0.0))
+        for k, i in enumerate(o):
+            moved.parameters[varying[i]].value = float(values[k])
+            moved.parameters[varying[i]].stderr = float(sd[k] * (values[k] if log[i] else 1.0))
+        for k, i in enumerate(f):
+            moved.parameters[varying[i]].value = float(target[k])
+        moved.correlation = np.eye(n)
+        moved.correlation[np.ix_(o, o)] = c / np.outer(np.where(sd > 0, sd, 1.0), np.where(sd > 0, sd, 1.0))
+        out.append((T, moved))
+    return out
+
+
+__all__ = ["fit_law", "segmented_fit", "aicc", "laws_on_information", "at_shared", "LOG_SPACE_BELOW"]

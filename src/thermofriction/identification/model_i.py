@@ -3,7 +3,6 @@ parameter through the estimates, and a joint refinement of the law coefficients 
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 import time
@@ -13,88 +12,18 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
-from ..models.friction import in_domain
-from .laws import fit_law
+from .laws import at_shared, fit_law, laws_on_information
 from .optimiser import fit
 from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
 from .problem import make_traces
-from .profile import Profiled, profiled, widened
-from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
+from .held import PRIOR_FACTOR
+from .profile import Profiled, profiled, secant_shifts, standard_errors, widened
+from .procedures import (along_temperatures, base_model, fit_friction, fit_result,
                          fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
 
-LOG_SPACE_BELOW = 0.3  # relative standard error below which a parameter's misfit is taken as quadratic in its log
-
-
-def _laws_on_information(Ts, per_T, laws: dict) -> dict:
-    """The laws' coefficients refitted to the per-temperature estimates weighted by each temperature's
-    full covariance (in log space, where the fits were made), not by its standard errors alone: the
-    per-temperature estimates are strongly correlated (sigma0 with fc), and the joint refinement then
-    starts near its optimum instead of some standard errors away. The law kinds stay as chosen; a law
-    is kept as it was if this fails or leaves its parameter's physical domain."""
-    names = list(laws)
-    blocks = []
-    for T, res in per_T:
-        varying = [p.name for p in res.parameters.varying]
-        if not all(n in varying for n in names):
-            return laws
-        idx = [varying.index(n) for n in names]
-        value = np.array([res.parameters[n].value for n in names])
-        se = np.array([res.parameters[n].stderr for n in names], float)
-        if np.any(value <= 0) or res.correlation.shape != (len(varying), len(varying)):
-            return laws
-        known = np.isfinite(se) & (se > 0)  # a parameter this temperature leaves open adds nothing
-        corr = res.correlation[np.ix_(idx, idx)][np.ix_(known, known)]
-        if not known.any() or not np.all(np.isfinite(corr)):
-            continue
-        # well-determined parameters in log space (where the fits were made), a poorly determined one
-        # (sigma1, often) in its own: its misfit is nearer quadratic there
-        log = se[known] < LOG_SPACE_BELOW * value[known]
-        unit = np.where(log, value[known], 1.0)
-        cov = corr * np.outer(se[known] / unit, se[known] / unit)
-        try:
-            root = np.linalg.cholesky(np.linalg.inv(cov))  # W = root root^T
-        except np.linalg.LinAlgError:
-            continue
-        blocks.append((T, np.flatnonzero(known), log, np.where(log, np.log(value[known]), value[known]), root))
-    if not blocks:
-        return laws
-    sizes = [len(laws[n].coefficients()) for n in names]
-    c0 = np.concatenate([laws[n].coefficients() for n in names])
-
-    def with_coefficients(c):
-        out, k = {}, 0
-        for n, size in zip(names, sizes):
-            out[n] = laws[n].with_coefficients(c[k:k + size])
-            k += size
-        return out
-
-    at = np.array([b[0] for b in blocks], float)
-
-    def residuals(c):
-        # each law evaluated once at every temperature (the same values as one temperature at a time: 0.5 s of
-        # Python per Model I fit went to evaluating them one by one, in the thousands of calls this fit can take)
-        trial = with_coefficients(c)
-        values = [np.asarray(trial[n](at), float) for n in names]
-        out = []
-        for k, (T, known, log, estimate, root) in enumerate(blocks):
-            predicted = np.array([values[i][k] for i in known])
-            if np.any(~np.isfinite(predicted)) or np.any(predicted <= 0):
-                return np.full(sum(len(b[1]) for b in blocks), 1e6)
-            out.append(root.T @ (np.where(log, np.log(predicted), predicted) - estimate))
-        return np.concatenate(out)
-
-    try:
-        res = optimize.least_squares(residuals, c0, x_scale=np.where(c0 != 0, np.abs(c0), 1.0))
-    except (ValueError, np.linalg.LinAlgError):
-        return laws
-    if not res.success or 2 * res.cost >= float(np.sum(residuals(c0) ** 2)):
-        return laws
-    refined = with_coefficients(res.x)
-    grid = np.linspace(float(np.min(Ts)), float(np.max(Ts)), 41)
-    return {n: refined[n] if in_domain(n, refined[n](grid)).all() else laws[n] for n in names}
 
 
 class _PerTemperature:
@@ -107,6 +36,7 @@ class _PerTemperature:
         self.init, self.names, self.free, self.opts = init, names, free, opts
         self.measurement, self.progress = measurement, progress
         self.held, self.warnings = [], []
+        self.joint = []  # held constants fitted on all experiments together in the joint refinement
 
     def run(self, groups):
         """[(temperature, result)] in temperature order."""
@@ -164,11 +94,25 @@ class _PerTemperature:
             first["starts"] = 1
         res = self.fit_one(group, T, base, self.held, first)
         if first_of_all:
-            undetermined = [n for n in names if not math.isfinite(_fitted(res, n).stderr)
-                            or _fitted(res, n).stderr > abs(_fitted(res, n).value)]
-            if undetermined and len(undetermined) < len(names):
+            undetermined = self.undetermined(res)
+            # a shape constant (no law in the initial model: vs, sigma2, ...) that one temperature cannot separate
+            # from the levels is held here and fitted once on all experiments together, where the temperatures'
+            # different velocities and levels separate it; the levels then get their own chance at this
+            # temperature. LuGre's default three keep the rule below (held at the initial model's, considered)
+            constants = [n for n in undetermined if n not in init.laws and n not in ("fc", "sigma0", "sigma1")]
+            if constants and len(constants) < len(names):
+                self.held, self.joint = list(constants), list(constants)
+                self.warnings.append(f"{', '.join(constants)} cannot be determined at one temperature (standard error "
+                                     f"above 100 % at {T:.4g} C): held in the per-temperature fits and fitted as "
+                                     f"{'a constant' if len(constants) == 1 else 'constants'} on all experiments "
+                                     f"together")
+                res = self.fit_one(group, T, base, self.held, self.opts)
+                undetermined = [n for n in self.undetermined(res) if n not in self.held]
+            if undetermined and len(undetermined) + len(self.held) < len(names):
+                undetermined = self.held + undetermined
                 self.held = undetermined
-                self.warnings.append(f"{', '.join(undetermined)} cannot be determined from these data (standard "
+                lacking = [n for n in undetermined if n not in self.joint]
+                self.warnings.append(f"{', '.join(lacking)} cannot be determined from these data (standard "
                                      f"error above 100 % at {T:.4g} C): held at the initial model's law")
                 res = self.fit_one(group, T, base.with_friction(**{n: base_model(init, T).friction.values()[n]
                                                                    for n in undetermined}), undetermined, self.opts)
@@ -185,6 +129,11 @@ class _PerTemperature:
             reset["fs"] = fc + max(at_T["fs"] - at_T["fc"], 0.0)
         following = res.model.with_friction(**reset) if reset else res.model
         return T, res, (T, following)
+
+    def undetermined(self, res) -> list:
+        """The fitted names whose standard error at this temperature is above their value (or not finite)."""
+        return [n for n in self.names if n not in self.held and (
+            not math.isfinite(_fitted(res, n).stderr) or _fitted(res, n).stderr > abs(_fitted(res, n).value))]
 
     def fit_one(self, group, T, base, fixed, opts):
         """One temperature's fit (fs as its excess over fc); a fit that fails names the temperature, the
@@ -218,56 +167,6 @@ def _estimate(res, name):
     return x.value + fc.value, math.sqrt(max(se_x ** 2 + se_fc ** 2 + 2 * rho * se_x * se_fc, 0.0))
 
 
-def _at_shared(per_T, free, shared):
-    """Each temperature's estimates where the freed plant parameters take their shared values (``shared``: the
-    median of the per-temperature estimates) instead of that temperature's own: the conditional mean and covariance
-    given them, from the fit's own covariance (each parameter in log space where its standard error is below
-    LOG_SPACE_BELOW of its value, as the fits were made, else in its own). The per-temperature estimates of sigma0
-    and fc move with that temperature's m_e; laws through them unmoved started the joint refinement far from its
-    optimum (8 temperatures from a start 2-3x off: 17 evaluations to a fit 1.2 times the noise, not adequate).
-    A temperature whose covariance is not usable is kept as it is."""
-    out = []
-    for T, res in per_T:
-        varying = [p.name for p in res.parameters.varying]
-        n = len(varying)
-        se = np.array([res.parameters[v].stderr for v in varying], float)
-        val = np.array([res.parameters[v].value for v in varying], float)
-        corr = np.asarray(res.correlation, float)
-        if corr.shape != (n, n) or not np.all(np.isfinite(se)) or not np.all(np.isfinite(corr)) \
-                or np.any(val <= 0) or not all(x in varying for x in free):
-            out.append((T, res))
-            continue
-        log = se < LOG_SPACE_BELOW * val
-        unit = np.where(log, val, 1.0)
-        cov = corr * np.outer(se / unit, se / unit)
-        y = np.where(log, np.log(val), val)
-        f = [varying.index(x) for x in free]
-        o = [i for i in range(n) if i not in f]
-        target = np.array([shared[x] for x in free])
-        try:
-            gain = cov[np.ix_(o, f)] @ np.linalg.inv(cov[np.ix_(f, f)])
-        except np.linalg.LinAlgError:
-            out.append((T, res))
-            continue
-        x = y[o] + gain @ (np.where(log[f], np.log(target), target) - y[f])
-        c = cov[np.ix_(o, o)] - gain @ cov[np.ix_(f, o)]
-        values = np.where(log[o], np.exp(np.minimum(x, 700.0)), x)
-        if np.any(values <= 0) or not np.all(np.isfinite(values)):
-            out.append((T, res))
-            continue
-        moved = copy.deepcopy(res)
-        sd = np.sqrt(np.maximum(np.diag(c), 0.0))
-        for k, i in enumerate(o):
-            moved.parameters[varying[i]].value = float(values[k])
-            moved.parameters[varying[i]].stderr = float(sd[k] * (values[k] if log[i] else 1.0))
-        for k, i in enumerate(f):
-            moved.parameters[varying[i]].value = float(target[k])
-        moved.correlation = np.eye(n)
-        moved.correlation[np.ix_(o, o)] = c / np.outer(np.where(sd > 0, sd, 1.0), np.where(sd > 0, sd, 1.0))
-        out.append((T, moved))
-    return out
-
-
 def _laws_through(per_T, names, held, init, laws):
     """A law per parameter through the per-temperature estimates (linear or exponential by AICc unless
     ``laws`` names one), refitted on the estimates' covariances; a held parameter keeps the initial model's."""
@@ -288,7 +187,7 @@ def _laws_through(per_T, names, held, init, laws):
         law_tables[n] = {"chosen": law.kind, "candidates": table, "temperatures": Ts, "values": vals,
                          "stderr": ses}
     fitted = [n for n in names if n not in held]
-    refined = _laws_on_information(Ts, per_T, {n: new_laws[n] for n in fitted})
+    refined = laws_on_information(Ts, per_T, {n: new_laws[n] for n in fitted})
     for n in fitted:
         if refined[n] is not new_laws[n]:  # the candidates' coefficients are by standard errors alone
             new_laws[n] = refined[n]
@@ -326,11 +225,40 @@ def _above_fc(new_laws, per_T, Ts):
             f"ratio {ratio:.4g} instead, as the joint refinement's start")
 
 
+#: [relative standard error] above which a constant fitted on all experiments together counts as undetermined: its
+#: 95 % interval would reach from near zero to twice its value, where the misfit is far from quadratic in it and a
+#: linearized interval of the others says nothing (a Stribeck velocity 2.3x off fitted as well as the truth)
+OPEN_CONSTANT = 0.5
+
+
+def _open_constants(prof: Profiled, joint) -> list:
+    """The constants of ``joint`` the joint refinement left undetermined (standard error above OPEN_CONSTANT of
+    their value), taken out of ``prof``'s fitted parameters (held at the value reached: the optimum is the same) so
+    that their uncertainty reaches the others' intervals as a held law's stated range does (held.py)."""
+    errors = standard_errors(prof.params, prof.outcome, prof.traces, prof.model)
+    names = [p.name for p in prof.params.varying]
+    value = dict(zip(names, np.asarray(prof.outcome.theta, float)))
+    open_ = [n for n in joint if f"{n}.value" in names and not (np.isfinite(errors[f"{n}.value"]) and errors[
+        f"{n}.value"] < OPEN_CONSTANT * abs(value[f"{n}.value"]))]
+    keep = np.array([name not in {f"{n}.value" for n in open_} for name in names])
+    if keep.all():
+        return []
+    for n in open_:  # held where the refinement left it (a held parameter's value is not read from theta)
+        prof.params[f"{n}.value"].value = value[f"{n}.value"]
+        prof.params[f"{n}.value"].vary = False
+    o = prof.outcome
+    at_bound = [a for a, k in zip(o.at_bound, keep) if k] if len(o.at_bound) == len(keep) else o.at_bound
+    bounds = tuple(np.asarray(b)[keep] for b in o.bounds) if len(o.bounds) == 2 else o.bounds
+    prof.outcome = dataclasses.replace(o, theta=np.asarray(o.theta)[keep], J=o.J[:, keep], at_bound=at_bound,
+                                       bounds=bounds)
+    return open_
+
+
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
                      parameters=None, **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
     ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
-    ``parameters``: the friction parameters fitted (default :func:`default_fit_parameters`), each with its
+    ``parameters``: the friction parameters fitted (default: procedures.default_fit_parameters), each with its
     own law; any other with a law in ``init`` keeps it, held. ``free``: plant parameters (e.g. m_e) fitted
     too, one value shared by all experiments (per temperature first; their median starts the joint refinement)."""
     free = list(free)
@@ -341,20 +269,26 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     names = fitted_names(init, parameters)
     per_temperature = _PerTemperature(init, names, free, opts, measurement, progress)
     per_T = per_temperature.run(groups)
-    held, warns = per_temperature.held, per_temperature.warnings
-    details = {"held_for_lack_of_information": list(held), "per_temperature": [
+    held, warns, joint = per_temperature.held, per_temperature.warnings, per_temperature.joint
+    if not refine:  # without a joint refinement nothing fits the constants: they stay held
+        joint = []
+    details = {"held_for_lack_of_information": [n for n in held if n not in joint], "fitted_as_constant": joint,
+               "held_where_reached": [],
+               "per_temperature": [
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
          "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
     # one plant for all temperatures: the median of the per-temperature estimates, each temperature's estimates
     # moved to it before the laws are drawn through them
     shared = {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free}
-    estimates = _at_shared(per_T, free, shared) if free else per_T
+    estimates = at_shared(per_T, free, shared) if free else per_T
     new_laws, details["laws"] = _laws_through(estimates, names, held, init, laws)
+    for n in joint:
+        details["laws"][n]["chosen"] = "a constant fitted on all experiments together"
     Ts = np.array([T for T, _ in per_T])
     crossed = _above_fc(new_laws, estimates, Ts)
     warns += [crossed] if crossed else []
     kept = {n: law for n, law in init.laws.items() if n not in names}  # held with their laws
-    held = held + list(kept)
+    held = [n for n in held if n not in joint] + list(kept)
     new_laws = {**new_laws, **kept}
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in new_laws})
     model = dataclasses.replace(init, friction=friction, thermal=ModelI(new_laws))
@@ -378,6 +312,16 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     if free:  # a plant parameter's step can be blocked where a law meets its domain's edge (profile.py)
         prof = profiled(model, params, outcome, traces, experiments, measurement, free,
                         lambda m, fr: _law_parameters(dict(m.thermal.laws), held, fr, m), ropts)
+    if joint:
+        kept_open = _open_constants(prof, joint)
+        details["held_for_lack_of_information"] += kept_open
+        details["held_where_reached"] = kept_open
+        # their stated range's effect on the others by refits at its ends, not by the linearization (held.py)
+        fixed = held + kept_open
+        details["_secants"] = {n: [list(map(float, d)) for d in secant_shifts(
+            prof, f"{n}.value", PRIOR_FACTOR, experiments, measurement,
+            lambda m: _law_parameters(dict(m.thermal.laws), fixed, free, m), ropts)] for n in kept_open}
+        details["fitted_as_constant"] = [n for n in joint if n not in kept_open]
     res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details)
     widened(res, prof.widen)
     res.nfev += sum(r.nfev for _, r in per_T) + prof.nfev
