@@ -7,7 +7,11 @@ its value plus or minus two standard errors, the mass no longer asks for that st
 on a Stribeck truth with the mass twice the start's, both held fits reached 150-200 (in chi-square) below the
 "optimum" and the refit from the better one ended at the true mass, inside its interval. So each freed plant
 parameter is held at both sides once; where one is better by more than the noise could make it, the joint
-refinement starts again from there."""
+refinement starts again from there.
+
+A constant fitted on all experiments that stays undetermined (Model I's shape constants, e.g. vs) is held at both
+ends of its stated range and the rest refitted (:func:`held_refits`): the shifts are the secants by which its range
+reaches the other intervals (held.py)."""
 
 from __future__ import annotations
 
@@ -109,22 +113,25 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
     return out
 
 
-def secant_shifts(prof: Profiled, name: str, factor: float, experiments, measurement, parameters_of, ropts) -> list:
-    """The shifts of ``prof``'s fitted parameters when the held constant ``name`` (a Parameter, e.g. "vs.value") is
-    moved by ``factor`` either way and the rest refitted (2 HELD_EVALUATIONS each, from the optimum): the
-    secants that replace a held value's linearized sensitivities where the misfit is far from quadratic in it (a
-    Stribeck velocity: the fitted fs moved 12 % where the linearization at the optimum gave 3 %). [] where a refit
-    fails or does not fit the same parameters."""
+@dataclasses.dataclass
+class HeldEnd:
+    """A refit with a constant held at an end of its range: its fitted parameters' names and values."""
+    names: list
+    theta: np.ndarray
+
+
+def held_refits(prof: Profiled, name: str, factor: float, experiments, measurement, parameters_of, ropts) -> list:
+    """Refits with the constant ``name`` (a Parameter, e.g. "vs.value") held at its optimum value divided and
+    multiplied by ``factor``, the rest (``parameters_of(model)``, which holds it) from the optimum, with 2
+    HELD_EVALUATIONS each: [HeldEnd, HeldEnd], or [] where one fails."""
     names = [p.name for p in prof.params.varying]
     theta = np.asarray(prof.outcome.theta, float)
     optimum = with_values(prof.model, dict(zip(names, theta)))
-    value = float(prof.params[name].value)
-    shifts = []
+    value = float(theta[names.index(name)]) if name in names else float(prof.params[name].value)
+    ends = []
     for side in (1.0 / factor, factor):
         held = with_values(optimum, {name: value * side})
         params = parameters_of(held)
-        if [p.name for p in params.varying] != names:
-            return []
         try:
             trial = fit(held, params, make_traces(experiments, held, measurement),
                         **{**ropts, "near": True, "starts": 1, "max_nfev": 2 * HELD_EVALUATIONS})
@@ -133,8 +140,19 @@ def secant_shifts(prof: Profiled, name: str, factor: float, experiments, measure
         prof.nfev, prof.njev = prof.nfev + trial.nfev, prof.njev + trial.njev
         if not np.all(np.isfinite(trial.theta)):
             return []
-        shifts.append(np.asarray(trial.theta, float) - theta)
-    return shifts
+        ends.append(HeldEnd([p.name for p in params.varying], np.asarray(trial.theta, float)))
+    return ends
+
+
+def secant_shifts(prof: Profiled, ends) -> list:
+    """The shifts of ``prof``'s fitted parameters to each of ``ends`` (refits with a constant held at the ends of
+    its stated range): the secants that replace its linearized sensitivities where the misfit is far from quadratic
+    in it (a Stribeck velocity: the fitted fs moved 12 % where the linearization at the optimum gave 3 %). [] where
+    the ends do not fit the same parameters."""
+    names = [p.name for p in prof.params.varying]
+    if len(ends) != 2 or any(e.names != names for e in ends):
+        return []
+    return [e.theta - np.asarray(prof.outcome.theta, float) for e in ends]
 
 
 def widened(result, factors: dict) -> None:
@@ -154,5 +172,5 @@ def widened(result, factors: dict) -> None:
             f"widened {factor:.2g}x, to [{par.ci95[0]:.4g}, {par.ci95[1]:.4g}]")
 
 
-__all__ = ["profiled", "Profiled", "secant_shifts", "standard_errors", "widened", "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING",
-           "HELD_EVALUATIONS"]
+__all__ = ["profiled", "Profiled", "HeldEnd", "held_refits", "secant_shifts", "standard_errors", "widened",
+           "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING", "HELD_EVALUATIONS"]
