@@ -202,10 +202,9 @@ def _consider(res, tests, secants=None):
     cov = np.nan_to_num(res.correlation) * np.outer(se, se)
     sd = math.log(PRIOR_FACTOR) / 1.959964
     for t in tests:
-        if len((secants or {}).get(t["name"]) or ()) == 2:  # refits at the range's ends (model_i.py): G from their secants
-            for shift in secants[t["name"]]:
-                G = np.asarray(shift, float) / math.log(PRIOR_FACTOR)
-                cov = cov + np.outer(G, G) * sd ** 2 / 2
+        if len((secants or {}).get(t["name"]) or ()) == 2:  # refits at its range's ends (model_i.py): the shifts
+            for shift in secants[t["name"]]:                 # to them as 1.96 standard deviations, half each
+                cov = cov + np.outer(shift, shift) / (2 * 1.959964 ** 2)
             continue
         law = res.model.laws[t["name"]]
         c = np.array(law.coefficients(), float)
@@ -224,15 +223,24 @@ def _consider(res, tests, secants=None):
             par.ci95 = (par.value - tq * s, par.value + tq * s)
     with np.errstate(invalid="ignore", divide="ignore"):
         res.correlation = cov / np.outer(se_new, se_new)
-    names = ", ".join(t["name"] for t in tests)
     grown = max(se_new / np.where(se > 0, se, np.inf))
-    reached = set(res.details.get("held_where_reached") or ())
-    where = ("where the joint refinement left " + ("it" if len(tests) == 1 else "them")
-             if reached >= {t["name"] for t in tests} else "at the initial model's law")
-    res.warnings.append(f"{names} could not be determined and {'is' if len(tests) == 1 else 'are'} held {where}; "
-                        f"the intervals include {'its' if len(tests) == 1 else 'their'} level within a "
-                        f"stated factor {PRIOR_FACTOR:g} either way (95 %): standard errors up to {grown:.3g} times "
-                        f"those with it held exactly")
+    ranges = res.details.get("held_ranges") or {}
+    grown_text = f"standard errors up to {grown:.3g} times those with {'it' if len(tests) == 1 else 'them'} held exactly"
+    for name in (t["name"] for t in tests if t["name"] in ranges):
+        span = ranges[name]
+        lacking = name in (res.details.get("held_for_lack_of_information") or ())
+        source = ("where the per-temperature fits' misfit, profiled over it, rises by 3.84 in chi-square"
+                  if span["from"] == "profile" else f"a stated factor {PRIOR_FACTOR:g} either way")
+        res.warnings.append(f"{name} {'could not be determined and ' if lacking else ''}is held where the joint "
+                            f"refinement left it ({span['value']:.4g}); its range, "
+                            f"{span['low']:.4g} to {span['high']:.4g} (95 %: {source}), reaches the other intervals "
+                            f"through refits with it held at both ends: {grown_text}")
+    others = [t["name"] for t in tests if t["name"] not in ranges]
+    if others:
+        one = len(others) == 1
+        res.warnings.append(f"{', '.join(others)} could not be determined and {'is' if one else 'are'} held at the "
+                            f"initial model's law; the intervals include {'its' if one else 'their'} level within a "
+                            f"stated factor {PRIOR_FACTOR:g} either way (95 %): {grown_text}")
     res.details["considered"] = {"parameters": [t["name"] for t in tests], "prior_factor": PRIOR_FACTOR}
 
 
@@ -249,7 +257,8 @@ def with_held_tests(res, experiments, measurement, rtol=1e-8):
     res.fit_quality["held"] = [{k: t[k] for k in ("name", "value", "statistic", "dof", "p_value", "misfit_share",
                                                   "contradicted")} for t in tests]
     bad = [t for t in tests if t["contradicted"] and t["same_as"] is None]
-    lack = [t for t in tests if t["name"] in (res.details.get("held_for_lack_of_information") or ())]
+    lack = [t for t in tests if t["name"] in (res.details.get("held_for_lack_of_information") or ())
+            or t["name"] in (res.details.get("held_ranges") or {})]
     if lack:
         _consider(res, lack, secants or {})
     if bad:
