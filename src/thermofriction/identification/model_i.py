@@ -16,27 +16,14 @@ from .laws import at_shared, fit_law, laws_on_information
 from .optimiser import fit
 from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
 from .problem import make_traces
-from .profile import Profiled, profiled, settled_constants, widened
+from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
+                      profiled, settled_constants, widened)
 from .procedures import (along_temperatures, base_model, fit_friction, fit_result,
                          fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
 
-
-
-#: the 1-D search of a constant fitted on all experiments (profiled_constant): within this factor of the start (the
-#: 2-3x a rough start is off, and more), to this tolerance in its log, in at most this many points
-PROFILE_RANGE = 10.0
-PROFILE_XTOL = 0.05
-PROFILE_POINTS = 12
-CHI2_95 = 3.841  # the 95 % quantile of chi-square with one degree of freedom
-#: the range the data leave the constant is found in steps of this (in its log: x1.6) from the minimum, at most
-#: this many a side (then the range is taken to end at the last step: at least that wide)
-PROFILE_STEP_OUT = 0.47
-PROFILE_OUTWARD = 4
-#: the evaluations of each temperature's fit at a point of the search (from the fit at the nearest point tried)
-PROFILE_FIT_EVALUATIONS = 20
 
 
 class _PerTemperature:
@@ -148,80 +135,56 @@ class _PerTemperature:
             reset["fs"] = fc + max(at_T["fs"] - at_T["fc"], 0.0)
         return res.model.with_friction(**reset) if reset else res.model
 
+    def refit_all(self, groups, temps, starts, values: dict, opts) -> list:
+        """Every temperature's fit with ``values`` held, each from ``starts[i]`` (what it determined), on the two
+        continuation threads; raises ComputationError where one fails."""
+        fits, index = {}, list(range(len(groups)))
+        half = (len(index) + 1) // 2
+
+        def step(i, carried, first):
+            base = self.carried(starts[i], temps[i]).with_friction(**values)
+            fits[i] = self.fit_one(groups[i], temps[i], base, self.held, {**self.opts, "starts": 1, **opts})
+            self.nfev += fits[i].nfev
+            return carried
+
+        along_temperatures([(index[:half], None), (index[half:], None)], step, alone=(index, None))
+        return [fits[i] for i in index]
+
     def profiled_constant(self, groups, per_T):
         """The per-temperature fits at the value of the one constant fitted on all experiments (``self.joint``)
         that minimizes their summed misfit, a bounded 1-D search in its log within a factor PROFILE_RANGE of the
         start, each temperature refitted with it held (from the fits at the nearest value tried). Given the
         constant, each temperature determines the levels; the joint refinement, left to find the constant along
         the valley the levels make with it, crept: a Stribeck velocity 2.5x off moved to 2.3x in 30 evaluations
-        and to 1.07x in 100 (2 s records). Returns per_T at the best value (unchanged if none is better)."""
+        and to 1.07x in 100 (2 s records). Sets ``self.region``; returns per_T at the best value."""
         (name,) = self.joint
         v0 = float(self.init.friction.values()[name])
         temps = [T for T, _ in per_T]
         tried = {0.0: (sum(r.cost for _, r in per_T), [r for _, r in per_T])}
-        index = list(range(len(per_T)))
-        half = (len(index) + 1) // 2
 
         def cost(log_factor):
             nearest = tried[min(tried, key=lambda x: abs(x - log_factor))][1]
-            fits = {}
-
-            def step(i, carried, first):
-                base = self.carried(nearest[i], temps[i]).with_friction(**{name: v0 * math.exp(log_factor)})
-                fits[i] = self.fit_one(groups[i], temps[i], base, self.held,
-                                       {**self.opts, "starts": 1, "max_nfev": PROFILE_FIT_EVALUATIONS})
-                self.nfev += fits[i].nfev
-                return carried
-
             try:
-                along_temperatures([(index[:half], None), (index[half:], None)], step, alone=(index, None))
+                fits = self.refit_all(groups, temps, nearest, {name: v0 * math.exp(log_factor)},
+                                      {"max_nfev": PROFILE_FIT_EVALUATIONS})
             except ComputationError:
                 return math.inf
-            tried[float(log_factor)] = (sum(f.cost for f in fits.values()), [fits[i] for i in index])
+            tried[float(log_factor)] = (sum(f.cost for f in fits), fits)
             return tried[float(log_factor)][0]
 
         optimize.minimize_scalar(cost, bounds=(-math.log(PROFILE_RANGE), math.log(PROFILE_RANGE)), method="bounded",
                                  options={"xatol": PROFILE_XTOL, "maxiter": PROFILE_POINTS})
-        # the values the data do not exclude (95 %, one parameter: 3.84 in chi-square, in the best fits' residual
-        # variance times their autocorrelation's inflation): stepped out from the minimum until the rise passes that
-        # (the search's own points cluster at the minimum), the crossing interpolated
-        fits = tried[min(tried, key=lambda x: tried[x][0])][1]
-        n = sum(f.n_points for f in fits)
-        unit = tried[min(tried, key=lambda x: tried[x][0])][0] / max(
-            n - sum(len(f.parameters.varying) for f in fits), 1)
-        unit *= CHI2_95 * max(f.statistics.get("variance_inflation", 1.0) for f in fits)
-        ends = []
-        for direction in (-1.0, 1.0):
-            low = min(tried, key=lambda x: tried[x][0])
-            x, end = low, None
-            for _ in range(PROFILE_OUTWARD):
-                nxt = float(np.clip(x + direction * PROFILE_STEP_OUT, -math.log(PROFILE_RANGE), math.log(PROFILE_RANGE)))
-                if nxt == x:
-                    break
-                rise = (cost(nxt) - tried[low][0]) / unit
-                if rise > 1.0:
-                    inner = (tried[x][0] - tried[low][0]) / unit
-                    end = x + (nxt - x) * (1.0 - inner) / max(rise - inner, 1e-12)
-                    break
-                x = nxt
-            ends.append(x if end is None else end)
-        self.region = (v0 * math.exp(ends[0]), v0 * math.exp(ends[1]))
         best = min(tried, key=lambda x: tried[x][0])
+        self.region = tuple(v0 * math.exp(x) for x in profile_range(tried, best, cost))
+        if best == 0.0:
+            return per_T
         # the fits the laws are drawn through: at the best value with the full budget, from the first fits (the
         # search's short fits, chained from point to point, can leave a poorly determined sigma1 far out)
-        final = {}
-
-        def step(i, carried, first):
-            base = self.carried(per_T[i][1], temps[i]).with_friction(**{name: v0 * math.exp(best)})
-            final[i] = self.fit_one(groups[i], temps[i], base, self.held, {**self.opts, "starts": 1})
-            self.nfev += final[i].nfev
-            return carried
-
         try:
-            along_temperatures([(index[:half], None), (index[half:], None)], step, alone=(index, None))
+            final = self.refit_all(groups, temps, [r for _, r in per_T], {name: v0 * math.exp(best)}, {})
         except ComputationError:
-            return list(zip(temps, tried[best][1]))
-        return [(temps[i], final[i]) for i in index]
+            final = tried[best][1]
+        return list(zip(temps, final))
 
     def undetermined(self, res) -> list:
         """The fitted names whose standard error at this temperature is above their value (or not finite)."""

@@ -225,6 +225,47 @@ def settled_constants(prof: Profiled, joint, region, parameters_of, experiments,
     return kept_open, undetermined, secants, ranges
 
 
+#: the 1-D search of a constant fitted on all experiments (profiled_constant): within this factor of the start (the
+#: 2-3x a rough start is off, and more), to this tolerance in its log, in at most this many points
+PROFILE_RANGE = 10.0
+PROFILE_XTOL = 0.05
+PROFILE_POINTS = 12
+CHI2_95 = 3.841  # the 95 % quantile of chi-square with one degree of freedom
+#: the range the data leave the constant is found in steps of this (in its log: x1.6) from the minimum, at most
+#: this many a side (then the range is taken to end at the last step: at least that wide)
+PROFILE_STEP_OUT = 0.47
+PROFILE_OUTWARD = 4
+#: the evaluations of each temperature's fit at a point of the search (from the fit at the nearest point tried)
+PROFILE_FIT_EVALUATIONS = 20
+
+
+def profile_range(tried, best, cost) -> tuple:
+    """(low, high) in the log of the profiled constant: where the per-temperature fits' summed misfit (``tried``:
+    log value -> (misfit, fits); ``cost`` adds a point) has risen from its least (at ``best``) by 3.84 in
+    chi-square (95 %, one parameter; in the best fits' residual variance times their autocorrelation's
+    inflation), stepped out from the least (the search's own points cluster there), the crossing interpolated;
+    at the last step where PROFILE_OUTWARD steps do not reach it."""
+    fits = tried[best][1]
+    n = sum(f.n_points for f in fits)
+    unit = tried[best][0] / max(n - sum(len(f.parameters.varying) for f in fits), 1)
+    unit *= CHI2_95 * max(f.statistics.get("variance_inflation", 1.0) for f in fits)
+    ends = []
+    for direction in (-1.0, 1.0):
+        x, end = best, None
+        for _ in range(PROFILE_OUTWARD):
+            nxt = float(np.clip(x + direction * PROFILE_STEP_OUT, -math.log(PROFILE_RANGE), math.log(PROFILE_RANGE)))
+            if nxt == x:
+                break
+            rise = (cost(nxt) - tried[best][0]) / unit
+            if rise > 1.0:
+                inner = (tried[x][0] - tried[best][0]) / unit
+                end = x + (nxt - x) * (1.0 - inner) / max(rise - inner, 1e-12)
+                break
+            x = nxt
+        ends.append(x if end is None else end)
+    return tuple(ends)
+
+
 def widened(result, factors: dict) -> None:
     """Widens ``result``'s standard error and 95 % interval of each parameter in ``factors`` (name -> factor
     from :func:`profiled`) where the factor is above 1, and says so in its warnings and details."""
@@ -242,6 +283,7 @@ def widened(result, factors: dict) -> None:
             f"widened {factor:.2g}x, to [{par.ci95[0]:.4g}, {par.ci95[1]:.4g}]")
 
 
-__all__ = ["profiled", "Profiled", "HeldEnd", "held_refits", "secant_shifts", "standard_errors", "widened",
+__all__ = ["profiled", "Profiled", "profile_range", "PROFILE_RANGE", "PROFILE_XTOL", "PROFILE_POINTS",
+           "PROFILE_FIT_EVALUATIONS", "CHI2_95", "HeldEnd", "held_refits", "secant_shifts", "standard_errors", "widened",
            "open_constants", "settled_constants", "OPEN_CONSTANT",
            "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING", "HELD_EVALUATIONS"]
