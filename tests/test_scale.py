@@ -155,6 +155,38 @@ def test_two_threads_inside_their_blocks_at_once_record_their_own_warnings():
     assert (list(warnings.filters), warnings.showwarning) == before
 
 
+def test_recorded_blocks_nest_and_validations_side_by_side_keep_their_own_warnings(monkeypatch):
+    """Two validations on a Runner's threads, both inside their experiment's prediction at once (a barrier), each
+    at a temperature outside the laws' range: each result names its own temperature only, as a sequential run
+    does. Before, validation recorded with warnings.catch_warnings (global state): a fleet's held-out lists could
+    swap or lose warnings. The simulation's own check records in a block nested in validation's and passes its
+    warnings on to it."""
+    import thermofriction.validation as V
+
+    model = tf.load_model("li2009-model-i")
+    datasets = [tf.synthesize(model, [T], duration=0.05, sample_rate=2000.0, noise=0.0, seed=1) for T in (27.0, 29.0)]
+    barrier = threading.Barrier(2)
+    original = V.measurement_of
+
+    def measurement_of(exps, **kw):
+        measurement = original(exps, **kw)
+        predict = measurement.predict
+
+        def predicted(*args, **kwargs):
+            barrier.wait(timeout=30)
+            return predict(*args, **kwargs)
+
+        object.__setattr__(measurement, "predict", predicted)
+        return measurement
+
+    monkeypatch.setattr(V, "measurement_of", measurement_of)
+    with Runner(workers=2) as runner:
+        out = runner.map(lambda d: tf.validate(model, d).warnings, [(d,) for d in datasets], records_warnings=True)
+    for T, caught in zip((27, 29), out):
+        assert any(f"temperature {T} C is outside" in w for w in caught), caught
+        assert not any(f"temperature {56 - T} C" in w for w in caught), caught
+
+
 def test_a_task_that_raises_stops_the_run_as_in_sequential_mode():
     def task(i):
         if i == 3:

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import dataclasses
 import html
-import warnings
 
 from ._io import dump_json, jsonable
+from ._warning_routes import recorded_warnings
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from . import _args
 from .data.experiments import Dataset
@@ -180,9 +180,7 @@ def validate(model: Model, data, experiments=None, *, offset=None) -> Validation
     measurement.check_model(model, exps)
     caught, preds, failures, pairs = [], [], [], []
     for exp in exps:
-        with warnings.catch_warnings(record=True) as w:
-            warnings.simplefilter("always", TemperatureRangeWarning)
-            warnings.simplefilter("always", MetricWarning)
+        with recorded_warnings() as w:  # this experiment's own, also where fits run side by side on threads
             try:
                 preds.append(measurement.predict(model, exp))
                 pairs.append((exp, preds[-1].measured, preds[-1].predicted))

@@ -25,12 +25,11 @@ import numbers
 import os
 import pickle
 import sys
-import threading
 import time
 import uuid
-import warnings
 
 from .. import _args
+from .._warning_routes import RoutedWarnings, recorded_warnings, route_this_thread
 from ..errors import ComputationError, InputError, shorten
 from .chunks import CHUNK_SECONDS, chunk_spans
 from .connect import probe, read_scheduler_file
@@ -77,62 +76,6 @@ def check_options(scheduler=None, workers=None, batch_size=None, progress=None):
     _args.function(progress, "progress")
 
 
-#: per thread of a Runner's pool: where the warnings of the running task go (see recorded_warnings)
-_local = threading.local()
-
-
-@contextlib.contextmanager
-def recorded_warnings():
-    """The warnings raised in the block, every one (``simplefilter("always")``), as a list of
-    ``warnings.WarningMessage``, without showing them. In a thread of a Runner's pool the block's own
-    thread's warnings are routed here by the runner (``warnings.catch_warnings`` changes the warnings
-    module's global state: two threads that enter and leave it out of turn lose warnings)."""
-    if getattr(_local, "routed", False):
-        caught = []
-        _local.sink = caught
-        try:
-            yield caught
-        finally:
-            _local.sink = None
-    else:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            yield caught
-
-
-class _RoutedWarnings:
-    """While a thread pool works: a pool thread's warnings go into its task's list when the task records
-    them (recorded_warnings), elsewhere as before; with ``always``, every one is shown (as
-    recorded_warnings asks: the same list as in sequential mode). On leaving, the warnings module is as
-    it was, whatever the threads did to it."""
-
-    def __init__(self, always: bool):
-        self.always = always
-
-    def __enter__(self):
-        self._saved = warnings.catch_warnings()
-        self._saved.__enter__()
-        if self.always:
-            warnings.simplefilter("always")
-        self._show = warnings.showwarning
-        warnings.showwarning = self._route
-        return self
-
-    def _route(self, message, category, filename, lineno, file=None, line=None):
-        sink = getattr(_local, "sink", None)
-        if sink is None:
-            self._show(message, category, filename, lineno, file, line)
-        else:
-            sink.append(warnings.WarningMessage(message, category, filename, lineno, file, line))
-
-    def __exit__(self, *exc):
-        return self._saved.__exit__(*exc)
-
-
-def _route_this_thread():
-    _local.routed = True
-
-
 class Runner:
     """Runs tasks ``fn(*args)`` on the chosen scheduler and hands back their results in task order.
 
@@ -177,7 +120,7 @@ class Runner:
             # with nothing to start, to pickle or to send
             self._threads = self.workers or os.cpu_count() or 1
             self._pool = concurrent.futures.ThreadPoolExecutor(
-                max_workers=self._threads, thread_name_prefix="thermofriction-scale", initializer=_route_this_thread)
+                max_workers=self._threads, thread_name_prefix="thermofriction-scale", initializer=route_this_thread)
             self._stack.callback(self._stop_pool)
             return
         distributed = _distributed()
@@ -327,7 +270,7 @@ class Runner:
         as in sequential mode."""
         results = [None] * len(arg_tuples)
         done = 0
-        with _RoutedWarnings(always=records_warnings):
+        with RoutedWarnings(always=records_warnings):
             futures = {self._pool.submit(fn, *args): i for i, args in enumerate(arg_tuples)}
             try:
                 for fut in concurrent.futures.as_completed(futures):

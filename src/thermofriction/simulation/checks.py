@@ -11,6 +11,7 @@ import weakref
 
 import numpy as np
 
+from .._warning_routes import recorded_warnings
 from ..errors import ConditioningWarning, InputError, PassivityWarning, SolverError, TemperatureRangeWarning
 from ..models import Model, ModelI, ModelII, check_friction_values, dissipativity_violation
 from ..plausible import check_temperature
@@ -79,7 +80,8 @@ def check_temperature_coverage(temperature, t0: float, t1: float):
 # benchmark) is checked once. The entry goes with its model (a weak reference's callback).
 _PASSED: dict = {}
 # catch_warnings changes the warnings module's global state: threads that simulate side by side (tf.sweep's)
-# take turns here, or one would restore the state another had set and the warnings after it would be lost
+# take turns here, or one would restore the state another had set and the warnings after it would be lost (a
+# Runner's pool threads record into their own lists instead: _warning_routes.py)
 _RECORDING = threading.RLock()
 
 
@@ -95,8 +97,7 @@ def check_temperatures(model: Model, temperature):
     key = None if isinstance(temperature, Sampled) else temperature
     if key is not None and key in _passed(model):
         return
-    with _RECORDING, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with _RECORDING, recorded_warnings() as caught:
         _check_temperatures(model, temperature)
     for w in caught:  # passed on as they came (stacklevel as the checks set it)
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
