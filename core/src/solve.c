@@ -92,6 +92,7 @@ static tf_status start(tf_driver *d, const tf_ode *ode, const tf_solver_options 
     /* without a Jacobian (e.g. sensitivity systems) only the explicit method applies */
     d->requested = ode->jac ? opt->method : TF_METHOD_DOPRI5;
     d->method = d->requested == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : d->requested;
+    d->kinks = d->requested == TF_METHOD_AUTO && ode->kink_scale > 0.0; /* reversals (below) */
     int no_memory = tf_auto_start(d);
     d->ne = ode->events ? ode->nevent : 0;
     d->f0 = (double *)malloc(sizeof(double) * d->n);
@@ -165,8 +166,8 @@ static tf_status restart(tf_driver *d, double seg_end)
  * sign (LuGre's |v_r|), and Dormand-Prince's embedded error estimate does not see a kink inside a step:
  * in the ringing after a sawtooth's flyback, which reverses v_r every 0.2-1 ms, the steps across a
  * reversal had true local errors of 2.5-92 times the tolerance while the estimate accepted them, and
- * these steps made the default's largest errors (docs/performance.md). So Dormand-Prince's steps end at
- * reversals of the ODE's kink velocity (integrator.h): the accepted step's dense output, extrapolated over
+ * these steps made the default's largest errors (docs/performance.md). So AUTO's Dormand-Prince steps end
+ * at reversals of the ODE's kink velocity (integrator.h): the accepted step's dense output, extrapolated over
  * the next step, predicts a reversal in it, and the next step ends just past it (no step is wasted); a
  * step across a reversal that was not predicted is also judged by its dense output at mid-step against
  * the cubic Hermite interpolant of its ends (as Rodas4's steps are, rodas4.c), which tracks the kink's
@@ -178,7 +179,11 @@ static tf_status restart(tf_driver *d, double seg_end)
  * accuracy. An oscillation of v_r above that bound also keeps AUTO from switching to Rodas4 (kink_stiff):
  * Rodas4's long steps do not resolve it and miss its reversals' kinks as well (on a set of the accuracy
  * benchmark, an early switch in such ringing drifted to 1.9e-3 %), while Dormand-Prince must resolve it
- * anyway; the stiffness test's verdict waits until the oscillation has decayed below the bound. */
+ * anyway; the stiffness test's verdict waits until the oscillation has decayed below the bound.
+ *
+ * AUTO only: it pays there because the explicit phases can then run at 1/20 of the tolerances instead of
+ * 1/50 (auto.c). A Dopri5 asked for by name keeps its steps: at its tolerance the cuts cost more steps
+ * (+20 % on the preset) than a tighter tolerance of the same accuracy would. */
 enum {
     KINK_MAX_CUTS = 2,         /* a step is cut at most twice; then its mid-step check judges it */
     KINK_LOCATE_ITERATIONS = 8 /* of the regula falsi on the dense output */
@@ -308,7 +313,7 @@ static tf_status attempt(tf_driver *d, double seg_end, double *err)
         *err = tf_rodas4_step(&d->w, d->t, d->h, d->y, d->f0, d->yd);
     } else {
         *err = tf_dopri5_step(&d->w, d->t, d->h, d->y, d->f0);
-        if (d->ode->kink_scale > 0.0) *err = kink_check(d, *err);
+        if (d->kinks) *err = kink_check(d, *err);
     }
     return TF_OK;
 }
@@ -375,7 +380,7 @@ static double next_step(tf_driver *d, double err, double t_new, int last)
         hnew = tf_dopri5_next_h(err, d->h, &d->facold);
         int stiff = tf_dopri5_stiff(w, d->opt, d->h, &d->iasti, &d->nonsti);
         if (stiff) d->st->stiff_suspected = 1;
-        if (d->ode->kink_scale > 0.0) hnew = kink_next(d, hnew), stiff = kink_stiff(d, stiff);
+        if (d->kinks) hnew = kink_next(d, hnew), stiff = kink_stiff(d, stiff);
         memcpy(d->f0, w->k[6], sizeof(double) * d->n); /* FSAL */
         tf_auto_explicit_step(d, t_new, stiff);
     }

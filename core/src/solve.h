@@ -33,7 +33,7 @@ typedef struct {
      * of the step being attempted), the largest |v| of the current and of the last half-cycle, whether
      * the stiffness test fired since the restart */
     double kink_h, kink_h_orig, kink_peak, kink_last_peak;
-    int kink_cuts, stiff_seen;
+    int kinks, kink_cuts, stiff_seen; /* kinks: AUTO with a kink velocity */
     tf_rodas4_control rc;
     tf_auto au;
 } tf_driver;
