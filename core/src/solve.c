@@ -148,7 +148,7 @@ static tf_status restart(tf_driver *d, double seg_end)
     const tf_ode *ode = d->ode;
     d->w.t_clamp = INFINITY;
     d->kink_h = d->kink_h_orig = d->kink_peak = d->kink_last_peak = 0.0;
-    d->kink_cuts = d->stiff_seen = 0;
+    d->kink_cuts = d->kink_steps = d->stiff_seen = 0;
     if (ode->on_restart) ode->on_restart(d->t, d->y, ode->ctx);
     if (d->ne) ode->events(d->t, d->y, d->g0, ode->ctx);
     if (rhs(&d->w, d->t, d->y, d->f0)) return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, d->h, -1, 0);
@@ -186,7 +186,8 @@ static tf_status restart(tf_driver *d, double seg_end)
  * (+20 % on the preset) than a tighter tolerance of the same accuracy would. */
 enum {
     KINK_MAX_CUTS = 2,         /* a step is cut at most twice; then its mid-step check judges it */
-    KINK_LOCATE_ITERATIONS = 8 /* of the regula falsi on the dense output */
+    KINK_LOCATE_ITERATIONS = 8, /* of the regula falsi on the dense output */
+    KINK_RINGING_STEPS = 15     /* a half-cycle of more steps is no ringing (kink_stiff) */
 };
 static const double KINK_SIGNIFICANT = 5.0;   /* in tolerances of the kink velocity (above) */
 static const double KINK_PAST = 1e-4;         /* a step cut at a reversal ends this fraction past it */
@@ -283,8 +284,10 @@ static double kink_next(tf_driver *d, double hnew)
     if (g0 * g1 < 0.0) { /* a new half-cycle */
         d->kink_last_peak = d->kink_peak;
         d->kink_peak = a1;
-    } else if (a1 > d->kink_peak) {
-        d->kink_peak = a1;
+        d->kink_steps = 0;
+    } else {
+        if (a1 > d->kink_peak) d->kink_peak = a1;
+        d->kink_steps++;
     }
     const double reach = hnew < KINK_PREDICT_REACH * h ? hnew / h : KINK_PREDICT_REACH;
     const double gb = kink_dense(w, ode, 1.0 + reach);
@@ -294,11 +297,13 @@ static double kink_next(tf_driver *d, double hnew)
 }
 
 /* AUTO's switch to the stiff method (stiff: Dormand-Prince's stiffness test fired) waits while v_r
- * oscillates significantly (above). */
+ * oscillates significantly (above): while its half-cycles peak above the bound and last fewer steps than
+ * the stiffness test's count (a slower motion is no ringing that the explicit method sits on). */
 static int kink_stiff(tf_driver *d, int stiff)
 {
     if (stiff) d->stiff_seen = 1;
-    return d->stiff_seen && !(kink_amplitude(d) > kink_significant(&d->w, d->ode));
+    int ringing = d->kink_steps < KINK_RINGING_STEPS && kink_amplitude(d) > kink_significant(&d->w, d->ode);
+    return d->stiff_seen && !ringing;
 }
 
 /* One attempted step of the current method into *err (negative: non-finite or singular). */

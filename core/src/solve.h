@@ -33,7 +33,8 @@ typedef struct {
      * of the step being attempted), the largest |v| of the current and of the last half-cycle, whether
      * the stiffness test fired since the restart */
     double kink_h, kink_h_orig, kink_peak, kink_last_peak;
-    int kinks, kink_cuts, stiff_seen; /* kinks: AUTO with a kink velocity */
+    int kinks, kink_cuts, kink_steps, stiff_seen; /* kinks: AUTO with a kink velocity; kink_steps: of the
+                                                   * current half-cycle */
     tf_rodas4_control rc;
     tf_auto au;
 } tf_driver;
