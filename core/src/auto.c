@@ -1,5 +1,6 @@
 /* AUTO: per phase of the input (every corner starts one), DOPRI5 at AUTO_EXPLICIT_TOL (with the
- * reversal handling of solve.c: AUTO_EXPLICIT_TOL_KINKS) times the tolerances until its stiffness test fires (15 steps in a row near the stability boundary) and the
+ * reversal handling of solve.c: AUTO_EXPLICIT_TOL_KINKS) times the tolerances until its stiffness test
+ * fires (15 steps in a row near the stability boundary) and the
  * relative velocity no longer oscillates (solve.c: reversals); then
  * RODAS4 on probation: after PROBE_STEPS steps its work per simulated second is compared with DOPRI5's
  * over its last window, and the cheaper method goes on (work counted in rhs evaluations, with

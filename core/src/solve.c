@@ -178,16 +178,17 @@ static tf_status restart(tf_driver *d, double seg_end)
  * Dormand-Prince makes v_r oscillate by itself, changing sign every step or two, by 3.6 (li2009-model-i)
  * to 9 (li2009-base) times the tolerance, and cutting steps there buys no accuracy and keeps the steps
  * short, so that the stiffness test never fires (li2009-base ran in Dormand-Prince throughout, at 2.4
- * times the work); the ringing after a flyback changes sign every 3-5 steps. An oscillation of v_r above that bound also keeps AUTO from switching to Rodas4 (kink_stiff):
- * Rodas4's long steps do not resolve it and miss its reversals' kinks as well (on a set of the accuracy
- * benchmark, an early switch in such ringing drifted to 1.9e-3 %), while Dormand-Prince must resolve it
- * anyway; the stiffness test's verdict waits until the oscillation has decayed below the bound.
+ * times the work); the ringing after a flyback changes sign every 3-5 steps. Ringing of v_r above that
+ * bound also keeps AUTO from switching to Rodas4 (kink_stiff): Rodas4's long steps do not resolve it and
+ * miss its reversals' kinks as well (on a set of the accuracy benchmark, an early switch in such ringing
+ * drifted to 1.9e-3 %), while Dormand-Prince must resolve it anyway; the stiffness test's verdict waits
+ * until the ringing has decayed below the bound.
  *
  * AUTO only: it pays there because the explicit phases can then run at 1/20 of the tolerances instead of
  * 1/50 (auto.c). A Dopri5 asked for by name keeps its steps: at its tolerance the cuts cost more steps
  * (+20 % on the preset) than a tighter tolerance of the same accuracy would. */
 enum {
-    KINK_MAX_CUTS = 2,         /* a step is cut at most twice; then its mid-step check judges it */
+    KINK_MAX_CUTS = 2,          /* a step is cut at most twice; then its mid-step check judges it */
     KINK_LOCATE_ITERATIONS = 8, /* of the regula falsi on the dense output */
     KINK_RINGING_STEPS = 15,    /* a half-cycle of more steps is no ringing (kink_stiff) */
     KINK_RING_HALF_CYCLE = 2,   /* ... nor one of fewer (kink_stiff) */
