@@ -1,9 +1,10 @@
-"""Where the default's error on a random parameter set comes from (docs/performance.md, "Where the
-default's error comes from"): replays AutoSwitch's Dormand-Prince phase after a flyback, step by step,
-and compares each accepted step's embedded error estimate with its true local error.
+"""Where the default's error on a random parameter set came from (docs/performance.md, "Where the
+default's error came from"): replays AutoSwitch's Dormand-Prince phase after a flyback, step by step, as
+it ran before its steps ended at reversals of the relative velocity, and compares each accepted step's
+embedded error estimate with its true local error.
 
 The replay starts from the reference solution (rtol 1e-11) at t0 and steps as the C core's Dormand-Prince
-does in AutoSwitch's explicit phases: the same tableau, tolerances of 1/50 of the default's (per-state
+did in AutoSwitch's explicit phases: the same tableau, tolerances of 1/50 of the default's (per-state
 absolute tolerances rtol x each state's scale, positions without the relative part), the same RMS
 norm and PI control, from a first step of 1e-7 s (the core's own first step differs, so its steps fall
 elsewhere: the run ends this window 1.7e-4 % off, the replay 1.1e-4 %). The true local error of a step is its result minus a DOP853 solution at rtol 1e-13
@@ -27,7 +28,7 @@ from thermofriction.simulation import input_of
 
 from bench_accuracy import random_sets
 
-EXPLICIT_TOL = 0.02  # AutoSwitch's explicit phases run at 1/50 of the tolerances (core/src/auto.c)
+EXPLICIT_TOL = 0.02  # AutoSwitch's explicit phases ran at 1/50 of the tolerances then (now 1/20: core/src/auto.c)
 A = [[1 / 5], [3 / 40, 9 / 40], [44 / 45, -56 / 15, 32 / 9],
      [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729],
      [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],

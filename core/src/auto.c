@@ -1,5 +1,7 @@
-/* AUTO: per phase of the input (every corner starts one), DOPRI5 at AUTO_EXPLICIT_TOL times the
- * tolerances until its stiffness test fires (15 steps in a row near the stability boundary); then
+/* AUTO: per phase of the input (every corner starts one), DOPRI5 at AUTO_EXPLICIT_TOL (with the
+ * reversal handling of solve.c: AUTO_EXPLICIT_TOL_KINKS) times the tolerances until its stiffness test
+ * fires (15 steps in a row near the stability boundary) and the
+ * relative velocity no longer oscillates (solve.c: reversals); then
  * RODAS4 on probation: after PROBE_STEPS steps its work per simulated second is compared with DOPRI5's
  * over its last window, and the cheaper method goes on (work counted in rhs evaluations, with
  * Jacobians and LUs weighted by the system size). A failed probe doubles the number of explicit steps
@@ -15,6 +17,8 @@ enum { PROBE_STEPS = 200, WINDOW_STEPS = 200, FIRST_LOCK = 2000 };
 #ifndef AUTO_EXPLICIT_TOL
 #define AUTO_EXPLICIT_TOL 0.02 /* 1/50 */
 #endif
+/* ... and where the explicit method's steps end at reversals of a kink velocity (solve.c) */
+#define AUTO_EXPLICIT_TOL_KINKS 0.05 /* 1/20 */
 
 /* Work in right-hand-side evaluations, for AUTO's choice. Deterministic (counted, not timed),
  * so that the same problem always takes the same path. An analytic Jacobian costs a few rhs
@@ -33,13 +37,17 @@ int tf_auto_start(tf_driver *d)
     /* AUTO's explicit phases run at AUTO_EXPLICIT_TOL times the tolerances: at equal tolerances
      * Dopri5's global error is ~10-50x Rodas4's on stick-slip, so that mixing the two at one
      * tolerance made the error depend on which ran where, not on the tolerance (and the cost
-     * comparison that picks the method compared unequal accuracies) */
+     * comparison that picks the method compared unequal accuracies). 1/20 where Dopri5's steps end at
+     * the relative velocity's reversals (solve.c), whose kinks made most of that error; elsewhere (GMS,
+     * whose looser explicit phases would reach the stability limit sooner and probe Rodas4's 52 x 52 LU
+     * more) 1/50. */
     int n = d->n;
     d->atol_x = (double *)malloc(sizeof(double) * n);
     d->opt_x = *d->opt;
+    const double factor = d->kinks ? AUTO_EXPLICIT_TOL_KINKS : AUTO_EXPLICIT_TOL;
     if (d->atol_x) {
-        for (int i = 0; i < n; i++) d->atol_x[i] = AUTO_EXPLICIT_TOL * d->opt->atol[i];
-        d->opt_x.rtol *= AUTO_EXPLICIT_TOL;
+        for (int i = 0; i < n; i++) d->atol_x[i] = factor * d->opt->atol[i];
+        d->opt_x.rtol *= factor;
         d->opt_x.atol = d->atol_x;
     }
     if (d->requested == TF_METHOD_AUTO) d->w.opt = &d->opt_x;

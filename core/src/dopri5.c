@@ -73,10 +73,7 @@ double tf_dopri5_step(work *w, double t, double h, const double *y, const double
 
 TF_SIZED void dopri5_dense_n(const work *w, double s, double *y, const int n)
 {
-    double s1 = 1.0 - s;
-    for (int i = 0; i < n; i++)
-        y[i] = w->cont[0][i] +
-               s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * (w->cont[3][i] + s1 * w->cont[4][i])));
+    for (int i = 0; i < n; i++) y[i] = tf_dopri5_dense_component(w, i, s);
 }
 
 void tf_dopri5_dense(const work *w, double s, double *y)

@@ -605,8 +605,19 @@ static void model_restart(double t, double *y, void *ctx) { tf_model_on_restart(
 tf_ode tf_model_ode(tf_model *model)
 {
     tf_ode ode = {tf_model_nstate(model), model, lugre_constant_T(model) ? rhs_lugre_constant_T : tf_model_rhs,
-                  tf_model_jac, tf_model_next_corner, tf_model_nevent(model), tf_model_events, model_restart};
+                  tf_model_jac, tf_model_next_corner, tf_model_nevent(model), tf_model_events, model_restart,
+                  0.0, 0, -1};
     if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
+    if ((model->plant == TF_PLANT_STICK_SLIP || model->plant == TF_PLANT_MASS) && !ode.nevent) {
+        /* the friction's relative velocity (relative_velocity), at the scale its tolerance is rtol times;
+         * not for GMS, whose elements' switches between sticking and sliding are events (a restart each) */
+        double scale[TF_MAX_STATES];
+        tf_model_state_scale(model, scale);
+        int stick_slip = model->plant == TF_PLANT_STICK_SLIP;
+        ode.kink_plus = stick_slip ? VE : V;
+        ode.kink_minus = stick_slip ? VP : -1;
+        ode.kink_scale = scale[ode.kink_plus];
+    }
     return ode;
 }
 

@@ -29,6 +29,12 @@ typedef struct {
     int jac_current, reject, poll;
     double facold;                 /* Dopri5's PI control */
     int iasti, nonsti;             /* Dopri5's stiffness test */
+    /* reversals of the kink velocity (solve.c): a step cut at one (its size, the size it replaced, the cuts
+     * of the step being attempted), the largest |v| of the current and of the last half-cycle, whether
+     * the stiffness test fired since the restart */
+    double kink_h, kink_h_orig, kink_peak, kink_last_peak;
+    int kinks, kink_cuts, stiff_seen; /* kinks: AUTO with a kink velocity */
+    int kink_steps, kink_last_steps;  /* accepted steps of the current and of the last half-cycle */
     tf_rodas4_control rc;
     tf_auto au;
 } tf_driver;

@@ -83,6 +83,12 @@ TF_SIZED int all_finite(const double *v, const int n)
 double tf_dopri5_step(work *w, double t, double h, const double *y, const double *f0);
 /* The dense output at the fraction s of the last step. */
 void tf_dopri5_dense(const work *w, double s, double *y);
+/* ... and of its component i alone */
+static inline double tf_dopri5_dense_component(const work *w, int i, double s)
+{
+    double s1 = 1.0 - s;
+    return w->cont[0][i] + s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * (w->cont[3][i] + s1 * w->cont[4][i])));
+}
 /* PI step-size control after an accepted step of error err; *facold is the controller's memory. */
 double tf_dopri5_next_h(double err, double h, double *facold);
 /* The step after a rejected one. */

@@ -24,6 +24,12 @@ typedef struct {
     int nevent;
     void (*events)(double t, const double *y, double *g, void *ctx);
     void (*on_restart)(double t, double *y, void *ctx);
+    /* Optional (kink_scale 0: none): a velocity whose sign change puts a kink in the right-hand side
+     * (LuGre's |v_r|), the state kink_plus minus the state kink_minus (kink_minus < 0: the state alone),
+     * and its scale (a sign change within a few rtol times it is the integrator's noise). AUTO's Dormand-Prince
+     * steps end at its reversals (solve.c), whose kink their error estimate does not see. */
+    double kink_scale;
+    int kink_plus, kink_minus;
 } tf_ode;
 
 typedef enum {

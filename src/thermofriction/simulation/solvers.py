@@ -38,9 +38,12 @@ class AutoSwitch:
 
     Every corner of the input (a sawtooth's flyback and period start; and every GMS mode switch)
     starts a new phase with Dopri5: the ringing after a flyback is cheaper to follow with the
-    explicit method, the slow ramp that follows with the stiff one. The Dopri5 phases run at 1/50 of the tolerances: at equal
-    tolerances Dopri5's global error on stick-slip is 10-50x Rodas4's, and the error only follows
-    the tolerance when both kinds of phase deliver about the same accuracy."""
+    explicit method, the slow ramp that follows with the stiff one. The Dopri5 phases run at 1/20 of
+    the tolerances (GMS: 1/50): at equal tolerances Dopri5's global error on stick-slip is 10-50x
+    Rodas4's, and the error only follows the tolerance when both kinds of phase deliver about the same
+    accuracy. Their steps end at the relative velocity's reversals (not for GMS), where the friction's
+    |v| kinks (Dopri5's error estimate does not see a kink inside a step), and Rodas4 waits until the
+    velocity no longer rings (docs/performance.md)."""
 
     name = "auto"
 
