@@ -9,9 +9,10 @@ on a Stribeck truth with the mass twice the start's, both held fits reached 150-
 parameter is held at both sides once; where one is better by more than the noise could make it, the joint
 refinement starts again from there.
 
-A constant fitted on all experiments that stays undetermined (Model I's shape constants, e.g. vs) is held at both
-ends of its stated range and the rest refitted (:func:`held_refits`): the shifts are the secants by which its range
-reaches the other intervals (held.py)."""
+A shape constant fitted on all experiments (Model I's vs, where no single temperature determines it) has its range
+from a profile of the per-temperature fits over it (:func:`profile_range`; a stated factor where it has none): it
+is held where the joint refinement left it, at both ends of that range the rest is refitted (:func:`held_refits`),
+and the shifts are the secants by which its range reaches the other intervals (held.py)."""
 
 from __future__ import annotations
 
@@ -194,10 +195,10 @@ def settled_constants(prof: Profiled, joint, region, parameters_of, experiments,
     held where reached, and refits with them held at the ends of the range the data leave them (``region``, from
     profiled_constant; else a factor PRIOR_FACTOR either way) give the secants of their effect on the others
     (held.py); a constant whose profile range is known is held so too, determined or not. Returns (held where
-    reached, of which undetermined, {name: secant shifts}, {name: {value, low, high, from}}). Tried and not kept:
-    starting the refinement again from a better end (as for a freed mass, :func:`profiled`) -- on the vs truths of
-    tests/coverage_study.py it moved 2 of 6 fits further along the flat valley (fs 31-38 % off), coverage 75/96
-    against 86/96."""
+    reached, of which undetermined, {name: secant shifts}, {name: {value, low, high, from}}). Tried and not kept
+    (before the profile): starting the refinement again from a better end (as for a freed mass, :func:`profiled`)
+    -- on the 0.4 s vs truths of tests/coverage_study.py it moved 2 of 6 fits further along the flat valley (fs
+    31-38 % off), coverage 75/96 against 86/96 without it."""
     names = [p.name for p in prof.params.varying]
     value_of = {n: float(prof.outcome.theta[names.index(f"{n}.value")]) for n in joint if f"{n}.value" in names}
     errors = standard_errors(prof.params, prof.outcome, prof.traces, prof.model)
