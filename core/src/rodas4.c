@@ -144,9 +144,7 @@ double tf_rodas4_step(work *w, double t, double h, const double *y, const double
             err = -1.0;
         } else {
             tf_rodas4_dense(w, 0.5, yd);
-            for (int i = 0; i < w->n; i++)
-                w->ytmp[i] = yd[i] - (0.5 * (y[i] + w->y1[i]) + 0.125 * h * (f0[i] - f1[i]));
-            double e_mid = wnorm(w, w->ytmp, y, w->y1);
+            double e_mid = mid_step_error(w, h, y, f0, f1, yd);
             err = isfinite(e_mid) ? fmax(err, e_mid) : -1.0;
         }
     }

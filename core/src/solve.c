@@ -236,12 +236,12 @@ static inline int reversal(const work *w, const tf_ode *ode, double g0, double g
  * is narrower than KINK_PAST of the step (2-4 iterations mostly; the cut needs no more). */
 static double kink_locate(const work *w, const tf_ode *ode, double a, double ga, double b, double gb)
 {
-    double c[5]; /* the kink velocity's dense-output coefficients (tf_dopri5_dense_component) */
+    double c[5]; /* the kink velocity's own dense-output coefficients (one polynomial, not two) */
     for (int k = 0; k < 5; k++)
         c[k] = w->cont[k][ode->kink_plus] - (ode->kink_minus >= 0 ? w->cont[k][ode->kink_minus] : 0.0);
     for (int it = 0, side = 0; it < KINK_LOCATE_ITERATIONS && b - a > KINK_PAST; it++) {
-        double s = (a * gb - b * ga) / (gb - ga), s1 = 1.0 - s;
-        double gs = c[0] + s * (c[1] + s1 * (c[2] + s * (c[3] + s1 * c[4])));
+        double s = (a * gb - b * ga) / (gb - ga);
+        double gs = tf_dopri5_dense_poly(c, s);
         if (gs == 0.0) return s;
         if ((gs < 0.0) == (ga < 0.0)) {
             a = s, ga = gs;
@@ -266,12 +266,9 @@ static double kink_check(tf_driver *d, double err)
     double g0 = kink_velocity(ode, d->y), g1 = kink_velocity(ode, w->y1);
     if (!reversal(w, ode, g0, g1) || d->kink_steps + 1 < KINK_CUT_HALF_CYCLE) return err;
     if ((kink_dense(w, ode, 1.0 - KINK_AT_END) < 0.0) == (g0 < 0.0)) return err; /* a step cut just past it */
-    const int n = d->n;
-    const double h = d->h, *f0 = d->f0, *f1 = w->k[6]; /* f at the step's end: Dormand-Prince's FSAL */
+    const double h = d->h;
     tf_dopri5_dense(w, 0.5, d->yd);
-    for (int i = 0; i < n; i++)
-        w->ytmp[i] = d->yd[i] - (0.5 * (d->y[i] + w->y1[i]) + 0.125 * h * (f0[i] - f1[i]));
-    double e_mid = wnorm(w, w->ytmp, d->y, w->y1);
+    double e_mid = mid_step_error(w, h, d->y, d->f0, w->k[6], d->yd); /* k[6]: f at the end (FSAL) */
     if (!isfinite(e_mid)) return -1.0;
     if (e_mid <= 1.0 || d->kink_cuts >= KINK_MAX_CUTS) return fmax(err, e_mid);
     d->kink_h = fmin(kink_locate(w, ode, 0.0, g0, 1.0, g1) + KINK_PAST, 1.0) * h;

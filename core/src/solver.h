@@ -65,6 +65,17 @@ static inline double wnorm(const work *w, const double *e, const double *ya, con
     return wnorm_n(w, e, ya, yb, w->n);
 }
 
+/* A step's error inside it: its dense output yd at mid-step against the cubic Hermite interpolant of its ends
+ * (y, w->y1) and their slopes (f0, f1), which an error estimated at the step's end misses where the step
+ * crosses a fast transition or a kink (Rodas4's steps, rodas4.c; Dormand-Prince's across reversals, solve.c). */
+static inline double mid_step_error(work *w, double h, const double *y, const double *f0, const double *f1,
+                                    const double *yd)
+{
+    for (int i = 0; i < w->n; i++)
+        w->ytmp[i] = yd[i] - (0.5 * (y[i] + w->y1[i]) + 0.125 * h * (f0[i] - f1[i]));
+    return wnorm(w, w->ytmp, y, w->y1);
+}
+
 /* x^(1/4) for Rodas4's step-size control: two square roots cost a third of a pow */
 static inline double root4(double x) { return sqrt(sqrt(x)); }
 
@@ -83,11 +94,18 @@ TF_SIZED int all_finite(const double *v, const int n)
 double tf_dopri5_step(work *w, double t, double h, const double *y, const double *f0);
 /* The dense output at the fraction s of the last step. */
 void tf_dopri5_dense(const work *w, double s, double *y);
+/* Dormand-Prince's dense-output polynomial at the fraction s, from its five coefficients (one component's, or a
+ * difference of components' taken coefficient by coefficient) */
+static inline double tf_dopri5_dense_poly(const double c[5], double s)
+{
+    double s1 = 1.0 - s;
+    return c[0] + s * (c[1] + s1 * (c[2] + s * (c[3] + s1 * c[4])));
+}
 /* ... and of its component i alone */
 static inline double tf_dopri5_dense_component(const work *w, int i, double s)
 {
-    double s1 = 1.0 - s;
-    return w->cont[0][i] + s * (w->cont[1][i] + s1 * (w->cont[2][i] + s * (w->cont[3][i] + s1 * w->cont[4][i])));
+    const double c[5] = {w->cont[0][i], w->cont[1][i], w->cont[2][i], w->cont[3][i], w->cont[4][i]};
+    return tf_dopri5_dense_poly(c, s);
 }
 /* PI step-size control after an accepted step of error err; *facold is the controller's memory. */
 double tf_dopri5_next_h(double err, double h, double *facold);
