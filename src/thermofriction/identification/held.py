@@ -192,8 +192,8 @@ def _consider(res, tests, secants=None):
     """The fitted parameters' covariance with the uncertainty of the laws held for lack of information added (a
     consider covariance): each held law's level, within a factor PRIOR_FACTOR either way (95 %), shifts the fitted
     parameters by G = -J^+ j (j: the sensitivity to the law's log scale), so cov += G G^T sd^2 -- or, for a constant
-    the joint refinement left open (``secants``: name -> the shifts of refits with it held at the range's ends), by
-    those shifts over the log of the factor, averaged over both ends. Intervals,
+    held with its range (``secants``: name -> the shifts of refits with it held at the range's two ends, each end
+    1.96 standard deviations out), by those shifts: cov += d d^T / 1.96^2, half from each end. Intervals,
     standard errors and correlations are updated; the report says what was included."""
     varying = res.parameters.varying
     se = np.array([p.stderr for p in varying], float)

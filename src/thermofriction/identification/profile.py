@@ -164,13 +164,13 @@ def secant_shifts(prof: Profiled, ends) -> list:
 OPEN_CONSTANT = 0.5
 
 
-def open_constants(prof: Profiled, joint, ranged=()) -> tuple:
+def open_constants(prof: Profiled, joint, errors, ranged=()) -> tuple:
     """The constants of ``joint`` the joint refinement left undetermined (standard error above OPEN_CONSTANT of
     their value), and those of ``ranged`` (whose range the data leave them is known from a profile: a linearized
     interval would replace it with less), taken out of ``prof``'s fitted parameters (held at the value reached: the
     optimum is the same) so that their range reaches the others' intervals as a held law's stated range does
-    (held.py). Returns (taken out, of which undetermined)."""
-    errors = standard_errors(prof.params, prof.outcome, prof.traces, prof.model)
+    (held.py). ``errors``: the standard errors at the optimum (:func:`standard_errors`). Returns (taken out, of
+    which undetermined)."""
     names = [p.name for p in prof.params.varying]
     value = dict(zip(names, np.asarray(prof.outcome.theta, float)))
     undetermined = [n for n in joint if f"{n}.value" in names and not (np.isfinite(errors[f"{n}.value"]) and errors[
@@ -205,7 +205,7 @@ def settled_constants(prof: Profiled, joint, region, parameters_of, experiments,
     # a profile's range is used where the value reached lies inside it (else the profile saw another valley)
     ranged = [n for n in joint if region and len(joint) == 1 and n in value_of
               and region[0] < value_of[n] < region[1]]
-    kept_open, undetermined = open_constants(prof, joint, ranged)
+    kept_open, undetermined = open_constants(prof, joint, errors, ranged)
     secants, ranges = {}, {}
     for n in kept_open:
         value = float(prof.params[f"{n}.value"].value)
