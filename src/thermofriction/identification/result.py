@@ -64,7 +64,8 @@ class FitResult(Result):
     def law_interval(self, name: str, temperatures, level: float = 0.95):
         """The fitted law of ``name`` (a Model I parameter, or ``"dF"``) at ``temperatures`` with its
         ``level`` interval, by the delta method on the covariance of every fitted coefficient and
-        breakpoint of that law. Returns (value, lower, upper) arrays."""
+        breakpoint of that law (for an exponential law in the log of its value, where the law is linear in its
+        coefficients). Returns (value, lower, upper) arrays."""
         from scipy import stats
 
         from .parameters import with_values
@@ -82,14 +83,26 @@ class FitResult(Result):
         se = np.array([self.parameters[names[i]].stderr for i in own], float)
         if not np.all(np.isfinite(se)):
             return value, np.full_like(value, -math.inf), np.full_like(value, math.inf)
-        cov = self.correlation[np.ix_(own, own)] * np.outer(se, se)
+        cov = np.nan_to_num(self.correlation[np.ix_(own, own)] * np.outer(se, se))
+        z = stats.norm.ppf(0.5 + level / 2)
+        law = law_of(self.model)
+        if law.kind == "exp" and len(own) == 2:
+            # log(a exp(bT)) = log a + bT is linear in the coefficients: the delta method is exact there, with the
+            # gradient (1/a, T) exact too, and the interval stays positive. In the law's own scale a poorly
+            # determined law run towards zero took its interval with it (1e-9 wide around 1e-13 against a
+            # truth of 14); and a finite difference in b, 1 % off, lost the cancellation between a and b's
+            # correlated errors that sets the interval where the data determine the law
+            grad = np.vstack([np.full_like(T, 1.0 / law.a), T])
+            sd_log = np.sqrt(np.maximum(np.einsum("it,ij,jt->t", grad, cov, grad), 0.0))
+            with np.errstate(over="ignore"):
+                spread = np.exp(z * sd_log)
+            return value, value / spread, value * spread
         grad = np.empty((len(own), len(T)))
         for j in range(len(own)):
             h = 1e-6 * max(abs(theta[j]), se[j], 1e-12)
             up = with_values(self.model, {names[own[j]]: theta[j] + h})
             grad[j] = (np.asarray(law_of(up)(T), float) - value) / h
-        sd = np.sqrt(np.maximum(np.einsum("it,ij,jt->t", grad, np.nan_to_num(cov), grad), 0.0))
-        z = stats.norm.ppf(0.5 + level / 2)
+        sd = np.sqrt(np.maximum(np.einsum("it,ij,jt->t", grad, cov, grad), 0.0))
         return value, value - z * sd, value + z * sd
 
     def recovery(self, truth: Model, temperatures, level: float = 0.95) -> list:
