@@ -32,15 +32,17 @@ def test_coverage_of_the_95_percent_intervals_on_random_truths():
 
 
 def test_coverage_with_vs_fitted_on_records_that_hardly_determine_it():
-    """tests/coverage_study.py's stribeck_vs on 0.4 s records over 6 data seeds (measured: 81/96 = 0.84 with vs's
-    range from the profile of the per-temperature fits, widened to the linearized interval, reaching the others
-    through refits at its ends; 69/96 = 0.72 with the linearized sensitivities alone; every fit called adequate at
-    residuals 0.99-1.01 times the noise; in 2 of 6 the range excludes the truth's vs, which fits 3-7 in
-    chi-square worse on these records)."""
+    """tests/coverage_study.py's stribeck_vs on 0.4 s records over 6 data seeds (measured: 88/96 = 0.92 with vs's
+    range from the profile of the per-temperature fits with sigma1 -- held for lack of information in 4 of the 6 --
+    free at each temperature, widened to the linearized interval, reaching the others through refits at its ends;
+    81/96 = 0.84 with sigma1 held at the start's law, 2x off, in that profile: its range then excluded the truth's
+    vs in 2 of 6; 69/96 = 0.72 with the linearized sensitivities alone; every fit called adequate at residuals
+    0.99-1.01 times the noise. Seeds 6-11: 96/96, 92/96 before; they showed why the search itself keeps sigma1
+    held: free there too, 2 of them stopped at the start's vs, 2.5x off)."""
     from coverage_study import stribeck_vs
     rows = [stribeck_vs(s) for s in range(6)]
     assert all(r["adequate"] for r in rows), rows
-    assert sum(r["covered"] for r in rows) >= 0.8 * sum(r["points"] for r in rows), rows
+    assert sum(r["covered"] for r in rows) >= 0.9 * sum(r["points"] for r in rows), rows
 
 
 def test_vs_recovered_where_the_records_determine_it():
