@@ -68,6 +68,23 @@ def test_vs_named_too_is_fitted_as_one_constant_and_the_levels_keep_their_laws__
     assert any(w.startswith("vs ") and "is held where the joint refinement left it" in w for w in res.warnings)
 
 
+def test_a_law_held_for_lack_of_information_is_free_where_vs_s_range_is_found__reference_truth(truth):
+    """Data seed 1 of the 0.4 s study (tests/coverage_study.py): the first temperature cannot determine sigma1, so it
+    is held at the start's law, 2x the truth's. Held there also in the profile that gives vs its range, it narrowed
+    the range to 0.0033-0.0050 m/s, excluding the truth's 0.006 (which fits 6.4 in chi-square worse with sigma1
+    so held, 2.6 with sigma1 at the truth's law), and fc's intervals missed at three temperatures. Free at each
+    temperature in the range's step-out, the range covers the truth; the JSON and the warning say what was free."""
+    data = reference_experiments(truth, seed=1)
+    start = start_from(truth, FAR, vs=2.5 * truth.friction.vs)
+    res = tf.identify(data, "model-i", init=start, parameters=["sigma0", "sigma1", "fc", "fs", "vs"])
+    assert res.details["held_for_lack_of_information"] == ["sigma1"]
+    span = res.details["held_ranges"]["vs"]
+    assert span["from"] == "profile" and span["free_in_profile"] == ["sigma1"], span
+    assert span["low"] <= truth.friction.vs <= span["high"], span
+    assert span["high"] / span["low"] < 4.0, span  # a range, not everything the search allowed (a factor 100)
+    assert any("sigma1 free at each temperature there" in w for w in res.warnings), res.warnings
+
+
 def test_a_parameter_held_with_a_law_keeps_its_law__reference_truth(truth, data):
     """fs not named: its law in the start (the truth's) is kept as it is, not flattened to a constant, and the
     per-temperature fits see it at their own temperature (not the lowest one's): fc within 5 % everywhere."""

@@ -229,7 +229,9 @@ def _consider(res, tests, secants=None):
     for name in (t["name"] for t in tests if t["name"] in ranges):
         span = ranges[name]
         lacking = name in (res.details.get("held_for_lack_of_information") or ())
+        free = span.get("free_in_profile") or []
         source = ("where the per-temperature fits' misfit, profiled over it, rises by 3.84 in chi-square"
+                  + (f", {', '.join(free)} free at each temperature there" if free else "")
                   if span["from"] == "profile" else f"a stated factor {PRIOR_FACTOR:g} either way")
         res.warnings.append(f"{name} {'could not be determined and ' if lacking else ''}is held where the joint "
                             f"refinement left it ({span['value']:.4g}); its range, "

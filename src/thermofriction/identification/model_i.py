@@ -39,6 +39,7 @@ class _PerTemperature:
         self.joint = []  # held constants fitted on all experiments together in the joint refinement
         self.nfev = 0  # the evaluations of the constant's profile (profiled_constant)
         self.region = None  # (lowest, highest) value of that constant the profile's points do not exclude
+        self.free_in_region = []  # the laws held for lack of information that were free in finding that range
 
     def run(self, groups):
         """[(temperature, result)] in temperature order."""
@@ -188,7 +189,8 @@ class _PerTemperature:
         # held: free, they flatten the profile so that its least can be anywhere (2 of 12 seeds stayed at the
         # start's vs, 2.5x off)
         around, around_cost = tried, cost
-        if [n for n in self.held if n not in self.joint]:
+        self.free_in_region = [n for n in self.held if n not in self.joint]
+        if self.free_in_region:
             around = {best: tried[best]}
             around_cost = profile(around, self.joint)
             around_cost(best)
@@ -365,7 +367,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
                 dict(m.thermal.laws), held + hold, free, m), experiments, measurement, ropts)
         details["held_for_lack_of_information"] += undetermined
         details["held_where_reached"] = kept_open
-        details["held_ranges"] = ranges
+        details["held_ranges"] = {n: {**span, "free_in_profile": list(per_temperature.free_in_region)}
+                                  if span["from"] == "profile" else span for n, span in ranges.items()}
         details["_secants"] = secants
         details["fitted_as_constant"] = [n for n in joint if n not in undetermined]
     res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details)

@@ -211,8 +211,7 @@ def settled_constants(prof: Profiled, joint, region, parameters_of, experiments,
         value = float(prof.params[f"{n}.value"].value)
         if n in ranged:
             # the range the data leave it: the profile's, widened to the linearized interval where that is wider
-            # (the profile's fits at each point are local: on records that do not determine vs, a temperature's
-            # fit from its neighbour's can stop in a worse minimum and make the profile too steep)
+            # (the profile's points are per-temperature fits, each local and from its neighbour's values)
             se = errors.get(f"{n}.value", math.inf)
             spread = math.exp(min(1.959964 * se / value, 700.0)) if math.isfinite(se) else PRIOR_FACTOR
             factors = (min(region[0] / value, 1.0 / spread), max(region[1] / value, spread))
