@@ -12,6 +12,7 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
+from .law_kinds import Refined, checked_kinds
 from .laws import at_shared, fit_law, laws_on_information
 from .optimiser import fit
 from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
@@ -357,6 +358,11 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     ropts.setdefault("max_nfev", 30)
     # from laws through the per-temperature optima weighted by their covariances: near the optimum
     outcome = fit(model, params, traces, near=True, **ropts)
+    checkable = [] if joint else [n for n in names if n not in held and n not in (laws or {})]  # (law_kinds.py)
+    parameters_of = lambda m: _law_parameters(dict(m.thermal.laws), held, free, m)  # noqa: E731
+    checked = checked_kinds(Refined(model, params, outcome, traces), per_T, checkable, experiments, measurement,
+                            parameters_of, ropts, details["laws"], warns)
+    model, params, outcome, traces = checked.model, checked.params, checked.outcome, checked.traces
     prof = Profiled(model, params, outcome, traces)
     if free:  # a plant parameter's step can be blocked where a law meets its domain's edge (profile.py)
         prof = profiled(model, params, outcome, traces, experiments, measurement, free,
@@ -373,8 +379,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         details["fitted_as_constant"] = [n for n in joint if n not in undetermined]
     res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details)
     widened(res, prof.widen)
-    res.nfev += sum(r.nfev for _, r in per_T) + prof.nfev + per_temperature.nfev
-    res.njev += sum(r.njev for _, r in per_T) + prof.njev
+    res.nfev += sum(r.nfev for _, r in per_T) + prof.nfev + per_temperature.nfev + checked.nfev
+    res.njev += sum(r.njev for _, r in per_T) + prof.njev + checked.njev
     return res
 
 
