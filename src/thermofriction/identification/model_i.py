@@ -284,6 +284,11 @@ def _law_parameters(new_laws, held, free, model) -> Parameters:
     return params
 
 
+def _parameters_of(held, free):
+    """The joint refinement's parameters of a model (its laws' coefficients, ``held`` held, ``free`` freed)."""
+    return lambda m: _law_parameters(dict(m.thermal.laws), held, free, m)
+
+
 def _above_fc(new_laws, per_T, Ts):
     """fs's law kept at or above fc's over the fit temperatures: where the laws through the estimates cross, fs's
     becomes fc's scaled by the estimates' median ratio fs/fc (at least 1). Returns a warning, or None."""
@@ -359,9 +364,8 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     # from laws through the per-temperature optima weighted by their covariances: near the optimum
     outcome = fit(model, params, traces, near=True, **ropts)
     checkable = [] if joint else [n for n in names if n not in held and n not in (laws or {})]  # (law_kinds.py)
-    parameters_of = lambda m: _law_parameters(dict(m.thermal.laws), held, free, m)  # noqa: E731
     checked = checked_kinds(Refined(model, params, outcome, traces), per_T, checkable, experiments, measurement,
-                            parameters_of, ropts, details["laws"], warns)
+                            _parameters_of(held, free), ropts, details["laws"], warns)
     model, params, outcome, traces = checked.model, checked.params, checked.outcome, checked.traces
     prof = Profiled(model, params, outcome, traces)
     if free:  # a plant parameter's step can be blocked where a law meets its domain's edge (profile.py)
