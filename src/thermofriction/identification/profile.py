@@ -280,7 +280,7 @@ def widened(result, factors: dict) -> None:
         result.warnings.append(
             f"'{name}': the fit changes less away from {par.value:.4g} than the Jacobian at the optimum says (held at "
             f"{PROFILE_STEP:g} standard errors either side, the laws refitted): its standard error and interval "
-            f"widened {factor:.2g}x, to [{par.ci95[0]:.4g}, {par.ci95[1]:.4g}]")
+            f"widened {factor:.3g}x, to [{par.ci95[0]:.4g}, {par.ci95[1]:.4g}]")
 
 
 __all__ = ["profiled", "Profiled", "profile_range", "PROFILE_RANGE", "PROFILE_XTOL", "PROFILE_POINTS",
