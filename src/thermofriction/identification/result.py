@@ -86,13 +86,13 @@ class FitResult(Result):
         cov = np.nan_to_num(self.correlation[np.ix_(own, own)] * np.outer(se, se))
         z = stats.norm.ppf(0.5 + level / 2)
         law = law_of(self.model)
-        if law.kind == "exp" and len(own) == 2:
+        if law.kind == "exp" and len(own) == 2 and law.a > 0:
             # log(a exp(bT)) = log a + bT is linear in the coefficients: the delta method is exact there, with the
             # gradient (1/a, T) exact too, and the interval stays positive. In the law's own scale a poorly
             # determined law run towards zero took its interval with it (1e-9 wide around 1e-13 against a
             # truth of 14); and a finite difference in b, 1 % off, lost the cancellation between a and b's
             # correlated errors that sets the interval where the data determine the law
-            grad = np.vstack([np.full_like(T, 1.0 / law.a), T])
+            grad = np.vstack([np.full_like(T, 1.0 / law.a) if names[i].endswith(".a") else T for i in own])
             sd_log = np.sqrt(np.maximum(np.einsum("it,ij,jt->t", grad, cov, grad), 0.0))
             with np.errstate(over="ignore"):
                 spread = np.exp(z * sd_log)
