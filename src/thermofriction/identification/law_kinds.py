@@ -18,7 +18,7 @@ from ..models import ModelI
 from .laws import fit_law
 from .optimiser import fit
 from .problem import make_traces
-from .uncertainty import inflation_of
+from .uncertainty import inflation_of, residual_variance
 
 #: the laws' misfit above the per-temperature fits', in chi-square less the coefficients it has fewer, beyond which
 #: the other kinds are tried: this many standard deviations of that chi-square (sqrt(2 dof))
@@ -44,9 +44,8 @@ class Refined:
 def chi_square_unit(outcome, traces) -> float:
     """One unit of chi-square in the misfit's terms: the residuals' variance times their autocorrelation's
     inflation (on correlated residuals a difference of misfits is that much larger for the same evidence)."""
-    r = outcome.r
-    inflation, _ = inflation_of(r, [t.n_residuals for t in traces])
-    return float(r @ r) / max(r.size - outcome.J.shape[1], 1) * max(inflation, 1.0)
+    inflation, _ = inflation_of(outcome.r, [t.n_residuals for t in traces])
+    return residual_variance(outcome) * max(inflation, 1.0)
 
 
 def excess_misfit(outcome, traces, per_T) -> tuple:

@@ -28,7 +28,7 @@ from .held import PRIOR_FACTOR
 from .optimiser import fit
 from .parameters import with_values
 from .problem import make_traces
-from .uncertainty import inflation_of, uncertainty
+from .uncertainty import inflation_of, residual_variance, uncertainty
 
 #: [standard errors] where each freed plant parameter is held
 PROFILE_STEP = 2.0
@@ -42,11 +42,6 @@ HELD_EVALUATIONS = 10
 #: the most a flat profile widens a standard error: beyond it the parameter is as good as undetermined, and the
 #: two held fits say no more
 MAX_WIDENING = 5.0
-
-
-def _variance(outcome) -> float:
-    """The residuals' variance at the optimum (sum of squares over the degrees of freedom)."""
-    return float(outcome.r @ outcome.r) / max(outcome.r.size - outcome.J.shape[1], 1)
 
 
 def standard_errors(params, outcome, traces, model) -> dict:
@@ -80,7 +75,7 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
     once = {**ropts, "near": True, "starts": 1}
     names = [p.name for p in params.varying]
     optimum = with_values(model, dict(zip(names, outcome.theta)))
-    variance = _variance(outcome)
+    variance = residual_variance(outcome)
     inflation, _ = inflation_of(outcome.r, [tr.n_residuals for tr in traces])
     errors = standard_errors(params, outcome, traces, model)
     cost = float(outcome.r @ outcome.r) / variance  # chi-square

@@ -92,6 +92,11 @@ def _one_sided(par, side, value, se, outcome, i, dof) -> tuple:
     return (bound, far) if side == "lower" else (far, bound)
 
 
+def residual_variance(outcome) -> float:
+    """The residuals' variance at an optimum (sum of squares over the residuals less the fitted parameters)."""
+    return float(outcome.r @ outcome.r) / max(outcome.r.size - outcome.J.shape[1], 1)
+
+
 def integrated_autocorrelation(x) -> float:
     """The integrated autocorrelation time of the series ``x`` (1 for independent values; (1 + rho)/(1 - rho)
     for an AR(1) series), by Geyer's initial positive sequence: the autocorrelations summed in pairs
@@ -130,4 +135,4 @@ def inflation_of(r, sizes):
     return float(np.average(taus, weights=weights)), float(np.mean(rhos))
 
 
-__all__ = ["uncertainty", "integrated_autocorrelation", "inflation_of"]
+__all__ = ["uncertainty", "residual_variance", "integrated_autocorrelation", "inflation_of"]
