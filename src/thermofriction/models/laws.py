@@ -54,6 +54,10 @@ class Law:
         """The unit of coefficient ``name`` of a law whose value is in ``unit``."""
         return unit
 
+    def scaled(self, factor: float) -> "Law":
+        """The law times ``factor`` (every kind but exp is linear in its coefficients; a table's PCHIP too)."""
+        return self.with_coefficients([c * factor for c in self.coefficients()])
+
     # -- values ------------------------------------------------------------------------------
     def __call__(self, T):
         return self.evaluate(T)[0]
@@ -153,6 +157,9 @@ class Exp(Law):
 
     def coefficient_unit(self, name, unit):
         return "1/C" if name == "b" else unit
+
+    def scaled(self, factor):
+        return dataclasses.replace(self, a=self.a * factor)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
