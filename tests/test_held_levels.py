@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
-from thermofriction.identification.model_i import held_at
+from thermofriction.identification.procedures import held_at
 from thermofriction.models.laws import Exp, Linear
 
 

@@ -19,7 +19,7 @@ from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
 from .problem import make_traces
 from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
                       profiled, settled_constants, widened)
-from .procedures import (along_temperatures, base_model, fit_friction, fit_result,
+from .procedures import (along_temperatures, base_model, fit_friction, fit_result, held_at, levels_held_as_ratios,
                          fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
@@ -224,18 +224,6 @@ class _PerTemperature:
                                    f"initial model's laws, with {opts.get('starts', 8)} start(s)): {e}") from e
 
 
-def held_at(init, T, base, held):
-    """``base`` with the ``held`` parameters at the initial model's law at ``T``; a held static level (fs, fs_neg)
-    keeps the initial model's ratio to its Coulomb level where that is fitted: fs >= fc is a relation, and the
-    start's fs 0.33 beside a fitted fc of 0.78 was refused as an error in the user's file."""
-    start, values = base_model(init, T).friction.values(), base.friction.values()
-    new = {n: start[n] for n in held}
-    for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg")):
-        if level in new and coulomb not in held and values.get(coulomb) is not None and start.get(coulomb):
-            new[level] = values[coulomb] * start[level] / start[coulomb]
-    return base.with_friction(**new)
-
-
 def _fitted(res, name):
     """The fitted Parameter of ``name`` (fs: its excess over fc, where it was fitted as one)."""
     return res.parameters[EXCESS] if name == "fs" and EXCESS in res.parameters else res.parameters[name]
@@ -317,16 +305,6 @@ def _above_fc(new_laws, per_T, Ts):
             f"ratio {ratio:.4g} instead, as the joint refinement's start")
 
 
-def _levels_held_as_ratios(init, names, new_laws, Ts) -> dict:
-    """A static level neither fitted nor with a law (fs, fs_neg held as a number) as a law: its Coulomb level's
-    times the initial model's ratio, held (a number would fall below the fitted law where that rises)."""
-    start = base_model(init, float(Ts.mean())).friction.values()
-    return {level: new_laws[coulomb].scaled(start[level] / start[coulomb])
-            for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg"))
-            if level not in names and level not in init.laws and coulomb in new_laws
-            and start.get(level) is not None and start.get(coulomb)}
-
-
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
                      parameters=None, **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
@@ -361,10 +339,9 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         new_laws[n] = Const(float(per_T[0][1].model.friction.values()[n]))
         details["laws"][n] = {"chosen": "a constant fitted on all experiments together", "law": new_laws[n].to_dict()}
     Ts = np.array([T for T, _ in per_T])
-    crossed = _above_fc(new_laws, estimates, Ts)
-    warns += [crossed] if crossed else []
-    kept = {n: law for n, law in init.laws.items() if n not in names}  # held with their laws
-    kept.update(_levels_held_as_ratios(init, names, new_laws, Ts))
+    warns += [w for w in [_above_fc(new_laws, estimates, Ts)] if w]
+    kept = {**{n: law for n, law in init.laws.items() if n not in names},  # held with their laws
+            **levels_held_as_ratios(init, names, new_laws, Ts)}
     held = [n for n in held if n not in joint] + list(kept)
     new_laws = {**new_laws, **kept}
     friction = dataclasses.replace(base_model(init, float(Ts.mean())).friction, **{n: None for n in new_laws})

@@ -158,6 +158,28 @@ def stribeck_start(model: Model, names) -> Model:
     return model.with_friction(fs=1.1 * values["fc"], vs=vs if vs and vs > 0 else 1e-3)
 
 
+def held_at(init, T, base, held):
+    """``base`` with the ``held`` parameters at the initial model's law at ``T``; a held static level (fs, fs_neg)
+    keeps the initial model's ratio to its Coulomb level where that is fitted: fs >= fc is a relation, and the
+    start's fs 0.33 beside a fitted fc of 0.78 was refused as an error in the user's file."""
+    start, values = base_model(init, T).friction.values(), base.friction.values()
+    new = {n: start[n] for n in held}
+    for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg")):
+        if level in new and coulomb not in held and values.get(coulomb) is not None and start.get(coulomb):
+            new[level] = values[coulomb] * start[level] / start[coulomb]
+    return base.with_friction(**new)
+
+
+def levels_held_as_ratios(init, names, new_laws, Ts) -> dict:
+    """A static level neither fitted nor with a law (fs, fs_neg held as a number) as a law: its Coulomb level's
+    times the initial model's ratio, held (a number would fall below the fitted law where that rises)."""
+    start = base_model(init, float(Ts.mean())).friction.values()
+    return {level: new_laws[coulomb].scaled(start[level] / start[coulomb])
+            for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg"))
+            if level not in names and level not in init.laws and coulomb in new_laws
+            and start.get(level) is not None and start.get(coulomb)}
+
+
 def base_model(model: Model, temperature=None) -> Model:
     """The model without its thermal extension: a Model I's laws evaluated at ``temperature``."""
     if isinstance(model.thermal, ModelI):
@@ -305,6 +327,6 @@ def temperature_groups(experiments):
     return groups
 
 
-__all__ = ["fit_friction", "fit_result", "unrefined_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes", "stribeck_start", "fitted_names",
+__all__ = ["held_at", "levels_held_as_ratios", "fit_friction", "fit_result", "unrefined_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes", "stribeck_start", "fitted_names",
            "identify_heat", "temperature_groups", "FRICTION_FIT_PARAMETERS", "DEFAULT_FRICTION_PARAMETERS",
            "DEFAULT_HEAT_PARAMETERS"]
