@@ -11,8 +11,10 @@ from ._warning_routes import recorded_warnings
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from . import _args
 from .data.experiments import Dataset
+from .data.motion import check_motion_option, driven_by
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
+from .models.fit_record import fit_record_of
 from .results import Result
 from .unit_scale import unit_warnings
 
@@ -47,6 +49,14 @@ class ValidationResult(Result):
     failures: list = dataclasses.field(default_factory=list)
     #: what was measured: it gives the metrics, the table's columns and what the RMSE has had removed
     measurement: Measurement = dataclasses.field(default_factory=lambda: measurement_of([]))
+    #: how the model was scored: the offset policy and the motion, each with where it came from ("the fit record",
+    #: "asked", "the default")
+    scored_as: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def scoring(self) -> str:
+        """How the model was scored, in words (every table says it)."""
+        return scoring_note(self.scored_as)
 
     @property
     def unit(self) -> str:
@@ -86,6 +96,7 @@ class ValidationResult(Result):
         d = {"model": self.model.name, "measurement": self.measurement.name, "unit": self.unit,
              "offset_removed": self.measurement.validation_removed, "experiments": self.experiments,
              "summary": self.summary(), "failed": [f.metrics() for f in self.failures], "warnings": self.warnings,
+             "scored_as": self.scored_as,
              **self.measurement.validation_extras(self.model)}
         return jsonable(d)
 
@@ -119,7 +130,7 @@ class ValidationResult(Result):
         from rich.table import Table
         # (escaped: rich would take "[nm]" in a header, or brackets in a file name, for markup)
         t = Table(title=escape(title or f"Validation of {self.model.name or 'the model'}"),
-                  caption=self.measurement.caption + "; definitions: docs/formats.md#validation-metrics")
+                  caption=self.measurement.caption + f"; {self.scoring}; definitions: docs/formats.md#validation-metrics")
         for name, _, _ in self._COLUMNS:
             t.add_column(escape(name), justify="left" if name in ("file", "role") else "right", no_wrap=True)
         for r in self.rows():
@@ -160,23 +171,65 @@ class ValidationResult(Result):
         notes += "".join(f"<li>{html.escape(f.file)}: not predicted: {html.escape(f.reason)}</li>" for f in self.failures)
         return (f"<div><b>Validation of {html.escape(self.model.name or 'the model')}</b> — {html.escape(summary)}"
                 f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-                f"<small>{html.escape(self.measurement.footer)}</small>"
+                f"<small>{html.escape(self.measurement.footer)} {html.escape(self.scoring)}.</small>"
                 + (f"<ul>{notes}</ul>" if notes else "") + "</div>")
 
 
-def validate(model: Model, data, experiments=None, *, offset=None) -> ValidationResult:
+def scoring_note(scored_as: dict) -> str:
+    """``scored_as`` (ValidationResult.scored_as) in words: "scored as fitted (the fit record): offset shared, motion
+    position"."""
+    if not scored_as:
+        return ""
+    parts = [f"{k} {scored_as[k]} ({scored_as[k + '_from']})" for k in ("offset", "motion") if k in scored_as]
+    sources = {scored_as.get(k + "_from") for k in ("offset", "motion") if k in scored_as}
+    lead = "scored as fitted" if sources == {"the fit record"} else "scored with"
+    return f"{lead}: " + ", ".join(parts)
+
+
+def _scoring(model, exps, offset, motion):
+    """(the experiments as scored, the offset policy, ``scored_as``): what is not asked is taken from the model's
+    fit record (models/fit_record.py), so that a model is scored the way it was fitted."""
+    record, how = fit_record_of(model) or {}, {}
+    if offset is None and record.get("offset"):
+        offset, how["offset_from"] = record["offset"], "the fit record"
+        try:
+            measurement_of(exps, offset=offset)
+        except InputError as e:
+            raise InputError(f"the model's [provenance.fit_record] 'offset': {e}") from None
+    else:
+        how["offset_from"] = "asked" if offset is not None else "the default"
+    if motion is None and record.get("motion"):
+        motion, how["motion_from"] = record["motion"], "the fit record"
+        check_motion_option(motion, "the model's [provenance.fit_record]")
+    elif motion is not None:
+        how["motion_from"] = "asked"
+    if motion is not None and any(getattr(e, "force", None) is not None for e in exps):
+        exps = [driven_by(e, motion) for e in exps]
+        how["motion"] = motion
+    else:
+        how.pop("motion_from", None)
+    return exps, offset, how
+
+
+def validate(model: Model, data, experiments=None, *, offset=None, motion=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
     zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
-    it, held-out runs included). Temperatures outside a law's calibrated range are reported as warnings, and so
+    it, held-out runs included). ``offset`` and ``motion`` ("position", "velocity", "auto": what drives force
+    experiments) default to the model's fit record, so a fitted model is scored the way ``identify`` scored it;
+    ``scored_as`` says how. Temperatures outside a law's calibrated range are reported as warnings, and so
     is a record whose span is a power of 1000 off the prediction's (unit_scale.py; also a UnitWarning)."""
     _args.model(model, Model)
     _args.dataset(data, Dataset, experiments=True)
     _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)
+    if motion is not None:
+        check_motion_option(motion, "motion")
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")
+    exps, offset, how = _scoring(model, exps, offset, motion)
     measurement = measurement_of(exps, offset=offset)  # asked once
+    how["offset"] = measurement.offset
     measurement.check_model(model, exps)
     caught, preds, failures, pairs = [], [], [], []
     for exp in exps:
@@ -189,7 +242,7 @@ def validate(model: Model, data, experiments=None, *, offset=None) -> Validation
         caught += [f"{exp.file}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
         caught += [str(x.message) for x in w if issubclass(x.category, MetricWarning)]
     caught = unit_warnings(pairs) + caught  # (first: a unit off by 1000 explains every error after it)
-    return ValidationResult(model, preds, caught, failures, measurement)
+    return ValidationResult(model, preds, caught, failures, measurement, how)
 
 
-__all__ = ["MetricWarning", "validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]
+__all__ = ["MetricWarning", "validate", "scoring_note", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]

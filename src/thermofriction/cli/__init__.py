@@ -34,8 +34,11 @@ def main(argv=None) -> int:
     caught = []
 
     def show(message, category, filename, lineno, file=None, line=None):
-        caught.append(f"warning: {message}")
-        print(f"thermofriction: warning: {message}", file=sys.stderr)
+        text = f"warning: {message}"
+        if text in caught:  # said once per command: a report simulates a model hundreds of times
+            return
+        caught.append(text)
+        print(f"thermofriction: {text}", file=sys.stderr)
 
     warnings.showwarning = show
     handlers = _io.install_signal_handlers()  # SIGTERM/SIGHUP remove temporary files too

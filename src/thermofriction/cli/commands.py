@@ -224,7 +224,7 @@ def cmd_validate(args) -> int:
     data = load_dataset(args.dataset, motion=args.motion)
     _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
     with warnings.catch_warnings(action="ignore", category=UnitWarning):  # in res.warnings, printed below
-        res = validate(model, data, offset=args.offset)
+        res = validate(model, data, offset=args.offset, motion=args.motion)
     if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")

@@ -73,15 +73,18 @@ def _solver_option(p, help_text):
     p.add_argument("--method", dest="solver_old", choices=sorted(SOLVERS), help=argparse.SUPPRESS)
 
 
-def _force_options(p):
-    """The options of force (torque) data (docs/force-data.md) for commands that read a dataset."""
+def _force_options(p, scoring=False):
+    """The options of force (torque) data (docs/force-data.md) for commands that read a dataset; ``scoring``: a
+    command that scores a fitted model, whose defaults are its fit record's (how identify scored it)."""
+    record = " (default: as the model was fitted, from its fit record; else" if scoring else " (default:"
     p.add_argument("--offset", choices=("shared", "per-experiment", "none"),
-                   help="force data: the sensor offset, one fitted for all experiments (shared, the default), one "
+                   help="force data: the sensor offset, one fitted for all experiments (shared), one "
                         "per experiment (a sensor re-zeroed between runs; in validate, estimated on every "
-                        "experiment, held-out ones included), or none (the model's own)")
+                        f"experiment, held-out ones included), or none (the model's own){record} shared)")
     p.add_argument("--motion", choices=("auto", "position", "velocity"),
-                   help="force data: what drives the model, overriding the dataset's 'motion' (default: auto, the "
-                        "velocity column where it is the position's derivative, else the position)")
+                   help="force data: what drives the model, overriding the dataset's 'motion'" + record +
+                        " the dataset's, else auto: the velocity column where it is the position's derivative, else "
+                        "the position)")
 
 
 def _writes(command, dest, what):
@@ -203,7 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("dataset", metavar="DATASET", help="dataset folder (with dataset.toml)")
     v.add_argument("--json", metavar="METRICS.json", help=_writes(
         "validate", "json", "the metrics (docs/formats.md#validation-metrics), as JSON or as MATLAB structs"))
-    _force_options(v)
+    _force_options(v, scoring=True)
     v.set_defaults(run=cmd_validate)
 
     r = sub.add_parser("report", help="an HTML report comparing models on a dataset",
@@ -219,6 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--bands", metavar="BANDS.json",
                    help="add the prediction bands that 'thermofriction propagate -o BANDS.json' wrote (displacement "
                         "data)")
+    _force_options(r, scoring=True)
     r.set_defaults(run=cmd_report)
 
     d = sub.add_parser("demo", help="the main job: synthesise the example dataset, identify, validate, report",

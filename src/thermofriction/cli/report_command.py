@@ -21,7 +21,7 @@ def cmd_report(args) -> int:
     if len(args.paths) < 2:
         raise InputError("report needs at least one model and a dataset: MODEL.toml... DATASET")
     *model_paths, dataset = args.paths
-    data = load_dataset(dataset)
+    data = load_dataset(dataset, motion=args.motion)
     entries = []
     inputs = list(_dataset_inputs(data)) + ([args.bands] if args.bands else [])
     bands = _bands(args.bands, data)
@@ -49,7 +49,7 @@ def cmd_report(args) -> int:
     _refuse_inputs(args, *inputs)
     with _io.publish_together(inputs=inputs):  # the page and its figures appear together, or none
         report(entries, data, args.output, figures_dir=args.figures, title=args.title, bands=bands,
-               command="thermofriction " + " ".join(sys.argv[1:]))
+               command="thermofriction " + " ".join(sys.argv[1:]), offset=args.offset, motion=args.motion)
     print(f"wrote {args.output}" + (f" and the figures in {args.figures}" if args.figures else ""))
     return 0
 

@@ -232,6 +232,17 @@ def choose_motion(path, time, position, velocity, motion: str = "auto", headers=
     return "position", check
 
 
+def driven_by(exp, motion: str):
+    """``exp`` driven by its position or its velocity column (``motion``: "position", "velocity"; "auto" leaves it
+    as it was read): a model is scored on held-out runs driven as its fit runs were (the fit record). An experiment
+    without a velocity column, or not a force experiment, is returned as it is."""
+    if getattr(exp, "force", None) is None or motion == "auto" or exp.motion_source == motion \
+            or (motion == "velocity" and exp.velocity is None):
+        return exp
+    drive_v = velocity_of(exp.time, exp.displacement, exp.velocity if motion == "velocity" else None)
+    return dataclasses.replace(exp, motion=motion, input=motion_waveform(exp.time, drive_v))
+
+
 # -- quantisation ----------------------------------------------------------------------------------
 
 def quantum(values, tolerance: float = 0.05, share: float = 0.9) -> float | None:
@@ -289,5 +300,5 @@ def with_v_smooth(model, experiments, steps: float = V_SMOOTH_STEPS):
 
 
 __all__ = ["MOTIONS", "POSITION_MISMATCH_ERROR", "on_uniform_grid", "MotionCheck", "MotionWarning", "SamplingWarning", "check_motion",
-           "check_motion_option", "choose_motion", "motion_waveform", "quantum", "v_smooth_for", "velocity_lag",
+           "check_motion_option", "choose_motion", "driven_by", "motion_waveform", "quantum", "v_smooth_for", "velocity_lag",
            "velocity_of", "velocity_resolution", "velocity_scale", "with_v_smooth"]

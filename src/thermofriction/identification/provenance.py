@@ -13,8 +13,11 @@ import numpy as np
 
 from .._version import __version__
 from ..data.files import dataset_sha256 as data_sha256
+from ..measurements import measurement_of
 from ..models import Model
 from .parameters import Parameters
+from .record import fit_record
+from .result import FitResult
 
 METHOD_NAMES = {"plant": "the plant (xi, wn, K)", "base": "a friction model without thermal effects",
                 "model-i": "Model I (temperature-dependent parameters)", "model-ii": "Model II (a thermal friction term)",
@@ -62,12 +65,15 @@ def stamp(fit, data, method: str, init, options: dict):
     opts = {k: plain(v) for k, v in opts.items()}
     date = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
     init_name = init.name or "a Model object" if isinstance(init, Model) else str(init)
+    policy = measurement_of(fit_runs or experiments, offset=options.get("offset")).offset
 
     def one(f, how):
         prov = {"method": f.method, "data": where, "data_sha256": digest,
                 "fit_files": [e.file for e in fit_runs], "held_out_files": [e.file for e in held],
                 "date": date, "thermofriction": __version__, "initial_model": init_name,
                 "options": {**opts, **how}}
+        if isinstance(f, FitResult):  # how it was scored: validate and report score it the same way
+            prov["fit_record"] = fit_record(f, fit_runs, policy)
         description = (f"{METHOD_NAMES.get(f.method, f.method)} identified by thermofriction {__version__} "
                        f"from {len(fit_runs)} experiment{'s' if len(fit_runs) != 1 else ''} of {label} "
                        f"at {temps} C" + (f" ({len(held)} held out)" if held else "")

@@ -21,6 +21,7 @@ from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
 from .friction import (FRICTION_MODELS, GMS, PARAMETER_DOMAIN, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,
                        Stribeck, check_friction_values, in_domain)
+from .fit_record import check_fit_record
 from .laws import PWL, Law, law_from_dict
 from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
@@ -193,7 +194,7 @@ _TOP_KEYS = {"name", "description", "plant", "friction", "thermal", "heat", "inp
 
 #: the [provenance] table's keys (docs/formats.md#provenance): strings, but for the lists and the options table
 PROVENANCE_KEYS = ("method", "data", "data_sha256", "fit_files", "held_out_files", "date", "thermofriction",
-                   "initial_model", "command", "options")
+                   "initial_model", "command", "options", "fit_record")
 
 
 def _toml_plain(v):
@@ -219,6 +220,8 @@ def check_provenance(p, where="[provenance]") -> dict:
         if key in ("fit_files", "held_out_files"):
             if not isinstance(value, (list, tuple)) or not all(isinstance(x, str) for x in value):
                 raise InputError(f"{where}: '{key}' must be a list of file names, got {shorten(value)}")
+        elif key == "fit_record":
+            check_fit_record(value, f"{where[:-1]}.fit_record]")
         elif key == "options":
             if not isinstance(value, dict):
                 raise InputError(f"{where}: 'options' must be a table, got {shorten(value)}")

@@ -16,6 +16,7 @@ from .force import render_force
 from .. import _args
 from ..data.experiments import Dataset
 from .studies import control_report, heating_report
+from ..validation import validate
 
 #: measurement name -> the page that shows it
 PAGES = {"displacement": render, "force": render_force, "command": render_force}
@@ -41,11 +42,13 @@ def _check_report_arguments(models, data, path, figures_dir, command, title, tru
     return list(models)
 
 
-def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
+def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None, offset=None,
+           motion=None) -> str:
     """Writes the HTML report comparing ``models`` (Model, FitResult, or (label, Model, fit dict)
     entries) on ``data``; returns the HTML. ``truth`` (label -> FitResult.recovery summary, for data
     made from a known model) adds a section saying whether the fits recover it; ``bands`` (what
-    ``tf.propagate`` returns) a section with the prediction bands."""
+    ``tf.propagate`` returns) a section with the prediction bands. Each model is scored as it was fitted (its fit
+    record: the offset policy, the motion), unless ``offset`` or ``motion`` says otherwise (see :func:`validate`)."""
     models = _check_report_arguments(models, data, path, figures_dir, command, title, truth)
     entries = []
     for m in models:
@@ -61,6 +64,9 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
             entries.append(Entry(label, model, fit))
     if not entries:
         raise InputError("give at least one model")
+    for e in entries:  # each scored as it was fitted, unless asked otherwise (validation.py: _scoring)
+        if e.validation is None:
+            e.validation = validate(e.model, data, offset=offset, motion=motion)
     render_page = PAGES[measurement_of(data).name]  # the page of what the data measured
     text = render_page(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title,
                        truth=truth, bands=bands)

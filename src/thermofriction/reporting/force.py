@@ -200,11 +200,9 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
         raise InputError("the dataset has no experiment with role 'validate': a report compares predictions on "
                          "experiments the models were not identified on")
     unit, vunit, xunit, what = _units(exps)
-    # fits with an offset per experiment are compared as they were made: each experiment's own offset removed
-    per_run = any(((e.fit or {}).get("sensor_offset") or {}).get("policy") == "per-experiment" for e in entries)
     for e in entries:
-        if e.validation is None:
-            e.validation = validate(e.model, data, offset="per-experiment" if per_run else None)
+        if e.validation is None:  # as it was fitted (its fit record)
+            e.validation = validate(e.model, data)
         # the default labels name the thermal model only (and the command line adds the file's stem to tell
         # them apart): here the friction model is what differs
         if e.label.startswith(("no thermal model", "Model I", "base")):
@@ -275,18 +273,26 @@ def _comparison_section(entries, unit, what) -> str:
         rows.append([e.label, fmt_number(k if f else None, "{:.0f}"), fmt_number(a[0] if a else None, "{:.1f}"),
                      fmt_number(a[1] if a else None, "{:.3f}"), fmt_number(s.get("fit", {}).get("rmse"), "{:.4g}"),
                      fmt_number(s.get("validate", {}).get("rmse"), "{:.4g}"), fmt_number(s.get("validate", {}).get("max_error_pct")),
-                     fmt_number(e.model.plant.sensor_offset, "{:.4g}")])
+                     fmt_number(e.model.plant.sensor_offset, "{:.4g}"), _scored(e.validation.scored_as)])
     return ("<section><h2>Friction models compared</h2>" + html_table(
         ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
-         "max error, held out [%]", f"sensor offset [{unit}]"], rows) +
+         "max error, held out [%]", f"sensor offset [{unit}]", "scored with"], rows, text=(8,), wrap=(8,)) +
         "<p style='font-size:13px;color:#4a5266'>" + basis + "ΔAICc is each fit's AICc minus the lowest among fits of the same "
         "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
-        "to one. The held-out RMSE compares the models on experiments none was fitted to; " + (
-            "each experiment's own offset was removed (the fits estimated one per experiment; on held-out "
-            "experiments it is estimated on them), so the errors are of the friction's shape. "
-            if entries and entries[0].validation.measurement.offset == "per-experiment" else
-            "the sensor offset was fitted once, on the fit experiments, and is used there as it is. ") +
+        "to one. The held-out RMSE compares the models on experiments none was fitted to, each model scored as it was "
+        "fitted (its fit record: \"scored with\"; a model without one by the defaults, shared offset and the "
+        "dataset's motion): with the offset per experiment, each experiment's own offset is removed (on held-out "
+        "experiments it is estimated on them), so the errors are of the friction's shape; with a shared offset, "
+        "the one fitted on the fit experiments is used as it is. " +
         "Max error is max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
+
+
+def _scored(scored_as: dict) -> str:
+    """How one model was scored, for a table cell: "offset per-experiment, motion position (fit record)"."""
+    parts = [f"{k} {scored_as[k]}" for k in ("offset", "motion") if k in scored_as]
+    sources = {scored_as.get(k + "_from") for k in ("offset", "motion") if k in scored_as}
+    return ", ".join(parts) + (" (fit record)" if sources == {"the fit record"} else
+                               " (asked)" if "asked" in sources else " (defaults)")
 
 
 def _parameters_section(entries, unit) -> str:
