@@ -5,6 +5,13 @@
 #include "fmi2Functions.h"
 #include "fmu_common.h"
 
+/* The modes the FMI 2.0 co-simulation state machine (its table of calls and states) allows: variables are
+ * read from initialization mode on (start values are the model description's) and set until terminated;
+ * the status of the last step is asked once initialized. */
+#define GETTABLE (FMU_IN_INITIALIZATION | FMU_IN_STEP | FMU_IN_TERMINATED)
+#define SETTABLE (FMU_IN_INSTANTIATED | FMU_IN_INITIALIZATION | FMU_IN_STEP)
+#define STEPPED (FMU_IN_STEP | FMU_IN_TERMINATED)
+
 /* The importer's printf-like logger; the message is already its own format ('%' doubled). */
 static void log_fmi2(const fmu_callbacks *cb, const char *name, fmu_status status, const char *category,
                  const char *message)
@@ -48,7 +55,8 @@ fmi2Status fmi2Reset(fmi2Component c) { return (fmi2Status)fmu_reset(c); }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
 {
-    return (fmi2Status)fmu_get_real(c, vr, n, value);
+    fmu_status s = fmu_require_mode(c, "fmi2GetReal", GETTABLE);
+    return (fmi2Status)(s == FMU_OK ? fmu_get_real(c, vr, n, value) : s);
 }
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
 {
@@ -102,27 +110,33 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer value[])
 {
-    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetInteger: this FMU has no integer variables");
+    fmu_status s = fmu_require_mode(c, "fmi2GetInteger", GETTABLE);
+    return s != FMU_OK ? (fmi2Status)s : n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetInteger: this FMU has no integer variables");
 }
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean value[])
 {
-    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetBoolean: this FMU has no boolean variables");
+    fmu_status s = fmu_require_mode(c, "fmi2GetBoolean", GETTABLE);
+    return s != FMU_OK ? (fmi2Status)s : n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetBoolean: this FMU has no boolean variables");
 }
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String value[])
 {
-    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetString: this FMU has no string variables");
+    fmu_status s = fmu_require_mode(c, "fmi2GetString", GETTABLE);
+    return s != FMU_OK ? (fmi2Status)s : n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2GetString: this FMU has no string variables");
 }
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer value[])
 {
-    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetInteger: this FMU has no integer variables");
+    fmu_status s = fmu_require_mode(c, "fmi2SetInteger", SETTABLE);
+    return s != FMU_OK ? (fmi2Status)s : n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetInteger: this FMU has no integer variables");
 }
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean value[])
 {
-    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetBoolean: this FMU has no boolean variables");
+    fmu_status s = fmu_require_mode(c, "fmi2SetBoolean", SETTABLE);
+    return s != FMU_OK ? (fmi2Status)s : n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetBoolean: this FMU has no boolean variables");
 }
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String value[])
 {
-    return n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetString: this FMU has no string variables");
+    fmu_status s = fmu_require_mode(c, "fmi2SetString", SETTABLE);
+    return s != FMU_OK ? (fmi2Status)s : n == 0 ? fmi2OK : (fmi2Status)fmu_fail(c, "fmi2SetString: this FMU has no string variables");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
@@ -131,7 +145,9 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
 }
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
 {
-    if (!c || !value) return fmi2Error;
+    fmu_status ok = fmu_require_mode(c, "fmi2GetRealStatus", STEPPED);
+    if (ok != FMU_OK) return (fmi2Status)ok;
+    if (!value) return (fmi2Status)fmu_fail(c, "fmi2GetRealStatus: NULL argument");
     if (s == fmi2LastSuccessfulTime) { *value = fmu_time(c); return fmi2OK; }
     return (fmi2Status)fmu_fail(c, "fmi2GetRealStatus: only fmi2LastSuccessfulTime");
 }

@@ -18,7 +18,9 @@ static const char *const NAMES[] = {"fmi2SetRealInputDerivatives", "fmi3SetFloat
                                     "fmi2SetupExperiment", "fmi3EnterInitializationMode",
                                     "fmi2EnterInitializationMode", "fmi3EnterInitializationMode",
                                     "fmi2ExitInitializationMode", "fmi3ExitInitializationMode",
-                                    "fmi2DoStep", "fmi3DoStep", "fmi2GetFMUstate", "fmi3GetFMUState", NULL};
+                                    "fmi2DoStep", "fmi3DoStep", "fmi2GetFMUstate", "fmi3GetFMUState",
+                                    "fmi2SetFMUstate", "fmi3SetFMUState", "fmi2FreeFMUstate", "fmi3FreeFMUState",
+                                    "fmi2Terminate", "fmi3Terminate", NULL};
 
 static void log_fmi3(const fmu_callbacks *cb, const char *name, fmu_status status, const char *category,
                      const char *message)
@@ -162,6 +164,8 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte bytes[], size_
     fmi3Status fmi3Set##name(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const type value[],       \
                              size_t nv)                                                                       \
     {                                                                                                         \
+        fmu_status s = fmu_require_mode(c, "fmi3Set" #name, FMU_IN_ANY & ~FMU_IN_TERMINATED);                  \
+        if (s != FMU_OK) return (fmi3Status)s; /* FMI 3: nothing is set once terminated */                     \
         return n == 0 ? fmi3OK : (fmi3Status)fmu_fail(c, "fmi3Set" #name ": this FMU has no " #name " variables"); \
     }
 NO_VARIABLES(Float32, fmi3Float32)

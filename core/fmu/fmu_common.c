@@ -79,7 +79,10 @@ struct fmu_instance {
     fmu_callbacks cb;
     char *name;
     int logging;
-    enum { S_INSTANTIATED, S_INIT, S_STEP, S_TERMINATED, S_ERROR } mode;
+    enum { S_INSTANTIATED = FMU_IN_INSTANTIATED, S_INIT = FMU_IN_INITIALIZATION, S_STEP = FMU_IN_STEP,
+           S_TERMINATED = FMU_IN_TERMINATED } mode;
+    int stop_defined;        /* the experiment's stop time (fmi2SetupExperiment): no step ends past it */
+    double stop;
 
     /* structure (resources) */
     int plant, modal, friction, n_gms, thermal, df_form, fs_follows_fc, heat, temperature_input;
@@ -155,6 +158,24 @@ fmu_status fmu_fail(instance *c, const char *fmt, ...)
     logv(c, FMU_ERROR, "logStatusError", fmt, ap);
     va_end(ap);
     return FMU_ERROR;
+}
+
+static const char *mode_name(int mode)
+{
+    switch (mode) {
+    case S_INSTANTIATED: return "instantiated (not yet initialized)";
+    case S_INIT: return "in initialization mode";
+    case S_STEP: return "in step mode (initialized)";
+    default: return "terminated";
+    }
+}
+
+fmu_status fmu_require_mode(fmu_instance *c, const char *call, unsigned allowed)
+{
+    if (!c) return FMU_ERROR;
+    if ((unsigned)c->mode & allowed) return FMU_OK;
+    return fmu_fail(c, "%s: not allowed while the instance is %s (the FMI standard's state machine)", call,
+                    mode_name(c->mode));
 }
 
 /* A temperature [degC] the package would take (thermofriction.plausible: -100 to 300 C). */
@@ -501,14 +522,19 @@ fmu_status fmu_setup_experiment(fmu_instance *c, int tol_defined, double tol, do
 {
     if (!c) return FMU_ERROR;
     if (c->mode != S_INSTANTIATED) return fmu_fail(c, "fmi2SetupExperiment: only after fmi2Instantiate");
-    if (tol_defined) {
-        if (!(tol > 0 && tol < 1)) return fmu_fail(c, "fmi2SetupExperiment: tolerance %g must be between 0 and 1", tol);
-        c->rtol = tol;
-    }
+    /* all checked before anything is taken: a refusal changes nothing */
+    if (tol_defined && !(tol > 0 && tol < 1))
+        return fmu_fail(c, "fmi2SetupExperiment: tolerance %g must be between 0 and 1", tol);
     if (!(fabs(start) <= TIME_LIMIT))
         return fmu_fail(c, "fmi2SetupExperiment: start time %g s: must be finite and within +-%g s (the integrator's "
                     "time limit)", start, TIME_LIMIT);
+    if (stop_defined && !(stop >= start))
+        return fmu_fail(c, "fmi2SetupExperiment: stop time %g s: must be a time not before the start time %g s", stop,
+                        start);
+    if (tol_defined) c->rtol = tol;
     c->t = start;
+    c->stop_defined = stop_defined != 0;
+    c->stop = stop_defined ? stop : 0.0;
     return FMU_OK;
 }
 
@@ -543,9 +569,9 @@ fmu_status fmu_exit_initialization(fmu_instance *c)
 
 fmu_status fmu_terminate(fmu_instance *c)
 {
-    if (!c) return FMU_ERROR;
-    c->mode = S_TERMINATED;
-    return FMU_OK;
+    fmu_status s = fmu_require_mode(c, "fmi2Terminate", FMU_IN_STEP); /* FMI 2 and 3: once initialized, once */
+    if (s == FMU_OK) c->mode = S_TERMINATED;
+    return s;
 }
 
 fmu_status fmu_reset(fmu_instance *c)
@@ -556,6 +582,7 @@ fmu_status fmu_reset(fmu_instance *c)
     c->du_set = 0;
     c->t = 0;
     c->out_of_range = 0;
+    c->stop_defined = 0, c->stop = 0.0; /* as instantiated: no experiment yet */
     memset(c->y, 0, sizeof c->y);
     memset(c->model.gms.mode, 0, sizeof c->model.gms.mode);
     c->mode = S_INSTANTIATED;
@@ -596,7 +623,7 @@ fmu_status fmu_set_real(fmu_instance *c, const fmu_vr vr[], size_t n, const doub
 {
     if (!c) return FMU_ERROR;
     if (n > 0 && (!vr || !value)) return fmu_fail(c, "fmi2SetReal: NULL argument");
-    if (c->mode == S_TERMINATED || c->mode == S_ERROR) return fmu_fail(c, "fmi2SetReal: the instance is terminated");
+    if (c->mode == S_TERMINATED) return fmu_fail(c, "fmi2SetReal: the instance is terminated");
     int changed = 0;
     double before[MAX_VR];
     memcpy(before, c->r, sizeof before);
@@ -652,7 +679,7 @@ fmu_status fmu_set_input_derivatives(fmu_instance *c, const fmu_vr vr[], size_t 
 {
     if (!c) return FMU_ERROR;
     if (n > 0 && (!vr || !order || !value)) return fmu_fail(c, "fmi2SetRealInputDerivatives: NULL argument");
-    if (c->mode == S_TERMINATED || c->mode == S_ERROR)
+    if (c->mode == S_TERMINATED)
         return fmu_fail(c, "fmi2SetRealInputDerivatives: the instance is terminated");
     double du = c->du, dT = c->dT; /* a refusal changes nothing */
     int du_set = c->du_set;
@@ -737,11 +764,15 @@ static int realtime_steps(instance *c, double h, double *y)
 
 fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
 {
-    if (!c) return FMU_ERROR;
-    if (c->mode != S_STEP) return fmu_fail(c, "fmi2DoStep: only after initialization");
+    if (fmu_require_mode(c, "fmi2DoStep", FMU_IN_STEP) != FMU_OK) return FMU_ERROR; /* initialized, not terminated */
     if (!(h > 0) || !isfinite(h) || !isfinite(t)) return fmu_fail(c, "fmi2DoStep: bad step (t = %g, h = %g)", t, h);
     if (fabs(t - c->t) > 1e-9 * fmax(1.0, fabs(t))) /* the importer's clock and ours must agree */
         return fmu_fail(c, "fmi2DoStep: communication point %.17g s is not the FMU's time %.17g s", t, c->t);
+    /* FMI 2 and 3: computing past a defined stop time is an error; within 1e-9 of it relative to the times
+     * (the rounding of an importer's grid, fmpy's isclose) it is the stop time */
+    if (c->stop_defined && c->t + h > c->stop + 1e-9 * fmax(fabs(c->stop), fabs(c->t) + h))
+        return fmu_fail(c, "fmi2DoStep: the step from %.17g s over %g s ends at %.17g s, past the experiment's stop "
+                        "time %.17g s: refused", c->t, h, c->t + h, c->stop);
     if (!isfinite(c->r[VR_DRIVE]) || !isfinite(c->r[VR_TEMPERATURE]))
         return fmu_fail(c, "at time %g s the inputs are not finite (drive %g, temperature %g)", t, c->r[VR_DRIVE],
                      c->r[VR_TEMPERATURE]);
@@ -837,7 +868,8 @@ static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_s
 
 fmu_status fmu_get_state(fmu_instance *c, void **state)
 {
-    if (!c || !state) return FMU_ERROR;
+    if (!c) return FMU_ERROR;
+    if (!state) return fmu_fail(c, "fmi2GetFMUstate: NULL argument");
     instance *s = *state ? *state : c->cb.allocateMemory(1, sizeof *s);
     if (!s) return fmu_fail(c, "fmi2GetFMUstate: out of memory");
     memcpy(s, c, sizeof *s);
@@ -845,14 +877,30 @@ fmu_status fmu_get_state(fmu_instance *c, void **state)
     return FMU_OK;
 }
 
+/* The state machine's mode and the experiment's stop time are the importer's, not the FMU state's:
+ * fmi2SetFMUstate is no transition of the standards' state machines, so the instance keeps its mode (a
+ * state taken in step mode restored once terminated leaves it terminated). A state taken on the other
+ * side of the initialization (its time and model states meaningless there) or of another FMU is refused. */
 fmu_status fmu_set_state(fmu_instance *c, void *state)
 {
-    if (!c || !state) return FMU_ERROR;
+    if (!c) return FMU_ERROR;
+    if (!state) return fmu_fail(c, "fmi2SetFMUstate: NULL argument");
+    const instance *from = state;
+    if (strncmp(from->guid, c->guid, sizeof c->guid) != 0)
+        return fmu_fail(c, "fmi2SetFMUstate: the state is of another FMU (GUID %.63s, this one %s): refused",
+                        from->guid, c->guid);
+    int initialized = (c->mode & (S_STEP | S_TERMINATED)) != 0, was = (from->mode & (S_STEP | S_TERMINATED)) != 0;
+    if (initialized != was)
+        return fmu_fail(c, "fmi2SetFMUstate: the state was taken %s initialization and the instance is %s: a state "
+                        "is restored on the side of the initialization it was taken on: refused",
+                        was ? "after" : "before", mode_name(c->mode));
     char *name = c->name;
     fmu_callbacks cb = c->cb;
-    int logging = c->logging;
+    int logging = c->logging, mode = c->mode, stop_defined = c->stop_defined;
+    double stop = c->stop;
     memcpy(c, state, sizeof *c);
     c->name = name, c->cb = cb, c->logging = logging;
+    c->mode = mode, c->stop_defined = stop_defined, c->stop = stop;
     tf_gms_elements modes = c->model.gms;
     if (build_model(c, &c->model) != 0) return FMU_ERROR;
     c->model.gms = modes;
@@ -861,7 +909,8 @@ fmu_status fmu_set_state(fmu_instance *c, void *state)
 
 fmu_status fmu_free_state(fmu_instance *c, void **state)
 {
-    if (!c || !state) return FMU_ERROR;
+    if (!c) return FMU_ERROR;
+    if (!state) return fmu_fail(c, "fmi2FreeFMUstate: NULL argument");
     if (*state) c->cb.freeMemory(*state);
     *state = NULL;
     return FMU_OK;

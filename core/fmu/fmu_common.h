@@ -29,6 +29,16 @@ typedef struct fmu_instance fmu_instance;
 
 /* NULL when the resources cannot be read, the GUID (instantiation token) is not theirs or the model
  * is invalid (logged). resources: a file: URI (resources_is_uri, FMI 2) or a folder path (FMI 3). */
+/* The modes of the standards' co-simulation state machines this FMU goes through (FMI 2: instantiated,
+ * initialization mode, slave initialized, terminated; FMI 3: Instantiated, Initialization Mode, Step
+ * Mode, Terminated), as bits: the calls each mode allows (docs/fmu.md, "Calling sequence"). */
+enum { FMU_IN_INSTANTIATED = 1, FMU_IN_INITIALIZATION = 2, FMU_IN_STEP = 4, FMU_IN_TERMINATED = 8 };
+#define FMU_IN_ANY 15u
+
+/* FMU_OK where the instance is in one of the modes `allowed` (FMU_IN_* bits); else logs that `call` is
+ * not allowed in its mode and returns FMU_ERROR (a NULL instance: FMU_ERROR). */
+fmu_status fmu_require_mode(fmu_instance *c, const char *call, unsigned allowed);
+
 fmu_instance *fmu_instantiate(const char *name, const char *guid, const char *resources, int resources_is_uri,
                               const fmu_callbacks *cb, int logging);
 void fmu_free_instance(fmu_instance *c);

@@ -21,7 +21,13 @@
  * - a step answered fmi2OK / fmi2Warning moved the FMU's time (fmi2LastSuccessfulTime) by exactly h and
  *   left finite outputs; a refused one moved neither the time nor any output (bit for bit);
  * - a refused fmi2SetReal or fmi2SetRealInputDerivatives changed no variable;
- * - the undeclared value references 7-15 are never read or written with fmi2OK.
+ * - the undeclared value references 7-15 are never read or written with fmi2OK;
+ * - the calls follow the standard's state machine (this target keeps its own model of the modes, moved by
+ *   the calls answered OK; fmi2SetFMUstate moves none): fmi2EnterInitializationMode only when instantiated,
+ *   fmi2ExitInitializationMode only in initialization mode, fmi2DoStep and fmi2Terminate only in step mode,
+ *   no fmi2SetReal of a variable once terminated, fmi2GetRealStatus only once initialized (issue 41);
+ * - no step answered OK ends past a stop time the last fmi2SetupExperiment defined (1e-9 relative, the
+ *   FMU's rounding) (issue 41).
  *
  * Build: cmake -S core -B build-fuzz -DCMAKE_C_COMPILER=clang -DTF_BUILD_FUZZERS=ON
  * Run:   build-fuzz/fuzz_fmu -max_total_time=600 core/fuzz/corpus_fmu   (docs/hardening.md) */
@@ -132,10 +138,21 @@ typedef struct {
     int ok[16 + MAXV];
 } view;
 
+/* The mode the standard's state machine is in, as the calls answered OK moved it, and the experiment's
+ * stop time. */
+static enum { M_INSTANTIATED, M_INIT, M_STEP, M_TERMINATED } mode;
+static int have_stop;
+static double stop_time;
+
 static void look(fmi2Component c, view *w)
 {
     memset(w, 0, sizeof *w);
-    if (fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &w->t) != fmi2OK) FAIL("fmi2LastSuccessfulTime refused");
+    int errors = errors_logged;
+    fmi2Status st = fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &w->t);
+    check_status(st, errors);
+    if ((st == fmi2OK) != (mode == M_STEP || mode == M_TERMINATED))
+        FAIL("fmi2LastSuccessfulTime refused once initialized, or answered before");
+    if (st != fmi2OK) w->t = NAN;
     for (int k = 0; k < 16 + nvars; k++) {
         fmi2ValueReference vr = k < 16 ? (fmi2ValueReference)k : vars[k - 16];
         int before = errors_logged;
@@ -180,6 +197,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     fmi2FMUstate state = NULL;
     view a, b;
+    mode = M_INSTANTIATED, have_stop = 0, stop_time = 0.0;
     for (int op = 0; op < 48 && r.n; op++) {
         before = errors_logged;
         fmi2Status s = fmi2OK;
@@ -187,12 +205,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         switch (call) {
         case 0: {
             uint8_t f = byte(&r);
-            double tol = number(&r), start = f & 2 ? number(&r) : 0.0;
-            s = fmi2SetupExperiment(c, f & 1, tol, start, f & 4, number(&r));
+            double tol = number(&r), start = f & 2 ? number(&r) : 0.0, stop = number(&r);
+            s = fmi2SetupExperiment(c, f & 1, tol, start, f & 4, stop);
+            if (s != fmi2Error) have_stop = (f & 4) != 0, stop_time = stop;
             break;
         }
-        case 1: s = fmi2EnterInitializationMode(c); break;
-        case 2: s = fmi2ExitInitializationMode(c); break;
+        case 1:
+            s = fmi2EnterInitializationMode(c);
+            if (s != fmi2Error && mode != M_INSTANTIATED) FAIL("fmi2EnterInitializationMode answered OK once initialized");
+            if (s != fmi2Error) mode = M_INIT;
+            break;
+        case 2:
+            s = fmi2ExitInitializationMode(c);
+            if (s != fmi2Error && mode != M_INIT) FAIL("fmi2ExitInitializationMode answered OK outside initialization mode");
+            if (s != fmi2Error) mode = M_STEP;
+            break;
         case 3: { /* SetReal: a refusal changes nothing */
             fmi2ValueReference vr[3];
             double v[3];
@@ -203,6 +230,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             s = fmi2SetReal(c, nulls == 1 ? NULL : vr, n, nulls == 2 ? NULL : v);
             look(c, &b);
             if (s == fmi2Error && !same_view(&a, &b)) FAIL("a refused fmi2SetReal changed a variable or the time");
+            if (s != fmi2Error && n && mode == M_TERMINATED) FAIL("fmi2SetReal answered OK once terminated");
             if (s != fmi2Error && n)
                 for (size_t k = 0; k < n; k++)
                     if (vr[k] >= 7 && vr[k] < 16) FAIL("an undeclared value reference (7-15) set with fmi2OK");
@@ -238,6 +266,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             look(c, &b);
             if (s == fmi2Error && !same_view(&a, &b)) FAIL("a refused fmi2DoStep moved the time or an output");
             if (s != fmi2Error) {
+                if (mode != M_STEP) FAIL("fmi2DoStep answered OK outside step mode");
+                if (have_stop && a.t + h > stop_time + 1e-9 * fmax(fabs(stop_time), fabs(a.t) + h))
+                    FAIL("fmi2DoStep answered OK for a step past the stop time");
                 if (!(b.t == a.t + h)) FAIL("fmi2DoStep answered OK without moving the time by h");
                 for (int k = 0; k < OUTPUTS; k++)
                     if (b.ok[OUT_VR[k]] && !isfinite(b.v[OUT_VR[k]])) FAIL("fmi2DoStep answered OK with a non-finite output");
@@ -249,8 +280,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             else s = fmi2SetFMUstate(c, state);
             break;
         case 8: s = fmi2FreeFMUstate(c, &state); break;
-        case 9: s = fmi2Reset(c); break;
-        case 10: s = fmi2Terminate(c); break;
+        case 9:
+            s = fmi2Reset(c);
+            if (s != fmi2Error) mode = M_INSTANTIATED, have_stop = 0;
+            break;
+        case 10:
+            s = fmi2Terminate(c);
+            if (s != fmi2Error && mode != M_STEP) FAIL("fmi2Terminate answered OK outside step mode");
+            if (s != fmi2Error) mode = M_TERMINATED;
+            break;
         case 11: s = fmi2SetDebugLogging(c, byte(&r) & 1, 0, NULL); break;
         case 12: { /* the types this FMU has none of */
             fmi2ValueReference vr = pick_vr(&r);

@@ -30,8 +30,9 @@ class Program:
         i = self.vars.index(name_or_vr)
         return bytes([96 + (i - 96) % len(self.vars)])
 
-    def setup(self, tol=1e-6, start=0.0):
-        self.b += bytes([0, 3]) + num(tol) + num(start) + num(1.0)
+    def setup(self, tol=1e-6, start=0.0, stop=None):
+        self.b += bytes([0, 3 | (4 if stop is not None else 0)]) + num(tol) + num(start) + num(
+            1.0 if stop is None else stop)
 
     def enter(self):
         self.b += bytes([1])
@@ -147,6 +148,32 @@ def programs(tfm: str):
     p.step(4)
     p.raw(13, 0, 13, 1, 13, 2, 1, 12, 3, 1, 0)
     yield "refusals", p
+    # the state machine (issue 41): a stop time, calls outside their modes, states across modes
+    p = Program(tfm)
+    p.setup(stop=2e-3)
+    p.raw(10)  # terminate before the initialization: refused
+    p.enter()
+    if thermal:
+        p.set(1, 35.0)
+    p.save()  # a state from initialization mode
+    p.exit()
+    p.restore()  # ... into step mode: refused
+    p.raw(7, 1)  # a state from step mode
+    p.step(3)
+    p.step(3)  # ends on the stop time
+    p.step(3)  # past it: refused
+    p.raw(10)  # terminate
+    p.restore()  # allowed: the instance stays terminated
+    p.step(3)
+    p.set(0, 1.0)
+    p.raw(10)
+    p.raw(9)  # reset: no stop time any more
+    p.restore()  # a state from step mode into an instantiated instance: refused
+    p.setup()
+    p.enter()
+    p.exit()
+    p.step(h=1.0)
+    yield "modes", p
 
 
 def main(out: Path):
