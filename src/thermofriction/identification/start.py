@@ -121,6 +121,19 @@ def with_friction_model(model: Model, kind: str) -> Model:
     return dataclasses.replace(model, friction=cls(**kw), thermal=thermal)
 
 
+def moving_speed(experiments) -> float:
+    """The 95th percentile speed of the experiments' driving motion; a record at rest (in 95 % of its samples or
+    more) determines no friction, and is refused before any fit (InputError naming its files)."""
+    exps = list(experiments)
+    speed = np.abs(np.concatenate([np.asarray(e.drive_velocity, float) for e in exps])) if exps else np.zeros(0)
+    top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
+    if not top > 0:
+        files = ", ".join(str(e.file) for e in exps[:3]) + (f" and {len(exps) - 3} more" if len(exps) > 3 else "")
+        raise InputError(f"{files}: the motion does not move (at rest in 95 % of the samples or more): no friction "
+                         f"can be taken from it")
+    return top
+
+
 def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None) -> dict:
     """A [friction] section of ``kind`` with starting values read off the data:
 
@@ -138,9 +151,7 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     F = np.concatenate([e.force for e in exps])
     x = [np.asarray(e.displacement, float) for e in exps]
     speed = np.abs(v)
-    top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
-    if not top > 0:
-        raise InputError(f"{exps[0].file}: the motion does not move: no friction can be taken from it")
+    top = moving_speed(exps)
     sliding = speed > 0.02 * top
     fast = sliding & (speed >= np.median(speed[sliding]))
     both_ways = np.any(v[fast] > 0) and np.any(v[fast] < 0)
@@ -194,4 +205,4 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     return with_friction_model(start, kind).friction.to_dict()
 
 
-__all__ = ["lugre_start", "force_start", "with_friction_model"]
+__all__ = ["lugre_start", "force_start", "moving_speed", "with_friction_model"]
