@@ -13,15 +13,15 @@ import numpy as np
 from .._lazy import lazy
 from ..data.force import units_of
 from ..data.motion import with_v_smooth
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..models import LuGre, Model, PrescribedMotion, StickSlipPlant, load_model
-from ..measurements.command import (MIN_DELAY_SAMPLES, DelaySearch, acceleration, applied_delay, coulomb_columns, delay_scan, nuisance_columns,
-                                    shifted)
+from ..measurements.command import (MIN_DELAY_SAMPLES, DelaySearch, acceleration, applied_delay, check_within_scan,
+                                    coulomb_columns, delay_scan, nuisance_columns, scan_grid, shifted)
 from ..measurements.force import FD_RTOL, Force
 from ..models.plants import rotary_unit
 from .parameters import get_value
 from .problem import Problem, make_traces
-from .start import force_start, lugre_start, with_friction_model
+from .start import force_start, lugre_start, moving_speed, with_friction_model
 
 stats = lazy("scipy.stats")
 
@@ -75,6 +75,7 @@ def force_initial(init, method, data, experiments, *, friction=None, free=(), pr
         init = with_friction_model(init, friction)
     if init.heat is not None:
         raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet")
+    moving_speed(experiments)  # a record at rest is refused whatever the initial model (it determines nothing)
     return _v_smooth_from_data(init, experiments)
 
 
@@ -183,12 +184,14 @@ def command_initial(init, method, data, experiments, **options):
     gets J0 and the delay (applied only beyond about a sample)."""
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
+    moving_speed(experiments)
     d0, _, coef, _ = delay_scan(experiments, [coulomb_columns(e) for e in experiments])
     adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * acceleration(e))
                 for e in experiments]
     init = force_initial(init, method, data, adjusted, **options)
     columns = [np.column_stack([coulomb_columns(e), Force().friction_of(init, e)]) for e in experiments]
     delay, _, coef, dt = delay_scan(experiments, columns)
+    check_within_scan(delay, *scan_grid([e.time for e in experiments]))
     plant = dataclasses.replace(init.plant, inertia=max(float(coef[0]), 0.0), delay=applied_delay(delay, dt))
     return dataclasses.replace(init, plant=plant)
 
@@ -210,6 +213,8 @@ def command_finish(res, experiments, init, measurement):
     r, _ = Problem(res.model, [], plain, rtol=FD_RTOL, parallel=len(plain) > 1).evaluate(np.array([]), jac=False)
     estimate, _, se = search.best(r + m) if r is not None else (math.nan, None, math.nan)
     delay = estimate if res.model.plant.delay and math.isfinite(estimate) else 0.0
+    if delay:  # the fitted friction's delay too (the fit searched it): not at the search's end
+        check_within_scan(delay, search.dt, int(search.ks[-1]))
     X = search.shift(nuisance_columns(traces, policy), delay)
     if delay:  # the delay's column, so that its error has the friction's in it: d(model at t + delay)/d delay
         X = np.column_stack([X, _delay_column(search, r + m, X, m, delay)])
@@ -235,14 +240,24 @@ def command_finish(res, experiments, init, measurement):
                        "note": "fitted with the friction (the model's friction and acceleration taken at t + delay)"
                        if delay else f"not applied: the estimate before the fit was within {MIN_DELAY_SAMPLES:g} "
                                      f"sampling interval ({search.dt * 1e3:.3g} ms)"}}
+    _check_inertia(inertia, plant["inertia"]["unit"])
     model = dataclasses.replace(res.model, plant=dataclasses.replace(
-        res.model.plant, inertia=max(inertia["value"], 0.0), sensor_offset=offset["value"], delay=delay))
+        res.model.plant, inertia=inertia["value"], sensor_offset=offset["value"], delay=delay))
     out = completed(res, model, offset, unit)
     out.details["plant"] = plant
-    if not inertia["value"] > 0:
-        out.warnings.append(f"the fitted inertia is not positive ({inertia['value']:.4g} {plant['inertia']['unit']}): "
-                            f"the motion's acceleration does not explain the command; the model holds 0")
     return out
+
+
+def _check_inertia(inertia: dict, unit: str) -> None:
+    """A moving part has a positive inertia: a fit that lands on none or a negative one failed (its model could
+    not predict a command; validate refuses it), ComputationError saying so."""
+    if not inertia["value"] > 0:
+        lo, hi = inertia["ci95"]
+        raise ComputationError(
+            f"the fitted inertia is not positive ({inertia['value']:.4g} {unit}, 95 %: [{lo:.4g}, {hi:.4g}]): the "
+            f"motion's acceleration does not explain the command. Check that the position resolves the acceleration "
+            f"(a velocity column helps), the command's sign and torque constant, and that the command and the motion "
+            f"are recorded on the same clock (docs/force-data.md#drives-without-a-torque-sensor)")
 
 
 def _delay_column(search, F, X, m, delay):

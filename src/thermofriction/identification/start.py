@@ -121,6 +121,34 @@ def with_friction_model(model: Model, kind: str) -> Model:
     return dataclasses.replace(model, friction=cls(**kw), thermal=thermal)
 
 
+#: a position that stays within this many steps of its resolution dithers at rest (an encoder's last count
+#: flickering): its "motion" is quantisation noise, and a fit to it determines nothing (issue 41)
+MIN_TRAVEL_STEPS = 2
+
+
+def _travel_in_steps(x) -> float:
+    """The position's range in steps of its resolution (the least change between samples); 0 if it never moves."""
+    steps = np.abs(np.diff(np.asarray(x, float)))
+    steps = steps[steps > 0]
+    return float(np.ptp(x)) / float(steps.min()) if steps.size else 0.0
+
+
+def moving_speed(experiments) -> float:
+    """The 95th percentile speed of the experiments' driving motion. Records at rest determine no friction and are
+    refused before any fit (InputError naming their files): at rest in 95 % of the samples or more, or every
+    position within MIN_TRAVEL_STEPS steps of its resolution."""
+    exps = list(experiments)
+    speed = np.abs(np.concatenate([np.asarray(e.drive_velocity, float) for e in exps])) if exps else np.zeros(0)
+    top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
+    why = "at rest in 95 % of the samples or more" if not top > 0 else (
+        f"the position stays within {MIN_TRAVEL_STEPS} steps of its resolution, a dither at rest"
+        if all(_travel_in_steps(e.displacement) <= MIN_TRAVEL_STEPS for e in exps) else None)
+    if why:
+        files = ", ".join(str(e.file) for e in exps[:3]) + (f" and {len(exps) - 3} more" if len(exps) > 3 else "")
+        raise InputError(f"{files}: the motion does not move ({why}): no friction can be taken from it")
+    return top
+
+
 def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None) -> dict:
     """A [friction] section of ``kind`` with starting values read off the data:
 
@@ -138,9 +166,7 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     F = np.concatenate([e.force for e in exps])
     x = [np.asarray(e.displacement, float) for e in exps]
     speed = np.abs(v)
-    top = float(np.quantile(speed, 0.95)) if speed.size else 0.0
-    if not top > 0:
-        raise InputError(f"{exps[0].file}: the motion does not move: no friction can be taken from it")
+    top = moving_speed(exps)
     sliding = speed > 0.02 * top
     fast = sliding & (speed >= np.median(speed[sliding]))
     both_ways = np.any(v[fast] > 0) and np.any(v[fast] < 0)
@@ -194,4 +220,4 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     return with_friction_model(start, kind).friction.to_dict()
 
 
-__all__ = ["lugre_start", "force_start", "with_friction_model"]
+__all__ = ["lugre_start", "force_start", "moving_speed", "MIN_TRAVEL_STEPS", "with_friction_model"]

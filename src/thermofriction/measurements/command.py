@@ -34,7 +34,7 @@ import numpy as np
 from .._lazy import lazy
 from ..data.force import ForceExperiment
 from ..data.motion import on_uniform_grid
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from .base import Trace
 from .force import FORCE_ADVICE, Force
 
@@ -116,6 +116,27 @@ def linear_fit(experiments, columns, delay: float, rows=None):
     return coef, float(res @ res), u.size
 
 
+def scan_grid(times) -> tuple[float, int]:
+    """The delay scan's grid over records sampled at ``times`` (one array per record): (the median sampling
+    interval [s], K) -- whole intervals from -K to K, K spanning MAX_DELAY, at most MAX_DELAY_SAMPLES and a quarter
+    of the shortest record."""
+    dt = float(np.median(np.concatenate([np.diff(np.asarray(t, float)) for t in times])))
+    return dt, max(1, min(int(round(MAX_DELAY / dt)), MAX_DELAY_SAMPLES, min(len(t) for t in times) // 4))
+
+
+def check_within_scan(delay: float, dt: float, K: int) -> None:
+    """A delay at the end of the scan is no estimate: the least residuals lie beyond what the scan covers (the
+    command and the motion misaligned by more, or a motion that does not determine a delay), and the fit would
+    take the misalignment up with the inertia and the friction (issue 41: a command 0.5 s late fitted a negative
+    inertia). ComputationError saying so."""
+    if abs(delay) >= K * dt * (1 - 1e-9):  # (at the end, no parabola: exactly K dt)
+        raise ComputationError(
+            f"the command and the motion look misaligned in time by {K * dt * 1e3:.4g} ms or more: the delay search's "
+            f"least residuals lie at its end ({delay * 1e3:.4g} ms; it spans {MAX_DELAY * 1e3:g} ms either way, at "
+            f"most a quarter of the shortest record), or the motion does not determine a delay. Check that the "
+            f"command and the motion are recorded on the same clock (docs/force-data.md#drives-without-a-torque-sensor)")
+
+
 def delay_scan(experiments, columns):
     """The delay of the commands on the motion: the sum of squared residuals of :func:`linear_fit` on whole
     sampling intervals either way (MAX_DELAY), a parabola through the least and its neighbours for the fraction.
@@ -123,9 +144,7 @@ def delay_scan(experiments, columns):
     what a rough friction model gets wrong, and a delay would take it up. Returns (delay [s], its standard error
     from the parabola's curvature, the coefficients there, the sampling interval)."""
     exps = list(experiments)
-    dt = float(np.median(np.concatenate([np.diff(np.asarray(e.time, float)) for e in exps])))
-    shortest = min(len(e.time) for e in exps)
-    K = max(1, min(int(round(MAX_DELAY / dt)), MAX_DELAY_SAMPLES, shortest // 4))
+    dt, K = scan_grid([e.time for e in exps])
     ks = np.arange(-K, K + 1)
     rows = [sliding(e) for e in exps]
     cost = np.array([linear_fit(exps, columns, k * dt, rows)[1] for k in ks])
@@ -173,8 +192,7 @@ class DelaySearch:
     def __init__(self, traces, policy: str, search: bool = True):
         self.traces = traces
         self.edges = np.cumsum([0] + [tr.n_residuals for tr in traces])
-        self.dt = float(np.median(np.concatenate([np.diff(tr.time) for tr in traces])))
-        K = max(1, min(int(round(MAX_DELAY / self.dt)), MAX_DELAY_SAMPLES, min(tr.time.size for tr in traces) // 4))
+        self.dt, K = scan_grid([tr.time for tr in traces])
         self.ks = np.arange(-K, K + 1) if search else np.array([0])
         held = [tr.held_offset if policy == "none" else 0.0 for tr in traces]
         self.u = np.concatenate([tr.command - h for tr, h in zip(traces, held)])
@@ -307,4 +325,4 @@ class Command(Force):
 
 
 __all__ = ["Command", "CommandTrace", "DelaySearch", "implied_friction", "acceleration", "shifted", "delay_scan", "linear_fit", "coulomb_columns",
-           "applied_delay", "nuisance_columns", "ACCEL_WINDOW", "MAX_DELAY", "MIN_DELAY_SAMPLES"]
+           "applied_delay", "nuisance_columns", "scan_grid", "check_within_scan", "ACCEL_WINDOW", "MAX_DELAY", "MIN_DELAY_SAMPLES"]
