@@ -30,6 +30,9 @@ def ripple_keys(table, where="[friction]") -> dict:
     if "period" not in table:
         raise InputError(f"{where}: 'ripple' needs its 'period' (one revolution, a screw pitch, ... in m or rad)")
     out = {"ripple_period": num(table["period"], where, "ripple.period")}
+    if not out["ripple_period"] > 0:
+        raise InputError(f"{where}: 'ripple.period' must be positive (one revolution, a screw pitch, ... in m or rad), "
+                         f"got {out['ripple_period']!r}")
     for f in ("cos", "sin"):
         if f not in table:  # absent: no amplitudes of that kind (each 0), as docs/models.md says
             continue

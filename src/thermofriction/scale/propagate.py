@@ -89,10 +89,12 @@ def _covariance(result):
     with np.errstate(over="ignore"):
         reach = np.abs(centre) + _REACH * sd
         reach = np.where(log, np.exp(reach), reach)
-    bad = [n for n, r in zip(names, reach) if not np.isfinite(r)]
+    bad = [k for k, r in enumerate(reach) if not np.isfinite(r)]
     if bad:
-        raise InputError(f"'{bad[0]}': its standard error is too large to draw from (its draws would overflow the "
-                         f"floating-point range): fix it, or fit it on more informative data")
+        k = bad[0]
+        raise InputError(f"'{names[k]}': its standard error ({se[k]:.3g}{' = %.3g x its value' % sd[k] if log[k] else ''}"
+                         f") is too large to draw from (draws within 10 sd would overflow the floating-point range): "
+                         f"hold it, or fit it on more informative data")
     return names, centre, corr * np.outer(sd, sd), log
 
 
