@@ -74,10 +74,14 @@ def _fraction(text):
 def cmd_propagate(args) -> int:
     """The bands are computed, then written (nothing is written on a failure or Ctrl-C)."""
     from ..scale.cluster import progress_bar
-    from ..scale.propagate import propagate
+    from ..scale.propagate import check_drawable, propagate
     from .fits import load_fit
 
     fit = load_fit(args.fit)
+    try:  # the fit's uncertainty, before any work: the message names the file
+        check_drawable(fit)
+    except InputError as e:
+        raise InputError(f"{args.fit}: {e}") from None
     waveform = parse_waveform(args.input) if args.input else None
     if waveform is None and fit.model.input is None:
         raise InputError(f"{args.fit}: the fitted model has no [input]: give --input")

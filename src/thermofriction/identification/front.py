@@ -20,6 +20,7 @@ from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
 from ..models import Model
+from ..models.sides import needs_period
 from ..simulation import StepSizeController
 from .parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
@@ -144,7 +145,9 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
     experiments = list(getattr(data, "fit", data))
     initial, finish = SETUP[measurement.name]
+    source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
     init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure)
+    needs_period(list(parameters or ()), init.friction.values(), source)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)

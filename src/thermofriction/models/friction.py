@@ -12,7 +12,7 @@ import numpy as np
 from .._bridge import PARAMETER_UNITS, PARAMETERS
 from ..errors import InputError, shorten, unknown_keys
 from ._parse import num, num_array
-from .sides import NEGATIVE_SIDE, check_sides, ripple_keys, side_values
+from .sides import NEGATIVE_SIDE, check_sides, side_values, with_ripple_table
 
 # PARAMETERS and PARAMETER_UNITS (the one table of units: files, reports and fit results use it) come
 # from the core's parameter list (friction.h, TF_PARAMETERS).
@@ -70,10 +70,8 @@ class _Friction(_Ripple):
 
     @classmethod
     def from_dict(cls, d: dict, where="[friction]"):
-        d = dict(d)
+        d = with_ripple_table(dict(d), where)
         d.pop("model", None)
-        if "ripple" in d:
-            d.update(ripple_keys(d.pop("ripple"), where))
         allowed = [f.name for f in fields(cls)]
         unknown = set(d) - set(allowed)
         if unknown:

@@ -30,12 +30,40 @@ def ripple_keys(table, where="[friction]") -> dict:
     if "period" not in table:
         raise InputError(f"{where}: 'ripple' needs its 'period' (one revolution, a screw pitch, ... in m or rad)")
     out = {"ripple_period": num(table["period"], where, "ripple.period")}
+    if not out["ripple_period"] > 0:
+        raise InputError(f"{where}: 'ripple.period' must be positive (one revolution, a screw pitch, ... in m or rad), "
+                         f"got {out['ripple_period']!r}")
     for f in ("cos", "sin"):
-        amps = list(num_array(table.get(f, []), where, f"ripple.{f}"))
+        if f not in table:  # absent: no amplitudes of that kind (each 0), as docs/models.md says
+            continue
+        amps = list(num_array(table[f], where, f"ripple.{f}"))
         if len(amps) > RIPPLE_ORDER:
             raise InputError(f"{where}: 'ripple.{f}' has {len(amps)} amplitudes; at most {RIPPLE_ORDER} harmonics")
         out.update({f"ripple_{f}{k + 1}": float(a) for k, a in enumerate(amps)})
     return out
+
+
+def with_ripple_table(d: dict, where="[friction]") -> dict:
+    """A [friction] section with its ``ripple`` table (if any) as the flat keys; a key given both ways is refused
+    (the table would silently replace the flat value)."""
+    if "ripple" not in d:
+        return d
+    d = dict(d)
+    flat = ripple_keys(d.pop("ripple"), where)
+    both = sorted(set(flat) & set(d))
+    if both:
+        raise InputError(f"{where}: '{both[0]}' is given both as a key and in the 'ripple' table; give it once")
+    return {**d, **flat}
+
+
+def needs_period(names, values: dict, where: str):
+    """Ripple amplitudes (among ``names``: given or to be fitted) need the ripple's period, which is given, not
+    fitted: InputError naming ``where`` (the model) where it has none."""
+    amps = [n for n in names if n in RIPPLE_AMPLITUDES]
+    if amps and values.get("ripple_period") is None:
+        raise InputError(f"{where}: ripple amplitudes ({', '.join(amps)}) need the ripple's period in the model "
+                         f"([friction] ripple = {{ period = ..., cos = [...], sin = [...] }}: one revolution, a screw "
+                         f"pitch, ... in m or rad)")
 
 
 def side_values(values: dict) -> dict:
@@ -69,6 +97,4 @@ def check_sides(values: dict, where: str, check_side):
     for name in amps:
         if not (isinstance(values[name], (int, float)) and math.isfinite(values[name])):
             raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(values[name])}")
-    if amps and values.get("ripple_period") is None:
-        raise InputError(f"{where}: ripple amplitudes ({', '.join(amps)}) need the ripple's period "
-                         f"(ripple = {{ period = ..., cos = [...], sin = [...] }})")
+    needs_period(amps, values, where)

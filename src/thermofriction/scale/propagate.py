@@ -32,8 +32,42 @@ from .sweep import check_run_options
 MAX_DRAWS = 1_000_000
 
 
+#: how far a correlation matrix may stray from one by rounding (a fit's is exact to ~1e-15): a negative eigenvalue
+#: down to -ROUNDING is taken as zero (the draws' square root clips it), anything further is refused
+ROUNDING = 1e-8
+#: draws stay within this many standard deviations of the centre (P(|z| > 10) = 2e-23 a draw): a spread whose
+#: 10-sd range overflows a float is refused rather than drawn into infinities
+_REACH = 10.0
+
+
+def check_correlation(corr, names):
+    """InputError unless ``corr`` is a correlation matrix of ``names``: square, finite, symmetric, unit
+    diagonal, entries in [-1, 1], positive semi-definite (to ROUNDING). The message names the key 'correlation'."""
+    corr = np.asarray(corr, float)
+    n = len(names)
+    if corr.shape != (n, n) or not np.all(np.isfinite(corr)):
+        raise InputError(f"the fit's 'correlation' matrix must be {n} x {n} and finite ({', '.join(names)}): its "
+                         f"uncertainty cannot be propagated")
+    i, j = np.unravel_index(np.argmax(np.abs(corr - corr.T)), corr.shape)
+    if abs(corr[i, j] - corr[j, i]) > ROUNDING:
+        raise InputError(f"the fit's 'correlation' is not symmetric: C({names[i]}, {names[j]}) = {corr[i, j]:.6g} but "
+                         f"C({names[j]}, {names[i]}) = {corr[j, i]:.6g}")
+    k = int(np.argmax(np.abs(np.diag(corr) - 1.0)))
+    if abs(corr[k, k] - 1.0) > ROUNDING:
+        raise InputError(f"the fit's 'correlation' must have 1 on its diagonal: C({names[k]}, {names[k]}) = "
+                         f"{corr[k, k]:.6g}")
+    i, j = np.unravel_index(np.argmax(np.abs(corr)), corr.shape)
+    if abs(corr[i, j]) > 1.0 + ROUNDING:
+        raise InputError(f"the fit's 'correlation' must lie in [-1, 1]: C({names[i]}, {names[j]}) = {corr[i, j]:.6g}")
+    low = float(np.linalg.eigvalsh((corr + corr.T) / 2)[0])
+    if low < -ROUNDING:
+        raise InputError(f"the fit's 'correlation' is not positive semi-definite (smallest eigenvalue {low:.3g}): "
+                         f"no parameter set has these correlations")
+
+
 def _covariance(result):
-    """(names, centre in the drawing space, covariance there, which are drawn in log space)."""
+    """(names, centre in the drawing space, covariance there, which are drawn in log space); InputError, before any
+    work, where the fit's uncertainty cannot be drawn from."""
     varying = [p for p in result.parameters.values() if p.vary]
     if not varying:
         raise InputError("the fit has no fitted parameters: nothing to propagate")
@@ -44,13 +78,30 @@ def _covariance(result):
     if bad:
         raise InputError(f"'{bad[0]}' has no finite standard error (not identifiable from the fit's data): its "
                          f"uncertainty cannot be propagated; fix it or fit it on more informative data")
+    bad = [(n, s) for n, s in zip(names, se) if s < 0]
+    if bad:
+        raise InputError(f"'{bad[0][0]}': its standard error must be 0 or more, got {bad[0][1]!r}")
     corr = np.array(result.correlation, float)[:len(names), :len(names)]
-    if corr.shape != (len(names), len(names)) or not np.all(np.isfinite(corr)):
-        raise InputError("the fit's correlation matrix is missing or not finite: its uncertainty cannot be propagated")
+    check_correlation(corr, names)
     log = np.array([p.positive for p in varying])
     centre = np.where(log, np.log(np.where(log, theta, 1.0)), theta)
     sd = np.where(log, se / np.where(log, theta, 1.0), se)  # log space: the relative error, to first order
+    with np.errstate(over="ignore"):
+        reach = np.abs(centre) + _REACH * sd
+        reach = np.where(log, np.exp(reach), reach)
+    bad = [k for k, r in enumerate(reach) if not np.isfinite(r)]
+    if bad:
+        k = bad[0]
+        raise InputError(f"'{names[k]}': its standard error ({se[k]:.3g}{' = %.3g x its value' % sd[k] if log[k] else ''}"
+                         f") is too large to draw from (draws within 10 sd would overflow the floating-point range): "
+                         f"hold it, or fit it on more informative data")
     return names, centre, corr * np.outer(sd, sd), log
+
+
+def check_drawable(result):
+    """InputError, before any work, where the fit's uncertainty cannot be drawn from (what :func:`propagate`
+    refuses: no finite or a negative standard error, a correlation that is not one, a spread that overflows)."""
+    _covariance(result)
 
 
 def draw_parameters(result, draws: int, seed: int = 0):
@@ -210,6 +261,11 @@ def load_propagation(path) -> PropagationResult:
         values[f.name] = v
     res = PropagationResult(**values)
     n_T, n_t = res.temperatures.size, res.time.size
+    # the axes first: an empty or unordered one would fail in the report's figures, after its work
+    if res.temperatures.ndim != 1 or not n_T or not np.all(np.isfinite(res.temperatures)):
+        raise InputError(f"{path}: 'temperatures' must be a non-empty list of finite numbers [C]")
+    if res.time.ndim != 1 or not n_t or not np.all(np.isfinite(res.time)) or not np.all(np.diff(res.time) > 0):
+        raise InputError(f"{path}: 'time' must be a non-empty, increasing list of finite times [s]")
     for name in ("nominal", "median", "lower", "upper", "prediction_lower", "prediction_upper"):
         if getattr(res, name).shape != (n_T, n_t):
             raise InputError(f"{path}: '{name}' must have one row of {n_t} samples per temperature ({n_T})")
@@ -235,6 +291,7 @@ def _checked(result, temperatures, draws, seed, input, duration, sample_rate, le
     model = getattr(result, "model", None)
     if model is None or not hasattr(result, "parameters"):
         raise InputError(f"result must be a fit (tf.identify's FitResult), got {shorten(result)}")
+    check_drawable(result)  # before the nominal runs
     if isinstance(draws, bool) or not isinstance(draws, numbers.Integral) or not 2 <= draws <= MAX_DRAWS:
         raise InputError(f"draws must be a whole number from 2 to {MAX_DRAWS}, got {shorten(draws)}")
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
@@ -313,4 +370,4 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
         wall_time=time.perf_counter() - t0, where=where)
 
 
-__all__ = ["propagate", "PropagationResult", "draw_parameters", "load_propagation"]
+__all__ = ["propagate", "PropagationResult", "draw_parameters", "load_propagation", "check_drawable"]
