@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 from conftest import run_cli
 
 
@@ -49,7 +50,7 @@ def test_sigterm_during_demo_leaves_no_folders(tmp_path):
     """Before: `demo/` and `demo/data/` stayed (empty) while the message said no output was written."""
     out = tmp_path / "new" / "demo"
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "demo", "-o", out], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_signals)
     lines = []
     try:
         for line in proc.stderr:  # progress lines (stderr is a pipe): wait until identification runs
