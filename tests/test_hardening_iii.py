@@ -171,19 +171,6 @@ def test_synthesize_reports_progress_after_each_experiment():
     assert seen == [(1, 3), (2, 3), (3, 3)]
 
 
-def test_synth_prints_progress_lines_on_a_pipe_during_a_long_run(tmp_path, monkeypatch):
-    from thermofriction.data import synth
-    monkeypatch.setattr(synth, "PROGRESS_INTERVAL", 0.0)  # every experiment counts as "long"
-    import io
-    err = io.StringIO()
-    monkeypatch.setattr(sys, "stderr", err)
-    update, stop = synth._progress(3)
-    for k in (1, 2, 3):
-        update(k, 3)
-    stop()
-    assert err.getvalue().splitlines() == ["  synth: 1 of 3 experiments, 0 s", "  synth: 2 of 3 experiments, 0 s"]
-
-
 # -- force data from a stuck load cell ------------------------------------------------------------
 
 def _force_dataset(folder, force, header="friction_force[N]", position="position[m]"):
