@@ -71,3 +71,132 @@ def test_every_test_that_signals_a_child_sets_the_childs_dispositions():
                     missing.append(f"{path.name}:{call.lineno} ({name})")
     assert checked >= 7, checked  # the rule sees the tests it is about
     assert not missing, missing
+
+
+# -- progress in a pipe or a log -------------------------------------------------------------------
+
+import io  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+import time  # noqa: E402
+
+import pytest  # noqa: E402
+
+import thermofriction as tf  # noqa: E402
+from thermofriction import _progress  # noqa: E402
+from thermofriction._progress import INTERVAL_ENV, Progress  # noqa: E402
+
+ANSI = re.compile(r"\x1b|\r")  # a terminal's escapes and carriage returns: none in a log
+#: [s] the interval the tests set: the commands below run for several of it
+SHORT = 0.2
+
+
+def _cli(*args, interval=SHORT, cwd=None):
+    """The command line as a job under a scheduler runs it: stdout and stderr are pipes."""
+    env = {**os.environ, INTERVAL_ENV: str(interval)}
+    return subprocess.run([sys.executable, "-m", "thermofriction", *map(str, args)], capture_output=True, text=True,
+                          env=env, cwd=cwd, timeout=300)
+
+
+def _progress_lines(stderr, label):
+    return [line for line in stderr.splitlines() if line.startswith(f"thermofriction: {label}: ")]
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    """A base fit (identify -o --json) of synthesised data, identify's stderr kept."""
+    folder = tmp_path_factory.mktemp("progress")
+    tf.save_dataset(tf.synthesize(tf.load_model("li2009-model-i"), [31.0, 41.0], duration=0.4, sample_rate=2000,
+                                  seed=2), folder / "data")
+    r = _cli("identify", folder / "data", "--method", "base", "--starts", "1", "-o", folder / "fit.toml",
+             "--json", folder / "fit.json", interval=0.05)
+    assert r.returncode == 0, r.stderr
+    return folder, r
+
+
+def test_propagate_in_a_pipe_prints_plain_lines_with_the_time_left(fitted):
+    """Before: 1,000 draws printed nothing in 100 s when stderr was not a terminal."""
+    folder, _ = fitted
+    t0 = time.monotonic()
+    r = _cli("propagate", folder / "fit.json", "--temperatures", "33,38", "--draws", "40", "--duration", "0.4",
+             "--workers", "1")
+    took = time.monotonic() - t0
+    assert r.returncode == 0, r.stderr
+    lines = _progress_lines(r.stderr, "propagate")
+    assert took > 6 * SHORT and len(lines) >= 2, (took, r.stderr)
+    assert not ANSI.search(r.stderr), repr(r.stderr)
+    counted = [re.fullmatch(r"thermofriction: propagate: (\d+) of 40 draws \((\d+) %\) in .+", x) for x in lines]
+    assert all(counted), lines
+    assert [int(m.group(1)) for m in counted] == sorted(int(m.group(1)) for m in counted)
+    assert any(re.search(r", about (under 1 s|\d+ s|\d+ min \d+ s) left$", x) for x in lines), lines
+    assert len(lines) <= took / SHORT + 1  # at most one a interval
+
+
+def test_identify_in_a_pipe_says_what_it_is_doing(fitted):
+    """Before: identify on a pipe printed each stage as it began (none while a stage or the reading of a large
+    file lasted): now a line every interval, naming the stage, with the time so far."""
+    _, r = fitted
+    lines = _progress_lines(r.stderr, "identify")
+    assert lines and all(re.search(r"; (under 1 s|\d+ s) so far$", x) for x in lines), r.stderr
+    assert not ANSI.search(r.stderr) and "Traceback" not in r.stderr
+
+
+def test_quick_work_and_quiet_print_no_progress(tmp_path):
+    """Work shorter than the interval prints no line; --quiet none however long."""
+    grid = ("--grid", "temperature=30:41.5:0.1", "--duration", "0.5")  # ~0.5 s of work
+    quick = _cli("sweep", "li2009-model-i", *grid, "-o", tmp_path / "a.csv", interval=30)
+    assert quick.returncode == 0 and quick.stderr == "", quick.stderr
+    quiet = _cli("sweep", "li2009-model-i", *grid, "-q", "-o", tmp_path / "b.csv", interval=0.01)
+    assert quiet.returncode == 0 and quiet.stderr == "", quiet.stderr
+    shown = _cli("sweep", "li2009-model-i", *grid, "-o", tmp_path / "c.csv", interval=0.01)
+    assert _progress_lines(shown.stderr, "sweep"), shown.stderr  # the same work, with lines: the two above count
+
+
+def test_synth_in_a_pipe_counts_experiments(tmp_path):
+    r = _cli("synth", "li2009-model-i", "--temperatures", "30,32,34,36,38,40", "--duration", "1",
+             "--sample-rate", "20000", "-o", tmp_path / "d", interval=0.05)
+    assert r.returncode == 0, r.stderr
+    lines = _progress_lines(r.stderr, "synth")
+    assert lines and all(re.search(r"(\d+) of 6 experiments", x) for x in lines), r.stderr
+    assert not ANSI.search(r.stderr)
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "soon", "nan", "inf"])
+def test_a_bad_interval_is_one_message_naming_the_variable(tmp_path, value):
+    r = _cli("sweep", "li2009-model-i", "--grid", "temperature=30:31:1", "--duration", "0.1", "-o",
+             tmp_path / "s.csv", interval=value)
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert len(r.stderr.splitlines()) == 1 and INTERVAL_ENV in r.stderr and repr(value) in r.stderr, r.stderr
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_the_plain_line_and_its_estimate(monkeypatch):
+    """The line's arithmetic: what, how far, the time so far and the time left from the rate so far."""
+    monkeypatch.setenv(INTERVAL_ENV, "1000")  # no line from the clock during this test
+    p = Progress("propagate", 1000, "draws", stream=io.StringIO(), terminal=False)
+    try:
+        t0 = p._t0
+        assert p.line(t0 + 3) == "thermofriction: propagate: 0 of 1,000 draws (0 %) in 3 s, time left not known yet"
+        p.count(250)
+        assert p.line(t0 + 100) == ("thermofriction: propagate: 250 of 1,000 draws (25 %) in 1 min 40 s, "
+                                    "about 5 min 0 s left")
+        p.stage("reading big.csv")
+        assert p.line(t0 + 7300).startswith("thermofriction: propagate: reading big.csv; 250 of 1,000 draws (25 %) "
+                                             "in 2 h 1 min, about 6 h 5 min left")
+    finally:
+        p.stop()
+    assert p._stream.getvalue() == ""
+    assert _progress.duration(0.4) == "under 1 s"
+
+
+def test_lines_come_from_the_clock_while_a_stage_lasts_and_stop_with_the_work(monkeypatch):
+    """A stage that lasts several intervals without a call gets a line per interval; none after stop()."""
+    monkeypatch.setenv(INTERVAL_ENV, "0.05")
+    out = io.StringIO()
+    with Progress("identify", stream=out, terminal=False) as p:
+        p.stage("Model I: per-temperature fits")
+        time.sleep(0.5)
+    n = len(out.getvalue().splitlines())
+    time.sleep(0.2)
+    assert len(out.getvalue().splitlines()) == n and 3 <= n <= 11, out.getvalue()
+    assert out.getvalue().splitlines()[0].startswith("thermofriction: identify: Model I: per-temperature fits; ")
