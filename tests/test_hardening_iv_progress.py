@@ -4,11 +4,18 @@ a background job (``nohup make test &``)."""
 from __future__ import annotations
 
 import ast
+import io
+import os
+import re
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
+import pytest
+
+import thermofriction as tf
 from child_signals import SENT
 
 TESTS = Path(__file__).resolve().parent
@@ -75,16 +82,7 @@ def test_every_test_that_signals_a_child_sets_the_childs_dispositions():
 
 # -- progress in a pipe or a log -------------------------------------------------------------------
 
-import io  # noqa: E402
-import os  # noqa: E402
-import re  # noqa: E402
-import time  # noqa: E402
-
-import pytest  # noqa: E402
-
-import thermofriction as tf  # noqa: E402
-from thermofriction import _progress  # noqa: E402
-from thermofriction._progress import INTERVAL_ENV, Progress  # noqa: E402
+INTERVAL_ENV = "THERMOFRICTION_PROGRESS_INTERVAL"  # the documented name (docs/cli.md#progress)
 
 ANSI = re.compile(r"\x1b|\r")  # a terminal's escapes and carriage returns: none in a log
 #: [s] the interval the tests set: the commands below run for several of it
@@ -172,6 +170,8 @@ def test_a_bad_interval_is_one_message_naming_the_variable(tmp_path, value):
 
 def test_the_plain_line_and_its_estimate(monkeypatch):
     """The line's arithmetic: what, how far, the time so far and the time left from the rate so far."""
+    from thermofriction import _progress
+    from thermofriction._progress import Progress
     monkeypatch.setenv(INTERVAL_ENV, "1000")  # no line from the clock during this test
     p = Progress("propagate", 1000, "draws", stream=io.StringIO(), terminal=False)
     try:
@@ -191,6 +191,7 @@ def test_the_plain_line_and_its_estimate(monkeypatch):
 
 def test_lines_come_from_the_clock_while_a_stage_lasts_and_stop_with_the_work(monkeypatch):
     """A stage that lasts several intervals without a call gets a line per interval; none after stop()."""
+    from thermofriction._progress import Progress
     monkeypatch.setenv(INTERVAL_ENV, "0.05")
     out = io.StringIO()
     with Progress("identify", stream=out, terminal=False) as p:
