@@ -51,6 +51,10 @@ def duration(seconds: float) -> str:
     return f"{s // 3600} h {s % 3600 // 60} min"
 
 
+def _left(seconds: float) -> str:
+    return "under 1 s left" if seconds < 0.5 else f"about {duration(seconds)} left"
+
+
 class Progress:
     """``label``'s progress: ``count(done)`` of ``total`` ``unit`` (counted work), or ``stage(message)``.
 
@@ -92,7 +96,7 @@ class Progress:
             return f"{what}{duration(elapsed)} so far"
         done, total = self.done, self.total
         pct = f" ({100 * done / total:.0f} %)" if total else ""
-        left = (f", about {duration(elapsed * (total - done) / done)} left" if 0 < done < total
+        left = (f", {_left(elapsed * (total - done) / done)}" if 0 < done < total
                 else ", time left not known yet" if done == 0 else "")
         return f"{what}{done:,} of {total:,} {self.unit}{pct} in {duration(elapsed)}{left}"
 
