@@ -82,7 +82,7 @@ def test_every_test_that_signals_a_child_sets_the_childs_dispositions():
 
 # -- progress in a pipe or a log -------------------------------------------------------------------
 
-INTERVAL_ENV = "THERMOFRICTION_PROGRESS_INTERVAL"  # the documented name (docs/cli.md#progress)
+INTERVAL_ENV = "THERMOFRICTION_PROGRESS_INTERVAL"  # the documented name (docs/cli.md#environment)
 
 ANSI = re.compile(r"\x1b|\r")  # a terminal's escapes and carriage returns: none in a log
 #: [s] the interval the tests set: the commands below run for several of it
