@@ -50,12 +50,13 @@ def test_sigterm_during_demo_leaves_no_folders(tmp_path):
     """Before: `demo/` and `demo/data/` stayed (empty) while the message said no output was written."""
     out = tmp_path / "new" / "demo"
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "demo", "-o", out], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, preexec_fn=default_signals)
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_signals,
+                            env={**os.environ, "THERMOFRICTION_PROGRESS_INTERVAL": "0.05"})
     lines = []
     try:
-        for line in proc.stderr:  # progress lines (stderr is a pipe): wait until identification runs
+        for line in proc.stderr:  # progress lines (stderr is a pipe), one every 0.05 s: wait until it identifies
             lines.append(line)
-            if "identifying" in line:
+            if line.startswith("thermofriction: demo: ") and "synthesising" not in line:
                 break
         time.sleep(0.5)
         assert out.is_dir()  # the run is working in it
