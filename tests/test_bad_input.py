@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from child_signals import default_signals
 from conftest import run_cli
 
 FIT = "T35.7C.csv"  # the dataset's fit experiment: time[s],voltage[V],displacement[um],temperature[C]
@@ -263,7 +264,7 @@ def test_ctrl_c_exits_130_and_leaves_no_partial_file(tmp_path):
     out_csv = tmp_path / "out.csv"
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "simulate", "li2009-model-i", "--temperature",
                              "35", "--duration", "100", "-o", str(out_csv)], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=default_signals)
     try:
         deadline = time.monotonic() + 120
         while not list(tmp_path.glob(".out.csv.*.tmp")):  # wait until it is writing 1,000,001 rows

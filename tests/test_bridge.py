@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 from thermofriction import _bridge, _core
 from thermofriction.simulation import SOLVERS
 
@@ -143,7 +144,7 @@ def test_ctrl_c_stops_a_long_simulation_within_a_second(tmp_path):
     out = tmp_path / "long.csv"
     cmd = [sys.executable, "-m", "thermofriction", "simulate", "li2009-model-i", "--temperature", "35",
            "--duration", "1e5", "--sample-rate", "1", "--max-steps", "1000000000", "-o", str(out)]
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=default_signals)
     try:
         time.sleep(4.0)  # start-up is 0.3-2 s: by now it integrates (the whole run takes minutes)
         assert p.poll() is None, p.communicate()

@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 
 distributed = pytest.importorskip("distributed")
 
@@ -50,7 +51,8 @@ class Cluster:
         log = open(self.folder / f"{name}.log", "w")
         self.logs.append(log)
         self.procs[name] = subprocess.Popen(_dask_command() + args, stdout=log, stderr=subprocess.STDOUT,
-                                            start_new_session=True, cwd=self.folder)
+                                            start_new_session=True, cwd=self.folder,
+                                            preexec_fn=default_signals)
 
     def start(self, n_workers=2):
         file = self.folder / "scheduler.json"

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 from conftest import run_cli
 
 
@@ -49,12 +50,13 @@ def test_sigterm_during_demo_leaves_no_folders(tmp_path):
     """Before: `demo/` and `demo/data/` stayed (empty) while the message said no output was written."""
     out = tmp_path / "new" / "demo"
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "demo", "-o", out], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_signals,
+                            env={**os.environ, "THERMOFRICTION_PROGRESS_INTERVAL": "0.05"})
     lines = []
     try:
-        for line in proc.stderr:  # progress lines (stderr is a pipe): wait until identification runs
+        for line in proc.stderr:  # progress lines (stderr is a pipe), one every 0.05 s: wait until it identifies
             lines.append(line)
-            if "identifying" in line:
+            if line.startswith("thermofriction: demo: ") and "synthesising" not in line:
                 break
         time.sleep(0.5)
         assert out.is_dir()  # the run is working in it
@@ -168,19 +170,6 @@ def test_synthesize_reports_progress_after_each_experiment():
     tf.synthesize(tf.load_model("li2009-model-i"), [33.0, 35.0], validate=[34.0], duration=0.05,
                   sample_rate=1000, progress=lambda done, total: seen.append((done, total)))
     assert seen == [(1, 3), (2, 3), (3, 3)]
-
-
-def test_synth_prints_progress_lines_on_a_pipe_during_a_long_run(tmp_path, monkeypatch):
-    from thermofriction.data import synth
-    monkeypatch.setattr(synth, "PROGRESS_INTERVAL", 0.0)  # every experiment counts as "long"
-    import io
-    err = io.StringIO()
-    monkeypatch.setattr(sys, "stderr", err)
-    update, stop = synth._progress(3)
-    for k in (1, 2, 3):
-        update(k, 3)
-    stop()
-    assert err.getvalue().splitlines() == ["  synth: 1 of 3 experiments, 0 s", "  synth: 2 of 3 experiments, 0 s"]
 
 
 # -- force data from a stuck load cell ------------------------------------------------------------

@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 from conftest import run_cli
 from thermofriction import _io, _signals
 
@@ -449,7 +450,7 @@ def test_sigterm_and_sighup_while_writing_remove_the_temporary_file(sig, tmp_pat
     out_csv = tmp_path / "out.csv"
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "simulate", "li2009-model-i", "--temperature",
                              "35", "--duration", "60", "-o", str(out_csv)], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=default_signals)
     try:
         deadline = time.monotonic() + 120
         while not list(tmp_path.glob(f".out.csv{_io.TMP_TAG}*.tmp")):  # writing 600,001 rows

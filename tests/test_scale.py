@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 from thermofriction.errors import InputError
 from thermofriction.scale.chunks import CHUNK_MAX_SECONDS, CHUNK_SECONDS, chunk_spans
 from thermofriction.scale.cluster import Runner, recorded_warnings
@@ -222,7 +223,8 @@ def test_ctrl_c_stops_the_threads_and_writes_nothing(tmp_path):
     psutil = pytest.importorskip("psutil")
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "sweep", "li2009-model-i", "--grid",
                              "temperature=30:41.5:0.002", "--duration", "2", "--workers", "2", "-o", "s.csv"],
-                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_signals)
     try:
         me, deadline = psutil.Process(proc.pid), time.monotonic() + 120
         while time.monotonic() < deadline and proc.poll() is None and me.cpu_times().user < 2.0:

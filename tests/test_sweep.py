@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from child_signals import default_signals
 from thermofriction.errors import InputError
 from thermofriction.scale.sweep import parse_axis
 
@@ -201,7 +202,8 @@ def test_ctrl_c_stops_the_local_cluster_and_writes_nothing(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "thermofriction", "sweep", "li2009-model-i", "--grid",
                              "temperature=30:41.5:0.01", "--duration", "2", "--scheduler", "processes", "--workers",
                              "1", "--batch-size", "5",
-                             "-o", "s.csv"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                             "-o", "s.csv"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_signals)
     try:
         deadline, workers = time.monotonic() + 120, []
         parent = psutil.Process(proc.pid)

@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from .. import _io
+from .._progress import Progress
 from ..errors import InputError, UnitWarning
 from ..models import PRESETS, MassPlant, load_model
 from ..simulation import SOLVERS, StepSizeController, simulate
@@ -74,25 +75,6 @@ def cmd_simulate(args) -> int:
     return 0
 
 
-def _progress(quiet):
-    """A status line on a terminal; a line per stage when stderr is a file or a pipe (a CI log);
-    nothing with --quiet."""
-    if quiet:
-        return None, None
-    if not sys.stderr.isatty():
-        def line(message):
-            print(f"  {message}", file=sys.stderr, flush=True)
-        return line, None
-    from rich.console import Console
-    console = Console(stderr=True)
-    status = console.status("identifying")
-    status.start()
-
-    def update(message):
-        status.update(message)
-    return update, status
-
-
 def _identify_options(args):
     """(laws, parameters) from identify's options, checked: one dataset or a fleet alike."""
     laws = {}
@@ -142,22 +124,21 @@ def cmd_identify(args) -> int:
     if getattr(args, "scheduler", None) or getattr(args, "workers", None):
         raise InputError("--scheduler and --workers apply to fleet identification (several datasets, or a folder "
                          "of datasets); one dataset is identified in this process")
-    data = load_dataset(args.dataset, motion=args.motion)
-    laws, params = _identify_options(args)
-    init = args.init if args.init and args.init not in PRESETS else None
-    _refuse_inputs(args, _dataset_inputs(data), init, *_model_inputs(init, None))
-    update, status = _progress(args.quiet)
-    try:
+    with Progress("identify", enabled=not args.quiet) as progress:
+        progress.stage(f"reading {args.dataset}")  # a file of millions of rows takes a while
+        data = load_dataset(args.dataset, motion=args.motion)
+        laws, params = _identify_options(args)
+        init = args.init if args.init and args.init not in PRESETS else None
+        _refuse_inputs(args, _dataset_inputs(data), init, *_model_inputs(init, None))
+        progress.stage("identifying")
         fit = identify(data, args.method, init=args.init, friction=args.friction, parameters=params,
                        free=args.free or (),
                        procedure=args.procedure,
                        laws=laws or None, refine=not args.no_refine,
                        reference_temperature=args.reference_temperature,
                        controller=StepSizeController(rtol=args.rtol), starts=args.starts,
-                       seed=args.seed, progress=update, offset=_offset(args), max_evaluations=args.max_evaluations)
-    finally:
-        if status is not None:
-            status.stop()
+                       seed=args.seed, progress=progress.stage, offset=_offset(args),
+                       max_evaluations=args.max_evaluations)
     import shlex
     fit = fit.with_command("thermofriction " + shlex.join(sys.argv[1:]))  # in the model's [provenance]
     with _io.publish_together():  # the model and its JSON appear together, or neither
@@ -184,7 +165,6 @@ def _fleet_paths(args):
 def cmd_identify_fleet(args) -> int:
     """``thermofriction identify DATASET DATASET ...``: every dataset identified on the cluster; the
     fitted models, their results and the fleet summary are written together at the end."""
-    from ..scale.cluster import progress_bar
     from ..scale.fleet import identify_fleet
 
     paths = _fleet_paths(args)
@@ -196,16 +176,13 @@ def cmd_identify_fleet(args) -> int:
     laws, params = _identify_options(args)
     from ..scale.fleet import refuse_overwriting_inputs
     refuse_overwriting_inputs(args.output, paths)  # before any identification, not after all of them
-    update, stop = progress_bar(len(paths), "identify", enabled=not args.quiet)
-    try:
+    with Progress("identify", len(paths), "datasets", enabled=not args.quiet) as progress:
         fleet = identify_fleet(paths, args.method, init=args.init, friction=args.friction, parameters=params,
                                free=args.free or (), procedure=args.procedure, laws=laws or None,
                                refine=not args.no_refine, reference_temperature=args.reference_temperature,
                                controller=StepSizeController(rtol=args.rtol), starts=args.starts, seed=args.seed,
                                scheduler=args.scheduler,
-                               workers=args.workers, progress=update)
-    finally:
-        stop()
+                               workers=args.workers, progress=progress.count)
     fleet.write(args.output)
     if not args.quiet:
         print(fleet.report())
@@ -221,10 +198,13 @@ def cmd_validate(args) -> int:
     from ..validation import validate
 
     model = load_model(args.model)
-    data = load_dataset(args.dataset, motion=args.motion)
-    _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
-    with warnings.catch_warnings(action="ignore", category=UnitWarning):  # in res.warnings, printed below
-        res = validate(model, data, offset=args.offset, motion=args.motion)
+    with Progress("validate") as progress:
+        progress.stage(f"reading {args.dataset}")
+        data = load_dataset(args.dataset, motion=args.motion)
+        _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
+        progress.stage(f"predicting {len(data.experiments)} experiments")
+        with warnings.catch_warnings(action="ignore", category=UnitWarning):  # in res.warnings, printed below
+            res = validate(model, data, offset=args.offset, motion=args.motion)
     if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")
@@ -243,17 +223,13 @@ def cmd_validate(args) -> int:
 def cmd_demo(args) -> int:
     from ..demo import run_demo
 
-    update, status = _progress(False)
     new_folders = _missing_folders(args.output, "data")  # run_demo creates them; a failed run removes them
     try:
-        with _io.publish_together():  # every file of the demo appears at the end, or none
-            out = run_demo(args.output, progress=update)
+        with _io.publish_together(), Progress("demo") as progress:  # every file of the demo at the end, or none
+            out = run_demo(args.output, progress=progress.stage)
     except BaseException:  # an error, Ctrl-C, SIGTERM: the temporaries are gone, so are the folders
         _remove_empty(new_folders)
         raise
-    finally:
-        if status is not None:
-            status.stop()
     t = out["timings"]
     fits = out["fits"]
     print(f"thermofriction demo: {t['total']:.1f} s in all")
@@ -291,7 +267,6 @@ def _remove_empty(folders):
 
 def cmd_sweep(args) -> int:
     """``thermofriction sweep``: the table is written once every point has run (nothing on Ctrl-C)."""
-    from ..scale.cluster import progress_bar
     from ..scale.sweep import sweep
 
     model = load_model(args.model)
@@ -308,14 +283,11 @@ def cmd_sweep(args) -> int:
     _refuse_inputs(args, _model_inputs(args.model, model), _waveform_inputs(waveform))
     from ..scale.sweep import _grid  # the grid's size for the progress bar, checked before any work
     _, n_points = _grid(args.grid)
-    update, stop = progress_bar(n_points, "sweep", enabled=not args.quiet)
-    try:
+    with Progress("sweep", n_points, "points", enabled=not args.quiet) as progress:
         res = sweep(model, args.grid, input=waveform, duration=args.duration, temperature=args.temperature,
                     metrics=args.metrics, sample_rate=args.sample_rate, solver=SOLVERS[solver_of(args)](),
                     controller=StepSizeController(rtol=args.rtol), scheduler=args.scheduler, workers=args.workers,
-                    batch_size=args.batch_size, progress=update)
-    finally:
-        stop()
+                    batch_size=args.batch_size, progress=progress.count)
     if args.output == "-":  # the table on standard output, the summary on standard error
         res.write_csv(sys.stdout)
         sys.stdout.flush()

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .._progress import Progress
 from ..errors import InputError
 from ..simulation import SOLVERS, StepSizeController
 from ..waveforms import parse_waveform
@@ -73,7 +74,6 @@ def _fraction(text):
 
 def cmd_propagate(args) -> int:
     """The bands are computed, then written (nothing is written on a failure or Ctrl-C)."""
-    from ..scale.cluster import progress_bar
     from ..scale.propagate import check_drawable, propagate
     from .fits import load_fit
 
@@ -88,14 +88,11 @@ def cmd_propagate(args) -> int:
     if args.rtol >= 1:
         raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
     _refuse_inputs(args, args.fit, _waveform_inputs(waveform))
-    update, stop = progress_bar(args.draws, "propagate", enabled=not args.quiet)
-    try:
+    with Progress("propagate", args.draws, "draws", enabled=not args.quiet) as progress:
         res = propagate(fit, args.temperatures, draws=args.draws, seed=args.seed, input=waveform,
                         duration=args.duration, sample_rate=args.sample_rate, level=args.level,
                         solver=SOLVERS[args.solver or "auto"](), controller=StepSizeController(rtol=args.rtol),
-                        scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size, progress=update)
-    finally:
-        stop()
+                        scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size, progress=progress.count)
     if args.output:
         res.save(_target(args, "output"))
     for i, reason in list(res.failures.items())[:3]:

@@ -6,22 +6,34 @@ from __future__ import annotations
 import sys
 
 from .. import _io
+from .._progress import Progress
 from ..errors import InputError
 from ..models import load_model
 from .outputs import _dataset_inputs, _model_inputs, _refuse_inputs
 
 
 def cmd_report(args) -> int:
-    import json
-    from pathlib import Path
-
     from ..data import load_dataset
-    from ..reporting import Entry, entry_label, report
 
     if len(args.paths) < 2:
         raise InputError("report needs at least one model and a dataset: MODEL.toml... DATASET")
     *model_paths, dataset = args.paths
-    data = load_dataset(dataset, motion=args.motion)
+    with Progress("report") as progress:
+        progress.stage(f"reading {dataset}")  # a file of millions of rows takes a while
+        data = load_dataset(dataset, motion=args.motion)
+        progress.stage(f"simulating the models on {len(data.experiments)} experiments, writing {args.output}")
+        _report(args, model_paths, data)
+    print(f"wrote {args.output}" + (f" and the figures in {args.figures}" if args.figures else ""))
+    return 0
+
+
+def _report(args, model_paths, data):
+    """The models (each with its results JSON where one sits beside it) compared on ``data``, written."""
+    import json
+    from pathlib import Path
+
+    from ..reporting import Entry, entry_label, report
+
     entries = []
     inputs = list(_dataset_inputs(data)) + ([args.bands] if args.bands else [])
     bands = _bands(args.bands, data)
@@ -50,8 +62,6 @@ def cmd_report(args) -> int:
     with _io.publish_together(inputs=inputs):  # the page and its figures appear together, or none
         report(entries, data, args.output, figures_dir=args.figures, title=args.title, bands=bands,
                command="thermofriction " + " ".join(sys.argv[1:]), offset=args.offset, motion=args.motion)
-    print(f"wrote {args.output}" + (f" and the figures in {args.figures}" if args.figures else ""))
-    return 0
 
 
 def _bands(path, data):

@@ -17,6 +17,7 @@ from ..simulation import StepSizeController, simulate
 from ..waveforms import Sampled, Waveform, parse_waveform
 from .experiments import MIN_SAMPLES, Dataset, Experiment
 from .._io import publish_together
+from .._progress import Progress
 from .files import check_temperature
 from .save import check_dataset_folder, save_dataset
 
@@ -277,54 +278,31 @@ def cmd_synth(args) -> int:
     if waveform is None and model.input is None:
         raise InputError(f"{args.model}: the model has no [input] waveform: give --input, "
                          f"e.g. --input sawtooth:amplitude=30,frequency=5")
-    update, stop = _progress(len(fit_T) + len(val_T))
-    try:
-        data = synthesize(model, fit_T, validate=val_T, duration=args.duration, sample_rate=args.sample_rate,
-                          input=waveform, noise=args.noise, quantization=args.quantization,
-                          temperature_noise=args.temperature_noise, drift=args.drift,
-                          record_temperature=args.record_temperature, record_stage=args.record_stage,
-                          seed=args.seed, progress=update)
-    except InputError as e:
-        raise InputError(f"synth: {e}") from None
-    finally:
-        stop()
-    inputs = [] if args.model in PRESETS else [args.model]
-    for w in (waveform, model.input):
-        if isinstance(w, Sampled) and w.file:
-            inputs += [w.file, str(Path(args.model).parent / w.file)]
-    with publish_together(inputs=inputs):  # refuses to replace or remove an input file
-        folder = save_dataset(data, args.output, overwrite=args.force)
+    with Progress("synth", len(fit_T) + len(val_T), "experiments") as progress:
+        data = _synthesized(model, fit_T, val_T, waveform, args, progress)
+        inputs = [] if args.model in PRESETS else [args.model]
+        for w in (waveform, model.input):
+            if isinstance(w, Sampled) and w.file:
+                inputs += [w.file, str(Path(args.model).parent / w.file)]
+        progress.stage(f"writing {args.output}")
+        with publish_together(inputs=inputs):  # refuses to replace or remove an input file
+            folder = save_dataset(data, args.output, overwrite=args.force)
     for e in data.experiments:
         print(f"wrote {folder / e.file} ({e.role}, {e.temperature:g} C, {e.time.size} samples)")
     print(f"wrote {folder / 'dataset.toml'} ({len(data.fit)} fit, {len(data.validate)} validate)")
     return 0
 
 
-#: [s] on a pipe or a file (a CI log), a progress line at most this often; a shorter run prints none
-PROGRESS_INTERVAL = 5.0
-
-
-def _progress(total):
-    """(update(done, total), stop()) for synth's progress: a bar on a terminal (a run of several
-    experiments); elsewhere a line on stderr every PROGRESS_INTERVAL seconds of a long run."""
-    import sys
-    import time
-
-    if total < 2:
-        return None, (lambda: None)
-    if sys.stderr.isatty():
-        from ..scale.cluster import progress_bar  # rich, loaded only here
-        bar, stop = progress_bar(total, "synth")
-        return (lambda done, _total: bar(done)), stop
-    t0 = last = time.monotonic()
-
-    def line(done, total):
-        nonlocal last
-        now = time.monotonic()
-        if now - last >= PROGRESS_INTERVAL and done < total:
-            last = now
-            print(f"  synth: {done} of {total} experiments, {now - t0:.0f} s", file=sys.stderr, flush=True)
-    return line, (lambda: None)
+def _synthesized(model, fit_T, val_T, waveform, args, progress):
+    """synth's dataset, counted on ``progress``; an InputError names the command."""
+    try:
+        return synthesize(model, fit_T, validate=val_T, duration=args.duration, sample_rate=args.sample_rate,
+                          input=waveform, noise=args.noise, quantization=args.quantization,
+                          temperature_noise=args.temperature_noise, drift=args.drift,
+                          record_temperature=args.record_temperature, record_stage=args.record_stage,
+                          seed=args.seed, progress=lambda done, _total: progress.count(done))
+    except InputError as e:
+        raise InputError(f"synth: {e}") from None
 
 
 __all__ = ["synthesize", "add_synth_command", "cmd_synth", "MAX_EXPERIMENTS"]

@@ -293,18 +293,5 @@ def _call(fn, payload: bytes) -> bytes:
     return pickle.dumps(fn(*pickle.loads(payload)), protocol=pickle.HIGHEST_PROTOCOL)
 
 
-def progress_bar(total, label, enabled=True):
-    """A rich progress bar on stderr (on a terminal only): returns (update(done), stop())."""
-    if not enabled or not sys.stderr.isatty():
-        return None, (lambda: None)
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-    bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                   console=Console(stderr=True), transient=True)
-    task = bar.add_task(label, total=total)
-    bar.start()
-    return (lambda done: bar.update(task, completed=done)), bar.stop
-
-
 __all__ = ["Runner", "SEQUENTIAL", "THREADS", "PROCESSES", "check_scheduler", "check_options", "read_scheduler_file",
-           "chunk_spans", "progress_bar", "is_client", "recorded_warnings"]
+           "chunk_spans", "is_client", "recorded_warnings"]
