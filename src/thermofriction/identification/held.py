@@ -20,6 +20,8 @@ import numpy as np
 
 from .._lazy import lazy
 from ..models import ModelI
+from ..measurements import amount
+from .advice import TRY_AT_MOST, tried
 from .parameters import EXCESS, PLANT_UNITS, get_value
 from .problem import Problem, make_traces
 
@@ -133,9 +135,11 @@ def _stribeck_columns(res, varying, traces, rtol):
     return np.column_stack(cols)
 
 
-def held_tests(res, experiments, measurement, rtol=1e-8) -> list:
+def held_tests(res, experiments, measurement, rtol=1e-8, inadequate=False) -> list:
     """The score test of every held value of the fit ``res``: [{name, value, statistic, dof, p_value,
-    contradicted, message}], most contradicted first. Empty where the model cannot be evaluated there."""
+    contradicted, message, tried}], most contradicted first. Empty where the model cannot be evaluated there. The
+    contradicted values are tried (a refit with each freed: advice.py), and where the fit is ``inadequate`` the
+    held values whose direction explains most of the misfit too, up to TRY_AT_MOST refits in all."""
     varying = [p.name for p in res.parameters.varying]
     if not res.n_points:
         return []
@@ -152,35 +156,68 @@ def held_tests(res, experiments, measurement, rtol=1e-8) -> list:
     s2tau = float(r @ r) / dof * float(res.statistics.get("variance_inflation", 1.0))
     groups, k = [], p
     for label, names in candidates:
-        groups.append((label, J[:, k:k + len(names)], get_value(res.model, names[0]) if len(names) == 1 else None))
+        groups.append((label, names, J[:, k:k + len(names)],
+                       get_value(res.model, names[0]) if len(names) == 1 else None))
         k += len(names)
     stribeck = _stribeck_columns(res, varying, traces, rtol)
     if stribeck is not None:
-        groups.append(("fs", stribeck, res.model.friction.values().get("fc")))
+        groups.append(("fs", ["fs"], stribeck, res.model.friction.values().get("fc")))
     out = []
-    for label, cols, value in groups:
+    for label, names, cols, value in groups:
         floor = value == 0.0 and cols.shape[1] == 1  # at the lower end of its domain: one-sided
         stat, df = _score(r, J[:, :p], cols, s2tau, floor)
         if df:
             out.append({"name": label, "value": value, "statistic": stat, "dof": df,
                         "p_value": float(special.chdtrc(df, stat)) * (0.5 if floor and stat > 0 else 1.0),
-                        "misfit_share": stat * s2tau / max(float(r @ r), 1e-300), "_columns": cols, "_J": J[:, :p]})
+                        "misfit_share": stat * s2tau / max(float(r @ r), 1e-300), "_columns": cols, "_J": J[:, :p],
+                        "_names": names})
     for i, t in enumerate(out):  # held values that move the data the same way (m and m_e on a modal plant): one
         t["same_as"] = next((u["name"] for u in out[:i] if u["dof"] == t["dof"]
                              and abs(u["statistic"] - t["statistic"]) <= 1e-6 * max(t["statistic"], 1e-300)), None)
     for t in out:
         t["contradicted"] = bool(t["p_value"] < LEVEL / len(out) and t["misfit_share"] >= MATERIAL)
-        what = f"{t['name']} held at {t['value']:.4g}" if t["value"] is not None else f"{t['name']}'s law held"
-        if t["name"] == "fs" and stribeck is not None:
-            what = "fs held at fc (no Stribeck effect)"
-        p_text = ("p < 1e-12" if t["p_value"] < 1e-12 else f"p = {t['p_value']:.2g}") + \
-            f", {100 * t['misfit_share']:.2g} % of the misfit"
-        also = [u["name"] for u in out if u["same_as"] == t["name"]]
-        also = f" (or {', '.join(also)}: the same direction in these data)" if also else ""
-        t["message"] = (f"{what} is contradicted by the data ({p_text}){also}: {_advice(t['name'], t['dof'])}"
-                        if t["contradicted"] else f"{what}: not contradicted by the data ({p_text}){also}")
     order = {t["name"]: i for i, t in enumerate(out)}
-    return sorted(out, key=lambda t: (t["same_as"] is not None, t["p_value"], order[t["name"]]))
+    out = sorted(out, key=lambda t: (t["same_as"] is not None, t["p_value"], order[t["name"]]))
+    to_try = [t for t in out if t["contradicted"] and t["same_as"] is None]
+    if inadequate:
+        to_try += sorted((t for t in out if t["same_as"] is None and not t["contradicted"]),
+                         key=lambda t: -t["misfit_share"])
+    for i, t in enumerate(to_try):
+        # the advice is tried before it is said (advice.py): a refit from the optimum with the value freed
+        t["tried"] = tried(res, t, traces, r, rtol, STRIBECK_VS) if i < TRY_AT_MOST else None
+        if t["tried"] is not None and t["tried"]["gain"] < MATERIAL:
+            t["contradicted"] = False
+    primary = {t["name"]: t for t in out}
+    for t in out:  # a value that moves the data as another does follows that one's verdict
+        if t["same_as"] is not None:
+            t["contradicted"] = primary[t["same_as"]]["contradicted"]
+        t["message"] = _message(t, out, stribeck is not None, res)
+    return out
+
+
+def _message(t, out, stribeck, res) -> str:
+    """What is said of one held value: contradicted, with the advice and the gain its refit measured; not
+    contradicted, with why (the score alone, or a refit that gained too little)."""
+    what = f"{t['name']} held at {t['value']:.4g}" if t["value"] is not None else f"{t['name']}'s law held"
+    if t["name"] == "fs" and stribeck:
+        what = "fs held at fc (no Stribeck effect)"
+    p_text = ("p < 1e-12" if t["p_value"] < 1e-12 else f"p = {t['p_value']:.2g}") + \
+        f", {100 * t['misfit_share']:.2g} % of the misfit by the linearization"
+    also = [u["name"] for u in out if u["same_as"] == t["name"]]
+    also = f" (or {', '.join(also)}: the same direction in these data)" if also else ""
+    trial = t.get("tried")
+    if trial is not None:
+        gain = (f"a refit with it free ({trial['evaluations']} evaluations) lowers the RMSE "
+                f"{amount(res.rmse, res.unit)} -> {amount(trial['rmse_after'], res.unit)} "
+                f"({100 * trial['gain']:.2g} % of the misfit)")
+        if t["contradicted"]:
+            return f"{what} is contradicted by the data ({p_text}){also}: {_advice(t['name'], t['dof'])}; {gain}"
+        return (f"{what}: the score test points away from it ({p_text}){also}, but {gain}, less than "
+                f"{100 * MATERIAL:g} %: not contradicted")
+    if t["contradicted"]:
+        return (f"{what} is contradicted by the data ({p_text}){also} (not tried: only the {TRY_AT_MOST} most "
+                f"contradicted values are refitted)")
+    return f"{what}: not contradicted by the data ({p_text}){also}"
 
 
 #: the stated prior range of a law held for lack of information: its level within a factor PRIOR_FACTOR either way
@@ -246,6 +283,18 @@ def _consider(res, tests, secants=None):
     res.details["considered"] = {"parameters": [t["name"] for t in tests], "prior_factor": PRIOR_FACTOR}
 
 
+def _tried_text(tests) -> str:
+    """The refits tried, with their measured gains, for the not-adequate warning: what would help and what not."""
+    out = []
+    for t in tests:
+        trial = t.get("tried")
+        if trial is None or t["contradicted"]:  # (a contradicted value is said with its gain in its own warning)
+            continue
+        what = "a Stribeck effect" if t["name"] == "fs" and t["dof"] > 1 else t["name"]
+        out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit")
+    return ", ".join(out) + (" (less than 1 % each: not worth a parameter)" if out else "")
+
+
 def with_held_tests(res, experiments, measurement, rtol=1e-8):
     """``res`` with ``fit_quality["held"]``; a contradicted held value makes the fit not adequate and is said
     first in its warnings (second, after the residuals' own "not adequate", where they are far above the noise)."""
@@ -255,14 +304,20 @@ def with_held_tests(res, experiments, measurement, rtol=1e-8):
     if res.details.get("refined") is False:  # not at an optimum: the residuals are not orthogonal to the fit's
         res.fit_quality["held"] = None
         return res
-    tests = held_tests(res, experiments, measurement, rtol)
-    res.fit_quality["held"] = [{k: t[k] for k in ("name", "value", "statistic", "dof", "p_value", "misfit_share",
-                                                  "contradicted")} for t in tests]
+    inadequate = res.fit_quality["adequate"] is False
+    tests = held_tests(res, experiments, measurement, rtol, inadequate)
+    res.fit_quality["held"] = [{**{k: t[k] for k in ("name", "value", "statistic", "dof", "p_value", "misfit_share",
+                                                     "contradicted")},
+                                **({"refit_gain": t["tried"]["gain"], "refit_rmse": t["tried"]["rmse_after"]}
+                                   if t.get("tried") else {})} for t in tests]
     bad = [t for t in tests if t["contradicted"] and t["same_as"] is None]
     lack = [t for t in tests if t["name"] in (res.details.get("held_for_lack_of_information") or ())
             or t["name"] in (res.details.get("held_ranges") or {})]
     if lack:
         _consider(res, lack, secants or {})
+    gains = _tried_text(tests)
+    if inadequate and gains and res.warnings and res.warnings[0].startswith("the fit is not adequate"):
+        res.warnings[0] += f"; tried: {gains}"
     if bad:
         # after the residuals' own verdict where that already says not adequate (a model far off: the held
         # directions then share out a misfit they do not all cause), else first

@@ -74,7 +74,8 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                         f"{amount(overall['noise'], unit)}, where a right model gives at most "
                         f"{overall['threshold']:.3g} times on these samples; not adequate in {len(bad)} of "
                         f"{len(per)} experiments): "
-                        f"the model misses what the data show. Try: {measurement.advice(model)}")
+                        f"the model misses what the data show" + "".join(
+                            f"; {c}" for c in measurement.checks(model, traces)))
     cost = float(outcome.r @ outcome.r)
     warns += _unsupported_excess(params, corr, unit)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,

@@ -91,9 +91,10 @@ class Measurement:
     def unit(self, experiments) -> str:
         raise NotImplementedError
 
-    def advice(self, model) -> str:
-        """What to try when a fit is not adequate."""
-        raise NotImplementedError
+    def checks(self, model, traces) -> list:
+        """What to check when a fit is not adequate and no refit can try it (a unit, the sampling), only where it
+        applies to these data; what can be tried (a held value freed) is tried after the fit (held.py, advice.py)."""
+        return []
 
     # -- validation ------------------------------------------------------------------------------
     def predict(self, model, exp):
@@ -142,6 +143,16 @@ class Measurement:
 OFFSETS = ("shared", "per-experiment", "none")
 
 
+def thermal_check(model, traces) -> list:
+    """A model without a thermal extension on runs that span temperatures: said, with what would compare (not
+    tried: a Model I or II fit costs as much as this one)."""
+    temps = [t.nominal_temperature for t in traces if math.isfinite(t.nominal_temperature)]
+    if getattr(model, "thermal", None) is not None or not temps or max(temps) - min(temps) < 0.5:
+        return []
+    return [f"the experiments span {min(temps):.4g} to {max(temps):.4g} C and the model has no thermal extension "
+            f"(not tried here: --method model-i or model-ii compares)"]
+
+
 def amount(value: float, unit: str) -> str:
     """A residual or an RMSE in its unit: metres shown in nm, N and N m as they are."""
     return f"{value * 1e9:.4g} nm" if unit == "m" else f"{value:.4g} {unit}"
@@ -169,4 +180,4 @@ def center_each(r, S, sizes):
     return r, S
 
 
-__all__ = ["center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center"]
+__all__ = ["center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center", "thermal_check"]

@@ -36,7 +36,7 @@ from ..data.force import ForceExperiment
 from ..data.motion import on_uniform_grid
 from ..errors import ComputationError, InputError
 from .base import Trace
-from .force import FORCE_ADVICE, Force
+from .force import Force
 
 signal = lazy("scipy.signal")
 
@@ -304,9 +304,10 @@ class Command(Force):
             self._cached = (key, DelaySearch(traces, self.offset, traces[0].search_delay))
         return self._cached[1]
 
-    def advice(self, model) -> str:
-        return (FORCE_ADVICE + "; for a drive's command: check the torque constant, and that the position resolves "
-                "the acceleration (docs/force-data.md#drives-without-a-torque-sensor)")
+    def checks(self, model, traces) -> list:
+        return super().checks(model, traces) + [
+            "for a drive's command: check the torque constant, and that the position resolves the acceleration "
+            "(docs/force-data.md#drives-without-a-torque-sensor)"]
 
     def check_model(self, model, experiments):
         super().check_model(model, experiments)

@@ -15,7 +15,7 @@ from ..drive import drive
 from ..errors import InputError
 from ..models import require_actuator
 from ..simulation import StepSizeController, simulate
-from .base import Measurement, MetricWarning, Trace, center
+from .base import Measurement, MetricWarning, Trace, center, thermal_check
 from .quality import fit_quality
 
 #: The parameters fitted by default for each friction model (docs/identification.md#friction-models):
@@ -94,13 +94,8 @@ class Displacement(Measurement):
     def per_trace(self, problem, model, theta):
         return [self._run(problem, model, tr, theta, False)[0] for tr in problem.traces]
 
-    def advice(self, model) -> str:
-        tips = ["free the plant's masses (--free m_e,m; free=[\"m_e\", \"m\"] in Python), which the fit otherwise "
-                "holds at the initial model's", "check the displacement unit in the files' headers",
-                "check that the friction model and its parameters held fixed (e.g. fs, vs) suit the contact"]
-        if getattr(model, "thermal", None) is None:
-            tips.append("fit a thermal model (--method model-i or model-ii) if the experiments span temperatures")
-        return "; ".join(tips)
+    def checks(self, model, traces) -> list:
+        return ["check the displacement unit in the files' headers"] + thermal_check(model, traces)
 
     # -- validation --------------------------------------------------------------------------------
     columns = (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),

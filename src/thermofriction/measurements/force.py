@@ -35,7 +35,7 @@ from ..models import Model, ModelI
 from ..models.sides import RIPPLE_AMPLITUDES
 from ..simulation import StepSizeController, simulate
 from ..waveforms import Sampled
-from .base import OFFSETS, Measurement, Trace, center, center_each
+from .base import OFFSETS, Measurement, Trace, center, center_each, thermal_check
 from .quality import fit_quality
 
 #: Relative step of the forward differences, and the tolerance of the runs they difference: the solver's
@@ -43,11 +43,16 @@ from .quality import fit_quality
 #: for Gauss-Newton steps and for the intervals (1e-10 costs half as much again for nothing visible).
 FD_STEP = 1e-5
 FD_RTOL = 1e-9
-#: What to try when a fit to force data is not adequate.
-FORCE_ADVICE = ("check the units in the files' headers; check that the sampling resolves the force's swing after "
-                "each reversal (a few samples at least); try another friction model (--friction) or fit the "
-                "parameters held fixed (--parameters); fit a thermal model (--method model-i or model-ii) if the "
-                "experiments span temperatures")
+#: What to check when a fit to force data is not adequate, where it applies (Force.checks)
+UNITS_CHECK = "check the units in the files' headers"
+SAMPLING_CHECK = "check that the sampling resolves the force's swing after each reversal (a few samples at least)"
+
+
+def reverses(trace) -> bool:
+    """Whether the motion that drives ``trace`` changes direction."""
+    d = np.diff(np.asarray(getattr(trace.waveform, "value", ()), float))
+    s = np.sign(d[d != 0])
+    return bool(s.size > 1 and np.any(s[1:] != s[:-1]))
 #: Force data see the whole friction-velocity map: the Stribeck and viscous parameters are fitted too.
 FIT_PARAMETERS = {
     "lugre": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
@@ -208,8 +213,13 @@ class Force(Measurement):
             r, J = center_each(r, J, [tr.n_residuals for tr in traces])
         return r, J
 
-    def advice(self, model) -> str:
-        return FORCE_ADVICE
+    def checks(self, model, traces) -> list:
+        """The units; the sampling at reversals where the runs reverse; a thermal model where they span
+        temperatures."""
+        out = [UNITS_CHECK]
+        if any(reverses(tr) for tr in traces):  # (one-way runs have no reversal to resolve)
+            out.append(SAMPLING_CHECK)
+        return out + thermal_check(model, traces)
 
     # -- validation --------------------------------------------------------------------------------
 
@@ -364,4 +374,4 @@ def steady_state_curve(model: Model, velocities, temperature=None) -> np.ndarray
     return np.array(out)
 
 
-__all__ = ["Force", "ForcePrediction", "steady_state_curve", "FD_STEP", "FD_RTOL", "FORCE_ADVICE", "FIT_PARAMETERS"]
+__all__ = ["Force", "ForcePrediction", "steady_state_curve", "FD_STEP", "FD_RTOL", "UNITS_CHECK", "SAMPLING_CHECK", "FIT_PARAMETERS"]
