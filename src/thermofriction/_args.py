@@ -56,9 +56,10 @@ def number(value, name: str, unit: str = "", *, none: bool = False, finite: bool
     False; ``positive``: > 0; ``minimum``: >= it."""
     if value is None and none:
         return None
-    what = f"{'a finite' if finite else 'a'} number{f' [{unit}]' if unit else ''}"
+    unit = f" [{unit}]" if unit else ""
     if not is_number(value):
-        refuse(name, what + (" or None" if none else ""), value)
+        refuse(name, f"a number{unit}" + (" or None" if none else ""), value)
+    what = f"{'a finite' if finite else 'a'} number{unit}"
     try:
         x = float(value)
     except OverflowError:  # an int beyond 1.8e308
