@@ -46,7 +46,7 @@ def _samples(where: str, name: str, values, n=None) -> np.ndarray:
     """A 1-D array of finite floats (n of them when given)."""
     try:
         a = np.ascontiguousarray(values, float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # (an int of 10**400 is no float)
         raise InputError(f"{where}: {name} must be an array of numbers") from None
     if a.ndim != 1 or (n is not None and a.size != n):
         raise InputError(f"{where}: {name} must be one-dimensional" + (f" with {n} values" if n is not None else "")
