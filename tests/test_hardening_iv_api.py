@@ -188,9 +188,9 @@ def test_strings_for_numbers_are_refused_in_t_eval_and_step(things):
 def test_huge_whole_numbers_are_refused_with_their_range(things):
     """A seed of 10**400 ran, then could not be written to a model file; samples=-10**400 was NumPy's
     ValueError, warmup_cycles=10**400 'Maximum allowed size exceeded'."""
-    with pytest.raises(tf.InputError, match=r"seed must be a whole number from 0 to 2\*\*63 - 1, got int 1000"):
+    with pytest.raises(tf.InputError, match=r"seed must be a whole number, 0 or more, got int 1000.*beyond a 64-bit integer"):
         tf.synthesize(things["model"], [35.0], duration=0.02, sample_rate=1000.0, seed=10 ** 400)
-    with pytest.raises(tf.InputError, match="samples must be a whole number from 1"):
+    with pytest.raises(tf.InputError, match="samples must be a positive whole number"):
         tf.heating.simulate_heating(things["heated"], 0.2, samples=-10 ** 400)
     with pytest.raises(tf.InputError, match="warmup_cycles must be a whole number from 0 to"):
         tf.heating.cycle_table(things["model"], tf.Sine(amplitude=30.0, frequency=5.0), [35.0],

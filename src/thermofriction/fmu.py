@@ -123,7 +123,7 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
     _args.text(model_identifier, "model_identifier", none=True)
     _args.text(source, "source", none=True)
     _args.text(solver, "solver")
-    _args.number(step, "step", "s", none=True)  # a number (not '1e-5'), before the model is loaded
+    _args.number(step, "step", "s", none=True, positive=True)  # a number (not '1e-5'), before the model is loaded
     _args.whole(fmi, "fmi")
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)

@@ -71,8 +71,7 @@ class StepSizeController:
         if not 0 < _args.number(self.rtol, "rtol") < 1:
             raise InputError(f"rtol must be between 0 and 1, got {shorten(self.rtol)}")
         _args.whole(self.max_steps, "max_steps", low=1)
-        if self.atol is not None and not (_args.number_list(self.atol, "atol") > 0).all():
-            raise InputError(f"atol must be a positive finite number (or one per state), got {shorten(self.atol)}")
+        _args.number_list(self.atol, "atol", none=True, positive=True)  # one, or one per state
         for name in ("first_step", "max_step"):
             _args.number(getattr(self, name), name, "s", none=True, positive=True)
 
