@@ -40,7 +40,7 @@ IN_RANGE = {("identify", "starts"): np.int64(1), ("identify", "max_evaluations")
             ("sweep", "temperature"): np.float64(35.0), ("propagate", "draws"): np.int64(2),
             ("propagate", "duration"): np.float64(0.02), ("propagate", "sample_rate"): np.float64(1000.0),
             ("propagate", "temperatures"): np.float64(35.0), ("export_fmu", "fmi"): np.int64(2),
-            ("export_fmu", "temperature"): np.float64(35.0), ("simulate_heating", "duration"): np.float64(0.2),
+            ("export_fmu", "temperature"): np.float64(35.0), ("simulate_heating", "duration"): np.float32(0.25),
             ("simulate_heating", "samples"): np.int64(10), ("simulate_heating", "temperature"): np.float64(25.0),
             ("cycle_table", "temperatures"): np.float64(35.0), ("cycle_table", "warmup_cycles"): np.int64(1),
             ("cycle_table", "measure_cycles"): np.int64(1), ("simulate_loop", "temperature"): np.float64(35.0),
