@@ -196,10 +196,10 @@ def test_friction_steps_refuses_a_model_ii_that_reverses_friction():
 @pytest.mark.parametrize("velocity, dt, temperature, match", [
     ([1e-3, math.nan, 1e-3], 1e-4, None, r"velocity\[1\] is nan"),
     ([1e-3, math.inf], 1e-4, None, r"velocity\[1\] is inf"),
-    ([1e-3], 0.0, None, "dt must be > 0"),
-    ([1e-3], math.nan, None, "dt must be finite"),
+    ([1e-3], 0.0, None, "dt must be a positive finite number"),
+    ([1e-3], math.nan, None, "dt must be a positive finite number"),
     ([1e-3], "1e-4", None, "dt must be a number"),
-    ([1e-3], 1e-4, math.nan, "temperature must be finite"),
+    ([1e-3], 1e-4, math.nan, "temperature must be a finite number"),
     ([1e-3, 1e-3], 1e-4, [35.0, math.inf], r"temperature\[1\] is inf"),
     ([1e-3, 1e-3], 1e-4, [35.0], "temperature must be one-dimensional with 2 values"),
     ("fast", 1e-4, None, "velocity must be an array of numbers"),
@@ -233,10 +233,10 @@ def test_simulate_loop_refuses_bad_arguments():
         (dict(reference="sine"), "reference must be a Reference"),
         (dict(reference=bad_ref), r"reference.position\[7\] is nan"),
         (dict(reference=C.Reference("one", ref.time[:1], ref.position[:1], ref.velocity[:1])), "two samples"),
-        (dict(temperature=math.nan), "temperature must be finite"),
+        (dict(temperature=math.nan), "temperature must be a finite number"),
         (dict(temperature="35"), "temperature must be a number"),
-        (dict(substeps=0), "substeps must be an integer >= 1"),
-        (dict(substeps=1.5), "substeps must be an integer >= 1"),
+        (dict(substeps=0), "substeps must be a positive whole number"),
+        (dict(substeps=1.5), "substeps must be a positive whole number"),
         (dict(pid=(1, 2, 3)), "pid must be a PID"),
         (dict(compensation="observer"), "compensation must be FeedForward, Observer or None"),
         (dict(temperature=80.0), "the stage.*Model I at 80 C"),
@@ -251,10 +251,10 @@ def test_simulate_loop_refuses_bad_arguments():
 def test_compensation_and_pid_check_their_arguments():
     stage = tf.load_model("stage-model-i")
     for make, match in [
-        (lambda: C.PID(kp=math.nan, ki=0, kd=0), "PID: kp must be finite"),
-        (lambda: C.PID(kp=1, ki=0, kd=0, tau_d=-1e-3), "PID: tau_d must be >= 0"),
-        (lambda: C.Observer(stage, gain=-1.0), "Observer: gain must be >= 0"),
-        (lambda: C.Observer(stage, temperature=math.inf), "Observer: temperature must be finite"),
+        (lambda: C.PID(kp=math.nan, ki=0, kd=0), "PID: kp must be a finite number"),
+        (lambda: C.PID(kp=1, ki=0, kd=0, tau_d=-1e-3), "PID: tau_d must be a finite number of 0 or more"),
+        (lambda: C.Observer(stage, gain=-1.0), "Observer: gain must be a finite number of 0 or more"),
+        (lambda: C.Observer(stage, temperature=math.inf), "Observer: temperature must be a finite number"),
         (lambda: C.FeedForward("stage-model-i"), "FeedForward: model must be a thermofriction Model"),
     ]:
         with pytest.raises(tf.InputError, match=match):

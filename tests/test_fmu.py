@@ -425,7 +425,7 @@ def test_realtime_choice_in_the_model_description(tmp_path):
     ({"solver": "realtime", "step": 0.0}, "positive"),
     ({"solver": "realtime", "step": -1e-5}, "positive"),
     ({"solver": "realtime", "step": float("nan")}, "positive"),
-    ({"solver": "realtime", "step": "fast"}, "number of seconds"),
+    ({"solver": "realtime", "step": "fast"}, r"step must be a number \[s\]"),
     ({"solver": "realtime"}, "needs its fixed step"),
     ({"solver": "realtime", "step": 1e-3}, "unstable"),  # li2009: wn = 6686 rad/s, 2 / wn = 0.3 ms
     ({"step": 1e-5}, "realtime solver's fixed step"),

@@ -20,6 +20,7 @@ The rule:
 
 from __future__ import annotations
 
+import math
 import numbers
 import os
 
@@ -43,22 +44,69 @@ def is_number(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
 
 
-def number(value, name: str, unit: str = "", *, none: bool = False):
-    """``value`` as a float when it is a real number (None passes with ``none``); else InputError."""
+#: whole numbers end at 64 bits: the C core's, NumPy's and a model file's integers (a seed of 10**400 would
+#: run, then fail to be written to the fitted model's provenance)
+WHOLE_LIMIT = 2 ** 63 - 1
+
+
+def number(value, name: str, unit: str = "", *, none: bool = False, finite: bool = True, positive: bool = False,
+           minimum=None):
+    """``value`` as a float when it is a real number (None passes with ``none``); else InputError. A number
+    too large for a float (an int of 10**400) is refused, and so are NaN and infinities unless ``finite`` is
+    False; ``positive``: > 0; ``minimum``: >= it."""
     if value is None and none:
         return None
+    unit = f" [{unit}]" if unit else ""
     if not is_number(value):
-        refuse(name, f"a number{f' [{unit}]' if unit else ''}" + (" or None" if none else ""), value)
-    return float(value)
+        refuse(name, f"a number{unit}" + (" or None" if none else ""), value)
+    what = (f"a{' positive' if positive else ''}{' finite' if finite else ''} number{unit}"
+            + (f" of {minimum:g} or more" if minimum is not None else ""))
+    try:
+        x = float(value)
+    except OverflowError:  # an int beyond 1.8e308
+        refuse(name, what, value, "too large for a floating-point number")
+    if (finite and not math.isfinite(x)) or (positive and not x > 0) or (minimum is not None and not x >= minimum):
+        refuse(name, what, value)
+    return x
 
 
-def whole(value, name: str, *, none: bool = False):
-    """``value`` as an int when it is a whole number (an Integral, not a boolean); else InputError."""
+def whole(value, name: str, *, none: bool = False, low: int = -WHOLE_LIMIT, high: int = WHOLE_LIMIT):
+    """``value`` as an int when it is a whole number (an Integral, NumPy's too, not a boolean) from ``low``
+    to ``high`` (by default, any 64-bit integer); else InputError."""
     if value is None and none:
         return None
+    what = ("a positive whole number" if (low, high) == (1, WHOLE_LIMIT)
+            else f"a whole number, {low} or more" if high == WHOLE_LIMIT and low > -WHOLE_LIMIT
+            else f"a whole number from {low} to {high}" if low > -WHOLE_LIMIT or high < WHOLE_LIMIT
+            else "a whole number") + (" or None" if none else "")
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        refuse(name, "a whole number" + (" or None" if none else ""), value)
+        refuse(name, what, value)
+    if not low <= value <= high:
+        refuse(name, what, value, "beyond a 64-bit integer" if abs(value) > WHOLE_LIMIT else "")
     return int(value)
+
+
+def number_list(value, name: str, unit: str = "", *, empty: bool = False, none: bool = False,
+                positive: bool = False):
+    """A number or a list (tuple, 1-D array) of numbers, each as :func:`number` takes it (finite, not a
+    string, not a boolean; ``positive``: > 0), as a 1-D float array; an empty list only with ``empty``; None
+    with ``none``."""
+    if value is None and none:
+        return None
+    if is_number(value):
+        return np.array([number(value, name, unit, positive=positive)])
+    what = (f"a number or a {'' if empty else 'non-empty '}list of {'positive ' if positive else ''}finite numbers"
+            + (f" [{unit}]" if unit else "") + (" or None" if none else ""))
+    if isinstance(value, np.ndarray) and value.ndim == 1 and value.dtype.kind in "iuf":  # at once: t_eval may be long
+        x = value.astype(float)
+        if (x.size or empty) and np.isfinite(x).all() and (not positive or (x > 0).all()):
+            return x
+        refuse(name, what, value)
+    items = list(value) if isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray)
+                                                                 and value.ndim == 1) else None
+    if items is None or (not items and not empty) or not all(is_number(v) for v in items):
+        refuse(name, what, value)
+    return np.array([number(v, name, unit, positive=positive) for v in items], dtype=float)
 
 
 def flag(value, name: str) -> bool:
@@ -155,5 +203,5 @@ def dataset(value, cls, name: str = "data", *, experiments: bool = False, none: 
            value, hint)
 
 
-__all__ = ["got", "refuse", "is_number", "number", "whole", "flag", "text", "function", "path", "names",
+__all__ = ["got", "refuse", "is_number", "number", "whole", "number_list", "WHOLE_LIMIT", "flag", "text", "function", "path", "names",
            "instance", "model", "dataset"]

@@ -14,7 +14,6 @@ observer of Canudas de Wit et al. 1995), each told a temperature: the measured o
 from __future__ import annotations
 
 import math
-import numbers
 import re
 import warnings
 from dataclasses import dataclass, field
@@ -32,17 +31,8 @@ from .results import Result
 # -- argument checks: the package's InputError naming the argument, before the C core sees it -----
 
 def _number(where: str, name: str, value, *, minimum=None, positive=False) -> float:
-    """A finite real number (not a string, not a bool), optionally > 0 or >= minimum."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise InputError(f"{where}: {name} must be a number, got {value!r}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise InputError(f"{where}: {name} must be finite, got {value!r}")
-    if positive and not x > 0:
-        raise InputError(f"{where}: {name} must be > 0, got {value!r}")
-    if minimum is not None and x < minimum:
-        raise InputError(f"{where}: {name} must be >= {minimum:g}, got {value!r}")
-    return x
+    """A finite real number (not a string, not a bool), optionally > 0 or >= minimum (_args.number)."""
+    return _args.number(value, f"{where}: {name}", minimum=minimum, positive=positive)
 
 
 def _model(where: str, name: str, model) -> Model:
@@ -56,7 +46,7 @@ def _samples(where: str, name: str, values, n=None) -> np.ndarray:
     """A 1-D array of finite floats (n of them when given)."""
     try:
         a = np.ascontiguousarray(values, float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # (an int of 10**400 is no float)
         raise InputError(f"{where}: {name} must be an array of numbers") from None
     if a.ndim != 1 or (n is not None and a.size != n):
         raise InputError(f"{where}: {name} must be one-dimensional" + (f" with {n} values" if n is not None else "")
@@ -261,8 +251,7 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
     if compensation is not None and not isinstance(compensation, (FeedForward, Observer)):
         raise InputError(f"{where}: compensation must be FeedForward, Observer or None, "
                          f"got {type(compensation).__name__}")
-    if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral) or substeps < 1:
-        raise InputError(f"{where}: substeps must be an integer >= 1, got {substeps!r}")
+    _args.whole(substeps, f"{where}: substeps", low=1)
     _check_at(f"{where}: the stage", stage, temperature)
     outs = [np.empty_like(x_ref) for _ in range(3)]
     comp_spec, T_comp, kind, gain = None, math.nan, "none", 0.0
@@ -337,12 +326,7 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
     if not (isinstance(references, (list, tuple)) and references and all(isinstance(r, Reference) for r in references)):
         raise InputError(f"{where}: references must be a non-empty list of References (sine_reference, point_to_point), "
                          f"got {type(references).__name__} {shorten(references)}")
-    if _args.is_number(temperatures):
-        temperatures = [temperatures]
-    if not (isinstance(temperatures, (list, tuple, np.ndarray)) and len(temperatures)
-            and all(_args.is_number(T) for T in temperatures)):
-        raise InputError(f"{where}: temperatures must be a number or a list of numbers [C], got "
-                         f"{type(temperatures).__name__} {shorten(temperatures)}")
+    temperatures = [float(T) for T in _args.number_list(temperatures, f"{where}: temperatures", "C")]
     _number(where, "calibration", calibration)
     _number(where, "observer_gain", observer_gain)
     if not isinstance(pid, PID):

@@ -88,12 +88,7 @@ def _check_step(model: Model, step) -> float:
     """The realtime solver's step [s]: a positive finite number, below the stability limit 2 / omega
     of semi-implicit Euler on the plant's stiffest spring (the stage's natural frequency, the mass's
     pulling spring)."""
-    try:
-        step = float(step)
-    except (TypeError, ValueError):
-        raise InputError(f"export_fmu: step must be a number of seconds, got {shorten(step)}") from None
-    if not (math.isfinite(step) and step > 0):
-        raise InputError(f"export_fmu: step = {step!r} s: the fixed step must be a positive number of seconds")
+    step = _args.number(step, "step", "s", positive=True)
     plant = model.plant
     omega, what = None, ""
     if isinstance(plant, StickSlipPlant):
@@ -124,19 +119,17 @@ def _solver(solver, integrator):
 def _checked(model, path, temperature, model_identifier, source, solver, step, fmi):
     """export_fmu's arguments, checked before any work: (the model, its source, the temperature, the step)."""
     _args.path(path, "path")
-    _args.number(temperature, "temperature", "degC", none=True)
+    temperature = _args.number(temperature, "temperature", "degC", none=True)  # finite
     _args.text(model_identifier, "model_identifier", none=True)
     _args.text(source, "source", none=True)
     _args.text(solver, "solver")
+    _args.number(step, "step", "s", none=True, positive=True)  # a number (not '1e-5'), before the model is loaded
+    _args.whole(fmi, "fmi")
     if isinstance(model, (str, os.PathLike)):
         source = os.fspath(model)
         model = load_model(model)
     if not isinstance(model, Model):
         raise InputError(f"export_fmu: model must be a Model, a model file or a preset name, got {shorten(model)}")
-    if temperature is not None:
-        temperature = float(temperature)
-        if temperature != temperature or abs(temperature) == float("inf"):
-            raise InputError(f"export_fmu: temperature must be a finite number of degrees C, got {temperature!r}")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); "
                          f"this is {platform.system()} {platform.machine()}")

@@ -32,7 +32,7 @@ from . import _args
 from .models import Model
 from .results import Result
 from .drive import input_of
-from .simulation import StepSizeController, check_heated_temperatures, simulate
+from .simulation import MAX_SAMPLES, StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
 
 integrate, interpolate = lazy("scipy.integrate"), lazy("scipy.interpolate")
@@ -155,16 +155,10 @@ def cycle_table(model: Model, input: Waveform, temperatures, warmup_cycles: int 
     over the periodic steps (one value per temperature)."""
     _args.model(model, Model)
     _args.instance(input, Waveform, "input", "a periodic Waveform")
-    if isinstance(temperatures, (str, bytes)) or not (_args.is_number(temperatures) or (
-            isinstance(temperatures, (list, tuple, np.ndarray)) and len(temperatures)
-            and all(_args.is_number(t) for t in temperatures))):
-        _args.refuse("temperatures", "a number or a non-empty list of numbers [C]", temperatures)
-    temperatures = np.atleast_1d(np.asarray(temperatures, float))
-    warmup_cycles = _args.whole(warmup_cycles, "warmup_cycles")
-    measure_cycles = _args.whole(measure_cycles, "measure_cycles")
-    if warmup_cycles < 0 or measure_cycles < 1:
-        raise InputError(f"warmup_cycles must be 0 or more and measure_cycles 1 or more, got {warmup_cycles} and "
-                         f"{measure_cycles}")
+    temperatures = _args.number_list(temperatures, "temperatures", "C")
+    # the cycle starts are the run's output times: as many as simulate's max_samples allows
+    warmup_cycles = _args.whole(warmup_cycles, "warmup_cycles", low=0, high=MAX_SAMPLES - 2)
+    measure_cycles = _args.whole(measure_cycles, "measure_cycles", low=1, high=MAX_SAMPLES - 1 - warmup_cycles)
     fast = dataclasses.replace(model, heat=None)
     period = input.period
     n = warmup_cycles + measure_cycles
@@ -199,16 +193,14 @@ def simulate_heating(model: Model, duration: float, *, input: Waveform | None = 
         solver = method
     method = solver
     _args.model(model, Model)
-    _args.number(duration, "duration", "s")
+    duration = _args.number(duration, "duration", "s", positive=True)
     _args.instance(input, Waveform, "input", "a periodic Waveform", none=True)
-    _args.number(temperature, "temperature", "degC", none=True)
+    temperature = _args.number(temperature, "temperature", "degC", none=True)
     _args.instance(method, (TwoTimeScale, Full), "solver", "TwoTimeScale() or Full()", none=True)
-    _args.whole(samples, "samples")
+    _args.whole(samples, "samples", low=1)
     if model.heat is None:
         raise InputError("simulate_heating needs a model with a [heat] section (docs/models.md#self-heating)")
     method = method or TwoTimeScale()
-    if not (isinstance(duration, (int, float)) and duration > 0 and math.isfinite(duration)):
-        raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
     waveform = _periodic_input(model, input)
     heat = model.heat.resolved(temperature)
     f = 1.0 / waveform.period

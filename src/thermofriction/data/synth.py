@@ -4,7 +4,6 @@ noise), and the ``thermofriction synth`` command."""
 from __future__ import annotations
 
 import math
-import numbers
 from pathlib import Path
 
 import numpy as np
@@ -49,10 +48,8 @@ def _check_types(model, temperatures, validate, duration, sample_rate, noise, qu
                  drift, input, record_temperature, record_stage, name):
     """synthesize's argument types (_args.py), before any work."""
     _args.model(model, Model)  # the argument types (_args.py): before any work
-    for label, v in (("temperatures", temperatures), ("validate", validate)):
-        if not (v is None or _args.is_number(v) or (isinstance(v, (list, tuple, np.ndarray)) and
-                                                     all(_args.is_number(T) for T in v))):
-            _args.refuse(label, "a number or a list of numbers [C]", v)
+    _args.number_list(temperatures, "temperatures", "C", empty=True, none=True)
+    _args.number_list(validate, "validate", "C", empty=True, none=True)
     for label, v in (("duration", duration), ("sample_rate", sample_rate), ("noise", noise),
                      ("quantization", quantization), ("temperature_noise", temperature_noise), ("drift", drift)):
         _args.number(v, label)
@@ -119,8 +116,7 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
         raise InputError(f"sample_rate must be positive [Hz], got {sample_rate!r}")
     if duration * sample_rate + 1 < MIN_SAMPLES:
         raise InputError(f"duration x sample_rate gives fewer than {MIN_SAMPLES} samples")
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-        raise InputError(f"seed must be a whole number, 0 or more, got {seed!r}"[:200])
+    _args.whole(seed, "seed", low=0)
     if record_temperature is None:  # a self-heating model's temperature is an output: always recorded
         record_temperature = temperature_noise > 0 or model.heat is not None
     runs = [(T, "fit", [int(seed), i]) for i, T in enumerate(fit_T)]

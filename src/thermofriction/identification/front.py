@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 import os
 import warnings
 
@@ -16,6 +15,7 @@ from ..data.experiments import TEMPERATURE_RANGE, Dataset
 from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
 from .held import with_held_tests
+from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .optimiser import one_blas_thread
@@ -36,36 +36,35 @@ METHODS = ("plant", "base", "model-i", "model-ii", "heat")
 
 #: The most starting points of the multi-start phase: each one simulates every fit experiment
 MAX_STARTS = 10_000
+#: The most model evaluations of a least-squares stage that max_evaluations may ask for
+MAX_EVALUATIONS = 100_000
 
 
 def _check_arguments(method, reference_temperature, rtol, starts, seed):
     if method not in METHODS:
         raise InputError(f"unknown method {shorten(method)} (one of: {', '.join(METHODS)})")
-
-    def whole(v):
-        return isinstance(v, numbers.Integral) and not isinstance(v, bool)
-
-    if not whole(starts) or not 1 <= starts <= MAX_STARTS:
-        raise InputError(f"starts must be a whole number from 1 to {MAX_STARTS}, got {shorten(starts)}")
-    if not whole(seed) or seed < 0:
-        raise InputError(f"seed must be a whole number, 0 or more, got {shorten(seed)}")
-    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not 0 < rtol < 1:
+    _args.whole(starts, "starts", low=1, high=MAX_STARTS)
+    _args.whole(seed, "seed", low=0)
+    if not 0 < _args.number(rtol, "rtol") < 1:
         raise InputError(f"rtol must be between 0 and 1, got {shorten(rtol)}")
     if reference_temperature is not None:
         if method != "model-ii":
             raise InputError("reference_temperature applies to method 'model-ii' only")
         lo, hi = TEMPERATURE_RANGE
-        if (isinstance(reference_temperature, bool) or not isinstance(reference_temperature, numbers.Real)
-                or not lo <= reference_temperature <= hi):
+        if not lo <= _args.number(reference_temperature, "reference_temperature", "degC") <= hi:
             raise InputError(f"reference_temperature must be a temperature from {lo:g} to {hi:g} C, "
                              f"got {shorten(reference_temperature)}")
 
 
-def _evaluation_limit(max_evaluations) -> int:
-    if isinstance(max_evaluations, bool) or not isinstance(max_evaluations, numbers.Integral) \
-            or not 1 <= max_evaluations <= 100_000:
-        raise InputError(f"max_evaluations must be a whole number from 1 to 100000, got {shorten(max_evaluations)}")
-    return int(max_evaluations)
+def _checked_laws(laws):
+    """laws: {parameter name: a law kind, or a list of kinds to choose from by AICc} (model_i._laws_through)."""
+    _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
+    for name, kind in (laws or {}).items():
+        if not isinstance(name, str):
+            _args.refuse("laws", "a dict keyed by parameter names; one key is", name)
+        kinds = [kind] if isinstance(kind, str) else kind
+        if not (isinstance(kinds, (list, tuple)) and kinds and all(k in FIT_LAW_KINDS for k in kinds)):
+            _args.refuse(f"laws[{name!r}]", f"a law kind ({', '.join(FIT_LAW_KINDS)}) or a list of them", kind)
 
 
 def _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine, reference_temperature,
@@ -78,7 +77,7 @@ def _checked_types(data, method, init, friction, parameters, free, procedure, la
     parameters = _args.names(parameters, "parameters", allow=Parameters)  # 'sigma0' is one name, not 5 letters
     free = free if isinstance(free, str) else (_args.names(free, "free") or ())  # (a string: "m_e,m")
     _args.text(procedure, "procedure")
-    _args.instance(laws, dict, "laws", "a dict (parameter -> law kind)", none=True)
+    _checked_laws(laws)
     _args.flag(refine, "refine")
     _args.number(reference_temperature, "reference_temperature", "degC", none=True)
     if rtol is not None:  # the earlier spelling: tolerances are given by a StepSizeController everywhere
@@ -137,7 +136,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     parameters, free, rtol = _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine,
                                             reference_temperature, controller, rtol, progress, offset)
     _check_arguments(method, reference_temperature, rtol, starts, seed)
-    max_nfev = None if max_evaluations is None else _evaluation_limit(max_evaluations)
+    max_nfev = _args.whole(max_evaluations, "max_evaluations", none=True, low=1, high=MAX_EVALUATIONS)
     _args.dataset(data, Dataset, experiments=True)  # after the options, whose messages name them first
     measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
     if method not in measurement.methods:

@@ -26,6 +26,10 @@ def aicc(ssr, n, k):
     return aic + 2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else aic
 
 
+#: the law kinds fit_law fits (identify(laws={name: kind}), --law NAME=KIND)
+FIT_LAW_KINDS = ("linear", "exp", "const")
+
+
 def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parameter=None):
     """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
     lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
@@ -60,7 +64,7 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
             law = Const(float(np.average(values, weights=w ** 2)), range=rng)
             k = 1
         else:
-            raise InputError(f"unknown law kind '{kind}' for a Model I parameter (linear, exp, const)")
+            raise InputError(f"unknown law kind '{kind}' for a Model I parameter ({', '.join(FIT_LAW_KINDS)})")
         ssr = float(np.sum(((law(T) - values) * w) ** 2))
         table[kind] = {"aicc": aicc(ssr, len(T), k), "law": law.to_dict()}
         if parameter is not None and not in_domain(parameter, law(np.linspace(rng[0], rng[1], 41))).all():
@@ -237,4 +241,4 @@ def at_shared(per_T, free, shared):
     return out
 
 
-__all__ = ["fit_law", "segmented_fit", "aicc", "laws_on_information", "at_shared", "LOG_SPACE_BELOW"]
+__all__ = ["fit_law", "FIT_LAW_KINDS", "segmented_fit", "aicc", "laws_on_information", "at_shared", "LOG_SPACE_BELOW"]

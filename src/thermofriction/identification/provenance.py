@@ -39,10 +39,10 @@ def _option(v):
         return {str(k): _option(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
         return [_option(x) for x in v]
+    if isinstance(v, np.generic):  # first: np.float64 is a float too, but not a plain one (np.float64(1) != ())
+        return v.item()
     if isinstance(v, (str, bool, int, float)) or v is None:
         return v
-    if isinstance(v, np.generic):
-        return v.item()
     return repr(v)
 
 
@@ -57,7 +57,8 @@ def stamp(fit, data, method: str, init, options: dict):
     held = [e for e in experiments if getattr(e, "role", "fit") != "fit"]
     label = _label(data)
     temps = ", ".join(f"{e.temperature:.4g}" for e in fit_runs)
-    opts = {k: _option(v) for k, v in options.items() if v is not None and v != () and v != []}
+    # (an option is tested once it is plain: np.int64(1) != () is an empty array, whose truth is an error)
+    opts = {k: o for k, o in ((k, _option(v)) for k, v in options.items()) if o is not None and o != [] and o != ()}
 
     def plain(x):  # what the model file's [provenance] holds; anything else as its text (never fail a fit here)
         items = list(x.values()) if isinstance(x, dict) else x if isinstance(x, list) else [x]

@@ -20,8 +20,8 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import contextlib
+import gc
 import logging
-import numbers
 import os
 import pickle
 import sys
@@ -70,9 +70,8 @@ def check_options(scheduler=None, workers=None, batch_size=None, progress=None):
     """The options of where and how the work runs, as sweep, propagate and identify_fleet take them,
     checked before any work: one InputError naming the argument."""
     check_scheduler(scheduler)
-    for name, value in (("workers", workers), ("batch_size", batch_size)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
-            _args.refuse(name, "a positive whole number or None", value)
+    _args.whole(workers, "workers", none=True, low=1)
+    _args.whole(batch_size, "batch_size", none=True, low=1)
     _args.function(progress, "progress")
 
 
@@ -144,13 +143,20 @@ class Runner:
         try:
             # the wait is Dask's own (distributed.comm.timeouts.connect, 30 s unless configured)
             self.client = self._stack.enter_context(distributed.Client(address=address))
+            return
         except MemoryError:  # a reply whose first bytes, read as a length, ask for exabytes
-            raise InputError(f"scheduler {address}: cannot connect (its reply is not Dask's protocol): not a Dask "
-                             f"scheduler; start one with 'dask scheduler' (docs/scale.md)") from None
+            failure = "cannot connect (its reply is not Dask's protocol): not a Dask scheduler; start one with " \
+                      "'dask scheduler' (docs/scale.md)"
         except Exception as e:  # noqa: BLE001 - OSError, TimeoutError, and whatever Dask raises on a reply it
             # cannot read (an AssertionError): all mean that no scheduler can be used there
-            raise InputError(f"scheduler {address}: cannot connect ({shorten(str(e) or type(e).__name__, 200)}); "
-                             f"start one with 'dask scheduler' and 'dask worker ADDRESS' (docs/scale.md)") from None
+            failure = (f"cannot connect ({shorten(str(e) or type(e).__name__, 200)}); start one with 'dask scheduler' "
+                       f"and 'dask worker ADDRESS' (docs/scale.md)")
+        # The Client that failed to start is garbage in a reference cycle (through the exception's frames), with
+        # its IO loop running. Collected here, outside the except block, its __del__ closes it now; left to a
+        # later collection, that close may run inside the next Client's start, which holds the lock of Dask's
+        # loop runners that the close takes too: the next run hangs for ever (issue 41).
+        gc.collect()
+        raise InputError(f"scheduler {address}: {failure}")
 
     def _stop_pool(self):
         # after Ctrl-C or a failed task: the chunks not started are dropped, the running ones end by

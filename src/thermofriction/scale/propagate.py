@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 
 import numpy as np
 
@@ -285,25 +284,15 @@ def _checked(result, temperatures, draws, seed, input, duration, sample_rate, le
     if input is not None and not isinstance(input, Waveform):
         _args.refuse("input", "a Waveform or None", input)
     check_run_options(duration, sample_rate, solver, controller, scheduler, workers, batch_size, progress)
-    if isinstance(temperatures, (str, bytes)) or not (_args.is_number(temperatures) or (
-            isinstance(temperatures, (list, tuple, np.ndarray)) and all(_args.is_number(t) for t in temperatures))):
-        _args.refuse("temperatures", "a number or a list of numbers [C]", temperatures)
+    temps = _args.number_list(temperatures, "temperatures", "C")
     model = getattr(result, "model", None)
     if model is None or not hasattr(result, "parameters"):
         raise InputError(f"result must be a fit (tf.identify's FitResult), got {shorten(result)}")
     check_drawable(result)  # before the nominal runs
-    if isinstance(draws, bool) or not isinstance(draws, numbers.Integral) or not 2 <= draws <= MAX_DRAWS:
-        raise InputError(f"draws must be a whole number from 2 to {MAX_DRAWS}, got {shorten(draws)}")
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-        raise InputError(f"seed must be a whole number, 0 or more, got {shorten(seed)}")
-    if isinstance(level, bool) or not isinstance(level, numbers.Real) or not 0 < level < 1:
+    _args.whole(draws, "draws", low=2, high=MAX_DRAWS)
+    _args.whole(seed, "seed", low=0)
+    if not 0 < _args.number(level, "level") < 1:
         raise InputError(f"level must be between 0 and 1, got {shorten(level)}")
-    try:
-        temps = np.atleast_1d(np.asarray(temperatures, dtype=float))
-    except (TypeError, ValueError):
-        raise InputError(f"temperatures must be numbers [C], got {shorten(temperatures)}") from None
-    if temps.ndim != 1 or temps.size == 0 or not np.all(np.isfinite(temps)):
-        raise InputError(f"temperatures must be a non-empty list of finite numbers [C], got {shorten(temperatures)}")
     return model, temps
 
 

@@ -188,15 +188,16 @@ def _check_arguments(model, input, controller, max_samples):
         raise InputError(f"input must be a Waveform{hint}, got {shorten(input)}")
     if controller is not None and not isinstance(controller, StepSizeController):
         raise InputError(f"controller must be a StepSizeController, got {shorten(controller)}")
-    if max_samples is not None and (isinstance(max_samples, bool) or not isinstance(max_samples, numbers.Integral)
-                                    or max_samples < 1):
-        raise InputError(f"max_samples must be a positive whole number or None, got {shorten(max_samples)}")
+    _args.whole(max_samples, "max_samples", none=True, low=1)
 
 
-def _check_types(duration, temperature, sample_rate, solver, friction_work):
-    """No coercion (_args.py): duration='2', temperature='35', sample_rate=True are refused."""
+def _check_types(duration, temperature, sample_rate, t_eval, solver, friction_work):
+    """No coercion (_args.py): duration='2', temperature='35', sample_rate=True, t_eval='0.01' are refused."""
     _args.number(duration, "duration", "s", none=True)
     _args.number(sample_rate, "sample_rate", "Hz")
+    _args.number_list(t_eval, "t_eval", "s", none=True)
+    if _args.is_number(temperature):
+        _args.number(temperature, "temperature", "degC")
     pair = isinstance(temperature, (tuple, list)) and len(temperature) == 2 and all(
         isinstance(x, (list, tuple, np.ndarray)) and np.ndim(x) == 1 for x in temperature)
     if not (temperature is None or _args.is_number(temperature) or isinstance(temperature, Sampled) or pair):
@@ -225,7 +226,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
         heat model), returned as ``friction_work``.
     """
     _check_arguments(model, input, controller, max_samples)
-    _check_types(duration, temperature, sample_rate, solver, friction_work)
+    _check_types(duration, temperature, sample_rate, t_eval, solver, friction_work)
     solver = solver or AutoSwitch()
     if isinstance(solver, str):
         if solver not in SOLVERS:

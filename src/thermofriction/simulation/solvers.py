@@ -6,14 +6,10 @@ limits. They are separate so that either can change without the other.
 
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass
 
-import numpy as np
-
+from .. import _args
 from ..errors import InputError, shorten
-
 
 
 @dataclass(frozen=True)
@@ -71,29 +67,13 @@ class StepSizeController:
     max_step: float | None = None
     max_steps: int = 10_000_000
 
-    def __post_init__(self):
-        if isinstance(self.rtol, bool) or not (isinstance(self.rtol, numbers.Real) and 0 < self.rtol < 1):
+    def __post_init__(self):  # one checker per kind of argument (_args.py)
+        if not 0 < _args.number(self.rtol, "rtol") < 1:
             raise InputError(f"rtol must be between 0 and 1, got {shorten(self.rtol)}")
-        if (isinstance(self.max_steps, bool) or not isinstance(self.max_steps, numbers.Integral)
-                or self.max_steps < 1):
-            raise InputError(f"max_steps must be a positive whole number, got {shorten(self.max_steps)}")
-        if self.atol is not None:
-            if isinstance(self.atol, (str, bytes, bool, np.bool_)) or (
-                    isinstance(self.atol, (list, tuple)) and not all(isinstance(a, (int, float)) and not isinstance(a, bool)
-                                                                     for a in self.atol)):
-                raise InputError(f"atol must be a positive finite number (or one per state), got "
-                                 f"{type(self.atol).__name__} {shorten(self.atol)}")
-            try:
-                atol = np.asarray(self.atol, dtype=float)
-            except (TypeError, ValueError):
-                atol = None
-            if atol is None or atol.ndim > 1 or atol.size < 1 or not np.all(np.isfinite(atol) & (atol > 0)):
-                raise InputError(f"atol must be a positive finite number (or one per state), got {shorten(self.atol)}")
+        _args.whole(self.max_steps, "max_steps", low=1)
+        _args.number_list(self.atol, "atol", none=True, positive=True)  # one, or one per state
         for name in ("first_step", "max_step"):
-            v = getattr(self, name)
-            if v is not None and (isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v)
-                                  or v <= 0):
-                raise InputError(f"{name} must be a positive finite number of seconds or None, got {shorten(v)}")
+            _args.number(getattr(self, name), name, "s", none=True, positive=True)
 
 
 # ---------------------------------------------------------------------------------------------
