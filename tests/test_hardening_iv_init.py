@@ -165,7 +165,9 @@ def test_init_refuses_a_manifest_that_is_a_fifo(run, tmp_path, capsys):
 # -- the old module names -----------------------------------------------------------------------------
 
 def _python(*args, code=None):
-    cmd = [sys.executable, "-W", "error::DeprecationWarning"] + (["-c", code] if code else list(args))
+    """A fresh interpreter (the first import of an old name is the one that warns); with ``code``, its warnings
+    are errors."""
+    cmd = [sys.executable] + (["-W", "error::DeprecationWarning", "-c", code] if code else list(args))
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
 
 
