@@ -158,8 +158,12 @@ def test_init_refuses_a_manifest_that_is_a_fifo(run, tmp_path, capsys):
     """A FIFO named dataset.toml: refused before any work (writing through it would wait for a reader)."""
     folder = _folder(tmp_path, run, "run_30C.csv")
     os.mkfifo(folder / "dataset.toml")
-    assert main(["init", str(folder), "--force"]) == 2
-    assert "not a regular file" in capsys.readouterr().err
+    reader = os.open(folder / "dataset.toml", os.O_RDONLY | os.O_NONBLOCK)  # (so that a regression fails, not hangs)
+    try:
+        assert main(["init", str(folder), "--force"]) == 2
+    finally:
+        os.close(reader)
+    assert "not a regular file; refusing to replace it" in capsys.readouterr().err
 
 
 # -- the old module names -----------------------------------------------------------------------------
