@@ -19,7 +19,7 @@ MAX_MODULE_LINES = 400
 LONG_FUNCTIONS = {
     "cli/parser.py:build_parser": "the command line's table of commands and options",
     "fmu_description.py:variables_of": "the table of the FMU's variables",
-    "data/files.py:load_dataset": "the dataset file's parser",
+    "data/files.py:manifest_dataset": "the dataset file's parser",
     "data/matlab.py:read_experiment_mat": "a MATLAB experiment's parser",
 }
 MAX_FUNCTION_LINES = 80

@@ -125,9 +125,9 @@ def test_init_that_would_not_load_writes_nothing(five, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("name, T", [("run_35.2C.csv", 35.2), ("T35.2.csv", 35.2), ("35.2degC.mat", 35.2),
-                                     ("stage-35p2C.csv", 35.2), ("temp_40.csv", 40.0), ("T30.8C-validate.csv", 30.8),
+                                     ("stage_35p2C.csv", 35.2), ("temp_40.csv", 40.0), ("T30.8C-validate.csv", 30.8),
                                      ("x_35.2°C.csv", 35.2), ("run7.csv", None), ("T30C_T40C.csv", None),
-                                     ("data.csv", None)])
+                                     ("data.csv", None), ("stage-35p2C.csv", None)])  # (+ or - 35.2: issue 41)
 def test_temperatures_in_file_names(name, T):
     assert temperature_from_name(name) == T
 

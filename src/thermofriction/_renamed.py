@@ -3,8 +3,11 @@
 ``thermofriction.identify``, ``.validate``, ``.simulate`` and ``.report`` were both modules and the functions
 the package exports, so the function shadowed its module (``thermofriction.validate.ValidationResult`` raised
 AttributeError). The modules are now ``identification``, ``validation``, ``simulation`` and ``reporting``;
-an import under an old name (``from thermofriction.identify import Parameter``) still works, warns, and
-returns the new module, while ``thermofriction.identify`` stays the function."""
+an import under an old name (``from thermofriction.identify import Parameter``, ``import
+thermofriction.identify.problem as p``) still works, warns, and returns the new module, while
+``thermofriction.identify`` stays the function -- so ``import thermofriction.identify as m``, which binds that
+attribute, gives the function, and the warning says so. ``python -m`` with an old name names the new one (the
+modules are no programs)."""
 
 from __future__ import annotations
 
@@ -20,28 +23,49 @@ RENAMED = {"identify": "identification", "validate": "validation", "simulate": "
            "report": "reporting"}
 
 
+def _new_name(fullname: str) -> str | None:
+    """``thermofriction.<new>[.sub]`` for ``thermofriction.<old>[.sub]``, else None."""
+    parts = fullname.split(".")
+    if len(parts) < 2 or parts[0] != "thermofriction" or parts[1] not in RENAMED:
+        return None
+    return ".".join(["thermofriction", RENAMED[parts[1]], *parts[2:]])
+
+
 class _OldNames(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     """Finds ``thermofriction.<old>[.sub]`` and loads it as the module under its new name."""
 
     def find_spec(self, fullname, path=None, target=None):
-        parts = fullname.split(".")
-        if len(parts) < 2 or parts[0] != "thermofriction" or parts[1] not in RENAMED:
-            return None
-        new = ".".join(["thermofriction", RENAMED[parts[1]], *parts[2:]])
-        if importlib.util.find_spec(new) is None:
+        new = _new_name(fullname)
+        if new is None or importlib.util.find_spec(new) is None:
             return None
         return importlib.util.spec_from_loader(fullname, self, origin=new)
 
     def create_module(self, spec):
-        warnings.warn(f"module {spec.name} is now {spec.origin}; the old name will be removed",
+        package, _, name = spec.name.rpartition(".")
+        # ``import thermofriction.simulate as s`` binds the package's attribute, the function: say so
+        note = (f" ({spec.name} is the function {name}: 'import {spec.name} as ...' gives the function, not the "
+                f"module)" if package == "thermofriction" else "")
+        warnings.warn(f"module {spec.name} is now {spec.origin}; the old name will be removed{note}",
                       DeprecationWarning, stacklevel=2)
         module = importlib.import_module(spec.origin)
         spec.loader_state = module.__spec__
         return module
 
     def exec_module(self, module):
+        old = module.__spec__.name
         # the import system has set the old name's spec on the real module: put its own back
         module.__spec__ = module.__spec__.loader_state
+        package, _, name = old.rpartition(".")
+        function = sys.modules["thermofriction"].__dict__.get(package.rpartition(".")[2])
+        if package.count(".") == 1 and callable(function) and not isinstance(function, types.ModuleType):
+            # ``import thermofriction.identify.problem as p`` takes p from attributes: thermofriction.identify
+            # (the function), then its ``problem``
+            setattr(function, name, module)
+
+    def get_code(self, fullname):
+        """``python -m thermofriction.simulate`` (runpy asks for the code): the modules are no programs."""
+        raise ImportError(f"{fullname} is now {_new_name(fullname)}, which is not a program either; the command "
+                          f"line is 'thermofriction --help' (or python -m thermofriction)")
 
 
 class Package(types.ModuleType):

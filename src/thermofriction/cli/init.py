@@ -13,10 +13,11 @@ from .. import _io
 from ..errors import InputError, shorten
 
 #: a temperature in a file name (docs/cli.md#init): a number with a Celsius unit after it (35.2C, 35.2degC,
-#: 35.2°C, 35p2C) or a T or temp before it (T35.2, T_35.2, temp35.2); "p" may stand for the decimal point
-_NUMBER = r"(\d+(?:[.p]\d+)?)"
+#: 35.2°C, 35p2C) or a T or temp before it (T35.2, T_35.2, temp35.2); "p" may stand for the decimal point; a sign
+#: before the number is read by _readings
+_NUMBER = r"(?P<sign>[-\u2212]?)(?P<number>\d+(?:[.p]\d+)?)"
 _NAME_PATTERNS = (re.compile(_NUMBER + r"\s*(?:°\s*C|deg_?C|C)(?![A-Za-z])", re.IGNORECASE),
-                  re.compile(r"(?<![A-Za-z])(?:T|temp|temperature)[_=-]?" + _NUMBER + r"(?![\d])", re.IGNORECASE))
+                  re.compile(r"(?<![A-Za-z])(?:T|temp|temperature)[_=]?" + _NUMBER + r"(?![\d])", re.IGNORECASE))
 #: a file name that says the run is held out (synth's T33C-validate.csv)
 _HELD_OUT = re.compile(r"validat|hold-?out|held-?out", re.IGNORECASE)
 #: the experiment files init lists
@@ -27,13 +28,14 @@ def add_init_command(sub):
     p = sub.add_parser(
         "init", help="write a dataset.toml for a folder of experiment files (CSV, .mat)",
         description="Write DIR/dataset.toml (docs/formats.md#datasets) listing every experiment file (.csv, .mat) "
-                    "in DIR, with its temperature and role, and check that the dataset loads. A file's temperature "
-                    "is, in this order: --temperature FILE=C; the mean of its temperature column "
+                    "in DIR, with its temperature and role, once the dataset it lists is checked to load. A file's "
+                    "temperature is, in this order: --temperature FILE=C; the mean of its temperature column "
                     "(temperature[C], or temperature/temperature_C in a .mat); a temperature in its name (35.2C, "
-                    "35.2degC, 35p2C, T35.2, temp35.2); else asked for on a terminal. Roles: --validate; else the "
-                    "files whose names say so (validate, holdout, held-out) are held out for validation; else, "
-                    "with 4 or more experiments, about a quarter of them at interior temperatures; the others "
-                    "are fitted.",
+                    "35.2degC, 35p2C, T35.2, temp35.2, run_-5C; a hyphen after a letter or digit may be a separator "
+                    "or a minus sign, so run-5C states none: docs/cli.md#init); else asked for on a terminal. Roles: "
+                    "--validate; else the files whose names say so (validate, holdout, held-out) are held out for "
+                    "validation; else, with 4 or more experiments, about a quarter of them at interior "
+                    "temperatures; the others are fitted.",
         epilog="example: thermofriction init measurements --temperature run7.csv=36.5 --validate run4.csv")
     p.add_argument("folder", metavar="DIR", help="the folder of experiment files; dataset.toml is written there")
     p.add_argument("--temperature", action="append", default=[], metavar="FILE=C",
@@ -56,14 +58,47 @@ def experiment_files(folder: Path, exclude=()) -> list[str]:
     return sorted(names)
 
 
-def temperature_from_name(name: str) -> float | None:
-    """The temperature [C] a file's name states (``run_35.2C.csv``, ``T35.2.csv``, ``35p2degC.mat``), or None
-    when it states none, or several different ones."""
+def _readings(stem: str, m) -> set:
+    """What one number in a name can mean. A hyphen before it is a minus sign at the start of the name or after
+    another separator (``run_-5C``, ``T=-10``); after a letter or a digit it may as well be a separator
+    (``stage-35C``, ``T-10``, ``run3-5C``), so the number reads both ways, unless one way is no plausible
+    temperature (``oven-150C``). A minus sign (U+2212) is one anywhere."""
+    value = float(m.group("number").replace("p", ".").replace("P", "."))
+    sign, at = m.group("sign"), m.start("sign")
+    separator = sign == "-" and at > 0 and (stem[at - 1].isalnum() or stem[at - 1] in "-.")
+    if sign == "\u2212" or (sign == "-" and not separator):
+        return {0.0 - value}  # (0.0 - 0.0 is 0.0: no -0.0 in a manifest)
+    if separator:
+        return {v for v in (value, 0.0 - value) if _plausible(v)} or {value}
+    return {value}
+
+
+def name_readings(name: str) -> set:
+    """Every temperature [C] a file's name can be read to state (none, one, or several: two numbers, or a
+    hyphen that is a separator or a minus sign)."""
     stem = os.path.splitext(name)[0]
     found = set()
     for pattern in _NAME_PATTERNS:
-        found |= {float(m.group(1).replace("p", ".").replace("P", ".")) for m in pattern.finditer(stem)}
+        for m in pattern.finditer(stem):
+            found |= _readings(stem, m)
+    return found
+
+
+def temperature_from_name(name: str) -> float | None:
+    """The temperature [C] a file's name states (``run_35.2C.csv``, ``run_-5C.csv``, ``T35.2.csv``,
+    ``35p2degC.mat``), or None when it states none, or can be read as several different ones."""
+    found = name_readings(name)
     return found.pop() if len(found) == 1 else None
+
+
+def refuse_unlistable(folder, files) -> None:
+    """Refuses the file names a manifest (UTF-8 text) cannot hold -- bytes that are not UTF-8, which Python
+    keeps as lone surrogates, or control characters -- naming them as bytes, before any work."""
+    bad = [f for f in files if not f.isprintable()]
+    if bad:
+        shown = ", ".join(shorten(os.fsencode(f)) for f in bad[:3]) + (f" and {len(bad) - 3} more" if bad[3:] else "")
+        raise InputError(f"{folder}: a manifest (UTF-8 text) cannot name {shown}: not UTF-8, or a control "
+                         f"character; rename the file, or leave it out with --exclude PATTERN")
 
 
 def has_temperature_column(path: Path) -> bool:
@@ -105,15 +140,22 @@ def _explicit(items, files) -> dict:
 def _ask(name: str) -> float:
     """A file's temperature asked for on the terminal, until it is a plausible one."""
     from ..data.files import check_temperature
+    reads = _reads(name)
     while True:
         try:
-            text = input(f"temperature of {name} [C]: ").strip()
+            text = input(f"temperature of {name} [C]{f' ({reads})' if reads else ''}: ").strip()
         except EOFError:
             raise InputError(f"{name}: no temperature given") from None
         try:
             return check_temperature(float(text), name)
         except ValueError:  # (an InputError is a ValueError too: the range)
             print(f"  not a plausible temperature [C]: {text!r}", file=sys.stderr)
+
+
+def _reads(name: str) -> str:
+    """How a name that states no temperature reads several ways ("its name reads -5 or 5 C"), or ""."""
+    found = sorted(name_readings(name))
+    return f"its name reads {' or '.join(f'{T:g}' for T in found)} C" if len(found) > 1 else ""
 
 
 def _plausible(T) -> bool:
@@ -136,9 +178,12 @@ def temperatures(folder: Path, files, explicit: dict, interactive: bool) -> dict
     unknown = [f for f in files if f not in out]
     if unknown and not interactive:
         listed = ", ".join(unknown[:8]) + (f", ... ({len(unknown)} files)" if len(unknown) > 8 else "")
+        several = [f"{f}: {_reads(f)}" for f in unknown if _reads(f)][:3]
+        why = (f" unambiguously ({'; '.join(several)}; a hyphen after a letter or digit may be a separator or a minus "
+               f"sign, an underscore before it makes it one: run_-5C.csv)" if several else "")
         raise InputError(f"{folder}: no temperature for {listed}: the file has no temperature column and its name "
-                         f"states none; give --temperature FILE=C (e.g. --temperature {unknown[0]}=35.2), name the "
-                         f"file with its temperature (run_35.2C.csv), or run init on a terminal to be asked")
+                         f"states none{why}; give --temperature FILE=C (e.g. --temperature {unknown[0]}=35.2), name "
+                         f"the file with its temperature (run_35.2C.csv), or run init on a terminal to be asked")
     for f in unknown:
         out[f] = (_ask(f), "asked")
     return out
@@ -212,24 +257,34 @@ def manifest_text(name, files, temps, role_of) -> str:
 
 
 def write_checked(folder: Path, text: str):
-    """Writes dataset.toml and loads the dataset; when it does not load, the folder is left as it was (the old
-    manifest back, or none) and the error names the file."""
-    from ..data import load_dataset
+    """Loads the dataset that the manifest ``text`` lists and only then writes it to dataset.toml, atomically: when
+    the dataset does not load, or init is interrupted (Ctrl-C, SIGTERM), the folder is as it was (the old manifest,
+    or none). The error names the file."""
+    import tomllib
+
+    from ..data.files import manifest_dataset
 
     manifest = folder / "dataset.toml"
-    old = manifest.read_bytes() if manifest.is_file() else None
-    with _io.atomic_write(manifest, "w", encoding="utf-8") as fh:
-        fh.write(text)
     try:
-        return load_dataset(folder)
+        data = manifest_dataset(tomllib.loads(text), folder, manifest)
     except InputError as e:
-        if old is None:
-            manifest.unlink()
-        else:
-            with _io.atomic_write(manifest, "wb") as fh:
-                fh.write(old)
         raise InputError(f"{e} -- so {manifest} was not written (leave a file out with --exclude, give a temperature "
                          f"with --temperature FILE=C, or fix the file)") from None
+    with _io.atomic_write(manifest, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    return data
+
+
+def _dataset_name(name, folder: Path) -> str:
+    """--name, which must be UTF-8 text (a manifest is), or else the folder's name, its bytes that are not UTF-8
+    replaced (U+FFFD)."""
+    if not name:
+        return os.fsencode(folder.resolve().name).decode("utf-8", errors="replace")
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:  # bytes of the command line that are not UTF-8 (kept as lone surrogates)
+        raise InputError(f"--name {shorten(os.fsencode(name))}: not UTF-8 text") from None
+    return name
 
 
 def cmd_init(args) -> int:
@@ -239,13 +294,16 @@ def cmd_init(args) -> int:
     manifest = folder / "dataset.toml"
     if (manifest.exists() or manifest.is_symlink()) and not args.force:
         raise InputError(f"{manifest}: already exists; give --force to replace it")
+    if _io.Target(manifest).check().kind != "file":  # (a FIFO would block the write, and no dataset reads it)
+        raise InputError(f"{manifest}: not a regular file; refusing to replace it")
     files = experiment_files(folder, args.exclude)
     if not files:
         raise InputError(f"{args.folder}: no experiment files ({', '.join(EXTENSIONS)}) in this folder")
+    refuse_unlistable(args.folder, files)
     explicit = _explicit(args.temperature, files)
     temps = temperatures(folder, files, explicit, interactive=sys.stdin is not None and sys.stdin.isatty())
     role_of, how = roles(files, temps, args.validate, folder)
-    data = write_checked(folder, manifest_text(args.name or folder.resolve().name, files, temps, role_of))
+    data = write_checked(folder, manifest_text(_dataset_name(args.name, folder), files, temps, role_of))
     width = max(map(len, files))
     source = {"--temperature": "given", "column": "mean of its temperature column", "name": "from the file name",
               "asked": "as you typed it"}

@@ -124,6 +124,15 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
         raise InputError(f"{manifest}: not UTF-8 text ({e.reason} at byte {e.start})") from None
     except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
         raise InputError(f"{manifest}: TOML nested too deeply") from None
+    data = manifest_dataset(meta, folder, manifest, motion=motion)
+    data.sha256 = dataset_sha256(data)
+    return data
+
+
+def manifest_dataset(meta: dict, folder: Path, manifest: Path, *, motion: str | None = None) -> Dataset:
+    """The dataset that a manifest's table (``meta``, as TOML reads it) lists, its files in ``folder``, all checked;
+    messages name ``manifest``. Apart from :func:`load_dataset` so that ``init`` checks a manifest before it
+    writes it (cli/init.py)."""
     unknown = set(meta) - set(_MANIFEST_KEYS)
     if unknown:
         raise InputError(f"{manifest}: {unknown_keys(unknown, _MANIFEST_KEYS)}")
@@ -211,8 +220,8 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
                 if problem:
                     raise InputError(f"{folder / f}: {label}: {problem}")
                 doubt = displacement_doubt(cols[column], unit)
-                if doubt:
-                    warnings.warn(f"{SUSPICIOUS}{folder / f}: {label}: {doubt}", UnitWarning, stacklevel=2)
+                if doubt:  # (stacklevel: the caller of load_dataset)
+                    warnings.warn(f"{SUSPICIOUS}{folder / f}: {label}: {doubt}", UnitWarning, stacklevel=3)
         problem = voltage_problem(cols["voltage"])
         if problem:
             raise InputError(f"{folder / f}: {headers['voltage'][0]}: {problem}")
@@ -231,9 +240,7 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
             units_of(exps)
     except InputError as err:
         raise InputError(f"{manifest}: {err}") from None
-    data = Dataset(path=folder, name=name, description=description, experiments=exps)
-    data.sha256 = dataset_sha256(data)
-    return data
+    return Dataset(path=folder, name=name, description=description, experiments=exps)
 
 
 def _read_experiment(path: Path, entry: dict, where: str):
