@@ -245,4 +245,4 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None) 
     return ValidationResult(model, preds, caught, failures, measurement, how)
 
 
-__all__ = ["MetricWarning", "validate", "scoring_note", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]
+__all__ = ["MetricWarning", "validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]
