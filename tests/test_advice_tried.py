@@ -85,3 +85,14 @@ def test_the_sampling_check_only_where_the_runs_reverse():
     one_way = [dataclasses.replace(e, input=motion_waveform(e.time, np.abs(e.drive_velocity) + 0.05))
                for e in two_way.experiments]
     assert SAMPLING_CHECK not in measurement.checks(model, make_traces(one_way, model, measurement))
+
+
+def test_the_stribeck_advice_can_be_followed_from_a_plant_only_start(tmp_path):
+    """The advice 'add fs,vs to --parameters' from the usual plant-only start ended with "'vs' has no value in this
+    model" (base fits did not give a start without a Stribeck excess one to start from, as Model I and II do)."""
+    plant = tf.load_model("li2009-base").plant
+    data = tf.synthesize(tf.load_model("li2009-base"), [30.0], duration=0.3, seed=4)
+    init = tf.Model(plant, tf.models.LuGre(sigma0=2e6, sigma1=2.0, fc=0.8))
+    res = tf.identify(data, "base", init=init, parameters=["sigma0", "sigma1", "fc", "fs", "vs"], starts=1)
+    assert res.model.friction.fs >= res.model.friction.fc
+    assert res.model.friction.vs > 0

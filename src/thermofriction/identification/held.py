@@ -291,8 +291,10 @@ def _tried_text(tests) -> str:
         if trial is None or t["contradicted"]:  # (a contradicted value is said with its gain in its own warning)
             continue
         what = "a Stribeck effect" if t["name"] == "fs" and t["dof"] > 1 else t["name"]
-        out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit")
-    return ", ".join(out) + (" (less than 1 % each: not worth a parameter)" if out else "")
+        verdict = _advice(t["name"], t["dof"]) if trial["gain"] >= MATERIAL else \
+            f"less than {100 * MATERIAL:g} %: not worth a parameter"
+        out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit ({verdict})")
+    return ", ".join(out)
 
 
 def with_held_tests(res, experiments, measurement, rtol=1e-8):

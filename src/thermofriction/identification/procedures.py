@@ -198,11 +198,14 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", m
     ``experiments``: one set of values shared by all of them. ``measurement``: how the residuals are formed
     (default: the experiments' own measurement with its default offset policy)."""
     t0 = time.perf_counter()
+    if not isinstance(parameters, Parameters):  # fs named on a model without an excess: one to start from
+        parameters = parameters or default_fit_parameters(model)
+        model = stribeck_start(model, parameters)
     traces = make_traces(experiments, model, measurement)
     if isinstance(parameters, Parameters):
         params = parameters
     else:
-        params = friction_parameters(model, parameters or default_fit_parameters(model))
+        params = friction_parameters(model, parameters)
     outcome = fit(model, params, traces, **opts)
     return fit_result(method, model, params, outcome, traces, t0, stribeck_notes(model, params))
 
