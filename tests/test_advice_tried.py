@@ -96,3 +96,33 @@ def test_the_stribeck_advice_can_be_followed_from_a_plant_only_start(tmp_path):
     res = tf.identify(data, "base", init=init, parameters=["sigma0", "sigma1", "fc", "fs", "vs"], starts=1)
     assert res.model.friction.fs >= res.model.friction.fc
     assert res.model.friction.vs > 0
+
+
+def test_one_verdict_where_the_noise_cannot_be_estimated(model_i):
+    """A 2x wrong held mass (reference truth) under AR(1) displacement noise (rho 0.95: the noise cannot be estimated
+    at the sample scale): the held-value test makes the fit not adequate, and the header, the first warning and the
+    JSON say the same -- not adequate on the held values, not a ratio to a noise level the same output calls
+    unknown."""
+    truth = dataclasses.replace(model_i, plant=dataclasses.replace(model_i.plant, end_effector_mass=0.1))
+    data = reference_experiments(truth, (31.0, 36.0, 41.0), duration=0.3, seed=11, noise=0.0)
+    rng = np.random.default_rng(3)
+    for e in data:
+        w = rng.standard_normal(e.time.size) * 20e-9 * np.sqrt(1 - 0.95 ** 2)
+        ar = np.empty_like(w)
+        ar[0] = w[0] / np.sqrt(1 - 0.95 ** 2)
+        for i in range(1, w.size):
+            ar[i] = 0.95 * ar[i - 1] + w[i]
+        e.displacement = e.displacement + ar
+    res = tf.identify(data, "model-i", init=model_i)
+    q = res.fit_quality
+    if not any(h["contradicted"] for h in q["held"]):
+        pytest.skip("the mass is not contradicted under this noise: nothing to check")
+    assert res.adequate is False
+    text = res.report()
+    header = text.splitlines()[1]
+    assert header.startswith("    NOT ADEQUATE")
+    if q.get("verdict_basis") == "held values":
+        assert "x the measurement noise" not in header
+        assert not any(w.startswith("adequacy unknown") for w in res.warnings)
+        n = sum(h["contradicted"] for h in q["held"])
+        assert res.warnings[0].startswith(f"the fit is not adequate: {n} held value(s)") and f"{n} held value(s)" in header

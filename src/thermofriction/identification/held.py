@@ -325,6 +325,14 @@ def with_held_tests(res, experiments, measurement, rtol=1e-8):
         # directions then share out a misfit they do not all cause), else first
         at = 1 if res.fit_quality["adequate"] is False and res.warnings and \
             res.warnings[0].startswith("the fit is not adequate") else 0
+        if res.fit_quality["adequate"] is None:  # one verdict: not adequate, on the held values alone
+            res.fit_quality["verdict_basis"] = "held values"
+            res.warnings[:] = [w for w in res.warnings if not w.startswith("adequacy unknown")]
+            n_bad = sum(1 for t in tests if t["contradicted"])  # (as the header counts them: result.py)
+            res.warnings.insert(0, f"the fit is not adequate: {n_bad} held value(s) contradicted by the data "
+                                   f"(below); its residuals are not held against the noise, which cannot be estimated "
+                                   f"from these data ({res.fit_quality.get('why')})")
+            at = 1
         res.fit_quality["adequate"] = False
         res.warnings[at:at] = [t["message"] for t in bad]
     return res

@@ -216,10 +216,13 @@ class FitResult(Result):
         """A table like lmfit's fit report."""
         lines = [f"[[Fit: {self.method}]]"]
         held = [h for h in (self.fit_quality or {}).get("held") or [] if h["contradicted"]]
-        if self.adequate is False:  # first, in plain words
-            lines.append(f"    NOT ADEQUATE: residuals {self.fit_quality['ratio']:.3g} x the measurement noise"
-                         + (f", {len(held)} held value(s) contradicted by the data" if held else "")
-                         + " (see the first warnings)")
+        if self.adequate is False:  # first, in plain words: the one verdict (fit_quality), as the warnings say it
+            on_held = self.fit_quality.get("verdict_basis") == "held values"
+            lines.append("    NOT ADEQUATE: " + (
+                f"{len(held)} held value(s) contradicted by the data (the noise cannot be estimated from these data: "
+                f"the residuals are not compared with it)" if on_held else
+                f"residuals {self.fit_quality['ratio']:.3g} x the measurement noise"
+                + (f", {len(held)} held value(s) contradicted by the data" if held else "")) + " (see the first warnings)")
         if self.n_points == 0 and "paper" in self.details:  # no trajectory fit: say what was done instead
             lines += [f"    {'done' if self.success else 'REFUSED'}: {self.message}"] + self._paper_lines()
         else:
@@ -328,6 +331,8 @@ def _plant_lines(plant) -> list:
 
 
 def _verdict(q) -> str:
+    if q["adequate"] is False and q.get("verdict_basis") == "held values":
+        return f"NOT adequate (held values contradicted; the noise cannot be estimated: {q.get('why')})"
     if q["adequate"] is None:
         return f"adequacy unknown ({q.get('why') or 'the noise cannot be estimated from the data'})"
     return "adequate" if q["adequate"] else "NOT adequate"
