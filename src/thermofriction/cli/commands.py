@@ -11,6 +11,7 @@ import numpy as np
 
 from .. import _io
 from ..errors import InputError, UnitWarning
+from ..measurements.delay import parse_delay
 from ..models import PRESETS, MassPlant, load_model
 from ..simulation import SOLVERS, StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
@@ -154,7 +155,8 @@ def cmd_identify(args) -> int:
                        laws=laws or None, refine=not args.no_refine,
                        reference_temperature=args.reference_temperature,
                        controller=StepSizeController(rtol=args.rtol), starts=args.starts,
-                       seed=args.seed, progress=update, offset=_offset(args), max_evaluations=args.max_evaluations)
+                       seed=args.seed, progress=update, offset=_offset(args), max_evaluations=args.max_evaluations,
+                       delay="auto" if args.delay is None else parse_delay(args.delay, "--delay"))
     finally:
         if status is not None:
             status.stop()
