@@ -150,6 +150,9 @@ def test_cli_delay_option(tmp_path):
     auto = tf.identify(tf.load_dataset(data), method="base", starts=1)
     assert "half the motion's time scale" in auto.details["plant"]["delay"]["note"]
     assert "searched" in auto.report()
+    both = make_command_dataset(tmp_path / "b", delay=0.008, validate=True)
+    html = tf.report([tf.identify(both, method="base", starts=1)], both, tmp_path / "report.html")
+    assert "inertia J" in html and "delay (fitted with the friction" in html and "half the motion" in html
 
 
 def test_hold_relation_of_the_truth():
