@@ -76,7 +76,8 @@ def dither(folder):
 
 
 def late(folder):
-    """The test joint's command recorded 0.5 s late: ten times the delay search's 50 ms."""
+    """The test joint's command recorded 0.5 s late: ten times the automatic delay search's range (half the
+    motion's time scale rms(v)/rms(a), about 50 ms)."""
     make_command_dataset(folder, delay=0.5)
     return Path(folder)
 
@@ -99,7 +100,7 @@ def assert_refused(r, status, *phrases):
 
 # each failing record: (its maker, the initial model or None, the exit status, what the message says, the API's error)
 FAILURES = {
-    "late": (late, None, 1, ("misaligned in time", "50 ms"), ComputationError),
+    "late": (late, None, 1, ("misaligned in time", "--delay MIN:MAX"), ComputationError),
     "wrong-sign-inertia": (wrong_sign_inertia, None, 1, ("inertia is not positive", "kg m^2"), ComputationError),
     "at-rest-full-init": (at_rest, INIT, 2, ("run0.csv", "does not move"), InputError),
     "at-rest-no-init": (at_rest, None, 2, ("run0.csv", "does not move"), InputError),
@@ -159,14 +160,19 @@ def test_every_model_identify_writes_is_one_validate_accepts(tmp_path, case):
 
 
 def test_delay_search_grid_and_its_bound():
-    """The scan's grid (one formula for the scan before the fit and the search in it) and the check at its end:
-    50 ms either way at 1 ms, a quarter of a short record; a delay at the end is refused, one within is not."""
-    from thermofriction.measurements.command import check_within_scan, scan_grid
+    """The scan's grid (one formula for the scan before the fit and the search in it) and the check at its end: the
+    half the motion's time scale rms(v)/rms(a) either way at 1 ms, a quarter of a short record; a delay at the end
+    is refused, one within is not."""
+    from thermofriction.measurements.delay import AUTO, check_not_at_end, search_range
 
-    assert scan_grid([np.arange(0.0, 4.0, DT)]) == (pytest.approx(DT), 50)
-    assert scan_grid([np.arange(0.0, 4.0, DT), np.arange(0.0, 0.1, DT)]) == (pytest.approx(DT), 25)
-    check_within_scan(49.5 * DT, DT, 50)  # the parabola's half sample short of the end: an estimate
-    check_within_scan(-49.5 * DT, DT, 50)
-    for d in (50 * DT, -50 * DT):
+    t = np.arange(0.0, 4.0, DT)
+    w = 2 * np.pi * 1.0  # a 1 Hz sine: rms(v)/rms(a) = 1/w = 159 ms
+    dt, ks, why = search_range(AUTO, [t], [np.cos(w * t)], [-w * np.sin(w * t)])
+    assert dt == pytest.approx(DT) and ks[-1] == 80 and ks[0] == -80 and "time scale" in why
+    dt, ks, why = search_range(AUTO, [t[:100]], [np.cos(w * t[:100])], [-w * np.sin(w * t[:100])])
+    assert ks[-1] == 25 and "quarter of the shortest record" in why
+    check_not_at_end(AUTO, 1, np.arange(-50, 51), DT, "")  # within: an estimate
+    check_not_at_end(AUTO, 99, np.arange(-50, 51), DT, "")
+    for i in (0, 100):
         with pytest.raises(ComputationError, match="misaligned in time by 50 ms or more"):
-            check_within_scan(d, DT, 50)
+            check_not_at_end(AUTO, i, np.arange(-50, 51), DT, "")

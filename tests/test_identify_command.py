@@ -209,5 +209,5 @@ def test_acceleration_is_lag_free_and_delay_scan_finds_a_shift():
     d = 3.4 * DT
     Run.force = 0.02 * motion(Run.time + d)[2] + 0.1 * np.tanh(motion(Run.time + d)[1] / 0.01)
     cols = [np.column_stack([a, np.ones(a.size), np.tanh(Run.drive_velocity / 0.01)])]
-    delay, se, coef, _ = delay_scan([Run], cols)
+    delay, se, coef, _ = delay_scan([Run], cols, (DT, np.arange(-50, 51)))
     assert abs(delay - d) < 0.2 * DT and coef[0] == pytest.approx(0.02, rel=0.05)

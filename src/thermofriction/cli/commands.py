@@ -12,6 +12,7 @@ import numpy as np
 from .. import _io
 from .._progress import Progress
 from ..errors import InputError, UnitWarning
+from ..measurements.delay import parse_delay
 from ..models import PRESETS, MassPlant, load_model
 from ..simulation import SOLVERS, StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
@@ -138,7 +139,8 @@ def cmd_identify(args) -> int:
                        reference_temperature=args.reference_temperature,
                        controller=StepSizeController(rtol=args.rtol), starts=args.starts,
                        seed=args.seed, progress=progress.stage, offset=_offset(args),
-                       max_evaluations=args.max_evaluations)
+                       max_evaluations=args.max_evaluations,
+                       delay="auto" if args.delay is None else parse_delay(args.delay, "--delay"))
     import shlex
     fit = fit.with_command("thermofriction " + shlex.join(sys.argv[1:]))  # in the model's [provenance]
     with _io.publish_together():  # the model and its JSON appear together, or neither

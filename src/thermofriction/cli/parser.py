@@ -187,6 +187,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the most model evaluations of each least-squares stage (default: the stages' own limits)")
     # force (torque) data (docs/force-data.md)
     _force_options(i)
+    i.add_argument("--delay", metavar="auto|none|VALUE|MIN:MAX",
+                   help="a drive's command data: the delay searched over a range read off the data (auto, the "
+                        "default), none (0), held at VALUE [s, or with a unit: 5ms], or searched within MIN:MAX")
     i.add_argument("--no-offset", action="store_true",
                    help="force data: the same as --offset none (hold the initial model's [plant] sensor_offset)")
     i.add_argument("-o", "--output", metavar="FITTED.toml", help=_writes(

@@ -14,6 +14,7 @@ from .. import _args
 from ..data.experiments import TEMPERATURE_RANGE, Dataset
 from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
+from ..measurements.delay import parse_delay
 from .held import with_held_tests
 from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
@@ -99,7 +100,7 @@ def _checked_types(data, method, init, friction, parameters, free, procedure, la
 @one_blas_thread  # (optimiser.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
              refine=True, reference_temperature=None, controller=None, starts=8, seed=0, progress=None, offset=True,
-             max_evaluations=None, rtol=None) -> FitResult:
+             max_evaluations=None, rtol=None, delay="auto") -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
@@ -126,6 +127,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         experiments), "per-experiment" (one per run: a sensor re-zeroed between runs) or "none" (or False: the
         initial model's ``[plant] sensor_offset`` held).
     max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
+    delay: a drive's command data only: "auto" (default: searched over a range read off the data), None or
+        "none" (0), a value held [s] (or a string with a unit, "5ms"), or a range searched, (min, max) or "MIN:MAX".
 
     After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
     (identification/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
@@ -139,13 +142,20 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     max_nfev = _args.whole(max_evaluations, "max_evaluations", none=True, low=1, high=MAX_EVALUATIONS)
     _args.dataset(data, Dataset, experiments=True)  # after the options, whose messages name them first
     measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
+    if delay != "auto" or measurement.name == "command":
+        spec = parse_delay(delay)  # (InputError naming delay)
+        if measurement.name != "command" and spec.kind != "auto":
+            raise InputError(f"delay applies to a drive's command data; these are {measurement.name} data")
+        if measurement.name == "command":
+            measurement.delay = spec
     if method not in measurement.methods:
         *most, last = measurement.methods
         raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
     experiments = list(getattr(data, "fit", data))
     initial, finish = SETUP[measurement.name]
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
-    init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure)
+    init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure,
+                   **({"delay": measurement.delay} if measurement.name == "command" else {}))
     needs_period(list(parameters or ()), init.friction.values(), source)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")

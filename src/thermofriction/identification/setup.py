@@ -15,8 +15,9 @@ from ..data.force import units_of
 from ..data.motion import with_v_smooth
 from ..errors import ComputationError, InputError
 from ..models import LuGre, Model, PrescribedMotion, StickSlipPlant, load_model
-from ..measurements.command import (MIN_DELAY_SAMPLES, DelaySearch, acceleration, applied_delay, check_within_scan,
-                                    coulomb_columns, delay_scan, nuisance_columns, scan_grid, shifted)
+from ..measurements.command import (MIN_DELAY_SAMPLES, acceleration, applied_delay, coulomb_columns, delay_scan,
+                                    delay_search, linear_fit, nuisance_columns, shifted, sliding)
+from ..measurements.delay import AUTO, check_not_at_end, search_range
 from ..measurements.force import FD_RTOL, Force
 from ..models.plants import rotary_unit
 from .parameters import get_value
@@ -175,24 +176,35 @@ def estimate_linear(model: Model, names, traces, columns=None, variance_inflatio
     return out, res
 
 
-def command_initial(init, method, data, experiments, **options):
+def command_initial(init, method, data, experiments, delay=AUTO, **options):
     """The initial model for a drive's command: the delay, the inertia J0 and a first offset by linear least
     squares ``u(t - delay) = J0 a + b + fc sgn(v) + sigma2 v`` on a scan of delays (measurements/command.py:
-    delay_scan); force data's initial model (:func:`force_initial`) with friction values read off
-    ``u(t - delay) - J0 a``; then the delay again with that model's friction as one more column (its Stribeck
-    curve). The model's [plant]
-    gets J0 and the delay (applied only beyond about a sample)."""
+    delay_scan; ``delay`` a DelaySpec: auto or a range scanned, a value or none held); force data's initial model
+    (:func:`force_initial`) with friction values read off ``u(t - delay) - J0 a``; then the delay again with that
+    model's friction as one more column (its Stribeck curve). The model's [plant] gets J0 and the delay (auto:
+    applied only beyond about a sample)."""
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     moving_speed(experiments)
-    d0, _, coef, _ = delay_scan(experiments, [coulomb_columns(e) for e in experiments])
+    grid = (None if delay.kind in ("none", "value") else
+            search_range(delay, [e.time for e in experiments], [e.drive_velocity for e in experiments],
+                         [acceleration(e) for e in experiments]))
+
+    def scan(columns):
+        if grid is None:
+            return delay.lo, linear_fit(experiments, columns, delay.lo, [sliding(e) for e in experiments])[0]
+        d, _, coef, i = delay_scan(experiments, columns, grid[:2])
+        check_not_at_end(delay, i, grid[1], grid[0], grid[2])
+        return d, coef
+
+    d0, coef = scan([coulomb_columns(e) for e in experiments])
     adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * acceleration(e))
                 for e in experiments]
     init = force_initial(init, method, data, adjusted, **options)
-    columns = [np.column_stack([coulomb_columns(e), Force().friction_of(init, e)]) for e in experiments]
-    delay, _, coef, dt = delay_scan(experiments, columns)
-    check_within_scan(delay, *scan_grid([e.time for e in experiments]))
-    plant = dataclasses.replace(init.plant, inertia=max(float(coef[0]), 0.0), delay=applied_delay(delay, dt))
+    d, coef = scan([np.column_stack([coulomb_columns(e), Force().friction_of(init, e)]) for e in experiments])
+    if delay.kind == "auto":
+        d = applied_delay(d, grid[0])
+    plant = dataclasses.replace(init.plant, inertia=max(float(coef[0]), 0.0), delay=d)
     return dataclasses.replace(init, plant=plant)
 
 
@@ -200,51 +212,76 @@ def command_finish(res, experiments, init, measurement):
     """The fit completed for a drive's command: the inertia J and the offsets (as the policy says) estimated
     together at the optimum with their standard errors (:func:`estimate_linear` on the acceleration's and the
     offsets' columns, at the delay), the delay at the fitted friction with its standard error (the curvature of
-    the cost over the delay, the friction held: measurements/command.py DelaySearch), all written into the
-    fitted model's [plant] and ``details["plant"]``."""
+    the cost over the delay, the friction held: measurements/command.py DelaySearch) where it is searched, all
+    written into the fitted model's [plant] and ``details["plant"]``."""
     traces = make_traces(experiments, res.model, measurement)
-    unit, policy = traces[0].unit, measurement.offset
+    unit, policy, spec = traces[0].unit, measurement.offset, measurement.delay
     names = [p.name for p in res.parameters.varying] if res.n_points else []
     if policy == "none":  # the model's own offset, held
         traces = [dataclasses.replace(tr, measured=tr.measured - tr.held_offset) for tr in traces]
-    search = DelaySearch(traces, "shared")
+    search = delay_search(traces, "shared", spec, res.model.plant.delay)
     m = np.concatenate([tr.measured for tr in traces])
     plain = [dataclasses.replace(tr, measurement=Force("none"), held_offset=0.0) for tr in traces]
     r, _ = Problem(res.model, [], plain, rtol=FD_RTOL, parallel=len(plain) > 1).evaluate(np.array([]), jac=False)
     estimate, _, se = search.best(r + m) if r is not None else (math.nan, None, math.nan)
-    delay = estimate if res.model.plant.delay and math.isfinite(estimate) else 0.0
-    if delay:  # the fitted friction's delay too (the fit searched it): not at the search's end
-        check_within_scan(delay, search.dt, int(search.ks[-1]))
+    searched = search.ks.size > 1 and math.isfinite(estimate)
+    delay = estimate if searched or spec.kind == "value" else 0.0
+    if searched:  # the fitted friction's delay too: not at the search's end
+        check_not_at_end(spec, search.at, search.ks, search.dt, _range_reason(spec, traces))
     X = search.shift(nuisance_columns(traces, policy), delay)
-    if delay:  # the delay's column, so that its error has the friction's in it: d(model at t + delay)/d delay
+    if searched:  # the delay's column, so that its error has the friction's in it: d(model at t + delay)/d delay
         X = np.column_stack([X, _delay_column(search, r + m, X, m, delay)])
     ests, _ = estimate_linear(res.model, names, traces, X, res.statistics.get("variance_inflation", 1.0),
                               at=lambda r, J: (search.shift(r + m, delay) - m, None if J is None else search.shift(J, delay)))
-    if delay:
+    if searched:
         se = ests.pop()["stderr"]
     inertia, offsets = ests[0], ests[1:]
-    if policy == "shared":
-        offset = offsets[0]
-    elif policy == "per-experiment":
-        offset = {"value": float(np.mean([o["value"] for o in offsets])), "stderr": None, "ci95": None,
-                  "per_experiment": [dict(o, file=tr.name) for o, tr in zip(offsets, traces)]}
-    else:
-        held = init.plant.sensor_offset
-        offset = {"value": held, "stderr": 0.0, "ci95": (held, held)}
+    offset = _offset_estimate(policy, offsets, traces, init)
     offset.update(unit=unit, fitted=policy != "none", policy=policy)
-    tq = float(stats.norm.ppf(0.975))
     plant = {"inertia": dict(inertia, unit="kg m^2" if unit == "N m" else "kg"),
-             "delay": {"value": delay, "estimate": estimate, "stderr": se, "ci95": (estimate - tq * se,
-                                                                                   estimate + tq * se),
-                       "applied": bool(delay), "sampling_interval": search.dt,
-                       "note": "fitted with the friction (the model's friction and acceleration taken at t + delay)"
-                       if delay else f"not applied: the estimate before the fit was within {MIN_DELAY_SAMPLES:g} "
-                                     f"sampling interval ({search.dt * 1e3:.3g} ms)"}}
+             "delay": _delay_record(spec, delay, estimate, se, searched, search, traces)}
     _check_inertia(inertia, plant["inertia"]["unit"])
     model = dataclasses.replace(res.model, plant=dataclasses.replace(
         res.model.plant, inertia=inertia["value"], sensor_offset=offset["value"], delay=delay))
     out = completed(res, model, offset, unit)
     out.details["plant"] = plant
+    return out
+
+
+def _offset_estimate(policy, offsets, traces, init) -> dict:
+    if policy == "shared":
+        return offsets[0]
+    if policy == "per-experiment":
+        return {"value": float(np.mean([o["value"] for o in offsets])), "stderr": None, "ci95": None,
+                "per_experiment": [dict(o, file=tr.name) for o, tr in zip(offsets, traces)]}
+    held = init.plant.sensor_offset
+    return {"value": held, "stderr": 0.0, "ci95": (held, held)}
+
+
+def _range_reason(spec, traces) -> str:
+    return search_range(spec, [tr.time for tr in traces], [tr.velocity for tr in traces],
+                        [tr.acceleration for tr in traces])[2]
+
+
+def _delay_record(spec, delay, estimate, se, searched, search, traces) -> dict:
+    """``details["plant"]["delay"]``: the delay applied, its estimate and interval where it was searched, how it
+    was taken (``spec``: auto, none, a value, a range), the range searched and why, and a note saying so."""
+    tq = float(stats.norm.ppf(0.975))
+    out = {"value": delay, "estimate": estimate if searched else delay, "stderr": se if searched else 0.0,
+           "ci95": (estimate - tq * se, estimate + tq * se) if searched else (delay, delay),
+           "applied": bool(delay), "sampling_interval": search.dt, "spec": str(spec), "searched": None}
+    if searched:
+        lo, hi = search.ks[0] * search.dt, search.ks[-1] * search.dt
+        out["searched"] = {"min": lo, "max": hi, "why": _range_reason(spec, traces)}
+        out["note"] = (f"fitted with the friction (the model's friction and acceleration taken at t + delay); "
+                       f"searched {lo * 1e3:.4g} to {hi * 1e3:.4g} ms ({out['searched']['why']})")
+    elif spec.kind == "value":
+        out["note"] = "held at the value given (--delay VALUE), not fitted"
+    elif spec.kind == "none":
+        out["note"] = "none fitted (--delay none)"
+    else:
+        out["note"] = (f"not applied: the estimate before the fit was within {MIN_DELAY_SAMPLES:g} sampling "
+                       f"interval ({search.dt * 1e3:.3g} ms)")
     return out
 
 

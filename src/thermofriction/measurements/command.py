@@ -19,9 +19,11 @@ residuals are ``F + J a + offset - u(t - delay)``.
   grid at the median sampling interval. A centred window is a symmetric (zero-phase) filter: it delays nothing,
   so that J a lines up with the friction; it averages the differentiation's noise over the window. (Noise left in
   ``a`` is an error in a regressor and pulls J towards zero: the position must resolve the acceleration.)
-- **The delay** is read off the data before the fit (:func:`delay_scan`) and applied by shifting the command
-  (linear interpolation, the first value held before the record's start); it is used only where it exceeds
-  about a sample (MIN_DELAY_SAMPLES), else it is 0, and the result says which.
+- **The delay** (identify's ``delay=``, measurements/delay.py): ``auto`` reads it off the data before the fit
+  (:func:`delay_scan` over a range from the data) and uses it only where it exceeds about a sample
+  (MIN_DELAY_SAMPLES), else it is 0, and the result says which; a range is searched within its bounds; a value
+  is held; ``none`` is 0. The model's side is shifted (linear interpolation, the end values held beyond the
+  record).
 """
 
 from __future__ import annotations
@@ -34,8 +36,9 @@ import numpy as np
 from .._lazy import lazy
 from ..data.force import ForceExperiment
 from ..data.motion import on_uniform_grid
-from ..errors import ComputationError, InputError
+from ..errors import InputError
 from .base import Trace
+from .delay import AUTO, search_range
 from .force import Force
 
 signal = lazy("scipy.signal")
@@ -43,9 +46,6 @@ signal = lazy("scipy.signal")
 #: the Savitzky-Golay window of the acceleration [samples, odd] and its polynomial's degree
 ACCEL_WINDOW = 9
 ACCEL_ORDER = 2
-#: the delay scan spans this long either way [s] (at most MAX_DELAY_SAMPLES samples and a quarter of the record)
-MAX_DELAY = 0.05
-MAX_DELAY_SAMPLES = 200
 #: a delay of less than this many sampling intervals is not applied (0)
 MIN_DELAY_SAMPLES = 1.0
 #: the delay is read off the sliding samples, faster than this fraction of the 95th percentile speed
@@ -65,6 +65,7 @@ class CommandTrace(Trace):
     command: np.ndarray | None = None
     search_delay: bool = False
     delay: float = 0.0
+    velocity: np.ndarray | None = None
 
 
 def acceleration(exp, window: int = ACCEL_WINDOW) -> np.ndarray:
@@ -116,36 +117,15 @@ def linear_fit(experiments, columns, delay: float, rows=None):
     return coef, float(res @ res), u.size
 
 
-def scan_grid(times) -> tuple[float, int]:
-    """The delay scan's grid over records sampled at ``times`` (one array per record): (the median sampling
-    interval [s], K) -- whole intervals from -K to K, K spanning MAX_DELAY, at most MAX_DELAY_SAMPLES and a quarter
-    of the shortest record."""
-    dt = float(np.median(np.concatenate([np.diff(np.asarray(t, float)) for t in times])))
-    return dt, max(1, min(int(round(MAX_DELAY / dt)), MAX_DELAY_SAMPLES, min(len(t) for t in times) // 4))
-
-
-def check_within_scan(delay: float, dt: float, K: int) -> None:
-    """A delay at the end of the scan is no estimate: the least residuals lie beyond what the scan covers (the
-    command and the motion misaligned by more, or a motion that does not determine a delay), and the fit would
-    take the misalignment up with the inertia and the friction (issue 41: a command 0.5 s late fitted a negative
-    inertia). ComputationError saying so."""
-    if abs(delay) >= K * dt * (1 - 1e-9):  # (at the end, no parabola: exactly K dt)
-        raise ComputationError(
-            f"the command and the motion look misaligned in time by {K * dt * 1e3:.4g} ms or more: the delay search's "
-            f"least residuals lie at its end ({delay * 1e3:.4g} ms; it spans {MAX_DELAY * 1e3:g} ms either way, at "
-            f"most a quarter of the shortest record), or the motion does not determine a delay. Check that the "
-            f"command and the motion are recorded on the same clock (docs/force-data.md#drives-without-a-torque-sensor)")
-
-
-def delay_scan(experiments, columns):
-    """The delay of the commands on the motion: the sum of squared residuals of :func:`linear_fit` on whole
-    sampling intervals either way (MAX_DELAY), a parabola through the least and its neighbours for the fraction.
-    Only the sliding samples count (:func:`sliding`): around a reversal the friction's own lag (presliding) is
-    what a rough friction model gets wrong, and a delay would take it up. Returns (delay [s], its standard error
-    from the parabola's curvature, the coefficients there, the sampling interval)."""
+def delay_scan(experiments, columns, grid):
+    """The delay of the commands on the motion: the sum of squared residuals of :func:`linear_fit` on the
+    candidate delays of ``grid`` (dt, the integers k of the delays k dt: :func:`search_range`), a parabola
+    through the least and its neighbours for the fraction. Only the sliding samples count (:func:`sliding`):
+    around a reversal the friction's own lag (presliding) is what a rough friction model gets wrong, and a delay
+    would take it up. Returns (delay [s], its standard error from the parabola's curvature, the coefficients
+    there, the index of the least cost in the grid)."""
     exps = list(experiments)
-    dt, K = scan_grid([e.time for e in exps])
-    ks = np.arange(-K, K + 1)
+    dt, ks = grid
     rows = [sliding(e) for e in exps]
     cost = np.array([linear_fit(exps, columns, k * dt, rows)[1] for k in ks])
     i = int(np.argmin(cost))
@@ -159,7 +139,7 @@ def delay_scan(experiments, columns):
     coef, S, n = linear_fit(exps, columns, delay, rows)
     dof = max(n - len(coef) - 1, 1)
     se = math.sqrt(2 * S / dof / curvature) if curvature > 0 else math.nan  # (S'' = 2 sum (dr/dd)^2)
-    return delay, se, coef, dt
+    return delay, se, coef, i
 
 
 def applied_delay(delay: float, dt: float) -> float:
@@ -184,20 +164,24 @@ def nuisance_columns(traces, policy: str) -> np.ndarray:
 
 class DelaySearch:
     """The delay that leaves the least residuals ``P_d (y(t + d) - u(t))`` (y: the friction, P_d: the projection
-    that profiles J and the offsets out, on the acceleration at t + d) over a grid of whole sampling intervals
-    either way (MAX_DELAY), refined by a parabola through the least cost and its neighbours. The model's side
-    is shifted, not the command: interpolating a noisy record between its samples would average its noise, and
-    a delay half a sample off would look better than the true one."""
+    that profiles J and the offsets out, on the acceleration at t + d) over candidate delays ``k dt`` (``grid``:
+    (dt, the integers k), delay.py search_range), refined by a parabola through the least cost and its
+    neighbours; ``grid`` None: the one delay ``held`` [s]. The model's side is shifted, not the command:
+    interpolating a noisy record between its samples would average its noise, and a delay half a sample off
+    would look better than the true one. ``at``: the index of the least cost in the grid (its ends: no
+    estimate)."""
 
-    def __init__(self, traces, policy: str, search: bool = True):
+    def __init__(self, traces, policy: str, grid=None, held: float = 0.0):
         self.traces = traces
         self.edges = np.cumsum([0] + [tr.n_residuals for tr in traces])
-        self.dt, K = scan_grid([tr.time for tr in traces])
-        self.ks = np.arange(-K, K + 1) if search else np.array([0])
-        held = [tr.held_offset if policy == "none" else 0.0 for tr in traces]
-        self.u = np.concatenate([tr.command - h for tr, h in zip(traces, held)])
+        self.dt = float(np.median(np.concatenate([np.diff(tr.time) for tr in traces])))
+        self.ks = np.array([0]) if grid is None else grid[1]
+        self.held = held if grid is None else 0.0
+        offsets = [tr.held_offset if policy == "none" else 0.0 for tr in traces]
+        self.u = np.concatenate([tr.command - h for tr, h in zip(traces, offsets)])
         self.X = nuisance_columns(traces, policy)
         self._Q = {}
+        self.at = 0
 
     def shift(self, y, delay: float):
         """A concatenated vector (or matrix) at each trace's ``t + delay``."""
@@ -221,8 +205,8 @@ class DelaySearch:
 
     def best(self, F):
         """(the best delay, the residuals there, its standard error) for the friction ``F`` at the samples."""
-        cost = np.array([float(np.sum(self.residuals(F, k * self.dt) ** 2)) for k in self.ks])
-        i = int(np.argmin(cost))
+        cost = np.array([float(np.sum(self.residuals(F, self.held + k * self.dt) ** 2)) for k in self.ks])
+        i = self.at = int(np.argmin(cost))
         frac, se = 0.0, math.nan
         if 0 < i < cost.size - 1:
             den = cost[i - 1] - 2 * cost[i] + cost[i + 1]
@@ -230,8 +214,18 @@ class DelaySearch:
                 frac = float(np.clip(0.5 * (cost[i - 1] - cost[i + 1]) / den, -0.5, 0.5))
                 dof = max(F.size - self.X.shape[1] - 1, 1)
                 se = math.sqrt(2 * cost[i] / dof / (den / self.dt ** 2))  # (S'' = 2 sum (dr/dd)^2)
-        delay = float((self.ks[i] + frac) * self.dt)
+        delay = float(self.held + (self.ks[i] + frac) * self.dt)
         return delay, self.residuals(F, delay), se
+
+
+def delay_search(traces, policy: str, spec, model_delay: float) -> DelaySearch:
+    """The search the spec asks for (delay.py): a value or none held; a range searched; auto searched over its
+    range where the initial model has a delay (one beyond about a sample was found before the fit), else 0."""
+    if spec.kind == "value" or spec.kind == "none" or (spec.kind == "auto" and not model_delay):
+        return DelaySearch(traces, policy, held=spec.lo if spec.kind == "value" else 0.0)
+    return DelaySearch(traces, policy, search_range(spec, [tr.time for tr in traces],
+                                                    [tr.velocity for tr in traces],
+                                                    [tr.acceleration for tr in traces]))
 
 
 def implied_friction(model, exp):
@@ -249,6 +243,8 @@ class Command(Force):
 
     name = "command"
     quantity = "drive command (force or torque)"
+    #: how the fit takes the delay (delay.py; identify's delay=)
+    delay = AUTO
 
     @staticmethod
     def recognises(exp) -> bool:
@@ -284,7 +280,8 @@ class Command(Force):
         tr = super().make_trace(exp, model)
         fields = {f.name: getattr(tr, f.name) for f in dataclasses.fields(tr)}
         return CommandTrace(**fields, acceleration=acceleration(exp), command=np.asarray(exp.force, float),
-                            search_delay=model.plant.delay != 0, delay=model.plant.delay)
+                            search_delay=model.plant.delay != 0, delay=model.plant.delay,
+                            velocity=np.asarray(exp.drive_velocity, float))
 
     def profiled(self, traces, r, J):
         """The residuals and Jacobian with J and the offsets profiled out: projected onto the complement of the
@@ -295,13 +292,13 @@ class Command(Force):
         cost is exact, by the envelope theorem)."""
         search = self._search(traces)
         F = r + search.u  # (Force: r = F - measured, the command as recorded)
-        delay = search.best(F)[0] if traces[0].search_delay else 0.0
+        delay = search.best(F)[0]
         return search.residuals(F, delay), None if J is None else search.project(search.shift(J, delay), delay)
 
     def _search(self, traces):
-        key = (id(traces), len(traces), traces[0].search_delay, self.offset)
+        key = (id(traces), len(traces), traces[0].delay, self.offset, self.delay)
         if getattr(self, "_cached", (None,))[0] != key:
-            self._cached = (key, DelaySearch(traces, self.offset, traces[0].search_delay))
+            self._cached = (key, delay_search(traces, self.offset, self.delay, traces[0].delay))
         return self._cached[1]
 
     def checks(self, model, traces) -> list:
@@ -325,5 +322,6 @@ class Command(Force):
                 "delay": model.plant.delay}
 
 
-__all__ = ["Command", "CommandTrace", "DelaySearch", "implied_friction", "acceleration", "shifted", "delay_scan", "linear_fit", "coulomb_columns",
-           "applied_delay", "nuisance_columns", "scan_grid", "check_within_scan", "ACCEL_WINDOW", "MAX_DELAY", "MIN_DELAY_SAMPLES"]
+__all__ = ["Command", "CommandTrace", "DelaySearch", "delay_search", "implied_friction", "acceleration", "shifted",
+           "delay_scan", "linear_fit", "coulomb_columns", "applied_delay", "nuisance_columns", "ACCEL_WINDOW",
+           "MIN_DELAY_SAMPLES"]

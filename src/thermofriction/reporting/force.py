@@ -310,10 +310,26 @@ def _parameters_section(entries, unit) -> str:
             param_rows.append([e.label, "sensor offset" + ("" if o.get("fitted") else " (held)"),
                                fmt_number(o.get("value"), "{:.6g}"), fmt_number(o.get("stderr"), "{:.3g}"),
                                f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", o.get("unit", unit)])
+        param_rows += _drive_rows(e.label, (f.get("details") or {}).get("plant"))
     if not param_rows:
         return ""
     return ("<section><h2>Identified parameters</h2>" + html_table(
         ["model", "parameter", "value", "std. error", "95 % interval", "unit"], param_rows) + "</section>")
+
+
+def _drive_rows(label, plant) -> list:
+    """A drive's inertia J and delay (command data: details["plant"]), the delay's note (how it was taken, the
+    range searched) in its name's cell."""
+    if not plant:
+        return []
+    rows = []
+    for name, p, scale, unit in (("inertia J", plant["inertia"], 1.0, plant["inertia"].get("unit", "")),
+                                 (f"delay ({plant['delay'].get('note', '')})", plant["delay"], 1e3, "ms")):
+        ci = p.get("ci95") or [math.nan, math.nan]
+        rows.append([label, name, fmt_number(p.get("estimate", p.get("value")) * scale, "{:.6g}"),
+                     fmt_number((p.get("stderr") or math.nan) * scale, "{:.3g}"),
+                     f"[{fmt_number(ci[0] * scale, '{:.5g}')}, {fmt_number(ci[1] * scale, '{:.5g}')}]", unit])
+    return rows
 
 
 __all__ = ["render_force", "reversals"]
