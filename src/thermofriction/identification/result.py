@@ -45,6 +45,8 @@ class FitResult(Result):
     removed: str = "each experiment's constant offset"
     #: force data: the sensor's offset (value, stderr, ci95, unit, fitted); empty where there is none
     sensor_offset: dict = dataclasses.field(default_factory=dict)
+    #: the groups of parameters the data determine only together (identification/identifiability.py)
+    identifiability: list = dataclasses.field(default_factory=list)
 
     @property
     def adequate(self) -> bool | None:
@@ -152,6 +154,7 @@ class FitResult(Result):
             "wall_time": self.wall_time,
             "experiments": self.experiments,
             "warnings": self.warnings,
+            "identifiability": self.identifiability,
             "statistics": self.statistics,
             "details": self.details,
             "model": self.model.to_dict(),

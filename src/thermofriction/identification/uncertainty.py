@@ -9,6 +9,7 @@ import numpy as np
 
 from .._lazy import lazy
 from ..models import Model
+from .identifiability import groups, no_information, scaled_svd
 from .optimiser import UNDETERMINED, FitOutcome
 from .parameters import Parameters, unit_of
 
@@ -31,22 +32,18 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
     s2 = float(r @ r) / dof
     inflation, rho = inflation_of(r, [tr.n_residuals for tr in traces])
     dof_eff = max(n / inflation - p - traces[0].measurement.offsets_in(traces), 1.0)
-    col = np.linalg.norm(J, axis=0)
-    col[col == 0] = 1.0
-    U, S, Vt = np.linalg.svd(J / col, full_matrices=False)
-    bad = S <= S[0] * UNDETERMINED if S.size and S[0] > 0 else np.ones_like(S, bool)
-    inv = np.where(bad, 0.0, 1.0 / np.where(bad, 1.0, S) ** 2)
-    cov = (Vt.T * inv) @ Vt / np.outer(col, col) * s2 * inflation
+    why_not = no_information([par.name for par in varying], np.linalg.norm(J, axis=0))
+    S, Vt, col, bad, cov1 = scaled_svd(J, UNDETERMINED)
+    cov = cov1 * (s2 * inflation)
     var = np.diag(cov).copy()
-    loading = (Vt[bad] ** 2).sum(axis=0) if bad.any() else np.zeros(p)
-    var[loading > 1e-6] = math.inf
     se = np.sqrt(var)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
     tq = float(special.stdtrit(dof_eff, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
-    warnings = []
+    found = groups(S, Vt, col, [par.name for par in varying], theta, se, s2 * inflation, bad=bad)
+    warnings = [g["warning"] for g in found]
     for i, par in enumerate(varying):
         par.value = float(theta[i])
         par.stderr = float(se[i])
@@ -59,7 +56,8 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
             continue
         if not math.isfinite(se[i]):
             par.ci95 = (0.0 if par.positive else -math.inf, math.inf)
-            warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)")
+            warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)"
+                            + (f": {why_not[par.name]}" if par.name in why_not else ""))
             continue
         if par.positive:
             f = math.exp(min(tq * se[i] / theta[i], 700.0))
@@ -75,7 +73,8 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
         if not par.unit:
             par.unit = unit_of(model, par.name)
     return corr, warnings, {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho,
-                            "variance_inflation": inflation, "effective_samples": n / inflation}
+                            "variance_inflation": inflation, "effective_samples": n / inflation,
+                            "identifiability": found}
 
 
 def _one_sided(par, side, value, se, outcome, i, dof) -> tuple:
