@@ -203,17 +203,9 @@ class FitResult(Result):
         save_results_mat(self.to_dict(), path)
 
     def _rows(self):
+        from .shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
         for p in self.parameters.values():
-            if p.stderr is None or not p.vary:
-                err, ci, rel = "", "", "fixed" if not p.vary else ""
-            elif p.at_bound:
-                err, rel = "", f"at {p.at_bound} bound"
-                ci = f"[{p.ci95[0]:.5g}, {p.ci95[1]:.5g}] (one-sided)"
-            else:
-                err = f"{p.stderr:.4g}"
-                rel = f"{100 * p.stderr / abs(p.value):.2g} %" if p.value and math.isfinite(p.stderr) else ""
-                ci = f"[{p.ci95[0]:.5g}, {p.ci95[1]:.5g}]"
-            yield p.name, f"{p.value:.6g}", err, rel, ci, p.unit
+            yield (p.name, *shown(p.to_dict()), p.unit)
 
     def report(self) -> str:
         """A table like lmfit's fit report."""
@@ -236,6 +228,8 @@ class FitResult(Result):
             elif o:
                 how = "fitted, shared by all experiments" if o.get("fitted") else "held (--offset none)"
                 err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
+                if err and not math.isfinite(o["stderr"]):
+                    err, how = "", how + "; not determined: see the warnings"
                 lines.append(f"    sensor offset    = {o['value']:.6g}{err} {self.unit} ({how})")
             lines += _plant_lines(self.details.get("plant"))
         if self.fit_quality is not None:
