@@ -47,6 +47,7 @@ def default_fit_parameters(model: Model) -> list:
 def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), details=None) -> FitResult:
     """The result of a fit: parameters with their uncertainty, per-experiment quality, warnings."""
     corr, warns, stats = uncertainty(params, outcome, traces, model)
+    found = stats.pop("identifiability", [])
     values = {p.name: p.value for p in params.values()}
     fitted = with_values(model, values)
     per, qualities, start = [], [], 0
@@ -84,7 +85,7 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                      success=outcome.success, message=str(outcome.message), experiments=per,
                      warnings=first + list(extra_warnings) + warns, statistics=stats, details=details or {},
                      fit_quality=overall, unit=unit, measurement=measurement.name,
-                     removed=measurement.removed)
+                     removed=measurement.removed, identifiability=found)
 
 
 def unrefined_result(method, model, params, experiments, measurement, t0, per_fits, message, warns=(), details=None,

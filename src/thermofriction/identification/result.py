@@ -45,6 +45,8 @@ class FitResult(Result):
     removed: str = "each experiment's constant offset"
     #: force data: the sensor's offset (value, stderr, ci95, unit, fitted); empty where there is none
     sensor_offset: dict = dataclasses.field(default_factory=dict)
+    #: the groups of parameters the data determine only together (identification/identifiability.py)
+    identifiability: list = dataclasses.field(default_factory=list)
 
     @property
     def adequate(self) -> bool | None:
@@ -152,6 +154,7 @@ class FitResult(Result):
             "wall_time": self.wall_time,
             "experiments": self.experiments,
             "warnings": self.warnings,
+            "identifiability": self.identifiability,
             "statistics": self.statistics,
             "details": self.details,
             "model": self.model.to_dict(),
@@ -200,17 +203,9 @@ class FitResult(Result):
         save_results_mat(self.to_dict(), path)
 
     def _rows(self):
+        from .shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
         for p in self.parameters.values():
-            if p.stderr is None or not p.vary:
-                err, ci, rel = "", "", "fixed" if not p.vary else ""
-            elif p.at_bound:
-                err, rel = "", f"at {p.at_bound} bound"
-                ci = f"[{p.ci95[0]:.5g}, {p.ci95[1]:.5g}] (one-sided)"
-            else:
-                err = f"{p.stderr:.4g}"
-                rel = f"{100 * p.stderr / abs(p.value):.2g} %" if p.value and math.isfinite(p.stderr) else ""
-                ci = f"[{p.ci95[0]:.5g}, {p.ci95[1]:.5g}]"
-            yield p.name, f"{p.value:.6g}", err, rel, ci, p.unit
+            yield (p.name, *shown(p.to_dict()), p.unit)
 
     def report(self) -> str:
         """A table like lmfit's fit report."""
@@ -236,6 +231,8 @@ class FitResult(Result):
             elif o:
                 how = "fitted, shared by all experiments" if o.get("fitted") else "held (--offset none)"
                 err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
+                if err and not math.isfinite(o["stderr"]):
+                    err, how = "", how + "; not determined: see the warnings"
                 lines.append(f"    sensor offset    = {o['value']:.6g}{err} {self.unit} ({how})")
             lines += _plant_lines(self.details.get("plant"))
         if self.fit_quality is not None:

@@ -20,6 +20,8 @@ from ..measurements.command import (MIN_DELAY_SAMPLES, acceleration, applied_del
 from ..measurements.delay import AUTO, check_not_at_end, search_range
 from ..measurements.force import FD_RTOL, Force
 from ..models.plants import rotary_unit
+from .identifiability import OFFSET, groups, scaled_svd, with_groups
+from .optimiser import UNDETERMINED
 from .parameters import get_value
 from .problem import Problem, make_traces
 from .start import force_start, lugre_start, moving_speed, with_friction_model
@@ -111,16 +113,19 @@ def force_finish(res, experiments, init, measurement):
     unit = traces[0].unit
     names = [p.name for p in res.parameters.varying] if res.n_points else []
     inflation = res.statistics.get("variance_inflation", 1.0)
+    found = []
     if measurement.offset == "shared":
-        est = estimate_offset(res.model, names, traces, inflation)
+        est = estimate_offset(res.model, names, traces, inflation, found)
     elif measurement.offset == "per-experiment":
-        runs = [dict(estimate_offset(res.model, names, [tr], inflation), file=tr.name) for tr in traces]
+        runs = [dict(estimate_offset(res.model, names, [tr], inflation, found), file=tr.name) for tr in traces]
         est = {"value": float(np.mean([r["value"] for r in runs])), "stderr": None, "ci95": None,
                "per_experiment": runs}
     else:
         est = {"value": init.plant.sensor_offset, "stderr": 0.0, "ci95": (init.plant.sensor_offset,) * 2}
     model = dataclasses.replace(res.model, plant=dataclasses.replace(res.model.plant, sensor_offset=est["value"]))
     est.update(unit=unit, fitted=measurement.offset != "none", policy=measurement.offset)
+    if names and measurement.offset != "none":  # the offset's column seen: these groups replace the fit's own
+        res = with_groups(res, found)
     return completed(res, model, est, unit)
 
 
@@ -138,19 +143,20 @@ def completed(res, model, offset: dict, unit: str):
     return dataclasses.replace(res, model=model, sensor_offset=offset, unit=unit)
 
 
-def estimate_offset(model: Model, names, traces, variance_inflation=1.0) -> dict:
+def estimate_offset(model: Model, names, traces, variance_inflation=1.0, found=None) -> dict:
     """The shared offset at ``model`` (``names`` the fitted parameters): the mean of ``F_meas - F_sim`` over
     all traces, and its standard error from the Jacobian augmented with the offset's column of ones (so that
-    the parameters' uncertainty is in it)."""
-    return estimate_linear(model, names, traces, None, variance_inflation)[0][0]
+    the parameters' uncertainty is in it); ``found``: as estimate_linear's."""
+    return estimate_linear(model, names, traces, None, variance_inflation, found=found)[0][0]
 
 
-def estimate_linear(model: Model, names, traces, columns=None, variance_inflation=1.0, at=None):
+def estimate_linear(model: Model, names, traces, columns=None, variance_inflation=1.0, at=None, found=None):
     """The linear parameters profiled out of a fit, at ``model`` (``names`` the fitted parameters): the least
     squares ``F_sim + columns beta = F_meas`` (``columns`` None: one column of ones, the shared offset), and
     their standard errors from the Jacobian augmented with those columns (so that the parameters' uncertainty
     is in them); ``at(r, J)``, where given, transforms the residuals and Jacobian first (a delay's shift).
-    Returns (one dict per column: value, stderr, ci95; the residuals at the estimate)."""
+    ``found``, a list where given, gets the undetermined groups (identifiability.groups) the columns (offsets) are
+    members of. Returns (one dict per column: value, stderr, ci95; the residuals at the estimate)."""
     plain = [dataclasses.replace(tr, measurement=Force("none"), held_offset=0.0) for tr in traces]
     problem = Problem(model, names, plain, rtol=FD_RTOL, parallel=len(plain) > 1)
     theta = np.array([get_value(model, n) for n in names], float)
@@ -165,9 +171,12 @@ def estimate_linear(model: Model, names, traces, columns=None, variance_inflatio
     A = np.column_stack([J, X]) if names else X
     dof = max(r.size - A.shape[1], 1)
     s2 = float(res @ res) / dof * variance_inflation
-    col = np.linalg.norm(A, axis=0)
-    col[col == 0] = 1.0
-    cov = np.linalg.pinv((A / col).T @ (A / col), rcond=1e-12) / np.outer(col, col) * s2
+    S, Vt, col, bad, cov1 = scaled_svd(A, UNDETERMINED)  # an offset the data do not determine: infinite error
+    cov = cov1 * s2
+    if found is not None and names:  # the groups the offset is part of (it is profiled out of the fit's own)
+        se = np.sqrt(np.diag(cov))
+        found += groups(S, Vt, col, list(names) + [OFFSET] * X.shape[1], np.concatenate([theta, beta]), se, s2,
+                        nuisance={OFFSET}, bad=bad)
     tq = float(stats.t.ppf(0.975, dof))
     out = []
     for k, value in enumerate(beta):

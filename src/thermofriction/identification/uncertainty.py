@@ -9,8 +9,10 @@ import numpy as np
 
 from .._lazy import lazy
 from ..models import Model
+from .identifiability import groups, no_information, scaled_svd
 from .optimiser import UNDETERMINED, FitOutcome
 from .parameters import Parameters, unit_of
+from .shown import REL_SHOWN
 
 special = lazy("scipy.special")
 
@@ -31,43 +33,44 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
     s2 = float(r @ r) / dof
     inflation, rho = inflation_of(r, [tr.n_residuals for tr in traces])
     dof_eff = max(n / inflation - p - traces[0].measurement.offsets_in(traces), 1.0)
-    col = np.linalg.norm(J, axis=0)
-    col[col == 0] = 1.0
-    U, S, Vt = np.linalg.svd(J / col, full_matrices=False)
-    bad = S <= S[0] * UNDETERMINED if S.size and S[0] > 0 else np.ones_like(S, bool)
-    inv = np.where(bad, 0.0, 1.0 / np.where(bad, 1.0, S) ** 2)
-    cov = (Vt.T * inv) @ Vt / np.outer(col, col) * s2 * inflation
+    why_not = no_information([par.name for par in varying], np.linalg.norm(J, axis=0))
+    S, Vt, col, bad, cov1 = scaled_svd(J, UNDETERMINED)
+    cov = cov1 * (s2 * inflation)
     var = np.diag(cov).copy()
-    loading = (Vt[bad] ** 2).sum(axis=0) if bad.any() else np.zeros(p)
-    var[loading > 1e-6] = math.inf
     se = np.sqrt(var)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
     tq = float(special.stdtrit(dof_eff, 0.975))  # Student's t quantile (scipy.stats takes 0.3 s to import)
-    warnings = []
+    found = groups(S, Vt, col, [par.name for par in varying], theta, se, s2 * inflation, bad=bad)
+    warnings = [g["warning"] for g in found]
     for i, par in enumerate(varying):
         par.value = float(theta[i])
         par.stderr = float(se[i])
         side = outcome.at_bound[i] if outcome.at_bound else None
         if side:
             par.at_bound, par.ci95 = side, _one_sided(par, side, float(theta[i]), float(se[i]), outcome, i, dof_eff)
-            warnings.append(f"'{par.name}' ended at its {side} bound ({par.value:.4g}): the data put it "
-                            f"{'below' if side == 'lower' else 'above'} {par.ci95[1 if side == 'lower' else 0]:.4g} "
-                            f"(one-sided 95 %), not at a value; hold it, or fit another model")
+            far = par.ci95[1 if side == "lower" else 0]
+            said = (f"the data put it {'below' if side == 'lower' else 'above'} {far:.4g} (one-sided 95 %)"
+                    if math.isfinite(far) and se[i] <= REL_SHOWN * abs(theta[i]) else  # (shown.py's rule)
+                    "the data do not bound it on the other side either")
+            warnings.append(f"'{par.name}' ended at its {side} bound ({par.value:.4g}): {said}, not at a value; "
+                            f"hold it, or fit another model")
             continue
         if not math.isfinite(se[i]):
             par.ci95 = (0.0 if par.positive else -math.inf, math.inf)
-            warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)")
+            warnings.append(f"'{par.name}' is not identifiable from these data (its interval is infinite)"
+                            + (f": {why_not[par.name]}" if par.name in why_not else ""))
             continue
-        if par.positive:
-            f = math.exp(min(tq * se[i] / theta[i], 700.0))
+        if par.positive:  # (beyond e^700 the factor is infinite: (0, inf), not the cap's 1e-302 to 1e306)
+            f = math.exp(tq * se[i] / theta[i]) if tq * se[i] / theta[i] < 700.0 else math.inf
             par.ci95 = (float(theta[i]) / f, float(theta[i]) * f)  # (Python floats: inf, not an overflow warning)
         else:
             par.ci95 = (theta[i] - tq * se[i], theta[i] + tq * se[i])
         if se[i] > 0.5 * abs(theta[i]):
-            rel = f"{100 * se[i] / abs(theta[i]):.0f} % of its value" if theta[i] else f"{se[i]:.3g} around 0"
+            rel = (f"> {100 * REL_SHOWN:.0f} %" if se[i] > REL_SHOWN * abs(theta[i]) else
+                   f"{100 * se[i] / abs(theta[i]):.0f} %") + " of its value" if theta[i] else f"{se[i]:.3g} around 0"
             warnings.append(f"'{par.name}' is poorly determined by these data (standard error {rel})")
     for par in params.values():
         if not par.vary:
@@ -75,7 +78,8 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
         if not par.unit:
             par.unit = unit_of(model, par.name)
     return corr, warnings, {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho,
-                            "variance_inflation": inflation, "effective_samples": n / inflation}
+                            "variance_inflation": inflation, "effective_samples": n / inflation,
+                            "identifiability": found}
 
 
 def _one_sided(par, side, value, se, outcome, i, dof) -> tuple:

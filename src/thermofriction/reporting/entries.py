@@ -12,6 +12,7 @@ import numpy as np
 from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
 from ..validation import ValidationResult
 from .page import fmt_number, html_table
+from ..identification.shown import cells
 from .fit_plots import as_float, law_outside_intervals, per_temperature_estimates
 
 @dataclasses.dataclass
@@ -221,9 +222,7 @@ def _parameter_table(entry, keep):
     for name, p in ((entry.fit or {}).get("parameters") or {}).items():
         if not keep(name):
             continue
-        ci = p.get("ci95") or ["", ""]
-        rows.append([name, fmt_number(p.get("value"), "{:.6g}"), fmt_number(p.get("stderr"), "{:.3g}"),
-                     f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", _unit(p.get("unit", ""))])
+        rows.append([name, *cells(p), _unit(p.get("unit", ""))])  # (the one display: identification/shown.py)
     return rows
 
 

@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
+from ..identification.shown import cells
 from ..measurements import steady_state_curve
 from ..measurements.command import implied_friction
 from ..models import ModelI, ModelII
@@ -301,15 +302,11 @@ def _parameters_section(entries, unit) -> str:
     for e in entries:
         f = e.fit or {}
         for name, p in (f.get("parameters") or {}).items():
-            ci = p.get("ci95") or ["", ""]
-            param_rows.append([e.label, name, fmt_number(p.get("value"), "{:.6g}"), fmt_number(p.get("stderr"), "{:.3g}"),
-                               f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", p.get("unit", "")])
+            param_rows.append([e.label, name, *cells(p), p.get("unit", "")])  # (identification/shown.py)
         o = f.get("sensor_offset")
         if o:
-            ci = o.get("ci95") or ["", ""]
             param_rows.append([e.label, "sensor offset" + ("" if o.get("fitted") else " (held)"),
-                               fmt_number(o.get("value"), "{:.6g}"), fmt_number(o.get("stderr"), "{:.3g}"),
-                               f"[{fmt_number(ci[0], '{:.5g}')}, {fmt_number(ci[1], '{:.5g}')}]", o.get("unit", unit)])
+                               *cells({**o, "vary": bool(o.get("fitted"))}), o.get("unit", unit)])
         param_rows += _drive_rows(e.label, (f.get("details") or {}).get("plant"))
     if not param_rows:
         return ""
