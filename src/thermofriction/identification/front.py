@@ -142,12 +142,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     max_nfev = _args.whole(max_evaluations, "max_evaluations", none=True, low=1, high=MAX_EVALUATIONS)
     _args.dataset(data, Dataset, experiments=True)  # after the options, whose messages name them first
     measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
-    if delay != "auto" or measurement.name == "command":
-        spec = parse_delay(delay)  # (InputError naming delay)
-        if measurement.name != "command" and spec.kind != "auto":
-            raise InputError(f"delay applies to a drive's command data; these are {measurement.name} data")
-        if measurement.name == "command":
-            measurement.delay = spec
+    _delay_of(measurement, delay)
     if method not in measurement.methods:
         *most, last = measurement.methods
         raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
@@ -179,6 +174,16 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
     res.warnings[:0] = units
     return res
+
+
+def _delay_of(measurement, delay):
+    """The delay option on the measurement of a drive's command (InputError naming delay; refused elsewhere)."""
+    if delay != "auto" or measurement.name == "command":
+        spec = parse_delay(delay)
+        if measurement.name != "command" and spec.kind != "auto":
+            raise InputError(f"delay applies to a drive's command data; these are {measurement.name} data")
+        if measurement.name == "command":
+            measurement.delay = spec
 
 
 def _fit(method, experiments, init, parameters, free, procedure, reference_temperature, laws, refine, progress,
