@@ -1,6 +1,6 @@
 """Advice tried before it is given: a held value the score test calls contradicted (held.py) is freed in a short refit
-from the optimum, and the advice to free it is said only with the gain that refit measured ("fitting m_e lowers the
-RMSE 58.5 -> 21.0 nm"). A refit that gains less than MATERIAL of the misfit means the score test's direction is not
+from the optimum, and the advice to free it is said only with the gain that refit measured ("a refit with it free
+lowers the RMSE 24.8 nm -> 20.7 nm", a 2x wrong mass). A refit that gains less than MATERIAL of the misfit means the score test's direction is not
 worth a parameter -- the linearization it rests on does not hold that far (a missing Stribeck effect at fs = fc
 "explaining 17 % of the misfit" that a Stribeck fit then leaves where it was): the value is then not called
 contradicted, and no advice is given."""

@@ -13,6 +13,7 @@ from .._io import dump_json, jsonable
 from ..measurements import amount
 from ..models import Model
 from ..results import Result
+from .shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
 from .parameters import Parameters
 
 
@@ -203,7 +204,6 @@ class FitResult(Result):
         save_results_mat(self.to_dict(), path)
 
     def _rows(self):
-        from .shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
         for p in self.parameters.values():
             yield (p.name, *shown(p.to_dict()), p.unit)
 
