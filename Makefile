@@ -7,7 +7,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 SOURCES = $(shell find core src -type f -not -name '*.pyc') pyproject.toml CMakeLists.txt
 
-.PHONY: demo test install bench docs clean
+.PHONY: demo test install bench docs clean octave
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -36,6 +36,10 @@ $(VENV)/.docs-installed: $(VENV)/.installed pyproject.toml
 docs: $(VENV)/.docs-installed
 	$(BIN)/python -m sphinx -b html -E -W --keep-going -q docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
+
+# the MATLAB/Octave MEX gateway (matlab/, docs/matlab.md), compiled by Octave's mkoctfile from the C sources
+octave:
+	octave-cli --no-gui --norc --eval "addpath('$(CURDIR)/matlab'); disp(thermofriction.build())"
 
 bench: install
 	$(BIN)/python benchmarks/bench_simulate.py

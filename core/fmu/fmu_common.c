@@ -918,3 +918,6 @@ fmu_status fmu_free_state(fmu_instance *c, void **state)
 
 /* The FMU's time: the last successful communication point. */
 double fmu_time(const fmu_instance *c) { return c->t; }
+
+/* The instance's tf_model (fmu_common.h). */
+const void *fmu_model(const fmu_instance *c) { return c ? &c->model : NULL; }

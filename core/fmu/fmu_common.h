@@ -58,6 +58,9 @@ fmu_status fmu_get_state(fmu_instance *c, void **state);
 fmu_status fmu_set_state(fmu_instance *c, void *state);
 fmu_status fmu_free_state(fmu_instance *c, void **state);
 double fmu_time(const fmu_instance *c);
+/* The instance's model (plant.h's tf_model, its laws pointing into the instance): for in-process importers that
+ * step its friction with the real-time API (matlab/thermofriction_mex.c); valid while the instance lives. */
+const void *fmu_model(const fmu_instance *c);
 /* Logs an error (message formatted as printf) and returns FMU_ERROR: for the wrappers' own refusals. */
 fmu_status fmu_fail(fmu_instance *c, const char *fmt, ...)
 #if defined(__GNUC__)
