@@ -244,7 +244,7 @@ class FitResult(Result):
                          f"{_verdict(q)}")
         lines += [
                  f"    evaluations      = {self.nfev} (Jacobians {self.njev}), starts = {self.starts}",
-                 f"    wall time        = {self.wall_time:.3g} s",
+                 f"    fit time         = {self.wall_time:.3g} s (the least-squares fits; not the checks after them)",
                  "[[Parameters]]"]
         rows = list(self._rows())
         w = [max(len(r[i]) for r in rows + [("name", "value", "stderr", "rel", "95 % interval", "unit")])
