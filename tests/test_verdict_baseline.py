@@ -98,3 +98,15 @@ def test_identify_says_its_own_time_beside_the_fits(tmp_path, capsys):
     took = float(out.split("identify took ")[1].split(" s")[0])
     assert "wall time" not in out and "not the checks after them" in out
     assert took >= fit
+
+
+def test_friction_stribeck_fits_a_stribeck_map(joint):
+    """Issue 40 item 7: '--friction stribeck' fitted a plain Coulomb map where the data's start showed no excess (the
+    default parameters drop fs and vs at fs = fc): the Stribeck map is fitted as asked, its fs and vs among the fitted
+    parameters, an excess fs > fc fitted and a lower RMSE than the Coulomb map's (before: the same fit, the same RMSE)."""
+    data = lookalike_experiments(truth=Truth(fc_neg=0.363, fs_neg=0.45, ripple=0.0), offsets=(0.02, 0.02, 0.02),
+                                 seed=1)[0]
+    stribeck = tf.identify(data, "base", friction="stribeck", starts=2)
+    coulomb = tf.identify(data, "base", friction="coulomb", starts=2)
+    assert {"fs", "vs"} <= {p.name for p in stribeck.parameters.varying}
+    assert stribeck.model.friction.fs > stribeck.model.friction.fc and stribeck.rmse < coulomb.rmse
