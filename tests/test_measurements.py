@@ -122,7 +122,9 @@ def test_per_experiment_offsets_follow_a_sensor_re_zeroed_between_runs(tmp_path)
     for r, true in zip(runs, (0.05, 0.35)):
         assert r["ci95"][0] <= true <= r["ci95"][1], r
     # the generalisation ratio says what the shared offset hides: the held-out run predicted far worse than fitted
-    assert shared.fit_quality["generalisation"]["ratio"] > 1.5 and "does not generalise" in shared.warnings[0]
+    # (second, after the verdict the noise gives, which comes first)
+    assert shared.warnings[0].startswith("the fit is not adequate")
+    assert shared.fit_quality["generalisation"]["ratio"] > 1.5 and "does not generalise" in shared.warnings[1]
     assert each.fit_quality["generalisation"]["ratio"] < 1.3
     held = tf.validate(each.model, data, offset="per-experiment")
     v = [p for p in held.predictions if p.role == "validate"][0]

@@ -125,6 +125,7 @@ def cmd_identify(args) -> int:
     if getattr(args, "scheduler", None) or getattr(args, "workers", None):
         raise InputError("--scheduler and --workers apply to fleet identification (several datasets, or a folder "
                          "of datasets); one dataset is identified in this process")
+    t0 = time.perf_counter()  # the command's own time, said after the fit's (which is only its least squares)
     with Progress("identify", enabled=not args.quiet) as progress:
         progress.stage(f"reading {args.dataset}")  # a file of millions of rows takes a while
         data = load_dataset(args.dataset, motion=args.motion)
@@ -156,6 +157,8 @@ def cmd_identify(args) -> int:
         for path in (args.output, args.json):
             if path:
                 print(f"wrote {path}")
+        print(f"identify took {time.perf_counter() - t0:.3g} s (reading, the fits, their checks and the held-out "
+              f"predictions, writing)")
     return 0
 
 

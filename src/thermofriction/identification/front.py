@@ -14,6 +14,7 @@ from .. import _args
 from ..data.experiments import TEMPERATURE_RANGE, Dataset
 from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
+from ..measurements.baseline import baseline_verdict, model_free
 from ..measurements.delay import parse_delay
 from .held import with_held_tests
 from .laws import FIT_LAW_KINDS
@@ -230,14 +231,25 @@ def _with_generalisation(res, data, held, measurement):
         return res
     heldout = float(np.sqrt(np.mean([p.rmse ** 2 for p in v.predictions])))
     ratio = heldout / res.rmse if res.rmse > 0 else math.inf
-    res.fit_quality["generalisation"] = {"heldout_rmse": heldout, "fit_rmse": res.rmse, "ratio": ratio,
-                                         "heldout_files": [p.file for p in v.predictions]}
+    q = res.fit_quality
+    gen = q["generalisation"] = {"heldout_rmse": heldout, "fit_rmse": res.rmse, "ratio": ratio,
+                                 "heldout_files": [p.file for p in v.predictions]}
+    base = model_free(measurement, list(data.fit), held)  # what a model-free map of the same runs does
+    verdict = baseline_verdict(q, base, heldout, len(v.predictions), res.unit) if base else None
+    if base:  # the baseline's own generalisation, and the model's held-out error against the baseline's
+        gen.update(baseline_heldout_rmse=base["heldout_rmse"], baseline_fit_rmse=base["fit_rmse"],
+                   baseline_ratio=q["baseline"]["ratio"])
     if ratio > GENERALISATION_WARN:
-        res.warnings.insert(0, f"the model predicts the {len(v.predictions)} held-out experiment(s) {ratio:.3g} times "
-                               f"worse than it fits the others (RMSE {amount(heldout, res.unit)} against "
-                               f"{amount(res.rmse, res.unit)}): it does not generalise; look for what differs "
-                               f"between runs (an offset re-zeroed per run: --offset per-experiment; the "
-                               f"temperature; the motion)")
+        than = "" if not base else (f"; a model-free map of the same runs: {amount(base['heldout_rmse'], res.unit)} "
+                                    f"against {amount(base['fit_rmse'], res.unit)}")
+        offset = "an offset re-zeroed per run: --offset per-experiment; " if measurement.offset == "shared" else ""
+        at = 1 if res.warnings and res.warnings[0].startswith("the fit is not adequate") else 0
+        res.warnings.insert(at, f"the model predicts the {len(v.predictions)} held-out experiment(s) {ratio:.3g} times "
+                                f"worse than it fits the others (RMSE {amount(heldout, res.unit)} against "
+                                f"{amount(res.rmse, res.unit)}{than}): it does not generalise; look for what differs "
+                                f"between runs ({offset}the temperature; the motion)")
+    if verdict:  # one verdict, first (replacing 'adequacy unknown')
+        res.warnings[:] = [verdict] + [w for w in res.warnings if not w.startswith("adequacy unknown")]
     return res
 
 

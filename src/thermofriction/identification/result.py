@@ -212,10 +212,12 @@ class FitResult(Result):
         lines = [f"[[Fit: {self.method}]]"]
         held = [h for h in (self.fit_quality or {}).get("held") or [] if h["contradicted"]]
         if self.adequate is False:  # first, in plain words: the one verdict (fit_quality), as the warnings say it
-            on_held = self.fit_quality.get("verdict_basis") == "held values"
+            basis, b = self.fit_quality.get("verdict_basis"), self.fit_quality.get("baseline") or {}
             lines.append("    NOT ADEQUATE: " + (
                 f"{len(held)} held value(s) contradicted by the data (the noise cannot be estimated from these data: "
-                f"the residuals are not compared with it)" if on_held else
+                f"the residuals are not compared with it)" if basis == "held values" else
+                f"held-out RMSE {b.get('ratio', math.nan):.3g} x a model-free map's on the same runs (the noise cannot "
+                f"be estimated from these data)" if basis == "baseline" else
                 f"residuals {self.fit_quality['ratio']:.3g} x the measurement noise"
                 + (f", {len(held)} held value(s) contradicted by the data" if held else "")) + " (see the first warnings)")
         if self.n_points == 0 and "paper" in self.details:  # no trajectory fit: say what was done instead
@@ -242,7 +244,7 @@ class FitResult(Result):
                          f"{_verdict(q)}")
         lines += [
                  f"    evaluations      = {self.nfev} (Jacobians {self.njev}), starts = {self.starts}",
-                 f"    wall time        = {self.wall_time:.3g} s",
+                 f"    fit time         = {self.wall_time:.3g} s (the least-squares fits; not the checks after them)",
                  "[[Parameters]]"]
         rows = list(self._rows())
         w = [max(len(r[i]) for r in rows + [("name", "value", "stderr", "rel", "95 % interval", "unit")])
@@ -330,6 +332,11 @@ def _plant_lines(plant) -> list:
 def _verdict(q) -> str:
     if q["adequate"] is False and q.get("verdict_basis") == "held values":
         return f"NOT adequate (held values contradicted; the noise cannot be estimated: {q.get('why')})"
+    if q.get("verdict_basis") == "baseline":  # the noise unknown: the model against a model-free map (baseline.py)
+        b = q["baseline"]
+        return (f"{'adequate' if q['adequate'] else 'NOT adequate'} relative to a model-free map of the same runs "
+                f"(held-out RMSE {b['ratio']:.3g} x the map's, at most {b['factor']:g}; the noise cannot be estimated: "
+                f"{q.get('why')})")
     if q["adequate"] is None:
         return f"adequacy unknown ({q.get('why') or 'the noise cannot be estimated from the data'})"
     return "adequate" if q["adequate"] else "NOT adequate"

@@ -76,10 +76,22 @@ def force_initial(init, method, data, experiments, *, friction=None, free=(), pr
                          f"{init.plant.motion}: set motion = \"{want}\" in its [plant]")
     if friction is not None:
         init = with_friction_model(init, friction)
+        if friction == "stribeck":  # asked for: a Stribeck map, not the Coulomb map a start without an excess fits
+            init = _with_excess(init, experiments)
     if init.heat is not None:
         raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet")
     moving_speed(experiments)  # a record at rest is refused whatever the initial model (it determines nothing)
     return _v_smooth_from_data(init, experiments)
+
+
+def _with_excess(init, experiments):
+    """A Stribeck map whose start has no excess (fs = fc: none seen in the data's slowest sliding) gets one to fit
+    from: fs a tenth above fc, vs a tenth of the data's moving speed (the fit's defaults drop fs and vs where there
+    is no excess, which made --friction stribeck a plain Coulomb map)."""
+    values = init.friction.values()
+    if "fs" in init.laws or values.get("fc") is None or (values.get("fs") or 0.0) > values["fc"]:
+        return init
+    return init.with_friction(fs=1.1 * values["fc"], vs=0.1 * moving_speed(experiments))
 
 
 def _v_smooth_from_data(init, experiments):
