@@ -101,3 +101,18 @@ def test_the_command_line_says_a_warning_once(joint, fits, tmp_path):
     assert out.returncode == 0, out.stderr
     lines = [x for x in out.stderr.splitlines() if x.startswith("thermofriction: warning:")]
     assert lines and len(lines) == len(set(lines))
+
+
+def test_velocity_columns_that_lag_alike_are_said_once(tmp_path):
+    """Issue 40 item 7: a dataset whose four velocity columns lag 40 ms gave four warnings on every command; now one,
+    naming each file with its lag."""
+    import warnings
+    from thermofriction.data.motion import MotionWarning
+    folder, _ = lookalike_dataset(tmp_path / "lag", offsets=(0.02, -0.015, 0.03, 0.01), lag=0.04, seed=1)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tf.load_dataset(folder)
+    said = [w for w in caught if issubclass(w.category, MotionWarning)]
+    assert len(said) == 1, [str(w.message) for w in said]
+    text = str(said[0].message)
+    assert "in 4 files" in text and all(f"run{k}.csv: it lags" in text for k in range(4))

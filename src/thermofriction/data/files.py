@@ -13,6 +13,7 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 
 from .._reading import read_text
+from .._warning_routes import recorded_warnings
 from .. import _args
 from ..errors import InputError, UnitWarning, shorten, unknown_keys
 from ..waveforms import parse_waveform
@@ -20,6 +21,7 @@ from .csv import read_experiment_csv
 from .command import check_torque_constant
 from .force import check_motion_option, force_experiment, is_force_data, is_force_file, units_of
 from .matlab import is_matlab, read_force_mat
+from .motion import one_motion_warning
 from ..plausible import (SUSPICIOUS, displacement_doubt, displacement_problem, input_voltage_problem, kelvin_hint,
                          voltage_problem)
 from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
@@ -124,7 +126,10 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
         raise InputError(f"{manifest}: not UTF-8 text ({e.reason} at byte {e.start})") from None
     except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
         raise InputError(f"{manifest}: TOML nested too deeply") from None
-    data = manifest_dataset(meta, folder, manifest, motion=motion)
+    with recorded_warnings() as caught:
+        data = manifest_dataset(meta, folder, manifest, motion=motion)
+    for w in one_motion_warning(caught):  # the files whose velocity columns lag alike: said once
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     data.sha256 = dataset_sha256(data)
     return data
 

@@ -47,7 +47,29 @@ class SamplingWarning(UserWarning):
 
 class MotionWarning(SamplingWarning):
     """A velocity column is not the position's derivative (lag, scale or shape): the numbers and the motion
-    that drives the model."""
+    that drives the model. ``path``, ``problems`` and ``outcome`` (what drives the model) let a dataset's loader say
+    the files that share an outcome in one warning (:func:`one_motion_warning`)."""
+
+    def __init__(self, message, path="", problems="", outcome=""):
+        super().__init__(message)
+        self.path, self.problems, self.outcome = path, problems, outcome
+
+
+def one_motion_warning(caught) -> list:
+    """``caught`` (recorded warnings) with the MotionWarnings that share an outcome said once, each file with its
+    numbers: a dataset of 20 runs whose velocity columns lag gave 20 warnings on every command."""
+    motion = [w.message for w in caught if isinstance(w.message, MotionWarning) and w.message.outcome]
+    out = [w for w in caught if not (isinstance(w.message, MotionWarning) and w.message.outcome)]
+    for outcome in dict.fromkeys(m.outcome for m in motion):
+        same = [m for m in motion if m.outcome == outcome]
+        if len(same) == 1:
+            out.append(warnings.WarningMessage(same[0], MotionWarning, __file__, 0))
+            continue
+        files = "; ".join(f"{m.path}: {m.problems}" for m in same)
+        out.append(warnings.WarningMessage(MotionWarning(
+            f"the velocity column is not the position's derivative in {len(same)} files ({files}); {outcome}"),
+            MotionWarning, __file__, 0))
+    return out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -223,12 +245,14 @@ def choose_motion(path, time, position, velocity, motion: str = "auto", headers=
         return "velocity", check
     problems = "; ".join(check.problems)
     if motion == "velocity":
-        warnings.warn(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; it "
-                      f"drives the model as asked (motion = \"velocity\")", MotionWarning, stacklevel=3)
+        outcome = "it drives the model as asked (motion = \"velocity\")"
+        warnings.warn(MotionWarning(f"{path}: the velocity column {vname} is not the position's derivative: "
+                                    f"{problems}; {outcome}", str(path), problems, outcome), stacklevel=3)
         return "velocity", check
-    warnings.warn(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; the "
-                  f"position drives the model (motion = \"auto\"; motion = \"velocity\" uses the column as it is)",
-                  MotionWarning, stacklevel=3)
+    outcome = ("the position drives the model (motion = \"auto\"; motion = \"velocity\" uses the column as it "
+               "is)")
+    warnings.warn(MotionWarning(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; "
+                                f"{outcome}", str(path), problems, outcome), stacklevel=3)
     return "position", check
 
 
@@ -300,5 +324,5 @@ def with_v_smooth(model, experiments, steps: float = V_SMOOTH_STEPS):
 
 
 __all__ = ["MOTIONS", "POSITION_MISMATCH_ERROR", "on_uniform_grid", "MotionCheck", "MotionWarning", "SamplingWarning", "check_motion",
-           "check_motion_option", "choose_motion", "driven_by", "motion_waveform", "quantum", "v_smooth_for", "velocity_lag",
+           "check_motion_option", "choose_motion", "driven_by", "one_motion_warning", "motion_waveform", "quantum", "v_smooth_for", "velocity_lag",
            "velocity_of", "velocity_resolution", "velocity_scale", "with_v_smooth"]
