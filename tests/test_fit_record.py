@@ -116,3 +116,14 @@ def test_velocity_columns_that_lag_alike_are_said_once(tmp_path):
     assert len(said) == 1, [str(w.message) for w in said]
     text = str(said[0].message)
     assert "in 4 files" in text and all(f"run{k}.csv: it lags" in text for k in range(4))
+
+
+def test_the_velocity_map_draws_only_the_directions_the_data_slide_in():
+    """Issue 40 item 7: one-way runs got a model curve on a negative branch the data never saw."""
+    from types import SimpleNamespace
+    from thermofriction.reporting.force import _map_velocities
+    one_way = [SimpleNamespace(drive_velocity=np.linspace(0.01, 0.5, 50))]
+    both = [SimpleNamespace(drive_velocity=np.linspace(-0.5, 0.5, 50))]
+    assert np.all(_map_velocities(one_way, 0.5) > 0)
+    v = _map_velocities(both, 0.5)
+    assert v.min() == pytest.approx(-0.5) and v.max() == pytest.approx(0.5)

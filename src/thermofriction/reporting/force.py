@@ -86,7 +86,7 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
         stride = max(len(e.time) // 1500, 1)
         ax.plot(v_e[::stride] * kv, F_e[::stride] * kf, ".", ms=2, alpha=0.35, color=col[e.temperature],
                 label="measured" if k == 0 else None)
-    v = np.concatenate([-np.geomspace(top, top * 1e-3, 40), np.geomspace(top * 1e-3, top, 40)])
+    v = _map_velocities(exps, top)
     T_mid = float(np.median(temps))
     for k, e in enumerate(entries):
         try:
@@ -99,6 +99,16 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
     return figs.render(fig, "velocity-map", f"The friction-velocity map: measured points (dots, coloured by "
                        f"temperature, {min(temps):.1f}–{max(temps):.1f} °C) and each model's steady-sliding "
                        f"{what} (simulated at constant velocity; sensor offset included).")
+
+
+def _map_velocities(exps, top):
+    """The velocities a map's model curves are drawn at: the directions the data slide in only (one-way runs drew
+    a negative branch the data never saw)."""
+    v_all = np.concatenate([e.drive_velocity for e in exps])
+    branches = [np.geomspace(top * 1e-3, top, 40)] if np.any(v_all > 1e-3 * top) else []
+    if np.any(v_all < -1e-3 * top):
+        branches.insert(0, -np.geomspace(top, top * 1e-3, 40))
+    return np.concatenate(branches or [np.geomspace(top * 1e-3, top, 40)])
 
 
 def reversals(position, n, excursion=0.05):
