@@ -124,8 +124,9 @@ def mark_held_out(ax, temperatures, label=True):
 
 def panels_width(cols, key=True) -> float:
     """A figure's width [in] from its number of panel columns (and a legend on the right): a single panel is not
-    stretched to the page's width; at most WIDE."""
-    return min(WIDE, PANEL * cols + (KEY if key else 0.3))
+    stretched to the page's width (it gets HALF, the pair's width, so that the plot and not its legend fills the
+    figure); at most WIDE."""
+    return min(WIDE, max(PANEL * cols, HALF) + (KEY if key else 0.3))
 
 
 def legend(target, handles=None, **kwargs):
