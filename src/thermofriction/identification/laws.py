@@ -26,6 +26,21 @@ def aicc(ssr, n, k):
     return aic + 2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else aic
 
 
+#: [degC] temperatures closer than this are one temperature to a fit (procedures.temperature_groups); a fitted law's
+#: range reaches at least this far beyond its fit temperatures, so that it holds at their nominal values: runs
+#: nominally at 24 and 45 C whose records average 24.0001 and 44.9995 C give 23.95..45.05, not 24.0001..44.9995
+SAME_TEMPERATURE = 0.05
+
+
+def fit_range(T) -> tuple:
+    """The range a law fitted at temperatures ``T`` is written with: from the lowest to the highest, widened by
+    SAME_TEMPERATURE and rounded outwards to its multiples."""
+    T = np.asarray(T, float)
+    lo = math.floor((float(T.min()) - SAME_TEMPERATURE) / SAME_TEMPERATURE) * SAME_TEMPERATURE
+    hi = math.ceil((float(T.max()) + SAME_TEMPERATURE) / SAME_TEMPERATURE) * SAME_TEMPERATURE
+    return round(lo, 9), round(hi, 9)
+
+
 #: the law kinds fit_law fits (identify(laws={name: kind}), --law NAME=KIND)
 FIT_LAW_KINDS = ("linear", "exp", "const")
 
@@ -44,7 +59,7 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
         if ok.all():
             w = 1.0 / se
             w = w / w.mean()
-    rng = (float(T.min()), float(T.max()))
+    rng = fit_range(T)
     table, best = {}, None
     for kind in kinds:
         if kind == "linear":
@@ -114,7 +129,7 @@ def segmented_fit(T, values, weights=None):
     _, tb, (c0, c1, c2) = best
     knots = np.array([T[0], tb, T[-1]])
     vals = c0 + c1 * (knots - tb) + c2 * np.maximum(knots - tb, 0.0)
-    return float(tb), PWL(knots, vals, range=(float(T[0]), float(T[-1]))), best[0]
+    return float(tb), PWL(knots, vals, range=fit_range(T)), best[0]
 
 
 def laws_on_information(Ts, per_T, laws: dict) -> dict:

@@ -16,7 +16,7 @@ from ..models import PWL, Const, Model, ModelII
 from ..simulation import simulate
 from .optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
 from .problem import Problem, make_traces, pool
-from .laws import aicc, segmented_fit
+from .laws import aicc, fit_range, segmented_fit
 from .parameters import Parameters
 from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
                          fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
@@ -107,7 +107,7 @@ def _model_ii_paper(groups, base, T_ref, details, t0, progress):
     r2 = 1 - np.sum((alpha + beta * dFs - D_sim) ** 2) / np.sum((D_sim - D_sim.mean()) ** 2)
     knots = D_law.T
     dF_knots = (D_law.values - alpha) / beta
-    law = PWL(knots, dF_knots, range=(float(Ts.min()), float(Ts.max())))
+    law = PWL(knots, dF_knots, range=fit_range(Ts))
     model = dataclasses.replace(base, thermal=ModelII(law))
     details["paper"] = {"temperatures": Ts, "displacement": D, "breakpoint": tb,
                         "displacement_law": D_law.to_dict(), "dF_grid": dFs, "displacement_vs_dF": D_sim,
@@ -238,7 +238,7 @@ def _dF_law(per_T):
     A = np.column_stack([Ts, np.ones_like(Ts)]) * w[:, None]
     coef, *_ = np.linalg.lstsq(A, vals * w, rcond=None)
     lin = PWL([Ts.min(), Ts.max()], [coef[0] * Ts.min() + coef[1], coef[0] * Ts.max() + coef[1]],
-              range=(float(Ts.min()), float(Ts.max())))
+              range=fit_range(Ts))
     candidates["linear"] = (lin, aicc(float(np.sum(((lin(Ts) - vals) * w) ** 2)), len(Ts), 2))
     if len(Ts) >= 4:
         tb, seg, ssr = segmented_fit(Ts, vals, w)

@@ -18,6 +18,7 @@ from ..models.sides import SIGNED
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
+from .laws import SAME_TEMPERATURE
 from .optimiser import FitOutcome, fit
 from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
 from .problem import Problem, make_traces
@@ -321,11 +322,11 @@ def along_temperatures(chains, step, *, alone):
 
 
 def temperature_groups(experiments):
-    """Fit experiments grouped by temperature (0.05 C apart count as one)."""
+    """Fit experiments grouped by temperature (SAME_TEMPERATURE, 0.05 C, apart count as one)."""
     exps = sorted(experiments, key=lambda e: e.temperature)
     groups = []
     for e in exps:
-        if groups and abs(e.temperature - groups[-1][0].temperature) < 0.05:
+        if groups and abs(e.temperature - groups[-1][0].temperature) < SAME_TEMPERATURE:
             groups[-1].append(e)
         else:
             groups.append([e])

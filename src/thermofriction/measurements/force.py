@@ -80,6 +80,10 @@ def _steps(model, names, theta):
     return np.array(out)
 
 
+#: what force data's tables call an error relative to the data: a signal that changes sign has no level to divide by,
+#: and its largest error sits at a reversal, so the RMSE is taken against the range the measured signal spans
+RANGE_PCT = "RMSE [% of range] = 100 RMSE / (max F_meas - min F_meas)"
+
 class Force(Measurement):
     name = "force"
     quantity = "friction force (torque)"
@@ -238,9 +242,8 @@ class Force(Measurement):
     @property
     def caption(self) -> str:
         if self.offset == "per-experiment":
-            return "RMSE: each experiment's own offset removed (estimated on it); NRMSE = RMSE / measured span"
-        return "RMSE: the model's sensor offset removed (fitted on the fit experiments, never re-fitted); " \
-               "NRMSE = RMSE / measured span"
+            return "RMSE: each experiment's own offset removed (estimated on it); " + RANGE_PCT
+        return "RMSE: the model's sensor offset removed (fitted on the fit experiments, never re-fitted); " + RANGE_PCT
 
     @property
     def footer(self) -> str:
@@ -249,14 +252,18 @@ class Force(Measurement):
                    "offset)" if self.offset == "per-experiment" else
                    "the model's sensor offset ([plant] sensor_offset) removed, as fitted on the fit experiments and "
                    "never re-fitted on held-out ones")
-        return (f"RMSE: {removed}; NRMSE = RMSE / measured span; max error: 100 max|error| / measured span; mean "
+        return (f"RMSE: {removed}; {RANGE_PCT}; max |error|: the largest single error, in the data's unit (on "
+                f"a signal that changes sign it is at a reversal, where a small timing difference shows large); mean "
                 f"error: the prediction's mean minus the measurement's, before any offset was removed "
-                f"(docs/force-data.md#validation)")
+                f"(docs/force-data.md#4-validation)")
+
+    #: the tables show NRMSE as a percentage of the range
+    column_scale = {"nrmse": 100.0}
 
     def columns_for(self, unit):
         return (("file", "file", "{}"), ("T [C]", "temperature", "{:.4g}"), ("role", "role", "{}"),
-                (f"RMSE [{unit}]", "rmse_offset_removed", "{:.4g}"), ("NRMSE", "nrmse", "{:.3g}"),
-                ("max error [%]", "max_error_pct", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
+                (f"RMSE [{unit}]", "rmse_offset_removed", "{:.4g}"), ("RMSE [% of range]", "nrmse", "{:.3g}"),
+                (f"max |error| [{unit}]", "max_error", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
 
     def friction_of(self, model, exp, rtol=1e-8, fast=False) -> np.ndarray:
         """The friction force (torque) ``model`` predicts along one experiment's measured motion, on its samples:
@@ -313,15 +320,18 @@ class Force(Measurement):
                                np.asarray(exp.displacement), np.asarray(exp.drive_velocity), meas, pred, rmse,
                                rmse / span if span > 0 else math.nan,
                                100 * float(np.max(np.abs(err))) / span if span > 0 else math.nan,
-                               bias, exp.force_unit, quality)
+                               bias, exp.force_unit, quality, float(np.max(np.abs(err))))
 
     def summary(self, predictions) -> dict:
         out = {}
         for role, ps in self.by_role(predictions):
             pcts = [p.max_error_pct for p in ps if not math.isnan(p.max_error_pct)]
             rmse = float(np.sqrt(np.mean([p.rmse ** 2 for p in ps])))
+            nrmse = [p.nrmse for p in ps if not math.isnan(p.nrmse)]
             out[role] = {"max_error_pct": max(pcts) if pcts else math.nan, "rmse": rmse,
-                         "rmse_offset_removed": rmse, "unit": ps[0].unit, "n": len(ps)}
+                         "rmse_offset_removed": rmse, "unit": ps[0].unit, "n": len(ps),
+                         "nrmse": float(np.sqrt(np.mean(np.square(nrmse)))) if nrmse else math.nan,
+                         "max_error": max(p.max_error for p in ps)}
         return out
 
 
@@ -343,13 +353,15 @@ class ForcePrediction:
     bias: float
     unit: str
     fit_quality: dict | None = None
+    #: max |error| in the data's unit (max_error_pct is it over the range: kept for readers, not shown)
+    max_error: float = math.nan
 
     def metrics(self) -> dict:
         # "rmse": the name this metric had before it was named as displacement's is (kept for readers of
         # earlier results; docs/formats.md)
         return {"file": self.file, "temperature": self.temperature, "role": self.role,
                 "rmse_offset_removed": self.rmse, "rmse": self.rmse, "nrmse": self.nrmse,
-                "max_error_pct": self.max_error_pct, "bias": self.bias, "unit": self.unit,
+                "max_error_pct": self.max_error_pct, "max_error": self.max_error, "bias": self.bias, "unit": self.unit,
                 "fit_quality": self.fit_quality}
 
 

@@ -85,13 +85,15 @@ def fig_residuals(figs, entries):
 def fig_model_i(figs, entry, held_out=()):
     if not entry.model.laws or not ((entry.fit or {}).get("details") or {}).get("per_temperature"):
         return ""
-    fig = fit_plots.laws_figure(entry.fit, entry.model, held_out)
+    paper = fit_plots.from_the_paper(entry.model)
+    fig = fit_plots.laws_figure(entry.fit, entry.model, held_out, paper=paper)
     return figs.render(fig, "model-i-parameters",
                        f"{entry.label}: each parameter identified per temperature with its 95 % interval (an "
                        "orange triangle where the interval is open upwards: the data do not bound the parameter "
                        "there), the law fitted through those estimates (dotted), the law refined on all "
-                       "experiments at once (solid; red rings where it leaves an interval), and the paper's "
-                       "Eqs. (9)–(11) (grey, Figs. 3–5). Pale red bands: held-out temperatures.")
+                       "experiments at once (solid; red rings where it leaves an interval)" +
+                       (", and the paper's Eqs. (9)–(11) (grey, Figs. 3–5; the model was fitted from the paper's "
+                        "preset)" if paper else "") + ". Pale red bands: held-out temperatures.")
 
 
 def fig_model_ii(figs, entry, held_out=()):
@@ -100,12 +102,15 @@ def fig_model_ii(figs, entry, held_out=()):
     alt = ((fit.get("alternatives") or {}).get("paper") or {}).get("details") or {}
     if not (det.get("paper") or alt.get("paper") or det.get("direct")) or not isinstance(entry.model.thermal, ModelII):
         return ""
-    fig = fit_plots.model_ii_figure(fit, entry.model, held_out)
+    paper = fit_plots.from_the_paper(entry.model)
+    fig = fit_plots.model_ii_figure(fit, entry.model, held_out, paper=paper)
     return figs.render(fig, "model-ii",
                        f"{entry.label}: the paper's procedure (net displacement against temperature with an "
                        "estimated breakpoint, Fig. 6; net displacement against dF by simulation, Fig. 7) where it "
                        "ran, and dF(T): fitted per temperature on the trajectories (direct, 95 % intervals), the "
-                       "fitted piecewise-linear law with its breakpoints, and the paper's Eq. (13) (grey).")
+                       "fitted piecewise-linear law with its breakpoints" +
+                       (", and the paper's Eq. (13) (grey; the model was fitted from the paper's preset)" if paper
+                        else "") + ".")
 
 
 __all__ = ["DEFINITIONS", "definitions", "fig_errors", "fig_steps", "fig_displacement", "fig_residuals",

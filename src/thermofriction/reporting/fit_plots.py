@@ -11,7 +11,21 @@ from ..models import PARAMETER_UNITS, ModelII, load_model
 from .friction_plots import force_overview
 from .units import scaled_axis, scaled_ticks
 from .plots import (HALF, MODEL_COLOURS, PAPER, WIDE, draw_displacement, draw_residuals, hide_unused, is_held_out,
-                    mark_held_out, new_figure, noise_handle, panel_grid, styled, temperature_key, temperature_styles)
+                    legend, mark_held_out, new_figure, noise_handle, panel_grid, panels_width, styled, temperature_key,
+                    temperature_styles)
+
+#: the presets of Li et al. (2009)'s actuator: their published laws (Eqs. 9-11, 13) are drawn beside a fit only
+#: when the model is one of them or was fitted from one
+PAPER_PRESETS = "li2009-"
+
+
+def from_the_paper(model) -> bool:
+    """Whether ``model`` is one of the paper's presets (li2009-*) or was identified starting from one (its
+    provenance's ``initial_model``): the paper's laws then describe the same actuator. A user's own actuator,
+    started from a model of its own or from the data, is not compared with them."""
+    import os
+    names = [getattr(model, "name", None), ((getattr(model, "provenance", None) or {}).get("initial_model"))]
+    return any(os.path.basename(str(n)).startswith(PAPER_PRESETS) for n in names if n)
 
 
 def as_float(x):
@@ -106,21 +120,19 @@ def draw_law(ax, fit, model, name, held_out=(), paper=True):
 
 
 @styled
-def laws_figure(fit, model, held_out=(), paper=True):
-    """Model I: every parameter with a law, one panel each (a fit's results dict and its model)."""
+def laws_figure(fit, model, held_out=(), paper=None):
+    """Model I: every parameter with a law, one panel each (a fit's results dict and its model); the paper's laws
+    where ``paper``, by default where the model is the paper's (:func:`from_the_paper`)."""
     names = list(model.laws)
     if not names:
         return None
+    paper = from_the_paper(model) if paper is None else paper
     rows, cols = panel_grid(len(names))
-    fig, axes = new_figure(WIDE, 3.6 * rows + 0.3, nrows=rows, ncols=cols)
+    fig, axes = new_figure(panels_width(cols), 3.6 * rows + 0.3, nrows=rows, ncols=cols)
     for ax, n in zip(axes.flat, names):
         draw_law(ax, fit, model, n, held_out, paper)
     hide_unused(axes, len(names))
-    handles = {}
-    for ax in axes.flat[:len(names)]:
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            handles.setdefault(lab, h)
-    fig.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
+    legend(fig, loc="outside right upper")
     return fig
 
 
@@ -164,16 +176,17 @@ def draw_dF(ax, fit, model, label="fitted dF(T)", held_out=(), paper=True):
 
 
 @styled
-def model_ii_figure(fit, model, held_out=(), paper=True):
+def model_ii_figure(fit, model, held_out=(), paper=None):
     """Model II: the paper's procedure (displacement against temperature, against dF) when it ran,
-    and dF(T)."""
+    and dF(T); the paper's Eq. (13) where ``paper``, by default where the model is the paper's."""
+    paper = from_the_paper(model) if paper is None else paper
     det = (fit or {}).get("details") or {}
     alt = (((fit or {}).get("alternatives") or {}).get("paper") or {}).get("details") or {}
     procedure = det.get("paper") or alt.get("paper")
     if not procedure and not det.get("direct") and not isinstance(model.thermal, ModelII):
         return None
     panels = 3 if procedure else 1
-    fig, axes = new_figure(WIDE if procedure else HALF + 1.5, 3.9, nrows=1, ncols=panels)
+    fig, axes = new_figure(panels_width(panels), 3.9, nrows=1, ncols=panels)
     axl = list(axes[0])
     if procedure:
         ax = axl.pop(0)
@@ -188,7 +201,7 @@ def model_ii_figure(fit, model, held_out=(), paper=True):
         mark_held_out(ax, held_out, label=False)
         ax.set_xlabel("temperature [°C]")
         ax.set_title("Fig. 6: against T")
-        ax.legend(loc="best")
+        legend(ax, loc="best")
         ax = axl.pop(0)
         dFg = np.array(procedure["dF_grid"], float)
         Ds = np.array(procedure["displacement_vs_dF"], float)
@@ -199,10 +212,10 @@ def model_ii_figure(fit, model, held_out=(), paper=True):
                 label=f"linear, R² = {lf['r2']:.4f}")
         ax.set_xlabel("dF [N]")
         ax.set_title("Fig. 7: against dF")
-        ax.legend(loc="best")
+        legend(ax, loc="best")
     ax = axl.pop(0)
     draw_dF(ax, fit, model, held_out=held_out, paper=paper)
-    fig.legend(handles=ax.get_legend_handles_labels()[0], loc="outside right upper")
+    legend(fig, ax.get_legend_handles_labels()[0], loc="outside right upper")
     return fig
 
 
@@ -285,11 +298,7 @@ def fit_figure(fit, validation=None, paper=False):
             draw_dF(a[len(laws)], d, model, held_out=held, paper=paper)
         for ax in a[law_panels:]:
             ax.set_visible(False)
-        handles = {}
-        for ax in a[:law_panels]:
-            for h, lab in zip(*ax.get_legend_handles_labels()):
-                handles.setdefault(lab, h)
-        sub.legend(handles=list(handles.values()), labels=list(handles), loc="outside right upper")
+        legend(sub, [h for ax in a[:law_panels] for h in ax.get_legend_handles_labels()[0]], loc="outside right upper")
     name = f"{model.name or 'fitted model'} ({d.get('method') or 'fit'})"
     inner = fig.get_suptitle()  # a single row of force data names its experiment there
     fig.suptitle(f"{name}: {inner}" if inner else name)

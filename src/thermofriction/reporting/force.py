@@ -19,6 +19,7 @@ from ..plausible import SUSPICIOUS
 from ..validation import validate
 from .entries import akaike_scaled
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
+from .plots import legend
 from .plots import thin as _thin
 from .units import scaled_axis
 
@@ -67,8 +68,7 @@ def fig_force_time(figs, entries, unit, what):
         ax.set_title(f"{p0.file}, {p0.temperature:.1f} °C" + (" (held out)" if p0.role == "validate" else ""),
                      fontsize=9)
     axes[-1, 0].set_xlabel("time [s]")
-    fig.legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, frameon=False, loc="outside lower center",
-               ncol=len(entries) + 1)
+    legend(fig, fontsize=8, frameon=False, loc="outside lower center", ncol=len(entries) + 1)
     return figs.render(fig, "force-time", f"Measured (markers) and predicted (lines) friction {what} over time, "
                        f"the model's sensor offset included; held-out experiments first.")
 
@@ -95,7 +95,7 @@ def fig_velocity_map(figs, entries, exps, unit, vunit, what):
             continue
         ax.plot(v * kv, F * kf, "-", lw=1.4, label=f"{e.label}, steady sliding at {T_mid:.1f} °C")
     ax.set_title(f"friction–velocity map at {T_mid:.1f} °C")
-    ax.legend(fontsize=7, frameon=False, loc="lower right")
+    legend(ax, fontsize=7, frameon=False, loc="lower right")
     return figs.render(fig, "velocity-map", f"The friction-velocity map: measured points (dots, coloured by "
                        f"temperature, {min(temps):.1f}–{max(temps):.1f} °C) and each model's steady-sliding "
                        f"{what} (simulated at constant velocity; sensor offset included).")
@@ -163,7 +163,7 @@ def fig_loops(figs, entries, unit, xunit, what):
     for ax in axes[0][1:]:  # the y label once, unless a panel's unit differs
         if ax.get_ylabel() == axes[0][0].get_ylabel():
             ax.set_ylabel("")
-    axes[0][0].legend(fontsize=7, frameon=False)
+    legend(axes[0][0], fontsize=7, frameon=False)
     return figs.render(fig, "presliding", f"Presliding: the {what} against the position around reversals of the "
                        f"motion, measured (markers) and predicted (lines); the loop's slope at the reversal is the "
                        f"bristle stiffness.")
@@ -192,8 +192,7 @@ def fig_hysteresis(figs, entries, unit, xunit, what):
                      fontsize=9)
     for ax in axes.flat[len(shown):]:
         ax.set_visible(False)
-    fig.legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, frameon=False, loc="outside lower center",
-               ncol=len(entries) + 1)
+    legend(fig, fontsize=8, frameon=False, loc="outside lower center", ncol=len(entries) + 1)
     return figs.render(fig, "hysteresis", f"The friction {what} against the measured position over each run: "
                        f"measured (markers) and predicted by each model (lines), the sensor offset included; "
                        f"held-out experiments first.")
@@ -227,7 +226,9 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
     parts = []
     held = {e.label: e.validation.summary().get("validate", {}).get("rmse", math.inf) for e in entries}
     best = min(entries, key=lambda e: held[e.label])
-    cards = [("best on held-out experiments", best.label, f"RMSE {held[best.label]:.3g} {unit}"),
+    held_pct = 100 * best.validation.summary().get("validate", {}).get("nrmse", math.nan)
+    cards = [("best on held-out experiments", best.label,
+              f"RMSE {held[best.label]:.3g} {unit} ({held_pct:.2g} % of the range)"),
              ("experiments", f"{len(exps)}", f"{sum(getattr(e, 'role', 'fit') == 'validate' for e in exps)} held out"),
              ("temperatures", f"{min(e.temperature for e in exps):.1f}–{max(e.temperature for e in exps):.1f} °C", ""),
              ("units", "rotary" if unit == "N m" else "linear", f"{xunit}, {vunit}, {unit}")]
@@ -256,11 +257,11 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
     if loops:
         parts.append("<section><h2>Presliding hysteresis</h2>" + loops + "</section>")
     err_rows = [[e.label, m["file"], fmt_number(m["temperature"], "{:.4g}"), m["role"], fmt_number(m["rmse"], "{:.4g}"),
-                 fmt_number(m["nrmse"]), fmt_number(m["max_error_pct"]), fmt_number(m["bias"], "{:+.3g}")]
+                 fmt_number(100 * m["nrmse"]), fmt_number(m["max_error"]), fmt_number(m["bias"], "{:+.3g}")]
                 for e in entries for m in e.validation.experiments]
     parts.append("<section><h2>Errors per experiment</h2>" + html_table(
-        ["model", "file", "T [°C]", "role", f"RMSE [{unit}]", "NRMSE", "max error [%]", f"mean error [{unit}]"],
-        err_rows) + "</section>")
+        ["model", "file", "T [°C]", "role", f"RMSE [{unit}]", "RMSE [% of range]", f"max |error| [{unit}]",
+         f"mean error [{unit}]"], err_rows) + f"<p class='note'>{html.escape(_range_note(what))}</p></section>")
     parameters = _parameters_section(entries, unit)
     if parameters:
         parts.append(parameters)
@@ -283,19 +284,28 @@ def _comparison_section(entries, unit, what) -> str:
         k = sum(1 for p in (f.get("parameters") or {}).values() if p.get("vary"))
         rows.append([e.label, fmt_number(k if f else None, "{:.0f}"), fmt_number(a[0] if a else None, "{:.1f}"),
                      fmt_number(a[1] if a else None, "{:.3f}"), fmt_number(s.get("fit", {}).get("rmse"), "{:.4g}"),
-                     fmt_number(s.get("validate", {}).get("rmse"), "{:.4g}"), fmt_number(s.get("validate", {}).get("max_error_pct")),
+                     fmt_number(s.get("validate", {}).get("rmse"), "{:.4g}"),
+                     fmt_number(100 * s.get("validate", {}).get("nrmse", math.nan)),
                      fmt_number(e.model.plant.sensor_offset, "{:.4g}"), _scored(e.validation.scored_as)])
     return ("<section><h2>Friction models compared</h2>" + html_table(
         ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
-         "max error, held out [%]", f"sensor offset [{unit}]", "scored with"], rows, text=(8,), wrap=(8,)) +
+         "RMSE, held out [% of range]", f"sensor offset [{unit}]", "scored with"], rows, text=(8,), wrap=(8,)) +
         "<p style='font-size:13px;color:#4a5266'>" + basis + "ΔAICc is each fit's AICc minus the lowest among fits of the same "
         "data (from the identification results beside each model file), the Akaike weight exp(−ΔAICc/2) normalised "
         "to one. The held-out RMSE compares the models on experiments none was fitted to, each model scored as it was "
         "fitted (its fit record: \"scored with\"; a model without one by the defaults, shared offset and the "
         "dataset's motion): with the offset per experiment, each experiment's own offset is removed (on held-out "
         "experiments it is estimated on them), so the errors are of the friction's shape; with a shared offset, "
-        "the one fitted on the fit experiments is used as it is. " +
-        "Max error is max |F_pred − F_meas| over the measured range of the " + what + ".</p></section>")
+        "the one fitted on the fit experiments is used as it is. " + html.escape(_range_note(what)) +
+        " Over the held-out experiments: the root mean square of theirs.</p></section>")
+
+
+def _range_note(what) -> str:
+    """What the force tables' relative error is, said where it is shown."""
+    return (f"RMSE [% of range] = 100 · RMSE / (max F_meas − min F_meas): the RMSE against the range the measured "
+            f"{what} spans (a {what} that changes sign has no level to divide by). Max |error| is the largest single "
+            f"error, in the data's unit: on a {what} that reverses it is at a reversal, where a small timing "
+            f"difference shows as a large error.")
 
 
 def _scored(scored_as: dict) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .plots import HALF, MODEL_COLOURS, WIDE, new_figure, styled, thin
+from .plots import HALF, MODEL_COLOURS, WIDE, legend, new_figure, styled, thin
 from .units import plain, scaled_axis
 
 #: the friction axis of a run whose few short spikes (a stick-slip sawtooth's flyback) would set its scale is
@@ -93,7 +93,7 @@ def simulation_figure(result, what=None, title=None):
         if len(both) > 1:
             ax.plot(*thin(result.time, both[1] * k, 1500), lw=0.9, color="0.55", label="stage")
             ax.lines[0].set_label("end effector")
-            ax.legend(loc="best")
+            legend(ax, loc="best")
         if p == "friction_force":
             robust_ylim(ax, y * k, ax.get_ylabel().rsplit("[", 1)[-1].rstrip("]"))
     axes[-1, 0].set_xlabel("time [s]")
@@ -122,7 +122,7 @@ def hysteresis_figure(result, title=None):
     xs, fs = _strided(x, result.friction_force)
     ax.plot(xs * kx, fs * ky, "-", lw=1.0, color=MODEL_COLOURS[0], label="friction")
     ax.plot([xs[0] * kx], [fs[0] * ky], "o", ms=5, color="k", label="start", zorder=3)
-    ax.legend(loc="lower right")
+    legend(ax, loc="lower right")
     ax.set_title(title or simulation_title(result))
     return fig
 
@@ -151,7 +151,7 @@ def force_hysteresis_figure(validation, files=None, max_panels=4, title=None, la
         draw_force_hysteresis(ax, p, x_u, f_u, what)
     for ax in axes.flat[len(shown):]:
         ax.set_visible(False)
-    axes.flat[0].legend(loc="best")
+    legend(axes.flat[0], loc="best")
     label = label or getattr(validation.model, "name", None) or "model"
     fig.suptitle(title or f"{label}: friction {what} against position")
     return fig
@@ -182,7 +182,7 @@ def force_overview(fig, validation):
     a[0].plot(*thin(p.time, p.predicted * k, 1500), "-", lw=1.1, color=MODEL_COLOURS[0], label="predicted")
     a[0].set_xlabel("time [s]")
     a[0].set_title("over time")
-    a[0].legend(loc="best")
+    legend(a[0], loc="best")
     draw_force_hysteresis(a[1], p, x_u, f_u, what)
     a[1].set_title("against position")
     fig.suptitle(f"{p.file}, {p.temperature:.1f} °C" + (" (held out)" if p.role == "validate" else ""))

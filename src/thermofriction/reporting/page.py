@@ -38,7 +38,7 @@ th.w,td.w{text-align:left;white-space:normal}
 thead th{background:#f0f2f7}
 tr.held td{background:#fdf0ef}
 figure{margin:8px 0 18px}
-figure svg{width:100%;height:auto;display:block}
+figure svg{max-width:100%;height:auto;display:block}
 .pair{display:grid;grid-template-columns:1fr 1fr;gap:24px}
 @media (max-width:900px){.pair{grid-template-columns:1fr}}
 dl.defs{font-size:13px;color:#4a5266;display:grid;grid-template-columns:max-content 1fr;gap:4px 14px;margin:12px 0 0}

@@ -21,14 +21,16 @@ import numpy as np
 
 from .units import scaled_axis
 
-#: font sizes in points; the report draws figures 11 in wide at the card's full width (~1070 px), so
-#: a point renders at ~1.35 px: 9 pt legend text is ~12 px on the page
+#: font sizes in points; the report draws each figure at its own size (a point is 1.33 px: 9 pt legend text is
+#: 12 px on the page), shrunk only where the page is narrower than the figure
 STYLE = {"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10.5, "xtick.labelsize": 9.5,
          "ytick.labelsize": 9.5, "legend.fontsize": 9, "legend.title_fontsize": 9.5, "axes.grid": True,
          "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
          "svg.fonttype": "none", "figure.dpi": 100, "axes.formatter.useoffset": False}
-WIDE = 11.0                      # a full-width figure [in]
+WIDE = 11.0                      # a full-width figure [in]: the widest the report's card holds (~1070 px)
 HALF = 5.6                       # one of two side by side [in]
+PANEL = 3.4                      # one panel of a grid [in]
+KEY = 1.8                        # a legend outside on the right [in]
 MODEL_COLOURS = ("#1f77b4", "#2ca02c", "#9467bd", "#8c6d31", "#17becf", "#7f7f7f")
 HELD_OUT_COLOURS = ("#d62728", "#ff7f0e", "#e377c2", "#8c564b")
 HELD_OUT_BAND = "#f7c6c5"
@@ -110,7 +112,7 @@ def temperature_key(fig, styles, title="temperature", extra=()):
     handles = [Line2D([], [], color=s["color"], ls=s["ls"], lw=s["lw"], marker=s["marker"], mfc=s["mfc"],
                       ms=s["ms"] + 1, label=s["label"])
                for _, s in sorted(styles.items(), key=lambda kv: (kv[1]["held"], kv[0][0]))]
-    fig.legend(handles=list(handles) + list(extra), title=title, loc="outside right upper")
+    legend(fig, list(handles) + list(extra), title=title, loc="outside right upper")
 
 
 def mark_held_out(ax, temperatures, label=True):
@@ -118,6 +120,27 @@ def mark_held_out(ax, temperatures, label=True):
     for i, T in enumerate(sorted(set(temperatures))):
         ax.axvspan(T - 0.15, T + 0.15, color=HELD_OUT_BAND, alpha=0.6, lw=0, zorder=0,
                    label="held-out temperature" if (label and i == 0) else None)
+
+
+def panels_width(cols, key=True) -> float:
+    """A figure's width [in] from its number of panel columns (and a legend on the right): a single panel is not
+    stretched to the page's width (it gets HALF, the pair's width, so that the plot and not its legend fills the
+    figure); at most WIDE."""
+    return min(WIDE, max(PANEL * cols, HALF) + (KEY if key else 0.3))
+
+
+def legend(target, handles=None, **kwargs):
+    """One legend on ``target`` (a Figure, SubFigure or Axes) with one entry per label: ``handles``, or every
+    labelled artist of its axes; a label met again (the same model in two panels) is dropped, the first kept."""
+    if handles is None:
+        axes = target.get_axes() if hasattr(target, "get_axes") else [target]  # a figure's, or the axes alone
+        handles = [h for ax in axes for h in ax.get_legend_handles_labels()[0]]
+    first = {}
+    for h in handles:
+        label = str(h.get_label())
+        if label and not label.startswith("_"):
+            first.setdefault(label, h)
+    return target.legend(handles=list(first.values()), labels=list(first), **kwargs)
 
 
 def panel_grid(n, per_row=3):
@@ -206,7 +229,7 @@ def _panel_per_model(entries, row_height, draw, key_extra, **subplots):
     preds = _predictions(entries)
     styles = temperature_styles([(p.temperature, p.role) for _, ps in preds for p in ps])
     rows, cols = panel_grid(len(preds))
-    fig, axes = new_figure(WIDE, row_height * rows + 0.4, nrows=rows, ncols=cols, **subplots)
+    fig, axes = new_figure(panels_width(cols), row_height * rows + 0.4, nrows=rows, ncols=cols, **subplots)
     for ax, (label, ps) in zip(axes.flat, preds):
         draw(ax, ps, styles)
         ax.set_title(label)
@@ -297,7 +320,7 @@ def draw_errors(ax, entries, metric="max_error_pct", paper=None):
 
 def below(ax, handles):
     """The panel's legend under its x axis, in columns: nothing of the data hidden."""
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2 if len(handles) > 4 else 1)
+    legend(ax, handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2 if len(handles) > 4 else 1)
 
 
 @styled

@@ -10,6 +10,7 @@ import numpy as np
 from .. import _args
 from .._lazy import lazy
 from .page import Figures, fmt_number, html_table, page_styled, subplots, write_page
+from .plots import legend
 from .units import scaled_axis
 
 matplotlib = lazy("matplotlib")
@@ -45,7 +46,7 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
     ax.set_xlabel("time [s]")
     ax.set_ylabel("interface temperature [°C]")
     ax.set_title("interface temperature")
-    ax.legend()
+    legend(ax)
     temp_fig = figs.render(fig, "heating_temperature", "Temperature of the friction interface (lines: two-time-scale "
                            "method; dotted: the full simulation through every cycle).")
     fig, ax = subplots(figsize=(7, 3.4))
@@ -58,7 +59,7 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
             ax.plot(ref.time, ref.step_size * k, ":", color="k", lw=1)
     ax.set_xlabel("time [s]")
     ax.set_title("step per cycle as the interface heats")
-    ax.legend()
+    legend(ax)
     step_fig = figs.render(fig, "heating_step_size", "Step size drift as the interface heats (dotted: full simulation).")
     fig, ax = subplots(figsize=(7, 3.4))
     rows = []
@@ -80,7 +81,7 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
     ax.set_xlabel("time [s]")
     ax.set_ylabel("constant-temperature error [%]")
     ax.set_yscale("symlog", linthresh=1.0)
-    ax.legend()
+    legend(ax)
     err_fig = figs.render(fig, "heating_constant_temperature_error", "Error of the displacement predicted at the "
                           "start temperature (no self-heating), relative to the prediction with self-heating.")
     parts.append("<section><h2>Summary</h2>" + html_table(
@@ -118,7 +119,7 @@ def control_report(rows, path, *, figures_dir=None, title=None, command=None) ->
         ax.set_xlabel("time [s]")
         ax.set_title(f"tracking error at {hottest:g} °C, {name}")
         ax.set_yscale("symlog", linthresh=1e-7 * k)  # linear within 0.1 µm, where the errors cross zero
-        ax.legend(fontsize=8)
+        legend(ax, fontsize=8)
         parts.append("<section><h2>" + html.escape(name) + "</h2>" + figs.render(
             fig, f"control_error_{i}", f"Tracking error at {hottest:g} °C, {name}: no compensation, and "
             f"feed-forward or observer compensation, temperature-blind or temperature-aware.") + "</section>")

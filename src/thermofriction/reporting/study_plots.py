@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plots import HALF, WIDE, new_figure, styled, thin
+from .plots import HALF, WIDE, legend, new_figure, styled, thin
 from .units import scaled_axis
 
 
@@ -36,7 +36,7 @@ def loop_figure(result):
     a.plot(*thin(result.time, result.position * k), color="#1f77b4", label="position")
     a.set_xlabel("time [s]")
     a.set_title("tracking")
-    a.legend(fontsize=8, frameon=False)
+    legend(a, fontsize=8, frameon=False)
     k = scaled_axis(b, "y", result.error, "error", "m")
     b.plot(*thin(result.time, result.error * k), color="#d62728")
     b.set_xlabel("time [s]")

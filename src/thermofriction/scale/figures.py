@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write
+from ..reporting.plots import legend
 from ..reporting.units import scaled_axis
 
 
@@ -48,7 +49,7 @@ def bands_figure(result):
         ax.text(0.01, 0.02, f"a new measurement adds the {result.noise * 1e9:.3g} nm sensor noise: "
                 f"up to ±{extra:.3g} nm (prediction_lower/upper)", transform=ax.transAxes, fontsize=7,
                 color="#4a5266")
-    ax.legend(fontsize=8, frameon=False, ncol=min(len(temps), 4))
+    legend(ax, fontsize=8, frameon=False, ncol=min(len(temps), 4))
     ok = np.isfinite(result.nominal_step)
     if ok.any():
         order = np.argsort(temps)
@@ -62,7 +63,7 @@ def bands_figure(result):
         for x, step in zip(T, nom):
             bx.annotate(f"{step * 1e6:.4g} µm", (x, 0), textcoords="offset points", xytext=(0, 6), ha="center",
                         fontsize=7, color="#4a5266")
-        bx.legend(fontsize=8, frameon=False, loc="lower right")
+        legend(bx, fontsize=8, frameon=False, loc="lower right")
     else:
         bx.text(0.5, 0.5, "no periodic input: no steps per cycle", ha="center", va="center",
                 transform=bx.transAxes)
