@@ -57,13 +57,17 @@ def test_identify_both_procedures_says_what_the_paper_procedure_did(model_ii_dat
 
 
 def test_identify_in_a_pipe_prints_a_line_per_stage_and_quiet_prints_none(model_ii_data):
-    """stderr is a pipe here, as in a CI log: each stage says what it does (not nothing, and not a
-    terminal status line's control codes); --quiet silences it."""
-    r = run_cli("identify", model_ii_data, "--method", "model-i", "--starts", "1")
+    """stderr is a pipe here, as in a CI log: the stages say what they do in plain lines (not nothing, and not a
+    terminal status line's control codes) -- at most one per interval (issue 41: 5 s by default, so quick work says
+    nothing; 0.05 s here); --quiet silences it."""
+    env = dict(os.environ, THERMOFRICTION_PROGRESS_INTERVAL="0.05")
+    r = subprocess.run([sys.executable, "-m", "thermofriction", "identify", str(model_ii_data), "--method",
+                        "model-i", "--starts", "1"], capture_output=True, text=True, timeout=300, env=env)
     assert r.returncode == 0, r.stderr
     lines = [line for line in r.stderr.splitlines() if line.strip()]
     assert len(lines) >= 3, r.stderr
     assert "\x1b[" not in r.stderr
     assert any("31" in line for line in lines)  # a per-temperature stage names its temperature
-    q = run_cli("identify", model_ii_data, "--method", "model-i", "--starts", "1", "--quiet")
+    q = subprocess.run([sys.executable, "-m", "thermofriction", "identify", str(model_ii_data), "--method",
+                        "model-i", "--starts", "1", "--quiet"], capture_output=True, text=True, timeout=300, env=env)
     assert q.returncode == 0 and q.stderr.strip() == "", q.stderr
