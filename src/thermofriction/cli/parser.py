@@ -276,8 +276,18 @@ def _add_fmu_command(sub):
                    help="the realtime solver's fixed step [s], e.g. 1e-5 (a tenth of the fastest time "
                         "constant or less)")
     f.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version: 2 (default) or 3")
+    f.add_argument("--platforms", type=_platform_list, metavar="LIST",
+                   help="build the binaries for these platforms now, comma-separated: linux64 (cc), win64 "
+                        "(x86_64-w64-mingw32-gcc); none: the C sources only (every FMU carries them). Default: the "
+                        "binaries built with the package")
     from .commands import cmd_fmu
     f.set_defaults(run=cmd_fmu)
+
+
+def _platform_list(text: str) -> list[str]:
+    """--platforms: comma-separated names (checked by export_fmu); none: no binary."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    return [] if names == ["none"] else names
 
 
 def _scheduler_options(parser, only=""):
