@@ -235,6 +235,9 @@ def test_wheel_built_from_the_sdist_installs_and_runs_in_a_clean_venv(tmp_path):
     with zipfile.ZipFile(wheels[0]) as z:
         names = z.namelist()
     assert "thermofriction/_fmu/sources/fmu_common.c" in names and "thermofriction/_fmu/thermofriction_fmi.so" in names
+    if shutil.which("x86_64-w64-mingw32-gcc"):  # built with the package where the cross compiler is (docs/fmu.md)
+        assert "thermofriction/_fmu/thermofriction_fmi.dll" in names
+    assert not any(n.startswith(("tests/", "core/", "src/")) for n in names)  # the package only
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     py = venv / "bin" / "python"

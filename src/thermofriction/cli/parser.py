@@ -254,8 +254,9 @@ def _add_fmu_command(sub):
     f = sub.add_parser(
         "fmu", help="export a model as an FMI 2.0 co-simulation FMU for Simulink, OpenModelica, fmpy, ... (docs/fmu.md)",
         description="Write MODEL as an FMI 2.0 (or, with --fmi 3, FMI 3.0) co-simulation FMU for Linux x86-64 and, "
-                    "when the package was built with the MinGW-w64 cross compiler, Windows x86-64 (the C core "
-                    "inside, the C library its only dependency). Inputs: the plant's drive (voltage, force or motion) and, for Model I "
+                    "when the package was built with the MinGW-w64 cross compiler (or --platforms asks for it), Windows "
+                    "x86-64 (the C core inside, the C library its only dependency), with its C sources, from "
+                    "which an importer compiles it for any other platform. Inputs: the plant's drive (voltage, force or motion) and, for Model I "
                     "and II, the temperature [C] (with a [heat] section, the ambient temperature). Outputs: "
                     "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
