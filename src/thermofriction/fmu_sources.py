@@ -62,8 +62,8 @@ def build_description(identifier: str, files: dict[str, bytes]) -> str:
              f'  <BuildConfiguration modelIdentifier={quoteattr(identifier)}>',
              '    <SourceFileSet language="C99">']
     lines += [f'      <SourceFile name={quoteattr(name)}/>' for name in c_files(files)]
-    lines += ['    </SourceFileSet>', '    <Library name="m"/>', '  </BuildConfiguration>',
-              '</fmiBuildDescription>', '']
+    # no <Library name="m"/>: MSVC has no libm (the C runtime has the math), and Linux importers load libm
+    lines += ['    </SourceFileSet>', '  </BuildConfiguration>', '</fmiBuildDescription>', '']
     return "\n".join(lines)
 
 
