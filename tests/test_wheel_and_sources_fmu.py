@@ -184,6 +184,9 @@ def test_cli_platforms_option(tmp_path):
     assert "'darwin64'" in out.stderr and "linux64, win64" in out.stderr and not bad.exists()
     with pytest.raises(InputError, match="platforms must be a name or a list of names"):
         export_fmu("canudas1995", tmp_path / "c.fmu", platforms=3)
+    export_fmu("canudas1995", tmp_path / "n.fmu", platforms="none")  # the command line's word, in Python too
+    with zipfile.ZipFile(tmp_path / "n.fmu") as z:
+        assert not any(n.startswith("binaries/") for n in z.namelist()) and "sources/solve.c" in z.namelist()
 
 
 # ---- make install and the cross compiler ----

@@ -74,16 +74,19 @@ def prebuilt_platforms() -> list[str]:
 
 
 def _platforms(platforms) -> tuple[str, ...] | None:
-    """``platforms=``: None (the prebuilt binaries) or names of ``PLATFORMS`` (FMI 3's names too), each once."""
+    """``platforms=``: None (the prebuilt binaries), names of ``PLATFORMS`` (FMI 3's names too), each once, or
+    ``[]`` (``"none"``) for the sources only."""
     names = _args.names(platforms, "platforms")
     if names is None:
         return None
+    if names == ["none"]:
+        return ()
     out = []
     for name in names:
         name = _ALIASES.get(name, name)
         if name not in PLATFORMS:
             raise InputError(f"export_fmu: platform {shorten(name)}: use {', '.join(PLATFORMS)} (FMI 3's names "
-                             f"{', '.join(_ALIASES)} too), or none for an FMU with its C sources only")
+                             f"{', '.join(_ALIASES)} too), or none ([]) for an FMU with its C sources only")
         if name not in out:
             out.append(name)
     return tuple(out)
