@@ -2,18 +2,27 @@
 #   make demo   -- creates .venv, builds and installs thermofriction, runs the main job
 #   make test   -- the same with the test extras, then the whole test suite (C core included)
 #   make docs   -- the documentation site into docs/_build/html (installs the docs extra into .venv)
+#   make dist   -- the wheel and the sdist into dist/ (python -m build; README.md, "Install with pip")
 PYTHON ?= python3
 VENV   ?= .venv
 BIN     = $(VENV)/bin
 SOURCES = $(shell find core src -type f -not -name '*.pyc') pyproject.toml CMakeLists.txt
+# the cross compiler the package build uses for the FMU's win64 DLL when it is on PATH (docs/fmu.md#windows)
+MINGW  ?= x86_64-w64-mingw32-gcc
 
-.PHONY: demo test install bench docs clean octave
+.PHONY: demo test install bench docs dist clean octave FORCE
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-$(VENV)/.installed: $(BIN)/python $(SOURCES)
+# which compilers the build finds, rewritten only when that changes (installing MinGW-w64 after a first
+# `make install` then rebuilds the package, with the DLL)
+$(VENV)/.compilers: FORCE
+	@mkdir -p $(VENV); found="$$(command -v $(MINGW) || echo 'no $(MINGW)')"; \
+	  [ "$$found" = "$$(cat $@ 2>/dev/null)" ] || echo "$$found" > $@
+
+$(VENV)/.installed: $(BIN)/python $(SOURCES) $(VENV)/.compilers
 	$(BIN)/python -m pip install --quiet '.[test]'
 	touch $@
 
@@ -41,8 +50,13 @@ docs: $(VENV)/.docs-installed
 octave:
 	octave-cli --no-gui --norc --eval "addpath('$(CURDIR)/matlab'); disp(thermofriction.build())"
 
+# the wheel and the sdist (the wheel built from the sdist), as CI tests them (tests/test_wheel_and_sources_fmu.py)
+dist: $(BIN)/python
+	$(BIN)/python -m pip install --quiet build
+	$(BIN)/python -m build --outdir dist .
+
 bench: install
 	$(BIN)/python benchmarks/bench_simulate.py
 
 clean:
-	rm -rf $(VENV) build docs/_build docs/api/generated docs/gallery docs/sg_execution_times.rst
+	rm -rf $(VENV) build dist docs/_build docs/api/generated docs/gallery docs/sg_execution_times.rst

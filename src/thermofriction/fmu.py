@@ -8,7 +8,8 @@ Exporting a model zips the binaries as ``binaries/linux64/<modelIdentifier>.so``
 generated ``modelDescription.xml`` and
 ``resources/model.tfm``, the model description the binary reads when it is instantiated (its plant,
 friction model, thermal extension, laws and every tunable parameter with its value reference). So an
-export needs no compiler.
+export needs no compiler. Every FMU also carries its C sources (``sources/``, fmu_sources.py), from which
+an importer builds it on any platform; ``platforms=`` builds the binaries at export time instead.
 
 The FMU has the plant's drive as input (a voltage for the stick-slip actuator, a force for a mass, the
 displacement for prescribed motion), the temperature [degC] for Model I and II (the ambient temperature
@@ -41,6 +42,7 @@ from .errors import InputError, shorten
 from . import _args
 from .fmu_description import (MAX_POINTS, default_experiment, description_xml2, description_xml3, resource_text,
                               variables_of)
+from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_description, c_files, source_files
 from .models import MassPlant, Model, StickSlipPlant, load_model
 
 #: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
@@ -50,18 +52,44 @@ FMI_VERSIONS = (2, 3)
 
 _BINARY = "thermofriction_fmi.so"
 _DLL = "thermofriction_fmi.dll"
-# where each platform's binary goes in an FMU of each version
-_PLATFORMS = {2: {"so": "linux64", "dll": "win64"}, 3: {"so": "x86_64-linux", "dll": "x86_64-windows"}}
+# FMI 3's names of the platforms, also accepted by platforms=
+_ALIASES = {FOLDERS[3][name]: name for name in PLATFORMS}
 
 
 class NoWindowsBinaryWarning(UserWarning):
-    """An exported FMU carries the Linux binary only (the package was built without MinGW-w64)."""
+    """An exported FMU carries the Linux binary only (the package was built without MinGW-w64, and no
+    ``platforms=`` asked for win64)."""
 
 
 def binary_path(platform_name: str = "linux64") -> Path:
     """The installed FMI binary (FMI 2 and 3 in one): ``"linux64"``, built with the package on Linux, or
     ``"win64"``, the DLL cross-compiled with MinGW-w64 when the package was built where it is installed."""
     return Path(str(resources.files("thermofriction"))) / "_fmu" / (_DLL if platform_name == "win64" else _BINARY)
+
+
+def prebuilt_platforms() -> list[str]:
+    """The platforms whose binary was built with the package (``linux64``, and ``win64`` with MinGW-w64): what
+    an export carries by default."""
+    return [name for name in PLATFORMS if binary_path(name).is_file()]
+
+
+def _platforms(platforms) -> tuple[str, ...] | None:
+    """``platforms=``: None (the prebuilt binaries), names of ``PLATFORMS`` (FMI 3's names too), each once, or
+    ``[]`` (``"none"``) for the sources only."""
+    names = _args.names(platforms, "platforms")
+    if names is None:
+        return None
+    if names == ["none"]:
+        return ()
+    out = []
+    for name in names:
+        name = _ALIASES.get(name, name)
+        if name not in PLATFORMS:
+            raise InputError(f"export_fmu: platform {shorten(name)}: use {', '.join(PLATFORMS)} (FMI 3's names "
+                             f"{', '.join(_ALIASES)} too), or none ([]) for an FMU with its C sources only")
+        if name not in out:
+            out.append(name)
+    return tuple(out)
 
 
 def _identifier(text: str) -> str:
@@ -116,9 +144,10 @@ def _solver(solver, integrator):
     return integrator
 
 
-def _checked(model, path, temperature, model_identifier, source, solver, step, fmi):
+def _checked(model, path, temperature, model_identifier, source, solver, step, fmi, platforms):
     """export_fmu's arguments, checked before any work: (the model, its source, the temperature, the step)."""
     _args.path(path, "path")
+    platforms = _platforms(platforms)
     temperature = _args.number(temperature, "temperature", "degC", none=True)  # finite
     _args.text(model_identifier, "model_identifier", none=True)
     _args.text(source, "source", none=True)
@@ -136,7 +165,7 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
     if fmi not in FMI_VERSIONS:
         raise InputError(f"export_fmu: fmi = {shorten(fmi)}: the FMI version is 2 or 3")
     binary = binary_path()
-    if not binary.is_file():
+    if platforms is None and not binary.is_file():
         raise InputError(f"this installation has no FMU binary ({binary}): reinstall thermofriction on Linux x86-64 "
                          "(the package builds it with CMake)")
     if solver not in SOLVERS:
@@ -148,16 +177,20 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
     elif step is not None:
         raise InputError("export_fmu: step is the realtime solver's fixed step; the adaptive solver chooses "
                          "its own (give solver='realtime', --solver realtime)")
-    return model, source, temperature, step
+    return model, source, temperature, step, platforms
 
 
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
                source: str | None = None, solver: str = "adaptive", step: float | None = None,
-               fmi: int = 2, integrator: str | None = None) -> Path | Target:
+               fmi: int = 2, platforms=None, integrator: str | None = None) -> Path | Target:
     """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 (``fmi=2``, the default) or
-    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md), with the linux64 binary and, when
-    the package was built with the MinGW-w64 cross compiler, the win64 one (else a NoWindowsBinaryWarning
-    says so). ``temperature``: the start value of the temperature input [degC] (with a
+    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md) with its C sources (``sources/``: an
+    importer compiles them for its own platform) and binaries. ``platforms``: None (default) for the binaries
+    built with the package, linux64 and, when it was built with the MinGW-w64 cross compiler, win64 (else a
+    NoWindowsBinaryWarning says so); or a list of ``"linux64"``, ``"win64"`` to build now with this machine's
+    compilers (cc, x86_64-w64-mingw32-gcc; a ComputationError names each platform that could not be built
+    and why, and nothing is written); ``[]`` for the sources only. ``temperature``: the start value of the
+    temperature input [degC] (with a
     heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
     ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
     ``source``: where the model came from (a file or preset name), for the FMU's description.
@@ -166,7 +199,8 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     semi-implicit Euler for the plant; docs/fmu.md#solvers). ``integrator``: ``solver``'s earlier name
     (deprecated)."""
     solver = _solver(solver, integrator)
-    model, source, temperature, step = _checked(model, path, temperature, model_identifier, source, solver, step, fmi)
+    model, source, temperature, step, platforms = _checked(model, path, temperature, model_identifier, source,
+                                                           solver, step, fmi, platforms)
     _check_exportable(model)
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
@@ -179,33 +213,46 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     tfm = resource_text(model, spec, variables, solver)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
     tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
-    xml = (description_xml2 if fmi == 2 else description_xml3)(model, variables, identifier, guid, source, step)
-    binaries = {"so": binary_path().read_bytes()}
-    if binary_path("win64").is_file():
-        binaries["dll"] = binary_path("win64").read_bytes()
+    sources = source_files(fmi)
+    if fmi == 2:
+        xml = description_xml2(model, variables, identifier, guid, source, step, sources=c_files(sources))
     else:
-        warnings.warn("this installation has no Windows binary (the package was built without the MinGW-w64 cross "
-                      "compiler x86_64-w64-mingw32-gcc): the FMU carries linux64 only", NoWindowsBinaryWarning,
-                      stacklevel=2)
+        xml = description_xml3(model, variables, identifier, guid, source, step)
+        sources["buildDescription.xml"] = build_description(identifier, sources).encode()
     target = path if isinstance(path, Target) else Path(os.fspath(path))
-    _write_fmu(target, identifier, fmi, xml, binaries, tfm, model)
+    if isinstance(target, Path) and target.is_dir():
+        raise InputError(f"{target}: is a folder; give a file name for the FMU (e.g. {target / (identifier + '.fmu')})")
+    _write_fmu(target, identifier, fmi, xml, _binaries(platforms, fmi), tfm, model, sources)
     return target
 
 
-def _write_fmu(target, identifier, fmi, xml, binaries, tfm, model):
-    """The FMU's zip archive, written atomically: the description, the binaries, the model as resources and the
-    FMI headers' licence."""
-    if isinstance(target, Path) and target.is_dir():
-        raise InputError(f"{target}: is a folder; give a file name for the FMU (e.g. {target / (identifier + '.fmu')})")
+def _binaries(platforms, fmi) -> dict[str, bytes]:
+    """platform -> binary: the ones built with the package (``platforms`` None), or built now."""
+    if platforms is not None:
+        return build_binaries(platforms, fmi)
+    binaries = {name: binary_path(name).read_bytes() for name in prebuilt_platforms()}
+    if "win64" not in binaries:
+        warnings.warn("this installation has no Windows binary (the package was built without the MinGW-w64 cross "
+                      "compiler x86_64-w64-mingw32-gcc): the FMU carries linux64 only (and its C sources); "
+                      "platforms=['linux64', 'win64'] (--platforms linux64,win64) builds win64 at export time where "
+                      "x86_64-w64-mingw32-gcc is installed", NoWindowsBinaryWarning, stacklevel=3)
+    return binaries
+
+
+def _write_fmu(target, identifier, fmi, xml, binaries, tfm, model, sources):
+    """The FMU's zip archive, written atomically: the description, the binaries, the sources, the model as
+    resources and the FMI headers' licence."""
     with atomic_write(target, "wb") as fh:
         with zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", xml)
-            for ext, data in binaries.items():
-                info = zipfile.ZipInfo(f"binaries/{_PLATFORMS[fmi][ext]}/{identifier}.{ext}",
+            for name, data in binaries.items():
+                info = zipfile.ZipInfo(f"binaries/{FOLDERS[fmi][name]}/{identifier}.{EXTENSIONS[name]}",
                                        date_time=(2020, 1, 1, 0, 0, 0))
                 info.external_attr = 0o755 << 16
                 info.compress_type = zipfile.ZIP_DEFLATED
                 z.writestr(info, data)
+            for name, data in sources.items():
+                z.writestr(f"sources/{name}", data)
             z.writestr("resources/model.tfm", tfm)
             z.writestr("resources/model.toml", model.to_toml())
             z.writestr(f"documentation/licenses/fmi{fmi}-headers.txt", _headers_licence(fmi))
@@ -224,5 +271,5 @@ def __getattr__(name):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["export_fmu", "binary_path", "default_experiment", "SOLVERS", "FMI_VERSIONS",
-           "NoWindowsBinaryWarning"]
+__all__ = ["export_fmu", "binary_path", "prebuilt_platforms", "default_experiment", "SOLVERS", "FMI_VERSIONS",
+           "PLATFORMS", "NoWindowsBinaryWarning"]

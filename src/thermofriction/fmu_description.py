@@ -195,12 +195,17 @@ def _default_experiment_xml(model: Model, step: float | None) -> str:
 
 
 def description_xml2(model: Model, variables, identifier: str, guid: str, source: str | None,
-                     step: float | None = None) -> str:
+                     step: float | None = None, sources=()) -> str:
+    """modelDescription.xml of an FMI 2.0 co-simulation FMU; ``sources``: the C files of its ``sources/`` folder
+    (``<SourceFiles>``, from which an importer compiles the FMU)."""
+    files = [f'      <File name={quoteattr(name)}/>' for name in sources]
     out = [*_head(model, identifier, f'fmiVersion="2.0" guid="{guid}"', source, step),
            '  variableNamingConvention="structured" numberOfEventIndicators="0">',
            f'  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"',
            '    canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"',
-           '    canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+           '    canSerializeFMUstate="false" providesDirectionalDerivative="false"'
+           + ('>' if files else '/>'),
+           *(['    <SourceFiles>', *files, '    </SourceFiles>', '  </CoSimulation>'] if files else []),
            *_units_xml(variables)]
     out += [*_LOG_CATEGORIES,
             _default_experiment_xml(model, step),

@@ -322,14 +322,15 @@ def cmd_sweep(args) -> int:
 
 def cmd_fmu(args) -> int:
     """Export a model as an FMI 2.0 or 3.0 co-simulation FMU (docs/fmu.md)."""
-    from ..fmu import binary_path, export_fmu  # zipfile and the binary only when asked for
+    from ..fmu import export_fmu, prebuilt_platforms  # zipfile and the binary only when asked for
 
     solver = solver_of(args, "adaptive", "--integrator")
     model = load_model(args.model)
     _refuse_inputs(args, _model_inputs(args.model, model))
     export_fmu(model, _target(args, "output"), temperature=args.temperature, model_identifier=args.model_identifier,
-               source=args.model, solver=solver, step=args.step, fmi=args.fmi)
+               source=args.model, solver=solver, step=args.step, fmi=args.fmi, platforms=args.platforms)
     how = f"fixed step {args.step:g} s" if solver == "realtime" else "adaptive integrator"
-    where = "linux64, win64" if binary_path("win64").is_file() else "linux64"
+    where = dict.fromkeys(prebuilt_platforms() if args.platforms is None else args.platforms)
+    where = ", ".join([*where, "C sources"])
     print(f"{model.name or args.model}: wrote {args.output} (FMI {args.fmi}.0 co-simulation, {where}, {how})")
     return 0

@@ -254,8 +254,9 @@ def _add_fmu_command(sub):
     f = sub.add_parser(
         "fmu", help="export a model as an FMI 2.0 co-simulation FMU for Simulink, OpenModelica, fmpy, ... (docs/fmu.md)",
         description="Write MODEL as an FMI 2.0 (or, with --fmi 3, FMI 3.0) co-simulation FMU for Linux x86-64 and, "
-                    "when the package was built with the MinGW-w64 cross compiler, Windows x86-64 (the C core "
-                    "inside, the C library its only dependency). Inputs: the plant's drive (voltage, force or motion) and, for Model I "
+                    "when the package was built with the MinGW-w64 cross compiler (or --platforms asks for it), Windows "
+                    "x86-64 (the C core inside, the C library its only dependency), with its C sources, from "
+                    "which an importer compiles it for any other platform. Inputs: the plant's drive (voltage, force or motion) and, for Model I "
                     "and II, the temperature [C] (with a [heat] section, the ambient temperature). Outputs: "
                     "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
@@ -276,8 +277,18 @@ def _add_fmu_command(sub):
                    help="the realtime solver's fixed step [s], e.g. 1e-5 (a tenth of the fastest time "
                         "constant or less)")
     f.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version: 2 (default) or 3")
+    f.add_argument("--platforms", type=_platform_list, metavar="LIST",
+                   help="build the binaries for these platforms now, comma-separated: linux64 (cc), win64 "
+                        "(x86_64-w64-mingw32-gcc); none: the C sources only (every FMU carries them). Default: the "
+                        "binaries built with the package")
     from .commands import cmd_fmu
     f.set_defaults(run=cmd_fmu)
+
+
+def _platform_list(text: str) -> list[str]:
+    """--platforms: comma-separated names (checked by export_fmu); none: no binary."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    return [] if names == ["none"] else names
 
 
 def _scheduler_options(parser, only=""):
