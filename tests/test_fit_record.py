@@ -127,3 +127,14 @@ def test_the_velocity_map_draws_only_the_directions_the_data_slide_in():
     assert np.all(_map_velocities(one_way, 0.5) > 0)
     v = _map_velocities(both, 0.5)
     assert v.min() == pytest.approx(-0.5) and v.max() == pytest.approx(0.5)
+
+
+def test_the_fmus_documentation_says_how_the_model_was_fitted(fits, tmp_path):
+    """Issue 40 item 2: the fit record travels into the FMU's documentation (documentation/index.html)."""
+    import zipfile
+    path = tf.export_fmu(fits[0].model, tmp_path / "joint.fmu")
+    with zipfile.ZipFile(path) as z:
+        page = z.read("documentation/index.html").decode()
+    assert "How it was fitted" in page
+    assert "sensor offset policy: per-experiment; motion: position" in page
+    assert "run0.csv: motion position, offset " in page

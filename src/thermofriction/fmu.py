@@ -24,7 +24,9 @@ in ``resources/model.tfm`` and the step is the fixed parameter ``integrator.step
 
 from __future__ import annotations
 
+
 import hashlib
+import html
 import math
 import os
 import platform
@@ -44,6 +46,7 @@ from .fmu_description import (MAX_POINTS, default_experiment, description_xml2, 
                               variables_of)
 from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_description, c_files, source_files
 from .models import MassPlant, Model, StickSlipPlant, load_model
+from .models.fit_record import fit_record_lines
 
 #: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
 SOLVERS = ("adaptive", "realtime")
@@ -256,6 +259,18 @@ def _write_fmu(target, identifier, fmi, xml, binaries, tfm, model, sources):
             z.writestr("resources/model.tfm", tfm)
             z.writestr("resources/model.toml", model.to_toml())
             z.writestr(f"documentation/licenses/fmi{fmi}-headers.txt", _headers_licence(fmi))
+            z.writestr("documentation/index.html", _documentation(model))
+
+
+def _documentation(model) -> str:
+    """The FMU's documentation page (FMI: documentation/index.html): the model's name and description and, for a
+    fitted model, how it was fitted (its fit record), so that who runs the FMU knows what it was scored on."""
+    lines = fit_record_lines(model)
+    fitted = ("<h2>How it was fitted</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in lines) + "</ul>"
+              if lines else "<p>Not a fitted model (no fit record).</p>")
+    return (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{html.escape(model.name or 'model')}</title>"
+            f"</head><body><h1>{html.escape(model.name or 'model')}</h1><p>{html.escape(model.description or '')}</p>"
+            f"{fitted}<p>The model file is resources/model.toml.</p></body></html>")
 
 
 def _headers_licence(fmi: int = 2) -> str:

@@ -60,9 +60,30 @@ def check_fit_record(record, where: str = "[provenance.fit_record]") -> dict:
     return record
 
 
+def fit_record_lines(model) -> list:
+    """How ``model`` was fitted, in words, one line each (the FMU's documentation; none for a model ``identify`` did
+    not make)."""
+    prov = getattr(model, "provenance", None) or {}
+    record = prov.get("fit_record")
+    if not record:
+        return []
+    lines = [f"identified by thermofriction {prov.get('thermofriction', '')}, method {prov.get('method', '?')}, "
+             f"from {prov.get('data', '?')} ({', '.join(prov.get('fit_files') or [])})",
+             f"measured quantity: {record.get('measurement', '?')}; sensor offset policy: {record.get('offset', '?')}"
+             + (f"; motion: {record['motion']}" if record.get("motion") else ""),
+             f"fitted: {', '.join(record.get('fitted') or []) or 'none'}; "
+             f"held: {', '.join(record.get('held') or []) or 'none'}"]
+    if record.get("noise") is not None:
+        lines.append(f"measurement noise estimated from the data: {record['noise']:.4g} {record.get('noise_unit', '')}")
+    for name, entry in (record.get("experiments") or {}).items():
+        parts = [f"{k.replace('_', ' ')} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in entry.items()]
+        lines.append(f"{name}: {', '.join(parts)}")
+    return lines
+
+
 def fit_record_of(model) -> dict | None:
     """The fit record of ``model`` (a dict, see the module), or None for a model ``identify`` did not make."""
     return (getattr(model, "provenance", None) or {}).get("fit_record")
 
 
-__all__ = ["FIT_RECORD_KEYS", "EXPERIMENT_KEYS", "check_fit_record", "fit_record_of"]
+__all__ = ["FIT_RECORD_KEYS", "EXPERIMENT_KEYS", "check_fit_record", "fit_record_of", "fit_record_lines"]
