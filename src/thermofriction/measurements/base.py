@@ -40,6 +40,8 @@ class Trace:
     held_offset: float = 0.0
     #: the SI unit of ``measured``
     unit: str = "m"
+    #: the recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py)
+    angle: np.ndarray | None = None
 
     @property
     def n_residuals(self) -> int:
