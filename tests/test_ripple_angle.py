@@ -1,4 +1,4 @@
-"""The position ripple in the joint's own angle (issue 40 item 3; docs/force-data.md#asymmetry-and-ripple).
+"""The position ripple in the joint's own angle (issue 40 item 3; docs/force-data.md, "The ripple's angle").
 
 The truth is tests/lookalike.py's: LuGre with direction-dependent levels integrated by SciPy (LSODA), a ripple of
 one harmonic per revolution added at the joint's absolute angle, per-run sensor offsets, AR(1) noise (rho 0.7), a
@@ -142,5 +142,6 @@ def test_the_ripple_phase_option_is_checked(homed, tmp_path):
         tf.validate(_init(), data, ripple_phase=1)
     from thermofriction.cli import main
     with pytest.raises(SystemExit) as e:
-        main(["identify", str(tmp_path), "--method", "base", "--ripple-phase", "absolute", "-o", str(tmp_path / "f.toml")])
+        main(["identify", str(tmp_path), "--method", "base", "--ripple-phase", "absolute", "-o",
+              str(tmp_path / "f.toml")])
     assert e.value.code == 2

@@ -101,7 +101,8 @@ def _checked_types(data, method, init, friction, parameters, free, procedure, la
 @one_blas_thread  # (optimiser.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
              refine=True, reference_temperature=None, controller=None, starts=8, seed=0, progress=None, offset=True,
-             max_evaluations=None, rtol=None, delay="auto", ripple_phase="auto") -> FitResult:
+             max_evaluations=None, rtol=None, delay="auto",
+             ripple_phase="auto") -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"

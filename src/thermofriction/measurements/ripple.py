@@ -1,4 +1,4 @@
-"""The position ripple of a force fit in the joint's own angle (docs/force-data.md#asymmetry-and-ripple).
+"""The position ripple of a force fit in the joint's own angle (docs/force-data.md, "The ripple's angle").
 
 Under a prescribed motion the ripple ``R(x) = sum_k a_k cos(2 pi k x / P) + b_k sin(2 pi k x / P)`` is added to the
 friction force and enters no state (core/src/plant.c: ``friction_at``; docs/models.md#direction-and-position), so
@@ -31,7 +31,7 @@ from ..errors import InputError, shorten
 from ..models import ModelI
 from ..models.sides import RIPPLE_AMPLITUDES, RIPPLE_ORDER
 
-#: The choices of the ripple's phase (docs/force-data.md#asymmetry-and-ripple).
+#: The choices of the ripple's phase (docs/force-data.md, "The ripple's angle").
 RIPPLE_PHASES = ("auto", "recorded", "per-run")
 #: "auto": runs start "at 0" when their first recorded position is within this fraction of the largest run's range.
 ZERO_START = 1e-3
