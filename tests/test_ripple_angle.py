@@ -145,3 +145,33 @@ def test_the_ripple_phase_option_is_checked(homed, tmp_path):
         main(["identify", str(tmp_path), "--method", "base", "--ripple-phase", "absolute", "-o",
               str(tmp_path / "f.toml")])
     assert e.value.code == 2
+
+
+def test_the_exact_stepping_adds_the_ripple_as_the_plant_does():
+    """``tf_prescribed_force`` on a model with a ripple of two harmonics (one amplitude under a Model I law): the
+    force equals the C core's adaptive integrator at rtol 1e-11 (which adds the ripple in the plant) to 1e-8 of its
+    range, and the amplitudes' sensitivities are cos(2 pi k x / P), sin(2 pi k x / P) at the waveform's position,
+    written here. (Before: the stepping left the ripple out.)"""
+    from thermofriction import _bridge
+    from thermofriction.data.motion import motion_waveform
+    from thermofriction.models.laws import Linear
+    from thermofriction.models.thermal import ModelI
+    rng = np.random.default_rng(1)
+    t = np.linspace(0.0, 3.0, 500)
+    w = motion_waveform(t, 0.6 * np.cos(2 * math.pi * 0.8 * t) + 0.03 * rng.normal(size=t.size), start=1.3)
+    P = 0.5
+    model = tf.Model(tf.PrescribedMotion(motion="rotary"),
+                     tf.LuGre(sigma0=3000.0, sigma1=0.3, fc=0.9, fs=1.4, vs=0.3, sigma2=0.35, ripple_period=P,
+                              ripple_cos1=None, ripple_sin1=0.05, ripple_sin2=-0.02),
+                     ModelI({"ripple_cos1": Linear(a=0.001, b=0.03)}))
+    spec = _bridge.model_spec(model, 40.0, w)
+    names = ("ripple_cos1", "ripple_sin1", "ripple_cos2", "ripple_sin2", "fc")
+    F, dF = _bridge.prescribed_force(spec, t, names)
+    out = np.empty((t.size, _bridge.n_outputs(model, False)))
+    _bridge.run(spec, t, out, method="auto", rtol=1e-11, max_steps=10_000_000)
+    ref = out[:, _bridge.OUTPUT_COLUMN["friction_force"]]
+    assert np.max(np.abs(F - ref)) <= 1e-8 * np.ptp(ref)
+    x = w(t)
+    assert x[0] == pytest.approx(1.3)
+    for j, (f, k) in enumerate(((np.cos, 1), (np.sin, 1), (np.cos, 2), (np.sin, 2))):
+        np.testing.assert_allclose(dF[:, j], f(2 * math.pi * k * x / P), atol=1e-12)

@@ -134,13 +134,11 @@ class Force(Measurement):
         """The friction parameters the exact stepping differentiates for this problem (the values at a run's
         temperature, ``problem.chain``, where laws are fitted), or None where it does not apply: a thermal model
         other than Model I, a temperature signal, a fitted name that is not a friction parameter, or a model the
-        core does not step exactly (``_bridge.prescribed_applies``). ``skip``: names left out (the ripple's
-        amplitudes where the ripple is added outside the stepping)."""
+        core does not step exactly (``_bridge.prescribed_applies``; a ripple it steps at the waveform's position).
+        ``skip``: names left out (the ripple's amplitudes where the ripple is added outside the stepping)."""
         if model.thermal is not None and not isinstance(model.thermal, ModelI):
             return None
         names = [n for n in (problem.chain if problem.chain is not None else problem.names) if n not in skip]
-        if ripple.has_ripple(model, names):
-            return None
         if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
             return None  # a law's base value fitted as such: not a value at the temperature
         arrays = getattr(model.friction, "arrays", ())
@@ -303,7 +301,7 @@ class Force(Measurement):
     @staticmethod
     def _stepped(d, model, exp):
         """The exact stepping's friction along ``exp`` (driven as ``d``), or None where it does not apply."""
-        if not isinstance(d.temperature, (int, float)) or ripple.has_ripple(model):
+        if not isinstance(d.temperature, (int, float)):
             return None
         spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform)
         if not _bridge.prescribed_applies(spec):

@@ -17,9 +17,9 @@ run), else
 ``"recorded"``, and says which (:func:`decide`).
 
 This applies to models whose ripple is a plain additive term: not Model II (which scales the ripple with the rest
-of the force) and no Model I law on a ripple parameter; those keep the ripple inside the integrated simulation,
-on the recorded angle (the driving waveform starts at the run's first recorded position), without per-run
-phases."""
+of the force) and no Model I law on a ripple parameter; those keep the ripple inside the model's own run (the C
+core's exact stepping where it applies, which adds it as the plant does, else the integrated runs) at the driving
+waveform's position (which starts at the run's first recorded position), without per-run phases."""
 
 from __future__ import annotations
 
