@@ -130,15 +130,14 @@ class Force(Measurement):
         return None if any(f is None for f in forces) else np.concatenate(forces)
 
     @staticmethod
-    def exact_names(problem, model, skip=()):
+    def exact_names(problem, model):
         """The friction parameters the exact stepping differentiates for this problem (the values at a run's
         temperature, ``problem.chain``, where laws are fitted), or None where it does not apply: a thermal model
         other than Model I, a temperature signal, a fitted name that is not a friction parameter, or a model the
-        core does not step exactly (``_bridge.prescribed_applies``; a ripple it steps at the waveform's position).
-        ``skip``: names left out (the ripple's amplitudes where the ripple is added outside the stepping)."""
+        core does not step exactly (``_bridge.prescribed_applies``; a ripple it steps at the waveform's position)."""
         if model.thermal is not None and not isinstance(model.thermal, ModelI):
             return None
-        names = [n for n in (problem.chain if problem.chain is not None else problem.names) if n not in skip]
+        names = problem.chain if problem.chain is not None else problem.names
         if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
             return None  # a law's base value fitted as such: not a value at the temperature
         arrays = getattr(model.friction, "arrays", ())
@@ -154,10 +153,7 @@ class Force(Measurement):
 
     def _exact(self, problem, model, names, jac):
         """(force, Jacobian in the fitted names or None) of every trace, concatenated, by the exact stepping;
-        (None, None) when a run fails. ``names``: those differentiated (the others' columns are zero)."""
-        full = problem.chain if problem.chain is not None else problem.names
-        cols = [full.index(n) for n in names]
-
+        (None, None) when a run fails."""
         def run(i):
             tr = problem.traces[i]
             T = float(tr.temperature)
@@ -168,9 +164,7 @@ class Force(Measurement):
                 return None
             if not jac:
                 return F, None
-            D = np.zeros((F.size, len(full)))
-            D[:, cols] = dF
-            return F, (D @ problem.chain_matrix(model, T) if problem.chain is not None else D)
+            return F, (dF @ problem.chain_matrix(model, T) if problem.chain is not None else dF)
         out = problem.run_all(run, jac)
         if any(o is None for o in out):
             return None, None
@@ -181,12 +175,11 @@ class Force(Measurement):
                                    for tr in problem.traces])
         outside = ripple.additive(model)  # the ripple added here, at the recorded angle (measurements/ripple.py)
         base = ripple.without(model) if outside else model
-        skip = RIPPLE_AMPLITUDES if outside else ()
-        names = self.exact_names(problem, base, skip)
+        names = self.exact_names(problem, base)  # (the amplitudes' columns 0 there: the base has no ripple)
         if names is not None:
             F, J = self._exact(problem, base, names, jac)
         else:
-            F, J = self._integrated(problem, base, theta, jac, skip, outside)
+            F, J = self._integrated(problem, base, theta, jac, RIPPLE_AMPLITUDES if outside else (), outside)
         if F is None:
             return None, None
         r, J, g = ripple.added(self, problem, model, F - measured, J) if outside else (F - measured, J, None)
