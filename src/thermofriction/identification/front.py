@@ -15,7 +15,7 @@ from ..data.experiments import TEMPERATURE_RANGE, Dataset
 from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
 from ..measurements.delay import parse_delay
-from ..measurements.ripple import has_ripple
+from ..measurements.ripple import check_per_run, has_ripple
 from .held import with_held_tests
 from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
@@ -156,7 +156,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
     init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure,
                    **({"delay": measurement.delay} if measurement.name == "command" else {}))
-    needs_period(list(parameters or ()), init.friction.values(), source)  # before the fit, not as its failure
+    _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
@@ -179,6 +179,12 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
     res.warnings[:0] = units + _ripple_note(measurement, res.model)
     return res
+
+
+def _ripple_checks(parameters, init, source, measurement, method):
+    """Ripple amplitudes need a period (needs_period); a phase per run needs an additive ripple (check_per_run)."""
+    needs_period(list(parameters or ()), init.friction.values(), source)
+    check_per_run(measurement, init, list(parameters or ()), method)
 
 
 def _ripple_note(measurement, model) -> list:

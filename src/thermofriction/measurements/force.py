@@ -233,6 +233,7 @@ class Force(Measurement):
     # -- validation --------------------------------------------------------------------------------
 
     def check_model(self, model, experiments):
+        ripple.check_per_run(self, model)
         if model.plant.type != "prescribed":
             raise InputError(f"force data are predicted with a prescribed-motion model ([plant] type = "
                              f"\"prescribed\"); this model's plant is '{model.plant.type}'")

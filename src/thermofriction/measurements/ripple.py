@@ -48,9 +48,11 @@ def check_phase_option(value, where: str = "ripple_phase") -> str:
 
 
 def has_ripple(model, names=()) -> bool:
-    """Whether ``model`` has a ripple (a period and an amplitude) or ``names`` fit an amplitude."""
+    """Whether ``model`` has a ripple (a period and an amplitude, a value or a Model I law) or ``names`` fit an
+    amplitude."""
     f = model.friction
-    return (bool(getattr(f, "ripple_period", None)) and any(getattr(f, n, None) for n in RIPPLE_AMPLITUDES)) or \
+    return (bool(getattr(f, "ripple_period", None)) and any(getattr(f, n, None) or n in model.laws
+                                                            for n in RIPPLE_AMPLITUDES)) or \
         any(n in RIPPLE_AMPLITUDES for n in names)
 
 
@@ -176,6 +178,22 @@ def for_run(measurement, model, exp, base, measured=None) -> np.ndarray:
     return evaluate(model, x + phi)[0]
 
 
+def check_per_run(measurement, model, names=(), method=None):
+    """A phase per run needs the ripple as a plain additive term (:func:`additive`) in every model the fit or the
+    validation runs: InputError (naming ripple_phase) for Model II, a Model I law on a ripple parameter, or a
+    ripple amplitude that ``method`` "model-i" would give a law (``names``: the parameters fitted)."""
+    if getattr(measurement, "ripple_phase", None) != "per-run" or not has_ripple(model, names):
+        return
+    laws = method == "model-i" and any(n in RIPPLE_AMPLITUDES for n in names)
+    if method == "model-ii" or laws or not additive(model) and getattr(model.friction, "ripple_period", None):
+        why = ("Model II scales the ripple with the rest of the force" if method == "model-ii" or (
+            model.thermal is not None and not isinstance(model.thermal, ModelI)) else
+            "a Model I law on a ripple amplitude makes it part of the model's run")
+        raise InputError(f"ripple_phase \"per-run\" (a phase per run) needs the ripple as a plain term added to the "
+                         f"force, and {why}: fit the amplitudes with method \"base\" (or hold them), or give "
+                         f"ripple_phase \"recorded\" (--ripple-phase recorded)")
+
+
 def decide(experiments) -> tuple:
     """("recorded" | "per-run", why): per-run where every one of two or more runs starts at position 0 (within
     ZERO_START of the largest run's range of positions), recorded otherwise."""
@@ -191,4 +209,4 @@ def decide(experiments) -> tuple:
 
 
 __all__ = ["RIPPLE_PHASES", "ZERO_START", "added", "additive", "amplitudes", "best_phase", "check_phase_option",
-           "decide", "evaluate", "for_run", "has_ripple", "projected", "without"]
+           "check_per_run", "decide", "evaluate", "for_run", "has_ripple", "projected", "without"]
