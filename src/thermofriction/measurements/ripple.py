@@ -27,7 +27,8 @@ import math
 
 import numpy as np
 
-from ..errors import InputError, shorten
+from .. import _args
+from ..errors import InputError
 from ..models import ModelI
 from ..models.sides import RIPPLE_AMPLITUDES, RIPPLE_ORDER
 
@@ -42,8 +43,8 @@ _PARAMS = ("ripple_period", *RIPPLE_AMPLITUDES)
 
 
 def check_phase_option(value, where: str = "ripple_phase") -> str:
-    if value not in RIPPLE_PHASES:
-        raise InputError(f"{where}: must be one of {', '.join(repr(p) for p in RIPPLE_PHASES)}, got {shorten(value)}")
+    if not isinstance(value, str) or value not in RIPPLE_PHASES:
+        _args.refuse(where, "one of " + ", ".join(repr(p) for p in RIPPLE_PHASES), value)
     return value
 
 
