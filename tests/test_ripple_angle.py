@@ -78,7 +78,8 @@ def test_a_phase_per_run_where_positions_are_relative():
     """Positions relative to each run (every run starts at 0): "auto" estimates a phase per run and says so; the
     amplitudes are those of the first run's angle (truth there: 0.08 sin(x + 0.3) = a cos x + b sin x with
     a = 0.08 sin 0.3, b = 0.08 cos 0.3) and the held-out run, its phase estimated on it, is at the noise. Forcing
-    the recorded angle on the same data loses the ripple (held-out 1.4 times the noise)."""
+    the recorded angle on the same data loses the ripple (held-out 1.4 times the noise). The validation says that
+    it estimated each run's phase."""
     data, runs = _data(relative=True)
     fit = _fit(data)
     assert any("phase is estimated" in w for w in fit.warnings)
@@ -86,6 +87,8 @@ def test_a_phase_per_run_where_positions_are_relative():
     a, b = RIPPLE * math.sin(START_ANGLES[0]), RIPPLE * math.cos(START_ANGLES[0])
     assert math.hypot(fr.ripple_cos1 - a, fr.ripple_sin1 - b) < 0.2 * RIPPLE
     assert _heldout_ratio(fit, data, runs) < 1.15
+    said = tf.validate(fit.model, data, offset="per-experiment").to_dict()["offset_removed"]
+    assert "ripple phase estimated on it" in said  # what the RMSE has had removed, said
     forced = _fit(data, ripple_phase="recorded")
     assert _heldout_ratio(forced, data, runs, ripple_phase="recorded") > 1.25
 

@@ -100,7 +100,7 @@ class Force(Measurement):
     def validation_removed(self) -> str:
         return ("each experiment's own sensor offset (its mean error), estimated on every experiment, held-out ones "
                 "included" if self.offset == "per-experiment" else
-                "the model's sensor offset ([plant] sensor_offset), as fitted")
+                "the model's sensor offset ([plant] sensor_offset), as fitted") + ripple.phases_said(self)
 
     def unit(self, experiments=()) -> str:
         exps = list(getattr(experiments, "experiments", experiments))
@@ -248,9 +248,10 @@ class Force(Measurement):
     @property
     def caption(self) -> str:
         if self.offset == "per-experiment":
-            return "RMSE: each experiment's own offset removed (estimated on it); NRMSE = RMSE / measured span"
-        return "RMSE: the model's sensor offset removed (fitted on the fit experiments, never re-fitted); " \
-               "NRMSE = RMSE / measured span"
+            return f"RMSE: each experiment's own offset removed (estimated on it){ripple.phases_said(self)}; NRMSE = " \
+                   f"RMSE / measured span"
+        return f"RMSE: the model's sensor offset removed (fitted on the fit experiments, never re-fitted)" \
+               f"{ripple.phases_said(self)}; NRMSE = RMSE / measured span"
 
     @property
     def footer(self) -> str:
@@ -259,7 +260,7 @@ class Force(Measurement):
                    "offset)" if self.offset == "per-experiment" else
                    "the model's sensor offset ([plant] sensor_offset) removed, as fitted on the fit experiments and "
                    "never re-fitted on held-out ones")
-        return (f"RMSE: {removed}; NRMSE = RMSE / measured span; max error: 100 max|error| / measured span; mean "
+        return (f"RMSE: {removed}{ripple.phases_said(self)}; NRMSE = RMSE / measured span; max error: 100 max|error| / measured span; mean "
                 f"error: the prediction's mean minus the measurement's, before any offset was removed "
                 f"(docs/force-data.md#validation)")
 

@@ -174,6 +174,7 @@ def for_run(measurement, model, exp, base, measured=None) -> np.ndarray:
     x = np.asarray(exp.displacement, float)
     phi = 0.0
     if measurement.ripple_phase == "per-run" and measured is not None:
+        measurement.phases_estimated = True
         phi = best_phase(model, x, base + model.plant.sensor_offset - np.asarray(measured, float),
                          measurement.offset == "per-experiment")
     return evaluate(model, x + phi)[0]
@@ -195,6 +196,12 @@ def check_per_run(measurement, model, names=(), method=None):
                          f"ripple_phase \"recorded\" (--ripple-phase recorded)")
 
 
+def phases_said(measurement) -> str:
+    """What a validation's RMSE has had removed besides the offsets, where it estimated each run's ripple phase."""
+    return "; each experiment's ripple phase estimated on it (ripple_phase \"per-run\"), held-out ones included" \
+        if getattr(measurement, "phases_estimated", False) else ""
+
+
 def decide(experiments) -> tuple:
     """("recorded" | "per-run", why): per-run where every one of two or more runs starts at position 0 (within
     ZERO_START of the largest run's range of positions), recorded otherwise."""
@@ -210,4 +217,4 @@ def decide(experiments) -> tuple:
 
 
 __all__ = ["RIPPLE_PHASES", "ZERO_START", "added", "additive", "amplitudes", "best_phase", "check_phase_option",
-           "check_per_run", "decide", "evaluate", "for_run", "has_ripple", "projected", "without"]
+           "check_per_run", "decide", "phases_said", "evaluate", "for_run", "has_ripple", "projected", "without"]
