@@ -101,9 +101,10 @@ def motion(t, amplitude, frequency, harmonic=0.3):
     return x, v
 
 
-def true_friction(truth: Truth, t, amplitude, frequency, harmonic=0.3, rtol=1e-9):
-    """The truth's friction at times ``t`` under :func:`motion`, the bristles at rest at t = 0: LuGre
-    integrated by SciPy's LSODA (stiff where the bristles are), the ripple added. (position, velocity, F)."""
+def true_friction(truth: Truth, t, amplitude, frequency, harmonic=0.3, rtol=1e-9, start=0.0):
+    """The truth's friction at times ``t`` under :func:`motion` from the angle ``start``, the bristles at rest at
+    t = 0: LuGre integrated by SciPy's LSODA (stiff where the bristles are), the ripple added at the absolute
+    angle. (absolute position, velocity, F)."""
     def vel(tt):
         return motion(np.asarray(tt, float), amplitude, frequency, harmonic)[1]
 
@@ -122,6 +123,7 @@ def true_friction(truth: Truth, t, amplitude, frequency, harmonic=0.3, rtol=1e-9
         raise RuntimeError(sol.message)
     z = sol.y[0]
     x, v = motion(t, amplitude, frequency, harmonic)
+    x = x + start
     zdot = v - truth.sigma0 * np.abs(v) * z / truth.g(v)
     F = truth.sigma0 * z + truth.sigma1 * zdot + truth.sigma2 * v
     return x, v, F + truth.ripple * np.sin(2 * math.pi * x / truth.ripple_period)
@@ -145,12 +147,14 @@ def _quantise(a, step):
 def lookalike_runs(*, truth: Truth = Truth(), offsets=(0.02, -0.015, 0.03), roles=None, temperatures=None,
                    rate=66.7, jitter=0.1, duration=8.0, amplitude=0.6, frequency=0.25, lag=0.005,
                    velocity_scale=1.0, velocity_step=0.0098, position_step=3.834e-4, force_step=0.0137,
-                   noise=0.02, rho=0.5, reaction=False, seed=0) -> list:
+                   noise=0.02, rho=0.5, reaction=False, seed=0, start_angles=None, relative=False) -> list:
     """Look-alike runs, one per entry of ``offsets`` (the sensor offset of each run [N m]); run k moves with
     amplitude ``amplitude (1 + 0.15 k)`` [rad] and frequency ``frequency (1 + 0.1 k)`` [Hz] so that runs
     differ. ``roles`` (default: the last run "validate" when there are three or more, the others "fit") and
     ``temperatures`` [C] (default 25) per run. Steps of 0 mean no quantisation. Every default is measured
-    (tests/data/README.md)."""
+    (tests/data/README.md). ``start_angles`` [rad]: the joint's absolute angle where each run starts (default 0),
+    the ripple's argument; the recorded position is that absolute angle, or with ``relative`` the angle moved
+    since the run's start (an encoder zeroed per run, no homing)."""
     rng = np.random.default_rng(seed)
     k_runs = len(offsets)
     if roles is None:
@@ -161,7 +165,9 @@ def lookalike_runs(*, truth: Truth = Truth(), offsets=(0.02, -0.015, 0.03), role
         n = int(round(duration * rate)) + 1
         t = sample_times(n, rate, jitter, rng)
         A, f = amplitude * (1 + 0.15 * k), frequency * (1 + 0.1 * k)
-        x, v, F = true_friction(truth, t, A, f)
+        x0 = 0.0 if start_angles is None else float(start_angles[k])
+        x, v, F = true_friction(truth, t, A, f, start=x0)
+        x = x - x0 if relative else x
         v_late = motion(t - lag, A, f)[1]
         e = ar1(n, rho, noise, rng)
         sign = -1.0 if reaction else 1.0

@@ -163,13 +163,16 @@ static void within_segment(run_state *s, double t, double t1)
     advance(s, t1 - t);
 }
 
-/* The force and its parameter derivatives at the current state (dF: np values). */
-static double output(run_state *s, double *dF)
+/* The force and its parameter derivatives at the current state (dF: np values), with the position ripple at
+ * the prescribed position x, added to the friction as the plant adds it (plant.c: friction_at; it has no state). */
+static double output(run_state *s, double x, double *dF)
 {
     double dz[NZ];
     tf_friction_partials jac;
     tf_friction_param_partials dp;
     double F = tf_friction_eval(s->kind, s->p, &s->gms, s->v, s->z, dz, s->np ? &jac : 0, s->np ? &dp : 0);
+    if (s->p[TF_P_RIPPLE_PERIOD] > 0.0) /* its amplitudes' partials added to dp's (tf_friction_ripple adds) */
+        F += tf_friction_ripple(s->p, x, 0, s->np ? dp.dF_dp : 0);
     for (int j = 0; j < s->np; j++) {
         double d = pd(s, dp.dF_dp, j);
         for (int i = 0; i < s->nz; i++) d += jac.dF_dz[i] * s->S[i][j];
@@ -227,7 +230,7 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
             }
         }
         double *d = np ? dF + (size_t)i * (size_t)np : 0;
-        F[i] = output(s, d);
+        F[i] = output(s, tf_waveform_value(w, t_out[i]), d);
         int finite = isfinite(F[i]);
         for (int j = 0; j < np; j++) finite &= isfinite(d[j]) != 0;
         if (!finite) return tf_error_set(err, TF_ERR_NONFINITE, "prescribed", "friction force", t, i);

@@ -211,13 +211,16 @@ def _scoring(model, exps, offset, motion):
     return exps, offset, how
 
 
-def validate(model: Model, data, experiments=None, *, offset=None, motion=None) -> ValidationResult:
+def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
+             ripple_phase="auto") -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
     zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
     it, held-out runs included). ``offset`` and ``motion`` ("position", "velocity", "auto": what drives force
     experiments) default to the model's fit record, so a fitted model is scored the way ``identify`` scored it;
-    ``scored_as`` says how. Temperatures outside a law's calibrated range are reported as warnings, and so
+    ``scored_as`` says how. ``ripple_phase``: force data's position ripple at the recorded angle ("recorded"), at
+    each run's own phase, estimated on it ("per-run"), or "auto" (per-run where every run starts at 0). Temperatures
+    outside a law's calibrated range are reported as warnings, and so
     is a record whose span is a power of 1000 off the prediction's (unit_scale.py; also a UnitWarning)."""
     _args.model(model, Model)
     _args.dataset(data, Dataset, experiments=True)
@@ -228,7 +231,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None) 
     if not exps:
         raise InputError("the dataset has no experiments")
     exps, offset, how = _scoring(model, exps, offset, motion)
-    measurement = measurement_of(exps, offset=offset)  # asked once
+    measurement = measurement_of(exps, offset=offset, ripple_phase=ripple_phase)  # asked once
     how["offset"] = measurement.offset
     measurement.check_model(model, exps)
     caught, preds, failures, pairs = [], [], [], []

@@ -141,7 +141,8 @@ def cmd_identify(args) -> int:
                        controller=StepSizeController(rtol=args.rtol), starts=args.starts,
                        seed=args.seed, progress=progress.stage, offset=_offset(args),
                        max_evaluations=args.max_evaluations,
-                       delay="auto" if args.delay is None else parse_delay(args.delay, "--delay"))
+                       delay="auto" if args.delay is None else parse_delay(args.delay, "--delay"),
+                       ripple_phase=args.ripple_phase)
     import shlex
     fit = fit.with_command("thermofriction " + shlex.join(sys.argv[1:]))  # in the model's [provenance]
     with _io.publish_together():  # the model and its JSON appear together, or neither
@@ -209,7 +210,7 @@ def cmd_validate(args) -> int:
         _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
         progress.stage(f"predicting {len(data.experiments)} experiments")
         with warnings.catch_warnings(action="ignore", category=UnitWarning):  # in res.warnings, printed below
-            res = validate(model, data, offset=args.offset, motion=args.motion)
+            res = validate(model, data, offset=args.offset, motion=args.motion, ripple_phase=args.ripple_phase)
     if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))
     res.print_table(title=f"{model.name or args.model} on {args.dataset}")

@@ -61,7 +61,8 @@ def _report(args, model_paths, data):
     _refuse_inputs(args, *inputs)
     with _io.publish_together(inputs=inputs):  # the page and its figures appear together, or none
         report(entries, data, args.output, figures_dir=args.figures, title=args.title, bands=bands,
-               command="thermofriction " + " ".join(sys.argv[1:]), offset=args.offset, motion=args.motion)
+               command="thermofriction " + " ".join(sys.argv[1:]), offset=args.offset, motion=args.motion,
+               ripple_phase=args.ripple_phase)
 
 
 def _bands(path, data):

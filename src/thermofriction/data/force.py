@@ -351,8 +351,8 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
         check_sign(path, drive_v, F, column)
     return ForceExperiment(file=name, time=t, voltage=None, displacement=cols["position"], temperature=temperature,
                            temperature_signal=sig, role=role, description=description,
-                           input=motion_waveform(t, drive_v), force=F, velocity=v, rotary=cols["rotary"],
-                           struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
+                           input=motion_waveform(t, drive_v, cols["position"][0]), force=F, velocity=v,
+                           rotary=cols["rotary"], struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
                            column=column, headers=_headers(path, cols))
 
 

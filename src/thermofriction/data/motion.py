@@ -114,14 +114,15 @@ def velocity_of(time, position, velocity):
     return np.gradient(np.asarray(position, float), np.asarray(time, float))
 
 
-def motion_waveform(time, velocity) -> Sampled:
+def motion_waveform(time, velocity, start: float = 0.0) -> Sampled:
     """A continuous position whose slope is ``velocity[i]`` on each sample's half-intervals either side: knots
-    at the samples and at the midpoints between them, positions by the trapezoidal rule at the samples. At a
-    sample time both one-sided slopes equal the sample's velocity, so the model sees it exactly there."""
+    at the samples and at the midpoints between them, positions by the trapezoidal rule at the samples, from
+    ``start`` (a run's first recorded position: the joint's own angle, which a position ripple's phase needs). At
+    a sample time both one-sided slopes equal the sample's velocity, so the model sees it exactly there."""
     t = np.asarray(time, float)
     v = np.asarray(velocity, float)
     dt = np.diff(t)
-    x = np.concatenate([[0.0], np.cumsum(0.5 * dt * (v[:-1] + v[1:]))])
+    x = float(start) + np.concatenate([[0.0], np.cumsum(0.5 * dt * (v[:-1] + v[1:]))])
     knots = np.empty(2 * len(t))
     values = np.empty_like(knots)
     knots[0::2], values[0::2] = t, x
@@ -264,7 +265,7 @@ def driven_by(exp, motion: str):
             or (motion == "velocity" and exp.velocity is None):
         return exp
     drive_v = velocity_of(exp.time, exp.displacement, exp.velocity if motion == "velocity" else None)
-    return dataclasses.replace(exp, motion=motion, input=motion_waveform(exp.time, drive_v))
+    return dataclasses.replace(exp, motion=motion, input=motion_waveform(exp.time, drive_v, exp.displacement[0]))
 
 
 # -- quantisation ----------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
 from ..measurements.baseline import baseline_verdict, model_free
 from ..measurements.delay import parse_delay
+from ..measurements.ripple import check_per_run, has_ripple
 from .held import with_held_tests
 from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
@@ -101,7 +102,8 @@ def _checked_types(data, method, init, friction, parameters, free, procedure, la
 @one_blas_thread  # (optimiser.py) for the whole procedure, whose fits run side by side
 def identify(data, method="model-i", init=None, *, friction=None, parameters=None, free=(), procedure="direct", laws=None,
              refine=True, reference_temperature=None, controller=None, starts=8, seed=0, progress=None, offset=True,
-             max_evaluations=None, rtol=None, delay="auto") -> FitResult:
+             max_evaluations=None, rtol=None, delay="auto",
+             ripple_phase="auto") -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
     method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
@@ -130,6 +132,9 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
     delay: a drive's command data only: "auto" (default: searched over a range read off the data), None or
         "none" (0), a value held [s] (or a string with a unit, "5ms"), or a range searched, (min, max) or "MIN:MAX".
+    ripple_phase: force data with a position ripple: "recorded" (the ripple at the recorded angle), "per-run" (a
+        phase per run: positions relative to each run) or "auto" (default: per-run where every run starts at 0;
+        the choice is said among the warnings).
 
     After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
     (identification/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
@@ -142,7 +147,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     _check_arguments(method, reference_temperature, rtol, starts, seed)
     max_nfev = _args.whole(max_evaluations, "max_evaluations", none=True, low=1, high=MAX_EVALUATIONS)
     _args.dataset(data, Dataset, experiments=True)  # after the options, whose messages name them first
-    measurement = measurement_of(data, offset=offset)  # asked once: what was measured, its offset policy
+    measurement = measurement_of(data, offset=offset, ripple_phase=ripple_phase)  # asked once: what, its offsets
     _delay_of(measurement, delay)
     if method not in measurement.methods:
         *most, last = measurement.methods
@@ -152,7 +157,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
     init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure,
                    **({"delay": measurement.delay} if measurement.name == "command" else {}))
-    needs_period(list(parameters or ()), init.friction.values(), source)  # before the fit, not as its failure
+    _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)
@@ -173,8 +178,20 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
     held = list(getattr(data, "validate", None) or [])
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
-    res.warnings[:0] = units
+    res.warnings[:0] = units + _ripple_note(measurement, res.model)
     return res
+
+
+def _ripple_checks(parameters, init, source, measurement, method):
+    """Ripple amplitudes need a period (needs_period); a phase per run needs an additive ripple (check_per_run)."""
+    needs_period(list(parameters or ()), init.friction.values(), source)
+    check_per_run(measurement, init, list(parameters or ()), method)
+
+
+def _ripple_note(measurement, model) -> list:
+    """How the ripple's phase was decided (ripple_phase "auto"), where the fitted model has a ripple."""
+    note = getattr(measurement, "ripple_note", None)
+    return [f"ripple phase: {note}"] if note and has_ripple(model) else []
 
 
 def _delay_of(measurement, delay):
@@ -223,7 +240,8 @@ def _with_generalisation(res, data, held, measurement):
     try:
         with warnings.catch_warnings():  # (the units were checked against the initial model: identify)
             warnings.simplefilter("ignore", UnitWarning)
-            v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None)
+            v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None,
+                         ripple_phase=getattr(measurement, "ripple_phase", "auto"))
     except ThermofrictionError as e:
         res.warnings.append(f"the held-out experiments could not be predicted: {e}")
         return res

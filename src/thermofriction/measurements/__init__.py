@@ -14,6 +14,7 @@ from .base import OFFSETS, Measurement, MetricWarning, Trace, amount, center  # 
 from .displacement import Displacement, Prediction, step_sizes  # (Prediction, step_sizes: validate's)
 from .force import Force, ForcePrediction, steady_state_curve
 from .command import Command
+from .ripple import RIPPLE_PHASES, check_phase_option, decide
 
 #: The measured quantities, the most specific first: an experiment is the first one's that recognises it.
 REGISTRY = {"command": Command, "force": Force, "displacement": Displacement}
@@ -23,11 +24,21 @@ def kind_of(exp) -> str:
     return next(name for name, cls in REGISTRY.items() if cls.recognises(exp))
 
 
-def measurement_of(data, *, offset=None) -> Measurement:
+def measurement_of(data, *, offset=None, ripple_phase="auto") -> Measurement:
     """The measurement of ``data`` (a dataset or a list of experiments), with its offset policy: ``offset``
     None or True for the measurement's default, a policy's name (OFFSETS: "shared", "per-experiment", "none"),
-    or False for "none" (the model's own offset, fitted by none). A dataset that mixes measurements is
-    refused."""
+    or False for "none" (the model's own offset, fitted by none). Force data: ``ripple_phase`` the position
+    ripple's angle (measurements/ripple.py: "recorded", "per-run", or "auto", decided from ``data`` and said in
+    the measurement's ``ripple_note``). A dataset that mixes measurements is refused."""
+    m = _measurement_of(data, offset)
+    if isinstance(m, Force):
+        m.ripple_phase, m.ripple_note = ripple_phase, None
+        if check_phase_option(ripple_phase) == "auto":
+            m.ripple_phase, m.ripple_note = decide(data)
+    return m
+
+
+def _measurement_of(data, offset) -> Measurement:
     exps = list(getattr(data, "experiments", data))
     kinds = {kind_of(e) for e in exps} or {"displacement"}
     if len(kinds) > 1:
@@ -47,4 +58,4 @@ def measurement_of(data, *, offset=None) -> Measurement:
 
 
 __all__ = ["Measurement", "Trace", "OFFSETS", "Displacement", "Force", "Command", "ForcePrediction", "REGISTRY",
-           "measurement_of", "kind_of", "amount", "center", "steady_state_curve"]
+           "measurement_of", "kind_of", "RIPPLE_PHASES", "amount", "center", "steady_state_curve"]

@@ -40,6 +40,8 @@ class Trace:
     held_offset: float = 0.0
     #: the SI unit of ``measured``
     unit: str = "m"
+    #: the recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py)
+    angle: np.ndarray | None = None
 
     @property
     def n_residuals(self) -> int:
@@ -143,6 +145,13 @@ class Measurement:
 OFFSETS = ("shared", "per-experiment", "none")
 
 
+def reverses(trace) -> bool:
+    """Whether the motion that drives ``trace`` (a prescribed position) changes direction."""
+    s = np.sign(np.diff(np.asarray(getattr(trace.waveform, "value", ()), float)))
+    s = s[s != 0]
+    return bool(s.size > 1 and np.any(s[1:] != s[:-1]))
+
+
 def thermal_check(model, traces) -> list:
     """A model without a thermal extension on runs that span temperatures: said, with what would compare (not
     tried: a Model I or II fit costs as much as this one)."""
@@ -180,4 +189,4 @@ def center_each(r, S, sizes):
     return r, S
 
 
-__all__ = ["center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center", "thermal_check"]
+__all__ = ["center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center", "reverses", "thermal_check"]

@@ -10,14 +10,13 @@ sensor_offset``, where validation uses it as it is, never re-fitting it on held-
 included, for a sensor re-zeroed between runs), or none fitted ("none": the model's own is used).
 
 The simulated force and its Jacobian come from the C core's exact stepping of the prescribed motion
-(core/src/prescribed.c, ``_bridge.prescribed_force``) wherever it applies: the measured motion is a piecewise-linear
-position, so the velocity is constant between its knots, and at a constant temperature the friction state's rate
-(LuGre, Dahl, each GMS element) is affine in the state there, with a closed-form step and closed-form sensitivities
-to the friction parameters; static maps have no state; the elasto-plastic bristle is affine outside its transition
-band and integrated with its variational equations inside it (core/src/prescribed_ep.c). Model I's laws act at a
-run's temperature through their values there (the chain rule of ``Problem.chain_matrix``). Elsewhere -- Model II,
-a temperature signal, a fitted name that is not a friction parameter -- the runs are integrated and the Jacobian
-is by forward differences of whole runs at a tighter tolerance.
+(core/src/prescribed.c, ``_bridge.prescribed_force``) wherever it applies: the motion is piecewise linear, so at a
+constant temperature the friction state's rate (LuGre, Dahl, each GMS element) is affine in the state between knots,
+with a closed-form step and sensitivities; static maps have no state; the elasto-plastic bristle is integrated with
+its variational equations inside its transition band (core/src/prescribed_ep.c). Model I's laws act through their
+values at a run's temperature (``Problem.chain_matrix``). Elsewhere -- Model II, a temperature signal, a fitted name
+that is not a friction parameter -- runs are integrated and the Jacobian is by forward differences of whole runs.
+A position ripple is added outside either, at the recorded angle, in closed form (measurements/ripple.py).
 """
 
 from __future__ import annotations
@@ -33,9 +32,10 @@ from ..errors import InputError, SolverError
 from ..data.force import ForceExperiment
 from ..models import Model, ModelI
 from ..models.sides import RIPPLE_AMPLITUDES
+from . import ripple
 from ..simulation import StepSizeController, simulate
 from ..waveforms import Sampled
-from .base import OFFSETS, Measurement, Trace, center, center_each, thermal_check
+from .base import OFFSETS, Measurement, Trace, center, center_each, reverses, thermal_check
 from .quality import fit_quality
 
 #: Relative step of the forward differences, and the tolerance of the runs they difference: the solver's
@@ -47,12 +47,6 @@ FD_RTOL = 1e-9
 UNITS_CHECK = "check the units in the files' headers"
 SAMPLING_CHECK = "check that the sampling resolves the force's swing after each reversal (a few samples at least)"
 
-
-def reverses(trace) -> bool:
-    """Whether the motion that drives ``trace`` changes direction."""
-    d = np.diff(np.asarray(getattr(trace.waveform, "value", ()), float))
-    s = np.sign(d[d != 0])
-    return bool(s.size > 1 and np.any(s[1:] != s[:-1]))
 #: Force data see the whole friction-velocity map: the Stribeck and viscous parameters are fitted too.
 FIT_PARAMETERS = {
     "lugre": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
@@ -64,20 +58,11 @@ FIT_PARAMETERS = {
 }
 
 
-def _has_ripple(model) -> bool:
-    """Whether the model has a position ripple: the plant's term, which the exact stepping (friction only) lacks."""
-    return bool(getattr(model.friction, "ripple_period", None)) and any(
-        getattr(model.friction, n, 0.0) for n in RIPPLE_AMPLITUDES)
-
-
 def _steps(model, names, theta):
     """The forward-difference step of each parameter: FD_STEP of its magnitude, of the friction level for a
     Model II value that starts at zero."""
-    out = []
-    for name, v in zip(names, theta):
-        scale = abs(v) if v != 0 else (abs(model.reference_force()) if name.startswith("dF") else 1.0)
-        out.append(FD_STEP * max(scale, 1e-300))
-    return np.array(out)
+    return np.array([FD_STEP * max(abs(v) if v != 0 else (abs(model.reference_force()) if name.startswith("dF")
+                                                            else 1.0), 1e-300) for name, v in zip(names, theta)])
 
 
 #: what force data's tables call an error relative to the data: a signal that changes sign has no level to divide by,
@@ -95,10 +80,14 @@ class Force(Measurement):
     def recognises(exp) -> bool:
         return isinstance(exp, ForceExperiment)
 
-    def __init__(self, offset: str = "shared"):
+    def __init__(self, offset: str = "shared", ripple_phase: str = "recorded"):
         if offset not in OFFSETS:
             raise InputError(f"offset must be one of {', '.join(OFFSETS)} for force data, got {offset!r}")
         self.offset = offset
+        #: the ripple's angle: "recorded" or "per-run" (measurement_of resolves "auto" from the data, ripple_note why)
+        self.ripple_phase = ripple.check_phase_option(ripple_phase)
+        self.ripple_note = None
+        self.phases_fitted = 0
 
     @property
     def removed(self) -> str:
@@ -109,7 +98,7 @@ class Force(Measurement):
     def validation_removed(self) -> str:
         return ("each experiment's own sensor offset (its mean error), estimated on every experiment, held-out ones "
                 "included" if self.offset == "per-experiment" else
-                "the model's sensor offset ([plant] sensor_offset), as fitted")
+                "the model's sensor offset ([plant] sensor_offset), as fitted") + ripple.phases_said(self)
 
     def unit(self, experiments=()) -> str:
         exps = list(getattr(experiments, "experiments", experiments))
@@ -125,7 +114,8 @@ class Force(Measurement):
         d = drive(exp, model, start="record")
         return Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.force, float),
                      d.temperature, d.waveform, getattr(exp, "role", "fit"), float(exp.temperature), self,
-                     held_offset=model.plant.sensor_offset, unit=exp.force_unit)
+                     held_offset=model.plant.sensor_offset, unit=exp.force_unit,
+                     angle=np.ascontiguousarray(exp.displacement, float))
 
     def _forces(self, problem, model, rtol):
         """The simulated force of every trace, concatenated; None when a run fails. (No sensitivities: the
@@ -142,12 +132,10 @@ class Force(Measurement):
         """The friction parameters the exact stepping differentiates for this problem (the values at a run's
         temperature, ``problem.chain``, where laws are fitted), or None where it does not apply: a thermal model
         other than Model I, a temperature signal, a fitted name that is not a friction parameter, or a model the
-        core does not step exactly (``_bridge.prescribed_applies``)."""
+        core does not step exactly (``_bridge.prescribed_applies``; a ripple it steps at the waveform's position)."""
         if model.thermal is not None and not isinstance(model.thermal, ModelI):
             return None
         names = problem.chain if problem.chain is not None else problem.names
-        if _has_ripple(model) or any(n in RIPPLE_AMPLITUDES for n in names):
-            return None
         if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
             return None  # a law's base value fitted as such: not a value at the temperature
         arrays = getattr(model.friction, "arrays", ())
@@ -183,31 +171,46 @@ class Force(Measurement):
     def residuals(self, problem, model, theta, jac):
         measured = np.concatenate([tr.measured - (tr.held_offset if self.offset == "none" else 0.0)
                                    for tr in problem.traces])
-        names = self.exact_names(problem, model)
+        outside = ripple.additive(model)  # the ripple added here, at the recorded angle (measurements/ripple.py)
+        base = ripple.without(model) if outside else model
+        names = self.exact_names(problem, base)  # (the amplitudes' columns 0 there: the base has no ripple)
         if names is not None:
-            F, J = self._exact(problem, model, names, jac)
-            return (None, None) if F is None else self.profiled(problem.traces, F - measured, J)
-        rtol = min(problem.rtol, FD_RTOL) if jac else problem.rtol
-        F = self._forces(problem, model, rtol)
+            F, J = self._exact(problem, base, names, jac)
+        else:
+            F, J = self._integrated(problem, base, theta, jac, RIPPLE_AMPLITUDES if outside else (), outside)
         if F is None:
             return None, None
-        r = F - measured
-        J = None
-        if jac:
-            h = _steps(problem.model, problem.names, theta)
-            J = np.empty((r.size, theta.size))
-            for k in range(theta.size):
-                for sign in (1.0, -1.0):  # backwards where a step forwards breaks a rule (fs >= fc)
-                    step = theta.copy()
-                    step[k] += sign * h[k]
-                    mk = problem.model_at(step)
-                    Fk = None if mk is None else self._forces(problem, mk, rtol)
-                    if Fk is not None:
-                        J[:, k] = (Fk - F) / (sign * h[k])
-                        break
-                else:
-                    return None, None
-        return self.profiled(problem.traces, r, J)
+        r, J, g = ripple.added(self, problem, model, F - measured, J) if outside else (F - measured, J, None)
+        r, J = self.profiled(problem.traces, r, J)
+        return r, (ripple.projected(J, g, problem.traces, self.offset) if outside else J)
+
+    def _integrated(self, problem, model, theta, jac, skip=(), outside=False):
+        """(force, Jacobian by forward differences of whole runs, zero in ``skip``) of every trace, integrated;
+        (None, None) when a run fails. ``outside``: the ripple is added elsewhere (each stepped model without it)."""
+        rtol = min(problem.rtol, FD_RTOL) if jac else problem.rtol
+        F = self._forces(problem, model, rtol)
+        if F is None or not jac:
+            return F, None
+        h = _steps(problem.model, problem.names, theta)
+        J = np.zeros((F.size, theta.size))
+        for k in range(theta.size):
+            if problem.names[k] in skip:
+                continue
+            for sign in (1.0, -1.0):  # backwards where a step forwards breaks a rule (fs >= fc)
+                step = theta.copy()
+                step[k] += sign * h[k]
+                mk = problem.model_at(step)
+                mk = ripple.without(mk) if mk is not None and outside else mk
+                Fk = None if mk is None else self._forces(problem, mk, rtol)
+                if Fk is not None:
+                    J[:, k] = (Fk - F) / (sign * h[k])
+                    break
+            else:
+                return None, None
+        return F, J
+
+    def offsets_in(self, traces) -> int:
+        return super().offsets_in(traces) + self.phases_fitted  # the ripple's phases per run
 
     def profiled(self, traces, r, J):
         """The residuals and Jacobian with the offsets the policy fits profiled out."""
@@ -228,6 +231,7 @@ class Force(Measurement):
     # -- validation --------------------------------------------------------------------------------
 
     def check_model(self, model, experiments):
+        ripple.check_per_run(self, model)
         if model.plant.type != "prescribed":
             raise InputError(f"force data are predicted with a prescribed-motion model ([plant] type = "
                              f"\"prescribed\"); this model's plant is '{model.plant.type}'")
@@ -241,9 +245,9 @@ class Force(Measurement):
 
     @property
     def caption(self) -> str:
-        if self.offset == "per-experiment":
-            return "RMSE: each experiment's own offset removed (estimated on it); " + RANGE_PCT
-        return "RMSE: the model's sensor offset removed (fitted on the fit experiments, never re-fitted); " + RANGE_PCT
+        removed = "each experiment's own offset removed (estimated on it)" if self.offset == "per-experiment" else \
+            "the model's sensor offset removed (fitted on the fit experiments, never re-fitted)"
+        return f"RMSE: {removed}{ripple.phases_said(self)}; {RANGE_PCT}"
 
     @property
     def footer(self) -> str:
@@ -252,7 +256,7 @@ class Force(Measurement):
                    "offset)" if self.offset == "per-experiment" else
                    "the model's sensor offset ([plant] sensor_offset) removed, as fitted on the fit experiments and "
                    "never re-fitted on held-out ones")
-        return (f"RMSE: {removed}; {RANGE_PCT}; max |error|: the largest single error, in the data's unit (on "
+        return (f"RMSE: {removed}{ripple.phases_said(self)}; {RANGE_PCT}; max |error|: the largest single error, in the data's unit (on "
                 f"a signal that changes sign it is at a reversal, where a small timing difference shows large); mean "
                 f"error: the prediction's mean minus the measurement's, before any offset was removed "
                 f"(docs/force-data.md#4-validation)")
@@ -265,12 +269,16 @@ class Force(Measurement):
                 (f"RMSE [{unit}]", "rmse_offset_removed", "{:.4g}"), ("RMSE [% of range]", "nrmse", "{:.3g}"),
                 (f"max |error| [{unit}]", "max_error", "{:.3g}"), (f"mean error [{unit}]", "bias", "{:+.3g}"))
 
-    def friction_of(self, model, exp, rtol=1e-8, fast=False) -> np.ndarray:
+    def friction_of(self, model, exp, rtol=1e-8, fast=False, measured=None) -> np.ndarray:
         """The friction force (torque) ``model`` predicts along one experiment's measured motion, on its samples:
         simulated (with the simulation's checks and warnings); where the integrator cannot finish (bristles so
         stiff that a fit driven by the exact stepping put them there), by the exact stepping itself, which
         needs no step size. ``fast``: by the exact stepping wherever it applies (no simulation checks: for
-        what only needs the values, the unit check)."""
+        what only needs the values, the unit check). A ripple is added at the recorded angle (measurements/ripple.py;
+        per run: at the angle offset that fits ``measured``)."""
+        if ripple.additive(model):
+            base = self.friction_of(ripple.without(model), exp, rtol, fast)
+            return base + ripple.for_run(self, model, exp, base, measured)
         d = drive(exp, model, start="model")
         stepped = self._stepped(d, model, exp) if fast else None
         if stepped is not None:
@@ -288,7 +296,7 @@ class Force(Measurement):
     @staticmethod
     def _stepped(d, model, exp):
         """The exact stepping's friction along ``exp`` (driven as ``d``), or None where it does not apply."""
-        if not isinstance(d.temperature, (int, float)) or _has_ripple(model):
+        if not isinstance(d.temperature, (int, float)):
             return None
         spec = _bridge.model_spec(d.model(model), d.temperature, d.waveform)
         if not _bridge.prescribed_applies(spec):
@@ -297,7 +305,8 @@ class Force(Measurement):
 
     def predicted(self, model, exp, rtol=1e-8, fast=False):
         """(predicted, measured) of one experiment: the friction plus the sensor offset, and the record."""
-        return self.friction_of(model, exp, rtol, fast) + model.plant.sensor_offset, np.asarray(exp.force, float)
+        measured = np.asarray(exp.force, float)
+        return self.friction_of(model, exp, rtol, fast, measured) + model.plant.sensor_offset, measured
 
     def spans(self, model, exp, rtol=1e-6):
         """(measured, predicted) for the unit check, by the exact stepping where it applies."""

@@ -43,12 +43,13 @@ def _check_report_arguments(models, data, path, figures_dir, command, title, tru
 
 
 def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None, offset=None,
-           motion=None) -> str:
+           motion=None, ripple_phase="auto") -> str:
     """Writes the HTML report comparing ``models`` (Model, FitResult, or (label, Model, fit dict)
     entries) on ``data``; returns the HTML. ``truth`` (label -> FitResult.recovery summary, for data
     made from a known model) adds a section saying whether the fits recover it; ``bands`` (what
     ``tf.propagate`` returns) a section with the prediction bands. Each model is scored as it was fitted (its fit
-    record: the offset policy, the motion), unless ``offset`` or ``motion`` says otherwise (see :func:`validate`)."""
+    record: the offset policy, the motion), unless ``offset`` or ``motion`` says otherwise (see :func:`validate`, which
+    also takes ``ripple_phase``)."""
     models = _check_report_arguments(models, data, path, figures_dir, command, title, truth)
     entries = []
     for m in models:
@@ -66,7 +67,7 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
         raise InputError("give at least one model")
     for e in entries:  # each scored as it was fitted, unless asked otherwise (validation.py: _scoring)
         if e.validation is None:
-            e.validation = validate(e.model, data, offset=offset, motion=motion)
+            e.validation = validate(e.model, data, offset=offset, motion=motion, ripple_phase=ripple_phase)
     render_page = PAGES[measurement_of(data).name]  # the page of what the data measured
     text = render_page(entries, data, figures_dir=figures_dir, command=command or " ".join(sys.argv), title=title,
                        truth=truth, bands=bands)
