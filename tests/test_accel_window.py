@@ -51,3 +51,28 @@ def test_the_window_is_the_narrowest_within_the_bias(sigma):
 def test_a_quantised_velocity_counts_its_step():
     """A quantised velocity's noise is at least its step over sqrt(12), however its differences fall."""
     assert velocity_noise(np.zeros(100), resolution=0.012) == pytest.approx(0.012 / math.sqrt(12))
+
+
+def test_gms_on_a_coulomb_level_holds_c_and_says_so(tmp_path):
+    """Issue 40 item 7: a GMS fit on force data whose friction is a plain Coulomb level (a static map written
+    here with NumPy, 0.3 tanh(v / 2 mrad/s) plus 3 mN m noise). With fs = fc a slipping element sits at its
+    capacity and C changes nothing (GMS's slip law C (sgn(v) w_i - F_i / g) is zero there), so C is held with
+    a warning naming it, and fc is reported determined (a finite interval within a few % of its value). Before:
+    C fitted, running off to 3e-4 with a standard error of 5e13."""
+    import tomli_w
+
+    import thermofriction as tf
+
+    t = np.arange(0.0, 4.0, DT)
+    x, v = A * np.sin(W * t), A * W * np.cos(W * t)
+    F = 0.3 * np.tanh(v / 0.002) + np.random.default_rng(0).normal(0.0, 0.003, t.size)
+    np.savetxt(tmp_path / "run0.csv", np.column_stack([t, x, v, F]), delimiter=",", comments="", fmt="%.12g",
+               header="time[s],position[rad],velocity[rad/s],friction_torque[N*m]")
+    (tmp_path / "dataset.toml").write_text(tomli_w.dumps({"name": "c", "experiment": [
+        {"file": "run0.csv", "temperature": 25.0}]}))
+    res = tf.identify(tf.load_dataset(tmp_path), method="base", friction="gms", starts=1)
+    assert "C" not in [p.name for p in res.parameters.varying]
+    said = [w for w in res.warnings if w.startswith("'C'")]
+    assert len(said) == 1 and "fs = fc" in said[0] and "held" in said[0], res.warnings
+    fc = res.parameters["fc"]
+    assert math.isfinite(fc.stderr) and fc.stderr < 0.05 * fc.value and fc.ci95[1] - fc.ci95[0] < 0.2 * fc.value
