@@ -165,13 +165,12 @@ def test_hold_relation_of_the_truth():
     assert np.ptp(v) > 3.0 and np.ptp(u) > 0.5
 
 
-@pytest.mark.xfail(strict=True, reason="open (issue 40 item 6): the 9-sample Savitzky-Golay acceleration blurs the "
-                   "presliding ringing after reversals; the delay comes out 5.58-5.62 ms +- 0.025 (truth 5.5), "
-                   "sigma1 0.076 (0.04), rmse 1.47x the noise; with a 3-sample window 5.49-5.53 +- 0.009")
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_servo_with_a_held_command(tmp_path, seed):
     """From the data's own start (no --init): the delay, J and fc within a few % of the truth (the delay: of 5 ms
-    plus half the hold), and their 95 % intervals cover it."""
+    plus half the hold), and their 95 % intervals cover it. (Failed with the fixed 9-sample acceleration, which
+    blurred the presliding ringing after reversals: 5.58-5.62 ms +- 0.025; the window chosen from the record, 3
+    samples on this noise-free velocity, gives 5.49-5.52 ms +- 0.009.)"""
     res = tf.identify(tf.load_dataset(servo_dataset(tmp_path / "d", seed)), method="base", starts=1)
     plant = res.details["plant"]
     d, inertia, fc = plant["delay"], plant["inertia"], res.parameters["fc"]
@@ -180,3 +179,14 @@ def test_servo_with_a_held_command(tmp_path, seed):
     assert covers(d["ci95"], EFFECTIVE), d
     assert covers(inertia["ci95"], J), inertia
     assert covers(fc.ci95, LUGRE["fc"]), fc.ci95
+
+
+@pytest.mark.xfail(strict=True, reason="open (issue 40 item 6): with the 3-sample acceleration sigma1 comes out "
+                   "0.043-0.049 (95 % intervals 0.041-0.052, missing 0.04 in 5 of 5 seeds), sigma0 59.1-59.8 "
+                   "(60): the bristles' fast change after a reversal (a time scale g/(sigma0 |v|) of a few ms) is "
+                   "modelled at point samples while the drive realises the mean of each held sample")
+@pytest.mark.parametrize("seed", [0, 1])
+def test_servo_sigma1(tmp_path, seed):
+    """The presliding damping sigma1 of the servo truth within its 95 % interval."""
+    res = tf.identify(tf.load_dataset(servo_dataset(tmp_path / "d", seed)), method="base", starts=1)
+    assert covers(res.parameters["sigma1"].ci95, LUGRE["sigma1"]), res.parameters["sigma1"]

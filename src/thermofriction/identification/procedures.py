@@ -31,7 +31,8 @@ DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")  # LuGre's (the paper's
 def default_fit_parameters(model: Model) -> list:
     """The default fitted parameters of ``model``'s friction model (the ``fit_parameters`` of the measurement its
     plant is fitted to: displacement's, FRICTION_FIT_PARAMETERS, for an actuator; force's for prescribed motion),
-    less those it leaves unset or at zero; under Model I, those with a law (if any has one)."""
+    less those it leaves unset or at zero, and GMS's C without a Stribeck effect (:func:`no_stribeck_rate`);
+    under Model I, those with a law (if any has one)."""
     table = next((m.fit_parameters for m in REGISTRY.values() if model.plant.type in m.plants),
                  FRICTION_FIT_PARAMETERS)
     names = table.get(model.friction.model, DEFAULT_FRICTION_PARAMETERS)
@@ -40,9 +41,25 @@ def default_fit_parameters(model: Model) -> list:
     if model.friction.model in ("stribeck", "gms", "lugre", "elastoplastic") and \
             values.get("fs") in (None, values.get("fc")) and "fs" not in laws:
         values = {k: v for k, v in values.items() if k not in ("fs", "vs")}  # no Stribeck effect to fit
+        values.pop("C" if model.friction.model == "gms" else "", None)  # (no_stribeck_rate)
     names = [n for n in names if n in laws or (values.get(n) or 0.0) > 0.0]
     with_law = [n for n in names if n in laws]
     return with_law or names
+
+
+def no_stribeck_rate(model, params) -> list:
+    """GMS's C is the rate at which slipping elements follow the Stribeck curve g(v): where there is none (fs = fc,
+    no law on fs), a slipping element sits at its capacity w_i g and C changes nothing, so no data determine it
+    (a fit of it runs off, to 1e-10 or 6e17, issue 40 item 7). The default holds it; a warning naming C says
+    so, whether it was held or fitted."""
+    values = model.friction.values()
+    if model.friction.model != "gms" or values.get("fs") not in (None, values.get("fc")) or "fs" in model.laws:
+        return []
+    fitted = "C" in params and params["C"].vary
+    how = "was fitted, but" if fitted else f"is held at {values['C']:.4g} N m/s:"
+    return [f"'C' (the rate at which slipping GMS elements follow the Stribeck curve) {how} with no Stribeck "
+            f"effect (fs = fc) a slipping element stays at its capacity and C changes nothing, so these data "
+            f"cannot determine it{'; hold it' if fitted else ''} (fit fs and vs to bring it in)"]
 
 
 def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), details=None) -> FitResult:
@@ -79,7 +96,7 @@ def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), de
                         f"the model misses what the data show" + "".join(
                             f"; {c}" for c in measurement.checks(model, traces)))
     cost = float(outcome.r @ outcome.r)
-    warns += _unsupported_excess(params, corr, unit)
+    warns += _unsupported_excess(params, corr, unit) + no_stribeck_rate(fitted, params)
     return FitResult(method=method, model=fitted, parameters=params, correlation=corr, cost=cost,
                      rmse=math.sqrt(cost / len(outcome.r)), n_points=len(outcome.r), nfev=outcome.nfev,
                      njev=outcome.njev, starts=outcome.starts, wall_time=time.perf_counter() - t0,

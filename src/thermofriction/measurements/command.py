@@ -15,10 +15,13 @@ residuals are ``F + J a + offset - u(t - delay)``.
   holds J, the offset and the delay in its ``[plant]`` (``inertia``, ``sensor_offset``, ``delay``), so that
   validation predicts a command from a model file alone.
 - **The acceleration** is a Savitzky-Golay derivative (SciPy's ``savgol_filter``: a quadratic fitted by least
-  squares over ACCEL_WINDOW samples, its slope at the centre) of the velocity that drives the model, on a uniform
+  squares over a window of samples, its slope at the centre) of the velocity that drives the model, on a uniform
   grid at the median sampling interval. A centred window is a symmetric (zero-phase) filter: it delays nothing,
-  so that J a lines up with the friction; it averages the differentiation's noise over the window. (Noise left in
-  ``a`` is an error in a regressor and pulls J towards zero: the position must resolve the acceleration.)
+  so that J a lines up with the friction; it averages the differentiation's noise over the window, and it blurs
+  what changes within it (a lightly damped presliding ringing after a reversal: a 9-sample window shifted a 1 kHz
+  servo's delay by 0.1 ms and doubled its sigma1). The window is chosen from each record (:func:`accel_window`):
+  the narrowest whose noise biases J by at most ACCEL_BIAS. (Noise left in ``a`` is an error in a regressor and
+  pulls J towards zero by its variance over the acceleration's: the position must resolve the acceleration.)
 - **The delay** (identify's ``delay=``, measurements/delay.py): ``auto`` reads it off the data before the fit
   (:func:`delay_scan` over a range from the data) and uses it only where it exceeds about a sample
   (MIN_DELAY_SAMPLES), else it is 0, and the result says which; a range is searched within its bounds; a value
@@ -43,9 +46,11 @@ from .force import Force
 
 signal = lazy("scipy.signal")
 
-#: the Savitzky-Golay window of the acceleration [samples, odd] and its polynomial's degree
-ACCEL_WINDOW = 9
+#: the Savitzky-Golay acceleration's polynomial degree, and its window's bounds [samples, odd] (accel_window)
 ACCEL_ORDER = 2
+MIN_ACCEL_WINDOW, MAX_ACCEL_WINDOW = 3, 51
+#: the acceleration's noise may bias J by at most this fraction (its variance over the acceleration's)
+ACCEL_BIAS = 1e-3
 #: a delay of less than this many sampling intervals is not applied (0)
 MIN_DELAY_SAMPLES = 1.0
 #: the delay is read off the sliding samples, faster than this fraction of the 95th percentile speed
@@ -68,11 +73,40 @@ class CommandTrace(Trace):
     velocity: np.ndarray | None = None
 
 
-def acceleration(exp, window: int = ACCEL_WINDOW) -> np.ndarray:
-    """The acceleration of an experiment's driving motion at its samples (Savitzky-Golay, zero-phase)."""
+def velocity_noise(v, resolution=None) -> float:
+    """The standard deviation of white noise on a uniformly sampled velocity: the median absolute deviation of
+    its third differences (robust: a smooth motion's are ~dt^3 times its third derivative, a reversal's few are
+    outliers), over sqrt(20) (a third difference of white noise has 20 times its variance); at least a quantised
+    velocity's step over sqrt(12)."""
+    d = np.diff(np.asarray(v, float), 3)
+    mad = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(20.0) if d.size else 0.0
+    return max(mad, (resolution or 0.0) / math.sqrt(12.0))
+
+
+def accel_window(exp) -> int:
+    """The acceleration's Savitzky-Golay window for an experiment: the narrowest (odd, from MIN_ACCEL_WINDOW to
+    MAX_ACCEL_WINDOW) whose noise -- the velocity's (:func:`velocity_noise`) through the window's coefficients h,
+    variance sigma_v^2 sum h^2 -- is at most ACCEL_BIAS of the acceleration's own variance, else the widest.
+    Why: noise in the regressor ``a`` biases J by the ratio of the two variances (attenuation), and a window
+    wider than that needs blurs the fast motion after reversals into the friction's presliding (sigma1, the
+    delay); the window depends only on the record, so that a fit and its validation take the same."""
+    dt, (v,) = on_uniform_grid(exp.time, exp.drive_velocity)
+    noise2 = velocity_noise(v, getattr(exp, "velocity_resolution", None)) ** 2
+    widest = min(MAX_ACCEL_WINDOW, v.size - (1 - v.size % 2))
+    for w in range(MIN_ACCEL_WINDOW, widest + 1, 2):
+        h2 = float(np.sum(signal.savgol_coeffs(w, ACCEL_ORDER, deriv=1, delta=dt) ** 2))
+        a = signal.savgol_filter(v, w, ACCEL_ORDER, deriv=1, delta=dt)
+        if noise2 * h2 <= ACCEL_BIAS * max(float(np.var(a)) - noise2 * h2, 0.0):
+            return w
+    return max(widest, MIN_ACCEL_WINDOW)
+
+
+def acceleration(exp, window: int | None = None) -> np.ndarray:
+    """The acceleration of an experiment's driving motion at its samples (Savitzky-Golay, zero-phase; ``window``
+    None: :func:`accel_window`)."""
     t = np.asarray(exp.time, float)
     dt, (v,) = on_uniform_grid(t, exp.drive_velocity)
-    w = min(window, v.size - (1 - v.size % 2))
+    w = min(window or accel_window(exp), v.size - (1 - v.size % 2))
     if w <= ACCEL_ORDER:
         return np.gradient(np.asarray(exp.drive_velocity, float), t)
     a = signal.savgol_filter(v, w, ACCEL_ORDER, deriv=1, delta=dt)
@@ -323,5 +357,5 @@ class Command(Force):
 
 
 __all__ = ["Command", "CommandTrace", "DelaySearch", "delay_search", "implied_friction", "acceleration", "shifted",
-           "delay_scan", "linear_fit", "coulomb_columns", "applied_delay", "nuisance_columns", "ACCEL_WINDOW",
-           "MIN_DELAY_SAMPLES"]
+           "delay_scan", "linear_fit", "coulomb_columns", "applied_delay", "nuisance_columns", "accel_window",
+           "velocity_noise", "ACCEL_BIAS", "MIN_DELAY_SAMPLES"]
