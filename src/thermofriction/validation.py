@@ -213,12 +213,45 @@ def _scoring(model, exps, offset, motion):
 
 def validate(model: Model, data, experiments=None, *, offset=None, motion=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
-    errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
-    zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
-    it, held-out runs included). ``offset`` and ``motion`` ("position", "velocity", "auto": what drives force
-    experiments) default to the model's fit record, so a fitted model is scored the way ``identify`` scored it;
-    ``scored_as`` says how. Temperatures outside a law's calibrated range are reported as warnings, and so
-    is a record whose span is a power of 1000 off the prediction's (unit_scale.py; also a UnitWarning)."""
+    errors (docs/formats.md#validation-metrics) as the data's measurement says.
+
+    Displacement: about each run's zero; force: with the model's sensor offset, or with
+    ``offset="per-experiment"`` each run's own, estimated on it, held-out runs included. Temperatures outside a
+    law's calibrated range are reported as warnings, and so is a record whose span is a power of 1000 off the
+    prediction's (unit_scale.py; also a UnitWarning).
+
+    Parameters
+    ----------
+    model : Model
+        The model to score (``FitResult.model`` for a fit).
+    data : Dataset
+        The measurements (``load_dataset``).
+    experiments : Dataset or list of Experiment, optional
+        The experiments to predict; default every experiment of ``data`` (fit and held out).
+    offset : {"shared", "per-experiment", "none"} or bool, optional
+        Force data: how the sensor offset is taken; default the model's fit record (so that a fitted model is
+        scored the way ``identify`` scored it), else the model's own offset.
+    motion : {"position", "velocity", "auto"}, optional
+        Force data: what drives the experiments; default the model's fit record, else "auto".
+
+    Returns
+    -------
+    ValidationResult
+        One prediction per experiment with its metrics (RMSE in the data's unit, relative errors), the
+        warnings, and ``scored_as``: how the offset and motion were chosen.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; a dataset without experiments; a model that cannot predict
+        these data (a stick-slip actuator for force data, say), or an ``offset`` or ``motion`` that does not
+        apply.
+
+    Warns
+    -----
+    UnitWarning
+        A record a power of 1000 off the model's prediction.
+    """
     _args.model(model, Model)
     _args.dataset(data, Dataset, experiments=True)
     _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)

@@ -339,8 +339,32 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
 
 
 def parse_waveform(spec: str) -> Waveform:
-    """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
-    ``sampled:file=u.csv``."""
+    """Parses an ``--input`` spec such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
+    ``sampled:file=u.csv`` (docs/formats.md): the waveform's kind, a colon, its fields as ``key=value``.
+
+    Parameters
+    ----------
+    spec : str
+        The spec; the keys are the fields of the waveform's class (``Sawtooth``, ``Sine``, ``Square``,
+        ``Step``, ``Sampled``).
+
+    Returns
+    -------
+    Waveform
+        The waveform.
+
+    Raises
+    ------
+    InputError
+        Not a string; an unknown kind or key; a value that is not a number or out of range, named
+        (``--input sawtooth:...: 'rise' must be between 0 and 1``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> tf.parse_waveform("sawtooth:amplitude=30,frequency=5,rise=0.999")
+    Sawtooth(amplitude=30.0, frequency=5.0, rise=0.999, offset=0.0, direction=1)
+    """
     if not isinstance(spec, str):
         raise InputError(f"spec must be a string, a waveform spec such as 'sawtooth:amplitude=30,frequency=5', "
                          f"got {type(spec).__name__} {shorten(spec)}")

@@ -320,8 +320,36 @@ def preset_path(name: str):
 
 
 def load_model(source, friction_from=None) -> Model:
-    """Loads a model file, or a shipped preset by name (see ``PRESETS``). ``friction_from``: see
-    :func:`model_from_dict`."""
+    """Loads a model file (TOML, docs/formats.md#model-files), or a shipped preset by name (``PRESETS``).
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        A model file's path, or a preset's name (``"li2009-model-i"``); a file of that name comes first.
+    friction_from : callable, optional
+        For a file without a ``[friction]`` section: a function of the parsed plant and input that returns
+        one (identification's starting values from the data; ``model_from_dict``).
+
+    Returns
+    -------
+    Model
+        The model, checked: plant, friction model, thermal extension, heat model and input.
+
+    Raises
+    ------
+    InputError
+        A source that is not a path or a preset; a file that cannot be read; a bad key or value, named with
+        its file and section (``li2009.toml: [friction] sigma0 must be positive, got -1``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> model = tf.load_model("li2009-model-i")
+    >>> model.name
+    'li2009-model-i'
+    >>> type(model.friction).__name__
+    'LuGre'
+    """
     _args.path(source, "source")
     _args.function(friction_from, "friction_from")
     source = os.fspath(source)
