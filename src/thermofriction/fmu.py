@@ -154,17 +154,51 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
                source: str | None = None, solver: str = "adaptive", step: float | None = None,
                fmi: int = 2, integrator: str | None = None) -> Path | Target:
-    """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 (``fmi=2``, the default) or
-    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md), with the linux64 binary and, when
-    the package was built with the MinGW-w64 cross compiler, the win64 one (else a NoWindowsBinaryWarning
-    says so). ``temperature``: the start value of the temperature input [degC] (with a
-    heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
-    ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
-    ``source``: where the model came from (a file or preset name), for the FMU's description.
-    ``solver``: "adaptive" (default: the core's error-controlled integrator between communication
-    points) or "realtime" (fixed steps of ``step`` seconds: the core's real-time friction step and
-    semi-implicit Euler for the plant; docs/fmu.md#solvers). ``integrator``: ``solver``'s earlier name
-    (deprecated)."""
+    """Writes ``model`` as an FMI 2.0 or FMI 3.0 co-simulation FMU to ``path`` (docs/fmu.md), with the linux64
+    binary and, when the package was built with the MinGW-w64 cross compiler, the win64 one.
+
+    Parameters
+    ----------
+    model : Model or str or os.PathLike
+        The model: a Model, a model file or a preset name.
+    path : str or os.PathLike
+        The ``.fmu`` file written (atomically: all of it or nothing).
+    temperature : float, optional
+        The start value of the temperature input [C] (with a heat model, of the ambient temperature); default
+        the model's T_amb, else the low end of the laws' range.
+    model_identifier : str, optional
+        The binary's name inside the FMU: letters, digits and ``_``, not starting with a digit; default from
+        the model's name.
+    source : str, optional
+        Where the model came from (a file or preset name), for the FMU's description.
+    solver : {"adaptive", "realtime"}, default "adaptive"
+        "adaptive": the core's error-controlled integrator between communication points; "realtime": fixed
+        steps of ``step`` seconds, the core's real-time friction step and semi-implicit Euler for the plant
+        (docs/fmu.md#solvers).
+    step : float, optional
+        The fixed step [s] of the "realtime" solver.
+    fmi : {2, 3}, default 2
+        The FMI standard's version.
+    integrator : str, optional
+        Deprecated: ``solver``'s earlier name.
+
+    Returns
+    -------
+    pathlib.Path
+        The FMU's path.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; what an FMU cannot carry (a sampled external heat, a
+        law with more points than the binary holds), named with what to do; a path that is a folder or cannot
+        be written.
+
+    Warns
+    -----
+    NoWindowsBinaryWarning
+        The installation has no win64 binary: the FMU carries linux64 only.
+    """
     solver = _solver(solver, integrator)
     model, source, temperature, step = _checked(model, path, temperature, model_identifier, source, solver, step, fmi)
     _check_exportable(model)

@@ -249,14 +249,40 @@ class FleetResult:
 
 def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, workers=None, progress=None,
                    **identify_options) -> FleetResult:
-    """Identifies every dataset (folders, or Dataset objects) with ``tf.identify(data, method,
-    init=init, **identify_options)``, one task per dataset, and returns a :class:`FleetResult`.
-    A dataset that cannot be read or identified is recorded with its reason; the others go on.
+    """Identifies every dataset with ``tf.identify(data, method, init=init, **identify_options)``, one task per
+    dataset. A dataset that cannot be read or identified is recorded with its reason; the others go on.
 
-    datasets: a list of dataset folders or ``Dataset`` objects, or one folder of dataset folders.
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process; an
-        identification is seconds of work, so each dataset is one task).
-    progress: called with the number of datasets done."""
+    Parameters
+    ----------
+    datasets : list or str or os.PathLike
+        A list of dataset folders or ``Dataset`` objects, or one folder of dataset folders.
+    method : str, default "model-i"
+        As for ``identify``.
+    init : Model or str or os.PathLike, optional
+        The initial model, as for ``identify``.
+    scheduler : str or distributed.Client, optional
+        Where the tasks run: None or "threads" (threads in this process, one per core, or ``workers`` of them:
+        the C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded local
+        Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler file) or a
+        ``distributed.Client`` (docs/scale.md).
+    workers : int, optional
+        The threads or processes; default one per core. An identification is seconds of work, so each dataset is one
+        task.
+    progress : callable, optional
+        Called with the number of datasets done.
+    **identify_options
+        Passed on to ``identify`` (``friction``, ``parameters``, ``free``, ``starts``, ...).
+
+    Returns
+    -------
+    FleetResult
+        One fit or one failure (with its reason) per dataset, and the fleet's summary.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; no dataset; an option ``identify`` does not take.
+    """
     import time
 
     from ..data import Dataset, load_dataset

@@ -299,13 +299,56 @@ def _checked(result, temperatures, draws, seed, input, duration, sample_rate, le
 def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=None, duration: float = 1.0,
               sample_rate: float = 1000.0, level: float = 0.95, solver=None, controller=None, scheduler=None,
               workers=None, batch_size=None, progress=None) -> PropagationResult:
-    """Draws ``draws`` parameter sets from ``result``'s covariance (a ``FitResult``), simulates each
-    at every temperature [C] (``duration`` s of ``input``, default the model's), and returns the
-    central ``level`` bands of the displacement and of the mean step per cycle.
+    """Draws ``draws`` parameter sets from ``result``'s covariance, simulates each at every temperature, and
+    returns the central ``level`` bands of the displacement and of the mean step per cycle.
 
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process).
-    batch_size: draws per task (default: chunks of at least ~20 ms of work on threads, ~100 ms on Dask).
-    progress: called with the number of draws done."""
+    Parameters
+    ----------
+    result : FitResult
+        The fit whose parameters, standard errors and correlations are drawn from (a fit read back from its
+        results JSON too).
+    temperatures : sequence of float
+        The temperatures [C] simulated.
+    draws : int, default 200
+        The parameter sets drawn.
+    seed : int, default 0
+        The seed of the draws.
+    input : Waveform, optional
+        The drive; default the model's ``[input]``.
+    duration : float, default 1.0
+        Each simulation's length [s].
+    sample_rate : float, default 1000.0
+        The output grid's rate [Hz].
+    level : float, default 0.95
+        The bands' central probability, between 0 and 1.
+    solver : AutoSwitch or Dopri5 or Rodas4 or str, optional
+        As for ``simulate``.
+    controller : StepSizeController, optional
+        As for ``simulate``.
+    scheduler : str or distributed.Client, optional
+        Where the tasks run: None or "threads" (threads in this process, one per core, or ``workers`` of them:
+        the C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded local
+        Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler file) or a
+        ``distributed.Client`` (docs/scale.md).
+    workers : int, optional
+        The threads or processes; default one per core.
+    batch_size : int, optional
+        Draws per task; default chunks of at least ~20 ms of work on threads, ~100 ms on Dask.
+    progress : callable, optional
+        Called with the number of draws done.
+
+    Returns
+    -------
+    PropagationResult
+        Per temperature: the nominal prediction and its ``level`` bands, with the draws that failed.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; a fit without fitted parameters; a parameter without a
+        finite standard error; a correlation matrix that is not one (not symmetric, not positive
+        semi-definite), named.
+    """
     import time
 
     from ..simulation import simulate
