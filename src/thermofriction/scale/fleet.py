@@ -281,7 +281,7 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
     Raises
     ------
     InputError
-        An argument of the wrong type, named; no dataset; an option ``identify`` does not take.
+        An argument of the wrong type, named; no dataset.
     """
     import time
 

@@ -340,7 +340,9 @@ def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=No
     Returns
     -------
     PropagationResult
-        Per temperature: the nominal prediction and its ``level`` bands, with the draws that failed.
+        Per temperature and output time: the fitted model's displacement [m], the median and ``level`` bands
+        of the draws (the parameters' band, and with the measurement noise the fit estimated), the mean step per
+        cycle's band, and the draws that failed with their reasons.
 
     Raises
     ------
