@@ -30,7 +30,43 @@ from .thermal import Heat, ModelI, ModelII
 @dataclass(frozen=True)
 class Model:
     """One actuator: plant, friction model, thermal extension (or None), input (or None) and
-    lumped thermal model of self-heating (or None)."""
+    lumped thermal model of self-heating (or None).
+
+    Parameters
+    ----------
+    plant : StickSlipPlant or MassPlant or PrescribedMotion
+        What the friction acts in.
+    friction : LuGre or Coulomb or Stribeck or Dahl or ElastoPlastic or GMS
+        The friction model (None for each parameter a Model I law gives).
+    thermal : ModelI or ModelII, optional
+        The thermal extension; None: friction independent of temperature.
+    input : Waveform, optional
+        The drive (a model file's ``[input]``); ``simulate(input=...)`` overrides it.
+    name : str, optional
+        The model's name (a preset's, a fit's).
+    description : str, optional
+        A sentence on what the model is.
+    heat : Heat, optional
+        The lumped thermal model of self-heating; the temperature becomes a state.
+    provenance : dict, optional
+        Where a fitted model came from (docs/formats.md#provenance); not part of the physics (two models that
+        differ only here compare equal).
+
+    Raises
+    ------
+    InputError
+        A part of the wrong type, named (``Model: 'plant' must be a StickSlipPlant, ...``); a law for a parameter
+        the friction model also gives, or physically impossible values (fs < fc, ...), named.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> m = tf.Model(plant=tf.MassPlant(mass=1.0), friction=tf.LuGre(sigma0=1e5, sigma1=300.0, fc=1.0),
+    ...              input=tf.Sine(amplitude=2.0, frequency=1.0))
+    >>> res = tf.simulate(m, duration=0.5, sample_rate=100.0)
+    >>> res.displacement.shape
+    (51,)
+    """
 
     plant: StickSlipPlant | MassPlant | PrescribedMotion
     friction: LuGre | Coulomb | Stribeck | Dahl | ElastoPlastic | GMS
