@@ -169,7 +169,8 @@ def test_not_yet_names_only_public_callables():
 
 
 #: the entry points whose Examples run here (their examples need no files or long fits)
-EXAMPLES = ["load_model", "simulate", "parse_waveform", "Sine", "LuGre", "Const", "Linear"]
+EXAMPLES = ["load_model", "simulate", "synthesize", "parse_waveform", "Sine", "Sawtooth", "LuGre", "Const", "Linear",
+            "StepSizeController", "Model"]
 
 
 @pytest.mark.parametrize("name", EXAMPLES)

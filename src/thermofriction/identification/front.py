@@ -137,7 +137,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         given in its physical form); a string may list them with commas ("m_e,m").
     procedure : {"direct", "paper", "both"}, default "direct"
         Model II's procedure: dF(T) fitted directly on all experiments, the paper's per-temperature steps, or
-        both (the better kept, the other in ``FitResult.alternatives``).
+        both (the direct result, with the paper's in ``FitResult.alternatives["paper"]``).
     laws : dict, optional
         Model I law kinds per parameter, a kind or a list of kinds to choose from, e.g. ``{"sigma0": "exp"}``;
         default: each chosen by AICc.

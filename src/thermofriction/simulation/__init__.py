@@ -269,8 +269,8 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     >>> res = tf.simulate(model, duration=0.01, temperature=35.7, sample_rate=1000.0)
     >>> res.time.shape
     (11,)
-    >>> res.time[-1]
-    0.01
+    >>> float(res.time[-1]), float(res.displacement[0])
+    (0.01, 0.0)
     """
     _check_arguments(model, input, controller, max_samples)
     _check_types(duration, temperature, sample_rate, t_eval, solver, friction_work)
