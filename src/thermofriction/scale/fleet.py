@@ -126,7 +126,25 @@ def _identify_one(data, method, init, kw):
 @dataclasses.dataclass(eq=False)
 class FleetResult:
     """``names`` in the order given; ``fits`` name -> FitResult; ``failures`` name -> reason;
-    ``paths`` name -> the dataset's folder."""
+    ``paths`` name -> the dataset's folder.
+
+    Parameters
+    ----------
+    method : str
+        The identification method.
+    names : list of str
+        The datasets' names, in the order given.
+    paths : dict
+        Name -> the dataset's folder.
+    fits : dict
+        Name -> FitResult, for the datasets identified.
+    failures : dict
+        Name -> the reason a dataset could not be read or identified.
+    wall_time : float, default nan
+        The run's duration [s].
+    where : str, default ""
+        Where the tasks ran (threads, a Dask cluster's address).
+    """
 
     method: str
     names: list

@@ -149,7 +149,41 @@ def _run_draws(model, names, thetas, temperatures, waveform, sim):
 
 @dataclasses.dataclass(eq=False)
 class PropagationResult:
-    """Bands over draws, per temperature (rows) and output time (columns), SI units."""
+    """Bands over draws, per temperature (rows) and output time (columns), SI units.
+
+    Parameters
+    ----------
+    temperatures : numpy.ndarray
+        The temperatures [C], one row each.
+    time : numpy.ndarray
+        The output times [s], one column each.
+    level : float
+        The bands' central probability.
+    nominal : numpy.ndarray
+        The fitted model's displacement [m].
+    median, lower, upper : numpy.ndarray
+        The draws' median displacement and the parameters' band [m].
+    prediction_lower, prediction_upper : numpy.ndarray
+        The band with the measurement noise the fit estimated [m].
+    noise : float
+        The fit's noise estimate [m] (0 when it had none).
+    nominal_step, step_lower, step_upper : numpy.ndarray
+        The mean step per cycle [m] per temperature: the fitted model's and its band.
+    names : list of str
+        The drawn parameters' names.
+    parameters : numpy.ndarray
+        The draws (draws x parameters), in the parameters' units.
+    steps : numpy.ndarray
+        Each draw's mean step per temperature [m] (NaN where it failed).
+    final_displacement : numpy.ndarray
+        Each draw's final displacement per temperature [m].
+    failures : dict
+        A failed draw's index -> its reason.
+    wall_time : float, default nan
+        The run's duration [s].
+    where : str, default ""
+        Where the tasks ran (threads, a Dask cluster's address).
+    """
 
     temperatures: np.ndarray
     time: np.ndarray

@@ -177,7 +177,27 @@ class SweepResult:
     """One row per point: the coordinates, then the metrics (NaN where the point failed).
 
     ``res[name]`` is a column (coordinates and metrics by name), ``units[name]`` its unit;
-    ``errors`` maps a failed row's index to its reason; ``ok`` is a boolean column."""
+    ``errors`` maps a failed row's index to its reason; ``ok`` is a boolean column.
+
+    Parameters
+    ----------
+    coordinates : tuple of str
+        The grid's names, in order.
+    metrics : tuple of str
+        The metrics' names.
+    columns : dict
+        Name -> column (numpy.ndarray), coordinates and metrics.
+    units : dict
+        Name -> unit.
+    errors : dict
+        A failed row's index -> its reason.
+    warnings : list of str
+        The runs' warnings.
+    wall_time : float, default nan
+        The run's duration [s].
+    where : str, default ""
+        Where the tasks ran (threads, a Dask cluster's address).
+    """
 
     coordinates: tuple
     metrics: tuple
