@@ -22,9 +22,47 @@ import thermofriction as tf
 ROOT = Path(__file__).resolve().parents[1]
 API = ROOT / "docs" / "api"
 
-#: public callables whose docstrings are not yet in numpydoc form (issue 44 item 4, still to do). The test
-#: fails when one of them is documented (take it off the list) or when a callable outside it is not.
-NOT_YET: set[str] = set()
+#: public callables whose docstrings are not yet in numpydoc form (issue 44 item 4, still to do: the subpackages'
+#: own names; every name of thermofriction.__all__ is done). The test fails when one of them is documented (take it
+#: off the list) or when a callable outside it is not.
+NOT_YET: set[str] = {
+    *(f"thermofriction.control.{n}" for n in (
+        "FeedForward", "LoopResult", "Observer", "PID", "Reference", "compare_compensation", "friction_steps",
+        "point_to_point", "simulate_loop", "sine_reference"
+    )),
+    *(f"thermofriction.data.{n}" for n in (
+        "add_synth_command", "cmd_synth", "max_rows", "read_experiment_csv", "read_experiment_mat"
+    )),
+    *(f"thermofriction.fmu.{n}" for n in ("binary_path", "default_experiment")),
+    *(f"thermofriction.heating.{n}" for n in (
+        "CycleTable", "Full", "HeatingResult", "TwoTimeScale", "cycle_table", "simulate_heating"
+    )),
+    *(f"thermofriction.identification.{n}" for n in (
+        "PlantFit", "base_model", "compare_friction_models", "fit", "fit_friction", "fit_law", "fit_plant",
+        "force_start", "identify_heat", "identify_model_i", "identify_model_ii", "make_traces", "segmented_fit",
+        "step_response", "uncertainty", "with_friction_model"
+    )),
+    *(f"thermofriction.measurements.{n}" for n in (
+        "Command", "Displacement", "Force", "ForcePrediction", "Trace", "amount", "center", "kind_of",
+        "measurement_of", "steady_state_curve"
+    )),
+    *(f"thermofriction.models.{n}" for n in (
+        "check_friction_values", "dissipativity_violation", "law_from_dict", "model_from_dict", "plant_from_dict",
+        "preset_path", "require_actuator", "stribeck_curve"
+    )),
+    *(f"thermofriction.reporting.{n}" for n in (
+        "Entry", "control_report", "heating_report", "render", "render_force"
+    )),
+    *(f"thermofriction.scale.{n}" for n in ("Runner", "draw_parameters", "fleet_datasets", "parse_axis")),
+    *(f"thermofriction.simulation.{n}" for n in (
+        "as_temperature", "check_heated_temperatures", "check_passivity", "check_prescribed_motion",
+        "check_temperatures", "output_grid"
+    )),
+    *(f"thermofriction.validation.{n}" for n in (
+        "Failure", "Prediction", "ValidationResult", "predict", "step_sizes"
+    )),
+    *(f"thermofriction.waveforms.{n}" for n in ("read_two_column_csv", "waveform_from_dict")),
+}
 
 
 def _pages():
