@@ -46,10 +46,6 @@ NOT_YET: set[str] = {
         "Command", "Displacement", "Force", "ForcePrediction", "Trace", "amount", "center", "kind_of",
         "measurement_of", "steady_state_curve"
     )),
-    *(f"thermofriction.models.{n}" for n in (
-        "check_friction_values", "dissipativity_violation", "law_from_dict", "model_from_dict", "plant_from_dict",
-        "preset_path", "require_actuator", "stribeck_curve"
-    )),
     *(f"thermofriction.reporting.{n}" for n in (
         "Entry", "control_report", "heating_report", "render", "render_force"
     )),
@@ -61,7 +57,6 @@ NOT_YET: set[str] = {
     *(f"thermofriction.validation.{n}" for n in (
         "Failure", "Prediction", "ValidationResult", "predict", "step_sizes"
     )),
-    *(f"thermofriction.waveforms.{n}" for n in ("read_two_column_csv", "waveform_from_dict")),
 }
 
 

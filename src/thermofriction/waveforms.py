@@ -355,7 +355,26 @@ class Sampled(Waveform):
 
 
 def read_two_column_csv(path: Path, first: str):
-    """A CSV with a header ``first[unit]`` and one value column; time units s or ms."""
+    """A CSV with a header ``first[unit]`` and one value column; time units s or ms.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file.
+    first : str
+        The first column's name (``"time"``).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (the first column in seconds, the values).
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read or is not UTF-8 CSV, a wrong header or unit, fewer than two data rows, a
+        value that is not a number, named with the file and line.
+    """
     try:
         text = read_bytes(path, "CSV file").decode("utf-8-sig")
         reader = csv.reader(io.StringIO(text, newline=""))
@@ -409,7 +428,28 @@ _KINDS = {"sawtooth": Sawtooth, "sine": Sine, "square": Square, "step": Step}
 
 
 def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Waveform:
-    """Builds a waveform from a model file's ``[input]`` table or a parsed ``--input`` spec."""
+    """Builds a waveform from a model file's ``[input]`` table or a parsed ``--input`` spec.
+
+    Parameters
+    ----------
+    d : dict
+        ``waveform`` (the kind: sawtooth, sine, square, step, sampled) and the waveform's fields; a sampled one
+        takes ``file``, or ``time`` and ``value`` arrays.
+    where : str, default "[input]"
+        The table's place, for the messages.
+    base_dir : str or os.PathLike, optional
+        The folder a sampled waveform's relative ``file`` is read from.
+
+    Returns
+    -------
+    Waveform
+
+    Raises
+    ------
+    InputError
+        Not a table, an unknown kind or key, a bad value, a sampled file that cannot be read, named with
+        ``where``.
+    """
     if not isinstance(d, dict):
         raise InputError(f"{where}: must be a table such as {{ waveform = \"sawtooth\", amplitude = 30, frequency = 5 }}")
     d = dict(d)

@@ -474,7 +474,25 @@ def in_domain(name: str, values) -> np.ndarray:
 
 def check_friction_values(values: dict, where: str):
     """Physical checks on a full set of parameter values (numbers and laws evaluated), on both
-    sides of a direction-dependent model, and on the ripple."""
+    sides of a direction-dependent model, and on the ripple.
+
+    Parameters
+    ----------
+    values : dict
+        Parameter name -> value, in the units of ``PARAMETER_UNITS``.
+    where : str
+        Where the values came from (a model file's section, ``"[friction]"``), for the messages.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        A value outside the physical domain (a stiffness that is not positive, fs < fc, vs <= 0 with a Stribeck
+        effect, z_ba >= fc/sigma0, ...), named with ``where``.
+    """
     _check_side(values, where, "")
     check_sides(values, where, _check_side)
 
@@ -503,7 +521,26 @@ def _check_side(values: dict, where: str, side: str):
 
 
 def stribeck_curve(values: dict, v):
-    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fs = fc: no Stribeck effect), NumPy, for checks and reports."""
+    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fs = fc: no Stribeck effect), NumPy, for checks and reports.
+
+    Parameters
+    ----------
+    values : dict
+        ``fc`` [N], and ``fs`` [N], ``vs`` [m/s], ``delta`` [-] where there is a Stribeck effect.
+    v : float or array_like
+        The sliding velocity [m/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        g(v) [N], the shape of ``v``.
+
+    Raises
+    ------
+    KeyError
+        ``values`` without ``fc``, or without ``vs`` where fs differs from fc (the values are not checked here:
+        ``check_friction_values`` does that).
+    """
     fc = values["fc"]
     fs = values.get("fs", fc)
     fs = fc if fs is None else fs
@@ -521,9 +558,28 @@ def dissipativity_violation(model_name: str, values: dict):
     when sigma1 is large against sigma2 and the Stribeck drop (fs - fc)/fc -- at high speed it
     needs sigma1 <= sigma2 fc / (fs - fc) -- which is why a constant, large sigma1 makes LuGre
     non-passive (Barabanov and Ortega 2000) and a velocity-dependent sigma1(v) = sigma1
-    exp(-(v/vd)^2) (Olsson 1996) restores it. Returns (velocity, message) for the lowest failing
-    speed on a log grid from 1 nm/s to 100 m/s. (For the elasto-plastic model, alpha <= 1 only
-    lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
+    exp(-(v/vd)^2) (Olsson 1996) restores it. (For the elasto-plastic model, alpha <= 1 only
+    lowers the relaxation term, so the LuGre condition is checked as the stricter one.)
+
+    Parameters
+    ----------
+    model_name : str
+        The friction model's name (``"lugre"``, ``"elastoplastic"``; any other has no such test: None).
+    values : dict
+        Parameter name -> value (numbers, laws evaluated), in the units of ``PARAMETER_UNITS``; each side of a
+        direction-dependent model is tested on its own.
+
+    Returns
+    -------
+    tuple or None
+        (velocity [m/s], message) for the lowest failing speed on a log grid from 1 nm/s to 100 m/s; None
+        where the condition holds.
+
+    Raises
+    ------
+    KeyError
+        ``values`` without a parameter the model requires (the values are not checked here).
+    """
     if model_name not in ("lugre", "elastoplastic"):
         return None
     if any(values.get(n) is not None for n in NEGATIVE_SIDE):  # each side on its own, the positive first

@@ -379,7 +379,25 @@ LAWS = {cls.kind: cls for cls in (Const, Linear, Exp, Poly, PWL, Table)}
 
 
 def law_from_dict(d, where: str) -> Law:
-    """A law from its inline table, e.g. ``{ law = "exp", a = 1.15e8, b = -0.136 }``."""
+    """A law from its inline table in a model file, e.g. ``{ law = "exp", a = 1.15e8, b = -0.136 }``.
+
+    Parameters
+    ----------
+    d : dict
+        The parsed table: ``law`` (the kind), its coefficients and an optional ``range``.
+    where : str
+        The table's place in the file (``"[thermal.laws] sigma0"``), for the messages.
+
+    Returns
+    -------
+    Law
+
+    Raises
+    ------
+    InputError
+        Not a table, an unknown kind or key, a missing coefficient, a value that is not a number, named with
+        ``where``.
+    """
     if not isinstance(d, dict):
         raise InputError(f"{where}: a law must be a table such as {{ law = \"linear\", a = ..., b = ... }}")
     kind = d.get("law")

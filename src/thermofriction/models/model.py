@@ -272,9 +272,31 @@ def check_provenance(p, where="[provenance]") -> dict:
 
 
 def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_from=None) -> Model:
-    """Builds a model from a parsed model file; errors name the file and the key. ``friction_from``:
-    for a file without a [friction] section, a function of the parsed plant and input that returns one
-    (identification's starting values from the data)."""
+    """Builds a model from a parsed model file; errors name the file and the key.
+
+    Parameters
+    ----------
+    d : dict
+        The parsed TOML: ``[plant]``, ``[friction]``, and optionally ``[thermal]``, ``[input]``, ``[heat]``,
+        ``name``, ``description``, ``[provenance]``.
+    source : str, default "<model>"
+        The file's name (or a preset's), for the messages.
+    base_dir : str or os.PathLike, optional
+        The folder that relative file names (a sampled input's ``file``) are read from.
+    friction_from : callable, optional
+        For a file without a ``[friction]`` section: a function of the parsed plant and input that returns one
+        (identification's starting values from the data).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    InputError
+        A missing section, an unknown key, a bad value or physically impossible values, named with
+        ``source`` and the key.
+    """
     try:
         fr = d.get("friction")
         bare = isinstance(fr, dict) and set(fr) == {"model"}  # a friction model named, no values: from the data
@@ -336,7 +358,24 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_fr
 
 
 def require_actuator(model: Model, task: str):
-    """Datasets (docs/formats.md#datasets) record a stick-slip actuator: voltage in, end-effector displacement out."""
+    """Datasets (docs/formats.md#datasets) record a stick-slip actuator: voltage in, end-effector displacement out.
+
+    Parameters
+    ----------
+    model : Model
+        The model a task is asked to run on a dataset.
+    task : str
+        The task (``"synthesize"``), for the message.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        The model's plant is not a ``StickSlipPlant``.
+    """
     if not isinstance(model.plant, StickSlipPlant):
         raise InputError(f"{task} works on the stick-slip actuator (datasets record its voltage and displacement); "
                          f"this model's plant is '{model.plant.type}'")
@@ -352,6 +391,23 @@ def preset_hint(name: str) -> str:
 
 
 def preset_path(name: str):
+    """The shipped file of a preset.
+
+    Parameters
+    ----------
+    name : str
+        A preset's name (``PRESETS``).
+
+    Returns
+    -------
+    pathlib.Path
+        The preset's TOML file inside the installed package.
+
+    Raises
+    ------
+    None
+        Nothing is checked: an unknown name gives a path that does not exist (check ``name in PRESETS``).
+    """
     return resources.files("thermofriction").joinpath("presets", f"{name}.toml")
 
 

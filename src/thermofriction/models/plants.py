@@ -287,6 +287,24 @@ PLANTS = {"stick-slip": StickSlipPlant, "mass": MassPlant, "prescribed": Prescri
 
 
 def plant_from_dict(d: dict, where="[plant]"):
+    """A plant from a model file's ``[plant]`` table (docs/formats.md#model-files).
+
+    Parameters
+    ----------
+    d : dict
+        The parsed table: ``type`` and the plant's keys (``m``, ``m_e``, ``xi``, ``wn``, ``K``, ...).
+    where : str, default "[plant]"
+        The table's place, for the messages.
+
+    Returns
+    -------
+    StickSlipPlant or MassPlant or PrescribedMotion
+
+    Raises
+    ------
+    InputError
+        An unknown ``type`` or key, a missing or bad value, named with ``where``.
+    """
     kind = d.get("type")
     if not isinstance(kind, str) or kind not in PLANTS:
         raise InputError(f"{where}: 'type' must be one of {', '.join(repr(k) for k in PLANTS)}, got {kind!r}")
