@@ -100,13 +100,15 @@ def _bars(text):
 
 
 def _docstring_as_rst(app, what, name, obj, options, lines):
+    if what in _AS_WRITTEN:  # napoleon's reading undone (_keep_as_written)
+        lines[:] = _KEPT.pop((what, name), lines)
     if what == "data" and type(obj).__doc__ and lines and "\n".join(lines).strip() == type(obj).__doc__.strip():
         lines[:] = []  # a constant without a docstring of its own: not its type's (dict's, tuple's) docstring
         return
     if what == "attribute" or _NUMPYDOC.search(getattr(obj, "__doc__", None) or ""):
         # numpydoc sections (napoleon has made them reStructuredText) and attributes' "#:" comments (one sentence,
         # never a list of "name: ..." items: "force data: the sensor's offset" is not an item) are left as written
-        lines[:] = _linked_paths(lines)
+        lines[:] = _linked_paths(lines, bars=True)
         return
     out, prev_indent, literal_indent, in_item, last = [], None, None, False, ""
     for k, line in enumerate(lines):
@@ -140,6 +142,18 @@ def _docstring_as_rst(app, what, name, obj, options, lines):
     lines[:] = _linked_paths(out)
 
 
+# napoleon reads the first line of an attribute's, a constant's or a property's docstring as "type: text"
+# (numpydoc's inline attribute form), which the package never writes: "force data: the sensor's offset" became the
+# type "force data". Their docstrings are kept before napoleon runs and put back after it.
+_AS_WRITTEN = ("attribute", "data", "property")
+_KEPT = {}
+
+
+def _keep_as_written(app, what, name, obj, options, lines):
+    if what in _AS_WRITTEN:
+        _KEPT[(what, name)] = list(lines)
+
+
 _NUMPYDOC = re.compile(r"^\s*(Parameters|Returns|Attributes)\n\s*-{3,}\s*$", re.M)
 
 # --- Repository paths in the docstrings as links ---------------------------------------------------------
@@ -162,7 +176,9 @@ def _path_target(path: str):
     return "_modules/" + module.replace(".", "/"), module
 
 
-def _linked_paths(lines):
+def _linked_paths(lines, bars=False):
+    """The lines with repository paths as :tfpath: links (and with ``bars``, |x| escaped as _bars does),
+    outside inline literals and literal blocks."""
     out, literal = [], None
     for line in lines:
         stripped = line.lstrip()
@@ -171,7 +187,8 @@ def _linked_paths(lines):
             literal = None
         if literal is None:
             parts = line.split("``")
-            line = "``".join(p if i % 2 else _PATH.sub(_path_role, p) for i, p in enumerate(parts))
+            line = "``".join(p if i % 2 else _PATH.sub(_path_role, p.replace("|", r"\|") if bars else p)
+                             for i, p in enumerate(parts))
             if line.rstrip().endswith("::"):
                 literal = indent
         out.append(line)
@@ -254,7 +271,8 @@ def _fix_backlinks(app, pagename, templatename, context, doctree):
 
 
 def setup(app):
-    app.connect("autodoc-process-docstring", _docstring_as_rst)
+    app.connect("autodoc-process-docstring", _keep_as_written, priority=400)  # before napoleon's
+    app.connect("autodoc-process-docstring", _docstring_as_rst)  # after napoleon's (same priority, loaded first)
     app.add_role("tfpath", _tfpath)
     app.connect("doctree-read", _record_ids)
     app.connect("doctree-read", _source_pages, priority=600)

@@ -232,7 +232,7 @@ def default_experiment(model: Model, step: float | None = None) -> tuple[float, 
     model's ``[input]``: 1/200 of its period and 1/20 of its shortest ramp (a sawtooth's fall or rise, a
     square's or step's slew, the closest samples), over two periods (a step: until ten slews after it; no
     periodic input: 1 s). Without an ``[input]``: 0.1 ms over 1 s. With the realtime integrator the step is
-    a whole number of its fixed steps (at least one). docs/fmu.md#the-default-experiment says why."""
+    a whole number of its fixed steps (at least one). docs/fmu.md#the-default-experiment-and-held-inputs says why."""
     w = model.input
     stop, why = 1.0, "no [input] in the model: 0.1 ms"
     candidates = []

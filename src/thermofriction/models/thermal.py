@@ -80,7 +80,9 @@ class ModelII:
 
 @dataclass(frozen=True)
 class Heat:
-    """Lumped thermal model of the friction interface (docs/models.md#self-heating): the temperature becomes a state,
+    """Lumped thermal model of the friction interface (docs/models.md#self-heating).
+
+    The temperature becomes a state::
 
         C_th T' = eta |F v_r| - (T - T_amb) / R_th + P_ext(t),    T(0) = T_0.
 
