@@ -88,7 +88,9 @@ html_show_sourcelink = False
 # reStructuredText, the items would run into each other, the code would be a quotation and |x| a
 # substitution reference. These rewrites (the only ones) make each item a definition-list entry (term
 # "name", the text as its definition) and each such indented block a literal block, and escape the bars
-# outside inline literals, without changing what the docstrings say.
+# outside inline literals, without changing what the docstrings say. Docstrings in numpydoc's form (Parameters,
+# Returns, Raises, Examples: the API reference's) are napoleon's; they only get their bars escaped and their
+# repository paths linked.
 
 _ITEM = re.compile(r"([A-Za-z_][\w ,.*()\[\]\"'=-]{0,40}): (\S.*)")
 
