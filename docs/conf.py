@@ -53,6 +53,8 @@ autodoc_typehints = "signature"
 autodoc_preserve_defaults = True
 napoleon_google_docstring = True
 napoleon_numpy_docstring = True
+# one entry per Parameters line: "fc_neg, fs_neg, vs_neg, sigma2_neg : float" stays one entry, not four copies
+napoleon_use_param = False
 add_module_names = False
 # the docstrings use ``x`` for code and the ASCII names of the quantities; nothing else is a reference
 default_role = "literal"
