@@ -33,7 +33,6 @@ NOT_YET: set[str] = {
     *(f"thermofriction.data.{n}" for n in (
         "add_synth_command", "cmd_synth", "max_rows", "read_experiment_csv", "read_experiment_mat"
     )),
-    *(f"thermofriction.fmu.{n}" for n in ("binary_path", "default_experiment")),
     *(f"thermofriction.heating.{n}" for n in (
         "CycleTable", "Full", "HeatingResult", "TwoTimeScale", "cycle_table", "simulate_heating"
     )),
@@ -50,10 +49,6 @@ NOT_YET: set[str] = {
         "Entry", "control_report", "heating_report", "render", "render_force"
     )),
     *(f"thermofriction.scale.{n}" for n in ("Runner", "draw_parameters", "fleet_datasets", "parse_axis")),
-    *(f"thermofriction.simulation.{n}" for n in (
-        "as_temperature", "check_heated_temperatures", "check_passivity", "check_prescribed_motion",
-        "check_temperatures", "output_grid"
-    )),
     *(f"thermofriction.validation.{n}" for n in (
         "Failure", "Prediction", "ValidationResult", "predict", "step_sizes"
     )),

@@ -60,7 +60,23 @@ class NoWindowsBinaryWarning(UserWarning):
 
 def binary_path(platform_name: str = "linux64") -> Path:
     """The installed FMI binary (FMI 2 and 3 in one): ``"linux64"``, built with the package on Linux, or
-    ``"win64"``, the DLL cross-compiled with MinGW-w64 when the package was built where it is installed."""
+    ``"win64"``, the DLL cross-compiled with MinGW-w64 when the package was built where it is installed.
+
+    Parameters
+    ----------
+    platform_name : {"linux64", "win64"}, default "linux64"
+        The platform; any other name is taken as "linux64".
+
+    Returns
+    -------
+    pathlib.Path
+        The binary's path inside the installed package (the win64 one may not exist: ``.is_file()``).
+
+    Raises
+    ------
+    None
+        Nothing is checked.
+    """
     return Path(str(resources.files("thermofriction"))) / "_fmu" / (_DLL if platform_name == "win64" else _BINARY)
 
 

@@ -71,7 +71,30 @@ def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
 
 
 def output_grid(duration, sample_rate, t_eval, max_samples) -> np.ndarray:
-    """The requested output times: ``t_eval``, or a uniform grid from 0 to ``duration``."""
+    """The requested output times: ``t_eval``, or a uniform grid from 0 to ``duration``.
+
+    Parameters
+    ----------
+    duration : float or None
+        The grid's end [s] (with ``sample_rate``), where ``t_eval`` is None.
+    sample_rate : float
+        The uniform grid's rate [Hz].
+    t_eval : array_like or None
+        Any non-empty, non-decreasing array of finite times [s].
+    max_samples : int or None
+        The most samples allowed; None: no limit.
+
+    Returns
+    -------
+    numpy.ndarray
+        The times [s].
+
+    Raises
+    ------
+    InputError
+        Neither ``duration`` nor ``t_eval``; values that are not numbers, a grid that is not
+        non-decreasing or finite, a span out of range, more than ``max_samples`` samples.
+    """
     if t_eval is not None:
         try:
             t_grid = np.ascontiguousarray(t_eval, dtype=float)
