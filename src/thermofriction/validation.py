@@ -21,7 +21,19 @@ from .unit_scale import unit_warnings
 
 @dataclasses.dataclass
 class Failure:
-    """An experiment the model could not be run on, and why."""
+    """An experiment the model could not be run on, and why.
+
+    Parameters
+    ----------
+    file : str
+        The experiment's file.
+    temperature : float
+        Its temperature [C].
+    role : {"fit", "validate"}
+        Its role in the dataset.
+    reason : str
+        Why the model could not be run on it (the error's message).
+    """
 
     file: str
     temperature: float

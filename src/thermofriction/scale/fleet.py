@@ -37,7 +37,22 @@ def fleet_datasets(paths) -> list[Path] | None:
     """The dataset folders of a fleet, or None when ``paths`` is one dataset (the single path).
 
     A fleet is two or more paths, or one folder without a dataset.toml whose sub-folders hold
-    datasets (each sub-folder with a dataset.toml, in name order)."""
+    datasets (each sub-folder with a dataset.toml, in name order).
+
+    Parameters
+    ----------
+    paths : str or os.PathLike or sequence of them
+        The paths given (the command line's DATASET arguments).
+
+    Returns
+    -------
+    list of pathlib.Path or None
+
+    Raises
+    ------
+    None
+        Nothing is checked: a folder that cannot be read is taken as one dataset (None), whose loading says why.
+    """
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     paths = [Path(p) for p in paths]

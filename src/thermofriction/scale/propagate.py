@@ -104,7 +104,28 @@ def check_drawable(result):
 
 
 def draw_parameters(result, draws: int, seed: int = 0):
-    """(names, array (draws, parameters)): seeded draws from the fit's covariance."""
+    """Seeded draws from the fit's covariance (positive parameters drawn in log space, as they were fitted).
+
+    Parameters
+    ----------
+    result : FitResult
+        The fit (or one read back from its results JSON).
+    draws : int
+        The number of parameter sets drawn.
+    seed : int, default 0
+        The seed of the draws.
+
+    Returns
+    -------
+    tuple
+        (names, array (draws x parameters)), in the parameters' units.
+
+    Raises
+    ------
+    InputError
+        A fit without fitted parameters, a parameter without a finite standard error, or a correlation matrix
+        that is not one, named.
+    """
     names, centre, cov, log = _covariance(result)
     w, V = np.linalg.eigh((cov + cov.T) / 2)
     root = V * np.sqrt(np.clip(w, 0.0, None))  # a covariance that is singular to rounding stays usable

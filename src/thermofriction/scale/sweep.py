@@ -69,7 +69,24 @@ def check_run_options(duration, sample_rate, solver, controller, scheduler, work
 
 def parse_axis(text: str):
     """``NAME=START:STOP:STEP`` (STOP included when the steps reach it), ``NAME=V1,V2,...`` or
-    ``NAME=V``: (name, values)."""
+    ``NAME=V``: (name, values).
+
+    Parameters
+    ----------
+    text : str
+        One ``--grid`` axis, e.g. ``temperature=30:42:0.25`` or ``amplitude=10,20,30``.
+
+    Returns
+    -------
+    tuple
+        (name, list of float).
+
+    Raises
+    ------
+    InputError
+        Not NAME=..., a value that is not a finite number, a range without START <= STOP and a positive STEP,
+        named with the axis.
+    """
     _args.text(text, "text")
     name, eq, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
