@@ -48,9 +48,6 @@ NOT_YET: set[str] = {
     *(f"thermofriction.reporting.{n}" for n in (
         "Entry", "control_report", "heating_report", "render", "render_force"
     )),
-    *(f"thermofriction.validation.{n}" for n in (
-        "Prediction", "ValidationResult", "predict", "step_sizes"
-    )),
 }
 
 

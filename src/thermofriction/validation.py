@@ -45,14 +45,53 @@ class Failure:
 
 
 def predict(model: Model, exp, rtol=1e-8):
-    """Simulates one experiment and computes its metrics, as its measurement says."""
+    """Simulates one experiment and computes its metrics, as its measurement says.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    exp : Experiment or ForceExperiment
+        The experiment.
+    rtol : float, default 1e-8
+        The simulation's relative tolerance.
+
+    Returns
+    -------
+    Prediction or ForcePrediction
+        The measured and predicted records and the metrics (docs/formats.md#validation-metrics).
+
+    Raises
+    ------
+    InputError
+        A model that cannot predict the experiment (its plant or temperature range), named.
+    SolverError
+        The simulation failed.
+    """
     return measurement_of([exp]).predict(model, exp, rtol)
 
 
 @dataclasses.dataclass
 class ValidationResult(Result):
     """What :func:`validate` returns: the model, one Prediction per experiment with its metrics, the warnings,
-    and the experiments it could not be run on; a table in a notebook, ``to_json``, ``to_dataframe``, ``plot``."""
+    and the experiments it could not be run on; a table in a notebook, ``to_json``, ``to_dataframe``, ``plot``.
+
+    Parameters
+    ----------
+    model : Model
+        The model scored.
+    predictions : list of Prediction or ForcePrediction
+        One per experiment run, with its metrics.
+    warnings : list of str
+        "FILE: message": temperatures outside a law's calibrated range, records a power of 1000 off.
+    failures : list of Failure, default []
+        The experiments the model could not be run on, with why; the others are still computed.
+    measurement : Measurement, optional
+        What was measured: it gives the metrics, the table's columns and what the RMSE has had removed.
+    scored_as : dict, default {}
+        How the model was scored: the offset policy and the motion, each with where it came from ("the fit
+        record", "asked", "the default").
+    """
 
     model: Model
     predictions: list
