@@ -30,9 +30,6 @@ NOT_YET: set[str] = {
         "FeedForward", "LoopResult", "Observer", "PID", "Reference", "compare_compensation", "friction_steps",
         "point_to_point", "simulate_loop", "sine_reference"
     )),
-    *(f"thermofriction.data.{n}" for n in (
-        "add_synth_command", "cmd_synth", "max_rows", "read_experiment_csv", "read_experiment_mat"
-    )),
     *(f"thermofriction.heating.{n}" for n in (
         "CycleTable", "Full", "HeatingResult", "TwoTimeScale", "cycle_table", "simulate_heating"
     )),

@@ -27,7 +27,17 @@ MAX_ROWS_ENV = "THERMOFRICTION_MAX_ROWS"
 
 
 def max_rows() -> int:
-    """The row limit of experiment files: ``THERMOFRICTION_MAX_ROWS`` when set, else ``MAX_ROWS``."""
+    """The row limit of experiment files: ``THERMOFRICTION_MAX_ROWS`` when set, else ``MAX_ROWS``.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    InputError
+        ``THERMOFRICTION_MAX_ROWS`` set to something that is not a positive whole number.
+    """
     text = os.environ.get(MAX_ROWS_ENV, "").strip()
     if not text:
         return MAX_ROWS

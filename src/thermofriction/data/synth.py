@@ -243,7 +243,23 @@ def _float_list(text, what):
 
 
 def add_synth_command(subparsers):
-    """Registers ``thermofriction synth`` on an argparse subparsers object."""
+    """Registers ``thermofriction synth`` on an argparse subparsers object.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The command line's subcommands.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``synth`` command's parser.
+
+    Raises
+    ------
+    argparse.ArgumentError
+        A command of that name already registered.
+    """
     s = subparsers.add_parser(
         "synth", help="synthesise a measured dataset from a model, with realistic sensor effects",
         description="Simulate MODEL at each temperature and write a dataset folder (docs/formats.md#datasets: dataset.toml "
@@ -294,7 +310,24 @@ def add_synth_command(subparsers):
 
 
 def cmd_synth(args) -> int:
-    """``thermofriction synth``: writes the dataset and prints one line per file."""
+    """``thermofriction synth``: writes the dataset and prints one line per file.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (docs/cli.md#synth).
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    InputError
+        A bad option (``--duration`` that is not positive, ...), named; an output folder that cannot be
+        written.
+    """
     for opt, v in (("--duration", args.duration), ("--sample-rate", args.sample_rate)):
         if not (v > 0 and math.isfinite(v)):
             raise InputError(f"{opt} must be a positive number, got {v!r}")
