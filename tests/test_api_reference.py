@@ -42,9 +42,6 @@ NOT_YET: set[str] = {
         "Command", "Displacement", "Force", "ForcePrediction", "Trace", "amount", "center", "kind_of",
         "measurement_of", "steady_state_curve"
     )),
-    *(f"thermofriction.reporting.{n}" for n in (
-        "Entry", "control_report", "heating_report", "render", "render_force"
-    )),
 }
 
 
