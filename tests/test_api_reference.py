@@ -38,10 +38,6 @@ NOT_YET: set[str] = {
         "force_start", "identify_heat", "identify_model_i", "identify_model_ii", "make_traces", "segmented_fit",
         "step_response", "uncertainty", "with_friction_model"
     )),
-    *(f"thermofriction.measurements.{n}" for n in (
-        "Command", "Displacement", "Force", "ForcePrediction", "Trace", "amount", "center", "kind_of",
-        "measurement_of", "steady_state_curve"
-    )),
 }
 
 

@@ -58,7 +58,19 @@ SIGN_FRACTION = 0.02
 @dataclasses.dataclass
 class CommandTrace(Trace):
     """A trace of a drive's command: ``measured`` is the command as recorded, ``acceleration`` the motion's
-    [m/s^2 or rad/s^2]."""
+    [m/s^2 or rad/s^2].
+
+    Parameters
+    ----------
+    offset : {"shared", "per-experiment", "none"}, default "shared"
+        The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
+        estimated on it; "none", the model's own, held.
+
+    Raises
+    ------
+    InputError
+        An offset policy that does not apply to these data.
+    """
 
     acceleration: np.ndarray | None = None
     #: the command as recorded, and whether the fit searches the delay (the model has one)

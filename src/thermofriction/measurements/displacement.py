@@ -36,6 +36,19 @@ FIT_PARAMETERS = {
 
 
 class Displacement(Measurement):
+    """Displacement driven by a voltage: a stick-slip actuator's end effector; each run's zero removed.
+
+    Parameters
+    ----------
+    offset : {"per-experiment"}, default "per-experiment"
+        The only policy of displacement data: each run's own zero.
+
+    Raises
+    ------
+    InputError
+        Any other offset policy (it applies to force data).
+    """
+
     name = "displacement"
     quantity = "displacement"
     plants = ("stick-slip",)
