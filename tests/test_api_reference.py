@@ -30,9 +30,6 @@ NOT_YET: set[str] = {
         "FeedForward", "LoopResult", "Observer", "PID", "Reference", "compare_compensation", "friction_steps",
         "point_to_point", "simulate_loop", "sine_reference"
     )),
-    *(f"thermofriction.heating.{n}" for n in (
-        "CycleTable", "Full", "HeatingResult", "TwoTimeScale", "cycle_table", "simulate_heating"
-    )),
     *(f"thermofriction.identification.{n}" for n in (
         "PlantFit", "base_model", "compare_friction_models", "fit", "fit_friction", "fit_law", "fit_plant",
         "force_start", "identify_heat", "identify_model_i", "identify_model_ii", "make_traces", "segmented_fit",
