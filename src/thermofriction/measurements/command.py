@@ -58,19 +58,7 @@ SIGN_FRACTION = 0.02
 @dataclasses.dataclass
 class CommandTrace(Trace):
     """A trace of a drive's command: ``measured`` is the command as recorded, ``acceleration`` the motion's
-    [m/s^2 or rad/s^2].
-
-    Parameters
-    ----------
-    offset : {"shared", "per-experiment", "none"}, default "shared"
-        The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
-        estimated on it; "none", the model's own, held.
-
-    Raises
-    ------
-    InputError
-        An offset policy that does not apply to these data.
-    """
+    [m/s^2 or rad/s^2]."""
 
     acceleration: np.ndarray | None = None
     #: the command as recorded, and whether the fit searches the delay (the model has one)
@@ -251,7 +239,19 @@ def implied_friction(model, exp):
 
 
 class Command(Force):
-    """A drive's command (force, torque, or current times the torque constant) under a measured motion."""
+    """A drive's command (force, torque, or current times the torque constant) under a measured motion.
+
+    Parameters
+    ----------
+    offset : {"shared", "per-experiment", "none"}, default "shared"
+        The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
+        estimated on it; "none", the model's own, held.
+
+    Raises
+    ------
+    InputError
+        An offset policy that does not apply to these data.
+    """
 
     name = "command"
     quantity = "drive command (force or torque)"
