@@ -175,6 +175,7 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     - the bristle stiffness sigma0 from the force's rise over the motion after each reversal (the secant
       over half the swing, times ln 2, is sigma0 for LuGre), else fc over 1/1000 of the stroke;
     - sigma1 so that its force at the typical sliding speed is a tenth of fc.
+
     A rough start: the fit's multi-start spans a decade either way.
 
     Parameters
