@@ -4,7 +4,9 @@
 is named in the numpydoc ``Parameters`` section of its docstring, and a function's docstring has ``Returns``
 and ``Raises`` sections. The sections are read with a small parser of numpydoc's layout (a title underlined
 with dashes; ``name : type`` at the section's indent, ``a, b : type`` for several), written here, not taken
-from the package. The ``Examples`` of the main entry points run as doctests."""
+from the package. The ``Examples`` of the main entry points run as doctests; and the site's own rewrites of the
+docstrings (docs/conf.py: attributes kept from napoleon's misreading, repository paths as links, the source pages'
+links back) do what they say."""
 
 from __future__ import annotations
 
@@ -184,3 +186,66 @@ def test_examples_run(name):
     assert test.examples, f"{name}: its Examples have no >>> lines"
     result = runner.run(test, out=lambda s: None)
     assert result.failed == 0, f"{name}: {result.failed} of {result.attempted} examples failed"
+
+
+# --- the site's rendering of the docstrings (docs/conf.py) --------------------------------------------------
+
+def _conf():
+    pytest.importorskip("sphinx")
+    ns = {"__file__": str(ROOT / "docs" / "conf.py"), "__name__": "conf"}
+    exec(compile((ROOT / "docs" / "conf.py").read_text(), "conf.py", "exec"), ns)
+    return ns
+
+
+def test_attribute_comments_are_not_read_as_type_and_text():
+    """napoleon reads an attribute's first line "force data: the sensor's offset" as the type "force data" (the
+    FitResult.sensor_offset and .removed entries of issue 44); the site keeps such docstrings as written."""
+    from sphinx.ext.napoleon import Config, _process_docstring
+    conf = _conf()
+
+    class App:
+        config = Config(napoleon_use_param=False)
+
+    text = "force data: the sensor's offset (value, stderr, ci95, unit, fitted); empty where there is none"
+    lines = [text]
+    conf["_keep_as_written"](App, "attribute", "FitResult.sensor_offset", None, {}, lines)
+    _process_docstring(App, "attribute", "FitResult.sensor_offset", None, {}, lines)
+    conf["_docstring_as_rst"](App, "attribute", "FitResult.sensor_offset", None, {}, lines)
+    assert lines == [text]
+
+
+def test_repository_paths_become_links_outside_literals():
+    conf = _conf()
+    out = conf["_linked_paths"](["See docs/models.md#friction-models and identification/start.py; not ``docs/cli.md``",
+                                 "or docs/no-such-guide.md.", "Code::", "", "    x = |v|  # docs/models.md"],
+                                bars=True)
+    assert out[0] == ("See :tfpath:`docs/models.md#friction-models` and :tfpath:`identification/start.py`; "
+                      "not ``docs/cli.md``")
+    assert out[1] == "or docs/no-such-guide.md."  # names no guide: left as text
+    assert out[4] == "    x = |v|  # docs/models.md"  # a literal block: as written
+
+
+def test_source_pages_link_back_to_the_anchor_the_page_has():
+    """viewcode's "[docs]" link is the page + "#" + one module name per source file + the name: for an object
+    documented under another module (thermofriction.simulation.output_grid, while simulate is
+    thermofriction.simulate) that anchor does not exist (31 such links were broken); the site writes the id the
+    object's page has."""
+    conf = _conf()
+    module, doc = "thermofriction.simulation", "api/generated/thermofriction.simulation.output_grid"
+
+    class Env:
+        _viewcode_modules = {module: ("code", {}, {"output_grid": doc}, "thermofriction")}
+        tf_object_ids = {(module, "output_grid", doc): "thermofriction.simulation.output_grid"}
+
+    class App:
+        env = Env()
+
+        class builder:
+            @staticmethod
+            def get_relative_uri(frm, to):
+                return "../../" + to + ".html"
+
+    page = "../../" + doc + ".html"
+    context = {"body": f'<a class="viewcode-back" href="{page}#thermofriction.output_grid">[docs]</a>'}
+    conf["_fix_backlinks"](App, "_modules/thermofriction/simulation", "page.html", context, None)
+    assert context["body"] == f'<a class="viewcode-back" href="{page}#thermofriction.simulation.output_grid">[docs]</a>'
