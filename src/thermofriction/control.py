@@ -75,7 +75,24 @@ OBSERVED_MODELS = ("lugre", "dahl", "elastoplastic")
 
 @dataclass(frozen=True)
 class PID:
-    """u = kp e + ki int e + kd de/dt (derivative filtered with time constant ``tau_d``), e = x_ref - x."""
+    """u = kp e + ki int e + kd de/dt (derivative filtered with time constant ``tau_d``), e = x_ref - x.
+
+    Parameters
+    ----------
+    kp : float
+        The proportional gain [N/m].
+    ki : float
+        The integral gain [N/(m s)].
+    kd : float
+        The derivative gain [N s/m].
+    tau_d : float, default 0.0
+        The derivative filter's time constant [s], >= 0 (0: unfiltered).
+
+    Raises
+    ------
+    InputError
+        A gain that is not a finite number, or a negative ``tau_d``, named.
+    """
 
     kp: float
     ki: float
@@ -94,7 +111,20 @@ def _temperature(where: str, temperature):
 
 @dataclass(frozen=True)
 class FeedForward:
-    """u_ff = F(v_ref, T) from ``model`` told ``temperature`` (None: the stage's, i.e. measured)."""
+    """u_ff = F(v_ref, T) from ``model`` told ``temperature`` (None: the stage's, i.e. measured).
+
+    Parameters
+    ----------
+    model : Model
+        The friction model used for compensation.
+    temperature : float, optional
+        The temperature [C] the model is told; None: the stage's (measured).
+
+    Raises
+    ------
+    InputError
+        Not a Model, or a temperature that is not a number, named.
+    """
 
     model: Model
     temperature: float | None = None
@@ -112,7 +142,22 @@ class Observer:
 
     The observer estimates a bristle deflection, so ``model`` must have one: LuGre, Dahl or
     elasto-plastic. Coulomb and Stribeck have no state to observe (use ``FeedForward``); GMS has one
-    per element and no published observer. ``gain`` [1/s] >= 0 (0: no correction)."""
+    per element and no published observer. ``gain`` [1/s] >= 0 (0: no correction).
+
+    Parameters
+    ----------
+    model : Model
+        The model, with a LuGre, Dahl or elasto-plastic friction model.
+    gain : float, default 100.0
+        The observer gain [1/s], >= 0.
+    temperature : float, optional
+        The temperature [C] the model is told; None: the stage's (measured).
+
+    Raises
+    ------
+    InputError
+        Not a Model, a friction model without a bristle state, a negative gain, named.
+    """
 
     model: Model
     gain: float = 100.0
@@ -131,7 +176,19 @@ class Observer:
 
 @dataclass(frozen=True)
 class Reference:
-    """A position reference sampled at the control period: time, position x_ref, velocity v_ref."""
+    """A position reference sampled at the control period: time, position x_ref, velocity v_ref.
+
+    Parameters
+    ----------
+    name : str
+        The reference's name in tables.
+    time : numpy.ndarray
+        The control instants [s].
+    position : numpy.ndarray
+        x_ref [m].
+    velocity : numpy.ndarray
+        v_ref [m/s].
+    """
 
     name: str
     time: np.ndarray
@@ -150,7 +207,28 @@ def _check_length(where, duration, dt):
 
 
 def sine_reference(amplitude: float, frequency: float, duration: float, dt: float = 1e-4) -> Reference:
-    """x_ref = amplitude (1 - cos(2 pi f t)): starts at rest at 0, reverses every half period."""
+    """x_ref = amplitude (1 - cos(2 pi f t)): starts at rest at 0, reverses every half period.
+
+    Parameters
+    ----------
+    amplitude : float
+        [m]; the reference spans 0 to 2 amplitude.
+    frequency : float
+        [Hz], > 0.
+    duration : float
+        [s], > 0.
+    dt : float, default 1e-4
+        The control period [s], > 0.
+
+    Returns
+    -------
+    Reference
+
+    Raises
+    ------
+    InputError
+        A value that is not a finite number or out of range, named; more samples than the limit.
+    """
     where = "sine_reference"
     amplitude, frequency = _number(where, "amplitude", amplitude), _number(where, "frequency", frequency, positive=True)
     duration, dt = _number(where, "duration", duration, positive=True), _number(where, "dt", dt, positive=True)
@@ -162,7 +240,28 @@ def sine_reference(amplitude: float, frequency: float, duration: float, dt: floa
 
 
 def point_to_point(distance: float, move_time: float, dwell: float, dt: float = 1e-4) -> Reference:
-    """A quintic (minimum-jerk) move of ``distance`` in ``move_time``, a dwell, and back the same way."""
+    """A quintic (minimum-jerk) move of ``distance`` in ``move_time``, a dwell, and back the same way.
+
+    Parameters
+    ----------
+    distance : float
+        [m].
+    move_time : float
+        Each move's duration [s], > 0.
+    dwell : float
+        The rest between the moves [s], >= 0.
+    dt : float, default 1e-4
+        The control period [s], > 0.
+
+    Returns
+    -------
+    Reference
+
+    Raises
+    ------
+    InputError
+        A value that is not a finite number or out of range, named; more samples than the limit.
+    """
     where = "point_to_point"
     distance, move_time = _number(where, "distance", distance), _number(where, "move_time", move_time, positive=True)
     dwell, dt = _number(where, "dwell", dwell, minimum=0.0), _number(where, "dt", dt, positive=True)
@@ -181,7 +280,21 @@ def point_to_point(distance: float, move_time: float, dwell: float, dt: float = 
 
 @dataclass(eq=False)
 class LoopResult(Result):
-    """One closed-loop run, per control period (plain arrays, SI)."""
+    """One closed-loop run, per control period (plain arrays, SI).
+
+    Parameters
+    ----------
+    time : numpy.ndarray
+        The control instants [s].
+    reference, position : numpy.ndarray
+        x_ref and the stage's x [m].
+    control : numpy.ndarray
+        The controller's force [N], compensation included.
+    compensation : numpy.ndarray
+        The friction compensation's share [N].
+    stats : dict, default {}
+        The run's costs.
+    """
 
     time: np.ndarray
     reference: np.ndarray
@@ -229,7 +342,34 @@ DEFAULT_PID = PID(kp=4e4, ki=4e5, kd=280.0, tau_d=2e-4)
 def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid: PID = DEFAULT_PID,
                   compensation: FeedForward | Observer | None = None, substeps: int = 10) -> LoopResult:
     """The closed loop of control.h: the C core runs every control period (fixed step, ``reference``'s
-    sampling) and ``substeps`` plant steps within it."""
+    sampling) and ``substeps`` plant steps within it.
+
+    Parameters
+    ----------
+    stage : Model
+        The stage: a model with a single-mass plant.
+    reference : Reference
+        The position reference.
+    temperature : float
+        The stage's temperature [C].
+    pid : PID, default DEFAULT_PID
+        The feedback controller.
+    compensation : FeedForward or Observer, optional
+        The friction compensation; None: none.
+    substeps : int, default 10
+        Plant steps per control period.
+
+    Returns
+    -------
+    LoopResult
+
+    Raises
+    ------
+    InputError
+        A stage that is not a single mass, a reference or argument of the wrong type or value, named.
+    SolverError
+        The closed loop went unstable (a non-finite position).
+    """
     where = "simulate_loop"
     _model(where, "stage", stage)
     if not isinstance(stage.plant, MassPlant):
@@ -275,8 +415,31 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
 
 def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None):
     """The real-time model (realtime.h: tf_rt_step) stepped at ``dt`` through the sliding velocities
-    ``velocity`` (one per step, held over it) at ``temperature`` (a number, or one per step):
-    returns (forces, seconds spent in C)."""
+    ``velocity`` (one per step, held over it) at ``temperature``.
+
+    Parameters
+    ----------
+    model : Model
+        The friction model.
+    velocity : array_like
+        The sliding velocity [m/s], one per step.
+    dt : float
+        The step [s], > 0.
+    temperature : float or array_like, optional
+        The temperature [C], one value or one per step; required for a thermal model.
+
+    Returns
+    -------
+    tuple
+        (forces [N] as a numpy.ndarray, seconds spent in C).
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; a temperature where the model is invalid.
+    SolverError
+        The real-time step failed.
+    """
     where = "friction_steps"
     _model(where, "model", model)
     if not isinstance(velocity, (list, tuple, np.ndarray)) or not len(velocity) or np.asarray(velocity).dtype.kind not in "iuf":
@@ -320,7 +483,36 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
                          observer_gain: float = 100.0, pid: PID = DEFAULT_PID):
     """Tracking errors with no compensation, temperature-blind compensation (the model told
     ``calibration``) and temperature-aware compensation (told the stage's temperature), feed-forward
-    and observer, for each reference and stage temperature. Returns a list of row dicts."""
+    and observer, for each reference and stage temperature.
+
+    Parameters
+    ----------
+    stage : Model
+        The stage (a single-mass plant).
+    references : list of Reference
+        The references tracked.
+    temperatures : sequence of float, default (30.0, 41.5)
+        The stage's temperatures [C].
+    calibration : float, default 30.0
+        The temperature [C] the blind compensation is told.
+    observer_gain : float, default 100.0
+        The observer's gain [1/s].
+    pid : PID, default DEFAULT_PID
+        The feedback controller.
+
+    Returns
+    -------
+    list of dict
+        One row per reference, temperature and compensation: ``reference``, ``temperature``,
+        ``compensation``, ``rms_error`` [m], ``max_error`` [m], ``result`` (the LoopResult).
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named.
+    SolverError
+        A closed-loop run went unstable.
+    """
     where = "compare_compensation"
     _model(where, "stage", stage)
     if not (isinstance(references, (list, tuple)) and references and all(isinstance(r, Reference) for r in references)):

@@ -66,7 +66,23 @@ class NoWindowsBinaryWarning(UserWarning):
 
 def binary_path(platform_name: str = "linux64") -> Path:
     """The installed FMI binary (FMI 2 and 3 in one): ``"linux64"``, built with the package on Linux, or
-    ``"win64"``, the DLL cross-compiled with MinGW-w64 when the package was built where it is installed."""
+    ``"win64"``, the DLL cross-compiled with MinGW-w64 when the package was built where it is installed.
+
+    Parameters
+    ----------
+    platform_name : {"linux64", "win64"}, default "linux64"
+        The platform; any other name is taken as "linux64".
+
+    Returns
+    -------
+    pathlib.Path
+        The binary's path inside the installed package (the win64 one may not exist: ``.is_file()``).
+
+    Raises
+    ------
+    None
+        Nothing is checked.
+    """
     return Path(str(resources.files("thermofriction"))) / "_fmu" / (_DLL if platform_name == "win64" else _BINARY)
 
 
@@ -186,21 +202,57 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
                source: str | None = None, solver: str = "adaptive", step: float | None = None,
                fmi: int = 2, platforms=None, integrator: str | None = None) -> Path | Target:
-    """Writes ``model`` (a Model, a model file or a preset name) as an FMI 2.0 (``fmi=2``, the default) or
-    FMI 3.0 (``fmi=3``) co-simulation FMU to ``path`` (docs/fmu.md) with its C sources (``sources/``: an
-    importer compiles them for its own platform) and binaries. ``platforms``: None (default) for the binaries
-    built with the package, linux64 and, when it was built with the MinGW-w64 cross compiler, win64 (else a
-    NoWindowsBinaryWarning says so); or a list of ``"linux64"``, ``"win64"`` to build now with this machine's
-    compilers (cc, x86_64-w64-mingw32-gcc; a ComputationError names each platform that could not be built
-    and why, and nothing is written); ``[]`` for the sources only. ``temperature``: the start value of the
-    temperature input [degC] (with a
-    heat model, of the ambient temperature; default: the model's T_amb, else the laws' range's low end).
-    ``model_identifier``: the binary's name inside the FMU (default: from the model's name).
-    ``source``: where the model came from (a file or preset name), for the FMU's description.
-    ``solver``: "adaptive" (default: the core's error-controlled integrator between communication
-    points) or "realtime" (fixed steps of ``step`` seconds: the core's real-time friction step and
-    semi-implicit Euler for the plant; docs/fmu.md#solvers). ``integrator``: ``solver``'s earlier name
-    (deprecated)."""
+    """Writes ``model`` as an FMI 2.0 or FMI 3.0 co-simulation FMU to ``path`` (docs/fmu.md), with its C sources
+    (``sources/``: an importer compiles them for its own platform) and binaries.
+
+    Parameters
+    ----------
+    model : Model or str or os.PathLike
+        The model: a Model, a model file or a preset name.
+    path : str or os.PathLike
+        The ``.fmu`` file written (atomically: all of it or nothing).
+    temperature : float, optional
+        The start value of the temperature input [C] (with a heat model, of the ambient temperature); default
+        the model's T_amb, else the low end of the laws' range.
+    model_identifier : str, optional
+        The binary's name inside the FMU: letters, digits and ``_``, not starting with a digit; default from
+        the model's name.
+    source : str, optional
+        Where the model came from (a file or preset name), for the FMU's description.
+    solver : {"adaptive", "realtime"}, default "adaptive"
+        "adaptive": the core's error-controlled integrator between communication points; "realtime": fixed
+        steps of ``step`` seconds, the core's real-time friction step and semi-implicit Euler for the plant
+        (docs/fmu.md#solvers).
+    step : float, optional
+        The fixed step [s] of the "realtime" solver.
+    fmi : {2, 3}, default 2
+        The FMI standard's version.
+    platforms : list of str, optional
+        None (default): the binaries built with the package, linux64 and, when it was built with the MinGW-w64
+        cross compiler, win64 (else a NoWindowsBinaryWarning says so); a list of ``"linux64"``, ``"win64"`` to
+        build now with this machine's compilers (cc, x86_64-w64-mingw32-gcc); ``[]`` for the sources only.
+    integrator : str, optional
+        Deprecated: ``solver``'s earlier name.
+
+    Returns
+    -------
+    pathlib.Path
+        The FMU's path.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; what an FMU cannot carry (a sampled external heat, a
+        law with more points than the binary holds), named with what to do; a path that is a folder or cannot
+        be written; an unknown platform.
+    ComputationError
+        A platform asked for that could not be built, each named with why; nothing is written.
+
+    Warns
+    -----
+    NoWindowsBinaryWarning
+        The installation has no win64 binary: the FMU carries linux64 only.
+    """
     solver = _solver(solver, integrator)
     model, source, temperature, step, platforms = _checked(model, path, temperature, model_identifier, source,
                                                            solver, step, fmi, platforms)

@@ -233,11 +233,30 @@ def description_xml2(model: Model, variables, identifier: str, guid: str, source
 
 
 def default_experiment(model: Model, step: float | None = None) -> tuple[float, float, str]:
-    """The FMU's default experiment (stop time [s], communication step [s], why): a step that resolves the
-    model's ``[input]``: 1/200 of its period and 1/20 of its shortest ramp (a sawtooth's fall or rise, a
-    square's or step's slew, the closest samples), over two periods (a step: until ten slews after it; no
-    periodic input: 1 s). Without an ``[input]``: 0.1 ms over 1 s. With the realtime integrator the step is
-    a whole number of its fixed steps (at least one). docs/fmu.md#the-default-experiment says why."""
+    """The FMU's default experiment: a step that resolves the model's ``[input]``.
+
+    1/200 of its period and 1/20 of its shortest ramp (a sawtooth's fall or rise, a square's or step's slew,
+    the closest samples), over two periods (a step: until ten slews after it; no periodic input: 1 s). Without
+    an ``[input]``: 0.1 ms over 1 s. With the realtime integrator the step is a whole number of its fixed
+    steps (at least one). docs/fmu.md#the-default-experiment-and-held-inputs says why.
+
+    Parameters
+    ----------
+    model : Model
+        The model exported.
+    step : float, optional
+        The realtime integrator's fixed step [s]; None for the adaptive one.
+
+    Returns
+    -------
+    tuple
+        (stop time [s], communication step [s], why: the sentence the FMU's description carries).
+
+    Raises
+    ------
+    None
+        Nothing is checked here: ``export_fmu`` checks its arguments first.
+    """
     w = model.input
     stop, why = 1.0, "no [input] in the model: 0.1 ms"
     candidates = []

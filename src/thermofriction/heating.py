@@ -45,7 +45,26 @@ class TwoTimeScale:
     balance alone (at ``controller``'s relative tolerance, default 1e-8). The table spans the start and ambient
     temperatures and the steady state the heat balance predicts; it grows by itself if the temperature leaves
     it. (``rtol=``, the earlier way to give the tolerance, still works with a DeprecationWarning: tolerances are
-    given by a StepSizeController everywhere.)"""
+    given by a StepSizeController everywhere.)
+
+    Parameters
+    ----------
+    points : int, default 17
+        The table's temperatures (>= 4).
+    warmup_cycles : int, default 6
+        Cycles to reach the periodic state at each (>= 1).
+    measure_cycles : int, default 4
+        Cycles averaged over at each (>= 1).
+    controller : StepSizeController, optional
+        Its relative tolerance is the heat balance's; default 1e-8.
+    rtol : float, optional
+        Deprecated (DeprecationWarning): the earlier way to give the tolerance.
+
+    Raises
+    ------
+    InputError
+        Fewer points or cycles than said, named.
+    """
 
     points: int = 17
     warmup_cycles: int = 6
@@ -69,7 +88,13 @@ class TwoTimeScale:
 
 @dataclass(frozen=True)
 class Full:
-    """The fully coupled simulation through every cycle (``simulate`` with the heat model)."""
+    """The fully coupled simulation through every cycle (``simulate`` with the heat model).
+
+    Parameters
+    ----------
+    controller : StepSizeController, optional
+        Tolerances and step limits of the simulation; default ``simulate``'s.
+    """
 
     controller: StepSizeController | None = None
     name = "full"
@@ -77,7 +102,21 @@ class Full:
 
 @dataclass(eq=False)
 class CycleTable:
-    """Per-cycle quantities of the fast model at fixed temperatures (periodic steady state)."""
+    """Per-cycle quantities of the fast model at fixed temperatures (periodic steady state).
+
+    Parameters
+    ----------
+    temperature : numpy.ndarray
+        The temperatures [C].
+    step_size : numpy.ndarray
+        The end effector's displacement per cycle [m] at each.
+    cycle_work : numpy.ndarray
+        The friction work per cycle, the integral of abs(F v_r) [J], at each.
+    frequency : float
+        The input's frequency [Hz].
+    startup : numpy.ndarray, optional
+        The warm-up's displacement from rest beyond its periodic steps [m], at each.
+    """
 
     temperature: np.ndarray  # [degC]
     step_size: np.ndarray    # end-effector displacement per cycle [m]
@@ -98,7 +137,29 @@ class HeatingResult(Result):
     the cycle that starts there (two-time-scale: s(T) at that temperature; full: the simulated
     cycle, the last sample repeating the last cycle's); ``friction_work`` the work of friction
     from the start. ``table`` is the two-time-scale method's CycleTable (None for ``Full``);
-    ``stats`` its costs (seconds, fast cycles simulated)."""
+    ``stats`` its costs (seconds, fast cycles simulated).
+
+    Parameters
+    ----------
+    time : numpy.ndarray
+        The sampled cycle starts [s].
+    temperature : numpy.ndarray
+        The interface temperature [C] there.
+    displacement : numpy.ndarray
+        The end effector's displacement [m] there.
+    step_size : numpy.ndarray
+        The step [m] of the cycle that starts there.
+    friction_work : numpy.ndarray
+        The friction work [J] from the start.
+    frequency : float
+        The input's frequency [Hz].
+    method : str
+        "two-time-scale" or "full".
+    table : CycleTable, optional
+        The two-time-scale method's table; None for ``Full``.
+    stats : dict, default {}
+        The method's costs (seconds, fast cycles simulated).
+    """
 
     time: np.ndarray
     temperature: np.ndarray
@@ -152,7 +213,32 @@ def cycle_table(model: Model, input: Waveform, temperatures, warmup_cycles: int 
     """Step per cycle and friction work per cycle of ``model`` (its heat model removed) at each
     fixed temperature: simulated from rest for warmup + measure cycles, averaged over the last
     ``measure_cycles``. ``startup`` is the extra displacement of the first warmup cycles from rest
-    over the periodic steps (one value per temperature)."""
+    over the periodic steps (one value per temperature).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    input : Waveform
+        A periodic drive.
+    temperatures : sequence of float
+        The fixed temperatures [C].
+    warmup_cycles : int, default 6
+        Cycles simulated to reach the periodic state (>= 0).
+    measure_cycles : int, default 4
+        Cycles averaged over (>= 1).
+
+    Returns
+    -------
+    CycleTable
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named.
+    SolverError
+        A simulation failed.
+    """
     _args.model(model, Model)
     _args.instance(input, Waveform, "input", "a periodic Waveform")
     temperatures = _args.number_list(temperatures, "temperatures", "C")
@@ -180,10 +266,35 @@ def simulate_heating(model: Model, duration: float, *, input: Waveform | None = 
                      solver=None, samples: int = 1000, method=None) -> HeatingResult:
     """Simulates ``duration`` seconds of periodic operation of a model with a [heat] section.
 
-    temperature: the ambient temperature [degC] (default: the model's T_amb).
-    solver: ``TwoTimeScale()`` (default) or ``Full()``. (``method=``, its earlier name, still works with a
-        DeprecationWarning: ``method`` names the identification method only.)
-    samples: the result holds about this many cycle starts, evenly spread.
+    Parameters
+    ----------
+    model : Model
+        A model with a heat model (docs/models.md#self-heating).
+    duration : float
+        The run's length [s], > 0 and at least one cycle of the input.
+    input : Waveform, optional
+        The periodic drive; default the model's ``[input]``.
+    temperature : float, optional
+        The ambient temperature [C]; default the model's T_amb.
+    solver : TwoTimeScale or Full, optional
+        ``TwoTimeScale()`` (default) or ``Full()``.
+    samples : int, default 1000
+        The result holds about this many cycle starts, evenly spread.
+    method : TwoTimeScale or Full, optional
+        Deprecated (DeprecationWarning): ``solver``'s earlier name.
+
+    Returns
+    -------
+    HeatingResult
+        Temperature, displacement, step per cycle and friction work at the sampled cycle starts.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; a model without a [heat] section; a duration shorter
+        than one cycle; both ``solver`` and ``method``.
+    SolverError
+        A simulation failed.
     """
     if method is not None:
         warnings.warn("simulate_heating(method=...) is now simulate_heating(solver=...)", DeprecationWarning,

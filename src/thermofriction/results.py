@@ -1,4 +1,4 @@
-"""The protocol every result of the package follows (docs/architecture.md#results): one source, ``to_dict()``,
+"""The protocol every result of the package follows (docs/architecture.md): one source, ``to_dict()``,
 and the same views of it everywhere.
 
 - ``to_dict()``: the result as JSON-able data (each result implements it);

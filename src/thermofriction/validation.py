@@ -21,7 +21,19 @@ from .unit_scale import unit_warnings
 
 @dataclasses.dataclass
 class Failure:
-    """An experiment the model could not be run on, and why."""
+    """An experiment the model could not be run on, and why.
+
+    Parameters
+    ----------
+    file : str
+        The experiment's file.
+    temperature : float
+        Its temperature [C].
+    role : {"fit", "validate"}
+        Its role in the dataset.
+    reason : str
+        Why the model could not be run on it (the error's message).
+    """
 
     file: str
     temperature: float
@@ -33,14 +45,53 @@ class Failure:
 
 
 def predict(model: Model, exp, rtol=1e-8):
-    """Simulates one experiment and computes its metrics, as its measurement says."""
+    """Simulates one experiment and computes its metrics, as its measurement says.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    exp : Experiment or ForceExperiment
+        The experiment.
+    rtol : float, default 1e-8
+        The simulation's relative tolerance.
+
+    Returns
+    -------
+    Prediction or ForcePrediction
+        The measured and predicted records and the metrics (docs/formats.md#validation-metrics).
+
+    Raises
+    ------
+    InputError
+        A model that cannot predict the experiment (its plant or temperature range), named.
+    SolverError
+        The simulation failed.
+    """
     return measurement_of([exp]).predict(model, exp, rtol)
 
 
 @dataclasses.dataclass
 class ValidationResult(Result):
     """What :func:`validate` returns: the model, one Prediction per experiment with its metrics, the warnings,
-    and the experiments it could not be run on; a table in a notebook, ``to_json``, ``to_dataframe``, ``plot``."""
+    and the experiments it could not be run on; a table in a notebook, ``to_json``, ``to_dataframe``, ``plot``.
+
+    Parameters
+    ----------
+    model : Model
+        The model scored.
+    predictions : list of Prediction or ForcePrediction
+        One per experiment run, with its metrics.
+    warnings : list of str
+        "FILE: message": temperatures outside a law's calibrated range, records a power of 1000 off.
+    failures : list of Failure, default []
+        The experiments the model could not be run on, with why; the others are still computed.
+    measurement : Measurement, optional
+        What was measured: it gives the metrics, the table's columns and what the RMSE has had removed.
+    scored_as : dict, default {}
+        How the model was scored: the offset policy and the motion, each with where it came from ("the fit
+        record", "asked", "the default").
+    """
 
     model: Model
     predictions: list
@@ -214,14 +265,48 @@ def _scoring(model, exps, offset, motion):
 def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
              ripple_phase="auto") -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
-    errors (docs/formats.md#validation-metrics) as the data's measurement says (displacement: about each run's
-    zero; force: with the model's sensor offset, or with ``offset="per-experiment"`` each run's own, estimated on
-    it, held-out runs included). ``offset`` and ``motion`` ("position", "velocity", "auto": what drives force
-    experiments) default to the model's fit record, so a fitted model is scored the way ``identify`` scored it;
-    ``scored_as`` says how. ``ripple_phase``: force data's position ripple at the recorded angle ("recorded"), at
-    each run's own phase, estimated on it ("per-run"), or "auto" (per-run where every run starts at 0). Temperatures
-    outside a law's calibrated range are reported as warnings, and so
-    is a record whose span is a power of 1000 off the prediction's (unit_scale.py; also a UnitWarning)."""
+    errors (docs/formats.md#validation-metrics) as the data's measurement says.
+
+    Displacement: about each run's zero; force: with the model's sensor offset, or with
+    ``offset="per-experiment"`` each run's own, estimated on it, held-out runs included. Temperatures outside a
+    law's calibrated range are reported as warnings, and so is a record whose span is a power of 1000 off the
+    prediction's (unit_scale.py; also a UnitWarning).
+
+    Parameters
+    ----------
+    model : Model
+        The model to score (``FitResult.model`` for a fit).
+    data : Dataset
+        The measurements (``load_dataset``).
+    experiments : Dataset or list of Experiment, optional
+        The experiments to predict; default every experiment of ``data`` (fit and held out).
+    offset : {"shared", "per-experiment", "none"} or bool, optional
+        Force data: how the sensor offset is taken; default the model's fit record (so that a fitted model is
+        scored the way ``identify`` scored it), else the model's own offset.
+    motion : {"position", "velocity", "auto"}, optional
+        Force data: what drives the experiments; default the model's fit record, else "auto".
+    ripple_phase : {"auto", "recorded", "per-run"}, default "auto"
+        Force data's position ripple at the recorded angle ("recorded"), at each run's own phase, estimated on it
+        ("per-run"), or per-run where every run starts at 0 ("auto").
+
+    Returns
+    -------
+    ValidationResult
+        One prediction per experiment with its metrics (RMSE in the data's unit, relative errors), the
+        warnings, and ``scored_as``: how the offset and motion were chosen.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; a dataset without experiments; a model that cannot predict
+        these data (a stick-slip actuator for force data, say), or an ``offset`` or ``motion`` that does not
+        apply.
+
+    Warns
+    -----
+    UnitWarning
+        A record a power of 1000 off the model's prediction.
+    """
     _args.model(model, Model)
     _args.dataset(data, Dataset, experiments=True)
     _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)

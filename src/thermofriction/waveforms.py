@@ -79,7 +79,37 @@ class Zero(Waveform):
 class Sawtooth(Waveform):
     """Rises linearly for ``rise`` of each period from ``offset`` to ``offset + amplitude``,
     falls linearly in the rest. ``direction=-1`` mirrors it in time (fast rise, slow fall),
-    which drives a stick-slip actuator the other way with the same, unipolar voltage range."""
+    which drives a stick-slip actuator the other way with the same, unipolar voltage range.
+
+    Parameters
+    ----------
+    amplitude : float
+        The rise, in the input's unit (V for an actuator's voltage, N for a mass's force, m or rad for a prescribed motion,
+        W for an external heat).
+    frequency : float
+        The frequency [Hz], > 0.
+    rise : float, default 0.99
+        The fraction of each period spent rising, between 0 and 1.
+    offset : float, default 0.0
+        The low level, in the same unit as ``amplitude``.
+    direction : {1, -1}, default 1
+        -1 mirrors the waveform in time (fast rise, slow fall).
+
+    Raises
+    ------
+    InputError
+        A field that is not a finite number or out of its range, named with the waveform
+        (``sawtooth: 'rise' must be between 0 and 1``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> w = tf.Sawtooth(amplitude=30.0, frequency=5.0, rise=0.5)
+    >>> w.period
+    0.2
+    >>> [round(float(x), 9) for x in w([0.0, 0.05, 0.1])]
+    [0.0, 15.0, 30.0]
+    """
 
     amplitude: float
     frequency: float
@@ -112,7 +142,31 @@ class Sawtooth(Waveform):
 
 @dataclass(frozen=True)
 class Sine(Waveform):
-    """``offset + amplitude * sin(2 pi frequency t)``: starts at ``offset``, rising."""
+    """``offset + amplitude * sin(2 pi frequency t)``: starts at ``offset``, rising.
+
+    Parameters
+    ----------
+    amplitude : float
+        The amplitude, in the input's unit (V for an actuator's voltage, N for a mass's force, m or rad for a prescribed motion,
+        W for an external heat).
+    frequency : float
+        The frequency [Hz], > 0.
+    offset : float, default 0.0
+        The mean level, in the same unit as ``amplitude``.
+
+    Raises
+    ------
+    InputError
+        A field that is not a finite number or out of its range, named with the waveform
+        (``sawtooth: 'rise' must be between 0 and 1``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> w = tf.Sine(amplitude=2.0, frequency=10.0, offset=1.0)
+    >>> [round(float(x), 9) for x in w([0.0, 0.025])]
+    [1.0, 3.0]
+    """
 
     amplitude: float
     frequency: float
@@ -135,7 +189,28 @@ class Sine(Waveform):
 @dataclass(frozen=True)
 class Square(Waveform):
     """Between ``offset`` and ``offset + amplitude``: ramps up over ``slew`` seconds at the start
-    of each period, holds, ramps down over ``slew`` at ``duty`` of the period, holds."""
+    of each period, holds, ramps down over ``slew`` at ``duty`` of the period, holds.
+
+    Parameters
+    ----------
+    amplitude : float
+        The step between the levels, in the input's unit (V for an actuator's voltage, N for a mass's force, m or rad for a prescribed motion,
+        W for an external heat).
+    frequency : float
+        The frequency [Hz], > 0.
+    slew : float
+        The ramps' duration [s], > 0 and shorter than the high and low parts of the period.
+    offset : float, default 0.0
+        The low level, in the same unit as ``amplitude``.
+    duty : float, default 0.5
+        The fraction of the period from the start of the rise to the start of the fall, between 0 and 1.
+
+    Raises
+    ------
+    InputError
+        A field that is not a finite number or out of its range, named with the waveform
+        (``sawtooth: 'rise' must be between 0 and 1``).
+    """
 
     amplitude: float
     frequency: float
@@ -171,7 +246,26 @@ class Square(Waveform):
 @dataclass(frozen=True)
 class Step(Waveform):
     """``offset`` before ``time``, ``offset + amplitude`` after, ramped over ``slew`` seconds
-    (``slew=0``: an ideal step, which the integrator handles exactly by stopping there)."""
+    (``slew=0``: an ideal step, which the integrator handles exactly by stopping there).
+
+    Parameters
+    ----------
+    amplitude : float
+        The step, in the input's unit (V for an actuator's voltage, N for a mass's force, m or rad for a prescribed motion,
+        W for an external heat).
+    time : float, default 0.0
+        When the step starts [s].
+    slew : float, default 0.0
+        The ramp's duration [s], >= 0.
+    offset : float, default 0.0
+        The level before the step, in the same unit as ``amplitude``.
+
+    Raises
+    ------
+    InputError
+        A field that is not a finite number or out of its range, named with the waveform
+        (``sawtooth: 'rise' must be between 0 and 1``).
+    """
 
     amplitude: float
     time: float = 0.0
@@ -195,7 +289,24 @@ class Step(Waveform):
 @dataclass(frozen=True, eq=False)
 class Sampled(Waveform):
     """Linear interpolation through (time, value) pairs; held constant beyond the ends.
-    ``file`` records where the samples came from, for saving a model."""
+    ``file`` records where the samples came from, for saving a model.
+
+    Parameters
+    ----------
+    time : array_like
+        The sample times [s], finite and strictly increasing; at least two.
+    value : array_like
+        The values, in the input's unit (V for an actuator's voltage, N for a mass's force, m or rad for a prescribed motion,
+        W for an external heat); as many as ``time``.
+    file : str, optional
+        The file the samples were read from (a model file's ``sampled:file=...``).
+
+    Raises
+    ------
+    InputError
+        Arrays that are not numbers, of unequal lengths or shorter than two, non-finite, or times that do not
+        increase strictly, named with the file.
+    """
 
     time: np.ndarray
     value: np.ndarray
@@ -244,7 +355,26 @@ class Sampled(Waveform):
 
 
 def read_two_column_csv(path: Path, first: str):
-    """A CSV with a header ``first[unit]`` and one value column; time units s or ms."""
+    """A CSV with a header ``first[unit]`` and one value column; time units s or ms.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file.
+    first : str
+        The first column's name (``"time"``).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (the first column in seconds, the values).
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read or is not UTF-8 CSV, a wrong header or unit, fewer than two data rows, a
+        value that is not a number, named with the file and line.
+    """
     try:
         text = read_bytes(path, "CSV file").decode("utf-8-sig")
         reader = csv.reader(io.StringIO(text, newline=""))
@@ -298,7 +428,28 @@ _KINDS = {"sawtooth": Sawtooth, "sine": Sine, "square": Square, "step": Step}
 
 
 def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Waveform:
-    """Builds a waveform from a model file's ``[input]`` table or a parsed ``--input`` spec."""
+    """Builds a waveform from a model file's ``[input]`` table or a parsed ``--input`` spec.
+
+    Parameters
+    ----------
+    d : dict
+        ``waveform`` (the kind: sawtooth, sine, square, step, sampled) and the waveform's fields; a sampled one
+        takes ``file``, or ``time`` and ``value`` arrays.
+    where : str, default "[input]"
+        The table's place, for the messages.
+    base_dir : str or os.PathLike, optional
+        The folder a sampled waveform's relative ``file`` is read from.
+
+    Returns
+    -------
+    Waveform
+
+    Raises
+    ------
+    InputError
+        Not a table, an unknown kind or key, a bad value, a sampled file that cannot be read, named with
+        ``where``.
+    """
     if not isinstance(d, dict):
         raise InputError(f"{where}: must be a table such as {{ waveform = \"sawtooth\", amplitude = 30, frequency = 5 }}")
     d = dict(d)
@@ -339,8 +490,32 @@ def waveform_from_dict(d: dict, where: str = "[input]", base_dir=None) -> Wavefo
 
 
 def parse_waveform(spec: str) -> Waveform:
-    """Parses ``--input`` specs such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
-    ``sampled:file=u.csv``."""
+    """Parses an ``--input`` spec such as ``sawtooth:amplitude=30,frequency=5,rise=0.999`` or
+    ``sampled:file=u.csv`` (docs/formats.md): the waveform's kind, a colon, its fields as ``key=value``.
+
+    Parameters
+    ----------
+    spec : str
+        The spec; the keys are the fields of the waveform's class (``Sawtooth``, ``Sine``, ``Square``,
+        ``Step``, ``Sampled``).
+
+    Returns
+    -------
+    Waveform
+        The waveform.
+
+    Raises
+    ------
+    InputError
+        Not a string; an unknown kind or key; a value that is not a number or out of range, named
+        (``--input sawtooth:...: 'rise' must be between 0 and 1``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> tf.parse_waveform("sawtooth:amplitude=30,frequency=5,rise=0.999")
+    Sawtooth(amplitude=30.0, frequency=5.0, rise=0.999, offset=0.0, direction=1)
+    """
     if not isinstance(spec, str):
         raise InputError(f"spec must be a string, a waveform spec such as 'sawtooth:amplitude=30,frequency=5', "
                          f"got {type(spec).__name__} {shorten(spec)}")

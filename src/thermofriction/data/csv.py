@@ -114,7 +114,26 @@ def read_experiment_csv(path, with_headers: bool = False) -> dict:
     ``displacement`` and, where the file has them, ``temperature`` and ``stage_displacement``.
 
     The format is strict; any problem is one InputError naming the file and, where it applies, the
-    line (the header is line 1) and the column."""
+    line (the header is line 1) and the column.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
+    with_headers : bool, default False
+        Also return, per column, (where the file holds it, the unit its header declared), for a dataset's checks.
+
+    Returns
+    -------
+    dict
+        Column -> numpy.ndarray in SI units (s, V, m, C); with ``with_headers``, (that dict, the headers).
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read, is not UTF-8, has a bad header, unit or value, too few or too many rows, or
+        times that do not increase, named with the file, line and column.
+    """
     _args.path(path, "path")
     _args.flag(with_headers, "with_headers")
     path = Path(path)

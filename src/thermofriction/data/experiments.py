@@ -27,7 +27,17 @@ MAX_ROWS_ENV = "THERMOFRICTION_MAX_ROWS"
 
 
 def max_rows() -> int:
-    """The row limit of experiment files: ``THERMOFRICTION_MAX_ROWS`` when set, else ``MAX_ROWS``."""
+    """The row limit of experiment files: ``THERMOFRICTION_MAX_ROWS`` when set, else ``MAX_ROWS``.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    InputError
+        ``THERMOFRICTION_MAX_ROWS`` set to something that is not a positive whole number.
+    """
     text = os.environ.get(MAX_ROWS_ENV, "").strip()
     if not text:
         return MAX_ROWS
@@ -46,7 +56,36 @@ class Experiment:
 
     ``temperature`` is the manifest's value or else the mean of the recorded ``temperature_signal``;
     ``input`` is the exact waveform when the manifest gives one (``input = "sawtooth:..."``), else
-    None (the recorded ``voltage`` is the input)."""
+    None (the recorded ``voltage`` is the input).
+
+    Parameters
+    ----------
+    file : str
+        The file the run was read from (its name in the dataset's folder).
+    time : numpy.ndarray
+        The sample times [s].
+    voltage : numpy.ndarray
+        The drive's voltage [V], one per sample.
+    displacement : numpy.ndarray
+        The measured displacement [m] (of the end effector), one per sample.
+    temperature : float
+        The run's temperature [C].
+    temperature_signal : numpy.ndarray, optional
+        The recorded temperature [C], one per sample.
+    stage_displacement : numpy.ndarray, optional
+        The recorded stage displacement [m], one per sample.
+    role : {"fit", "validate"}, default "fit"
+        Whether ``identify`` fits the run or holds it out.
+    description : str, default ""
+        The manifest's note on the run.
+    input : Waveform, optional
+        The exact drive when the manifest gives one.
+    struct : str, optional
+        In a MATLAB file holding several runs, the struct holding this one (docs/formats.md#matlab-files).
+    headers : dict, optional
+        Per column read ("displacement", "force", ...): (where the file holds it, the unit its header
+        declared), what a unit warning names; None for an experiment made in memory.
+    """
 
     file: str
     time: np.ndarray
@@ -105,7 +144,22 @@ def _moving_average(x, w):
 
 @dataclasses.dataclass(eq=False)
 class Dataset:
-    """Experiments and where they came from (``path``: the folder, or None if not saved)."""
+    """Experiments and where they came from (``path``: the folder, or None if not saved).
+
+    Parameters
+    ----------
+    path : pathlib.Path, optional
+        The dataset's folder; None for a dataset made in memory.
+    name : str, optional
+        The dataset's name.
+    description : str, default ""
+        The manifest's description.
+    experiments : list of Experiment, default []
+        The runs (``fit`` and ``validate`` list them by role).
+    sha256 : tuple, optional
+        (what was hashed, SHA-256) of the files as they were loaded; it travels with the dataset, to a worker
+        on another machine too.
+    """
 
     path: Path | None = None
     name: str | None = None

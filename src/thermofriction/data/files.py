@@ -93,9 +93,25 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
     all checked; any problem is one InputError naming the file (and its line, column or
     ``[[experiment]] N`` entry).
 
-    motion: what drives the models of force experiments, "auto", "position" or "velocity"
-        (docs/force-data.md#the-motion-that-drives-the-model); given, it overrides the manifest's ``motion``
-        keys; None: the manifest's, else "auto"."""
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The dataset's folder, or its ``dataset.toml``.
+    motion : {"auto", "position", "velocity"}, optional
+        What drives the models of force experiments (docs/force-data.md#the-motion-that-drives-the-model);
+        given, it overrides the manifest's ``motion`` keys; None: the manifest's, else "auto".
+
+    Returns
+    -------
+    Dataset
+        The experiments (CSV or MATLAB files) in SI units, with their roles ("fit", "validate").
+
+    Raises
+    ------
+    InputError
+        A folder without ``dataset.toml``, a bad manifest key, a file that cannot be read or whose columns,
+        units or samples are wrong: one message naming the file and where in it.
+    """
     _args.path(path, "path")
     if motion is not None:
         check_motion_option(motion, "motion")

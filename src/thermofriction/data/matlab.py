@@ -90,14 +90,33 @@ def _vector(path, label, value) -> np.ndarray:
 
 
 def read_experiment_mat(path, struct: str | None = None, units: dict | None = None, with_headers: bool = False):
-    """Reads one experiment from a MATLAB file into SI arrays, as :func:`read_experiment_csv` does
+    """Reads one experiment from a MATLAB file into SI arrays, as ``read_experiment_csv`` does
     from a CSV file: a dict with ``time``, ``voltage``, ``displacement`` and, where present,
-    ``temperature`` and ``stage_displacement``.
+    ``temperature`` and ``stage_displacement`` (docs/formats.md#matlab-files).
 
-    struct: the name of a struct variable whose fields hold the run (default: the file's variables).
-    units: units of columns whose variable has no unit suffix (the manifest's ``units`` table,
-        e.g. ``{"displacement": "um"}``); a suffix that disagrees with it is an error.
-    with_headers: also return, per column, (where it is, its unit) for a dataset's checks."""
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.mat`` file.
+    struct : str, optional
+        The name of a struct variable whose fields hold the run; default the file's variables.
+    units : dict, optional
+        Units of columns whose variable has no unit suffix (the manifest's ``units`` table, e.g.
+        ``{"displacement": "um"}``); a suffix that disagrees with it is an error.
+    with_headers : bool, default False
+        Also return, per column, (where the file holds it, the unit its header declared), for a dataset's checks.
+
+    Returns
+    -------
+    dict
+        Column -> numpy.ndarray in SI units; with ``with_headers``, (that dict, the headers).
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read, a missing struct or variable, a bad unit or value, named with the file and
+        the variable.
+    """
     from .csv import check_columns
 
     _args.path(path, "path")

@@ -54,14 +54,35 @@ def _listed_files(folder: Path) -> list[Path]:
 def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     """Writes ``folder`` (created if needed): one CSV per experiment (``time[s],voltage[V],
     displacement[um]``, and ``temperature[C]`` and ``stage_displacement[um]`` where present, ten
-    significant digits) and ``dataset.toml``. Returns the folder and sets ``dataset.path`` to it.
+    significant digits) and ``dataset.toml``, and sets ``dataset.path`` to it.
 
     A folder that already holds a dataset is refused unless ``overwrite``; then the files its old
     manifest lists and the new one does not are removed. The files are published as a set: every
     file is written to a temporary one first; then the old manifest is removed, the CSV files are
     renamed into place and the manifest comes last. A write interrupted between those renames
-    leaves a folder without ``dataset.toml``, which :func:`load_dataset` refuses, naming the
-    temporary files left; on an error nothing is changed and folders created for it are removed."""
+    leaves a folder without ``dataset.toml``, which ``load_dataset`` refuses, naming the
+    temporary files left; on an error nothing is changed and folders created for it are removed.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        The experiments to write (``synthesize``'s, or a loaded dataset).
+    folder : str or os.PathLike
+        The dataset folder written.
+    overwrite : bool, default False
+        Replace a dataset already in ``folder``.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; a folder holding a dataset without ``overwrite``; a folder that
+        cannot be written (``OutputError``, an InputError, naming it).
+    """
     from .._io import publish_together
     _args.instance(dataset, Dataset, "dataset", "a Dataset")
     _args.path(folder, "folder")

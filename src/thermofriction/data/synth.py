@@ -64,22 +64,68 @@ def synthesize(model: Model, temperatures, *, validate=(), duration=2.0, sample_
                noise=20e-9, quantization=0.0, temperature_noise=0.0, drift=0.0, record_temperature=None,
                record_stage=False, seed=0, name=None, progress=None) -> Dataset:
     """A dataset simulated from ``model`` at each temperature (role "fit") and at each ``validate``
-    temperature (role "validate"), with realistic sensor effects:
+    temperature (role "validate"), with realistic sensor effects.
 
-    - white Gaussian displacement noise of std ``noise`` [m];
-    - a slow linear sensor drift of ``drift`` [m/s] with a random sign;
-    - quantisation of the displacement to multiples of ``quantization`` [m] (0: none);
-    - a recorded temperature column with sensor noise of std ``temperature_noise`` [C], when
-      ``record_temperature`` (default None: when ``temperature_noise`` > 0);
-    - the stage displacement, with the same noise and quantisation, when ``record_stage``.
+    The manifest's temperature is the true one. Seeded and reproducible: each experiment draws from its own
+    stream (``default_rng([seed, i])`` for the i-th fit temperature, ``[seed, j, 1]`` for the j-th validate
+    one), so adding an experiment changes no other. At most ``MAX_EXPERIMENTS`` temperatures in all.
 
-    The manifest's temperature is the true one. ``input`` defaults to the model's ``[input]``.
-    Seeded and reproducible: each experiment draws from its own stream
-    (``default_rng([seed, i])`` for the i-th fit temperature, ``[seed, j, 1]`` for the j-th
-    validate one), so adding an experiment changes no other.
+    Parameters
+    ----------
+    model : Model
+        The model simulated (an actuator or a stage driven by a voltage).
+    temperatures : sequence of float
+        The fit experiments' temperatures [C], one experiment each.
+    validate : sequence of float, default ()
+        The held-out experiments' temperatures [C].
+    duration : float, default 2.0
+        Each experiment's length [s].
+    sample_rate : float, default 10000.0
+        The sampling rate [Hz].
+    input : Waveform, optional
+        The drive; default the model's ``[input]``.
+    noise : float, default 20e-9
+        The standard deviation of the white Gaussian displacement noise [m].
+    quantization : float, default 0.0
+        The displacement quantised to multiples of it [m]; 0: none.
+    temperature_noise : float, default 0.0
+        The standard deviation of the recorded temperature's sensor noise [C].
+    drift : float, default 0.0
+        A slow linear sensor drift [m/s], with a random sign per experiment.
+    record_temperature : bool, optional
+        Record a temperature column; default when ``temperature_noise`` > 0 (always with a heat model, whose
+        temperature is an output).
+    record_stage : bool, default False
+        Record the stage displacement too, with the same noise and quantisation.
+    seed : int, default 0
+        The seed of the noise's random streams.
+    name : str, optional
+        The dataset's name; default ``"synthetic-"`` and the model's name.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each experiment.
 
-    At most :data:`MAX_EXPERIMENTS` temperatures in all. ``progress(done, total)`` is called after each
-    experiment."""
+    Returns
+    -------
+    Dataset
+        The experiments in memory (``save_dataset`` writes them as a dataset folder).
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; a model without an ``[input]`` and no ``input``; no
+        temperature; more than ``MAX_EXPERIMENTS`` temperatures; fewer than ``MIN_SAMPLES`` samples per
+        experiment.
+    SolverError
+        A simulation failed.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> model = tf.load_model("li2009-model-i")
+    >>> data = tf.synthesize(model, [30.0, 40.0], validate=[35.0], duration=0.05, sample_rate=2000.0)
+    >>> [(e.role, e.temperature) for e in data.experiments]
+    [('fit', 30.0), ('fit', 40.0), ('validate', 35.0)]
+    """
     _check_types(model, temperatures, validate, duration, sample_rate, noise, quantization, temperature_noise, drift,
                  input, record_temperature, record_stage, name)
     require_actuator(model, "synthesize")
@@ -197,7 +243,23 @@ def _float_list(text, what):
 
 
 def add_synth_command(subparsers):
-    """Registers ``thermofriction synth`` on an argparse subparsers object."""
+    """Registers ``thermofriction synth`` on an argparse subparsers object.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The command line's subcommands.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``synth`` command's parser.
+
+    Raises
+    ------
+    argparse.ArgumentError
+        A command of that name already registered.
+    """
     s = subparsers.add_parser(
         "synth", help="synthesise a measured dataset from a model, with realistic sensor effects",
         description="Simulate MODEL at each temperature and write a dataset folder (docs/formats.md#datasets: dataset.toml "
@@ -248,7 +310,24 @@ def add_synth_command(subparsers):
 
 
 def cmd_synth(args) -> int:
-    """``thermofriction synth``: writes the dataset and prints one line per file."""
+    """``thermofriction synth``: writes the dataset and prints one line per file.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (docs/cli.md#synth).
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    InputError
+        A bad option (``--duration`` that is not positive, ...), named; an output folder that cannot be
+        written.
+    """
     for opt, v in (("--duration", args.duration), ("--sample-rate", args.sample_rate)):
         if not (v > 0 and math.isfinite(v)):
             raise InputError(f"{opt} must be a positive number, got {v!r}")

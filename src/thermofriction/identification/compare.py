@@ -13,12 +13,36 @@ from .front import identify
 
 
 def compare_friction_models(data, kinds=("coulomb", "stribeck", "lugre"), init=None, *, offset=True, **opts) -> dict:
-    """Fits each friction model of ``kinds`` (method base) to the fit experiments and predicts the held-out ones:
-    ``{kind: {"aicc", "delta_aicc", "rmse", "heldout_rmse", "n_parameters", "result", "rank", "basis"}}``,
-    delta_aicc against the best, divided by the residuals' integrated autocorrelation time where they are
+    """Fits each friction model of ``kinds`` (method base) to the fit experiments and predicts the held-out ones.
+    ``delta_aicc`` is against the best, divided by the residuals' integrated autocorrelation time where they are
     correlated; ``rank`` by ``basis``: AICc, or the held-out RMSE where the residuals are far from white (an
     autocorrelation time above 2) and every model predicted the held-out runs. A model that fails to fit is
-    reported with its reason (``failed``)."""
+    reported with its reason (``failed``).
+
+    Parameters
+    ----------
+    data : Dataset
+        The measurements.
+    kinds : sequence of str, default ("coulomb", "stribeck", "lugre")
+        The friction models compared.
+    init : Model or str or os.PathLike, optional
+        The initial model, as for ``identify``.
+    offset : str or bool, default True
+        Force data: the offset policy, as for ``identify``.
+    **opts
+        Passed on to ``identify``.
+
+    Returns
+    -------
+    dict
+        ``{kind: {"aicc", "delta_aicc", "rmse", "heldout_rmse", "n_parameters", "result", "rank", "basis"}}``, or
+        ``{kind: {"failed": reason}}``.
+
+    Raises
+    ------
+    InputError
+        A dataset that cannot be validated on; a model's failure to fit is recorded, not raised.
+    """
     out = {}
     held = list(getattr(data, "validate", []))
     for kind in kinds:

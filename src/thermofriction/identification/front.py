@@ -106,41 +106,102 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
              ripple_phase="auto") -> FitResult:
     """Identifies a model from a dataset's ``fit`` experiments.
 
-    method: "plant" (xi, wn, K from the experiments that record the stage displacement), "base"
-        (one friction model for all experiments, no thermal model), "model-i" or "model-ii".
-    init: the initial model (its plant, masses and input are kept); a model, a file or a preset
-        name. Default: the paper's preset for the method. A file with a [plant] and no [friction]
-        section starts LuGre from values taken from the data (identification/start.py).
-    friction: the friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb);
-        default the initial model's. When it differs, the initial friction model is built from the
-        initial model's values (:func:`with_friction_model`).
-    parameters: the friction parameters to fit (any of the friction model's: fs, vs, sigma2, delta, z_ba, ...);
-        default the friction model's (procedures.FRICTION_FIT_PARAMETERS; LuGre: sigma0, sigma1, fc). "base" also
-        takes a Parameters object; Model I fits each named one with its own law (any other with a law in the
+    After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
+    (identification/held.py: ``fit_quality["held"]``); a contradicted one makes the fit not adequate. What was
+    measured (displacement, force, a drive's command) is the dataset's measurement (thermofriction.measurements):
+    it forms the residuals and their offsets; the steps particular to it are in identification/setup.py.
+
+    Parameters
+    ----------
+    data : Dataset
+        The measurements (``load_dataset``); its ``fit`` experiments are fitted, its ``validate`` experiments
+        held out and predicted by the fitted model.
+    method : {"model-i", "plant", "base", "model-ii", "heat"}, default "model-i"
+        "plant" (xi, wn, K from the experiments that record the stage displacement), "base" (one friction model
+        for all experiments, no thermal model), "model-i" (temperature laws of the friction parameters),
+        "model-ii" (a thermal friction term dF(T)) or "heat" (a heat model's parameters).
+    init : Model or str or os.PathLike, optional
+        The initial model (its plant, masses and input are kept): a model, a model file or a preset name.
+        Default: the paper's preset for the method. A file with a ``[plant]`` and no ``[friction]`` section
+        starts LuGre from values taken from the data (identification/start.py).
+    friction : str, optional
+        The friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb); default the
+        initial model's. When it differs, the initial friction model is built from the initial model's values
+        (``with_friction_model``).
+    parameters : list of str or Parameters, optional
+        The friction parameters to fit (any of the friction model's: fs, vs, sigma2, delta, z_ba, ...); one
+        name is that name. Default the friction model's (LuGre: sigma0, sigma1, fc). "base" also takes a
+        ``Parameters`` object; Model I fits each named one with its own law (any other with a law in the
         initial model keeps it, held); Model II fits them as its base parameters. fs is fitted as its excess
         over fc, in log space, so that fs >= fc holds by construction.
-    procedure: Model II's "direct" (default), "paper" or "both".
-    free: plant parameters fitted too, in any method but "plant", one value shared by all experiments:
-        "m_e", "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a
-        plant given in its physical form).
-    laws: Model I law kinds per parameter, e.g. {"sigma0": "exp"}; default: chosen by AICc.
-    controller: a StepSizeController whose relative tolerance the fit's simulations keep (default: rtol 1e-8);
-        ``rtol=``, the earlier way to give it, still works with a DeprecationWarning. starts: the multi-start size.
-    offset: force data only (docs/force-data.md): "shared" (default: one sensor offset fitted for all
+    free : list of str or str, default ()
+        Plant parameters fitted too, in any method but "plant", one value shared by all experiments: "m_e",
+        "m" (the masses, which the paper does not give), "xi", "wn", "K" (or "c", "k", "T_em" for a plant
+        given in its physical form); a string may list them with commas ("m_e,m").
+    procedure : {"direct", "paper", "both"}, default "direct"
+        Model II's procedure: dF(T) fitted directly on all experiments, the paper's per-temperature steps, or
+        both (the direct result, with the paper's in ``FitResult.alternatives["paper"]``).
+    laws : dict, optional
+        Model I law kinds per parameter, a kind or a list of kinds to choose from, e.g. ``{"sigma0": "exp"}``;
+        default: each chosen by AICc.
+    refine : bool, default True
+        Model I and II: end with a joint refinement of every law coefficient on all experiments together.
+    reference_temperature : float, optional
+        Model II's reference temperature T_0 [C] (method "model-ii" only); default chosen from the data.
+    controller : StepSizeController, optional
+        The step-size controller whose relative tolerance the fit's simulations keep; default rtol 1e-8.
+    starts : int, default 8
+        The multi-start size: starting points screened before the local fits (1 to ``MAX_STARTS``).
+    seed : int, default 0
+        The seed of the multi-start's Latin hypercube: the same seed, the same fit.
+    progress : callable, optional
+        Called with one line of text at each stage (the command line shows them on standard error).
+    offset : {True, "shared", "per-experiment", "none", False}, default True
+        Force data only (docs/force-data.md): "shared" (True: one sensor offset [N or N m] fitted for all
         experiments), "per-experiment" (one per run: a sensor re-zeroed between runs) or "none" (or False: the
-        initial model's ``[plant] sensor_offset`` held).
-    max_evaluations: the most model evaluations of each least-squares stage (default: the stages' own limits).
-    delay: a drive's command data only: "auto" (default: searched over a range read off the data), None or
-        "none" (0), a value held [s] (or a string with a unit, "5ms"), or a range searched, (min, max) or "MIN:MAX".
-    ripple_phase: force data with a position ripple: "recorded" (the ripple at the recorded angle), "per-run" (a
-        phase per run: positions relative to each run) or "auto" (default: per-run where every run starts at 0;
-        the choice is said among the warnings).
+        initial model's ``[plant] sensor_offset`` held). Displacement data take each run's own zero.
+    max_evaluations : int, optional
+        The most model evaluations of each least-squares stage (1 to 100000); default the stages' own limits.
+    rtol : float, optional
+        Deprecated (DeprecationWarning): the earlier spelling of ``controller=StepSizeController(rtol=...)``.
+    delay : str or float or tuple of float or None, default "auto"
+        A drive's command data only: "auto" (searched over a range read off the data), None or "none" (0), a
+        value held [s] (or a string with a unit, "5ms"), or a range searched, (min, max) [s] or "MIN:MAX".
+    ripple_phase : {"auto", "recorded", "per-run"}, default "auto"
+        Force data with a position ripple: "recorded" (the ripple at the recorded angle), "per-run" (a phase per
+        run: positions relative to each run) or "auto" (per-run where every run starts at 0; the choice is said
+        among the warnings).
 
-    After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
-    (identification/held.py: fit_quality["held"]); a contradicted one makes the fit not adequate.
+    Returns
+    -------
+    FitResult
+        The fitted model, its parameters with standard errors, 95 % intervals and correlations, the fit's
+        quality against the noise estimated from the data, its warnings, and the held-out experiments'
+        metrics.
 
-    What was measured (displacement, force) is the dataset's measurement (thermofriction.measurements):
-    it forms the residuals and their offsets; the steps particular to it are in identification/setup.py.
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named (``starts must be ...``); a method that does not apply
+        to the data's measurement; a dataset without ``fit`` experiments; an initial model that cannot be read.
+    ComputationError
+        The fit failed (its simulations or the least-squares solver); SolverError, a ComputationError, where
+        an integrator stopped.
+
+    Warns
+    -----
+    UnitWarning
+        An experiment's record a power of 1000 off what the initial model predicts for it.
+
+    Examples
+    --------
+    A Model I fit of data synthesised from the paper's actuator (a fit of some minutes):
+
+    >>> import thermofriction as tf
+    >>> truth = tf.load_model("li2009-model-i")
+    >>> data = tf.synthesize(truth, [25, 30, 35, 40, 45], validate=[37.5])  # doctest: +SKIP
+    >>> fit = tf.identify(data, method="model-i", init="li2009-base")  # doctest: +SKIP
+    >>> print(fit.report())  # doctest: +SKIP
     """
     parameters, free, rtol = _checked_types(data, method, init, friction, parameters, free, procedure, laws, refine,
                                             reference_temperature, controller, rtol, progress, offset)

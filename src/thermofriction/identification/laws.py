@@ -49,8 +49,33 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
     """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
     lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
     kind is better by more than 2 (a difference the data support). A law that leaves the physical
-    domain of ``parameter`` (e.g. sigma1 < 0) anywhere in its range is not a candidate. Returns
-    (law, table)."""
+    domain of ``parameter`` (e.g. sigma1 < 0) anywhere in its range is not a candidate.
+
+    Parameters
+    ----------
+    T : array_like
+        The temperatures [C].
+    values : array_like
+        The per-temperature estimates, in the parameter's unit.
+    stderr : array_like, optional
+        Their standard errors (the weights); default equal weights.
+    kinds : sequence of str, default ("linear", "exp")
+        The law kinds tried.
+    prefer : str, optional
+        A kind kept unless another is better by more than 2 in AICc.
+    parameter : str, optional
+        The parameter's name, for its physical domain.
+
+    Returns
+    -------
+    tuple
+        (the winning Law, {kind: {"aicc", "law", and "excluded" where it left the domain}}).
+
+    Raises
+    ------
+    InputError
+        An unknown law kind.
+    """
     T, values = np.asarray(T, float), np.asarray(values, float)
     w = np.ones_like(values)
     if stderr is not None:
@@ -112,7 +137,28 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
 
 def segmented_fit(T, values, weights=None):
     """Two linear segments meeting at an estimated breakpoint (the paper's Fig. 6): a grid
-    search over the breakpoint, linear least squares at each. Returns (breakpoint, law)."""
+    search over the breakpoint, linear least squares at each.
+
+    Parameters
+    ----------
+    T : array_like
+        The temperatures [C]; at least 4.
+    values : array_like
+        The values at them.
+    weights : array_like, optional
+        The residuals' weights; default 1.
+
+    Returns
+    -------
+    tuple
+        (the breakpoint [C], the PWL law through the ends and the breakpoint, the weighted sum of squared
+        residuals).
+
+    Raises
+    ------
+    InputError
+        Fewer than 4 temperatures.
+    """
     T, values = np.asarray(T, float), np.asarray(values, float)
     w = np.ones_like(T) if weights is None else np.asarray(weights, float)
     order = np.argsort(T)

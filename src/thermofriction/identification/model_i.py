@@ -309,9 +309,42 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
                      parameters=None, **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
     ``laws`` names one), then a joint refinement of the law coefficients on all experiments.
-    ``parameters``: the friction parameters fitted (default: procedures.default_fit_parameters), each with its
-    own law; any other with a law in ``init`` keeps it, held. ``free``: plant parameters (e.g. m_e) fitted
-    too, one value shared by all experiments (per temperature first; their median starts the joint refinement)."""
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The experiments fitted (a dataset's ``fit``).
+    init : Model
+        The initial model.
+    laws : dict, optional
+        Law kinds per parameter, a kind or a list to choose from by AICc; default each chosen by AICc.
+    refine : bool, default True
+        End with the joint refinement.
+    progress : callable, optional
+        Called with one line of text at each stage.
+    free : sequence of str, default ()
+        Plant parameters (e.g. m_e) fitted too, one value shared by all experiments (per temperature first;
+        their median starts the joint refinement).
+    measurement : Measurement, optional
+        How the residuals are formed; default the experiments' own, with its default offset policy.
+    parameters : list of str, optional
+        The friction parameters fitted, each with its own law; default the friction model's. Any other with a
+        law in ``init`` keeps it, held.
+    **opts
+        Passed on to ``fit``: ``rtol``, ``starts``, ``seed``, ``max_nfev``, ...
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    InputError
+        Bad arguments (an unknown parameter name, no parameter to fit, an initial value outside its bounds),
+        named.
+    ComputationError
+        The fit failed (SolverError where a simulation stopped).
+    """
     free = list(free)
     t0 = time.perf_counter()
     groups = temperature_groups(experiments)

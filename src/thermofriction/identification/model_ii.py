@@ -35,7 +35,43 @@ def identify_model_ii(experiments, init: Model, *, procedure="direct", reference
     against temperature by a segmented linear fit with an estimated breakpoint; displacement
     against dF by simulation; composed dF(T). ``"direct"``: dF fitted per temperature on the
     trajectories, then a law (linear or two segments by AICc) and a joint refinement.
-    ``"both"``: the direct result, with the paper's in ``alternatives["paper"]``."""
+    ``"both"``: the direct result, with the paper's in ``alternatives["paper"]``.
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The experiments fitted (a dataset's ``fit``).
+    init : Model
+        The initial model.
+    procedure : {"direct", "paper", "both"}, default "direct"
+        As above.
+    reference_temperature : float, optional
+        T_0 [C]; default chosen from the data.
+    refine : bool, default True
+        End with the joint refinement.
+    free : sequence of str, default ()
+        Plant parameters fitted too, one value shared by all experiments.
+    progress : callable, optional
+        Called with one line of text at each stage.
+    measurement : Measurement, optional
+        How the residuals are formed; default the experiments' own, with its default offset policy.
+    parameters : list of str, optional
+        The base parameters fitted; default the friction model's.
+    **opts
+        Passed on to ``fit``: ``rtol``, ``starts``, ``seed``, ``max_nfev``, ...
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    InputError
+        Bad arguments (an unknown parameter name, no parameter to fit, an initial value outside its bounds),
+        named.
+    ComputationError
+        The fit failed (SolverError where a simulation stopped).
+    """
     if procedure not in ("direct", "paper", "both"):
         raise InputError(f"Model II procedure must be 'direct', 'paper' or 'both', got {procedure!r}")
     t0 = time.perf_counter()

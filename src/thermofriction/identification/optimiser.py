@@ -268,13 +268,49 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         tight=False, progress=None, near=False, small_step=SMALL_STEP) -> FitOutcome:
     """Fits the varying parameters; returns the optimum with its residuals and Jacobian.
 
-    ``near``: the start is known to be within a standard error or so of the optimum (a refinement from
-    fits that already converged): no coarse stage at rtol 1e-6, whose integration error is of that size.
-    ``small_step``: the fit stops where the Gauss-Newton step is below this many standard errors at a
-    misfit at the noise (COARSE_STEP for a fit that only starts another one). ``max_nfev``: the most
-    evaluations of each least-squares stage (default: 40 for the coarse stage, 15 for the fine one, 60 for a
-    ``near`` or ``tight`` fit; a fit at rtol 1e-6 or looser has only the coarse stage, with its 40: with 15, a
-    start 2-3x off ran out of evaluations and went on to the multi-start, three times as many)."""
+    Parameters
+    ----------
+    model : Model
+        The model the parameters are set in.
+    params : Parameters
+        The parameters; the varying ones are fitted, from their values, within their bounds.
+    traces : list of Trace
+        The measured runs (``make_traces``).
+    rtol : float, default 1e-8
+        The simulations' relative tolerance.
+    starts : int, default 8
+        The multi-start size (1: the local fit only).
+    seed : int, default 0
+        The multi-start's seed.
+    max_nfev : int, optional
+        The most evaluations of each least-squares stage (default: 40 for the coarse stage, 15 for the fine
+        one, 60 for a ``near`` or ``tight`` fit; a fit at rtol 1e-6 or looser has only the coarse stage, with
+        its 40: with 15, a start 2-3x off ran out of evaluations and went on to the multi-start, three times as
+        many).
+    tight : bool, default False
+        Down to the solver's own floor (for checks against noise-free data), not only to the data's noise.
+    progress : callable, optional
+        Called with one line of text at each stage.
+    near : bool, default False
+        The start is known to be within a standard error or so of the optimum (a refinement from fits that
+        already converged): no coarse stage at rtol 1e-6, whose integration error is of that size.
+    small_step : float, default SMALL_STEP
+        The fit stops where the Gauss-Newton step is below this many standard errors at a misfit at the noise
+        (COARSE_STEP for a fit that only starts another one).
+
+    Returns
+    -------
+    FitOutcome
+        The optimum, its residuals and Jacobian, the counts, and where it is at a bound.
+
+    Raises
+    ------
+    InputError
+        Bad arguments (an unknown parameter name, no parameter to fit, an initial value outside its bounds),
+        named.
+    ComputationError
+        The fit failed (SolverError where a simulation stopped).
+    """
     t_start = time.perf_counter()
     varying = params.varying
     if not varying:

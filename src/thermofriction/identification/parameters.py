@@ -36,6 +36,32 @@ HEAT_PARAMETERS = {sym: (field, unit, _bridge.HEAT_PARAMETER_INDEX[sym]) for sym
 
 @dataclasses.dataclass
 class Parameter:
+    """One parameter of a fit, like lmfit's: its value, bounds, and after the fit its standard error and interval.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name: a friction parameter (``sigma0``), a law coefficient (``sigma0.b``), a plant's
+        (``m_e``), a heat model's (``C_th``) or Model II's (``dF.values[1]``).
+    value : float
+        The value, in ``unit``.
+    min, max : float, default -inf, inf
+        The bounds; a lower bound >= 0 fits the parameter in log space.
+    vary : bool, default True
+        Fitted (True) or held (False).
+    unit : str, default ""
+        The value's SI unit.
+    stderr : float, optional
+        The standard error after the fit, in ``unit``; None where not computed.
+    ci95 : tuple of float, optional
+        The 95 % interval (low, high) after the fit, in ``unit``.
+    init_value : float, optional
+        The starting value.
+    at_bound : {"lower", "upper"}, optional
+        Where the fit ended at a bound (its own, or the fit's e^+-30 around the start): the interval is then
+        one-sided, from the bound.
+    """
+
     name: str
     value: float
     min: float = -math.inf

@@ -40,7 +40,43 @@ UNITS = {"damping_ratio": "", "natural_frequency": "rad/s", "gain": "m/V"}
 @dataclasses.dataclass
 class PlantFit:
     """The fitted plant: values, standard errors and 95 % intervals (in ``parameters``, and as
-    ``stderr`` / ``ci95`` dicts), the correlation matrix of (xi, wn, K), and the fit statistics."""
+    ``stderr`` / ``ci95`` dicts), the correlation matrix of (xi, wn, K), and the fit statistics.
+
+    Parameters
+    ----------
+    damping_ratio : float
+        xi [-].
+    natural_frequency : float
+        wn [rad/s].
+    gain : float
+        K [m/V].
+    parameters : Parameters
+        xi, wn and K with their standard errors and 95 % intervals.
+    rmse : float
+        The residuals' root mean square [m].
+    n_points : int
+        The samples fitted.
+    wall_time : float
+        The fit's duration [s].
+    offset : float, default 0.0
+        The sensor's zero [m], profiled out.
+    covariance, correlation : numpy.ndarray, optional
+        Of (xi, wn, K).
+    cost : float, default nan
+        The sum of squared residuals [m^2].
+    nfev : int, default 0
+        The residuals' evaluations.
+    success : bool, default True
+        Whether the solver converged.
+    message : str, default ""
+        The solver's message.
+    hold : {"foh", "zoh"}, default "foh"
+        How the input was taken between samples.
+    warnings : list of str, default []
+        What the reader should know (strongly correlated residuals, ...).
+    statistics : dict, default {}
+        The residuals' statistics (degrees of freedom, autocorrelation, variance inflation).
+    """
 
     damping_ratio: float
     natural_frequency: float              # [rad/s]
@@ -242,10 +278,30 @@ def fit_plant(time, voltage, stage_displacement, *, initial=None, hold="foh") ->
     """Fits xi, wn [rad/s] and K [m/V] to a measured stage displacement [m] under a measured
     voltage [V] (any input that moves the stage: a step, a sawtooth...).
 
-    initial: optional (xi, wn[, K]) or dict; default: the best of a coarse grid over wn (from
-        about one period per record to the Nyquist frequency) and xi (0.01 to 3); K is always
-        solved for exactly.
-    hold: how the input behaves between samples, "foh" (linear; default) or "zoh" (constant)."""
+    Parameters
+    ----------
+    time : array_like
+        The sample times [s], strictly increasing.
+    voltage : array_like
+        The drive's voltage [V], one per sample.
+    stage_displacement : array_like
+        The stage's displacement [m], one per sample; at least 20 samples in all.
+    initial : tuple or dict, optional
+        (xi, wn[, K]) or a dict of them; default: the best of a coarse grid over wn (from about one period
+        per record to the Nyquist frequency) and xi (0.01 to 3); K is always solved for exactly.
+    hold : {"foh", "zoh"}, default "foh"
+        How the input behaves between samples: linear or constant.
+
+    Returns
+    -------
+    PlantFit
+
+    Raises
+    ------
+    InputError
+        Records of unequal length or shorter than 20 samples, non-finite values, time not increasing, a
+        constant voltage, an unknown ``hold``.
+    """
     t0 = _time.perf_counter()
     t, u, y = _checked_record(time, voltage, stage_displacement, hold)
     warns = []

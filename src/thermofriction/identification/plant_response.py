@@ -20,7 +20,33 @@ UNIFORM_TOLERANCE = 1e-6
 
 def step_response(time, xi, wn, K, amplitude, t_step=0.0):
     """Exact response of the stage, at rest at zero, to a step of ``amplitude`` volts at ``t_step``:
-    underdamped (xi < 1), critically damped or overdamped."""
+    underdamped (xi < 1), critically damped or overdamped.
+
+    Parameters
+    ----------
+    time : array_like
+        The times [s].
+    xi : float
+        The damping ratio [-].
+    wn : float
+        The natural frequency [rad/s].
+    K : float
+        The static gain [m/V].
+    amplitude : float
+        The step [V].
+    t_step : float, default 0.0
+        When the step happens [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The stage displacement [m] at ``time``.
+
+    Raises
+    ------
+    None
+        Nothing is checked (NumPy's errors for values that are not numbers).
+    """
     tau = np.clip(np.asarray(time, float) - t_step, 0.0, None)
     if xi < 1:
         r = math.sqrt(1 - xi ** 2)

@@ -204,7 +204,26 @@ class Problem:
 
 def make_traces(experiments, model: Model, measurement=None):
     """One trace per experiment, made by their measurement (default: the experiments' own, with its default
-    offset policy)."""
+    offset policy).
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The experiments.
+    model : Model
+        The model the traces are driven as (its input and temperature handling).
+    measurement : Measurement, optional
+        How the residuals are formed; default the experiments' own, with its default offset policy.
+
+    Returns
+    -------
+    list of Trace
+
+    Raises
+    ------
+    InputError
+        An experiment the measurement cannot drive the model with.
+    """
     measurement = measurement or measurement_of(experiments)
     return [measurement.make_trace(exp, model) for exp in experiments]
 

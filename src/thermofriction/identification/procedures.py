@@ -201,7 +201,25 @@ def levels_held_as_ratios(init, names, new_laws, Ts) -> dict:
 
 
 def base_model(model: Model, temperature=None) -> Model:
-    """The model without its thermal extension: a Model I's laws evaluated at ``temperature``."""
+    """The model without its thermal extension: a Model I's laws evaluated at ``temperature``.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    temperature : float, optional
+        The temperature [C] Model I's laws are evaluated at; default the middle of their range (35 C without
+        one).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    InputError
+        A law whose value is outside the parameter's physical domain there.
+    """
     if isinstance(model.thermal, ModelI):
         if temperature is None:
             lo_hi = model.temperature_range()
@@ -214,8 +232,35 @@ def base_model(model: Model, temperature=None) -> Model:
 
 def fit_friction(experiments, model: Model, parameters=None, *, method="base", measurement=None, **opts) -> FitResult:
     """Fits the named friction parameters (default sigma0, sigma1, fc) of ``model`` jointly on
-    ``experiments``: one set of values shared by all of them. ``measurement``: how the residuals are formed
-    (default: the experiments' own measurement with its default offset policy)."""
+    ``experiments``: one set of values shared by all of them.
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The experiments fitted (a dataset's ``fit``).
+    model : Model
+        The initial model.
+    parameters : list of str or Parameters, optional
+        The parameters fitted; default the friction model's.
+    method : str, default "base"
+        The method the result names.
+    measurement : Measurement, optional
+        How the residuals are formed; default the experiments' own, with its default offset policy.
+    **opts
+        Passed on to ``fit``: ``rtol``, ``starts``, ``seed``, ``max_nfev``, ...
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    InputError
+        Bad arguments (an unknown parameter name, no parameter to fit, an initial value outside its bounds),
+        named.
+    ComputationError
+        The fit failed (SolverError where a simulation stopped).
+    """
     t0 = time.perf_counter()
     if not isinstance(parameters, Parameters):  # fs named on a model without an excess: one to start from
         parameters = parameters or default_fit_parameters(model)
@@ -276,7 +321,34 @@ def identify_heat(experiments, init: Model, parameters=None, free=(), **opts) ->
     record weighted by its range, then with each weighted by its residual scatter at that first
     optimum (so that both carry unit variance, which the intervals assume), from there.
     Without a known heat input (the model's P_ext) the records fix only eta R_th and R_th C_th:
-    then one of the three gets an infinite interval and a warning, as it should."""
+    then one of the three gets an infinite interval and a warning, as it should.
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The experiments fitted, with recorded temperatures.
+    init : Model
+        The initial model, with a [heat] section.
+    parameters : list of str, optional
+        The parameters fitted: heat parameters (C_th, R_th, eta, T_0) and friction ones; default C_th, R_th,
+        eta.
+    free : sequence of str, default ()
+        Plant parameters fitted too.
+    **opts
+        Passed on to ``fit``: ``rtol``, ``starts``, ``seed``, ``max_nfev``, ...
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    InputError
+        Bad arguments (an unknown parameter name, no parameter to fit, an initial value outside its bounds),
+        named.
+    ComputationError
+        The fit failed (SolverError where a simulation stopped).
+    """
     if init.heat is None:
         raise InputError("the heat fit needs an initial model with a [heat] section (C_th, R_th, eta guesses)")
     t0 = time.perf_counter()

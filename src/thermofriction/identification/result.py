@@ -19,6 +19,61 @@ from .parameters import Parameters
 
 @dataclasses.dataclass
 class FitResult(Result):
+    """What ``identify`` returns: the fitted model, its parameters with errors and intervals, the fit's quality,
+    a readable ``report()``, the results JSON (``to_json``, docs/formats.md#results-json) and an HTML table for
+    notebooks.
+
+    Parameters
+    ----------
+    method : str
+        The identification method ("plant", "base", "model-i", "model-ii", "heat").
+    model : Model
+        The fitted model.
+    parameters : Parameters
+        The fitted and held parameters, each with its value, unit, standard error and 95 % interval.
+    correlation : numpy.ndarray
+        The correlation matrix of the fitted parameters (in ``parameters.varying``'s order).
+    cost : float
+        The sum of squared residuals [unit^2].
+    rmse : float
+        The residuals' root mean square [unit].
+    n_points : int
+        The number of residuals (samples fitted).
+    nfev, njev : int
+        The least-squares solver's evaluations of the residuals and of their Jacobian.
+    starts : int
+        The multi-start's starting points.
+    wall_time : float
+        The fit's duration [s].
+    success : bool
+        Whether the solver converged.
+    message : str
+        The solver's message.
+    experiments : list, default []
+        Per experiment: its file, temperature, role and RMSE.
+    warnings : list of str, default []
+        What the reader should know (a parameter at a bound, a held value the data contradict, ...).
+    statistics : dict, default {}
+        The residuals' statistics (degrees of freedom, autocorrelation, ...).
+    details : dict, default {}
+        What the procedure chose and why (law kinds and their AICc, the per-temperature fits, ...).
+    alternatives : dict, default {}
+        Other results of the same call (Model II ``procedure="both"``: the paper's, under "paper").
+    fit_quality : dict, optional
+        The residuals against the noise estimated from the data (measurements/quality.py), the held values'
+        tests and the verdict; None where not measured.
+    measurement : str, default "displacement"
+        The measured quantity ("displacement", "force", "command").
+    unit : str, default "m"
+        The SI unit of the residuals and the RMSE.
+    removed : str, default "each experiment's constant offset"
+        What the RMSE has had removed (the measurement's ``removed``).
+    sensor_offset : dict, default {}
+        Force data: the sensor's offset (value, stderr, ci95, unit, fitted); empty where there is none.
+    identifiability : list, default []
+        The groups of parameters the data determine only together (identification/identifiability.py).
+    """
+
     method: str
     model: Model
     parameters: Parameters

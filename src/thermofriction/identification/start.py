@@ -95,7 +95,24 @@ def with_friction_model(model: Model, kind: str) -> Model:
     and the old one lacks is derived from the level fc and the presliding stiffness sigma0 (a GMS
     model's sum of k_i; else fc over 1 um): sigma1 = 1e-6 s x sigma0, z_ba = fc / (2 sigma0),
     C = 1e4 /s x fc, and GMS elements k_i proportional to 1/i summing to sigma0, w_i = 1/4 (four
-    elements breaking loose one after the other)."""
+    elements breaking loose one after the other).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    kind : str
+        The friction model wanted (``FRICTION_MODELS``: lugre, dahl, elastoplastic, gms, stribeck, coulomb).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    InputError
+        An unknown friction model.
+    """
     if kind not in FRICTION_MODELS:
         raise InputError(f"unknown friction model '{kind}' (one of: {', '.join(FRICTION_MODELS)})")
     if model.friction.model == kind:
@@ -158,7 +175,28 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
     - the bristle stiffness sigma0 from the force's rise over the motion after each reversal (the secant
       over half the swing, times ln 2, is sigma0 for LuGre), else fc over 1/1000 of the stroke;
     - sigma1 so that its force at the typical sliding speed is a tenth of fc.
-    A rough start: the fit's multi-start spans a decade either way."""
+
+    A rough start: the fit's multi-start spans a decade either way.
+
+    Parameters
+    ----------
+    experiments : list of ForceExperiment
+        The force experiments.
+    kind : str, default "lugre"
+        The friction model.
+    plant : PrescribedMotion, optional
+        The plant (its motion: linear or rotary).
+
+    Returns
+    -------
+    dict
+        The [friction] section: "model" and the starting values, in SI units.
+
+    Raises
+    ------
+    InputError
+        No experiment; an unknown friction model.
+    """
     exps = list(getattr(experiments, "fit", experiments))
     if not exps:
         raise InputError("no experiment to take starting values from")

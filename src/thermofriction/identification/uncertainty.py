@@ -25,7 +25,30 @@ def uncertainty(params: Parameters, outcome: FitOutcome, traces, model: Model):
     error instead of a falsely tight one. Correlated residuals carry less information than as many
     independent ones: s^2 is inflated by the residuals' integrated autocorrelation time (n over the
     effective sample size, :func:`inflation_of`), and the t quantile takes the effective number of degrees of
-    freedom. Returns the correlation matrix and warnings."""
+    freedom. Returns the correlation matrix and warnings.
+
+    Parameters
+    ----------
+    params : Parameters
+        The fitted parameters; their stderr, ci95 and at_bound are set here.
+    outcome : FitOutcome
+        ``fit``'s optimum with its residuals and Jacobian.
+    traces : list of Trace
+        The runs fitted.
+    model : Model
+        The fitted model (the parameters' units).
+
+    Returns
+    -------
+    tuple
+        (correlation matrix, warnings, statistics: dof, residual_std, autocorrelation, variance_inflation,
+        effective_samples, identifiability).
+
+    Raises
+    ------
+    None
+        Nothing is checked: the arguments come from ``fit``.
+    """
     varying = params.varying
     theta, r, J = outcome.theta, outcome.r, outcome.J
     n, p = J.shape

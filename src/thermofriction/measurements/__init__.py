@@ -21,15 +21,50 @@ REGISTRY = {"command": Command, "force": Force, "displacement": Displacement}
 
 
 def kind_of(exp) -> str:
+    """The measurement an experiment records: the first of ``REGISTRY`` that recognises it.
+
+    Parameters
+    ----------
+    exp : Experiment or ForceExperiment
+        The experiment.
+
+    Returns
+    -------
+    str
+        "command", "force" or "displacement".
+
+    Raises
+    ------
+    StopIteration
+        None recognises it (cannot happen: displacement takes every experiment).
+    """
     return next(name for name, cls in REGISTRY.items() if cls.recognises(exp))
 
 
 def measurement_of(data, *, offset=None, ripple_phase="auto") -> Measurement:
-    """The measurement of ``data`` (a dataset or a list of experiments), with its offset policy: ``offset``
-    None or True for the measurement's default, a policy's name (OFFSETS: "shared", "per-experiment", "none"),
-    or False for "none" (the model's own offset, fitted by none). Force data: ``ripple_phase`` the position
-    ripple's angle (measurements/ripple.py: "recorded", "per-run", or "auto", decided from ``data`` and said in
-    the measurement's ``ripple_note``). A dataset that mixes measurements is refused."""
+    """The measurement of ``data``, with its offset policy. A dataset that mixes measurements is refused.
+
+    Parameters
+    ----------
+    data : Dataset or list of Experiment
+        The dataset or its experiments.
+    offset : str or bool, optional
+        None or True for the measurement's default, a policy's name (OFFSETS: "shared", "per-experiment",
+        "none"), or False for "none" (the model's own offset, fitted by none).
+    ripple_phase : {"auto", "recorded", "per-run"}, default "auto"
+        Force data: the position ripple's angle (measurements/ripple.py), "auto" decided from ``data`` and said in
+        the measurement's ``ripple_note``.
+
+    Returns
+    -------
+    Measurement
+        ``Displacement``, ``Force`` or ``Command``.
+
+    Raises
+    ------
+    InputError
+        A dataset that mixes measurements; an offset policy that does not apply to them; an unknown ripple phase.
+    """
     m = _measurement_of(data, offset)
     if isinstance(m, Force):
         m.ripple_phase, m.ripple_note = ripple_phase, None

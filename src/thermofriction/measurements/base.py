@@ -23,7 +23,37 @@ class Trace:
 
     With a heat model (docs/models.md#self-heating) ``temperature`` is the ambient one, the run starts at
     ``initial_temperature``, and ``measured_temperature`` (the record) is fitted too: its residuals
-    are multiplied by ``temperature_weight`` [m/K] to share the displacement residuals' scale."""
+    are multiplied by ``temperature_weight`` [m/K] to share the displacement residuals' scale.
+
+    Parameters
+    ----------
+    name : str
+        The experiment's file.
+    time : numpy.ndarray
+        The sample times [s].
+    measured : numpy.ndarray
+        The record, in ``unit``.
+    temperature : float or Sampled
+        The temperature [C] the model is driven at (the ambient one with a heat model).
+    waveform : Waveform
+        The drive.
+    role : {"fit", "validate"}, default "fit"
+        The experiment's role.
+    nominal_temperature : float, default nan
+        The manifest's temperature [C].
+    measurement : Measurement, optional
+        How the residuals are formed.
+    measured_temperature : numpy.ndarray, optional
+        The recorded temperature [C], fitted too with a heat model.
+    initial_temperature : float, default nan
+        The run's start temperature [C] with a heat model.
+    temperature_weight : float, default 1.0
+        The temperature residuals' weight [m/K].
+    held_offset : float, default 0.0
+        The offset held where the measurement's policy is "none" (a force sensor's, from the model), in ``unit``.
+    unit : str, default "m"
+        The SI unit of ``measured``.
+    """
 
     name: str
     time: np.ndarray
@@ -163,13 +193,49 @@ def thermal_check(model, traces) -> list:
 
 
 def amount(value: float, unit: str) -> str:
-    """A residual or an RMSE in its unit: metres shown in nm, N and N m as they are."""
+    """A residual or an RMSE in its unit: metres shown in nm, N and N m as they are.
+
+    Parameters
+    ----------
+    value : float
+        The value, in ``unit``.
+    unit : str
+        Its SI unit ("m", "N", "N m").
+
+    Returns
+    -------
+    str
+        E.g. ``"12.5 nm"``, ``"0.031 N"``.
+
+    Raises
+    ------
+    TypeError
+        A value that is not a number (nothing is checked).
+    """
     return f"{value * 1e9:.4g} nm" if unit == "m" else f"{value:.4g} {unit}"
 
 
 def center(r, S=None):
     """Residuals (and their Jacobian's columns) about their mean: an offset fitted by linear least squares,
-    profiled out."""
+    profiled out.
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        The residuals, in the data's unit.
+    S : numpy.ndarray, optional
+        Their Jacobian (residuals x parameters).
+
+    Returns
+    -------
+    tuple
+        (r, S) about their means (S None where not given).
+
+    Raises
+    ------
+    None
+        Nothing is checked.
+    """
     r = r - r.mean()
     if S is not None:
         S = S - S.mean(axis=0)

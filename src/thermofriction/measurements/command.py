@@ -273,7 +273,19 @@ def implied_friction(model, exp):
 
 
 class Command(Force):
-    """A drive's command (force, torque, or current times the torque constant) under a measured motion."""
+    """A drive's command (force, torque, or current times the torque constant) under a measured motion.
+
+    Parameters
+    ----------
+    offset : {"shared", "per-experiment", "none"}, default "shared"
+        The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
+        estimated on it; "none", the model's own, held.
+
+    Raises
+    ------
+    InputError
+        An offset policy that does not apply to these data.
+    """
 
     name = "command"
     quantity = "drive command (force or torque)"

@@ -36,6 +36,19 @@ FIT_PARAMETERS = {
 
 
 class Displacement(Measurement):
+    """Displacement driven by a voltage: a stick-slip actuator's end effector; each run's zero removed.
+
+    Parameters
+    ----------
+    offset : {"per-experiment"}, default "per-experiment"
+        The only policy of displacement data: each run's own zero.
+
+    Raises
+    ------
+    InputError
+        Any other offset policy (it applies to force data).
+    """
+
     name = "displacement"
     quantity = "displacement"
     plants = ("stick-slip",)
@@ -173,7 +186,27 @@ def _zero(measured, predicted):
 
 
 def step_sizes(time, x, period):
-    """Displacement over each whole period, read off by linear interpolation at k * period."""
+    """Displacement over each whole period, read off by linear interpolation at k * period.
+
+    Parameters
+    ----------
+    time : numpy.ndarray
+        The sample times [s], increasing.
+    x : numpy.ndarray
+        The displacement [m] at those times.
+    period : float or None
+        The input's period [s]; None: no periodic input.
+
+    Returns
+    -------
+    numpy.ndarray
+        The displacement [m] over each whole period in the record; empty without a period or a whole one.
+
+    Raises
+    ------
+    None
+        Nothing is checked (NumPy's errors for arrays that are not numbers).
+    """
     if period is None:
         return np.empty(0)
     k0 = math.ceil(time[0] / period - 1e-9)
@@ -185,7 +218,39 @@ def step_sizes(time, x, period):
 
 @dataclasses.dataclass
 class Prediction:
-    """One experiment: the measurement, the model's prediction and its metrics (docs/formats.md#validation-metrics)."""
+    """One experiment: the measurement, the model's prediction and its metrics (docs/formats.md#validation-metrics).
+
+    With ``e = x_sim - x_meas`` at each sample (both from zero) and ``span = max x_meas - min x_meas``:
+
+    Parameters
+    ----------
+    file : str
+        The experiment's file.
+    temperature : float
+        Its temperature [C].
+    role : {"fit", "validate"}
+        Its role in the dataset.
+    time : numpy.ndarray
+        The sample times [s].
+    measured, predicted : numpy.ndarray
+        The measured and the predicted displacement [m].
+    max_error_pct : float
+        ``100 max abs(e) / span`` [%]: Li et al.'s (2009) "maximum prediction error".
+    rmse : float
+        The root mean square of ``e`` with its mean removed [m] (the same definition as identification's).
+    nrmse : float
+        ``rmse / span`` [-].
+    final_error_pct : float
+        The final displacement's error relative to the measured net displacement, signed [%].
+    step_error_pct : float
+        ``step_error`` relative to the mean measured step [%].
+    step_error : float
+        The mean absolute difference of the steps per period [m]; NaN without a periodic input.
+    measured_steps, predicted_steps : numpy.ndarray
+        The steps per period [m] (``step_sizes``).
+    fit_quality : dict, optional
+        A fit experiment's residuals against the noise estimated from the data.
+    """
 
     file: str
     temperature: float

@@ -70,6 +70,20 @@ def _steps(model, names, theta):
 RANGE_PCT = "RMSE [% of range] = 100 RMSE / (max F_meas - min F_meas)"
 
 class Force(Measurement):
+    """A friction force or torque under a measured motion (docs/force-data.md).
+
+    Parameters
+    ----------
+    offset : {"shared", "per-experiment", "none"}, default "shared"
+        The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
+        estimated on it; "none", the model's own, held.
+
+    Raises
+    ------
+    InputError
+        An offset policy that does not apply to these data.
+    """
+
     name = "force"
     quantity = "friction force (torque)"
     plants = ("prescribed",)
@@ -346,7 +360,36 @@ class Force(Measurement):
 
 @dataclasses.dataclass
 class ForcePrediction:
-    """One force experiment: measured and predicted force [N or N m], the motion, and the metrics."""
+    """One force experiment: measured and predicted force [N or N m], the motion, and the metrics.
+
+    Parameters
+    ----------
+    file : str
+        The experiment's file.
+    temperature : float
+        Its temperature [C].
+    role : {"fit", "validate"}
+        Its role in the dataset.
+    time : numpy.ndarray
+        The sample times [s].
+    position, velocity : numpy.ndarray
+        The measured motion [m, m/s] (rad, rad/s for a joint).
+    measured, predicted : numpy.ndarray
+        The measured and predicted force, in ``unit``.
+    rmse : float
+        The root mean square of predicted minus measured (less the run's own mean under the "per-experiment"
+        offset policy), in ``unit``.
+    nrmse : float
+        ``rmse`` over the measured force's span [-].
+    max_error_pct : float
+        100 times the largest absolute error over the measured force's span [%].
+    bias : float
+        The mean of predicted minus measured, in ``unit``.
+    unit : str
+        "N" or "N m".
+    fit_quality : dict, optional
+        A fit experiment's residuals against the noise estimated from the data.
+    """
 
     file: str
     temperature: float
@@ -375,9 +418,31 @@ class ForcePrediction:
 
 
 def steady_state_curve(model: Model, velocities, temperature=None) -> np.ndarray:
-    """The model's friction force in steady sliding at each of ``velocities`` [m/s or rad/s], by simulation
-    (any friction model, any thermal form): a constant velocity held over thirty presliding lengths (g/stiffness),
-    where the bristles have long settled. Without the sensor offset."""
+    """The model's friction force in steady sliding at each of ``velocities``, by simulation (any friction model,
+    any thermal form): a constant velocity held over thirty presliding lengths (g/stiffness), where the
+    bristles have long settled. Without the sensor offset.
+
+    Parameters
+    ----------
+    model : Model
+        A prescribed-motion model.
+    velocities : array_like
+        The sliding velocities [m/s or rad/s]; 0 gives 0.
+    temperature : float, optional
+        The temperature [C]; default 25 C for the parameters, the model's own for the simulation.
+
+    Returns
+    -------
+    numpy.ndarray
+        The friction force [N or N m] at each velocity.
+
+    Raises
+    ------
+    InputError
+        A model or temperature ``simulate`` refuses.
+    SolverError
+        A simulation failed.
+    """
     p = model.parameters_at(temperature if temperature is not None else 25.0)
     stiffness = p.get("sigma0") or (sum(p["k"]) if p.get("k") is not None else None)
     level = max(p.get("fc") or 0.0, p.get("fs") or 0.0)

@@ -88,14 +88,58 @@ class _Friction(_Ripple):
 
 @dataclass(frozen=True)
 class LuGre(_Friction):
-    """LuGre friction (Canudas de Wit et al. 1995), docs/models.md#friction-models::
+    """LuGre friction (Canudas de Wit et al. 1995; docs/models.md#friction-models).
+
+    The equations::
 
         z' = v - sigma0 |v| z / g(v),   F = sigma0 z + sigma1(v) z' + sigma2 v
         g(v) = fc + (fs - fc) exp(-|v/vs|^delta),   sigma1(v) = sigma1 exp(-(v/vd)^2) if vd
 
     A parameter that follows a Model I law is None here (the law lives in the thermal model).
-    ``fs`` defaults to ``fc`` (no Stribeck effect, the paper's case). ``v_smooth`` is the velocity
-    band of the smoothed sign used by Model II's offset form.
+
+    Parameters
+    ----------
+    sigma0 : float or None
+        The bristle stiffness [N/m], > 0; None where a Model I law gives it.
+    sigma1 : float or None
+        The bristle damping [N s/m], >= 0; None where a Model I law gives it.
+    fc : float or None
+        The Coulomb level [N], > 0; None where a Model I law gives it.
+    sigma2 : float or None, default 0.0
+        The viscous coefficient [N s/m], >= 0.
+    fs : float or None, optional
+        The static (breakaway) level [N], >= fc; default fc (no Stribeck effect).
+    vs : float or None, optional
+        The Stribeck velocity [m/s], > 0; needed where fs > fc.
+    delta : float or None, default 2.0
+        The Stribeck curve's exponent [-].
+    vd : float or None, optional
+        The velocity [m/s] over which the bristle damping decays,
+        sigma1(v) = sigma1 exp(-(v/vd)^2); default none (constant sigma1).
+    v_smooth : float, default 1e-6
+        The velocity band [m/s] of the smoothed sign used by Model II's offset form.
+    fc_neg, fs_neg, vs_neg, sigma2_neg : float or None, optional
+        The values of fc, fs, vs, sigma2 [N, N, m/s, N s/m] in negative sliding (docs/models.md#direction-and-position);
+        default the positive side's.
+    ripple_period, ripple_cos1, ripple_sin1, ripple_cos2, ripple_sin2, ripple_cos3, ripple_sin3 : float or None, optional
+        Keyword-only: the position ripple, a periodic force in the sliding position x added to the model's,
+        R(x) = sum_k ripple_cosk cos(2 pi k x / P) + ripple_sink sin(2 pi k x / P), of period
+        P = ``ripple_period`` [m] and amplitudes [N] (docs/models.md#direction-and-position); default none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, named with the model (``lugre friction: 'sigma0' ...``). The physical checks
+        (fs >= fc, positive stiffness, dissipativity) need the whole model: ``Model`` does them.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> f = tf.LuGre(sigma0=1e5, sigma1=300.0, fc=0.5, fs=0.7, vs=1e-3)
+    >>> f.model, f.delta
+    ('lugre', 2.0)
+    >>> f.with_values(fc=0.6).fc
+    0.6
     """
 
     sigma0: float | None
@@ -123,7 +167,30 @@ class LuGre(_Friction):
 class Coulomb(_Friction):
     """Coulomb + viscous friction, a static map: ``F = fc s(v) + sigma2 v`` with the sign smoothed
     over ``v_smooth`` [m/s], ``s(v) = tanh(v / v_smooth)`` (no sticking: below v_smooth the
-    force is viscous-like, fc/v_smooth N s/m)."""
+    force is viscous-like, fc/v_smooth N s/m).
+
+    Parameters
+    ----------
+    fc : float or None
+        The Coulomb level [N], > 0; None where a Model I law gives it.
+    sigma2 : float or None, default 0.0
+        The viscous coefficient [N s/m], >= 0.
+    v_smooth : float or None, default 1e-6
+        The smoothed sign's velocity band [m/s].
+    fc_neg, sigma2_neg : float or None, optional
+        The values of fc [N] and sigma2 [N s/m] in negative sliding (docs/models.md#direction-and-position);
+        default the positive side's.
+    ripple_period, ripple_cos1, ripple_sin1, ripple_cos2, ripple_sin2, ripple_cos3, ripple_sin3 : float or None, optional
+        Keyword-only: the position ripple, a periodic force in the sliding position x added to the model's,
+        R(x) = sum_k ripple_cosk cos(2 pi k x / P) + ripple_sink sin(2 pi k x / P), of period
+        P = ``ripple_period`` [m] and amplitudes [N] (docs/models.md#direction-and-position); default none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, named with the model (``lugre friction: 'sigma0' ...``). The physical checks
+        (fs >= fc, positive stiffness, dissipativity) need the whole model: ``Model`` does them.
+    """
 
     fc: float | None
     sigma2: float | None = 0.0
@@ -138,7 +205,36 @@ class Coulomb(_Friction):
 @dataclass(frozen=True)
 class Stribeck(_Friction):
     """Static Stribeck map: ``F = g(v) s(v) + sigma2 v``, g the Stribeck curve of docs/models.md#friction-models and
-    ``s(v) = tanh(v / v_smooth)``."""
+    ``s(v) = tanh(v / v_smooth)``.
+
+    Parameters
+    ----------
+    fc : float or None
+        The Coulomb level [N], > 0; None where a Model I law gives it.
+    fs : float or None, optional
+        The static (breakaway) level [N], >= fc; default fc (no Stribeck effect).
+    vs : float or None, optional
+        The Stribeck velocity [m/s], > 0; needed where fs > fc.
+    delta : float or None, default 2.0
+        The Stribeck curve's exponent [-].
+    sigma2 : float or None, default 0.0
+        The viscous coefficient [N s/m], >= 0.
+    v_smooth : float or None, default 1e-6
+        The smoothed sign's velocity band [m/s].
+    fc_neg, fs_neg, vs_neg, sigma2_neg : float or None, optional
+        The values of fc, fs, vs, sigma2 [N, N, m/s, N s/m] in negative sliding (docs/models.md#direction-and-position);
+        default the positive side's.
+    ripple_period, ripple_cos1, ripple_sin1, ripple_cos2, ripple_sin2, ripple_cos3, ripple_sin3 : float or None, optional
+        Keyword-only: the position ripple, a periodic force in the sliding position x added to the model's,
+        R(x) = sum_k ripple_cosk cos(2 pi k x / P) + ripple_sink sin(2 pi k x / P), of period
+        P = ``ripple_period`` [m] and amplitudes [N] (docs/models.md#direction-and-position); default none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, named with the model (``lugre friction: 'sigma0' ...``). The physical checks
+        (fs >= fc, positive stiffness, dissipativity) need the whole model: ``Model`` does them.
+    """
 
     fc: float | None
     fs: float | None = None
@@ -158,7 +254,29 @@ class Stribeck(_Friction):
 @dataclass(frozen=True)
 class Dahl(_Friction):
     """Dahl (1968): ``z' = v - sigma0 |v| z / fc``, ``F = sigma0 z`` -- presliding hysteresis
-    with a Coulomb level, no Stribeck effect, no viscous term."""
+    with a Coulomb level, no Stribeck effect, no viscous term.
+
+    Parameters
+    ----------
+    sigma0 : float or None
+        The bristle stiffness [N/m], > 0; None where a Model I law gives it.
+    fc : float or None
+        The Coulomb level [N], > 0; None where a Model I law gives it.
+    v_smooth : float or None, default 1e-6
+        The velocity band [m/s] of Model II's smoothed sign.
+    fc_neg : float or None, optional
+        The Coulomb level [N] in negative sliding (docs/models.md#direction-and-position); default fc.
+    ripple_period, ripple_cos1, ripple_sin1, ripple_cos2, ripple_sin2, ripple_cos3, ripple_sin3 : float or None, optional
+        Keyword-only: the position ripple, a periodic force in the sliding position x added to the model's,
+        R(x) = sum_k ripple_cosk cos(2 pi k x / P) + ripple_sink sin(2 pi k x / P), of period
+        P = ``ripple_period`` [m] and amplitudes [N] (docs/models.md#direction-and-position); default none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, named with the model (``lugre friction: 'sigma0' ...``). The physical checks
+        (fs >= fc, positive stiffness, dissipativity) need the whole model: ``Model`` does them.
+    """
 
     sigma0: float | None
     fc: float | None
@@ -177,7 +295,45 @@ class ElastoPlastic(_Friction):
     """Elasto-plastic friction (Dupont, Hayward, Armstrong and Altpeter 2002): LuGre with
     ``z' = v - alpha(z, v) sigma0 |v| z / g(v)``. alpha is 0 for |z| <= z_ba (and whenever z
     opposes v: purely elastic, so small oscillating forces cause no drift), 1 from the steady
-    deflection g(v)/sigma0 on, and a half sine between. Needs 0 <= z_ba < fc/sigma0."""
+    deflection g(v)/sigma0 on, and a half sine between. Needs 0 <= z_ba < fc/sigma0.
+
+    Parameters
+    ----------
+    sigma0 : float or None
+        The bristle stiffness [N/m], > 0; None where a Model I law gives it.
+    sigma1 : float or None
+        The bristle damping [N s/m], >= 0; None where a Model I law gives it.
+    fc : float or None
+        The Coulomb level [N], > 0; None where a Model I law gives it.
+    z_ba : float or None
+        The breakaway deflection [m], 0 <= z_ba < fc/sigma0; None where a Model I law gives it.
+    sigma2 : float or None, default 0.0
+        The viscous coefficient [N s/m], >= 0.
+    fs : float or None, optional
+        The static (breakaway) level [N], >= fc; default fc (no Stribeck effect).
+    vs : float or None, optional
+        The Stribeck velocity [m/s], > 0; needed where fs > fc.
+    delta : float or None, default 2.0
+        The Stribeck curve's exponent [-].
+    vd : float or None, optional
+        The velocity [m/s] over which the bristle damping decays,
+        sigma1(v) = sigma1 exp(-(v/vd)^2); default none (constant sigma1).
+    v_smooth : float or None, default 1e-6
+        The velocity band [m/s] of Model II's smoothed sign.
+    fc_neg, fs_neg, vs_neg, sigma2_neg : float or None, optional
+        The values of fc, fs, vs, sigma2 [N, N, m/s, N s/m] in negative sliding (docs/models.md#direction-and-position);
+        default the positive side's.
+    ripple_period, ripple_cos1, ripple_sin1, ripple_cos2, ripple_sin2, ripple_cos3, ripple_sin3 : float or None, optional
+        Keyword-only: the position ripple, a periodic force in the sliding position x added to the model's,
+        R(x) = sum_k ripple_cosk cos(2 pi k x / P) + ripple_sink sin(2 pi k x / P), of period
+        P = ``ripple_period`` [m] and amplitudes [N] (docs/models.md#direction-and-position); default none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, named with the model (``lugre friction: 'sigma0' ...``). The physical checks
+        (fs >= fc, positive stiffness, dissipativity) need the whole model: ``Model`` does them.
+    """
 
     sigma0: float | None
     sigma1: float | None
@@ -211,7 +367,42 @@ class GMS(_Friction):
     the motion reverses and it sticks again. The switches are events the integrator locates and
     restarts at -- no regularisation -- so presliding hysteresis keeps its return-point memory.
     (docs/models.md#friction-models prints the slip law as ``sgn(v) C (w_i - F_i/g)``; that is the same for v > 0 and
-    unstable for v < 0, so the sign is applied to the capacity instead.)"""
+    unstable for v < 0, so the sign is applied to the capacity instead.)
+
+    Parameters
+    ----------
+    k : sequence of float
+        The elements' stiffnesses [N/m], each > 0; 1 to 64 elements.
+    w : sequence of float
+        The elements' capacity fractions [-], each > 0, summing to one; as many as ``k``.
+    C : float or None
+        The slip rate [N/s], > 0; None where a Model I law gives it.
+    fc : float or None
+        The Coulomb level [N], > 0; None where a Model I law gives it.
+    fs : float or None, optional
+        The static (breakaway) level [N], >= fc; default fc (no Stribeck effect).
+    vs : float or None, optional
+        The Stribeck velocity [m/s], > 0; needed where fs > fc.
+    delta : float or None, default 2.0
+        The Stribeck curve's exponent [-].
+    sigma2 : float or None, default 0.0
+        The viscous coefficient [N s/m], >= 0.
+    v_smooth : float or None, default 1e-6
+        The velocity band [m/s] of Model II's smoothed sign.
+    fc_neg, fs_neg, vs_neg, sigma2_neg : float or None, optional
+        The values of fc, fs, vs, sigma2 [N, N, m/s, N s/m] in negative sliding (docs/models.md#direction-and-position);
+        default the positive side's.
+    ripple_period, ripple_cos1, ripple_sin1, ripple_cos2, ripple_sin2, ripple_cos3, ripple_sin3 : float or None, optional
+        Keyword-only: the position ripple, a periodic force in the sliding position x added to the model's,
+        R(x) = sum_k ripple_cosk cos(2 pi k x / P) + ripple_sink sin(2 pi k x / P), of period
+        P = ``ripple_period`` [m] and amplitudes [N] (docs/models.md#direction-and-position); default none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, named with the model (``lugre friction: 'sigma0' ...``). The physical checks
+        (fs >= fc, positive stiffness, dissipativity) need the whole model: ``Model`` does them.
+    """
 
     k: tuple
     w: tuple
@@ -283,7 +474,25 @@ def in_domain(name: str, values) -> np.ndarray:
 
 def check_friction_values(values: dict, where: str):
     """Physical checks on a full set of parameter values (numbers and laws evaluated), on both
-    sides of a direction-dependent model, and on the ripple."""
+    sides of a direction-dependent model, and on the ripple.
+
+    Parameters
+    ----------
+    values : dict
+        Parameter name -> value, in the units of ``PARAMETER_UNITS``.
+    where : str
+        Where the values came from (a model file's section, ``"[friction]"``), for the messages.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        A value outside the physical domain (a stiffness that is not positive, fs < fc, vs <= 0 with a Stribeck
+        effect, z_ba >= fc/sigma0, ...), named with ``where``.
+    """
     _check_side(values, where, "")
     check_sides(values, where, _check_side)
 
@@ -312,7 +521,26 @@ def _check_side(values: dict, where: str, side: str):
 
 
 def stribeck_curve(values: dict, v):
-    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fs = fc: no Stribeck effect), NumPy, for checks and reports."""
+    """g(v) = fc + (fs - fc) exp(-|v/vs|^delta) (fs = fc: no Stribeck effect), NumPy, for checks and reports.
+
+    Parameters
+    ----------
+    values : dict
+        ``fc`` [N], and ``fs`` [N], ``vs`` [m/s], ``delta`` [-] where there is a Stribeck effect.
+    v : float or array_like
+        The sliding velocity [m/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        g(v) [N], the shape of ``v``.
+
+    Raises
+    ------
+    KeyError
+        ``values`` without ``fc``, or without ``vs`` where fs differs from fc (the values are not checked here:
+        ``check_friction_values`` does that).
+    """
     fc = values["fc"]
     fs = values.get("fs", fc)
     fs = fc if fs is None else fs
@@ -330,9 +558,28 @@ def dissipativity_violation(model_name: str, values: dict):
     when sigma1 is large against sigma2 and the Stribeck drop (fs - fc)/fc -- at high speed it
     needs sigma1 <= sigma2 fc / (fs - fc) -- which is why a constant, large sigma1 makes LuGre
     non-passive (Barabanov and Ortega 2000) and a velocity-dependent sigma1(v) = sigma1
-    exp(-(v/vd)^2) (Olsson 1996) restores it. Returns (velocity, message) for the lowest failing
-    speed on a log grid from 1 nm/s to 100 m/s. (For the elasto-plastic model, alpha <= 1 only
-    lowers the relaxation term, so the LuGre condition is checked as the stricter one.)"""
+    exp(-(v/vd)^2) (Olsson 1996) restores it. (For the elasto-plastic model, alpha <= 1 only
+    lowers the relaxation term, so the LuGre condition is checked as the stricter one.)
+
+    Parameters
+    ----------
+    model_name : str
+        The friction model's name (``"lugre"``, ``"elastoplastic"``; any other has no such test: None).
+    values : dict
+        Parameter name -> value (numbers, laws evaluated), in the units of ``PARAMETER_UNITS``; each side of a
+        direction-dependent model is tested on its own.
+
+    Returns
+    -------
+    tuple or None
+        (velocity [m/s], message) for the lowest failing speed on a log grid from 1 nm/s to 100 m/s; None
+        where the condition holds.
+
+    Raises
+    ------
+    KeyError
+        ``values`` without a parameter the model requires (the values are not checked here).
+    """
     if model_name not in ("lugre", "elastoplastic"):
         return None
     if any(values.get(n) is not None for n in NEGATIVE_SIDE):  # each side on its own, the positive first

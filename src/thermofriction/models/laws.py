@@ -116,6 +116,28 @@ def _check_range(rng, where):
 
 @dataclass(frozen=True, eq=False, repr=False)
 class Const(Law):
+    """A constant: the value at every temperature.
+
+    Parameters
+    ----------
+    value : float
+        The value, in the unit of the parameter the law gives.
+    range : tuple of float, optional
+        The calibrated interval (low, high) [C], low < high; a simulation outside it warns
+        (TemperatureRangeWarning). Default None: no range.
+
+    Raises
+    ------
+    InputError
+        A coefficient that is not a finite number, or a range that is not (low, high) with low < high, named.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> float(tf.Const(value=2e5)(30.0))
+    200000.0
+    """
+
     value: float
     range: tuple | None = None
     kind = "const"
@@ -127,7 +149,30 @@ class Const(Law):
 
 @dataclass(frozen=True, eq=False, repr=False)
 class Linear(Law):
-    """a T + b"""
+    """a T + b, linear in the temperature T [C].
+
+    Parameters
+    ----------
+    a : float
+        The slope, in the parameter's unit per C.
+    b : float
+        The value at 0 C, in the parameter's unit.
+    range : tuple of float, optional
+        The calibrated interval (low, high) [C], low < high; a simulation outside it warns
+        (TemperatureRangeWarning). Default None: no range.
+
+    Raises
+    ------
+    InputError
+        A coefficient that is not a finite number, or a range that is not (low, high) with low < high, named.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> law = tf.Linear(a=-0.02, b=1.5, range=(20.0, 50.0))
+    >>> float(law(25.0))
+    1.0
+    """
 
     a: float
     b: float
@@ -144,7 +189,23 @@ class Linear(Law):
 
 @dataclass(frozen=True, eq=False, repr=False)
 class Exp(Law):
-    """a exp(b T)"""
+    """a exp(b T), exponential in the temperature T [C].
+
+    Parameters
+    ----------
+    a : float
+        The value at 0 C, in the parameter's unit.
+    b : float
+        The rate [1/C].
+    range : tuple of float, optional
+        The calibrated interval (low, high) [C], low < high; a simulation outside it warns
+        (TemperatureRangeWarning). Default None: no range.
+
+    Raises
+    ------
+    InputError
+        A coefficient that is not a finite number, or a range that is not (low, high) with low < high, named.
+    """
 
     a: float
     b: float
@@ -164,7 +225,21 @@ class Exp(Law):
 
 @dataclass(frozen=True, eq=False, repr=False)
 class Poly(Law):
-    """sum c[i] T^i"""
+    """sum c[i] T^i, a polynomial in the temperature T [C].
+
+    Parameters
+    ----------
+    c : array_like
+        The coefficients, lowest degree first; c[i] in the parameter's unit per C^i.
+    range : tuple of float, optional
+        The calibrated interval (low, high) [C], low < high; a simulation outside it warns
+        (TemperatureRangeWarning). Default None: no range.
+
+    Raises
+    ------
+    InputError
+        A coefficient that is not a finite number, or a range that is not (low, high) with low < high, named.
+    """
 
     c: np.ndarray
     range: tuple | None = None
@@ -209,7 +284,23 @@ class Poly(Law):
 
 @dataclass(frozen=True, eq=False, repr=False)
 class PWL(Law):
-    """Linear through (T[i], values[i]); extrapolated linearly with the end segments."""
+    """Linear through (T[i], values[i]); extrapolated linearly with the end segments.
+
+    Parameters
+    ----------
+    T : array_like
+        The breakpoints [C], strictly increasing.
+    values : array_like
+        The values at the breakpoints, in the parameter's unit; as many as ``T``.
+    range : tuple of float, optional
+        The calibrated interval (low, high) [C], low < high; a simulation outside it warns
+        (TemperatureRangeWarning). Default None: no range.
+
+    Raises
+    ------
+    InputError
+        A coefficient that is not a finite number, or a range that is not (low, high) with low < high, named.
+    """
 
     T: np.ndarray
     values: np.ndarray
@@ -260,7 +351,23 @@ class PWL(Law):
 
 @dataclass(frozen=True, eq=False, repr=False)
 class Table(PWL):
-    """Monotone cubic (PCHIP) through (T[i], values[i]); extrapolated linearly with the end slopes."""
+    """Monotone cubic (PCHIP) through (T[i], values[i]); extrapolated linearly with the end slopes.
+
+    Parameters
+    ----------
+    T : array_like
+        The breakpoints [C], strictly increasing.
+    values : array_like
+        The values at the breakpoints, in the parameter's unit; as many as ``T``.
+    range : tuple of float, optional
+        The calibrated interval (low, high) [C], low < high; a simulation outside it warns
+        (TemperatureRangeWarning). Default None: no range.
+
+    Raises
+    ------
+    InputError
+        A coefficient that is not a finite number, or a range that is not (low, high) with low < high, named.
+    """
 
     kind = "table"
 
@@ -272,7 +379,25 @@ LAWS = {cls.kind: cls for cls in (Const, Linear, Exp, Poly, PWL, Table)}
 
 
 def law_from_dict(d, where: str) -> Law:
-    """A law from its inline table, e.g. ``{ law = "exp", a = 1.15e8, b = -0.136 }``."""
+    """A law from its inline table in a model file, e.g. ``{ law = "exp", a = 1.15e8, b = -0.136 }``.
+
+    Parameters
+    ----------
+    d : dict
+        The parsed table: ``law`` (the kind), its coefficients and an optional ``range``.
+    where : str
+        The table's place in the file (``"[thermal.laws] sigma0"``), for the messages.
+
+    Returns
+    -------
+    Law
+
+    Raises
+    ------
+    InputError
+        Not a table, an unknown kind or key, a missing coefficient, a value that is not a number, named with
+        ``where``.
+    """
     if not isinstance(d, dict):
         raise InputError(f"{where}: a law must be a table such as {{ law = \"linear\", a = ..., b = ... }}")
     kind = d.get("law")

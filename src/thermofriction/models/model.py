@@ -30,7 +30,43 @@ from .thermal import Heat, ModelI, ModelII
 @dataclass(frozen=True)
 class Model:
     """One actuator: plant, friction model, thermal extension (or None), input (or None) and
-    lumped thermal model of self-heating (or None)."""
+    lumped thermal model of self-heating (or None).
+
+    Parameters
+    ----------
+    plant : StickSlipPlant or MassPlant or PrescribedMotion
+        What the friction acts in.
+    friction : LuGre or Coulomb or Stribeck or Dahl or ElastoPlastic or GMS
+        The friction model (None for each parameter a Model I law gives).
+    thermal : ModelI or ModelII, optional
+        The thermal extension; None: friction independent of temperature.
+    input : Waveform, optional
+        The drive (a model file's ``[input]``); ``simulate(input=...)`` overrides it.
+    name : str, optional
+        The model's name (a preset's, a fit's).
+    description : str, optional
+        A sentence on what the model is.
+    heat : Heat, optional
+        The lumped thermal model of self-heating; the temperature becomes a state.
+    provenance : dict, optional
+        Where a fitted model came from (docs/formats.md#provenance); not part of the physics (two models that
+        differ only here compare equal).
+
+    Raises
+    ------
+    InputError
+        A part of the wrong type, named (``Model: 'plant' must be a StickSlipPlant, ...``); a law for a parameter
+        the friction model also gives, or physically impossible values (fs < fc, ...), named.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> m = tf.Model(plant=tf.MassPlant(mass=1.0), friction=tf.LuGre(sigma0=1e5, sigma1=300.0, fc=1.0),
+    ...              input=tf.Sine(amplitude=2.0, frequency=1.0))
+    >>> res = tf.simulate(m, duration=0.5, sample_rate=100.0)
+    >>> res.displacement.shape
+    (51,)
+    """
 
     plant: StickSlipPlant | MassPlant | PrescribedMotion
     friction: LuGre | Coulomb | Stribeck | Dahl | ElastoPlastic | GMS
@@ -236,9 +272,31 @@ def check_provenance(p, where="[provenance]") -> dict:
 
 
 def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_from=None) -> Model:
-    """Builds a model from a parsed model file; errors name the file and the key. ``friction_from``:
-    for a file without a [friction] section, a function of the parsed plant and input that returns one
-    (identification's starting values from the data)."""
+    """Builds a model from a parsed model file; errors name the file and the key.
+
+    Parameters
+    ----------
+    d : dict
+        The parsed TOML: ``[plant]``, ``[friction]``, and optionally ``[thermal]``, ``[input]``, ``[heat]``,
+        ``name``, ``description``, ``[provenance]``.
+    source : str, default "<model>"
+        The file's name (or a preset's), for the messages.
+    base_dir : str or os.PathLike, optional
+        The folder that relative file names (a sampled input's ``file``) are read from.
+    friction_from : callable, optional
+        For a file without a ``[friction]`` section: a function of the parsed plant and input that returns one
+        (identification's starting values from the data).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    InputError
+        A missing section, an unknown key, a bad value or physically impossible values, named with
+        ``source`` and the key.
+    """
     try:
         fr = d.get("friction")
         bare = isinstance(fr, dict) and set(fr) == {"model"}  # a friction model named, no values: from the data
@@ -300,7 +358,24 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_fr
 
 
 def require_actuator(model: Model, task: str):
-    """Datasets (docs/formats.md#datasets) record a stick-slip actuator: voltage in, end-effector displacement out."""
+    """Datasets (docs/formats.md#datasets) record a stick-slip actuator: voltage in, end-effector displacement out.
+
+    Parameters
+    ----------
+    model : Model
+        The model a task is asked to run on a dataset.
+    task : str
+        The task (``"synthesize"``), for the message.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        The model's plant is not a ``StickSlipPlant``.
+    """
     if not isinstance(model.plant, StickSlipPlant):
         raise InputError(f"{task} works on the stick-slip actuator (datasets record its voltage and displacement); "
                          f"this model's plant is '{model.plant.type}'")
@@ -316,12 +391,57 @@ def preset_hint(name: str) -> str:
 
 
 def preset_path(name: str):
+    """The shipped file of a preset.
+
+    Parameters
+    ----------
+    name : str
+        A preset's name (``PRESETS``).
+
+    Returns
+    -------
+    pathlib.Path
+        The preset's TOML file inside the installed package.
+
+    Raises
+    ------
+    None
+        Nothing is checked: an unknown name gives a path that does not exist (check ``name in PRESETS``).
+    """
     return resources.files("thermofriction").joinpath("presets", f"{name}.toml")
 
 
 def load_model(source, friction_from=None) -> Model:
-    """Loads a model file, or a shipped preset by name (see ``PRESETS``). ``friction_from``: see
-    :func:`model_from_dict`."""
+    """Loads a model file (TOML, docs/formats.md#model-files), or a shipped preset by name (``PRESETS``).
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        A model file's path, or a preset's name (``"li2009-model-i"``); a file of that name comes first.
+    friction_from : callable, optional
+        For a file without a ``[friction]`` section: a function of the parsed plant and input that returns
+        one (identification's starting values from the data; ``model_from_dict``).
+
+    Returns
+    -------
+    Model
+        The model, checked: plant, friction model, thermal extension, heat model and input.
+
+    Raises
+    ------
+    InputError
+        A source that is not a path or a preset; a file that cannot be read; a bad key or value, named with
+        its file and section (``li2009.toml: [friction] sigma0 must be positive, got -1``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> model = tf.load_model("li2009-model-i")
+    >>> model.name
+    'li2009-model-i'
+    >>> type(model.friction).__name__
+    'LuGre'
+    """
     _args.path(source, "source")
     _args.function(friction_from, "friction_from")
     source = os.fspath(source)

@@ -21,6 +21,31 @@ class StickSlipPlant:
     Give either the modal form (``damping_ratio`` xi, ``natural_frequency`` wn [rad/s], ``gain``
     K [m/V]) or the physical one (``damping`` c, ``stiffness`` k, ``transducer_ratio`` T_em);
     the other is derived (k = m wn^2, c = 2 xi wn m, T_em = K k). The form given is the form saved.
+
+    Parameters
+    ----------
+    mass : float
+        The stage's equivalent mass m [kg], > 0.
+    end_effector_mass : float
+        The end effector's mass m_e [kg], > 0.
+    damping_ratio : float, optional
+        The modal form's damping ratio xi [-].
+    natural_frequency : float, optional
+        The modal form's natural frequency wn [rad/s].
+    gain : float, optional
+        The modal form's static gain K [m/V].
+    damping : float, optional
+        The physical form's damping c [N s/m].
+    stiffness : float, optional
+        The physical form's stiffness k [N/m].
+    transducer_ratio : float, optional
+        The physical form's transducer ratio T_em [N/V].
+
+    Raises
+    ------
+    InputError
+        Neither form complete, or both given; a value that is not a number, a mass, wn or k that is not
+        positive, a negative xi or c, named.
     """
 
     mass: float
@@ -109,7 +134,22 @@ class MassPlant:
 
     f(t) is the input waveform, a force [N] (none: zero). With ``spring_stiffness`` k_s [N/m] and
     ``pull_velocity`` v_0 [m/s] a spring pulled at constant speed drives the mass (the stick-slip
-    benchmark of Canudas de Wit et al. 1995); both forces add when both are given."""
+    benchmark of Canudas de Wit et al. 1995); both forces add when both are given.
+
+    Parameters
+    ----------
+    mass : float
+        The mass m [kg], > 0.
+    spring_stiffness : float, default 0.0
+        The pulling spring's stiffness k_s [N/m], >= 0.
+    pull_velocity : float, default 0.0
+        The speed v_0 [m/s] the spring's end is pulled at.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number, a mass that is not positive, a negative k_s, v_0 without k_s, named.
+    """
 
     mass: float
     spring_stiffness: float = 0.0
@@ -161,7 +201,24 @@ class PrescribedMotion:
     not part of the friction. ``inertia`` [kg, or kg m^2 for a joint] and ``delay`` [s]: what a drive's
     command adds to the friction (docs/force-data.md#drives-without-a-torque-sensor): the command recorded at
     ``t - delay`` is ``F + inertia * a + sensor_offset`` at ``t``; both are fitted from command data and
-    used to predict a command; a simulation of prescribed motion does not use them."""
+    used to predict a command; a simulation of prescribed motion does not use them.
+
+    Parameters
+    ----------
+    motion : {"linear", "rotary"}, default "linear"
+        A linear contact (m, N) or a rotary joint (rad, N m).
+    sensor_offset : float, default 0.0
+        The force (torque) sensor's constant bias [N, or N m for a joint].
+    inertia : float, default 0.0
+        A drive's moved inertia J [kg, or kg m^2 for a joint], for command data.
+    delay : float, default 0.0
+        A drive's command delay [s], for command data.
+
+    Raises
+    ------
+    InputError
+        An unknown ``motion``; a value that is not a finite number, or a negative inertia, named.
+    """
 
     motion: str = "linear"
     sensor_offset: float = 0.0
@@ -230,6 +287,24 @@ PLANTS = {"stick-slip": StickSlipPlant, "mass": MassPlant, "prescribed": Prescri
 
 
 def plant_from_dict(d: dict, where="[plant]"):
+    """A plant from a model file's ``[plant]`` table (docs/formats.md#model-files).
+
+    Parameters
+    ----------
+    d : dict
+        The parsed table: ``type`` and the plant's keys (``m``, ``m_e``, ``xi``, ``wn``, ``K``, ...).
+    where : str, default "[plant]"
+        The table's place, for the messages.
+
+    Returns
+    -------
+    StickSlipPlant or MassPlant or PrescribedMotion
+
+    Raises
+    ------
+    InputError
+        An unknown ``type`` or key, a missing or bad value, named with ``where``.
+    """
     kind = d.get("type")
     if not isinstance(kind, str) or kind not in PLANTS:
         raise InputError(f"{where}: 'type' must be one of {', '.join(repr(k) for k in PLANTS)}, got {kind!r}")

@@ -13,7 +13,19 @@ from .laws import Law
 
 @dataclass(frozen=True)
 class ModelI:
-    """Model I (docs/models.md#model-i): parameters of the base model follow laws of temperature."""
+    """Model I (docs/models.md#model-i): parameters of the base model follow laws of temperature.
+
+    Parameters
+    ----------
+    laws : dict, default {}
+        Parameter name -> ``Law``: each named friction parameter (``sigma0``, ``fc``, ...) is the law's value
+        at the temperature, in the parameter's unit; the friction model holds None for it.
+
+    Raises
+    ------
+    InputError
+        ``laws`` not a dict of parameter names to Law objects.
+    """
 
     laws: dict = field(default_factory=dict)
     model = "I"
@@ -36,7 +48,20 @@ class ModelII:
 
     ``form="scale"`` (default): F' = (1 + dF(T)/F_ref) F_base, F_ref the base model's steady
     sliding friction (fc) -- Eq. (12) in steady sliding, smooth and passive through v = 0.
-    ``form="offset"``: F' = F_base + dF(T) s(v), s a sign smoothed over ``v_smooth``."""
+    ``form="offset"``: F' = F_base + dF(T) s(v), s a sign smoothed over ``v_smooth``.
+
+    Parameters
+    ----------
+    dF : Law
+        The thermal-induced friction dF(T) [N] (N m for a joint).
+    form : {"scale", "offset"}, default "scale"
+        How dF enters the friction force (above).
+
+    Raises
+    ------
+    InputError
+        ``dF`` not a Law; an unknown ``form``.
+    """
 
     dF: Law
     form: str = "scale"
@@ -55,7 +80,9 @@ class ModelII:
 
 @dataclass(frozen=True)
 class Heat:
-    """Lumped thermal model of the friction interface (docs/models.md#self-heating): the temperature becomes a state,
+    """Lumped thermal model of the friction interface (docs/models.md#self-heating).
+
+    The temperature becomes a state::
 
         C_th T' = eta |F v_r| - (T - T_amb) / R_th + P_ext(t),    T(0) = T_0.
 
@@ -63,6 +90,26 @@ class Heat:
     eta (0..1) of the friction power that heats the interface, ``ambient_temperature`` T_amb
     [degC] (None: the temperature given to ``simulate``), ``initial_temperature`` T_0 (None:
     T_amb), ``external_heat`` P_ext(t) [W] (a waveform, e.g. the paper's heater; None: none).
+
+    Parameters
+    ----------
+    heat_capacity : float
+        The interface's heat capacity C_th [J/K], > 0.
+    thermal_resistance : float
+        The thermal resistance R_th [K/W] to ambient, > 0.
+    heat_fraction : float, default 1.0
+        The fraction eta (0..1) of the friction power that heats the interface.
+    ambient_temperature : float, optional
+        T_amb [C]; None: the temperature given to ``simulate``.
+    initial_temperature : float, optional
+        T_0 [C]; None: T_amb.
+    external_heat : Waveform, optional
+        An external heat input P_ext(t) [W] (the paper's heater); None: none.
+
+    Raises
+    ------
+    InputError
+        A value that is not a number or out of its range, named.
     """
 
     heat_capacity: float

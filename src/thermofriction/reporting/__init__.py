@@ -44,12 +44,52 @@ def _check_report_arguments(models, data, path, figures_dir, command, title, tru
 
 def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None, offset=None,
            motion=None, ripple_phase="auto") -> str:
-    """Writes the HTML report comparing ``models`` (Model, FitResult, or (label, Model, fit dict)
-    entries) on ``data``; returns the HTML. ``truth`` (label -> FitResult.recovery summary, for data
-    made from a known model) adds a section saying whether the fits recover it; ``bands`` (what
-    ``tf.propagate`` returns) a section with the prediction bands. Each model is scored as it was fitted (its fit
-    record: the offset policy, the motion), unless ``offset`` or ``motion`` says otherwise (see :func:`validate`, which
-    also takes ``ripple_phase``)."""
+    """Writes the HTML report comparing ``models`` on ``data`` and returns its HTML.
+
+    Each model is scored as it was fitted (its fit record: the offset policy, the motion), unless ``offset`` or
+    ``motion`` says otherwise (see ``validate``). The page is the data's measurement's (displacement: the paper's
+    figures and tables; force: the friction-velocity map, hysteresis and presliding loops). The file is written
+    atomically: all of it or nothing.
+
+    Parameters
+    ----------
+    models : list
+        The models compared: ``Model``, ``FitResult``, or (label, Model, fit dict) entries.
+    data : Dataset
+        The measurements the models are scored on.
+    path : str or os.PathLike
+        The HTML file written (one self-contained page: figures inline, no network needed).
+    figures_dir : str or os.PathLike, optional
+        A folder where the figures are also written as SVG and PNG files.
+    command : str, optional
+        The command line shown as how the report was made; default the running program's.
+    title : str, optional
+        The page's title.
+    truth : dict, optional
+        For data made from a known model: label -> ``FitResult.recovery`` summary; adds a section saying
+        whether the fits recover it.
+    bands : PropagationResult, optional
+        What ``tf.propagate`` returns: adds a section with the prediction bands.
+    offset : {"shared", "per-experiment", "none"} or bool, optional
+        Force data: how the sensor offset is taken, for every model (``validate``'s ``offset``).
+    motion : {"position", "velocity", "auto"}, optional
+        Force data: what drives the experiments, for every model (``validate``'s ``motion``).
+    ripple_phase : {"auto", "recorded", "per-run"}, default "auto"
+        Force data with a position ripple: its angle, for every model (``validate``'s ``ripple_phase``).
+
+    Returns
+    -------
+    str
+        The page's HTML, as written to ``path``.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; no model; a path that cannot be written (``OutputError``, an
+        InputError, naming it).
+    ComputationError
+        A model's predictions failed.
+    """
     models = _check_report_arguments(models, data, path, figures_dir, command, title, truth)
     entries = []
     for m in models:

@@ -18,6 +18,38 @@ from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fi
 from .page import Figures, fmt_number, html_table, page_html
 
 def render(entries, data, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
+    """The report's page for displacement data: the paper's figures and tables, the models compared on the
+    held-out experiments (``report`` writes it to a file).
+
+    Parameters
+    ----------
+    entries : list of Entry
+        The models compared, each with its label and, when known, its fit and validation.
+    data : Dataset
+        The measurements; at least one experiment with role "validate".
+    figures_dir : str or os.PathLike, optional
+        A folder where the figures are also written as SVG and PNG files.
+    command : str, optional
+        The command line shown as how the report was made.
+    title : str, optional
+        The page's title.
+    truth : dict, optional
+        Label -> ``FitResult.recovery`` summary, for data made from a known model.
+    bands : PropagationResult, optional
+        Prediction bands (``propagate``) shown in a section of their own.
+
+    Returns
+    -------
+    str
+        The page's HTML.
+
+    Raises
+    ------
+    InputError
+        A dataset without a held-out ("validate") experiment.
+    ComputationError
+        A model's predictions failed.
+    """
     exps = list(getattr(data, "experiments", data))
     if not any(getattr(e, "role", "fit") == "validate" for e in exps):
         raise InputError("the dataset has no experiment with role 'validate': a report compares predictions at "

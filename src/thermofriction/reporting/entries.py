@@ -17,7 +17,19 @@ from .fit_plots import as_float, law_outside_intervals, per_temperature_estimate
 
 @dataclasses.dataclass
 class Entry:
-    """One model in the report, with its identification results when known (FitResult.to_dict())."""
+    """One model in the report, with its identification results when known (FitResult.to_dict()).
+
+    Parameters
+    ----------
+    label : str
+        The model's name in the report ("Model I", "no thermal model", ...).
+    model : Model
+        The model.
+    fit : dict, optional
+        Its identification results (``FitResult.to_dict()``).
+    validation : ValidationResult, optional
+        Its validation on the report's data; computed by the report where None.
+    """
 
     label: str
     model: Model

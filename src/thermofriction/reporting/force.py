@@ -203,7 +203,38 @@ def _akaike(entries):
 
 
 def render_force(entries, data, *, figures_dir=None, command=None, title=None, truth=None, bands=None) -> str:
-    """The page for force data (``truth`` and ``bands`` are displacement studies' and not shown here)."""
+    """The page for force data (``truth`` and ``bands`` are displacement studies' and not shown here): the
+    friction-velocity map, hysteresis and presliding loops, the models compared on the held-out experiments.
+
+    Parameters
+    ----------
+    entries : list of Entry
+        The models compared, each with its label and, when known, its fit and validation.
+    data : Dataset
+        The measurements; at least one experiment with role "validate".
+    figures_dir : str or os.PathLike, optional
+        A folder where the figures are also written as SVG and PNG files.
+    command : str, optional
+        The command line shown as how the report was made.
+    title : str, optional
+        The page's title.
+    truth : dict, optional
+        Taken for the same call as ``render``; not shown.
+    bands : PropagationResult, optional
+        Taken for the same call as ``render``; not shown.
+
+    Returns
+    -------
+    str
+        The page's HTML.
+
+    Raises
+    ------
+    InputError
+        A dataset without a held-out ("validate") experiment.
+    ComputationError
+        A model's predictions failed.
+    """
 
     exps = list(getattr(data, "experiments", data))
     if not any(getattr(e, "role", "fit") == "validate" for e in exps):

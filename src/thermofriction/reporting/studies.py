@@ -28,11 +28,34 @@ def _check_arguments(name, items, what, path, figures_dir, title, command):
 
 
 def heating_report(runs, path, *, figures_dir=None, title=None, command=None) -> str:
-    """Writes an HTML report of long heated runs: ``runs`` is a list of dicts with ``label``,
-    ``result`` (a HeatingResult, the prediction with self-heating), optionally ``reference`` (the
-    full simulation on the same grid) and ``constant`` (the displacement predicted at the start
-    temperature, on the same grid). Figures: temperature rise, step-size drift, and the error of
-    the constant-temperature prediction; a table of the figures that matter."""
+    """Writes an HTML report of long heated runs. Figures: temperature rise, step-size drift, and the error of
+    the constant-temperature prediction; a table of the figures that matter.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Each with ``label``, ``result`` (a HeatingResult, the prediction with self-heating), optionally
+        ``reference`` (the full simulation on the same grid) and ``constant`` (the displacement [m] predicted
+        at the start temperature, on the same grid).
+    path : str or os.PathLike
+        The HTML file written.
+    figures_dir : str or os.PathLike, optional
+        A folder where the figures are also written as SVG and PNG files.
+    title : str, optional
+        The page's title.
+    command : str, optional
+        The command line shown as how the report was made.
+
+    Returns
+    -------
+    str
+        The page's HTML, as written to ``path``.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; a path that cannot be written.
+    """
     _check_arguments("runs", runs, "a non-empty list of dicts", path, figures_dir, title, command)
     figs = Figures(figures_dir)
     colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
@@ -96,9 +119,33 @@ def heating_report(runs, path, *, figures_dir=None, title=None, command=None) ->
 
 @page_styled
 def control_report(rows, path, *, figures_dir=None, title=None, command=None) -> str:
-    """Writes an HTML report of thermofriction.control.compare_compensation's rows: the table of RMS
+    """Writes an HTML report of ``thermofriction.control.compare_compensation``'s rows: the table of RMS
     and maximum tracking errors per reference, stage temperature and compensation, and for each
-    reference the tracking error over time at the hottest temperature."""
+    reference the tracking error over time at the hottest temperature.
+
+    Parameters
+    ----------
+    rows : list of dict
+        ``compare_compensation``'s rows.
+    path : str or os.PathLike
+        The HTML file written.
+    figures_dir : str or os.PathLike, optional
+        A folder where the figures are also written as SVG and PNG files.
+    title : str, optional
+        The page's title.
+    command : str, optional
+        The command line shown as how the report was made.
+
+    Returns
+    -------
+    str
+        The page's HTML, as written to ``path``.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; a path that cannot be written.
+    """
     _check_arguments("rows", rows, "a non-empty list of row dicts (compare_compensation)", path, figures_dir, title,
                      command)
     figs = Figures(figures_dir)

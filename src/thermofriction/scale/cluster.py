@@ -82,7 +82,21 @@ class Runner:
     ``spans, results = r.map_chunks(fn, n_items, args_of, ...)`` for items cut into chunks here.
     ``progress(done_weight)`` is called after each task with the sum of the finished tasks'
     weights. A task that raises stops the run (the task functions of this package catch the
-    failures of single points and datasets themselves and return them as results)."""
+    failures of single points and datasets themselves and return them as results).
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client, optional
+        None or "threads", "sequential", "processes", an address (``tcp://HOST:8786``, a scheduler file) or a
+        ``distributed.Client``, as for ``sweep``.
+    workers : int, optional
+        The threads or processes; default one per core.
+
+    Raises
+    ------
+    InputError
+        A scheduler or a number of workers that is not one, named.
+    """
 
     def __init__(self, scheduler=None, workers=None):
         check_options(scheduler, workers)

@@ -37,7 +37,22 @@ def fleet_datasets(paths) -> list[Path] | None:
     """The dataset folders of a fleet, or None when ``paths`` is one dataset (the single path).
 
     A fleet is two or more paths, or one folder without a dataset.toml whose sub-folders hold
-    datasets (each sub-folder with a dataset.toml, in name order)."""
+    datasets (each sub-folder with a dataset.toml, in name order).
+
+    Parameters
+    ----------
+    paths : str or os.PathLike or sequence of them
+        The paths given (the command line's DATASET arguments).
+
+    Returns
+    -------
+    list of pathlib.Path or None
+
+    Raises
+    ------
+    None
+        Nothing is checked: a folder that cannot be read is taken as one dataset (None), whose loading says why.
+    """
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     paths = [Path(p) for p in paths]
@@ -126,7 +141,25 @@ def _identify_one(data, method, init, kw):
 @dataclasses.dataclass(eq=False)
 class FleetResult:
     """``names`` in the order given; ``fits`` name -> FitResult; ``failures`` name -> reason;
-    ``paths`` name -> the dataset's folder."""
+    ``paths`` name -> the dataset's folder.
+
+    Parameters
+    ----------
+    method : str
+        The identification method.
+    names : list of str
+        The datasets' names, in the order given.
+    paths : dict
+        Name -> the dataset's folder.
+    fits : dict
+        Name -> FitResult, for the datasets identified.
+    failures : dict
+        Name -> the reason a dataset could not be read or identified.
+    wall_time : float, default nan
+        The run's duration [s].
+    where : str, default ""
+        Where the tasks ran (threads, a Dask cluster's address).
+    """
 
     method: str
     names: list
@@ -249,14 +282,40 @@ class FleetResult:
 
 def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, workers=None, progress=None,
                    **identify_options) -> FleetResult:
-    """Identifies every dataset (folders, or Dataset objects) with ``tf.identify(data, method,
-    init=init, **identify_options)``, one task per dataset, and returns a :class:`FleetResult`.
-    A dataset that cannot be read or identified is recorded with its reason; the others go on.
+    """Identifies every dataset with ``tf.identify(data, method, init=init, **identify_options)``, one task per
+    dataset. A dataset that cannot be read or identified is recorded with its reason; the others go on.
 
-    datasets: a list of dataset folders or ``Dataset`` objects, or one folder of dataset folders.
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process; an
-        identification is seconds of work, so each dataset is one task).
-    progress: called with the number of datasets done."""
+    Parameters
+    ----------
+    datasets : list or str or os.PathLike
+        A list of dataset folders or ``Dataset`` objects, or one folder of dataset folders.
+    method : str, default "model-i"
+        As for ``identify``.
+    init : Model or str or os.PathLike, optional
+        The initial model, as for ``identify``.
+    scheduler : str or distributed.Client, optional
+        Where the tasks run: None or "threads" (threads in this process, one per core, or ``workers`` of them:
+        the C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded local
+        Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler file) or a
+        ``distributed.Client`` (docs/scale.md).
+    workers : int, optional
+        The threads or processes; default one per core. An identification is seconds of work, so each dataset is one
+        task.
+    progress : callable, optional
+        Called with the number of datasets done.
+    **identify_options
+        Passed on to ``identify`` (``friction``, ``parameters``, ``free``, ``starts``, ...).
+
+    Returns
+    -------
+    FleetResult
+        One fit or one failure (with its reason) per dataset, and the fleet's summary.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type, named; no dataset.
+    """
     import time
 
     from ..data import Dataset, load_dataset

@@ -104,7 +104,28 @@ def check_drawable(result):
 
 
 def draw_parameters(result, draws: int, seed: int = 0):
-    """(names, array (draws, parameters)): seeded draws from the fit's covariance."""
+    """Seeded draws from the fit's covariance (positive parameters drawn in log space, as they were fitted).
+
+    Parameters
+    ----------
+    result : FitResult
+        The fit (or one read back from its results JSON).
+    draws : int
+        The number of parameter sets drawn.
+    seed : int, default 0
+        The seed of the draws.
+
+    Returns
+    -------
+    tuple
+        (names, array (draws x parameters)), in the parameters' units.
+
+    Raises
+    ------
+    InputError
+        A fit without fitted parameters, a parameter without a finite standard error, or a correlation matrix
+        that is not one, named.
+    """
     names, centre, cov, log = _covariance(result)
     w, V = np.linalg.eigh((cov + cov.T) / 2)
     root = V * np.sqrt(np.clip(w, 0.0, None))  # a covariance that is singular to rounding stays usable
@@ -149,7 +170,41 @@ def _run_draws(model, names, thetas, temperatures, waveform, sim):
 
 @dataclasses.dataclass(eq=False)
 class PropagationResult:
-    """Bands over draws, per temperature (rows) and output time (columns), SI units."""
+    """Bands over draws, per temperature (rows) and output time (columns), SI units.
+
+    Parameters
+    ----------
+    temperatures : numpy.ndarray
+        The temperatures [C], one row each.
+    time : numpy.ndarray
+        The output times [s], one column each.
+    level : float
+        The bands' central probability.
+    nominal : numpy.ndarray
+        The fitted model's displacement [m].
+    median, lower, upper : numpy.ndarray
+        The draws' median displacement and the parameters' band [m].
+    prediction_lower, prediction_upper : numpy.ndarray
+        The band with the measurement noise the fit estimated [m].
+    noise : float
+        The fit's noise estimate [m] (0 when it had none).
+    nominal_step, step_lower, step_upper : numpy.ndarray
+        The mean step per cycle [m] per temperature: the fitted model's and its band.
+    names : list of str
+        The drawn parameters' names.
+    parameters : numpy.ndarray
+        The draws (draws x parameters), in the parameters' units.
+    steps : numpy.ndarray
+        Each draw's mean step per temperature [m] (NaN where it failed).
+    final_displacement : numpy.ndarray
+        Each draw's final displacement per temperature [m].
+    failures : dict
+        A failed draw's index -> its reason.
+    wall_time : float, default nan
+        The run's duration [s].
+    where : str, default ""
+        Where the tasks ran (threads, a Dask cluster's address).
+    """
 
     temperatures: np.ndarray
     time: np.ndarray
@@ -299,13 +354,58 @@ def _checked(result, temperatures, draws, seed, input, duration, sample_rate, le
 def propagate(result, temperatures, *, draws: int = 200, seed: int = 0, input=None, duration: float = 1.0,
               sample_rate: float = 1000.0, level: float = 0.95, solver=None, controller=None, scheduler=None,
               workers=None, batch_size=None, progress=None) -> PropagationResult:
-    """Draws ``draws`` parameter sets from ``result``'s covariance (a ``FitResult``), simulates each
-    at every temperature [C] (``duration`` s of ``input``, default the model's), and returns the
-    central ``level`` bands of the displacement and of the mean step per cycle.
+    """Draws ``draws`` parameter sets from ``result``'s covariance, simulates each at every temperature, and
+    returns the central ``level`` bands of the displacement and of the mean step per cycle.
 
-    scheduler, workers: as for :func:`thermofriction.sweep` (None: threads in this process).
-    batch_size: draws per task (default: chunks of at least ~20 ms of work on threads, ~100 ms on Dask).
-    progress: called with the number of draws done."""
+    Parameters
+    ----------
+    result : FitResult
+        The fit whose parameters, standard errors and correlations are drawn from (a fit read back from its
+        results JSON too).
+    temperatures : sequence of float
+        The temperatures [C] simulated.
+    draws : int, default 200
+        The parameter sets drawn.
+    seed : int, default 0
+        The seed of the draws.
+    input : Waveform, optional
+        The drive; default the model's ``[input]``.
+    duration : float, default 1.0
+        Each simulation's length [s].
+    sample_rate : float, default 1000.0
+        The output grid's rate [Hz].
+    level : float, default 0.95
+        The bands' central probability, between 0 and 1.
+    solver : AutoSwitch or Dopri5 or Rodas4 or str, optional
+        As for ``simulate``.
+    controller : StepSizeController, optional
+        As for ``simulate``.
+    scheduler : str or distributed.Client, optional
+        Where the tasks run: None or "threads" (threads in this process, one per core, or ``workers`` of them:
+        the C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded local
+        Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler file) or a
+        ``distributed.Client`` (docs/scale.md).
+    workers : int, optional
+        The threads or processes; default one per core.
+    batch_size : int, optional
+        Draws per task; default chunks of at least ~20 ms of work on threads, ~100 ms on Dask.
+    progress : callable, optional
+        Called with the number of draws done.
+
+    Returns
+    -------
+    PropagationResult
+        Per temperature and output time: the fitted model's displacement [m], the median and ``level`` bands
+        of the draws (the parameters' band, and with the measurement noise the fit estimated), the mean step per
+        cycle's band, and the draws that failed with their reasons.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; a fit without fitted parameters; a parameter without a
+        finite standard error; a correlation matrix that is not one (not symmetric, not positive
+        semi-definite), named.
+    """
     import time
 
     from ..simulation import simulate

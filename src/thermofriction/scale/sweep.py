@@ -69,7 +69,24 @@ def check_run_options(duration, sample_rate, solver, controller, scheduler, work
 
 def parse_axis(text: str):
     """``NAME=START:STOP:STEP`` (STOP included when the steps reach it), ``NAME=V1,V2,...`` or
-    ``NAME=V``: (name, values)."""
+    ``NAME=V``: (name, values).
+
+    Parameters
+    ----------
+    text : str
+        One ``--grid`` axis, e.g. ``temperature=30:42:0.25`` or ``amplitude=10,20,30``.
+
+    Returns
+    -------
+    tuple
+        (name, list of float).
+
+    Raises
+    ------
+    InputError
+        Not NAME=..., a value that is not a finite number, a range without START <= STOP and a positive STEP,
+        named with the axis.
+    """
     _args.text(text, "text")
     name, eq, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
@@ -177,7 +194,27 @@ class SweepResult:
     """One row per point: the coordinates, then the metrics (NaN where the point failed).
 
     ``res[name]`` is a column (coordinates and metrics by name), ``units[name]`` its unit;
-    ``errors`` maps a failed row's index to its reason; ``ok`` is a boolean column."""
+    ``errors`` maps a failed row's index to its reason; ``ok`` is a boolean column.
+
+    Parameters
+    ----------
+    coordinates : tuple of str
+        The grid's names, in order.
+    metrics : tuple of str
+        The metrics' names.
+    columns : dict
+        Name -> column (numpy.ndarray), coordinates and metrics.
+    units : dict
+        Name -> unit.
+    errors : dict
+        A failed row's index -> its reason.
+    warnings : list of str
+        The runs' warnings.
+    wall_time : float, default nan
+        The run's duration [s].
+    where : str, default ""
+        Where the tasks ran (threads, a Dask cluster's address).
+    """
 
     coordinates: tuple
     metrics: tuple
@@ -307,20 +344,53 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
           scheduler=None, workers=None, batch_size=None, progress=None) -> SweepResult:
     """Simulates ``model`` at every point of ``grid`` and returns one row of ``metrics`` per point.
 
-    grid: name -> values. Names are ``temperature`` [C], a field of the input waveform
-        (``amplitude``, ``frequency``, ``rise``, ...), or any parameter the model can be given by name
-        (``sigma0``, ``fc``, a law coefficient ``sigma0.b``, ``dF.values[1]``, a plant's ``m_e``).
-    input: the waveform (default: the model's ``[input]``); temperature: the temperature [C] of
-        the points when the grid has no ``temperature`` axis.
-    metrics: names from ``METRICS`` (default: mean step per cycle, final displacement, peak
-        friction force).
-    scheduler: None or "threads" (threads in this process, one per core, or ``workers`` of them: the
-        C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded
-        local Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler
-        file) or a ``distributed.Client``.
-    batch_size: points per task (default: chunks sized from the first points' time, at least ~20 ms
-        of work each on threads and ~100 ms on Dask, at least 4 per worker; docs/scale.md).
-    progress: called with the number of points done.
+    Parameters
+    ----------
+    model : Model or str or os.PathLike
+        The model: a Model, a model file or a preset name.
+    grid : dict
+        Name -> values; the points are every combination. Names are ``temperature`` [C], a field of the input
+        waveform (``amplitude``, ``frequency``, ``rise``, ...), or any parameter the model can be given by name
+        (``sigma0``, ``fc``, a law coefficient ``sigma0.b``, ``dF.values[1]``, a plant's ``m_e``), in the
+        model file's units.
+    input : Waveform, optional
+        The waveform; default the model's ``[input]``.
+    duration : float, default 1.0
+        Each simulation's length [s].
+    temperature : float, optional
+        The temperature [C] of the points when the grid has no ``temperature`` axis.
+    metrics : sequence of str, default ("mean_step", "final_displacement", "peak_friction_force")
+        Names from ``METRICS``: the mean step per cycle [m], the final displacement [m], the peak friction
+        force [N], ...
+    sample_rate : float, default 10000.0
+        The output grid's rate [Hz].
+    solver : AutoSwitch or Dopri5 or Rodas4 or str, optional
+        As for ``simulate``.
+    controller : StepSizeController, optional
+        As for ``simulate``.
+    scheduler : str or distributed.Client, optional
+        Where the tasks run: None or "threads" (threads in this process, one per core, or ``workers`` of them:
+        the C core releases the GIL), "sequential" (in this process, in order), "processes" (an embedded local
+        Dask cluster of ``workers`` processes), an address (``tcp://HOST:8786``, a scheduler file) or a
+        ``distributed.Client`` (docs/scale.md).
+    workers : int, optional
+        The threads or processes; default one per core.
+    batch_size : int, optional
+        Points per task; default chunks sized from the first points' time, at least ~20 ms of work each on
+        threads and ~100 ms on Dask, at least 4 per worker (docs/scale.md).
+    progress : callable, optional
+        Called with the number of points done.
+
+    Returns
+    -------
+    SweepResult
+        One row per point: the grid's values and the metrics (``to_dataframe``, ``to_csv``); a point whose
+        simulation failed has NaN metrics and its reason.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or value, named; an unknown grid name or metric; a grid of no points.
     """
     import time
 

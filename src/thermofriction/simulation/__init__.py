@@ -71,7 +71,30 @@ def _grid(duration, sample_rate, max_samples=MAX_SAMPLES):
 
 
 def output_grid(duration, sample_rate, t_eval, max_samples) -> np.ndarray:
-    """The requested output times: ``t_eval``, or a uniform grid from 0 to ``duration``."""
+    """The requested output times: ``t_eval``, or a uniform grid from 0 to ``duration``.
+
+    Parameters
+    ----------
+    duration : float or None
+        The grid's end [s] (with ``sample_rate``), where ``t_eval`` is None.
+    sample_rate : float
+        The uniform grid's rate [Hz].
+    t_eval : array_like or None
+        Any non-empty, non-decreasing array of finite times [s].
+    max_samples : int or None
+        The most samples allowed; None: no limit.
+
+    Returns
+    -------
+    numpy.ndarray
+        The times [s].
+
+    Raises
+    ------
+    InputError
+        Neither ``duration`` nor ``t_eval``; values that are not numbers, a grid that is not
+        non-decreasing or finite, a span out of range, more than ``max_samples`` samples.
+    """
     if t_eval is not None:
         try:
             t_grid = np.ascontiguousarray(t_eval, dtype=float)
@@ -213,17 +236,64 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
              friction_work: bool = False) -> SimulationResult:
     """Simulates ``model`` from rest.
 
-    temperature: constant [degC], a ``Sampled`` signal, or (times, values); required for
-        thermal models. With a heat model (``model.heat``) the temperature is a state: a number
-        given here is the ambient temperature T_amb (overriding the model's).
-    input: a waveform overriding the model's ``[input]``.
-    duration, sample_rate: a uniform output grid from 0 to duration; or t_eval, any
-        non-decreasing grid starting at the initial time.
-    solver: ``AutoSwitch()`` (default), ``Dopri5()`` or ``Rodas4()``.
-    controller: ``StepSizeController`` (tolerances, step limits).
-    max_samples: the most output samples allowed (default 10 million, ~1 GB); None for no limit.
-    friction_work: also integrate the friction work W = integral |F v_r| dt (always done with a
-        heat model), returned as ``friction_work``.
+    Parameters
+    ----------
+    model : Model
+        The model to run (``load_model`` reads one from a file or a preset).
+    duration : float, optional
+        The end of a uniform output grid from 0 [s], sampled at ``sample_rate``. Give it or ``t_eval``.
+    temperature : float or Sampled or tuple of array_like, optional
+        A constant temperature [C], a ``Sampled`` temperature signal, or (times [s], values [C]); required
+        for thermal models. With a heat model (``model.heat``) the temperature is a state: a number given here
+        is the ambient temperature T_amb (overriding the model's), and a signal is refused.
+    input : Waveform, optional
+        The drive, overriding the model's ``[input]`` (a voltage [V], or the motion of a ``PrescribedMotion``).
+    sample_rate : float, default 10000.0
+        The output grid's rate [Hz] with ``duration``.
+    t_eval : array_like, optional
+        Any non-decreasing output grid [s] starting at the initial time, instead of ``duration`` and
+        ``sample_rate``.
+    solver : AutoSwitch or Dopri5 or Rodas4 or str, optional
+        The integrator, or its name (``"auto"``, ``"dopri5"``, ``"rodas4"``); default ``AutoSwitch()``.
+    controller : StepSizeController, optional
+        Tolerances and step limits; default ``StepSizeController()`` (rtol 1e-6).
+    max_samples : int or None, default 10_000_000
+        The most output samples allowed (10 million is ~1 GB); None for no limit.
+    friction_work : bool, default False
+        Also integrate the friction work W = integral of abs(F v_r) dt [J], returned as
+        ``SimulationResult.friction_work`` (always done with a heat model).
+
+    Returns
+    -------
+    SimulationResult
+        Time [s], displacement [m], velocity [m/s], friction force [N], the friction states and the step sizes,
+        as NumPy arrays in SI units.
+
+    Raises
+    ------
+    InputError
+        An argument of the wrong type or out of range, named (``duration must be a number [s], ...``); no
+        temperature for a thermal model; a temperature signal for a model with a heat model; an output grid
+        over ``max_samples``.
+    SolverError
+        The integrator stopped (too many steps, a non-finite state): its ``time`` and ``state`` say where.
+
+    Warns
+    -----
+    TemperatureRangeWarning
+        A temperature outside the range a law was calibrated on.
+    PassivityWarning
+        Friction parameters that can create energy.
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> model = tf.load_model("li2009-model-i")
+    >>> res = tf.simulate(model, duration=0.01, temperature=35.7, sample_rate=1000.0)
+    >>> res.time.shape
+    (11,)
+    >>> float(res.time[-1]), float(res.displacement[0])
+    (0.01, 0.0)
     """
     _check_arguments(model, input, controller, max_samples)
     _check_types(duration, temperature, sample_rate, t_eval, solver, friction_work)

@@ -20,7 +20,22 @@ from ..waveforms import Sampled, Sawtooth, Step, Waveform, Zero
 
 def as_temperature(temperature):
     """A number, a ``Sampled`` signal, or a (times, values) pair -> number or Sampled; a temperature
-    that is not plausible in degC (e.g. one in kelvin) is refused, as in data files."""
+    that is not plausible in degC (e.g. one in kelvin) is refused, as in data files.
+
+    Parameters
+    ----------
+    temperature : float or Sampled or tuple of array_like or None
+        A temperature [C], a temperature signal, or (times [s], values [C]); None passes.
+
+    Returns
+    -------
+    float or Sampled or None
+
+    Raises
+    ------
+    InputError
+        Not a number or a signal, not finite, or not plausible in C (a temperature in kelvin), named.
+    """
     if temperature is None:
         return temperature
     if isinstance(temperature, Sampled):
@@ -41,7 +56,22 @@ def as_temperature(temperature):
 
 
 def check_prescribed_motion(waveform: Waveform):
-    """Prescribed motion needs a continuous displacement: its slope is the sliding velocity."""
+    """Prescribed motion needs a continuous displacement: its slope is the sliding velocity.
+
+    Parameters
+    ----------
+    waveform : Waveform
+        The prescribed displacement x_r(t) [m] (an angle [rad] for a rotary joint).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        No waveform, an ideal step (no slew time), or a sawtooth with rise 0 or 1: a jump.
+    """
     if isinstance(waveform, Zero):
         raise InputError("prescribed motion needs an input waveform, the displacement x_r(t) in metres "
                          "(e.g. --input sine:amplitude=1e-6,frequency=1)")
@@ -52,7 +82,30 @@ def check_prescribed_motion(waveform: Waveform):
 
 
 def check_passivity(model: Model, temperatures=(math.nan,)):
-    """Warns (PassivityWarning) when a LuGre-type model can create energy at these temperatures."""
+    """Warns (PassivityWarning) when a LuGre-type model can create energy at these temperatures
+    (``dissipativity_violation``).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    temperatures : sequence of float, default (nan,)
+        The temperatures [C] tested (a model without laws: any value).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    KeyError
+        A friction model without a parameter the test requires (the model is not checked here).
+
+    Warns
+    -----
+    PassivityWarning
+        At the first temperature where the model may create energy.
+    """
     for T in temperatures:
         found = dissipativity_violation(model.friction.model, model.parameters_at(T))
         if found:
@@ -93,7 +146,32 @@ def _passed(model) -> set:
 def check_temperatures(model: Model, temperature):
     """Warns for temperatures outside a law's calibrated range; raises where the model is
     invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
-    Warns where a LuGre-type model is not dissipative."""
+    Warns where a LuGre-type model is not dissipative. A constant temperature that passed once is not tested
+    again for the same model.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    temperature : float or Sampled or None
+        The temperature [C], or a temperature signal (its range is tested).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        The model is invalid at the temperature, named with the parameter and the temperature.
+
+    Warns
+    -----
+    TemperatureRangeWarning
+        A temperature outside a law's calibrated range.
+    PassivityWarning
+        A LuGre-type model that may create energy there.
+    """
     key = None if isinstance(temperature, Sampled) else temperature
     if key is not None and key in _passed(model):
         return
@@ -179,7 +257,32 @@ def _check_temperatures(model: Model, temperature):
 
 def check_heated_temperatures(model: Model, time, temperature):
     """With self-heating the temperature range is known only after the run: warn where it left a
-    law's calibrated range, refuse a run that crossed a temperature where the model is invalid."""
+    law's calibrated range, refuse a run that crossed a temperature where the model is invalid.
+
+    Parameters
+    ----------
+    model : Model
+        The model simulated.
+    time : numpy.ndarray
+        The run's output times [s].
+    temperature : numpy.ndarray
+        The run's temperature [C] at those times.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    SolverError
+        The temperature reached values where the model is invalid (Model II's factor <= 0, a Model I
+        parameter out of its physical domain).
+
+    Warns
+    -----
+    TemperatureRangeWarning
+        The temperature left a law's calibrated range.
+    """
     lo, hi = float(np.min(temperature)), float(np.max(temperature))
     try:
         check_temperatures(model, Sampled(np.array([0.0, 1.0]), np.array([lo, hi])) if hi > lo else lo)

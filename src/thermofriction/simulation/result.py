@@ -22,7 +22,47 @@ class SimulationResult(Result):
     period starts, ``step_sizes[k]`` the displacement over cycle k, ``mean_velocity`` the mean
     of the step sizes times the frequency. ``friction_work`` [J] is the friction force's work
     integral of |F v_r| dt from the start (with a heat model, or ``friction_work=True``; else
-    None); with a heat model ``temperature`` is the interface temperature state."""
+    None); with a heat model ``temperature`` is the interface temperature state.
+
+    ``simulate`` makes it; each field is also an attribute.
+
+    Parameters
+    ----------
+    time : numpy.ndarray
+        The output times [s].
+    input : numpy.ndarray
+        The drive at those times, in ``input_unit``.
+    stage_displacement, stage_velocity : numpy.ndarray or None
+        The stage's displacement [m] and velocity [m/s]; None without a stage.
+    displacement, velocity : numpy.ndarray
+        The driven body's displacement [m] and velocity [m/s] (rad, rad/s for a rotary joint).
+    relative_displacement, relative_velocity : numpy.ndarray
+        The sliding displacement x_r [m] and velocity v_r [m/s] the friction sees.
+    friction_force : numpy.ndarray
+        The friction force [N] (N m for a rotary joint).
+    temperature : numpy.ndarray
+        The temperature [C] at each output time.
+    states : numpy.ndarray
+        The friction model's internal states, one column per state.
+    state_names, state_units : tuple of str
+        The states' names and units.
+    cycle_times : numpy.ndarray
+        A periodic input's period starts [s].
+    step_sizes : numpy.ndarray
+        The displacement over each cycle [m].
+    mean_velocity : float
+        The mean of the step sizes times the input's frequency [m/s].
+    input_unit : str, default "V"
+        The input's unit.
+    stats : dict, default {}
+        The integrator's counts (steps, rejected, rhs_evals, jac_evals, decompositions, events) and the solver used.
+    friction_work : numpy.ndarray, optional
+        The friction work [J] from the start, where asked or with a heat model.
+    model_name : str, optional
+        The simulated model's name (the figures' titles).
+    rotary : bool, default False
+        Whether the motion is a rotary joint's (rad, N m).
+    """
 
     time: np.ndarray
     input: np.ndarray

@@ -59,6 +59,31 @@ class StepSizeController:
     ``atol=None`` scales the absolute tolerance to each state: ``rtol`` times its characteristic
     magnitude (stage stroke for positions, stroke x natural frequency for velocities, fc/sigma0
     for the bristle deflection), so that micrometre motions are controlled as tightly as metres.
+
+    Parameters
+    ----------
+    rtol : float, default 1e-6
+        The relative tolerance, between 0 and 1.
+    atol : float or sequence of float, optional
+        The absolute tolerance: one value for every state, or one per state (in each state's SI unit), each
+        > 0; default None, scaled to each state as said above.
+    first_step : float, optional
+        The first step [s], > 0; default chosen by the integrator.
+    max_step : float, optional
+        The largest step [s], > 0; default none.
+    max_steps : int, default 10_000_000
+        The most steps of a run (>= 1); more is a SolverError ("max_steps").
+
+    Raises
+    ------
+    InputError
+        A value of the wrong type or out of its range, named (``rtol must be between 0 and 1, got 2``).
+
+    Examples
+    --------
+    >>> import thermofriction as tf
+    >>> tf.StepSizeController(rtol=1e-8, max_step=1e-4).rtol
+    1e-08
     """
 
     rtol: float = 1e-6
