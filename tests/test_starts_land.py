@@ -167,3 +167,19 @@ def test_progress_reports_a_long_model_i_fit(plant_only):
     for T in (20, 40, 60):
         assert any(f"at {T} C" in s for s in said), said
     assert any("joint refinement" in s for s in said)
+
+
+def test_the_screening_keeps_the_start_whose_short_fit_ends_lowest():
+    """Of two starts, the issue's wrong basin (fc half the truth's, sigma2 twice, vs ten times) and the data's own
+    reading, the screening keeps the one whose short fit ends lowest, whichever comes first: sigma2 within 5 % of the
+    truth's (0.25 N m s/rad at 40 C) and vs within a factor 3 of its 0.1 rad/s (the wrong start's short fit reaches
+    fc but ends with vs 57 rad/s and sigma2 0.215)."""
+    from thermofriction.identification.start import read_start, screened
+
+    exps = _joint(temperatures=(40.0, 40.0)).experiments
+    good = read_start(exps)[0]
+    wrong = {**good, "fc": 0.5 * good["fc"], "fs": 0.5 * good["fc"] + (good["fs"] - good["fc"]),
+             "sigma2": 2 * good["sigma2"], "vs": 10 * good["vs"]}
+    for candidates in ([wrong, good], [good, wrong]):
+        chosen = screened(exps, candidates, tf.PrescribedMotion(motion="rotary"))
+        assert abs(chosen["sigma2"] / 0.25 - 1) < 0.05 and 1 / 3 < chosen["vs"] / 0.1 < 3, chosen
