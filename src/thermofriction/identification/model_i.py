@@ -26,7 +26,6 @@ from .result import FitResult
 optimize = lazy("scipy.optimize")
 
 
-
 class _PerTemperature:
     """Model I's per-temperature fits: the lowest temperature first (it decides what the data cannot
     determine, which is then held at the initial model's law), then two continuation chains, one per core:
@@ -85,6 +84,16 @@ class _PerTemperature:
         return base
 
     def fit_at(self, group, previous, first_of_all=False, neighbour=True):
+        """:meth:`_fit_at`; a relation between the values it starts or continues from broken there (fs below fc)
+        fails as a computation naming the temperature, never as an error of the user's file (issue 40)."""
+        try:
+            return self._fit_at(group, previous, first_of_all, neighbour)
+        except InputError as e:
+            T, why = float(np.mean([x.temperature for x in group])), str(e).removeprefix("[friction]: ")
+            raise ComputationError(f"Model I: the fit at {T:.4g} C cannot start: {why}, in the values carried "
+                                   f"from the neighbouring temperature's fit, not in the initial model") from e
+
+    def _fit_at(self, group, previous, first_of_all=False, neighbour=True):
         """The fit at one temperature, from the neighbouring temperature's model (continuation) or,
         without one, from the initial model's values there with the multi-start; returns (T, result,
         what the next temperature continues from)."""

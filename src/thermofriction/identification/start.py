@@ -24,11 +24,12 @@ import numpy as np
 from ..drive import experiment_waveform
 from ..errors import ComputationError, InputError
 from ..models import FRICTION_MODELS, Coulomb, LuGre, Model, ModelI, PrescribedMotion
+from ..measurements.force import Force
 from ..simulation import simulate
 from .optimiser import fit
 from .parameters import Parameters
 from .problem import Problem, make_traces
-from .procedures import base_model
+from .procedures import base_model, friction_parameters
 
 #: the scan, in units of m_e times the stage's acceleration scale
 SCAN = np.logspace(-3, 1, 13)
@@ -166,59 +167,34 @@ def moving_speed(experiments) -> float:
     return top
 
 
-def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None) -> dict:
-    """A [friction] section of ``kind`` with starting values read off the data:
-
-    - the Coulomb level fc and viscous sigma2 (and the sensor offset, where the motion goes both ways) by
-      linear least squares ``F = b + fc sgn(v) + sigma2 v`` on the faster half of the sliding samples;
-    - a Stribeck excess fs - fc from the slowest sliding samples, and vs where it has fallen by 1/e;
-    - the bristle stiffness sigma0 from the force's rise over the motion after each reversal (the secant
-      over half the swing, times ln 2, is sigma0 for LuGre), else fc over 1/1000 of the stroke;
-    - sigma1 so that its force at the typical sliding speed is a tenth of fc.
-
-    A rough start: the fit's multi-start spans a decade either way.
-
-    Parameters
-    ----------
-    experiments : list of ForceExperiment
-        The force experiments.
-    kind : str, default "lugre"
-        The friction model.
-    plant : PrescribedMotion, optional
-        The plant (its motion: linear or rotary).
-
-    Returns
-    -------
-    dict
-        The [friction] section: "model" and the starting values, in SI units.
-
-    Raises
-    ------
-    InputError
-        No experiment; an unknown friction model.
-    """
-    exps = list(getattr(experiments, "fit", experiments))
-    if not exps:
-        raise InputError("no experiment to take starting values from")
-    v = np.concatenate([e.drive_velocity for e in exps])
-    F = np.concatenate([e.force for e in exps])
-    x = [np.asarray(e.displacement, float) for e in exps]
+def _static_map(e, top):
+    """(fc, sigma2, b) of one run: ``F = b + fc sgn(v) + sigma2 v`` by linear least squares on the faster half of
+    its sliding samples (b, its own offset, where it moves both ways); None with fewer than 4 such samples."""
+    v, F = np.asarray(e.drive_velocity, float), np.asarray(e.force, float)
     speed = np.abs(v)
-    top = moving_speed(exps)
     sliding = speed > 0.02 * top
+    if sliding.sum() < 8:
+        return None
     fast = sliding & (speed >= np.median(speed[sliding]))
-    both_ways = np.any(v[fast] > 0) and np.any(v[fast] < 0)
+    both_ways = bool(np.any(v[fast] > 0) and np.any(v[fast] < 0))
     cols = [np.sign(v[fast]), v[fast]] + ([np.ones(int(fast.sum()))] if both_ways else [])
     coef, *_ = np.linalg.lstsq(np.column_stack(cols), F[fast], rcond=None)
-    fc = abs(float(coef[0]))
-    b = float(coef[2]) if both_ways else 0.0
-    fc = fc if fc > 0 else float(np.quantile(np.abs(F), 0.5)) or 1.0
-    sigma2 = max(float(coef[1]), 1e-3 * fc / top)
-    # presliding stiffness from the reversals
+    return abs(float(coef[0])), float(coef[1]), float(coef[2]) if both_ways else 0.0
+
+
+def _reversals(e):
+    """The samples where one run's driving velocity changes sign."""
+    ve = np.asarray(e.drive_velocity, float)
+    return np.flatnonzero(np.sign(ve[1:]) * np.sign(ve[:-1]) < 0)
+
+
+def _stiffness(exps, fc):
+    """The bristle stiffness from the force's rise over the position after each reversal (the secant over half
+    the swing, times ln 2, is sigma0 for LuGre), at most where the swing spans a tenth of a typical sample's motion;
+    None where no swing is seen. Also each run's motion since its last reversal."""
     secants, travelled = [], []
-    for e, xe in zip(exps, x):
-        ve, Fe = e.drive_velocity, e.force
-        flips = np.flatnonzero(np.sign(ve[1:]) * np.sign(ve[:-1]) < 0)
+    for e in exps:
+        xe, Fe, flips = np.asarray(e.displacement, float), np.asarray(e.force, float), _reversals(e)
         for i in flips:
             j = i + 1
             while j < len(Fe) and abs(Fe[j] - Fe[i]) < fc and j - i < 10_000:
@@ -228,34 +204,150 @@ def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None
         start = np.zeros(len(xe), int)  # the sample of the last reversal before each sample
         start[flips + 1] = flips + 1
         travelled.append(np.abs(xe - xe[np.maximum.accumulate(start)]))
-    stroke = max(float(np.ptp(np.concatenate(x))), 1e-300)
-    sigma0 = math.log(2.0) * float(np.median(secants)) if secants else fc / (1e-3 * stroke)
-    # a swing within one sample gives no stiffness, only a bound: start where the presliding spans a tenth of a
-    # typical sample's motion (stiffer bristles change nothing the data can show, and make the runs stiff)
-    step = float(np.median(np.concatenate([np.abs(np.diff(xe)) for xe in x])))
-    if step > 0:
+    sigma0 = math.log(2.0) * float(np.median(secants)) if secants else None
+    step = float(np.median(np.concatenate([np.abs(np.diff(np.asarray(e.displacement, float))) for e in exps])))
+    if sigma0 is not None and step > 0:
         sigma0 = min(sigma0, 2.0 * fc / (0.1 * step))
-    typical = float(np.median(speed[sliding]))
-    section = {"model": "lugre", "fc": fc, "sigma2": sigma2, "sigma0": sigma0, "sigma1": 0.1 * fc / typical}
-    # Stribeck: the excess over the Coulomb-viscous line at the slowest speeds of steady sliding (five
-    # presliding lengths fc/sigma0 past a reversal)
-    steady = sliding & (np.concatenate(travelled) > 5.0 * fc / sigma0)
-    excess = np.sign(v[steady]) * (F[steady] - b) - fc - sigma2 * speed[steady]
-    s = speed[steady]
-    order = np.argsort(s)
+    return sigma0, travelled
+
+
+def _excess(exps, maps, travelled, length, top):
+    """The Stribeck excess over each run's own Coulomb-viscous line: (speeds, levels) binned by speed over the
+    steady sliding (``length`` past a reversal), and the median peak of the excess within 20 such lengths after
+    the reversals (where the bristles break away: the steady sliding of a smooth motion is rarely slow)."""
+    rows, peaks = [], []
+    for e, (fc, s2, b), moved in zip(exps, maps, travelled):
+        v, F = np.asarray(e.drive_velocity, float), np.asarray(e.force, float)
+        x = np.sign(v) * (F - b) - fc - s2 * np.abs(v)
+        steady = (np.abs(v) > 0.02 * top) & (moved > length)
+        rows.append(np.column_stack([np.abs(v[steady]), x[steady]]))
+        flips = _reversals(e)
+        for i, n in zip(flips, np.append(flips[1:], len(v) - 1)):
+            after = np.arange(i + 1, n + 1)
+            after = after[moved[after] < 20.0 * length]
+            if after.size:
+                peaks.append(float(np.max(x[after])))
+    rows = np.concatenate(rows) if rows else np.zeros((0, 2))
+    order = np.argsort(rows[:, 0])
     n_bin = max(len(order) // 40, 5)
     bins = [order[i:i + n_bin] for i in range(0, len(order), n_bin)]
-    levels = np.array([np.median(excess[i]) for i in bins])
-    speeds = np.array([np.median(s[i]) for i in bins])
+    return (np.array([np.median(rows[i, 0]) for i in bins]), np.array([np.median(rows[i, 1]) for i in bins]),
+            float(np.median(peaks)) if peaks else 0.0)
+
+
+def read_start(experiments) -> list:
+    """Starting values read off the data, as LuGre [friction] sections: the first from the static map and the
+    steady sliding, the others (where they differ) with the Stribeck excess from the break-away peaks after the
+    reversals, and with the bristle stiffness 3 times lower and higher (the secant's bias where the presliding
+    spans a sample or two).
+
+    - the Coulomb level fc and viscous sigma2 by linear least squares ``F = b + fc sgn(v) + sigma2 v`` on the
+      faster half of each run's sliding samples, each run with its own offset b (a sensor re-zeroed per run, a
+      temperature per run): their medians;
+    - a Stribeck excess fs - fc from the slowest steady sliding, and vs where it has fallen by 1/e;
+    - the bristle stiffness sigma0 from the force's rise over the motion after each reversal (the secant
+      over half the swing, times ln 2, is sigma0 for LuGre), else fc over 1/1000 of the stroke;
+    - sigma1 so that its force at the typical sliding speed is a tenth of fc."""
+    exps = list(getattr(experiments, "fit", experiments))
+    if not exps:
+        raise InputError("no experiment to take starting values from")
+    top = moving_speed(exps)
+    maps = [_static_map(e, top) for e in exps]
+    kept = [(e, m) for e, m in zip(exps, maps) if m is not None]
+    if not kept:
+        F = np.concatenate([e.force for e in exps])
+        kept = [(e, (float(np.quantile(np.abs(F), 0.5)) or 1.0, 0.0, 0.0)) for e in exps]
+    exps, maps = [e for e, _ in kept], [m for _, m in kept]
+    fc = float(np.median([m[0] for m in maps])) or 1.0
+    speed = np.abs(np.concatenate([e.drive_velocity for e in exps]))
+    sigma2 = max(float(np.median([m[1] for m in maps])), 1e-3 * fc / top)
+    stroke = max(float(np.ptp(np.concatenate([e.displacement for e in exps]))), 1e-300)
+    sigma0, travelled = _stiffness(exps, fc)
+    sigma0 = sigma0 or fc / (1e-3 * stroke)
+    typical = float(np.median(speed[speed > 0.02 * top]))
+    section = {"model": "lugre", "fc": fc, "sigma2": sigma2, "sigma0": sigma0, "sigma1": 0.1 * fc / typical}
+    speeds, levels, peak = _excess(exps, maps, travelled, 5.0 * fc / sigma0, top)
     if levels.size > 2 and levels[0] > 0.05 * fc:
-        fs = fc + float(levels[0])
         below = np.flatnonzero(levels < levels[0] / math.e)
         vs = float(speeds[below[0]]) if below.size else float(speeds[-1])
-        section.update(fs=fs, vs=max(vs, float(speeds[0])))
+        section.update(fs=fc + float(levels[0]), vs=max(vs, float(speeds[0])))
+    out = [section]
+    if peak > 0.05 * fc and peak > section.get("fs", fc) - fc:
+        out.append({**section, "fs": fc + peak, "vs": section.get("vs", typical / 4.0)})
+    out += [{**c, "sigma0": c["sigma0"] * f} for c in list(out) for f in (1 / 3, 3.0)]
+    return out
+
+
+#: the screening's short fit of each data-derived start: evaluations, and the runs it uses (the shortest few)
+SCREEN_EVALUATIONS = 8
+SCREEN_RUNS = 2
+
+
+def screened(experiments, candidates, plant=None, progress=None) -> dict:
+    """The candidate [friction] section whose short fit (SCREEN_EVALUATIONS evaluations at the coarse tolerance,
+    each run's own offset profiled out, on the SCREEN_RUNS runs nearest the middle temperature) ends with the least
+    misfit, as read (not the short fit's values: on a drive's command recorded 0.5 s late they walked to fc ~ 0, and
+    the delay's misalignment was no longer seen). A start whose fit cannot run is not chosen; the first where none
+    can."""
+    if len(candidates) < 2:
+        return candidates[0]
+    exps = list(getattr(experiments, "fit", experiments))
+    mid = float(np.median([e.temperature for e in exps]))
+    exps = sorted(exps, key=lambda e: (abs(e.temperature - mid), len(e.time)))[:SCREEN_RUNS]
+    best = (math.inf, candidates[0])
+    for k, section in enumerate(candidates):
+        model = Model(plant or PrescribedMotion(), LuGre.from_dict(section))
+        names = [n for n in ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2") if n in section]
+        try:
+            outcome = fit(model, friction_parameters(model, names, excess=True), make_traces(
+                exps, model, Force("per-experiment")), rtol=1e-6, starts=1, max_nfev=SCREEN_EVALUATIONS)
+        except (ComputationError, InputError):
+            continue
+        cost = float(outcome.r @ outcome.r)
+        if progress:
+            progress(f"start {k + 1} of {len(candidates)} read off the data: misfit {cost:.4g}")
+        if cost < best[0]:
+            best = (cost, section)
+    return best[1]
+
+
+def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None, screen: bool = True,
+                progress=None) -> dict:
+    """A [friction] section of ``kind`` with starting values read off the data (:func:`read_start`), screened.
+
+    Of the data-derived starts, the one whose short fit on the data ends lowest (:func:`screened`): a fit from the
+    wrong one ended at half the Coulomb level (issue 40). A rough start: the fit's multi-start spans a decade
+    either way.
+
+    Parameters
+    ----------
+    experiments : list of ForceExperiment
+        The force experiments (a Dataset's fit experiments where a Dataset is given).
+    kind : str, default "lugre"
+        The friction model.
+    plant : PrescribedMotion, optional
+        The plant (its motion: linear or rotary).
+    screen : bool, default True
+        Whether to screen the starts by short fits (else the first, from the static map).
+    progress : callable, optional
+        Called with a line saying what is done.
+
+    Returns
+    -------
+    dict
+        The [friction] section: "model" and the starting values, in SI units.
+
+    Raises
+    ------
+    InputError
+        No experiment; a record at rest; an unknown friction model.
+    """
+    candidates = read_start(experiments)
+    section = screened(experiments, candidates, plant, progress) if screen else candidates[0]
     if kind == "lugre":
         return section
     start = Model(plant or PrescribedMotion(), LuGre.from_dict(section))
     return with_friction_model(start, kind).friction.to_dict()
 
 
-__all__ = ["lugre_start", "force_start", "moving_speed", "MIN_TRAVEL_STEPS", "with_friction_model"]
+__all__ = ["lugre_start", "force_start", "read_start", "screened", "moving_speed", "MIN_TRAVEL_STEPS", "with_friction_model"]

@@ -149,7 +149,12 @@ class Force(Measurement):
         core does not step exactly (``_bridge.prescribed_applies``; a ripple it steps at the waveform's position)."""
         if model.thermal is not None and not isinstance(model.thermal, ModelI):
             return None
-        names = problem.chain if problem.chain is not None else problem.names
+        # a Stribeck excess fs - fc fitted as such (identification/parameters.py: EXCESS) is fs to the core, its
+        # column moved into fc's by Problem.in_names (integrated instead, Model I's per-temperature fits took 2x)
+        names = problem.chain if problem.chain is not None else [
+            "fs" if n == "fs_excess" else n for n in problem.names]
+        if _has_ripple(model) or any(n in RIPPLE_AMPLITUDES for n in names):
+            return None
         if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
             return None  # a law's base value fitted as such: not a value at the temperature
         arrays = getattr(model.friction, "arrays", ())
@@ -176,7 +181,7 @@ class Force(Measurement):
                 return None
             if not jac:
                 return F, None
-            return F, (dF @ problem.chain_matrix(model, T) if problem.chain is not None else dF)
+            return F, problem.in_names(dF, model, tr)
         out = problem.run_all(run, jac)
         if any(o is None for o in out):
             return None, None
