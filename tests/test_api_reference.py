@@ -200,8 +200,8 @@ def _conf():
 def test_attribute_comments_are_not_read_as_type_and_text():
     """napoleon reads an attribute's first line "force data: the sensor's offset" as the type "force data" (the
     FitResult.sensor_offset and .removed entries of issue 44); the site keeps such docstrings as written."""
+    conf = _conf()  # (skips without Sphinx, before its import)
     from sphinx.ext.napoleon import Config, _process_docstring
-    conf = _conf()
 
     class App:
         config = Config(napoleon_use_param=False)

@@ -87,8 +87,18 @@ def binary_path(platform_name: str = "linux64") -> Path:
 
 
 def prebuilt_platforms() -> list[str]:
-    """The platforms whose binary was built with the package (``linux64``, and ``win64`` with MinGW-w64): what
-    an export carries by default."""
+    """The platforms whose binary was built with the package: what an export carries by default.
+
+    Returns
+    -------
+    list of str
+        ``"linux64"``, and ``"win64"`` where the package was built with the MinGW-w64 cross compiler.
+
+    Raises
+    ------
+    None
+        Nothing is checked.
+    """
     return [name for name in PLATFORMS if binary_path(name).is_file()]
 
 

@@ -53,6 +53,8 @@ class Trace:
         The offset held where the measurement's policy is "none" (a force sensor's, from the model), in ``unit``.
     unit : str, default "m"
         The SI unit of ``measured``.
+    angle : numpy.ndarray, optional
+        The recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py).
     """
 
     name: str

@@ -280,11 +280,13 @@ class Command(Force):
     offset : {"shared", "per-experiment", "none"}, default "shared"
         The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
         estimated on it; "none", the model's own, held.
+    ripple_phase : {"recorded", "per-run", "auto"}, default "recorded"
+        The position ripple's angle, as for :class:`Force`.
 
     Raises
     ------
     InputError
-        An offset policy that does not apply to these data.
+        An offset policy that does not apply to these data; an unknown ripple phase.
     """
 
     name = "command"

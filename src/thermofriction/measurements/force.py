@@ -77,11 +77,13 @@ class Force(Measurement):
     offset : {"shared", "per-experiment", "none"}, default "shared"
         The offset policy (OFFSETS): "shared", one fitted offset for all runs; "per-experiment", each run's own,
         estimated on it; "none", the model's own, held.
+    ripple_phase : {"recorded", "per-run", "auto"}, default "recorded"
+        The position ripple's angle (measurements/ripple.py): at the recorded position, or each run's own phase.
 
     Raises
     ------
     InputError
-        An offset policy that does not apply to these data.
+        An offset policy that does not apply to these data; an unknown ripple phase.
     """
 
     name = "force"
@@ -153,8 +155,6 @@ class Force(Measurement):
         # column moved into fc's by Problem.in_names (integrated instead, Model I's per-temperature fits took 2x)
         names = problem.chain if problem.chain is not None else [
             "fs" if n == "fs_excess" else n for n in problem.names]
-        if _has_ripple(model) or any(n in RIPPLE_AMPLITUDES for n in names):
-            return None
         if problem.chain is None and any(n in getattr(model, "laws", {}) for n in names):
             return None  # a law's base value fitted as such: not a value at the temperature
         arrays = getattr(model.friction, "arrays", ())
@@ -388,6 +388,8 @@ class ForcePrediction:
         ``rmse`` over the measured force's span [-].
     max_error_pct : float
         100 times the largest absolute error over the measured force's span [%].
+    max_error : float
+        The largest absolute error, in ``unit``.
     bias : float
         The mean of predicted minus measured, in ``unit``.
     unit : str
