@@ -41,9 +41,9 @@ $(VENV)/.docs-installed: $(VENV)/.installed pyproject.toml
 	touch $@
 
 # HTML from the guides (docs/*.md), the API reference (docstrings) and the executed gallery (examples/gallery);
-# every warning is an error
+# every warning is an error; Sphinx says what it reads and writes as it goes (a build takes minutes)
 docs: $(VENV)/.docs-installed
-	$(BIN)/python -m sphinx -b html -E -W --keep-going -q docs docs/_build/html
+	$(BIN)/python -m sphinx -b html -E -W --keep-going docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
 
 # the MATLAB/Octave MEX gateway (matlab/, docs/matlab.md), compiled by Octave's mkoctfile from the C sources
