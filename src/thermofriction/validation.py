@@ -10,7 +10,7 @@ from ._io import dump_json, jsonable
 from ._warning_routes import recorded_warnings
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from . import _args
-from .data.experiments import Dataset
+from .data.experiments import Dataset, run_label
 from .data.motion import check_motion_option, driven_by
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
@@ -326,8 +326,8 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
                 preds.append(measurement.predict(model, exp))
                 pairs.append((exp, preds[-1].measured, preds[-1].predicted))
             except ThermofrictionError as e:  # one experiment the model cannot run: say why, go on
-                failures.append(Failure(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
-        caught += [f"{exp.file}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
+                failures.append(Failure(run_label(exp), float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
+        caught += [f"{run_label(exp)}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
         caught += [str(x.message) for x in w if issubclass(x.category, MetricWarning)]
     caught = unit_warnings(pairs) + caught  # (first: a unit off by 1000 explains every error after it)
     return ValidationResult(model, preds, caught, failures, measurement, how)

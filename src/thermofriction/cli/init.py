@@ -58,6 +58,24 @@ def experiment_files(folder: Path, exclude=()) -> list[str]:
     return sorted(names)
 
 
+def experiment_runs(folder: Path, files) -> dict:
+    """{label: (file, struct or None, the struct's fields or None)}, in order: one run per file, except a MATLAB
+    file holding its runs in structs (data/matlab.py: run_structs), one per struct, labelled ``runs.mat:run1``
+    as tables name them (Experiment.label). A .mat that cannot be read is one run: loading it says why."""
+    from ..data.matlab import run_structs
+    out = {}
+    for f in files:
+        try:
+            structs = run_structs(folder / f) if f.lower().endswith(".mat") else {}
+        except InputError:
+            structs = {}
+        for name, fields in structs.items():
+            out[f"{f}:{name}"] = (f, name, fields)
+        if not structs:
+            out[f] = (f, None, None)
+    return out
+
+
 def _readings(stem: str, m) -> set:
     """What one number in a name can mean. A hyphen before it is a minus sign at the start of the name or after
     another separator (``run_-5C``, ``T=-10``); after a letter or a digit it may as well be a separator
@@ -119,8 +137,12 @@ def has_temperature_column(path: Path) -> bool:
     return any(cell.partition("[")[0].strip().lower() == "temperature" for cell in head.split(","))
 
 
+def _listed(labels) -> str:
+    return f"{', '.join(labels[:5])}{', ...' if len(labels) > 5 else ''}"
+
+
 def _explicit(items, files) -> dict:
-    """--temperature FILE=C, checked: {file: temperature}."""
+    """--temperature FILE=C (FILE:STRUCT=C for a run in a MATLAB file's struct), checked: {label: temperature}."""
     from ..data.files import check_temperature
     out = {}
     for item in items:
@@ -128,8 +150,8 @@ def _explicit(items, files) -> dict:
         if not eq or not name:
             raise InputError(f"--temperature {shorten(item)}: expected FILE=C, e.g. --temperature run3.csv=35.2")
         if name not in files:
-            raise InputError(f"--temperature {shorten(item)}: {shorten(name)} is not one of the experiment files "
-                             f"({', '.join(files[:5])}{', ...' if len(files) > 5 else ''})")
+            raise InputError(f"--temperature {shorten(item)}: {shorten(name)} is not one of the experiments "
+                             f"({_listed(files)})")
         try:
             out[name] = check_temperature(float(value), f"--temperature {name}")
         except ValueError:
@@ -164,28 +186,47 @@ def _plausible(T) -> bool:
     return T is not None and TEMPERATURE_RANGE[0] <= T <= TEMPERATURE_RANGE[1]
 
 
-def temperatures(folder: Path, files, explicit: dict, interactive: bool) -> dict:
-    """{file: (temperature or None for the column's mean, where it came from)}; the files whose temperature is
-    nowhere are asked for (``interactive``) or refused, all named in one message."""
+def _temperature_of(folder: Path, run) -> tuple | None:
+    """(temperature or None for the column's mean, where it came from) of a run that states one, else None: its
+    column (a struct's temperature field), else its name (a struct's, then its file's)."""
+    f, struct, fields = run
+    if struct is None:
+        if has_temperature_column(folder / f):
+            return None, "column"
+        return (temperature_from_name(f), "name") if _plausible(temperature_from_name(f)) else None
+    from ..data.matlab import column_of
+    if any((column_of(x) or ("",))[0] == "temperature" for x in fields):
+        return None, "field"
+    for name, source in ((struct, "struct"), (f, "name")):
+        if _plausible(temperature_from_name(name)):
+            return temperature_from_name(name), source
+    return None
+
+
+def temperatures(folder: Path, runs: dict, explicit: dict, interactive: bool) -> dict:
+    """{label: (temperature or None for the column's mean, where it came from)} of the runs
+    (:func:`experiment_runs`); the runs whose temperature is nowhere are asked for (``interactive``) or refused,
+    all named in one message."""
     out = {}
-    for f in files:
-        if f in explicit:
-            out[f] = (explicit[f], "--temperature")
-        elif has_temperature_column(folder / f):
-            out[f] = (None, "column")
-        elif _plausible(temperature_from_name(f)):
-            out[f] = (temperature_from_name(f), "name")
-    unknown = [f for f in files if f not in out]
+    for label, run in runs.items():
+        found = (explicit[label], "--temperature") if label in explicit else _temperature_of(folder, run)
+        if found is not None:
+            out[label] = found
+    unknown = [r for r in runs if r not in out]
     if unknown and not interactive:
-        listed = ", ".join(unknown[:8]) + (f", ... ({len(unknown)} files)" if len(unknown) > 8 else "")
+        listed = ", ".join(unknown[:8]) + (f", ... ({len(unknown)} runs)" if len(unknown) > 8 else "")
         several = [f"{f}: {_reads(f)}" for f in unknown if _reads(f)][:3]
         why = (f" unambiguously ({'; '.join(several)}; a hyphen after a letter or digit may be a separator or a minus "
                f"sign, an underscore before it makes it one: run_-5C.csv)" if several else "")
-        raise InputError(f"{folder}: no temperature for {listed}: the file has no temperature column and its name "
-                         f"states none{why}; give --temperature FILE=C (e.g. --temperature {unknown[0]}=35.2), name "
-                         f"the file with its temperature (run_35.2C.csv), or run init on a terminal to be asked")
-    for f in unknown:
-        out[f] = (_ask(f), "asked")
+        structs = any(runs[r][1] for r in unknown)
+        what = ("the run has no temperature field or column and neither its struct's name nor its file's name "
+                "states one" if structs else "the file has no temperature column and its name states none")
+        raise InputError(f"{folder}: no temperature for {listed}: {what}{why}; give --temperature FILE=C (e.g. "
+                         f"--temperature {unknown[0]}=35.2), name the {'struct' if structs else 'file'} with its "
+                         f"temperature ({'run_35p2C' if structs else 'run_35.2C.csv'}), or run init on a terminal "
+                         f"to be asked")
+    for r in unknown:
+        out[r] = (_ask(r), "asked")
     return out
 
 
@@ -199,20 +240,22 @@ def default_validation(order) -> list:
     return [order[round((i + 1) * (n - 1) / (k + 1))] for i in range(k)]
 
 
-def roles(files, temps: dict, validate, folder: Path) -> tuple[dict, str]:
-    """({file: "fit" | "validate"}, how the split was made)."""
+def roles(runs: dict, temps: dict, validate, folder: Path) -> tuple[dict, str]:
+    """({label: "fit" | "validate"}, how the split was made) of the runs (:func:`experiment_runs`)."""
+    files = list(runs)
     if validate is not None:
         chosen = [] if validate.strip().lower() == "none" else [v.strip() for v in validate.split(",") if v.strip()]
         for v in chosen:
             if v not in files:
-                raise InputError(f"--validate: {shorten(v)} is not one of the experiment files in {folder}")
+                raise InputError(f"--validate: {shorten(v)} is not one of the experiments in {folder} "
+                                 f"({_listed(files)})")
         how = "held out as you chose (--validate)" if chosen else "none held out (--validate none)"
     elif any(_HELD_OUT.search(f) for f in files):
         chosen = [f for f in files if _HELD_OUT.search(f)]
         how = (f"{len(chosen)} of {len(files)} held out where the file name says so ('validat...', 'holdout', "
                f"'held-out'; --validate chooses others)")
     else:
-        mean = {f: _mean_temperature(folder / f) if T is None else T for f, (T, _) in temps.items()}
+        mean = {f: _mean_temperature(folder, runs[f]) if T is None else T for f, (T, _) in temps.items()}
         chosen = default_validation(sorted(files, key=lambda f: mean[f]))
         how = (f"the default split: {len(chosen)} of {len(files)} held out at interior temperatures (--validate "
                f"chooses others)" if chosen else
@@ -221,17 +264,18 @@ def roles(files, temps: dict, validate, folder: Path) -> tuple[dict, str]:
     return {f: "validate" if f in chosen else "fit" for f in files}, how
 
 
-def _mean_temperature(path: Path) -> float:
-    """The mean of an experiment file's temperature column (for ordering the files; the dataset's loading says
-    what is wrong with a file)."""
+def _mean_temperature(folder: Path, run) -> float:
+    """The mean of a run's temperature column (for ordering the runs; the dataset's loading says what is wrong
+    with a file)."""
     import numpy as np
 
     from ..data import read_experiment_csv, read_experiment_mat
     from ..data.force import is_force_file
+    path, struct = folder / run[0], run[1]
     try:
         if path.suffix.lower() == ".mat":
             from ..data.matlab import read_force_mat
-            cols = read_force_mat(path, struct=None, units=None) or read_experiment_mat(path)
+            cols = read_force_mat(path, struct=struct, units=None) or read_experiment_mat(path, struct=struct)
         elif is_force_file(path):
             from ..data.force import read_force_csv
             cols = read_force_csv(path)
@@ -242,11 +286,11 @@ def _mean_temperature(path: Path) -> float:
         return float("nan")
 
 
-def manifest_text(name, files, temps, role_of) -> str:
+def manifest_text(name, runs: dict, temps, role_of) -> str:
     import tomli_w
     entries = []
-    for f in files:
-        entry = {"file": f}
+    for f, (file, struct, _) in runs.items():
+        entry = {"file": file} | ({"struct": struct} if struct else {})
         if temps[f][0] is not None:
             entry["temperature"] = temps[f][0]
         entry["role"] = role_of[f]
@@ -300,15 +344,16 @@ def cmd_init(args) -> int:
     if not files:
         raise InputError(f"{args.folder}: no experiment files ({', '.join(EXTENSIONS)}) in this folder")
     refuse_unlistable(args.folder, files)
-    explicit = _explicit(args.temperature, files)
-    temps = temperatures(folder, files, explicit, interactive=sys.stdin is not None and sys.stdin.isatty())
-    role_of, how = roles(files, temps, args.validate, folder)
-    data = write_checked(folder, manifest_text(_dataset_name(args.name, folder), files, temps, role_of))
-    width = max(map(len, files))
+    runs = experiment_runs(folder, files)
+    explicit = _explicit(args.temperature, list(runs))
+    temps = temperatures(folder, runs, explicit, interactive=sys.stdin is not None and sys.stdin.isatty())
+    role_of, how = roles(runs, temps, args.validate, folder)
+    data = write_checked(folder, manifest_text(_dataset_name(args.name, folder), runs, temps, role_of))
+    width = max(map(len, runs))
     source = {"--temperature": "given", "column": "mean of its temperature column", "name": "from the file name",
-              "asked": "as you typed it"}
+              "field": "mean of its temperature field", "struct": "from the struct's name", "asked": "as you typed it"}
     for e in data.experiments:
-        print(f"  {e.file:<{width}}  {e.temperature:8.4g} C  {e.role:<8}  ({source[temps[e.file][1]]})")
+        print(f"  {e.label:<{width}}  {e.temperature:8.4g} C  {e.role:<8}  ({source[temps[e.label][1]]})")
     print(f"roles: {how}")
     print(f"wrote {manifest} ({len(data.fit)} fit, {len(data.validate)} validate)")
     return 0

@@ -104,6 +104,12 @@ class Experiment:
     headers: dict | None = dataclasses.field(default=None, repr=False)
 
     @property
+    def label(self) -> str:
+        """How tables, JSON and reports name the run: its file, and in a MATLAB file holding several runs the
+        struct too (``runs.mat:run1``)."""
+        return f"{self.file}:{self.struct}" if self.struct else self.file
+
+    @property
     def sample_rate(self) -> float:
         """[Hz] from the median sampling interval."""
         return float(1.0 / np.median(np.diff(self.time)))
@@ -126,6 +132,11 @@ class Experiment:
         if float(np.ptp(smooth)) > TEMPERATURE_VARIES:
             return Sampled(np.asarray(self.time, float), smooth)
         return self.temperature
+
+
+def run_label(exp) -> str:
+    """How tables name an experiment (:attr:`Experiment.label`; the file of a run made in memory without one)."""
+    return getattr(exp, "label", None) or exp.file
 
 
 def _moving_average(x, w):

@@ -89,6 +89,24 @@ def _vector(path, label, value) -> np.ndarray:
     return a.reshape(-1).astype(float)
 
 
+def run_structs(path) -> dict:
+    """{name: its field names} of the struct variables of a MATLAB file that each hold a run
+    (docs/formats.md#matlab-files), sorted by name, when the file holds its runs that way: it has no ``time``
+    variable of its own, and these structs have a ``time`` field (a struct array too: reading it says why it is
+    refused). {} for a file of plain variables (one run) or one without such structs; a file that cannot be
+    read raises InputError naming it."""
+    variables = {k: v for k, v in _load(Path(path)).items() if not k.startswith("__")}
+    if any((column_of(v) or ("",))[0] == "time" for v in variables):
+        return {}
+    out = {}
+    for name in sorted(variables):
+        value = variables[name]
+        fields = value.dtype.names if isinstance(value, np.ndarray) else None
+        if fields and any((column_of(f) or ("",))[0] == "time" for f in fields):
+            out[name] = tuple(fields)
+    return out
+
+
 def read_experiment_mat(path, struct: str | None = None, units: dict | None = None, with_headers: bool = False):
     """Reads one experiment from a MATLAB file into SI arrays, as ``read_experiment_csv`` does
     from a CSV file: a dict with ``time``, ``voltage``, ``displacement`` and, where present,

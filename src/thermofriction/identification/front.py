@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 
 from .. import _args
-from ..data.experiments import TEMPERATURE_RANGE, Dataset
+from ..data.experiments import TEMPERATURE_RANGE, Dataset, run_label
 from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
 from ..measurements import amount, measurement_of
 from ..measurements.baseline import baseline_verdict, model_free
@@ -359,11 +359,11 @@ def _identify_plant(experiments, init):
     corr = np.asarray(pf.correlation, float)[:n, :n] if getattr(pf, "correlation", None) is not None \
         else np.full((n, n), np.nan)
     return FitResult("plant", model, pf.parameters, corr, pf.rmse ** 2 * pf.n_points, pf.rmse,
-                     pf.n_points, 0, 0, 1, pf.wall_time, True, f"fitted on {exp.file}",
-                     experiments=[{"file": exp.file, "temperature": exp.temperature, "role": exp.role,
+                     pf.n_points, 0, 0, 1, pf.wall_time, True, f"fitted on {run_label(exp)}",
+                     experiments=[{"file": run_label(exp), "temperature": exp.temperature, "role": exp.role,
                                    "rmse": pf.rmse}],
                      warnings=list(getattr(pf, "warnings", [])) + (
-                         [] if len(staged) == 1 else [f"fitted on {exp.file}; {len(staged) - 1} more "
+                         [] if len(staged) == 1 else [f"fitted on {run_label(exp)}; {len(staged) - 1} more "
                                                       f"experiment(s) with a stage record were not used"]),
                      details={"note": "the equivalent masses m and m_e are kept from the initial model"})
 

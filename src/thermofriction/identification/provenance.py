@@ -12,6 +12,7 @@ import os
 import numpy as np
 
 from .._version import __version__
+from ..data.experiments import run_label
 from ..data.files import dataset_sha256 as data_sha256
 from ..measurements import measurement_of
 from ..models import Model
@@ -70,7 +71,7 @@ def stamp(fit, data, method: str, init, options: dict):
 
     def one(f, how):
         prov = {"method": f.method, "data": where, "data_sha256": digest,
-                "fit_files": [e.file for e in fit_runs], "held_out_files": [e.file for e in held],
+                "fit_files": [run_label(e) for e in fit_runs], "held_out_files": [run_label(e) for e in held],
                 "date": date, "thermofriction": __version__, "initial_model": init_name,
                 "options": {**opts, **how}}
         if isinstance(f, FitResult):  # how it was scored: validate and report score it the same way

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+from ..data.experiments import run_label
+
 
 def motion_policy(experiments) -> str:
     """The motion option that drives held-out runs as the fit's were: "position" where every fit run with a
@@ -28,8 +30,8 @@ def _experiment_entry(exp, offsets: dict) -> dict:
         check = exp.motion_check
         if check is not None and math.isfinite(check.lag) and math.isfinite(check.scale):
             entry.update(velocity_lag=float(check.lag), velocity_scale=float(check.scale))
-    if exp.file in offsets:
-        entry["offset"] = offsets[exp.file]
+    if run_label(exp) in offsets:
+        entry["offset"] = offsets[run_label(exp)]
     return entry
 
 
@@ -45,7 +47,7 @@ def fit_record(fit, experiments, offset_policy: str) -> dict:
     noise = (fit.fit_quality or {}).get("noise")
     if noise is not None and math.isfinite(noise) and noise > 0:
         record.update(noise=float(noise), noise_unit=fit.unit)
-    entries = {e.file: _experiment_entry(e, offsets) for e in experiments}
+    entries = {run_label(e): _experiment_entry(e, offsets) for e in experiments}
     record["experiments"] = {k: v for k, v in entries.items() if v}
     return record
 

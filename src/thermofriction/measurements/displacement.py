@@ -11,6 +11,7 @@ import warnings
 import numpy as np
 
 from .. import _bridge
+from ..data.experiments import run_label
 from ..drive import drive
 from ..errors import InputError
 from ..models import require_actuator
@@ -71,7 +72,7 @@ class Displacement(Measurement):
 
     def make_trace(self, exp, model) -> Trace:
         d = drive(exp, model, start="record")
-        trace = Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.displacement, float),
+        trace = Trace(run_label(exp), np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.displacement, float),
                       d.temperature, d.waveform, getattr(exp, "role", "fit"), float(exp.temperature), self)
         if model.heat is not None:
             trace.measured_temperature = d.measured_temperature
@@ -153,12 +154,12 @@ class Displacement(Measurement):
         def pct(value, scale, what):
             if scale > 0:
                 return 100 * value / scale
-            warnings.warn(f"{exp.file}: the measured {what} is zero: percentage errors relative to it are "
+            warnings.warn(f"{run_label(exp)}: the measured {what} is zero: percentage errors relative to it are "
                           f"undefined (NaN)", MetricWarning, stacklevel=3)
             return math.nan
 
         max_pct = pct(float(np.max(np.abs(err))), span, "displacement's span (it is constant)")
-        return Prediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time), meas,
+        return Prediction(run_label(exp), float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time), meas,
                           pred, max_pct, rmse, rmse / span if span > 0 else math.nan,
                           pct(float(err[-1]), abs(net), "net displacement (it ends where it starts)") if span > 0
                           else math.nan,

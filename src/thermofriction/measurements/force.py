@@ -29,6 +29,7 @@ import numpy as np
 from .. import _bridge
 from ..drive import drive
 from ..errors import InputError, SolverError
+from ..data.experiments import run_label
 from ..data.force import ForceExperiment
 from ..models import Model, ModelI
 from ..models.sides import RIPPLE_AMPLITUDES
@@ -128,7 +129,7 @@ class Force(Measurement):
             raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet; fit Model I or II on "
                              "the measured temperatures instead")
         d = drive(exp, model, start="record")
-        return Trace(exp.file, np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.force, float),
+        return Trace(run_label(exp), np.ascontiguousarray(exp.time, float), np.ascontiguousarray(exp.force, float),
                      d.temperature, d.waveform, getattr(exp, "role", "fit"), float(exp.temperature), self,
                      held_offset=model.plant.sensor_offset, unit=exp.force_unit,
                      angle=np.ascontiguousarray(exp.displacement, float))
@@ -344,7 +345,7 @@ class Force(Measurement):
             err, pred = err - bias, pred - bias
         quality = fit_quality(err, meas)
         rmse = float(np.sqrt(np.mean(err ** 2)))
-        return ForcePrediction(exp.file, float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time),
+        return ForcePrediction(run_label(exp), float(exp.temperature), getattr(exp, "role", "fit"), np.asarray(exp.time),
                                np.asarray(exp.displacement), np.asarray(exp.drive_velocity), meas, pred, rmse,
                                rmse / span if span > 0 else math.nan,
                                100 * float(np.max(np.abs(err))) / span if span > 0 else math.nan,
