@@ -88,7 +88,7 @@ def test_init_without_a_temperature_names_the_files_and_the_way_out(five, tmp_pa
                  "--temperature", "c.csv=40"]) == 0
     assert {f: e.temperature for f, e in _files(folder).items()} == {"a.csv": 31.0, "b.csv": 35.5, "c.csv": 40.0}
     assert main(["init", str(folder), "--force", "--temperature", "x.csv=31"]) == 2
-    assert "x.csv is not one of the experiment files" in capsys.readouterr().err.replace("'", "")
+    assert "x.csv is not one of the experiments" in capsys.readouterr().err.replace("'", "")  # (files or structs)
 
 
 def test_init_asks_on_a_terminal(five, tmp_path, monkeypatch, capsys):
