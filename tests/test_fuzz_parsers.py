@@ -762,9 +762,13 @@ def test_no_code_execution_from_data_files():
     no eval/exec/pickle/yaml/allow_pickle anywhere in the package's Python sources."""
     bad = re.compile(r"\b(eval|exec|compile|__import__)\s*\(|\bpickle\b|\bmarshal\b|\byaml\b|allow_pickle\s*=\s*True"
                      r"|\bshelve\b|\bsubprocess\b|os\.system")
+    # the one module that runs a program: the C compiler on the package's own FMU sources, when an export asks for
+    # platforms (an argument list, no shell; issue 44) -- subprocess only, nothing else of the pattern
+    compiler = {"fmu_sources.py": re.compile(r"\bsubprocess\b")}
     hits = [f"{p.name}:{i}: {line.strip()}" for p in SRC.glob("*.py")
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
-            if bad.search(line.split("#")[0])]
+            if bad.search(line.split("#")[0])
+            and not (p.name in compiler and not bad.search(compiler[p.name].sub("", line.split("#")[0])))]
     assert not hits, hits
 
 

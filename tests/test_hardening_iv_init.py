@@ -137,7 +137,13 @@ def test_an_interrupted_init_leaves_the_folder_as_it_was(run, tmp_path, monkeypa
         return read(*args, **kwargs)
 
     monkeypatch.setattr(files, "_read_experiment", interrupted)
-    assert main(["init", str(folder), "--force"]) == status
+    # as a background job (nohup, make test &) the suite runs with SIGINT/SIGHUP ignored, and the command line
+    # keeps an ignored signal ignored: this process's disposition set here, as tests/child_signals.py does a child's
+    previous = signal.signal(signum, signal.default_int_handler if signum == signal.SIGINT else signal.SIG_DFL)
+    try:
+        assert main(["init", str(folder), "--force"]) == status
+    finally:
+        signal.signal(signum, previous)
     assert "no output was written" in capsys.readouterr().err
     assert sorted(os.listdir(folder)) == sorted(["run_30C.csv", "run_35C.csv"] + (["dataset.toml"] if old else []))
     if old is not None:

@@ -10,6 +10,7 @@ import numpy as np
 
 from .._lazy import lazy
 from ..errors import InputError
+from ..models.laws import RANGE_TOLERANCE
 from ..models import PWL, Const, Exp, Linear
 from ..models.friction import in_domain
 
@@ -26,19 +27,18 @@ def aicc(ssr, n, k):
     return aic + 2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else aic
 
 
-#: [degC] temperatures closer than this are one temperature to a fit (procedures.temperature_groups); a fitted law's
-#: range reaches at least this far beyond its fit temperatures, so that it holds at their nominal values: runs
-#: nominally at 24 and 45 C whose records average 24.0001 and 44.9995 C give 23.95..45.05, not 24.0001..44.9995
-SAME_TEMPERATURE = 0.05
+#: [degC] temperatures closer than this are one temperature to a fit (procedures.temperature_groups), and a law
+#: holds within it of its range (models/laws.py: RANGE_TOLERANCE, the same number)
+SAME_TEMPERATURE = RANGE_TOLERANCE
 
 
 def fit_range(T) -> tuple:
-    """The range a law fitted at temperatures ``T`` is written with: from the lowest to the highest, widened by
-    SAME_TEMPERATURE and rounded outwards to its multiples."""
+    """The range a law fitted at temperatures ``T`` is written with: from the lowest to the highest, as fitted. (Widened
+    by SAME_TEMPERATURE, a fitted constant fs beside a falling fc law fell below it at the widened end, and the fit
+    could not start: the range stays what was fitted, and a law is taken to hold within RANGE_TOLERANCE of it, so
+    that runs nominally at 24 and 45 C whose records average 24.0001 and 44.9995 C are inside.)"""
     T = np.asarray(T, float)
-    lo = math.floor((float(T.min()) - SAME_TEMPERATURE) / SAME_TEMPERATURE) * SAME_TEMPERATURE
-    hi = math.ceil((float(T.max()) + SAME_TEMPERATURE) / SAME_TEMPERATURE) * SAME_TEMPERATURE
-    return round(lo, 9), round(hi, 9)
+    return float(T.min()), float(T.max())
 
 
 #: the law kinds fit_law fits (identify(laws={name: kind}), --law NAME=KIND)

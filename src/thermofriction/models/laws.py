@@ -19,6 +19,11 @@ from ..errors import InputError, unknown_keys
 from ._parse import num, num_array
 
 
+#: [degC] a law holds within this of its calibrated range (in_range): the temperatures a fit groups as one
+#: (identification's SAME_TEMPERATURE)
+RANGE_TOLERANCE = 0.05
+
+
 @dataclass(frozen=True, eq=False)
 class Law:
     """A function of temperature T [degC]. ``range`` is the calibrated interval (or None)."""
@@ -73,11 +78,13 @@ class Law:
         return self.evaluate(T)[1]
 
     def in_range(self, T) -> bool:
+        """Whether ``T`` lies in the calibrated range, within RANGE_TOLERANCE of its ends (a run nominally at a fit's
+        end temperature whose record averages a little off it is one of the fit's temperatures)."""
         rng = getattr(self, "range", None)
         if rng is None:
             return True
         T = np.atleast_1d(T)
-        return bool(np.all((T >= rng[0] - 1e-9) & (T <= rng[1] + 1e-9)))
+        return bool(np.all((T >= rng[0] - RANGE_TOLERANCE) & (T <= rng[1] + RANGE_TOLERANCE)))
 
     # -- file form ---------------------------------------------------------------------------
     def to_dict(self) -> dict:

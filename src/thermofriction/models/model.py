@@ -180,6 +180,26 @@ class Model:
             if not np.all(np.isfinite(lam) & (lam > 0)):
                 i = int(np.argmin(np.where(np.isfinite(lam), lam, -np.inf)))
                 return f"Model II's lambda(T) = 1 + dF/fc is {lam[i]:.4g} at {T[i]:.4g} C (friction would reverse)"
+        return self._level_below_coulomb(points)
+
+    def _level_below_coulomb(self, points: int) -> str | None:
+        """Where, over the laws' common range, a Model I static level falls below its Coulomb level (fs < fc, each a
+        law or a constant): a relation no single law's domain holds, which a fitted constant fs beside a falling fc
+        broke at the range's widened end (the model then could not be simulated at its own range's low end)."""
+        rng = self.temperature_range() if isinstance(self.thermal, ModelI) else None
+        if rng is None:
+            return None
+        T, values = np.linspace(rng[0], rng[1], points), self.friction.values()
+
+        def at(name):
+            if name in self.laws:
+                return np.atleast_1d(self.laws[name](T))
+            return None if values.get(name) is None else np.full(T.shape, float(values[name]))
+        for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg")):
+            a, b = at(level), at(coulomb)
+            if a is not None and b is not None and np.any(a < b):
+                i = int(np.argmax(a < b))
+                return f"'{level}' ({a[i]:.4g}) is below '{coulomb}' ({b[i]:.4g}) at {T[i]:.4g} C"
         return None
 
     # -- files ---------------------------------------------------------------------------
