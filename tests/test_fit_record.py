@@ -88,8 +88,8 @@ def test_a_record_value_validate_cannot_use_is_named(joint, fits):
 def test_report_scores_each_model_by_its_own_record(joint, fits, tmp_path):
     """Before, one per-experiment fit made report score every model with per-experiment offsets."""
     html = tf.report(list(fits), tf.load_dataset(joint), tmp_path / "r.html")
-    assert "offset per-experiment, motion position (fit record)" in html
-    assert "offset shared, motion auto (fit record)" in html
+    assert "scored as fitted: offset per-experiment (the fit record), motion position (the fit record)" in html
+    assert "scored as fitted: offset shared (the fit record), motion auto (the fit record)" in html
 
 
 def test_the_command_line_says_a_warning_once(joint, fits, tmp_path):

@@ -317,7 +317,7 @@ def _comparison_section(entries, unit, what) -> str:
                      fmt_number(a[1] if a else None, "{:.3f}"), fmt_number(s.get("fit", {}).get("rmse"), "{:.4g}"),
                      fmt_number(s.get("validate", {}).get("rmse"), "{:.4g}"),
                      fmt_number(100 * s.get("validate", {}).get("nrmse", math.nan)),
-                     fmt_number(e.model.plant.sensor_offset, "{:.4g}"), _scored(e.validation.scored_as)])
+                     fmt_number(e.model.plant.sensor_offset, "{:.4g}"), e.validation.scoring])
     return ("<section><h2>Friction models compared</h2>" + html_table(
         ["model", "fitted parameters", "ΔAICc", "Akaike weight", f"RMSE, fit [{unit}]", f"RMSE, held out [{unit}]",
          "RMSE, held out [% of range]", f"sensor offset [{unit}]", "scored with"], rows, text=(8,), wrap=(8,)) +
@@ -337,14 +337,6 @@ def _range_note(what) -> str:
             f"{what} spans (a {what} that changes sign has no level to divide by). Max |error| is the largest single "
             f"error, in the data's unit: on a {what} that reverses it is at a reversal, where a small timing "
             f"difference shows as a large error.")
-
-
-def _scored(scored_as: dict) -> str:
-    """How one model was scored, for a table cell: "offset per-experiment, motion position (fit record)"."""
-    parts = [f"{k} {scored_as[k]}" for k in ("offset", "motion") if k in scored_as]
-    sources = {scored_as.get(k + "_from") for k in ("offset", "motion") if k in scored_as}
-    return ", ".join(parts) + (" (fit record)" if sources == {"the fit record"} else
-                               " (asked)" if "asked" in sources else " (defaults)")
 
 
 def _parameters_section(entries, unit) -> str:
