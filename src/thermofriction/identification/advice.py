@@ -15,9 +15,8 @@ import numpy as np
 
 from ..errors import ThermofrictionError
 from ..models import ModelI
-from ..models.sides import SIGNED
 from .optimiser import fit
-from .parameters import EXCESS, Parameters, get_value, unit_of
+from .parameters import EXCESS, Parameters, fitted_positive, get_value, unit_of
 
 #: the most evaluations a tried refit may take: it starts at the optimum and needs only to show the gain
 TRY_EVALUATIONS = 12
@@ -38,7 +37,7 @@ def _freed(res, names, model) -> Parameters:
             params[n].vary = True
             continue
         v = get_value(model, n)
-        positive = "." not in n and not n.startswith("dF") and n not in SIGNED
+        positive = fitted_positive(n)
         params.add(n, v, min=0.0 if positive and v >= 0 else -math.inf, unit=unit_of(model, n))
     return params
 

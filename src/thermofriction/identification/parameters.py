@@ -13,7 +13,7 @@ import re
 from .. import _bridge
 from ..errors import InputError
 from ..models import PARAMETER_UNITS, PARAMETERS, Model, ModelI, ModelII
-from ..models.sides import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, side_values
+from ..models.sides import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, SIGNED, side_values
 
 TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
@@ -216,6 +216,12 @@ def get_value(model: Model, name: str) -> float:
     return float(values[base])
 
 
+def fitted_positive(name: str) -> bool:
+    """Whether ``name`` is fitted positive (in log space): not Model II's dF, not a law's coefficient, not a
+    parameter that may take either sign (models/sides.py: SIGNED)."""
+    return not name.startswith("dF") and "." not in name and name not in SIGNED
+
+
 def with_values(model: Model, values: dict) -> Model:
     """A copy of ``model`` with the named parameters set."""
     friction = {}
@@ -273,4 +279,4 @@ def unit_of(model: Model, name: str) -> str:
     return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["EXCESS", "KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of"]
+__all__ = ["EXCESS", "KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of", "fitted_positive"]

@@ -14,13 +14,13 @@ import numpy as np
 
 from ..errors import ComputationError, InputError
 from ..models import Model, ModelI
-from ..models.sides import SIGNED
+from ..models.sides import STATIC_LEVELS
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
 from ..measurements.quality import fit_quality, pooled
 from .laws import SAME_TEMPERATURE
 from .optimiser import FitOutcome, fit
-from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
+from .parameters import EXCESS, Parameters, fitted_positive, get_value, unit_of, with_values
 from .problem import Problem, make_traces
 from .result import FitResult
 from .uncertainty import uncertainty
@@ -141,7 +141,7 @@ def friction_parameters(model: Model, names, fixed=(), excess=False) -> Paramete
         if name == "fs" and excess and get_value(model, EXCESS) > 0:
             name = EXCESS
         v = get_value(model, name)
-        positive = not name.startswith("dF") and "." not in name and name not in SIGNED
+        positive = fitted_positive(name)
         params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
                    unit=unit_of(model, name))
     return params
@@ -184,7 +184,7 @@ def held_at(init, T, base, held):
     start's fs 0.33 beside a fitted fc of 0.78 was refused as an error in the user's file."""
     start, values = base_model(init, T).friction.values(), base.friction.values()
     new = {n: start[n] for n in held}
-    for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg")):
+    for level, coulomb in STATIC_LEVELS:
         if level in new and coulomb not in held and values.get(coulomb) is not None and start.get(coulomb):
             new[level] = values[coulomb] * start[level] / start[coulomb]
     return base.with_friction(**new)
@@ -195,7 +195,7 @@ def levels_held_as_ratios(init, names, new_laws, Ts) -> dict:
     times the initial model's ratio, held (a number would fall below the fitted law where that rises)."""
     start = base_model(init, float(Ts.mean())).friction.values()
     return {level: new_laws[coulomb].scaled(start[level] / start[coulomb])
-            for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg"))
+            for level, coulomb in STATIC_LEVELS
             if level not in names and level not in init.laws and coulomb in new_laws
             and start.get(level) is not None and start.get(coulomb)}
 

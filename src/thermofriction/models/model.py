@@ -23,6 +23,7 @@ from .friction import (FRICTION_MODELS, GMS, PARAMETER_DOMAIN, PARAMETERS, Coulo
                        Stribeck, check_friction_values, in_domain)
 from .fit_record import check_fit_record
 from .laws import PWL, Law, law_from_dict
+from .sides import STATIC_LEVELS
 from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
 
@@ -195,7 +196,7 @@ class Model:
             if name in self.laws:
                 return np.atleast_1d(self.laws[name](T))
             return None if values.get(name) is None else np.full(T.shape, float(values[name]))
-        for level, coulomb in (("fs", "fc"), ("fs_neg", "fc_neg")):
+        for level, coulomb in STATIC_LEVELS:
             a, b = at(level), at(coulomb)
             if a is not None and b is not None and np.any(a < b):
                 i = int(np.argmax(a < b))

@@ -11,6 +11,8 @@ from ._parse import num, num_array
 
 #: The negative side's parameters (docs/models.md#direction-and-position), each with its positive one.
 NEGATIVE_SIDE = {"fc_neg": "fc", "fs_neg": "fs", "vs_neg": "vs", "sigma2_neg": "sigma2"}
+#: Each side's static level and the Coulomb level it must not fall below (fs >= fc, fs_neg >= fc_neg).
+STATIC_LEVELS = (("fs", "fc"), ("fs_neg", "fc_neg"))
 #: The ripple's harmonics (friction.h, TF_RIPPLE_ORDER) and its amplitudes' names, in N or N m.
 RIPPLE_ORDER = 3
 RIPPLE_AMPLITUDES = tuple(f"ripple_{f}{k}" for k in range(1, RIPPLE_ORDER + 1) for f in ("cos", "sin"))
