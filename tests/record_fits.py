@@ -3,7 +3,8 @@ change is behaviour-preserving (issue 39: identification results identical befor
 
 Use: ``THERMOFRICTION_RECORD_FITS=before.jsonl pytest -p record_fits tests/`` on the old code, the same with
 ``after.jsonl`` on the new (with ``PYTHONPATH=tests/record_fits_site`` the command lines the tests start are
-recorded too), then ``python tests/record_fits.py before.jsonl after.jsonl``. Every call of
+recorded too), then ``python tests/record_fits.py before.jsonl after.jsonl [--subset]`` (``--subset``: only the tests the
+second run ran). Every call of
 ``thermofriction.identify`` (the API, the fleet and the command line's in-process calls) writes one line: the test,
 the call's number in it, and the result's JSON (``to_dict()``) less what is not a result (wall times, paths)."""
 
@@ -94,12 +95,16 @@ def _close(a, b, rtol, path, bad):
         bad.append(f"{path}: {a!r} vs {b!r}")
 
 
-def compare(before: str, after: str, rtol: float = 1e-10) -> list[str]:
-    """The differences between two recordings, one line each (empty: identical to ``rtol``)."""
+def compare(before: str, after: str, rtol: float = 1e-10, subset: bool = False) -> list[str]:
+    """The differences between two recordings, one line each (empty: identical to ``rtol``); with ``subset``,
+    only the tests the second recording ran (a part of the suite run after a change against all of it before)."""
     def load(p):
         with open(p, encoding="utf-8") as fh:
             return {(r["test"], r["call"]): r["result"] for r in map(json.loads, fh)}
     a, b = load(before), load(after)
+    if subset:
+        ran = {t for t, _ in b}
+        a = {k: v for k, v in a.items() if k[0] in ran}
     bad = [f"{k}: only in {'before' if k in a else 'after'}" for k in sorted(set(a) ^ set(b))]
     for k in sorted(set(a) & set(b)):
         _close(a[k], b[k], rtol, f"{k[0]}#{k[1]}", bad)
@@ -107,7 +112,9 @@ def compare(before: str, after: str, rtol: float = 1e-10) -> list[str]:
 
 
 if __name__ == "__main__":
-    diffs = compare(sys.argv[1], sys.argv[2], float(sys.argv[3]) if len(sys.argv) > 3 else 1e-10)
+    subset = "--subset" in sys.argv
+    paths = [a for a in sys.argv[1:] if a != "--subset"]
+    diffs = compare(paths[0], paths[1], float(paths[2]) if len(paths) > 2 else 1e-10, subset=subset)
     print("\n".join(diffs[:200]) or "identical")
     print(f"{len(diffs)} differences", file=sys.stderr)
     sys.exit(1 if diffs else 0)
