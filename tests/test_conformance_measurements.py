@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from conformance_cases import MEASUREMENT_CASES, case_of, problem_api  # noqa: E402
 
 from thermofriction.errors import InputError  # noqa: E402
-from thermofriction.measurements import OFFSETS, REGISTRY  # noqa: E402
+from thermofriction.measurements import OFFSETS, REGISTRY, measurement_of  # noqa: E402
 
 #: samples per run: the residual and Jacobian checks, and the degrees-of-freedom probe (one residual evaluation
 #: per sample of every run)
@@ -84,26 +84,30 @@ def _own(measurement, model, exps, record):
     return out
 
 
-def _problem(name, policy, model, exps, rtol=1e-8):
-    """The fitting engine's problem of ``model`` against ``exps`` in the parameters the measurement fits by
-    default, and those parameters' values in the model."""
-    Problem = problem_api()
-    measurement = REGISTRY[name](policy)
-    traces = [measurement.make_trace(e, model) for e in exps]
-    names = list(measurement.fit_parameters[model.friction.model])
-    theta = np.array([getattr(model.friction, n) for n in names], float)
-    return Problem(model, names, traces, rtol=rtol), theta
+def _measurement(name, policy, exps):
+    """The experiments' measurement with offset policy ``policy``, as identify and validate ask it (measurement_of),
+    checked to be the registered one the case is of."""
+    measurement = measurement_of(exps, offset=policy)
+    assert measurement.name == name and type(measurement) is REGISTRY[name], (
+        f"the case of {name!r} is recognised as {measurement.name!r}")
+    return measurement
 
 
 def _own_problem(name, policy, experiments, which=1, rtol=OWN_RTOL):
+    """(the fitting engine's problem, the parameters' values, the record's range, the measurement): ``model``
+    held against its own prediction (which=1: SAMPLES per run; 2: PROBE_SAMPLES) in the parameters the measurement
+    fits by default."""
     model, long, short = experiments(name)
-    measurement = REGISTRY[name](policy)
+    exps = (long, short)[which - 1]
+    measurement = _measurement(name, policy, exps)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        exps = _own(measurement, model, (long, short)[which - 1], _case(name).record)
-    problem, theta = _problem(name, policy, model, exps, rtol)
+        exps = _own(measurement, model, exps, _case(name).record)
+    traces = [measurement.make_trace(e, model) for e in exps]
+    names = list(measurement.fit_parameters[model.friction.model])
+    theta = np.array([getattr(model.friction, n) for n in names], float)
     scale = float(np.ptp(np.concatenate([getattr(e, _case(name).record) for e in exps])))
-    return problem, theta, scale
+    return problem_api()(model, names, traces, rtol=rtol), theta, scale, measurement
 
 
 @pytest.mark.parametrize("name", list(REGISTRY))
@@ -120,7 +124,7 @@ def test_own_simulation_gives_zero_residuals(name, policy, experiments):
     record's range: two integrations of the actuator differ by about 2e-8 of it (most at the sawtooth's flyback),
     a prescribed motion integrated and stepped exactly by about 1e-11; a residual that mislays an offset, a unit,
     a sample or a sign is of the order of the signal (against the cases' own placeholder records: 0.4-0.8)."""
-    problem, theta, scale = _own_problem(name, policy, experiments)
+    problem, theta, scale, _ = _own_problem(name, policy, experiments)
     assert scale > 0
     r, J = problem.evaluate(theta, jac=False)
     assert r is not None, "the fit's path failed on the model's own prediction"
@@ -146,7 +150,7 @@ def test_jacobian_matches_central_finite_differences(name, policy, experiments):
     sensitivities' own error at 1e-4 of itself, 1e-6 of the largest); the exact stepping of a prescribed motion
     has no integration error. A column of a wrong sign, scale, chain rule or projection is off by its own size,
     which in these cases is at least 1e-2 of the largest."""
-    problem, theta, _ = _own_problem(name, policy, experiments, rtol=FD_RTOL)
+    problem, theta, _, _ = _own_problem(name, policy, experiments, rtol=FD_RTOL)
     r, J = problem.evaluate(theta, jac=True)
     assert r is not None and J is not None and J.shape == (r.size, theta.size)
     D = np.empty_like(J)
@@ -175,7 +179,7 @@ def test_offsets_take_the_degrees_of_freedom_offsets_in_says(name, policy, exper
     P: what the offsets and any other profiled-out nuisance absorb) number ``offsets_in(traces)``. P is probed
     exactly (it is linear in the record), its rank taken from its singular values (1 or 0 for a projection:
     threshold 1e-6)."""
-    problem, theta, _ = _own_problem(name, policy, experiments, which=2)
+    problem, theta, _, measurement = _own_problem(name, policy, experiments, which=2)
     r0, _ = problem.evaluate(theta)
     assert r0 is not None
     n = r0.size
@@ -194,7 +198,6 @@ def test_offsets_take_the_degrees_of_freedom_offsets_in_says(name, policy, exper
     P = np.column_stack(columns)
     sv = np.linalg.svd(P, compute_uv=False)
     rank = int(np.sum(sv > 1e-6 * sv[0]))
-    measurement = problem.measurement
     assert n - rank == measurement.offsets_in(problem.traces), (
         f"{name} ({policy}): the record's {n - rank} directions the residuals do not see, offsets_in says "
         f"{measurement.offsets_in(problem.traces)}")
