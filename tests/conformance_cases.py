@@ -130,10 +130,10 @@ FRICTION_CASES = {
 
 @dataclasses.dataclass(frozen=True)
 class Domain:
-    """A parameter's domain: ``lower`` its bound and whether the bound itself is in (``closed``); ``at_least``
-    another parameter it must not fall below; ``below`` the expression of a strict upper bound (z_ba < fc/sigma0, on each side of a direction-dependent
-    model);
-    ``finite`` only (any sign). Arrays: each element."""
+    """A parameter's domain, always finite: ``lower`` its bound and whether the bound itself is in (``closed``);
+    ``at_least`` another parameter it must not fall below; ``below`` a strict upper bound (z_ba < fc/sigma0, on
+    each side of a direction-dependent model); none of them: any finite value, of either sign. An array's
+    domain is each element's."""
 
     lower: float | None = None
     closed: bool = False
@@ -183,8 +183,9 @@ def _plant_fit():
 
 def _fleet():
     base = tf.load_model("li2009-base")
-    data = [tf.synthesize(dataclasses.replace(base, friction=dataclasses.replace(base.friction, fc=base.friction.fc * f)),
-                          [35.0], duration=0.05, noise=20e-9, seed=k) for k, f in enumerate((0.9, 1.1))]
+    units = [dataclasses.replace(base, friction=dataclasses.replace(base.friction, fc=base.friction.fc * f))
+             for f in (0.9, 1.1)]
+    data = [tf.synthesize(m, [35.0], duration=0.05, noise=20e-9, seed=k) for k, m in enumerate(units)]
     return tf.identify_fleet(data, "base", scheduler="sequential", starts=1, parameters=["fc"])
 
 

@@ -113,9 +113,9 @@ def _domain_params():
 @pytest.mark.parametrize("kind, name", list(_domain_params()))
 def test_domain_edges_accepted_inside_refused_outside_naming_the_parameter(kind, name):
     """Oracle: the documented domain (conformance_cases.DOMAINS). Just inside (an open bound plus 1e-9 of the
-    parameter's value, a closed bound itself, fs = fc, z_ba one ulp below fc/sigma0, the lower side's fc) a model is made; just outside
-    (an open bound itself, one ulp below a closed one or below fc, fc/sigma0 for z_ba, non-finite values) it is
-    refused with an InputError naming the parameter (an array's element as ``k[0]``)."""
+    parameter's value, a closed bound itself, fs = fc, z_ba one ulp below fc/sigma0 with the lower side's fc) a
+    model is made; just outside (an open bound itself, one ulp below a closed one or below fc, fc/sigma0 for z_ba,
+    non-finite values) it is refused with an InputError naming the parameter (an array's element as ``k[0]``)."""
     if name not in DOMAINS:
         pytest.fail(f"no domain written for {kind}.{name} (tests/conformance_cases.py: DOMAINS)")
     start, inside, outside = _edges(kind, name)
