@@ -21,6 +21,7 @@ import sys
 IGNORED = {"wall_time", "created", "date", "data", "path", "file", "folder", "seconds", "elapsed", "time_s"}
 
 _current = {"test": None, "count": 0}
+_TMP = re.compile(r"\S*?/pytest-\d+/")
 
 
 def _plain(x):
@@ -65,7 +66,7 @@ def install_in_child():
     """In a command line a test started: every identification keyed by the test and the command's arguments."""
     import thermofriction.identification as identification
     test = os.environ["PYTEST_CURRENT_TEST"].rsplit(" (", 1)[0]
-    args = re.sub(r"\S*/pytest-\d+/", "<tmp>/", " ".join(sys.argv[1:]))
+    args = _TMP.sub("<tmp>/", " ".join(sys.argv[1:]))
     _current["test"] = f"{test} [cli {args}]"
     identification.identify = _wrap(identification.identify, os.environ["THERMOFRICTION_RECORD_FITS"])
 
@@ -91,6 +92,9 @@ def _close(a, b, rtol, path, bad):
             bad.append(f"{path}: {len(a)} items vs {len(b)}")
         for i, (x, y) in enumerate(zip(a, b)):
             _close(x, y, rtol, f"{path}[{i}]", bad)
+    elif isinstance(a, str) and isinstance(b, str):
+        if _TMP.sub("<tmp>/", a) != _TMP.sub("<tmp>/", b):  # (a test's temporary folder differs per run)
+            bad.append(f"{path}: {a!r} vs {b!r}")
     elif a != b:
         bad.append(f"{path}: {a!r} vs {b!r}")
 
