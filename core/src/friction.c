@@ -1,6 +1,7 @@
 /* Friction models (docs/models.md#friction-models). */
 #include "thermofriction/friction.h"
-#include "checks.h"
+#include "domain.h"
+#include "friction_private.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,6 +1,7 @@
 /* Input waveforms (docs/formats.md#inputs). */
 #include "thermofriction/waveform.h"
-#include "checks.h"
+#include "domain.h"
+#include "waveform_private.h"
 
 #include <math.h>
 
