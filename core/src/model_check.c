@@ -2,7 +2,7 @@
  * of the Python package's parameter checks. The plant's own fields are checked here; the input's,
  * the friction model's and the thermal extension's in their files (their private headers). */
 #include "thermofriction/plant.h"
-#include "domain.h"
+#include "domain_tests.h"
 #include "friction_private.h"
 #include "thermal_private.h"
 #include "waveform_private.h"

@@ -1,6 +1,6 @@
 /* Input waveforms (docs/formats.md#inputs). */
 #include "thermofriction/waveform.h"
-#include "domain.h"
+#include "domain_tests.h"
 #include "waveform_private.h"
 
 #include <math.h>

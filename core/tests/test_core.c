@@ -1059,8 +1059,45 @@ static void test_friction_parameter_partials_vs_finite_differences(void)
     }
 }
 
+/* The friction models' domain table (domains.h): every model has rows, every row names a parameter of the
+ * list, and the checks follow it: vd = 0 is "none" (sigma1 constant), a negative vd is refused, the other
+ * rules by the name of the first parameter refused. */
+static void test_friction_domain_table_drives_the_checks(void)
+{
+    int rows[TF_FRICTION_GMS + 1] = {0}, bad_rows = 0;
+#define ROW(model, param, rule, other, when)                                                              \
+    rows[TF_FRICTION_##model]++;                                                                            \
+    bad_rows += TF_P_##param < 0 || TF_P_##param >= TF_NPARAM || TF_DOMAIN_##rule >= TF_DOMAIN_NRULE ||     \
+                TF_P_##other >= TF_NPARAM || TF_DOMAIN_##when >= TF_DOMAIN_NWHEN;
+    TF_FRICTION_DOMAINS(ROW)
+#undef ROW
+    for (int k = 0; k <= TF_FRICTION_GMS; k++) CHECK(rows[k] >= 3, "domain table: model %d has %d rows", k, rows[k]);
+    CHECK(bad_rows == 0, "domain table: %d rows name no parameter, rule or condition", bad_rows);
+    static tf_rt_friction f;
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
+    p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_ZBA] = 1e-6;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_OK, "vd = 0: none (sigma1 constant)");
+    p[TF_P_VD] = 1e-3;
+    CHECK(tf_rt_init(&f, TF_FRICTION_ELASTOPLASTIC, p, NULL, &E) == TF_OK, "vd > 0");
+    p[TF_P_VD] = -1e-3;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "vd"), "vd < 0 refused");
+    p[TF_P_VD] = INFINITY;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "vd"), "vd = inf refused");
+    p[TF_P_VD] = 0.0, p[TF_P_ZBA] = 2e-5; /* at or above fc / sigma0 = 1e-5 */
+    CHECK(tf_rt_init(&f, TF_FRICTION_ELASTOPLASTIC, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "z_ba"), "z_ba");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_OK, "z_ba: the elasto-plastic model's only");
+    p[TF_P_FS] = 1.0, p[TF_P_VS] = -1.0;
+    CHECK(tf_rt_init(&f, TF_FRICTION_STRIBECK, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "v_smooth"),
+          "vs unchecked without a Stribeck effect; v_smooth always for a static map");
+    p[TF_P_FS] = 1.2;
+    CHECK(tf_rt_init(&f, TF_FRICTION_DAHL, p, NULL, &E) == TF_OK, "Dahl: no Stribeck curve");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "vs"), "vs where fs != fc");
+}
+
 int main(void)
 {
+    test_friction_domain_table_drives_the_checks();
     test_rt_init_and_setters_refuse_bad_arguments();
     test_rt_step_refuses_bad_samples_and_keeps_its_state();
     test_observer_pid_and_loop_refuse_bad_arguments();
