@@ -212,6 +212,13 @@ void tf_model_state_scale(const tf_model *model, double *scale)
     }
 }
 
+void tf_model_default_atol(const tf_model *model, double rtol, double *atol)
+{
+    tf_model_state_scale(model, atol);
+    int n = tf_model_nstate(model);
+    for (int i = 0; i < n; i++) atol[i] *= rtol;
+}
+
 void tf_model_rtol_weights(const tf_model *model, double *w)
 {
     int n = tf_model_nstate(model);

@@ -123,6 +123,8 @@ const double *tf_model_params_cached(tf_model *model, double T, double *lambda, 
 /* Friction force F' at (t, state). */
 double tf_model_friction(const tf_model *model, double t, const double *y);
 void tf_model_initial_state(const tf_model *model, double *y);
+/* The default absolute tolerances: rtol times each state's characteristic magnitude (tf_model_state_scale). */
+void tf_model_default_atol(const tf_model *model, double rtol, double *atol);
 /* The weights of the relative tolerance per state for tf_solver_options.rtol_weight: 0 for positions. */
 void tf_model_rtol_weights(const tf_model *model, double *w);
 /* What a sensitivity is taken with respect to. */
