@@ -6,7 +6,14 @@
 #include <math.h>
 #include <string.h>
 
-void tf_model_prepare(tf_model *model) { model->cache_valid = 0; }
+void tf_model_data_init(tf_model_data *data, const tf_model *model)
+{
+    memset(data, 0, sizeof *data);
+    data->model = model;
+    data->gms = model->gms;
+}
+
+void tf_model_data_changed(tf_model_data *data) { data->cache.valid = 0; }
 
 int tf_model_nstate(const tf_model *model)
 {
@@ -77,38 +84,41 @@ double tf_model_lambda(const tf_model *model, double T)
 }
 
 /* Parameters, scale factor and offset force at temperature T, cached per temperature. */
-const double *tf_model_params_cached(tf_model *m, double T, double *lambda, double *dF)
+const double *tf_model_params_cached(tf_model_data *d, double T, double *lambda, double *dF)
 {
+    const tf_model *m = d->model;
+    tf_params_cache *c = &d->cache;
     /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
-    if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
-        if (!m->cache_valid) m->cache_laws = tf_thermal_law_mask(m->law); /* after a prepare: laws may have changed */
-        tf_thermal_params_masked(m->thermal, m->p, m->law, m->cache_laws, m->fs_follows_fc, T, m->cache_p);
-        m->cache_lambda = tf_model_lambda(m, T);
-        m->cache_dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
-        m->cache_plain = !tf_friction_asymmetric(m->cache_p) && !(m->cache_p[TF_P_RIPPLE_PERIOD] > 0.0);
-        m->cache_T = T;
-        m->cache_valid = 1;
+    if (!c->valid || !(c->T == T || (isnan(T) && isnan(c->T)))) {
+        if (!c->valid) c->laws = tf_thermal_law_mask(m->law); /* after a change: laws may have changed */
+        tf_thermal_params_masked(m->thermal, m->p, m->law, c->laws, m->fs_follows_fc, T, c->p);
+        c->lambda = tf_model_lambda(m, T);
+        c->dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
+        c->plain = !tf_friction_asymmetric(c->p) && !(c->p[TF_P_RIPPLE_PERIOD] > 0.0);
+        c->T = T;
+        c->valid = 1;
     }
-    *lambda = m->cache_lambda;
-    *dF = m->cache_dF;
-    return m->cache_p;
+    *lambda = c->lambda;
+    *dF = c->dF;
+    return c->p;
 }
 
 /* F' at temperature T and, when jac is given, its partials (overwriting the base model's
  * partials). The base model's parameter partials go to dp, untouched by Model II (the caller
  * applies it: tf_thermal_param_partial). */
-double tf_plant_friction_at(tf_model *m, double T, double t, const double *y, double *dz, tf_friction_partials *jac,
-                          tf_friction_param_partials *dp, double *F_base)
+double tf_plant_friction_at(tf_model_data *d, double T, double t, const double *y, double *dz,
+                            tf_friction_partials *jac, tf_friction_param_partials *dp, double *F_base)
 {
+    const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, T, &lambda, &dF);
+    const double *p = tf_model_params_cached(d, T, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
     double F;
-    if (m->cache_plain) { /* symmetric, no ripple (cached with p): the models' equations alone */
-        F = tf_friction_eval_side(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+    if (d->cache.plain) { /* symmetric, no ripple (cached with p): the models' equations alone */
+        F = tf_friction_eval_side(m->friction, p, &d->gms, v, y + nmech(m), dz, jac, dp);
     } else {
-        F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+        F = tf_friction_eval(m->friction, p, &d->gms, v, y + nmech(m), dz, jac, dp);
         if (p[TF_P_RIPPLE_PERIOD] > 0.0) /* on the base force: Model II scales it with the rest */
             F += tf_friction_ripple(p, relative_position(m, t, y), jac ? &jac->dF_dx : 0, dp ? dp->dF_dp : 0);
     }
@@ -118,23 +128,26 @@ double tf_plant_friction_at(tf_model *m, double T, double t, const double *y, do
 
 /* F' and z' of the common case (tf_plant_fast): the same equations as tf_plant_friction_at, with the
  * run's parameters. */
-TF_SIZED double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
+TF_SIZED double lugre_constant_T_friction(tf_model_data *d, double v, double z, double *zd)
 {
-    double lambda = m->cache_lambda, dF = m->cache_dF;
-    const double *p = m->cache_p;
-    if (!m->cache_valid || !(m->cache_T == m->T_const || (isnan(m->T_const) && isnan(m->cache_T))))
-        p = tf_model_params_cached(m, m->T_const, &lambda, &dF);
+    const tf_model *m = d->model;
+    const tf_params_cache *c = &d->cache;
+    double lambda = c->lambda, dF = c->dF;
+    const double *p = c->p;
+    if (!c->valid || !(c->T == m->T_const || (isnan(m->T_const) && isnan(c->T))))
+        p = tf_model_params_cached(d, m->T_const, &lambda, &dF);
     double g = p[TF_P_FS] == p[TF_P_FC] ? p[TF_P_FC] : tf_stribeck(p, v, 0);
     double F = tf_lugre_value(p, v, z, g, tf_sigma1(p, v, 0, 0, 0), zd);
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 1, 0);
 }
 
-double tf_model_friction(const tf_model *model, double t, const double *y)
+double tf_model_friction(tf_model_data *data, double t, const double *y)
 {
+    const tf_model *model = data->model;
     double dz[TF_MAX_FRICTION_STATES];
     if (tf_plant_fast(model))
-        return lugre_constant_T_friction((tf_model *)model, relative_velocity(model, t, y), y[nmech(model)], dz);
-    return tf_plant_friction((tf_model *)model, t, y, dz, 0);
+        return lugre_constant_T_friction(data, relative_velocity(model, t, y), y[nmech(model)], dz);
+    return tf_plant_friction(data, t, y, dz, 0);
 }
 
 void tf_model_initial_state(const tf_model *model, double *y)
@@ -244,9 +257,10 @@ static void heat_rates(const tf_model *m, double t, const double *y, double F, d
 
 tf_status tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     int nm = nmech(m);
-    double F = tf_plant_friction(m, t, y, dy + nm, 0);
+    double F = tf_plant_friction(d, t, y, dy + nm, 0);
     if (has_work(m)) heat_rates(m, t, y, F, dy);
     mechanical_rhs(m, t, y, F, dy);
     return TF_OK;
@@ -255,16 +269,17 @@ tf_status tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 /* tf_model_rhs for the common case (tf_plant_fast). */
 tf_status tf_plant_rhs_fast(double t, const double *y, double *dy, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     int iz = m->plant == TF_PLANT_STICK_SLIP ? 4 : 2;
-    double F = lugre_constant_T_friction(m, relative_velocity(m, t, y), y[iz], &dy[iz]);
+    double F = lugre_constant_T_friction(d, relative_velocity(m, t, y), y[iz], &dy[iz]);
     mechanical_rhs(m, t, y, F, dy);
     return TF_OK;
 }
 
 double tf_model_next_corner(double t, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    const tf_model *m = ((const tf_model_data *)ctx)->model;
     double c = tf_waveform_next_corner(&m->input, t);
     if (m->plant == TF_PLANT_PRESCRIBED) c = fmin(c, tf_waveform_next_reversal(&m->input, t));
     if (m->heat.on) {
@@ -279,32 +294,35 @@ int tf_model_nevent(const tf_model *model) { return tf_friction_nevent(model->fr
 
 void tf_model_events(double t, const double *y, double *g, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, y), &lambda, &dF);
-    tf_friction_events(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m), g);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
+    tf_friction_events(m->friction, p, &d->gms, relative_velocity(m, t, y), y + nmech(m), g);
 }
 
 void tf_model_on_restart(double t, const double *y, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
     double v = relative_velocity(m, t, y);
     if (m->plant == TF_PLANT_PRESCRIBED) {
         /* a prescribed motion keeps one direction between restarts (corners and reversals), but
          * at a sine's extremum v(t) is rounding noise: take the direction from inside the segment */
-        double tc = tf_model_next_corner(t, m);
+        double tc = tf_model_next_corner(t, d);
         if (isfinite(tc)) v = copysign(fabs(v), tf_waveform_slope(&m->input, 0.5 * (t + tc)));
     }
-    tf_friction_update_modes(m->friction, p, &m->gms, v, y + nmech(m));
+    tf_friction_update_modes(m->friction, p, &d->gms, v, y + nmech(m));
 }
 
 static void model_restart(double t, double *y, void *ctx) { tf_model_on_restart(t, y, ctx); }
 
-tf_ode tf_model_ode(tf_model *model)
+tf_ode tf_model_ode(tf_model_data *data)
 {
-    tf_ode ode = {tf_model_nstate(model), model, tf_plant_fast(model) ? tf_plant_rhs_fast : tf_model_rhs,
+    const tf_model *model = data->model;
+    tf_ode ode = {tf_model_nstate(model), data, tf_plant_fast(model) ? tf_plant_rhs_fast : tf_model_rhs,
                   tf_model_jac, tf_model_next_corner, tf_model_nevent(model), tf_model_events, model_restart,
                   0.0, 0, -1};
     if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
@@ -321,8 +339,9 @@ tf_ode tf_model_ode(tf_model *model)
     return ode;
 }
 
-void tf_model_outputs_strided(const tf_model *model, double t, const double *y, double *out, long stride)
+void tf_model_outputs_strided(tf_model_data *data, double t, const double *y, double *out, long stride)
 {
+    const tf_model *model = data->model;
     const int fast = tf_plant_fast(model); /* LuGre: one state, no work state */
     int nm = nmech(model), nz = fast ? 1 : nfric(model);
     double u = tf_waveform_value(&model->input, t);
@@ -342,17 +361,17 @@ void tf_model_outputs_strided(const tf_model *model, double t, const double *y, 
     out[TF_OUT_RELATIVE_VELOCITY * stride] = v - vp;
     if (fast) { /* the common case, as its right-hand side computes it */
         double dz;
-        out[TF_OUT_FRICTION_FORCE * stride] = lugre_constant_T_friction((tf_model *)model, v - vp, y[nm], &dz);
+        out[TF_OUT_FRICTION_FORCE * stride] = lugre_constant_T_friction(data, v - vp, y[nm], &dz);
         out[TF_OUT_TEMPERATURE * stride] = model->T_const;
     } else {
-        out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(model, t, y);
+        out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(data, t, y);
         out[TF_OUT_TEMPERATURE * stride] = tf_model_temperature(model, t, y);
     }
     for (int j = 0; j < nz; j++) out[(TF_OUT_NFIXED + j) * stride] = y[nm + j];
     if (!fast && has_work(model)) out[(TF_OUT_NFIXED + nz) * stride] = y[tf_model_work_index(model)];
 }
 
-void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
+void tf_model_outputs(tf_model_data *data, double t, const double *y, double *out)
 {
-    tf_model_outputs_strided(model, t, y, out, 1);
+    tf_model_outputs_strided(data, t, y, out, 1);
 }

@@ -14,13 +14,14 @@ static void velocity_partials(const tf_model *m, double *dv_dy)
  * Jacobian. dF'/dT and dz'/dT come from a central difference in T: the laws are smooth and
  * most base models have no analytic parameter partials (h = 1e-3 K: truncation ~1e-8 relative
  * for the paper's laws, far below what Rodas4's Newton-free stages need). */
-static void heat_jacobian(tf_model *m, double t, const double *y, const tf_friction_partials *d, double *J)
+static void heat_jacobian(tf_model_data *md, double t, const double *y, const tf_friction_partials *d, double *J)
 {
+    const tf_model *m = md->model;
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
     double T = tf_model_temperature(m, t, y);
     double dz[TF_MAX_FRICTION_STATES], dzp[TF_MAX_FRICTION_STATES], dzm[TF_MAX_FRICTION_STATES];
-    double F = tf_plant_friction_at(m, T, t, y, dz, 0, 0, 0), v = relative_velocity(m, t, y);
+    double F = tf_plant_friction_at(md, T, t, y, dz, 0, 0, 0), v = relative_velocity(m, t, y);
     double s = (F * v > 0.0) - (F * v < 0.0);
     double dv_dy[TF_MAX_STATES], dP[TF_MAX_STATES]; /* dP/dy, P = |F v| */
     velocity_partials(m, dv_dy);
@@ -29,7 +30,8 @@ static void heat_jacobian(tf_model *m, double t, const double *y, const tf_frict
     double dF_dT = 0.0, ddz_dT[TF_MAX_FRICTION_STATES] = {0};
     if (m->heat.on && m->thermal != TF_THERMAL_NONE) {
         const double h = 1e-3;
-        double Fp = tf_plant_friction_at(m, T + h, t, y, dzp, 0, 0, 0), Fm = tf_plant_friction_at(m, T - h, t, y, dzm, 0, 0, 0);
+        double Fp = tf_plant_friction_at(md, T + h, t, y, dzp, 0, 0, 0);
+        double Fm = tf_plant_friction_at(md, T - h, t, y, dzm, 0, 0, 0);
         dF_dT = (Fp - Fm) / (2 * h);
         for (int j = 0; j < nz; j++) ddz_dT[j] = (dzp[j] - dzm[j]) / (2 * h);
     }
@@ -50,8 +52,9 @@ static void heat_jacobian(tf_model *m, double t, const double *y, const tf_frict
 }
 
 /* The state Jacobian from the friction force's partials d (after the thermal model). */
-static void jacobian_from(tf_model *m, double t, const double *y, const tf_friction_partials *d, double *J)
+static void jacobian_from(tf_model_data *md, double t, const double *y, const tf_friction_partials *d, double *J)
 {
+    const tf_model *m = md->model;
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     memset(J, 0, sizeof(double) * n * n);
 #define J_(i, j) J[(i) * n + (j)]
@@ -85,16 +88,16 @@ static void jacobian_from(tf_model *m, double t, const double *y, const tf_frict
     }
     for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d->ddz_dz[j];
 #undef J_
-    if (has_work(m)) heat_jacobian(m, t, y, d, J);
+    if (has_work(m)) heat_jacobian(md, t, y, d, J);
 }
 
 tf_status tf_model_jac(double t, const double *y, double *J, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *md = (tf_model_data *)ctx;
     double dz[TF_MAX_FRICTION_STATES];
     tf_friction_partials d;
-    tf_plant_friction(m, t, y, dz, &d);
-    jacobian_from(m, t, y, &d, J);
+    tf_plant_friction(md, t, y, dz, &d);
+    jacobian_from(md, t, y, &d, J);
     return TF_OK;
 }
 
@@ -127,30 +130,31 @@ static void plant_partials(const tf_model *m, double t, const double *y, const d
     }
 }
 
-tf_status tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
+tf_status tf_model_derivatives(tf_model_data *md, double t, const double *y, double *dy, double *J,
                                const tf_target *targets, int np, double *fp)
 {
+    const tf_model *m = md->model;
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
     int fast = tf_plant_fast(m);
     if (!np) {
-        if (fast) tf_plant_rhs_fast(t, y, dy, m);
-        else tf_model_rhs(t, y, dy, m);
-        if (J) tf_model_jac(t, y, J, m);
+        if (fast) tf_plant_rhs_fast(t, y, dy, md);
+        else tf_model_rhs(t, y, dy, md);
+        if (J) tf_model_jac(t, y, J, md);
         return TF_OK;
     }
-    if (!fast) tf_model_rhs(t, y, dy, m); /* else from the one friction evaluation below */
+    if (!fast) tf_model_rhs(t, y, dy, md); /* else from the one friction evaluation below */
     tf_friction_param_partials dp;
     tf_friction_partials d; /* the state and the parameter partials from one evaluation */
     double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
     double T = tf_model_temperature(m, t, y);
-    tf_model_params_cached(m, T, &lambda, &dF_offset);
-    double F = tf_plant_friction_at(m, T, t, y, dz, J ? &d : 0, &dp, &Fb);
+    tf_model_params_cached(md, T, &lambda, &dF_offset);
+    double F = tf_plant_friction_at(md, T, t, y, dz, J ? &d : 0, &dp, &Fb);
     if (fast) { /* the same equations as tf_plant_rhs_fast, with the partials' evaluation */
         dy[nm] = dz[0];
         mechanical_rhs(m, t, y, F, dy);
     }
-    if (J) jacobian_from(m, t, y, &d, J);
+    if (J) jacobian_from(md, t, y, &d, J);
     if (m->fs_follows_fc) { /* one parameter moves both */
         dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
         for (int j = 0; j < nz; j++) dp.ddz_dp[j][TF_P_FC] += dp.ddz_dp[j][TF_P_FS];
@@ -172,7 +176,7 @@ tf_status tf_model_derivatives(tf_model *m, double t, const double *y, double *d
             continue;
         }
         if (tg->kind == TF_TARGET_DF) {
-            dF = tf_thermal_df_coef_partial(m->dF_form, &m->dF, tg->coef, T, Fb, Fref, v, m->cache_p[TF_P_VSMOOTH]);
+            dF = tf_thermal_df_coef_partial(m->dF_form, &m->dF, tg->coef, T, Fb, Fref, v, md->cache.p[TF_P_VSMOOTH]);
         } else {
             if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T);
             dF = tf_thermal_param_partial(m->thermal, m->dF_form, lambda, Fref, i, chain * dp.dF_dp[i], Fb);
@@ -202,21 +206,22 @@ static double velocity_along(const tf_model *m, const double *w)
     }
 }
 
-void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_target *targets, int np)
+void tf_model_sensitivity_restart(tf_model_data *md, double t, double *Y, const tf_target *targets, int np)
 {
+    const tf_model *m = md->model;
     if (m->friction != TF_FRICTION_GMS) return;
     int n = tf_model_nstate(m), nm = nmech(m), ne = m->gms.n;
     int old[TF_MAX_FRICTION_STATES];
     double fm[TF_MAX_STATES], fpl[TF_MAX_STATES];
-    memcpy(old, m->gms.mode, sizeof(int) * (size_t)ne);
-    tf_model_rhs(t, Y, fm, m);
-    tf_model_on_restart(t, Y, m);
+    memcpy(old, md->gms.mode, sizeof(int) * (size_t)ne);
+    tf_model_rhs(t, Y, fm, md);
+    tf_model_on_restart(t, Y, md);
     int changed = 0;
-    for (int i = 0; i < ne; i++) changed |= old[i] != m->gms.mode[i];
+    for (int i = 0; i < ne; i++) changed |= old[i] != md->gms.mode[i];
     if (!changed || !np) return;
-    tf_model_rhs(t, Y, fpl, m);
+    tf_model_rhs(t, Y, fpl, md);
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, Y), &lambda, &dF);
+    const double *p = tf_model_params_cached(md, tf_model_temperature(m, t, Y), &lambda, &dF);
     double v = relative_velocity(m, t, Y), dg_dv, dg_p[TF_NPARAM];
     tf_stribeck(p, v, &dg_dv);
     tf_stribeck_param_partials(p, v, dg_p);
@@ -233,9 +238,9 @@ void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_tar
     double vdot = velocity_along(m, fm);
     double *S = Y + n;
     for (int i = 0; i < ne; i++) {
-        int a = old[i], b = m->gms.mode[i], row = nm + i;
+        int a = old[i], b = md->gms.mode[i], row = nm + i;
         if (a == b) continue;
-        double jump = fm[row] - fpl[row], w = m->gms.w[i];
+        double jump = fm[row] - fpl[row], w = md->gms.w[i];
         const double *dgs_p = a == 0 && b < 0 ? dgn_p : dg_p; /* the capacity of the side it broke loose to */
         double dgs_dv = a == 0 && b < 0 ? dgn_dv : dg_dv;
         /* the event function that fired: a stuck element reaching its capacity, b z_i - w_i g(v);

@@ -312,7 +312,7 @@ static int check_model(const tf_model *m)
 }
 
 typedef struct {
-    const tf_model *model;
+    tf_model_data *data;
     double *out;
     int nch;
     long n_out; /* > 0: out is column-major (Fortran order), a column per output channel */
@@ -322,10 +322,10 @@ static void emit_outputs(long i, double t, const double *y, void *ctx)
 {
     emit_ctx *e = (emit_ctx *)ctx;
     if (!e->n_out) {
-        tf_model_outputs(e->model, t, y, e->out + (size_t)i * e->nch);
+        tf_model_outputs(e->data, t, y, e->out + (size_t)i * e->nch);
         return;
     }
-    tf_model_outputs_strided(e->model, t, y, e->out + i, e->n_out);
+    tf_model_outputs_strided(e->data, t, y, e->out + i, e->n_out);
 }
 
 /* simulate(spec, t_out, out, method, rtol, atol|None, h0, hmax, max_steps) -> stats dict */
@@ -369,13 +369,15 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     if (check_model(&m)) goto done;
     double y[TF_MAX_STATES];
     tf_model_initial_state(&m, y);
-    tf_ode ode = tf_model_ode(&m);
+    tf_model_data md; /* the run's mutable part: parameter cache, GMS modes */
+    tf_model_data_init(&md, &m);
+    tf_ode ode = tf_model_ode(&md);
     double rtol_w[TF_MAX_STATES];
     tf_model_rtol_weights(&m, rtol_w);
     tf_solver_options opt = {.method = method, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
                              .max_steps = max_steps, .rtol_weight = rtol_w};
     tf_solver_stats st;
-    emit_ctx ec = {&m, (double *)outv->buf, nch, columns ? (long)n_out : 0};
+    emit_ctx ec = {&md, (double *)outv->buf, nch, columns ? (long)n_out : 0};
     int raised;
     tf_error e;
     tf_status status = solve_released(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st, &e, &raised);
@@ -393,7 +395,7 @@ done:
 }
 
 typedef struct {
-    const tf_model *model;
+    tf_model_data *data;
     double *out, *sens;
     int nch, n, np;
 } sens_emit_ctx;
@@ -401,7 +403,7 @@ typedef struct {
 static void emit_sensitivities(long i, double t, const double *Y, void *ctx)
 {
     sens_emit_ctx *e = (sens_emit_ctx *)ctx;
-    tf_model_outputs(e->model, t, Y, e->out + (size_t)i * e->nch);
+    tf_model_outputs(e->data, t, Y, e->out + (size_t)i * e->nch);
     memcpy(e->sens + (size_t)i * e->n * e->np, Y + e->n, sizeof(double) * e->n * e->np);
 }
 
@@ -427,7 +429,9 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     int np = (int)np_rows;
     tf_target targets[TF_MAX_TARGETS];
     for (int k = 0; k < np; k++) targets[k] = (tf_target){ti[3 * k], ti[3 * k + 1], ti[3 * k + 2]};
-    tf_sensitivity_system sys = {&m, np, targets};
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
+    tf_sensitivity_system sys = {&md, np, targets};
     tf_error e;
     if (tf_sensitivity_check(&sys, &e)) {
         PyErr_Format(PyExc_ValueError, "target %ld is not valid for this model", e.index);
@@ -451,7 +455,7 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     tf_solver_options opt = {.method = TF_METHOD_DOPRI5, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
                              .max_steps = max_steps};
     tf_solver_stats st;
-    sens_emit_ctx ec = {&m, out, sens, nch, n, np};
+    sens_emit_ctx ec = {&md, out, sens, nch, n, np};
     int raised;
     tf_status status = solve_released(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st, &e, &raised);
     if (status != TF_OK) {
@@ -482,9 +486,11 @@ static PyObject *py_rhs_jac(PyObject *self, PyObject *args)
     double *dy = out_array(&a, dy_obj, n, "dy has the wrong size");
     double *J = J_obj == Py_None || !dy ? NULL : out_array(&a, J_obj, (Py_ssize_t)n * n, "J has the wrong size");
     if (!dy || (J_obj != Py_None && !J)) goto done;
-    tf_model_rhs(t, y, dy, &m);
-    if (J) tf_model_jac(t, y, J, &m);
-    result = PyFloat_FromDouble(tf_model_friction(&m, t, y));
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
+    tf_model_rhs(t, y, dy, &md);
+    if (J) tf_model_jac(t, y, J, &md);
+    result = PyFloat_FromDouble(tf_model_friction(&md, t, y));
 done:
     arena_free(&a);
     return result;
@@ -507,11 +513,13 @@ static PyObject *py_time_rhs(PyObject *self, PyObject *args)
     if (PyErr_Occurred()) goto done;
     if (ny != n || n_evals < 1) { PyErr_Format(PyExc_ValueError, "y must have %d values, n_evals >= 1", n); goto done; }
     double dy[TF_MAX_STATES], sink = 0.0;
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
     struct timespec t0, t1;
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (long i = 0; i < n_evals; i++) {
-        tf_model_rhs(t + 1e-12 * (double)(i & 1023), y, dy, &m);
+        tf_model_rhs(t + 1e-12 * (double)(i & 1023), y, dy, &md);
         sink += dy[n - 1];
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);

@@ -15,7 +15,7 @@ extern "C" {
 #define TF_MAX_TARGETS 32
 
 typedef struct {
-    tf_model *model;
+    tf_model_data *data; /* the model's run (plant.h): tf_model_data_init before */
     int np;
     const tf_target *targets;
     int n; /* the model's states: set on the first evaluation (0 before) */
