@@ -621,7 +621,7 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     int substeps = (int)(substeps_in < 0 ? 0 : substeps_in);
     arena a = {0}, b = {0};
     tf_model pm, cm;
-    tf_rt_friction *rt = scratch(&a, 2 * sizeof(tf_rt_friction)); /* ~3 kB each: not on the stack */
+    tf_rt_friction *rt = scratch(&a, 2 * sizeof(tf_rt_friction)); /* ~5 kB each: not on the stack */
     PyObject *result = NULL;
     if (!rt) goto done;
     if (parse_model(&a, plant_spec, &pm)) goto done;

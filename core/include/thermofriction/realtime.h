@@ -24,7 +24,7 @@
  * The force is the model's at the new state and v. GMS elements switch stick/slip after each step
  * (tf_friction_update_modes).
  *
- * No allocation, no dependency beyond libm; a tf_rt_friction is a plain struct (about 6 kB with
+ * No allocation, no dependency beyond libm; a tf_rt_friction is a plain struct (about 5 kB with
  * its 64 GMS slots, twice: the model's and the run's) that the caller owns. Laws point to caller-owned breakpoint arrays. */
 #ifndef THERMOFRICTION_REALTIME_H
 #define THERMOFRICTION_REALTIME_H
