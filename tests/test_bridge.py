@@ -186,3 +186,25 @@ def test_a_signal_handler_that_raises_stops_the_integration():
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
     assert np.isfinite(tf.simulate(model, 0.01, temperature=35.0).displacement).all()
+
+
+def test_friction_domains_are_the_header_table_and_cover_every_model():
+    """One domain rule per parameter, written once (domains.h's X-macro): the binding exports the rows
+    the C checks walk, in their order, for every friction model, naming parameters of the list."""
+    text = (ROOT / "core" / "include" / "thermofriction" / "domains.h").read_text()
+    block = re.search(r"#define TF_FRICTION_DOMAINS\(X\)(.*?)\n\s*\n", text, flags=re.S).group(1)
+    rows = re.findall(r"X\((\w+),\s*(\w+),\s*(\w+),\s*(\w+),\s*(\w+)\)", block)
+    assert len(rows) > 30
+    code = {sym: value for sym, value in _core.C_NAMES.items()}
+    names = {group: {v: k for k, v in codes.items()} for group, codes in _core.CONSTANTS.items()}
+    expected = {}
+    for model, param, rule, other, when in rows:
+        expected.setdefault(names["friction"][code[f"TF_FRICTION_{model}"]], []).append(
+            (names["parameter"][code[f"TF_P_{param}"]], names["domain_rule"][code[f"TF_DOMAIN_{rule}"]],
+             None if other == "NONE" else names["parameter"][code[f"TF_P_{other}"]],
+             names["domain_when"][code[f"TF_DOMAIN_{when}"]]))
+    assert _bridge.FRICTION_DOMAINS == {k: tuple(v) for k, v in expected.items()}
+    assert set(_bridge.FRICTION_DOMAINS) == set(tf.models.FRICTION_MODELS)
+    for model, rows in _bridge.FRICTION_DOMAINS.items():
+        fields = set(tf.models.FRICTION_MODELS[model].__dataclass_fields__)
+        assert {row[0] for row in rows} <= fields | {"v_smooth"}, model  # v_smooth: Model II's offset form too

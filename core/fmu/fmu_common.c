@@ -100,8 +100,9 @@ struct fmu_instance {
     double u_prev;           /* prescribed motion: where the last step left the motion */
     double last_du;          /* prescribed motion: its slope over the last step (the velocity reported after it) */
 
-    /* the model and its state */
+    /* the model, its run's data (plant.h: the parameter cache and the GMS modes, which are state) and its state */
     tf_model model;
+    tf_model_data data;
     double wave_t[2], wave_v[2], temp_t[2], temp_v[2];
     double t, y[TF_MAX_STATES];
     double rtol;
@@ -304,10 +305,10 @@ static int read_resources(instance *c, const char *dir, int is_uri)
 
 /* ---- the model from the parameter values ---- */
 
-/* Builds c->model from the structure and the values; 0, or logs why not and returns -1. */
+/* Builds a model (c->model, or a trial copy) from the structure and the values; 0, or logs why not and
+ * returns -1. */
 static int build_model(instance *c, tf_model *m)
 {
-    tf_gms_elements keep = m->gms; /* GMS modes are state: kept across a rebuild */
     memset(m, 0, sizeof *m);
     m->plant = c->plant;
     m->friction = c->friction;
@@ -315,7 +316,6 @@ static int build_model(instance *c, tf_model *m)
     m->dF_form = c->df_form;
     m->fs_follows_fc = c->fs_follows_fc;
     m->gms.n = c->n_gms;
-    memcpy(m->gms.mode, keep.mode, sizeof keep.mode);
     m->m = 1.0;
     double xi = 0, wn = 0, gain = 0;
     for (int vr = VR_FIRST_PARAMETER; vr <= c->max_vr; vr++) {
@@ -386,7 +386,24 @@ static int build_model(instance *c, tf_model *m)
     m->input.n = 2;
     m->input.t = c->wave_t;
     m->input.v = c->wave_v;
-    tf_model_prepare(m);
+    return 0;
+}
+
+/* The run's data for c->model as now built: its cache refilled at the next use, the GMS modes kept (they
+ * are state, across a rebuild). */
+static void data_for_model(instance *c)
+{
+    int modes[TF_MAX_FRICTION_STATES];
+    memcpy(modes, c->data.gms.mode, sizeof modes);
+    tf_model_data_init(&c->data, &c->model);
+    memcpy(c->data.gms.mode, modes, sizeof modes);
+}
+
+/* c->model rebuilt from the values, and its data (build_model, data_for_model). */
+static int rebuild(instance *c)
+{
+    if (build_model(c, &c->model) != 0) return -1;
+    data_for_model(c);
     return 0;
 }
 
@@ -461,7 +478,7 @@ static double output(instance *c, int vr)
 {
     double out[TF_OUT_NFIXED + TF_MAX_FRICTION_STATES + 2];
     set_signals(c, &c->model, c->t, 0.0);
-    tf_model_outputs(&c->model, c->t, c->y, out);
+    tf_model_outputs(&c->data, c->t, c->y, out);
     switch (vr) {
     case VR_DISPLACEMENT: return out[TF_OUT_DISPLACEMENT];
     case VR_VELOCITY: return out[TF_OUT_VELOCITY];
@@ -496,7 +513,7 @@ fmu_instance *fmu_instantiate(const char *name, const char *guid, const char *re
     c->rtol = 1e-6;
     int bad_guid = 0;
     if (!resources || read_resources(c, resources, resources_is_uri) != 0 ||
-        (bad_guid = !guid || strcmp(guid, c->guid) != 0) || build_model(c, &c->model) != 0) {
+        (bad_guid = !guid || strcmp(guid, c->guid) != 0) || rebuild(c) != 0) {
         if (!resources) fmu_fail(c, "no resource location given");
         if (bad_guid)
             fmu_fail(c, "fmi2Instantiate: GUID %s is not this FMU's %s (a model description of another FMU?)",
@@ -556,12 +573,12 @@ fmu_status fmu_exit_initialization(fmu_instance *c)
     if ((c->temperature_input || c->heat) && !plausible_temperature(c->r[VR_TEMPERATURE]))
         return fmu_fail(c, "the temperature at the start %g C is not a plausible temperature (expected %g to %g C)",
                     c->r[VR_TEMPERATURE], T_MIN, T_MAX);
-    if (build_model(c, &c->model) != 0) return FMU_ERROR;
+    if (rebuild(c) != 0) return FMU_ERROR;
     c->u_prev = c->r[VR_DRIVE];
     set_signals(c, &c->model, c->t, 0.0);
     if (check_model(c, &c->model) != 0) return FMU_ERROR;
     tf_model_initial_state(&c->model, c->y);
-    tf_model_on_restart(c->t, c->y, &c->model); /* GMS modes consistent with the start */
+    tf_model_on_restart(c->t, c->y, &c->data); /* GMS modes consistent with the start */
     c->mode = S_STEP;
     if (c->temperature_input || c->heat) return check_range(c, output(c, VR_TEMPERATURE_OUT));
     return FMU_OK;
@@ -584,9 +601,9 @@ fmu_status fmu_reset(fmu_instance *c)
     c->out_of_range = 0;
     c->stop_defined = 0, c->stop = 0.0; /* as instantiated: no experiment yet */
     memset(c->y, 0, sizeof c->y);
-    memset(c->model.gms.mode, 0, sizeof c->model.gms.mode);
+    memset(c->data.gms.mode, 0, sizeof c->data.gms.mode);
     c->mode = S_INSTANTIATED;
-    return build_model(c, &c->model) == 0 ? FMU_OK : FMU_ERROR;
+    return rebuild(c) == 0 ? FMU_OK : FMU_ERROR;
 }
 
 static int is_output(fmu_vr vr)
@@ -666,10 +683,11 @@ fmu_status fmu_set_real(fmu_instance *c, const fmu_vr vr[], size_t n, const doub
         if (!bad) set_signals(c, &m, c->t, 0.0);
         if (bad || check_model(c, &m) != 0) {
             memcpy(c->r, before, sizeof before);
-            build_model(c, &c->model); /* the laws' stores back to the old values */
+            rebuild(c); /* the laws' stores back to the old values */
             return FMU_ERROR;
         }
         c->model = m;
+        data_for_model(c);
     }
     return FMU_OK;
 }
@@ -716,7 +734,7 @@ static double sliding_velocity(const tf_model *m, double t, const double *y)
  * then positions with the new velocities, as tf_loop_run does), the heat balance and frictional
  * work by explicit Euler; the drive and temperature held at their values at the step's start.
  * The plant's equations are the simulator's own (tf_model_rhs). 0, or logs why not and returns -1
- * (y and the model's GMS modes may then be changed: the caller restores them). */
+ * (y and the run's GMS modes may then be changed: the caller restores them). */
 static int realtime_steps(instance *c, double h, double *y)
 {
     tf_model *m = &c->model;
@@ -728,7 +746,7 @@ static int realtime_steps(instance *c, double h, double *y)
     int nz = tf_friction_nstate(m->friction, m->gms.n);
     int nm = m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
     memcpy(rt.z, y + nm, sizeof(double) * nz);
-    memcpy(rt.model.gms.mode, m->gms.mode, sizeof m->gms.mode);
+    memcpy(rt.data.gms.mode, c->data.gms.mode, sizeof c->data.gms.mode);
     double dt = c->fixed_step;
     /* whole steps, a communication step within 1e-9 of a whole number of steps counting as one */
     double ratio = h / dt;
@@ -749,8 +767,8 @@ static int realtime_steps(instance *c, double h, double *y)
             return (fmu_fail(c, "the fixed step at %g s (temperature %g C) was refused: %s ('%s')", ts, T,
                          tf_status_message(st), e.what), -1);
         memcpy(y + nm, rt.z, sizeof(double) * nz);
-        memcpy(m->gms.mode, rt.model.gms.mode, sizeof m->gms.mode);
-        tf_model_rhs(ts, y, dy, m); /* at the new friction states: the force the real-time step gave */
+        memcpy(c->data.gms.mode, rt.data.gms.mode, sizeof c->data.gms.mode);
+        tf_model_rhs(ts, y, dy, &c->data); /* at the new friction states: the force the real-time step gave */
         for (int i = 1; i < nm; i += 2) y[i] += dy[i] * hs;
         for (int i = 0; i < nm; i += 2) y[i] += y[i + 1] * hs;
         for (int i = nm + nz; i < n; i++) y[i] += dy[i] * hs;
@@ -798,18 +816,18 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
     int n = tf_model_nstate(&c->model);
     double y[TF_MAX_STATES], atol[TF_MAX_STATES];
     memcpy(y, c->y, sizeof(double) * n);
-    tf_gms_elements modes = c->model.gms;
+    tf_gms_elements modes = c->data.gms;
     if (c->fixed_step > 0) {
         if (realtime_steps(c, h, y) != 0) {
-            c->model.gms = modes;
-            tf_model_prepare(&c->model);
+            c->data.gms = modes;
+            tf_model_data_changed(&c->data);
             return FMU_ERROR;
         }
         return step_done(c, h, y, n, status, &modes);
     }
     tf_model_state_scale(&c->model, atol);
     for (int i = 0; i < n; i++) atol[i] *= c->rtol;
-    tf_ode ode = tf_model_ode(&c->model);
+    tf_ode ode = tf_model_ode(&c->data);
     double rtol_w[TF_MAX_STATES];
     tf_model_rtol_weights(&c->model, rtol_w);
     tf_solver_options opt = {.method = TF_METHOD_AUTO, .rtol = c->rtol, .atol = atol, .max_steps = MAX_ADAPTIVE_STEPS,
@@ -821,7 +839,7 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
     for (int i = 0; s == TF_OK && i < n; i++)
         if (!isfinite(y[i])) s = TF_ERR_NONFINITE, e.t = c->t + h, snprintf(e.what, sizeof e.what, "%s", "state");
     if (s != TF_OK) {
-        c->model.gms = modes;
+        c->data.gms = modes;
         return fmu_fail(c, "the integration from %g s over %g s failed at %g s: %s (%s)", c->t, h, e.t,
                     tf_status_message(s), e.what);
     }
@@ -853,7 +871,7 @@ static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_s
         memcpy(c->y, y_before, sizeof(double) * n);
         c->t = t, c->u_prev = u_prev, c->last_du = last_du, c->r[VR_DRIVE] = drive, c->r[VR_TEMPERATURE] = T;
         c->du = du, c->dT = dT, c->du_set = du_set;
-        c->model.gms = *modes;
+        c->data.gms = *modes;
         return fmu_fail(c, "the step from %g s over %g s gives a non-finite output (value reference %d: %g)", t, h,
                         vr, v);
     }
@@ -901,9 +919,7 @@ fmu_status fmu_set_state(fmu_instance *c, void *state)
     memcpy(c, state, sizeof *c);
     c->name = name, c->cb = cb, c->logging = logging;
     c->mode = mode, c->stop_defined = stop_defined, c->stop = stop;
-    tf_gms_elements modes = c->model.gms;
-    if (build_model(c, &c->model) != 0) return FMU_ERROR;
-    c->model.gms = modes;
+    if (rebuild(c) != 0) return FMU_ERROR; /* the laws' pointers and the data's, the modes as saved */
     return FMU_OK;
 }
 

@@ -119,7 +119,7 @@ static int same_object(const tf_rt_friction *f, const tf_rt_friction *g)
     if (!SAME(f->z, g->z) || !SAME(a->p, b->p) || a->friction != b->friction || a->thermal != b->thermal ||
         a->dF_form != b->dF_form || a->fs_follows_fc != b->fs_follows_fc || !same_law(&a->dF, &b->dF) ||
         a->gms.n != b->gms.n || !SAME(a->gms.k, b->gms.k) || !SAME(a->gms.w, b->gms.w) ||
-        !SAME(a->gms.mode, b->gms.mode))
+        !SAME(f->data.gms.mode, g->data.gms.mode))
         return 0;
     for (int i = 0; i < TF_NPARAM; i++)
         if (!same_law(&a->law[i], &b->law[i])) return 0;

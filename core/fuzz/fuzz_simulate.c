@@ -114,7 +114,7 @@ static void law(reader *r, tf_law *L, double *x, double *y, double *d)
 }
 
 typedef struct {
-    const tf_model *m;
+    tf_model_data *m;
     long count;
     double last_t;
     int nonfinite, channel;
@@ -131,7 +131,7 @@ static void emit(long i, double t, const double *y, void *ctx)
     double out[TF_OUT_NFIXED + TF_MAX_FRICTION_STATES + 8];
     tf_model_outputs(s->m, t, y, out); /* computed (sanitisers watch it), not required finite:
                                           finite but absurd magnitudes (1e165 m) may overflow */
-    for (int k = 0; k < tf_model_nstate(s->m); k++)
+    for (int k = 0; k < tf_model_nstate(s->m->model); k++)
         if (!isfinite(y[k]) && !s->nonfinite) s->nonfinite = 1, s->channel = k, s->t_bad = t;
 }
 
@@ -201,7 +201,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         m.T_t = st.Tt;
         m.T_v = st.Tv;
     }
-    tf_model_prepare(&m);
+    static tf_model_data md;
+    tf_model_data_init(&md, &m);
 
     /* user data goes through tf_model_check first; what it refuses is not simulated */
     tf_error e;
@@ -237,9 +238,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     double rtol = pow(10.0, -(double)(2 + byte(&r) % 9));
     for (int i = 0; i < n; i++) atol[i] = isfinite(atol[i]) && atol[i] > 0 ? rtol * atol[i] : rtol;
     tf_solver_options opt = {.method = byte(&r) % 3, .rtol = rtol, .atol = atol, .max_steps = 400};
-    tf_ode ode = tf_model_ode(&m);
+    tf_ode ode = tf_model_ode(&md);
     tf_solver_stats stats;
-    sink s = {&m, 0, 0.0, 0, 0, 0.0};
+    sink s = {&md, 0, 0.0, 0, 0, 0.0};
     tf_status status = tf_solve(&ode, &opt, t_out, n_out, y, emit, &s, &stats, &e);
     if (status != TF_OK && status != TF_ERR_NONFINITE && status != TF_ERR_STEP_UNDERFLOW &&
         status != TF_ERR_MAX_STEPS && status != TF_ERR_BAD_ARGUMENT)

@@ -85,7 +85,7 @@ tf_status tf_observer_step(tf_rt_friction *f, double v, double e, double k, doub
     tf_status status = tf_rt_params_at(f, T, p, &lambda, &dF, err); /* checks T and the parameters there */
     if (status) return status;
     double extra[1] = {-k * e}, z[1] = {f->z[0]};
-    tf_rt_advance(m->friction, p, &m->gms, z, v, dt, extra, dz, &Fh, 0); /* its arguments are valid here */
+    tf_rt_advance(m->friction, p, &f->data.gms, z, v, dt, extra, dz, &Fh, 0); /* its arguments are valid here */
     /* the observer's own z^' in the damping term: F^ = sigma0 z^ + sigma1 z^' + sigma2 v */
     if (m->friction != TF_FRICTION_DAHL) Fh += tf_sigma1(p, v, 0, 0, 0) * extra[0];
     tf_rt_thermal_force(Fh, v, p, lambda, dF, &Fh, 0);

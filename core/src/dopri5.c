@@ -1,6 +1,6 @@
 /* Dormand & Prince 5(4): FSAL, PI step control, Hairer's 4th-order continuous extension and
  * stiffness detection (Hairer & Wanner, Solving ODEs I, II.4-II.6). */
-#include "solver.h"
+#include "dopri5.h"
 
 #include <string.h>
 

@@ -1,6 +1,6 @@
 /* Event location for the discrete modes of tf_ode (GMS elements switching stick/slip): the earliest
  * upward zero crossing of the event functions within an accepted step, on the dense output. */
-#include "solver.h"
+#include "events.h"
 
 #include <float.h>
 

@@ -1,6 +1,7 @@
 /* Friction models (docs/models.md#friction-models). */
 #include "thermofriction/friction.h"
-#include "checks.h"
+#include "domain_tests.h"
+#include "friction_private.h"
 
 #include <math.h>
 #include <string.h>
@@ -417,28 +418,42 @@ const char *tf_friction_params_problem(int k, const double *p, int offset_form)
     return 0;
 }
 
+/* The friction models' domain table (domains.h), one row per rule. */
+typedef struct {
+    int model, param, rule, other, when;
+} domain_row;
+
+#define TF_DOMAIN_ROW_(model, param, rule, other, when) \
+    {TF_FRICTION_##model, TF_P_##param, TF_DOMAIN_##rule, TF_P_##other, TF_DOMAIN_##when},
+static const domain_row domains[] = {TF_FRICTION_DOMAINS(TF_DOMAIN_ROW_)};
+#undef TF_DOMAIN_ROW_
+
+#define TF_PARAMETER_NAME_(symbol, name, unit, meaning) name,
+static const char *const parameter_names[TF_NPARAM] = {TF_PARAMETERS(TF_PARAMETER_NAME_)};
+#undef TF_PARAMETER_NAME_
+
+/* Whether x, the value of a row's parameter in p, is in its domain. */
+static int in_domain(const domain_row *r, const double *p, double x)
+{
+    switch (r->rule) {
+    case TF_DOMAIN_POSITIVE: return tf_pos(x);
+    case TF_DOMAIN_NON_NEGATIVE: return tf_nonneg(x);
+    case TF_DOMAIN_AT_LEAST: return isfinite(x) && x >= p[r->other];
+    case TF_DOMAIN_BELOW_DEFLECTION: return tf_nonneg(x) && x < p[r->other] / p[TF_P_SIGMA0];
+    case TF_DOMAIN_POSITIVE_OR_ABSENT: return x == 0.0 || tf_pos(x);
+    default: return 0;
+    }
+}
+
+/* The first of model k's parameters in p outside its domain (domains.h), in the table's order. */
 static const char *side_problem(int k, const double *p, int offset_form)
 {
-    int stribeck = k == TF_FRICTION_STRIBECK || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC ||
-                   k == TF_FRICTION_GMS;
-    if (!tf_pos(p[TF_P_FC])) return "fc";
-    if (k != TF_FRICTION_DAHL && !tf_nonneg(p[TF_P_SIGMA2])) return "sigma2";
-    if (k == TF_FRICTION_DAHL || k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
-        if (!tf_pos(p[TF_P_SIGMA0])) return "sigma0";
+    for (size_t i = 0; i < sizeof domains / sizeof domains[0]; i++) {
+        const domain_row *r = &domains[i];
+        if (r->model != k) continue;
+        int applies = r->when == TF_DOMAIN_ALWAYS || (r->when == TF_DOMAIN_STRIBECK && p[TF_P_FS] != p[TF_P_FC]) ||
+                      (r->when == TF_DOMAIN_OFFSET_FORM && offset_form);
+        if (applies && !in_domain(r, p, p[r->param])) return parameter_names[r->param];
     }
-    if (k == TF_FRICTION_LUGRE || k == TF_FRICTION_ELASTOPLASTIC) {
-        if (!tf_nonneg(p[TF_P_SIGMA1])) return "sigma1";
-        if (isnan(p[TF_P_VD]) || p[TF_P_VD] == INFINITY) return "vd"; /* <= 0: sigma1 constant */
-    }
-    if (stribeck) {
-        if (!isfinite(p[TF_P_FS]) || p[TF_P_FS] < p[TF_P_FC]) return "fs";
-        if (p[TF_P_FS] != p[TF_P_FC] && !tf_pos(p[TF_P_VS])) return "vs";
-        if (p[TF_P_FS] != p[TF_P_FC] && !tf_pos(p[TF_P_DELTA])) return "delta";
-    }
-    if ((k == TF_FRICTION_COULOMB || k == TF_FRICTION_STRIBECK || offset_form) && !tf_pos(p[TF_P_VSMOOTH]))
-        return "v_smooth";
-    if (k == TF_FRICTION_ELASTOPLASTIC && !(tf_nonneg(p[TF_P_ZBA]) && p[TF_P_ZBA] < p[TF_P_FC] / p[TF_P_SIGMA0]))
-        return "z_ba";
-    if (k == TF_FRICTION_GMS && !tf_pos(p[TF_P_C])) return "C";
     return 0;
 }

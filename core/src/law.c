@@ -1,6 +1,7 @@
 /* Temperature laws (see law.h). */
 #include "thermofriction/law.h"
-#include "checks.h"
+#include "law_private.h"
+#include "waveform_private.h" /* tf_knots_ok */
 
 #include <math.h>
 

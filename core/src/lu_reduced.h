@@ -3,11 +3,11 @@
  * row: their unknowns follow from their velocity's, k_x = gamma h (b_x + k_v), and need no
  * elimination. The rest is a smaller dense system (3 x 3 instead of 5 x 5 for LuGre on the stick-slip
  * actuator), factored with partial pivoting and reciprocal pivots (no division in the six solves per
- * step). The factor and solve are inlined into Rodas4's stages with constant sizes (solver.h). */
+ * step). The factor and solve are inlined into Rodas4's stages with constant sizes (work.h). */
 #ifndef THERMOFRICTION_LU_REDUCED_H
 #define THERMOFRICTION_LU_REDUCED_H
 
-#include "solver.h"
+#include "work.h"
 
 /* Finds the kinematic rows of the current Jacobian (lu.c; after every Jacobian evaluation). */
 void tf_lu_structure(work *w);

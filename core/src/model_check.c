@@ -1,8 +1,11 @@
 /* The model check (plant.h: tf_model_check, tf_model_check_friction, tf_model_check_params): the C side
  * of the Python package's parameter checks. The plant's own fields are checked here; the input's,
- * the friction model's and the thermal extension's in their files (checks.h). */
+ * the friction model's and the thermal extension's in their files (their private headers). */
 #include "thermofriction/plant.h"
-#include "checks.h"
+#include "domain_tests.h"
+#include "friction_private.h"
+#include "thermal_private.h"
+#include "waveform_private.h"
 
 #include <math.h>
 

@@ -1,24 +1,19 @@
-/* Plants (docs/models.md#plants) with friction and thermal extension, as one ODE system. */
+/* Plants (docs/models.md#plants) with friction and thermal extension, as one ODE system: the right-hand side,
+ * the outputs, the corners and events, the scales; its Jacobian and partials are in plant_derivatives.c. */
 #include "thermofriction/plant.h"
-#include "inline.h" /* TF_SIZED */
+#include "plant_private.h"
 
 #include <math.h>
 #include <string.h>
 
-/* State indices: stick-slip x_p, v_p, x_e, v_e; mass x, v (X, V); prescribed none. */
-enum { XP = 0, VP, XE, VE };
-enum { X = 0, V };
-
-static int nmech(const tf_model *m)
+void tf_model_data_init(tf_model_data *data, const tf_model *model)
 {
-    return m->plant == TF_PLANT_STICK_SLIP ? 4 : m->plant == TF_PLANT_MASS ? 2 : 0;
+    memset(data, 0, sizeof *data);
+    data->model = model;
+    data->gms = model->gms;
 }
 
-static int nfric(const tf_model *m) { return tf_friction_nstate(m->friction, m->gms.n); }
-
-static int has_work(const tf_model *m) { return m->heat.on || m->work; }
-
-void tf_model_prepare(tf_model *model) { model->cache_valid = 0; }
+void tf_model_data_changed(tf_model_data *data) { data->cache.valid = 0; }
 
 int tf_model_nstate(const tf_model *model)
 {
@@ -39,7 +34,7 @@ int tf_model_work_index(const tf_model *model)
 
 /* The common case: LuGre on the stick-slip actuator or the mass, at one constant temperature
  * (no temperature signal, no heat or work state). Its parameters, lambda and dF are then the
- * run's, and tf_model_ode gives it a right-hand side (rhs_lugre_constant_T) that dispatches on
+ * run's, and tf_model_ode gives it a right-hand side (tf_plant_rhs_fast) that dispatches on
  * nothing per call: a third of the general path's cost on the paper's workload. */
 /* Whether a parameter is given (a number or a law): the direction-dependent ones are NaN when not,
  * the ripple's period <= 0. */
@@ -55,20 +50,10 @@ static int sided_or_ripple(const tf_model *m)
            given(m, TF_P_RIPPLE_PERIOD);
 }
 
-static int lugre_constant_T(const tf_model *m)
+int tf_plant_fast(const tf_model *m)
 {
     return m->friction == TF_FRICTION_LUGRE && m->T_n == 0 && !has_work(m) &&
            (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS) && !sided_or_ripple(m);
-}
-
-/* Relative sliding velocity v_r of the driven body on its driving surface. */
-static double relative_velocity(const tf_model *m, double t, const double *y)
-{
-    switch (m->plant) {
-    case TF_PLANT_STICK_SLIP: return y[VE] - y[VP];
-    case TF_PLANT_MASS: return y[V];
-    default: return tf_waveform_slope(&m->input, t);
-    }
 }
 
 /* Relative position x_r of the same bodies (the position ripple's argument). */
@@ -88,9 +73,6 @@ double tf_model_temperature(const tf_model *model, double t, const double *y)
     return model->T_const;
 }
 
-/* Model II's F_ref: from the base parameters, the same at every temperature. */
-static double reference_force(const tf_model *m) { return tf_friction_reference_force(m->friction, m->p); }
-
 void tf_model_params_at(const tf_model *model, double T, double *p)
 {
     tf_thermal_params(model->thermal, model->p, model->law, model->fs_follows_fc, T, p);
@@ -102,38 +84,41 @@ double tf_model_lambda(const tf_model *model, double T)
 }
 
 /* Parameters, scale factor and offset force at temperature T, cached per temperature. */
-const double *tf_model_params_cached(tf_model *m, double T, double *lambda, double *dF)
+const double *tf_model_params_cached(tf_model_data *d, double T, double *lambda, double *dF)
 {
+    const tf_model *m = d->model;
+    tf_params_cache *c = &d->cache;
     /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
-    if (!m->cache_valid || !(m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
-        if (!m->cache_valid) m->cache_laws = tf_thermal_law_mask(m->law); /* after a prepare: laws may have changed */
-        tf_thermal_params_masked(m->thermal, m->p, m->law, m->cache_laws, m->fs_follows_fc, T, m->cache_p);
-        m->cache_lambda = tf_model_lambda(m, T);
-        m->cache_dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
-        m->cache_plain = !tf_friction_asymmetric(m->cache_p) && !(m->cache_p[TF_P_RIPPLE_PERIOD] > 0.0);
-        m->cache_T = T;
-        m->cache_valid = 1;
+    if (!c->valid || !(c->T == T || (isnan(T) && isnan(c->T)))) {
+        if (!c->valid) c->laws = tf_thermal_law_mask(m->law); /* after a change: laws may have changed */
+        tf_thermal_params_masked(m->thermal, m->p, m->law, c->laws, m->fs_follows_fc, T, c->p);
+        c->lambda = tf_model_lambda(m, T);
+        c->dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
+        c->plain = !tf_friction_asymmetric(c->p) && !(c->p[TF_P_RIPPLE_PERIOD] > 0.0);
+        c->T = T;
+        c->valid = 1;
     }
-    *lambda = m->cache_lambda;
-    *dF = m->cache_dF;
-    return m->cache_p;
+    *lambda = c->lambda;
+    *dF = c->dF;
+    return c->p;
 }
 
 /* F' at temperature T and, when jac is given, its partials (overwriting the base model's
  * partials). The base model's parameter partials go to dp, untouched by Model II (the caller
  * applies it: tf_thermal_param_partial). */
-static double friction_at(tf_model *m, double T, double t, const double *y, double *dz, tf_friction_partials *jac,
-                          tf_friction_param_partials *dp, double *F_base)
+double tf_plant_friction_at(tf_model_data *d, double T, double t, const double *y, double *dz,
+                            tf_friction_partials *jac, tf_friction_param_partials *dp, double *F_base)
 {
+    const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, T, &lambda, &dF);
+    const double *p = tf_model_params_cached(d, T, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
     double F;
-    if (m->cache_plain) { /* symmetric, no ripple (cached with p): the models' equations alone */
-        F = tf_friction_eval_side(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+    if (d->cache.plain) { /* symmetric, no ripple (cached with p): the models' equations alone */
+        F = tf_friction_eval_side(m->friction, p, &d->gms, v, y + nmech(m), dz, jac, dp);
     } else {
-        F = tf_friction_eval(m->friction, p, &m->gms, v, y + nmech(m), dz, jac, dp);
+        F = tf_friction_eval(m->friction, p, &d->gms, v, y + nmech(m), dz, jac, dp);
         if (p[TF_P_RIPPLE_PERIOD] > 0.0) /* on the base force: Model II scales it with the rest */
             F += tf_friction_ripple(p, relative_position(m, t, y), jac ? &jac->dF_dx : 0, dp ? dp->dF_dp : 0);
     }
@@ -141,30 +126,28 @@ static double friction_at(tf_model *m, double T, double t, const double *y, doub
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, nz, jac);
 }
 
-static double friction(tf_model *m, double t, const double *y, double *dz, tf_friction_partials *jac)
-{
-    return friction_at(m, tf_model_temperature(m, t, y), t, y, dz, jac, 0, 0);
-}
-
-/* F' and z' of the common case (lugre_constant_T): the same equations as friction_at, with the
+/* F' and z' of the common case (tf_plant_fast): the same equations as tf_plant_friction_at, with the
  * run's parameters. */
-TF_SIZED double lugre_constant_T_friction(tf_model *m, double v, double z, double *zd)
+TF_SIZED double lugre_constant_T_friction(tf_model_data *d, double v, double z, double *zd)
 {
-    double lambda = m->cache_lambda, dF = m->cache_dF;
-    const double *p = m->cache_p;
-    if (!m->cache_valid || !(m->cache_T == m->T_const || (isnan(m->T_const) && isnan(m->cache_T))))
-        p = tf_model_params_cached(m, m->T_const, &lambda, &dF);
+    const tf_model *m = d->model;
+    const tf_params_cache *c = &d->cache;
+    double lambda = c->lambda, dF = c->dF;
+    const double *p = c->p;
+    if (!c->valid || !(c->T == m->T_const || (isnan(m->T_const) && isnan(c->T))))
+        p = tf_model_params_cached(d, m->T_const, &lambda, &dF);
     double g = p[TF_P_FS] == p[TF_P_FC] ? p[TF_P_FC] : tf_stribeck(p, v, 0);
     double F = tf_lugre_value(p, v, z, g, tf_sigma1(p, v, 0, 0, 0), zd);
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 1, 0);
 }
 
-double tf_model_friction(const tf_model *model, double t, const double *y)
+double tf_model_friction(tf_model_data *data, double t, const double *y)
 {
+    const tf_model *model = data->model;
     double dz[TF_MAX_FRICTION_STATES];
-    if (lugre_constant_T(model))
-        return lugre_constant_T_friction((tf_model *)model, relative_velocity(model, t, y), y[nmech(model)], dz);
-    return friction((tf_model *)model, t, y, dz, 0);
+    if (tf_plant_fast(model))
+        return lugre_constant_T_friction(data, relative_velocity(model, t, y), y[nmech(model)], dz);
+    return tf_plant_friction(data, t, y, dz, 0);
 }
 
 void tf_model_initial_state(const tf_model *model, double *y)
@@ -242,6 +225,13 @@ void tf_model_state_scale(const tf_model *model, double *scale)
     }
 }
 
+void tf_model_default_atol(const tf_model *model, double rtol, double *atol)
+{
+    tf_model_state_scale(model, atol);
+    int n = tf_model_nstate(model);
+    for (int i = 0; i < n; i++) atol[i] *= rtol;
+}
+
 void tf_model_rtol_weights(const tf_model *model, double *w)
 {
     int n = tf_model_nstate(model);
@@ -265,236 +255,31 @@ static void heat_rates(const tf_model *m, double t, const double *y, double F, d
     if (has_work(m)) dy[tf_model_work_index(m)] = P;
 }
 
-/* The plant's mechanical rows under the friction force F (a prescribed motion has none): the one
- * statement of the plant equations, for every right-hand side. */
-TF_SIZED void mechanical_rhs(const tf_model *m, double t, const double *y, double F, double *dy)
-{
-    if (m->plant == TF_PLANT_STICK_SLIP) {
-        double u = tf_waveform_value(&m->input, t);
-        dy[XP] = y[VP];
-        dy[VP] = (-m->c * y[VP] - m->k * y[XP] + m->T_em * u + F) / m->m;
-        dy[XE] = y[VE];
-        dy[VE] = -F / m->m_e;
-    } else if (m->plant == TF_PLANT_MASS) {
-        double f = tf_waveform_value(&m->input, t) + m->k_s * (m->v_0 * t - y[X]);
-        dy[X] = y[V];
-        dy[V] = (f - F) / m->m;
-    }
-}
-
 tf_status tf_model_rhs(double t, const double *y, double *dy, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     int nm = nmech(m);
-    double F = friction(m, t, y, dy + nm, 0);
+    double F = tf_plant_friction(d, t, y, dy + nm, 0);
     if (has_work(m)) heat_rates(m, t, y, F, dy);
     mechanical_rhs(m, t, y, F, dy);
     return TF_OK;
 }
 
-/* dv_r/dy for the mechanical states (prescribed motion: none). */
-/* tf_model_rhs for the common case (lugre_constant_T). */
-static tf_status rhs_lugre_constant_T(double t, const double *y, double *dy, void *ctx)
+/* tf_model_rhs for the common case (tf_plant_fast). */
+tf_status tf_plant_rhs_fast(double t, const double *y, double *dy, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     int iz = m->plant == TF_PLANT_STICK_SLIP ? 4 : 2;
-    double F = lugre_constant_T_friction(m, relative_velocity(m, t, y), y[iz], &dy[iz]);
+    double F = lugre_constant_T_friction(d, relative_velocity(m, t, y), y[iz], &dy[iz]);
     mechanical_rhs(m, t, y, F, dy);
-    return TF_OK;
-}
-
-static void velocity_partials(const tf_model *m, double *dv_dy)
-{
-    memset(dv_dy, 0, sizeof(double) * TF_MAX_STATES);
-    if (m->plant == TF_PLANT_STICK_SLIP) dv_dy[VE] = 1.0, dv_dy[VP] = -1.0;
-    else if (m->plant == TF_PLANT_MASS) dv_dy[V] = 1.0;
-}
-
-/* The rows of the temperature and work states, and the temperature column of every row, of the
- * Jacobian. dF'/dT and dz'/dT come from a central difference in T: the laws are smooth and
- * most base models have no analytic parameter partials (h = 1e-3 K: truncation ~1e-8 relative
- * for the paper's laws, far below what Rodas4's Newton-free stages need). */
-static void heat_jacobian(tf_model *m, double t, const double *y, const tf_friction_partials *d, double *J)
-{
-    int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
-    int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
-    double T = tf_model_temperature(m, t, y);
-    double dz[TF_MAX_FRICTION_STATES], dzp[TF_MAX_FRICTION_STATES], dzm[TF_MAX_FRICTION_STATES];
-    double F = friction_at(m, T, t, y, dz, 0, 0, 0), v = relative_velocity(m, t, y);
-    double s = (F * v > 0.0) - (F * v < 0.0);
-    double dv_dy[TF_MAX_STATES], dP[TF_MAX_STATES]; /* dP/dy, P = |F v| */
-    velocity_partials(m, dv_dy);
-    for (int k = 0; k < n; k++) dP[k] = s * (v * d->dF_dv + F) * dv_dy[k];
-    for (int j = 0; j < nz; j++) dP[nm + j] += s * v * d->dF_dz[j];
-    double dF_dT = 0.0, ddz_dT[TF_MAX_FRICTION_STATES] = {0};
-    if (m->heat.on && m->thermal != TF_THERMAL_NONE) {
-        const double h = 1e-3;
-        double Fp = friction_at(m, T + h, t, y, dzp, 0, 0, 0), Fm = friction_at(m, T - h, t, y, dzm, 0, 0, 0);
-        dF_dT = (Fp - Fm) / (2 * h);
-        for (int j = 0; j < nz; j++) ddz_dT[j] = (dzp[j] - dzm[j]) / (2 * h);
-    }
-#define J_(i, j) J[(i) * n + (j)]
-    if (m->heat.on) {
-        dP[iT] = s * v * dF_dT;
-        if (m->plant == TF_PLANT_STICK_SLIP) {
-            J_(VP, iT) = dF_dT / m->m;
-            J_(VE, iT) = -dF_dT / m->m_e;
-        } else if (m->plant == TF_PLANT_MASS) {
-            J_(V, iT) = -dF_dT / m->m;
-        }
-        for (int j = 0; j < nz; j++) J_(nm + j, iT) = ddz_dT[j];
-        tf_heat_rate_jacobian(&m->heat, n, iT, dP, &J_(iT, 0));
-    }
-    for (int k = 0; k < n; k++) J_(iW, k) = dP[k];
-#undef J_
-}
-
-/* The state Jacobian from the friction force's partials d (after the thermal model). */
-static void jacobian_from(tf_model *m, double t, const double *y, const tf_friction_partials *d, double *J)
-{
-    int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
-    memset(J, 0, sizeof(double) * n * n);
-#define J_(i, j) J[(i) * n + (j)]
-    if (m->plant == TF_PLANT_STICK_SLIP) {
-        J_(XP, VP) = 1.0;
-        J_(VP, XP) = -m->k / m->m;
-        J_(VP, VP) = (-m->c - d->dF_dv) / m->m;
-        J_(VP, VE) = d->dF_dv / m->m;
-        J_(XE, VE) = 1.0;
-        J_(VE, VP) = d->dF_dv / m->m_e;
-        J_(VE, VE) = -d->dF_dv / m->m_e;
-        if (d->dF_dx != 0.0) { /* the ripple, in x_e - x_p */
-            J_(VP, XE) += d->dF_dx / m->m, J_(VP, XP) -= d->dF_dx / m->m;
-            J_(VE, XE) -= d->dF_dx / m->m_e, J_(VE, XP) += d->dF_dx / m->m_e;
-        }
-        for (int j = 0; j < nz; j++) {
-            J_(VP, nm + j) = d->dF_dz[j] / m->m;
-            J_(VE, nm + j) = -d->dF_dz[j] / m->m_e;
-            J_(nm + j, VP) = -d->ddz_dv[j];
-            J_(nm + j, VE) = d->ddz_dv[j];
-        }
-    } else if (m->plant == TF_PLANT_MASS) {
-        J_(X, V) = 1.0;
-        J_(V, X) = -m->k_s / m->m;
-        J_(V, V) = -d->dF_dv / m->m;
-        J_(V, X) -= d->dF_dx / m->m;
-        for (int j = 0; j < nz; j++) {
-            J_(V, nm + j) = -d->dF_dz[j] / m->m;
-            J_(nm + j, V) = d->ddz_dv[j];
-        }
-    }
-    for (int j = 0; j < nz; j++) J_(nm + j, nm + j) = d->ddz_dz[j];
-#undef J_
-    if (has_work(m)) heat_jacobian(m, t, y, d, J);
-}
-
-tf_status tf_model_jac(double t, const double *y, double *J, void *ctx)
-{
-    tf_model *m = (tf_model *)ctx;
-    double dz[TF_MAX_FRICTION_STATES];
-    tf_friction_partials d;
-    friction(m, t, y, dz, &d);
-    jacobian_from(m, t, y, &d, J);
-    return TF_OK;
-}
-
-/* d(rhs)/d(plant parameter) into column k of fp (stride np): only the mechanical rows depend on
- * these directly (the friction force and its power are functions of the state). */
-static void plant_partials(const tf_model *m, double t, const double *y, const double *dy, int param,
-                           double *fp, int np, int k)
-{
-    if (m->plant == TF_PLANT_STICK_SLIP) {
-        double u = tf_waveform_value(&m->input, t);
-        double d_m = -dy[VP] / m->m, d_c = -y[VP] / m->m, d_k = -y[XP] / m->m, d_T = u / m->m;
-        double wn = sqrt(m->k / m->m), xi = m->c / (2.0 * wn * m->m), K = m->T_em / m->k;
-        double vp = 0.0;
-        switch (param) {
-        case TF_PLANT_P_M: vp = d_m; break;
-        case TF_PLANT_P_M_E: fp[VE * np + k] = -dy[VE] / m->m_e; return;
-        case TF_PLANT_P_C: vp = d_c; break;
-        case TF_PLANT_P_K: vp = d_k; break;
-        case TF_PLANT_P_T_EM: vp = d_T; break;
-        case TF_PLANT_P_XI: vp = d_c * 2.0 * wn * m->m; break;
-        case TF_PLANT_P_WN: vp = (d_c * xi + d_k * wn + d_T * K * wn) * 2.0 * m->m; break;
-        case TF_PLANT_P_GAIN: vp = d_T * m->k; break;
-        case TF_PLANT_P_M_MODAL: vp = d_m + d_c * 2.0 * xi * wn + (d_k + d_T * K) * wn * wn; break;
-        default: break;
-        }
-        fp[VP * np + k] = vp;
-    } else if (m->plant == TF_PLANT_MASS) {
-        if (param == TF_PLANT_P_M || param == TF_PLANT_P_M_MODAL) fp[V * np + k] = -dy[V] / m->m;
-        else if (param == TF_PLANT_P_K_S) fp[V * np + k] = (m->v_0 * t - y[X]) / m->m;
-    }
-}
-
-tf_status tf_model_derivatives(tf_model *m, double t, const double *y, double *dy, double *J,
-                               const tf_target *targets, int np, double *fp)
-{
-    int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
-    int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
-    int fast = lugre_constant_T(m);
-    if (!np) {
-        if (fast) rhs_lugre_constant_T(t, y, dy, m);
-        else tf_model_rhs(t, y, dy, m);
-        if (J) tf_model_jac(t, y, J, m);
-        return TF_OK;
-    }
-    if (!fast) tf_model_rhs(t, y, dy, m); /* else from the one friction evaluation below */
-    tf_friction_param_partials dp;
-    tf_friction_partials d; /* the state and the parameter partials from one evaluation */
-    double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
-    double T = tf_model_temperature(m, t, y);
-    tf_model_params_cached(m, T, &lambda, &dF_offset);
-    double F = friction_at(m, T, t, y, dz, J ? &d : 0, &dp, &Fb);
-    if (fast) { /* the same equations as rhs_lugre_constant_T, with the partials' evaluation */
-        dy[nm] = dz[0];
-        mechanical_rhs(m, t, y, F, dy);
-    }
-    if (J) jacobian_from(m, t, y, &d, J);
-    if (m->fs_follows_fc) { /* one parameter moves both */
-        dp.dF_dp[TF_P_FC] += dp.dF_dp[TF_P_FS];
-        for (int j = 0; j < nz; j++) dp.ddz_dp[j][TF_P_FC] += dp.ddz_dp[j][TF_P_FS];
-    }
-    double Fref = reference_force(m);
-    double v = relative_velocity(m, t, y);
-    double s = (F * v > 0.0) - (F * v < 0.0); /* d|F v|/dF = s v */
-    memset(fp, 0, sizeof(double) * (size_t)(n * np));
-    for (int k = 0; k < np; k++) {
-        const tf_target *tg = &targets[k];
-        double dF = 0.0, chain = 1.0; /* dF'/dtheta and d(param)/dtheta */
-        int i = tg->param;
-        if (tg->kind == TF_TARGET_PLANT) {
-            plant_partials(m, t, y, dy, i, fp, np, k);
-            continue;
-        }
-        if (tg->kind == TF_TARGET_HEAT) { /* only the heat balance depends on these */
-            if (m->heat.on) fp[iT * np + k] = tf_heat_param_partial(&m->heat, i, y[iT], fabs(F * v), dy[iT]);
-            continue;
-        }
-        if (tg->kind == TF_TARGET_DF) {
-            dF = tf_thermal_df_coef_partial(m->dF_form, &m->dF, tg->coef, T, Fb, Fref, v, m->cache_p[TF_P_VSMOOTH]);
-        } else {
-            if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T);
-            dF = tf_thermal_param_partial(m->thermal, m->dF_form, lambda, Fref, i, chain * dp.dF_dp[i], Fb);
-        }
-        if (m->plant == TF_PLANT_STICK_SLIP) {
-            fp[VP * np + k] = dF / m->m;
-            fp[VE * np + k] = -dF / m->m_e;
-        } else if (m->plant == TF_PLANT_MASS) {
-            fp[V * np + k] = -dF / m->m;
-        }
-        if (tg->kind != TF_TARGET_DF)
-            for (int j = 0; j < nz; j++) fp[(nm + j) * np + k] = chain * dp.ddz_dp[j][i];
-        double dP = s * v * dF; /* of the friction power |F' v| */
-        if (iT >= 0) fp[iT * np + k] = tf_heat_rate_dP(&m->heat, dP);
-        if (iW >= 0) fp[iW * np + k] = dP;
-    }
     return TF_OK;
 }
 
 double tf_model_next_corner(double t, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    const tf_model *m = ((const tf_model_data *)ctx)->model;
     double c = tf_waveform_next_corner(&m->input, t);
     if (m->plant == TF_PLANT_PRESCRIBED) c = fmin(c, tf_waveform_next_reversal(&m->input, t));
     if (m->heat.on) {
@@ -509,102 +294,35 @@ int tf_model_nevent(const tf_model *model) { return tf_friction_nevent(model->fr
 
 void tf_model_events(double t, const double *y, double *g, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, y), &lambda, &dF);
-    tf_friction_events(m->friction, p, &m->gms, relative_velocity(m, t, y), y + nmech(m), g);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
+    tf_friction_events(m->friction, p, &d->gms, relative_velocity(m, t, y), y + nmech(m), g);
 }
 
 void tf_model_on_restart(double t, const double *y, void *ctx)
 {
-    tf_model *m = (tf_model *)ctx;
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
     double v = relative_velocity(m, t, y);
     if (m->plant == TF_PLANT_PRESCRIBED) {
         /* a prescribed motion keeps one direction between restarts (corners and reversals), but
          * at a sine's extremum v(t) is rounding noise: take the direction from inside the segment */
-        double tc = tf_model_next_corner(t, m);
+        double tc = tf_model_next_corner(t, d);
         if (isfinite(tc)) v = copysign(fabs(v), tf_waveform_slope(&m->input, 0.5 * (t + tc)));
     }
-    tf_friction_update_modes(m->friction, p, &m->gms, v, y + nmech(m));
-}
-
-/* dv/dy . w: the relative velocity is linear in the state (zero under prescribed motion). */
-static double velocity_along(const tf_model *m, const double *w)
-{
-    switch (m->plant) {
-    case TF_PLANT_STICK_SLIP: return w[VE] - w[VP];
-    case TF_PLANT_MASS: return w[V];
-    default: return 0.0;
-    }
-}
-
-void tf_model_sensitivity_restart(tf_model *m, double t, double *Y, const tf_target *targets, int np)
-{
-    if (m->friction != TF_FRICTION_GMS) return;
-    int n = tf_model_nstate(m), nm = nmech(m), ne = m->gms.n;
-    int old[TF_MAX_FRICTION_STATES];
-    double fm[TF_MAX_STATES], fpl[TF_MAX_STATES];
-    memcpy(old, m->gms.mode, sizeof(int) * (size_t)ne);
-    tf_model_rhs(t, Y, fm, m);
-    tf_model_on_restart(t, Y, m);
-    int changed = 0;
-    for (int i = 0; i < ne; i++) changed |= old[i] != m->gms.mode[i];
-    if (!changed || !np) return;
-    tf_model_rhs(t, Y, fpl, m);
-    double lambda, dF;
-    const double *p = tf_model_params_cached(m, tf_model_temperature(m, t, Y), &lambda, &dF);
-    double v = relative_velocity(m, t, Y), dg_dv, dg_p[TF_NPARAM];
-    tf_stribeck(p, v, &dg_dv);
-    tf_stribeck_param_partials(p, v, dg_p);
-    if (m->fs_follows_fc) dg_p[TF_P_FC] += dg_p[TF_P_FS];
-    /* the negative capacity -w_i g_-(v) (direction-dependent levels: friction.h, tf_friction_side) */
-    double q[TF_NPARAM], dgn_dv, dgn_p[TF_NPARAM];
-    const double *pn = tf_friction_side(p, -1.0, q);
-    tf_stribeck(pn, v, &dgn_dv);
-    tf_stribeck_param_partials(pn, v, dgn_p);
-    tf_friction_side_partials(p, -1.0, dgn_p);
-    if (m->fs_follows_fc) dgn_p[TF_P_FC] += dgn_p[TF_P_FS];
-    /* dv/dt along the trajectory before the switch; under prescribed motion v(t) is the input's
-       slope, whose change is left out (it moves an event only through the Stribeck curve's slope) */
-    double vdot = velocity_along(m, fm);
-    double *S = Y + n;
-    for (int i = 0; i < ne; i++) {
-        int a = old[i], b = m->gms.mode[i], row = nm + i;
-        if (a == b) continue;
-        double jump = fm[row] - fpl[row], w = m->gms.w[i];
-        const double *dgs_p = a == 0 && b < 0 ? dgn_p : dg_p; /* the capacity of the side it broke loose to */
-        double dgs_dv = a == 0 && b < 0 ? dgn_dv : dg_dv;
-        /* the event function that fired: a stuck element reaching its capacity, b z_i - w_i g(v);
-           a slipping one whose motion reversed, -a v */
-        double rate = a == 0 ? b * fm[row] - w * dgs_dv * vdot : -a * vdot;
-        if (!(fabs(rate) > 0.0) || jump == 0.0) continue;
-        for (int k = 0; k < np; k++) {
-            const tf_target *tg = &targets[k];
-            double col[TF_MAX_STATES], num; /* column k of S (row-major n x np) */
-            for (int r = 0; r < n; r++) col[r] = S[r * np + k];
-            double dv = velocity_along(m, col);
-            if (a == 0) {
-                double dcap = 0.0; /* d(capacity g)/dtheta, directly */
-                if (tg->kind == TF_TARGET_PARAM) dcap = dgs_p[tg->param];
-                else if (tg->kind == TF_TARGET_LAW) dcap = tf_law_coef_derivative(&m->law[tg->param], tg->coef,
-                                                                                  tf_model_temperature(m, t, Y)) *
-                                                           dgs_p[tg->param];
-                num = b * col[row] - w * (dcap + dgs_dv * dv);
-            } else {
-                num = -a * dv;
-            }
-            S[row * np + k] -= jump * num / rate;
-        }
-    }
+    tf_friction_update_modes(m->friction, p, &d->gms, v, y + nmech(m));
 }
 
 static void model_restart(double t, double *y, void *ctx) { tf_model_on_restart(t, y, ctx); }
 
-tf_ode tf_model_ode(tf_model *model)
+tf_ode tf_model_ode(tf_model_data *data)
 {
-    tf_ode ode = {tf_model_nstate(model), model, lugre_constant_T(model) ? rhs_lugre_constant_T : tf_model_rhs,
+    const tf_model *model = data->model;
+    tf_ode ode = {tf_model_nstate(model), data, tf_plant_fast(model) ? tf_plant_rhs_fast : tf_model_rhs,
                   tf_model_jac, tf_model_next_corner, tf_model_nevent(model), tf_model_events, model_restart,
                   0.0, 0, -1};
     if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
@@ -621,9 +339,10 @@ tf_ode tf_model_ode(tf_model *model)
     return ode;
 }
 
-void tf_model_outputs_strided(const tf_model *model, double t, const double *y, double *out, long stride)
+void tf_model_outputs_strided(tf_model_data *data, double t, const double *y, double *out, long stride)
 {
-    const int fast = lugre_constant_T(model); /* LuGre: one state, no work state */
+    const tf_model *model = data->model;
+    const int fast = tf_plant_fast(model); /* LuGre: one state, no work state */
     int nm = nmech(model), nz = fast ? 1 : nfric(model);
     double u = tf_waveform_value(&model->input, t);
     double xp = 0.0, vp = 0.0, x, v;
@@ -642,17 +361,17 @@ void tf_model_outputs_strided(const tf_model *model, double t, const double *y, 
     out[TF_OUT_RELATIVE_VELOCITY * stride] = v - vp;
     if (fast) { /* the common case, as its right-hand side computes it */
         double dz;
-        out[TF_OUT_FRICTION_FORCE * stride] = lugre_constant_T_friction((tf_model *)model, v - vp, y[nm], &dz);
+        out[TF_OUT_FRICTION_FORCE * stride] = lugre_constant_T_friction(data, v - vp, y[nm], &dz);
         out[TF_OUT_TEMPERATURE * stride] = model->T_const;
     } else {
-        out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(model, t, y);
+        out[TF_OUT_FRICTION_FORCE * stride] = tf_model_friction(data, t, y);
         out[TF_OUT_TEMPERATURE * stride] = tf_model_temperature(model, t, y);
     }
     for (int j = 0; j < nz; j++) out[(TF_OUT_NFIXED + j) * stride] = y[nm + j];
     if (!fast && has_work(model)) out[(TF_OUT_NFIXED + nz) * stride] = y[tf_model_work_index(model)];
 }
 
-void tf_model_outputs(const tf_model *model, double t, const double *y, double *out)
+void tf_model_outputs(tf_model_data *data, double t, const double *y, double *out)
 {
-    tf_model_outputs_strided(model, t, y, out, 1);
+    tf_model_outputs_strided(data, t, y, out, 1);
 }

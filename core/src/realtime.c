@@ -43,14 +43,22 @@ tf_status tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_
         memset(m, 0, sizeof *m);
         return bad;
     }
+    tf_model_data_init(&f->data, m);
     return tf_rt_reset(f, err);
+}
+
+/* The run's data of f, pointing to f's model (the struct may have been copied since the last call). */
+static tf_model_data *rt_data(tf_rt_friction *f)
+{
+    f->data.model = &f->model;
+    return &f->data;
 }
 
 /* The last temperature stepped at, for checking a change there (the cache holds it). */
 static int last_T(const tf_rt_friction *f, double *T)
 {
-    *T = f->model.cache_T;
-    return f->model.cache_valid && f->model.thermal != TF_THERMAL_NONE;
+    *T = f->data.cache.T;
+    return f->data.cache.valid && f->model.thermal != TF_THERMAL_NONE;
 }
 
 /* After a setter: a refusal restored the model (the cache still holds); an accepted change
@@ -60,8 +68,8 @@ static tf_status set_done(tf_rt_friction *f, tf_status bad, int known, double T)
 {
     if (!bad) {
         double l, d;
-        tf_model_prepare(&f->model);
-        if (known) tf_model_params_cached(&f->model, T, &l, &d);
+        tf_model_data_changed(rt_data(f));
+        if (known) tf_model_params_cached(rt_data(f), T, &l, &d);
     }
     return bad;
 }
@@ -125,7 +133,7 @@ tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err)
     if (!f) return rt_done(err, TF_ERR_BAD_ARGUMENT, "f (NULL)");
     memset(f->z, 0, sizeof f->z);
     int n = f->model.gms.n;
-    for (int i = 0; i < n && i < TF_MAX_FRICTION_STATES; i++) f->model.gms.mode[i] = 0;
+    for (int i = 0; i < n && i < TF_MAX_FRICTION_STATES; i++) f->data.gms.mode[i] = 0;
     return rt_done(err, TF_OK, 0);
 }
 
@@ -134,21 +142,22 @@ tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err)
  * A refused temperature leaves the cache invalid, so that it is refused again next time. */
 static const double *rt_params(tf_rt_friction *f, double T, double *lambda, double *dF, tf_error *err)
 {
-    tf_model *m = &f->model;
+    const tf_model *m = &f->model;
+    tf_params_cache *c = &f->data.cache;
     if (m->thermal == TF_THERMAL_NONE) {
         T = NAN; /* ignored: any value hits the cache */
     } else if (!isfinite(T)) {
         rt_done(err, TF_ERR_BAD_ARGUMENT, "T (not finite)");
         return 0;
     }
-    if (m->cache_valid && (m->cache_T == T || (isnan(T) && isnan(m->cache_T)))) {
-        *lambda = m->cache_lambda;
-        *dF = m->cache_dF;
-        return m->cache_p;
+    if (c->valid && (c->T == T || (isnan(T) && isnan(c->T)))) {
+        *lambda = c->lambda;
+        *dF = c->dF;
+        return c->p;
     }
-    const double *p = tf_model_params_cached(m, T, lambda, dF);
+    const double *p = tf_model_params_cached(rt_data(f), T, lambda, dF);
     if (tf_model_check_params(m, p, *lambda, *dF, err)) {
-        m->cache_valid = 0;
+        c->valid = 0;
         return 0;
     }
     return p;
@@ -223,20 +232,22 @@ static tf_status rt_step(tf_rt_friction *f, double v, double T, double dt, doubl
 {
     if (!isfinite(v)) return rt_done(err, TF_ERR_BAD_ARGUMENT, "v (not finite)");
     if (!isfinite(dt)) return rt_done(err, TF_ERR_BAD_ARGUMENT, "dt (not finite)");
-    tf_model *m = &f->model;
+    const tf_model *m = &f->model;
+    tf_gms_elements *gms_data = &f->data.gms;
+    const tf_params_cache *c = &f->data.cache;
     double lambda, dF, dz[TF_MAX_FRICTION_STATES], z0[TF_MAX_FRICTION_STATES];
     int mode0[TF_MAX_FRICTION_STATES];
     const double *p;
-    if (m->thermal == TF_THERMAL_NONE && m->cache_valid) {
-        p = m->cache_p, lambda = m->cache_lambda, dF = m->cache_dF;
+    if (m->thermal == TF_THERMAL_NONE && c->valid) {
+        p = c->p, lambda = c->lambda, dF = c->dF;
     } else if (!(p = rt_params(f, T, &lambda, &dF, err))) {
         return TF_ERR_BAD_ARGUMENT;
     }
     int nz = nstate(m), gms = m->friction == TF_FRICTION_GMS;
     for (int j = 0; j < nz; j++) z0[j] = f->z[j];
     if (gms)
-        for (int j = 0; j < nz; j++) mode0[j] = m->gms.mode[j];
-    double F = advance(m->friction, nz, p, &m->gms, f->z, v, dt, 0, dz);
+        for (int j = 0; j < nz; j++) mode0[j] = gms_data->mode[j];
+    double F = advance(m->friction, nz, p, gms_data, f->z, v, dt, 0, dz);
     double x = dt > 0.0 ? f->x + v * dt : f->x;
     if (p[TF_P_RIPPLE_PERIOD] > 0.0) F += tf_friction_ripple(p, x, 0, 0);
     F = tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 0, 0);
@@ -245,7 +256,7 @@ static tf_status rt_step(tf_rt_friction *f, double v, double T, double dt, doubl
     if (!isfinite(F)) {
         for (int j = 0; j < nz; j++) f->z[j] = z0[j];
         if (gms)
-            for (int j = 0; j < nz; j++) m->gms.mode[j] = mode0[j];
+            for (int j = 0; j < nz; j++) gms_data->mode[j] = mode0[j];
         return rt_done(err, TF_ERR_NONFINITE, "force or state not finite (v or dt too large)");
     }
     f->x = x;
@@ -275,6 +286,6 @@ tf_status tf_rt_from_model(tf_rt_friction *f, const tf_model *m, tf_error *err)
     if (tf_model_check_friction(m, NAN, err)) return TF_ERR_BAD_ARGUMENT;
     memset(f, 0, sizeof *f); /* every field from a known state: the position (the ripple's argument) at 0 */
     f->model = *m;
-    tf_model_prepare(&f->model);
+    tf_model_data_init(&f->data, &f->model);
     return tf_rt_reset(f, err);
 }

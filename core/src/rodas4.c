@@ -1,6 +1,7 @@
 /* Rodas4: Hairer & Wanner's 6-stage Rosenbrock method of order 4(3), L-stable and stiffly accurate,
  * with its 3rd-order dense output (Solving ODEs II, IV.7), the analytic state Jacobian and predictive
  * (Gustafsson) step control. Its linear systems are reduced by the kinematic rows (lu_reduced.h). */
+#include "rodas4.h"
 #include "lu_reduced.h"
 
 #include <float.h>

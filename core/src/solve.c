@@ -1,12 +1,35 @@
 /* The driver of the adaptive integrators (integrator.h: tf_solve): it integrates segment by segment
  * between the input's corners, restarts at every corner and event, writes the dense output on the
  * caller's grid, and bounds its work (max_steps, the interrupt poll). The methods are in dopri5.c and
- * rodas4.c, the choice between them (AUTO) in auto.c, event location in events.c. */
-#include "solve.h"
+ * rodas4.c, the choice between them (AUTO) and the reversal handling of AUTO's explicit steps in auto.c (auto.h:
+ * the driver asks, AUTO answers), event location in events.c, the work space in work.c. */
+#include "auto.h"
+#include "events.h" /* and the methods, dopri5.h and rodas4.h */
 
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The state of one tf_solve. */
+typedef struct {
+    work w;                        /* the methods' vectors (work.h) */
+    const tf_ode *ode;
+    const tf_solver_options *opt;  /* the caller's tolerances (Rodas4's, and Dopri5's unless AUTO) */
+    tf_solver_stats *st;
+    tf_error *err;                 /* the caller's record (may be NULL) */
+    const double *t_out;
+    long n_out, next;              /* the output grid and its next sample */
+    tf_emit_fn emit;
+    void *emit_ctx;
+    int n, ne, method;             /* states, event functions, the method running */
+    double t, h, *y;               /* where the integration is, the next step, the state (the caller's) */
+    double *f0, *yd, *g0, *g1, *gm; /* f(t, y), a dense-output sample, the event functions at t, t + h, mid */
+    int jac_current, reject, poll;
+    double facold;                 /* Dopri5's PI control */
+    int iasti, nonsti;             /* Dopri5's stiffness test */
+    tf_rodas4_control rc;
+    tf_auto au;                    /* AUTO's choice and its explicit steps' reversals (auto.h) */
+} tf_driver;
 
 /* A failure: the step size in the statistics, the rest in the error record (status.h). */
 static tf_status fail(tf_solver_stats *st, tf_error *err, tf_status status, double t, double h, long index,
@@ -17,7 +40,7 @@ static tf_status fail(tf_solver_stats *st, tf_error *err, tf_status status, doub
 }
 
 /* Hairer's starting step: an explicit Euler step's change in f sets the scale. */
-double tf_initial_step(work *w, double t, const double *y, const double *f0, int order, double hmax)
+static double tf_initial_step(work *w, double t, const double *y, const double *f0, int order, double hmax)
 {
     int n = w->n;
     double d0 = wnorm(w, y, y, y), d1 = wnorm(w, f0, y, y);
@@ -30,38 +53,6 @@ double tf_initial_step(work *w, double t, const double *y, const double *f0, int
     double dm = fmax(d1, d2);
     double h1 = dm <= 1e-15 ? fmax(1e-6, h0 * 1e-3) : pow(0.01 / dm, 1.0 / (order + 1));
     return fmin(100.0 * h0, h1);
-}
-
-/* The work space: one allocation for all of the methods' vectors. */
-static tf_status setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_solver_stats *st)
-{
-    int n = ode->n;
-    memset(w, 0, sizeof *w);
-    w->t_clamp = INFINITY;
-    w->ode = ode; w->opt = opt; w->st = st; w->n = n;
-    size_t nvec = 7 + 4 + 5 + 3;
-    w->block = (double *)malloc(sizeof(double) * (nvec * n + 3 * (size_t)n * n) + sizeof(int) * 5 * n);
-    if (!w->block) return TF_ERR_NO_MEMORY;
-    double *p = w->block;
-    for (int i = 0; i < 7; i++, p += n) w->k[i] = p;
-    w->ytmp = p; p += n;
-    w->y1 = p; p += n;
-    w->ysti = p; p += n;
-    w->ft = p; p += n;
-    for (int i = 0; i < 5; i++, p += n) w->cont[i] = p;
-    w->J = p; p += n * n;
-    w->W = p; p += n * n;
-    w->Jpos = p; p += n * n;
-    w->dinv = p; p += n;
-    w->xr = p; p += n;
-    w->rtol_w = p; p += n;
-    for (int i = 0; i < n; i++) w->rtol_w[i] = opt->rtol_weight ? opt->rtol_weight[i] : 1.0;
-    w->piv = (int *)p;
-    w->pos = w->piv + n;
-    w->partner = w->pos + n;
-    w->red = w->partner + n;
-    w->qcol = w->red + n;
-    return TF_OK;
 }
 
 /* The grid is non-decreasing, finite and within +-1e12 s (beyond it a double resolves time to ~1e-4 s,
@@ -88,12 +79,12 @@ static tf_status start(tf_driver *d, const tf_ode *ode, const tf_solver_options 
     d->ode = ode, d->opt = opt, d->st = st, d->err = err;
     d->t_out = t_out, d->n_out = n_out, d->emit = emit, d->emit_ctx = emit_ctx;
     d->n = ode->n, d->y = y, d->t = t_out[0];
-    if (setup(&d->w, ode, opt, st)) return fail(st, err, TF_ERR_NO_MEMORY, d->t, 0.0, -1, 0);
+    if (tf_work_setup(&d->w, ode, opt, st)) return fail(st, err, TF_ERR_NO_MEMORY, d->t, 0.0, -1, 0);
     /* without a Jacobian (e.g. sensitivity systems) only the explicit method applies */
-    d->requested = ode->jac ? opt->method : TF_METHOD_DOPRI5;
-    d->method = d->requested == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : d->requested;
-    d->kinks = d->requested == TF_METHOD_AUTO && ode->kink_scale > 0.0; /* reversals (below) */
-    int no_memory = tf_auto_start(d);
+    int requested = ode->jac ? opt->method : TF_METHOD_DOPRI5;
+    d->method = requested == TF_METHOD_AUTO ? TF_METHOD_DOPRI5 : requested;
+    int no_memory = tf_auto_start(&d->au, ode, opt, requested, d->t, st);
+    d->w.opt = tf_auto_explicit_options(&d->au, opt);
     d->ne = ode->events ? ode->nevent : 0;
     d->f0 = (double *)malloc(sizeof(double) * d->n);
     d->yd = (double *)malloc(sizeof(double) * d->n);
@@ -110,9 +101,9 @@ static void finish(tf_driver *d)
 {
     free(d->f0);
     free(d->yd);
-    free(d->atol_x);
     free(d->g0);
-    free(d->w.block);
+    tf_auto_free(&d->au);
+    tf_work_free(&d->w);
 }
 
 /* Emits the grid's samples up to t_lim from the dense output of the step [t, t + h], each checked
@@ -147,12 +138,15 @@ static tf_status restart(tf_driver *d, double seg_end)
 {
     const tf_ode *ode = d->ode;
     d->w.t_clamp = INFINITY;
-    d->kink_h = d->kink_h_orig = d->kink_peak = d->kink_last_peak = 0.0;
-    d->kink_cuts = d->kink_steps = d->kink_last_steps = d->stiff_seen = 0;
     if (ode->on_restart) ode->on_restart(d->t, d->y, ode->ctx);
     if (d->ne) ode->events(d->t, d->y, d->g0, ode->ctx);
     if (rhs(&d->w, d->t, d->y, d->f0)) return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, d->h, -1, 0);
-    tf_auto_restart(d);
+    if (tf_auto_restart(&d->au, d->method, d->t, d->t_out[0])) { /* AUTO: the explicit method again, */
+        d->method = TF_METHOD_DOPRI5;
+        d->w.opt = tf_auto_explicit_options(&d->au, d->opt);
+        d->iasti = d->nonsti = 0;
+        d->h = tf_initial_step(&d->w, d->t, d->y, d->f0, 5, d->opt->hmax); /* not the stiff method's long ramp step */
+    }
     if (d->h <= 0.0)
         d->h = d->opt->h0 > 0 ? d->opt->h0
                               : tf_initial_step(&d->w, d->t, d->y, d->f0, d->method == TF_METHOD_DOPRI5 ? 5 : 4,
@@ -160,155 +154,6 @@ static tf_status restart(tf_driver *d, double seg_end)
     d->w.t_clamp = nextafter(seg_end, -INFINITY);
     d->jac_current = 0;
     return TF_OK;
-}
-
-/* Reversals. The friction models' right-hand side has a kink where the relative velocity v_r changes
- * sign (LuGre's |v_r|), and Dormand-Prince's embedded error estimate does not see a kink inside a step:
- * in the ringing after a sawtooth's flyback, which reverses v_r every 0.2-1 ms, the steps across a
- * reversal had true local errors of 2.5-92 times the tolerance while the estimate accepted them, and
- * these steps made the default's largest errors (docs/performance.md). So AUTO's Dormand-Prince steps end
- * at reversals of the ODE's kink velocity (integrator.h): the accepted step's dense output, extrapolated over
- * the next step, predicts a reversal in it, and the next step ends just past it (no step is wasted); a
- * step across a reversal that was not predicted is also judged by its dense output at mid-step against
- * the cubic Hermite interpolant of its ends (as Rodas4's steps are, rodas4.c), which tracks the kink's
- * error, and retried ending just past the reversal if that fails. Both sides of a kink are smooth.
- *
- * A sign change counts only where |v_r| exceeds KINK_SIGNIFICANT times its tolerance at an end of the
- * step, and only at the end of a half-cycle of at least KINK_CUT_HALF_CYCLE steps: at its stability limit
- * Dormand-Prince makes v_r oscillate by itself, changing sign every step or two, by 3.6 (li2009-model-i)
- * to 9 (li2009-base) times the tolerance, and cutting steps there buys no accuracy and keeps the steps
- * short, so that the stiffness test never fires (li2009-base ran in Dormand-Prince throughout, at 2.4
- * times the work); the ringing after a flyback changes sign every 3-5 steps. Ringing of v_r above that
- * bound also keeps AUTO from switching to Rodas4 (kink_stiff): Rodas4's long steps do not resolve it and
- * miss its reversals' kinks as well (on a set of the accuracy benchmark, an early switch in such ringing
- * drifted to 1.9e-3 %), while Dormand-Prince must resolve it anyway; the stiffness test's verdict waits
- * until the ringing has decayed below the bound.
- *
- * AUTO only: it pays there because the explicit phases can then run at 1/20 of the tolerances instead of
- * 1/50 (auto.c). A Dopri5 asked for by name keeps its steps: at its tolerance the cuts cost more steps
- * (+20 % on the preset) than a tighter tolerance of the same accuracy would. */
-enum {
-    KINK_MAX_CUTS = 2,          /* a step is cut at most twice; then its mid-step check judges it */
-    KINK_LOCATE_ITERATIONS = 8, /* of the regula falsi on the dense output */
-    KINK_RINGING_STEPS = 15,    /* a half-cycle of more steps is no ringing (kink_stiff) */
-    KINK_RING_HALF_CYCLE = 2,   /* ... nor one of fewer (kink_stiff) */
-    KINK_CUT_HALF_CYCLE = 3     /* a reversal that ends a half-cycle of fewer steps is not cut */
-};
-static const double KINK_SIGNIFICANT = 5.0;   /* in tolerances of the kink velocity (above) */
-static const double KINK_PAST = 1e-4;         /* a step cut at a reversal ends this fraction past it */
-static const double KINK_PREDICT_REACH = 2.0; /* the dense output extrapolated at most 2 steps ahead */
-static const double KINK_MIN_CUT = 1e-3;      /* a reversal this close (of the next step) is not cut */
-static const double KINK_AT_END = 1e-3;       /* a kink this near a step's end makes no error: unchecked */
-
-static inline double kink_velocity(const tf_ode *ode, const double *y)
-{
-    return ode->kink_minus >= 0 ? y[ode->kink_plus] - y[ode->kink_minus] : y[ode->kink_plus];
-}
-
-/* The kink velocity on Dormand-Prince's dense output of the last step, at its fraction s. */
-static inline double kink_dense(const work *w, const tf_ode *ode, double s)
-{
-    double v = tf_dopri5_dense_component(w, ode->kink_plus, s);
-    return ode->kink_minus >= 0 ? v - tf_dopri5_dense_component(w, ode->kink_minus, s) : v;
-}
-
-/* The bound above which an oscillation of the kink velocity is the model's, not the integrator's. */
-static inline double kink_significant(const work *w, const tf_ode *ode)
-{
-    return KINK_SIGNIFICANT * w->opt->rtol * ode->kink_scale;
-}
-
-/* The oscillation's amplitude: the larger of its last half-cycle's peak |v| and the current one's. */
-static inline double kink_amplitude(const tf_driver *d)
-{
-    return d->kink_peak > d->kink_last_peak ? d->kink_peak : d->kink_last_peak;
-}
-
-/* A sign change of the kink velocity from g0 to g1, significant (above). */
-static inline int reversal(const work *w, const tf_ode *ode, double g0, double g1)
-{
-    double a0 = fabs(g0), a1 = fabs(g1);
-    return g0 * g1 < 0.0 && (a0 > a1 ? a0 : a1) > kink_significant(w, ode);
-}
-
-/* The reversal between the fractions a and b of the last step (kink velocities ga, gb of opposite
- * signs) on its dense output, from b's side: the Illinois variant of the regula falsi, until the bracket
- * is narrower than KINK_PAST of the step (2-4 iterations mostly; the cut needs no more). */
-static double kink_locate(const work *w, const tf_ode *ode, double a, double ga, double b, double gb)
-{
-    double c[5]; /* the kink velocity's own dense-output coefficients (one polynomial, not two) */
-    for (int k = 0; k < 5; k++)
-        c[k] = w->cont[k][ode->kink_plus] - (ode->kink_minus >= 0 ? w->cont[k][ode->kink_minus] : 0.0);
-    for (int it = 0, side = 0; it < KINK_LOCATE_ITERATIONS && b - a > KINK_PAST; it++) {
-        double s = (a * gb - b * ga) / (gb - ga);
-        double gs = tf_dopri5_dense_poly(c, s);
-        if (gs == 0.0) return s;
-        if ((gs < 0.0) == (ga < 0.0)) {
-            a = s, ga = gs;
-            if (side == -1) gb *= 0.5;
-            side = -1;
-        } else {
-            b = s, gb = gs;
-            if (side == 1) ga *= 0.5;
-            side = 1;
-        }
-    }
-    return b;
-}
-
-/* A Dormand-Prince step of error err (accepted by it) across a reversal: its error is the larger of err
- * and the mid-step check's; one that fails the check is retried ending just past the reversal (reject). */
-static double kink_check(tf_driver *d, double err)
-{
-    const tf_ode *ode = d->ode;
-    work *w = &d->w;
-    if (!(err >= 0.0 && err <= 1.0)) return err;
-    double g0 = kink_velocity(ode, d->y), g1 = kink_velocity(ode, w->y1);
-    if (!reversal(w, ode, g0, g1) || d->kink_steps + 1 < KINK_CUT_HALF_CYCLE) return err;
-    if ((kink_dense(w, ode, 1.0 - KINK_AT_END) < 0.0) == (g0 < 0.0)) return err; /* a step cut just past it */
-    const double h = d->h;
-    tf_dopri5_dense(w, 0.5, d->yd);
-    double e_mid = mid_step_error(w, h, d->y, d->f0, w->k[6], d->yd); /* k[6]: f at the end (FSAL) */
-    if (!isfinite(e_mid)) return -1.0;
-    if (e_mid <= 1.0 || d->kink_cuts >= KINK_MAX_CUTS) return fmax(err, e_mid);
-    d->kink_h = fmin(kink_locate(w, ode, 0.0, g0, 1.0, g1) + KINK_PAST, 1.0) * h;
-    if (!d->kink_cuts++) d->kink_h_orig = h;
-    return fmax(e_mid, 2.0);
-}
-
-/* After an accepted Dormand-Prince step: the oscillation's half-cycle peaks, and the next step, hnew by
- * its control, shortened to end just past a reversal that its dense output, extrapolated, puts inside it. */
-static double kink_next(tf_driver *d, double hnew)
-{
-    const tf_ode *ode = d->ode;
-    const work *w = &d->w;
-    const double h = d->h, g0 = kink_velocity(ode, d->y), g1 = kink_velocity(ode, w->y1), a1 = fabs(g1);
-    if (g0 * g1 < 0.0) { /* a new half-cycle */
-        d->kink_last_peak = d->kink_peak;
-        d->kink_peak = a1;
-        d->kink_last_steps = d->kink_steps + 1;
-        d->kink_steps = 0;
-    } else {
-        if (a1 > d->kink_peak) d->kink_peak = a1;
-        d->kink_steps++;
-    }
-    const double reach = hnew < KINK_PREDICT_REACH * h ? hnew / h : KINK_PREDICT_REACH;
-    const double gb = kink_dense(w, ode, 1.0 + reach);
-    if (!reversal(w, ode, g1, gb) || d->kink_steps + 2 < KINK_CUT_HALF_CYCLE) return hnew;
-    double h_kink = (kink_locate(w, ode, 1.0, g1, 1.0 + reach, gb) - 1.0) * h * (1.0 + KINK_PAST);
-    return h_kink > KINK_MIN_CUT * hnew ? h_kink : hnew;
-}
-
-/* AUTO's switch to the stiff method (stiff: Dormand-Prince's stiffness test fired) waits while v_r
- * rings significantly (above): while its half-cycles peak above the bound and last at least 2 steps
- * (Dormand-Prince's own oscillation changes sign every step or two) and fewer than the stiffness test's
- * count (a slower motion is no ringing that the explicit method sits on). */
-static int kink_stiff(tf_driver *d, int stiff)
-{
-    if (stiff) d->stiff_seen = 1;
-    int ringing = d->kink_steps < KINK_RINGING_STEPS && d->kink_last_steps >= KINK_RING_HALF_CYCLE &&
-                  kink_amplitude(d) > kink_significant(&d->w, d->ode);
-    return d->stiff_seen && !ringing;
 }
 
 /* One attempted step of the current method into *err (negative: non-finite or singular). */
@@ -323,7 +168,7 @@ static tf_status attempt(tf_driver *d, double seg_end, double *err)
         *err = tf_rodas4_step(&d->w, d->t, d->h, d->y, d->f0, d->yd);
     } else {
         *err = tf_dopri5_step(&d->w, d->t, d->h, d->y, d->f0);
-        if (d->kinks) *err = kink_check(d, *err);
+        *err = tf_auto_check_step(&d->au, &d->w, d->y, d->f0, d->h, d->yd, *err); /* at a reversal */
     }
     return TF_OK;
 }
@@ -331,15 +176,15 @@ static tf_status attempt(tf_driver *d, double seg_end, double *err)
 /* A step that failed (non-finite numbers, a singular matrix) or whose error is too large: retried smaller. */
 static tf_status reject(tf_driver *d, double err)
 {
+    double h_retry;
     d->st->rejected++;
     d->reject = 1;
     if (err < 0.0) {
         d->h *= 0.25;
         if (d->h <= 16.0 * DBL_EPSILON * fmax(fabs(d->t), 1e-300))
             return fail(d->st, d->err, TF_ERR_NONFINITE, d->t, d->h, -1, 0);
-    } else if (d->kink_h > 0.0) { /* retried ending just past a reversal (kink_check) */
-        d->h = d->kink_h;
-        d->kink_h = 0.0;
+    } else if ((h_retry = tf_auto_retry_step(&d->au)) > 0.0) { /* ending just past a reversal (auto.c) */
+        d->h = h_retry;
         d->reject = 0;
     } else {
         d->h = d->method == TF_METHOD_RODAS4 ? tf_rodas4_rejected_h(err, d->h) : tf_dopri5_rejected_h(err, d->h);
@@ -390,11 +235,19 @@ static double next_step(tf_driver *d, double err, double t_new, int last)
         hnew = tf_dopri5_next_h(err, d->h, &d->facold);
         int stiff = tf_dopri5_stiff(w, d->opt, d->h, &d->iasti, &d->nonsti);
         if (stiff) d->st->stiff_suspected = 1;
-        if (d->kinks) hnew = kink_next(d, hnew), stiff = kink_stiff(d, stiff);
+        if (tf_auto_explicit_step(&d->au, w, d->y, d->h, t_new, stiff, &hnew, d->st)) { /* AUTO: to Rodas4 */
+            d->method = TF_METHOD_RODAS4;
+            d->w.opt = d->opt;
+            d->rc.first = 1;
+            d->iasti = 0;
+        }
         memcpy(d->f0, w->k[6], sizeof(double) * d->n); /* FSAL */
-        tf_auto_explicit_step(d, t_new, stiff);
     }
-    tf_auto_probe(d, t_new);
+    if (tf_auto_probe(&d->au, d->method, t_new, d->st)) { /* AUTO: Rodas4 did not pay, back to Dopri5 */
+        d->method = TF_METHOD_DOPRI5;
+        d->w.opt = tf_auto_explicit_options(&d->au, d->opt);
+        d->iasti = d->nonsti = 0; /* f0 = f(t_new, y1) is current: Rodas4 computed it */
+    }
     return hnew;
 }
 
@@ -408,9 +261,7 @@ static tf_status accept(tf_driver *d, double err, int last, double seg_end, doub
     d->st->steps++;
     double hnew = next_step(d, err, t_new, last);
     if (d->reject) hnew = fmin(hnew, d->h);
-    if (d->kink_h_orig > 0.0) hnew = fmax(hnew, d->kink_h_orig); /* after a cut at a reversal: the step it cut */
-    d->kink_h_orig = 0.0;
-    d->kink_cuts = 0;
+    hnew = tf_auto_accepted(&d->au, hnew); /* after a cut at a reversal: at least the step it cut */
     d->reject = 0;
     memcpy(d->y, d->w.y1, sizeof(double) * d->n);
     d->t = t_new;

@@ -1,6 +1,9 @@
 /* Thermal extensions: Model I, Model II and the lumped heat balance (see thermal.h). */
 #include "thermofriction/thermal.h"
-#include "checks.h"
+#include "domain_tests.h"
+#include "law_private.h"
+#include "thermal_private.h"
+#include "waveform_private.h" /* the heat input P_ext */
 
 #include <math.h>
 #include <string.h>

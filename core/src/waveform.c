@@ -1,6 +1,7 @@
 /* Input waveforms (docs/formats.md#inputs). */
 #include "thermofriction/waveform.h"
-#include "checks.h"
+#include "domain_tests.h"
+#include "waveform_private.h"
 
 #include <math.h>
 
@@ -189,6 +190,23 @@ double tf_waveform_next_reversal(const tf_waveform *w, double t)
     if (w->kind != TF_WAVE_SINE || !(w->frequency > 0)) return INFINITY; /* the others: corners */
     double c[2] = {0.25, 0.75};
     return periodic_next(t, w->frequency, c, 2);
+}
+
+long tf_waveform_corners(const tf_waveform *w, double a, double b, double *out, long cap)
+{
+    /* start a little before a: next_corner skips corners within 1e-12 (relative) of its argument, and a
+       corner exactly at a belongs in [a, b] */
+    double margin = 1e-12 * fmax(1.0, fabs(a));
+    double c = a - 3.0 * margin;
+    long count = 0;
+    for (int guard = 0; guard < 1000000; guard++) {
+        c = tf_waveform_next_corner(w, c);
+        if (!(c <= b)) break;
+        if (c < a - margin) continue;
+        if (count < cap) out[count] = c;
+        count++;
+    }
+    return count;
 }
 
 /* ---- checks (tf_model_check, plant.h) ---- */

@@ -296,6 +296,7 @@ static void test_lugre_steady_sliding(void)
 static void test_jacobian_vs_finite_differences(void)
 {
     tf_model m;
+    tf_model_data md;
     paper_like(&m, 35.0);
     m.p[TF_P_FS] = 1.5 * m.p[TF_P_FC];
     m.p[TF_P_SIGMA2] = 0.3;
@@ -307,18 +308,18 @@ static void test_jacobian_vs_finite_differences(void)
             m.dF = (tf_law){TF_LAW_PWL, 0, 0, 2, dFx, dFy, 0};
             m.dF_form = form == 1 ? TF_DF_SCALE : TF_DF_OFFSET;
         }
-        tf_model_prepare(&m);
+        tf_model_data_init(&md, &m);
         double y[5] = {1e-7, 2e-3, 3e-7, -1e-3, 2e-7}, J[25], f0[5], f1[5], f2[5];
-        tf_model_jac(0.01, y, J, &m);
-        tf_model_rhs(0.01, y, f0, &m);
+        tf_model_jac(0.01, y, J, &md);
+        tf_model_rhs(0.01, y, f0, &md);
         double worst = 0;
         for (int j = 0; j < 5; j++) {
             double yp[5], ym[5];
             memcpy(yp, y, sizeof y); memcpy(ym, y, sizeof y);
             double h = 1e-7 * fmax(fabs(y[j]), 1e-9);
             yp[j] += h; ym[j] -= h;
-            tf_model_rhs(0.01, yp, f1, &m);
-            tf_model_rhs(0.01, ym, f2, &m);
+            tf_model_rhs(0.01, yp, f1, &md);
+            tf_model_rhs(0.01, ym, f2, &md);
             for (int i = 0; i < 5; i++) {
                 double fd = (f1[i] - f2[i]) / (2 * h);
                 double scale = fabs(fd) + fabs(J[i * 5 + j]) + 1e-300;
@@ -336,17 +337,18 @@ static void test_frictionless_step_response(void)
 {
     /* friction removed: the stage is an exact damped second-order system under a unit step */
     tf_model m;
+    tf_model_data md;
     paper_like(&m, 35.0);
     m.p[TF_P_SIGMA0] = m.p[TF_P_SIGMA1] = 0.0;
     m.p[TF_P_FC] = m.p[TF_P_FS] = 1.0;
     m.input = (tf_waveform){TF_WAVE_STEP, 10.0, 0, 0, 0, 0, 0.0, 1e-3, 0, 0, 0};
-    tf_model_prepare(&m);
+    tf_model_data_init(&md, &m);
     int n = tf_model_nstate(&m);
     double atol[5], y[5];
     tf_model_state_scale(&m, atol);
     for (int i = 0; i < n; i++) atol[i] *= 1e-8;
     tf_model_initial_state(&m, y);
-    tf_ode ode = tf_model_ode(&m);
+    tf_ode ode = tf_model_ode(&md);
     long N = 201;
     double t[201], xp[201];
     for (int i = 0; i < N; i++) t[i] = 5e-3 * i / (N - 1);
@@ -371,13 +373,14 @@ static void test_grid_end_one_ulp_past_a_corner(void)
 {
     /* the last output time can sit a rounding error past a corner: no spurious underflow */
     tf_model m;
+    tf_model_data md;
     paper_like(&m, 35.0);
     m.input.rise = 0.999;
-    tf_model_prepare(&m);
+    tf_model_data_init(&md, &m);
     double atol[5], y[5];
     tf_model_state_scale(&m, atol);
     for (int i = 0; i < 5; i++) atol[i] *= 1e-6;
-    tf_ode ode = tf_model_ode(&m);
+    tf_ode ode = tf_model_ode(&md);
     tf_solver_options opt = {TF_METHOD_DOPRI5, 1e-6, atol, 0, 0, 1000000};
     tf_solver_stats st;
     double corner = 3.0 / 5.0;
@@ -396,6 +399,7 @@ static void test_parameter_derivatives_vs_finite_differences(void)
     double dFx[3] = {30.0, 38.4, 41.5}, dFy[3] = {0.0, -0.145, -0.4775};
     for (int form = 0; form < 3; form++) {
         tf_model m;
+        tf_model_data md;
         paper_like(&m, 36.0);
         m.p[TF_P_FS] = 1.4 * m.p[TF_P_FC];
         m.p[TF_P_SIGMA2] = 0.3;
@@ -412,16 +416,16 @@ static void test_parameter_derivatives_vs_finite_differences(void)
             m.dF_form = form == 1 ? TF_DF_SCALE : TF_DF_OFFSET;
             np = 8;
         }
-        tf_model_prepare(&m);
+        tf_model_data_init(&md, &m);
         double y[5] = {1e-7, 2e-3, 3e-7, -1e-3, 2e-7}, dy[5], fp[5 * 8], f1[5], f2[5];
-        tf_model_derivatives(&m, 0.01, y, dy, 0, tg, np, fp);
+        tf_model_derivatives(&md, 0.01, y, dy, 0, tg, np, fp);
         double worst = 0;
         for (int k = 0; k < np; k++) {
             double *slot = tg[k].kind == TF_TARGET_DF ? &dFy[tg[k].coef] : &m.p[tg[k].param];
             double save = *slot, h = 1e-6 * fabs(save);
-            *slot = save + h; tf_model_prepare(&m); tf_model_rhs(0.01, y, f1, &m);
-            *slot = save - h; tf_model_prepare(&m); tf_model_rhs(0.01, y, f2, &m);
-            *slot = save; tf_model_prepare(&m);
+            *slot = save + h; tf_model_data_init(&md, &m); tf_model_rhs(0.01, y, f1, &md);
+            *slot = save - h; tf_model_data_init(&md, &m); tf_model_rhs(0.01, y, f2, &md);
+            *slot = save; tf_model_data_init(&md, &m);
             for (int i = 0; i < 5; i++) {
                 double fd = (f1[i] - f2[i]) / (2 * h), an = fp[i * np + k];
                 double err = fabs(fd - an) / (fabs(fd) + fabs(an) + 1e-300);
@@ -462,7 +466,7 @@ static void test_lu_solves_systems_that_need_pivoting_in_later_columns(void)
     CHECK(worst < 1e-8, "LU solve error %g", worst);
 }
 
-typedef struct { int dim; double *F; const tf_model *m; } force_record;
+typedef struct { int dim; double *F; tf_model_data *m; } force_record;
 static void emit_force(long i, double t, const double *y, void *ctx)
 {
     force_record *r = (force_record *)ctx;
@@ -493,11 +497,12 @@ static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
      * (F -> w fc at rate C) and, when the motion reverses at the sawtooth's corner, sticks again
      * (F falls at k v' from where it was). Analytic solution, every method. */
     tf_model m;
+    tf_model_data md;
     single_gms_element(&m);
     m.T_const = NAN;
     /* up at 1e-4 m/s for 0.6 s, down for 0.4 s (sawtooth, amplitude 6e-5 m, 1 Hz, rise 0.6) */
     m.input = (tf_waveform){TF_WAVE_SAWTOOTH, 6e-5, 1.0, 0.6, 0.0, 1.0, 0, 0, 0, 0, 0};
-    tf_model_prepare(&m);
+    tf_model_data_init(&md, &m);
     double v = 1e-4, k = 1e5, fc = 2.0, t_star = fc / (k * v); /* 0.2 s */
     double t[6] = {0.0, 0.1, t_star, 0.4, 0.6, 0.7};
     double exact[6];
@@ -510,11 +515,11 @@ static void test_gms_element_breaks_loose_exactly_at_its_capacity(void)
     exact[5] = fc + k * vdown * 0.1; /* stuck again after the reversal */
     for (int method = 1; method <= 2; method++) {
         double y[1] = {0.0}, atol[1] = {1e-12}, F[6];
-        force_record r = {1, F, &m};
-        tf_ode ode = tf_model_ode(&m);
+        force_record r = {1, F, &md};
+        tf_ode ode = tf_model_ode(&md);
         tf_solver_options opt = {method, 1e-9, atol, 0, 0, 100000};
         tf_solver_stats st;
-        memset(m.gms.mode, 0, sizeof m.gms.mode);
+        memset(md.gms.mode, 0, sizeof md.gms.mode);
         int status = tf_solve(&ode, &opt, t, 6, y, emit_force, &r, &st, &E);
         double worst = 0.0;
         for (int i = 0; i < 6; i++) worst = fmax(worst, fabs(F[i] - exact[i]));
@@ -1059,8 +1064,45 @@ static void test_friction_parameter_partials_vs_finite_differences(void)
     }
 }
 
+/* The friction models' domain table (domains.h): every model has rows, every row names a parameter of the
+ * list, and the checks follow it: vd = 0 is "none" (sigma1 constant), a negative vd is refused, the other
+ * rules by the name of the first parameter refused. */
+static void test_friction_domain_table_drives_the_checks(void)
+{
+    int rows[TF_FRICTION_GMS + 1] = {0}, bad_rows = 0;
+#define ROW(model, param, rule, other, when)                                                              \
+    rows[TF_FRICTION_##model]++;                                                                            \
+    bad_rows += TF_P_##param < 0 || TF_P_##param >= TF_NPARAM || TF_DOMAIN_##rule >= TF_DOMAIN_NRULE ||     \
+                TF_P_##other >= TF_NPARAM || TF_DOMAIN_##when >= TF_DOMAIN_NWHEN;
+    TF_FRICTION_DOMAINS(ROW)
+#undef ROW
+    for (int k = 0; k <= TF_FRICTION_GMS; k++) CHECK(rows[k] >= 3, "domain table: model %d has %d rows", k, rows[k]);
+    CHECK(bad_rows == 0, "domain table: %d rows name no parameter, rule or condition", bad_rows);
+    static tf_rt_friction f;
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA0] = 1e5, p[TF_P_SIGMA1] = 316.2, p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5;
+    p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0, p[TF_P_ZBA] = 1e-6;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_OK, "vd = 0: none (sigma1 constant)");
+    p[TF_P_VD] = 1e-3;
+    CHECK(tf_rt_init(&f, TF_FRICTION_ELASTOPLASTIC, p, NULL, &E) == TF_OK, "vd > 0");
+    p[TF_P_VD] = -1e-3;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "vd"), "vd < 0 refused");
+    p[TF_P_VD] = INFINITY;
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "vd"), "vd = inf refused");
+    p[TF_P_VD] = 0.0, p[TF_P_ZBA] = 2e-5; /* at or above fc / sigma0 = 1e-5 */
+    CHECK(tf_rt_init(&f, TF_FRICTION_ELASTOPLASTIC, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "z_ba"), "z_ba");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_OK, "z_ba: the elasto-plastic model's only");
+    p[TF_P_FS] = 1.0, p[TF_P_VS] = -1.0;
+    CHECK(tf_rt_init(&f, TF_FRICTION_STRIBECK, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "v_smooth"),
+          "vs unchecked without a Stribeck effect; v_smooth always for a static map");
+    p[TF_P_FS] = 1.2;
+    CHECK(tf_rt_init(&f, TF_FRICTION_DAHL, p, NULL, &E) == TF_OK, "Dahl: no Stribeck curve");
+    CHECK(tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &E) == TF_ERR_BAD_ARGUMENT && !strcmp(E.what, "vs"), "vs where fs != fc");
+}
+
 int main(void)
 {
+    test_friction_domain_table_drives_the_checks();
     test_rt_init_and_setters_refuse_bad_arguments();
     test_rt_step_refuses_bad_samples_and_keeps_its_state();
     test_observer_pid_and_loop_refuse_bad_arguments();

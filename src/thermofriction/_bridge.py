@@ -57,6 +57,12 @@ COMPENSATION_CODES = dict(_GROUPS["compensation"])
 OUTPUTS = _ordered("output")
 OUTPUT_COLUMN = {name: i for i, name in enumerate(OUTPUTS)}
 LIMITS = dict(_GROUPS["limit"])
+#: The friction models' parameter domains, the C checks' own table (domains.h): model -> rows
+#: (parameter, rule, other parameter or None, where it applies), in the order the core checks them. Rules:
+#: "positive", "non-negative", "at-least" (other), "below-deflection" (below other / sigma0),
+#: "positive-or-absent" (None in a model, 0 in the core); where: "always", "stribeck" (fs != fc),
+#: "offset-form" (Model II's offset form).
+FRICTION_DOMAINS = dict(_core.FRICTION_DOMAINS)
 
 
 def n_outputs(model, friction_work: bool) -> int:

@@ -1,6 +1,8 @@
 /* Thin CPython binding of the C core: it unpacks a model description (a dict of numbers
  * and float64 arrays built by thermofriction.simulate) into a tf_model, and moves whole
- * arrays in and out. No numerics here. */
+ * arrays in and out (every argument through one set of buffer helpers, below). No numerics here:
+ * what computes is the core's (default tolerances, the sensitivities' initial state and target check,
+ * a waveform's corners). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
@@ -12,11 +14,16 @@
 
 static PyObject *SolverError;
 
-#define MAX_VIEWS 64
+/* ---- the buffers of one call, written once ----
+ * Every function's array arguments and scratch memory go into one arena, released together at the end
+ * of the call whatever happened: in_array (a float64 input), out_array (a float64 output of a known size),
+ * in_int32, scratch (memory the call owns). Each sets the Python exception and returns NULL on a refusal. */
+#define MAX_VIEWS 96
+#define MAX_OWNED 32
 typedef struct {
     Py_buffer views[MAX_VIEWS];
     int nviews;
-    double *owned[TF_NPARAM + 2];
+    void *owned[MAX_OWNED];
     int nowned;
 } arena;
 
@@ -27,21 +34,62 @@ static void arena_free(arena *a)
     a->nviews = a->nowned = 0;
 }
 
+/* A buffer of obj held until arena_free (flags: PyBUF_*); NULL with the exception set. */
+static Py_buffer *view(arena *a, PyObject *obj, int flags)
+{
+    if (a->nviews >= MAX_VIEWS) { PyErr_SetString(PyExc_ValueError, "too many arrays"); return NULL; }
+    Py_buffer *v = &a->views[a->nviews];
+    if (PyObject_GetBuffer(obj, v, flags) < 0) return NULL;
+    a->nviews++;
+    return v;
+}
+
+static int is_float64(const Py_buffer *v) { return v->itemsize == 8 && v->format && strcmp(v->format, "d") == 0; }
+
 /* A read-only contiguous float64 array; NULL (no error) for None. */
 static const double *get_array(arena *a, PyObject *obj, Py_ssize_t *len, const char *what)
 {
     *len = 0;
     if (obj == NULL || obj == Py_None) return NULL;
-    if (a->nviews >= MAX_VIEWS) { PyErr_SetString(PyExc_ValueError, "too many arrays"); return NULL; }
-    Py_buffer *v = &a->views[a->nviews];
-    if (PyObject_GetBuffer(obj, v, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) return NULL;
-    a->nviews++;
-    if (v->itemsize != 8 || v->format == NULL || strcmp(v->format, "d") != 0) {
+    Py_buffer *v = view(a, obj, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT);
+    if (!v) return NULL;
+    if (!is_float64(v)) {
         PyErr_Format(PyExc_TypeError, "%s must be a contiguous float64 array", what);
         return NULL;
     }
     *len = v->len / 8;
     return (const double *)v->buf;
+}
+
+/* A writable C-contiguous float64 array of exactly n values; else ValueError(what). */
+static double *out_array(arena *a, PyObject *obj, Py_ssize_t n, const char *what)
+{
+    Py_buffer *v = view(a, obj, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT);
+    if (!v) return NULL;
+    if (!is_float64(v) || v->len != 8 * n) { PyErr_SetString(PyExc_ValueError, what); return NULL; }
+    return (double *)v->buf;
+}
+
+/* A read-only contiguous int32 array of a multiple of `width` values (at least one row): its rows in *rows. */
+static const int *in_int32(arena *a, PyObject *obj, int width, Py_ssize_t *rows, const char *what)
+{
+    Py_buffer *v = view(a, obj, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT);
+    if (!v) return NULL;
+    if (v->itemsize != 4 || v->len % (4 * width) != 0 || v->len == 0) {
+        PyErr_SetString(PyExc_ValueError, what);
+        return NULL;
+    }
+    *rows = v->len / (4 * width);
+    return (const int *)v->buf;
+}
+
+/* Memory owned by the call (zeroed), freed by arena_free; NULL with MemoryError. */
+static void *scratch(arena *a, size_t bytes)
+{
+    void *p = a->nowned < MAX_OWNED ? PyMem_Calloc(1, bytes ? bytes : 1) : NULL;
+    if (!p) { PyErr_NoMemory(); return NULL; }
+    a->owned[a->nowned++] = p;
+    return p;
 }
 
 static int get_double(PyObject *dict, const char *key, double *out)
@@ -79,9 +127,8 @@ static int parse_law(arena *a, PyObject *obj, tf_law *law)
         return -1;
     }
     if (law->kind == TF_LAW_TABLE) {
-        double *d = PyMem_Malloc(sizeof(double) * ny);
-        if (!d) { PyErr_NoMemory(); return -1; }
-        a->owned[a->nowned++] = d;
+        double *d = scratch(a, sizeof(double) * ny);
+        if (!d) return -1;
         tf_pchip_slopes(law->n, law->x, law->y, d);
         law->d = d;
     }
@@ -265,7 +312,7 @@ static int check_model(const tf_model *m)
 }
 
 typedef struct {
-    const tf_model *model;
+    tf_model_data *data;
     double *out;
     int nch;
     long n_out; /* > 0: out is column-major (Fortran order), a column per output channel */
@@ -275,10 +322,10 @@ static void emit_outputs(long i, double t, const double *y, void *ctx)
 {
     emit_ctx *e = (emit_ctx *)ctx;
     if (!e->n_out) {
-        tf_model_outputs(e->model, t, y, e->out + (size_t)i * e->nch);
+        tf_model_outputs(e->data, t, y, e->out + (size_t)i * e->nch);
         return;
     }
-    tf_model_outputs_strided(e->model, t, y, e->out + i, e->n_out);
+    tf_model_outputs_strided(e->data, t, y, e->out + i, e->n_out);
 }
 
 /* simulate(spec, t_out, out, method, rtol, atol|None, h0, hmax, max_steps) -> stats dict */
@@ -294,8 +341,6 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
-    Py_buffer outv = {0};
-    int have_out = 0;
     if (parse_model(&a, spec, &m)) goto done;
     Py_ssize_t n_out, n_atol;
     const double *t_out = get_array(&a, t_obj, &n_out, "t_out");
@@ -304,11 +349,11 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     int n = tf_model_nstate(&m), nch = tf_model_noutput(&m);
     /* out: (n_out, nch), C order (a row per sample) or Fortran order (a contiguous column per channel,
      * which the package reads as views without copying) */
-    if (PyObject_GetBuffer(out_obj, &outv, PyBUF_STRIDES | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
-    have_out = 1;
-    int rows = PyBuffer_IsContiguous(&outv, 'C'), columns = !rows && PyBuffer_IsContiguous(&outv, 'F');
-    if (outv.itemsize != 8 || strcmp(outv.format, "d") != 0 || outv.ndim != 2 || outv.shape[0] != n_out ||
-        outv.shape[1] != nch || !(rows || columns)) {
+    Py_buffer *outv = view(&a, out_obj, PyBUF_STRIDES | PyBUF_WRITABLE | PyBUF_FORMAT);
+    if (!outv) goto done;
+    int rows = PyBuffer_IsContiguous(outv, 'C'), columns = !rows && PyBuffer_IsContiguous(outv, 'F');
+    if (!is_float64(outv) || outv->ndim != 2 || outv->shape[0] != n_out || outv->shape[1] != nch ||
+        !(rows || columns)) {
         PyErr_Format(PyExc_ValueError, "out must be a contiguous float64 array of shape (%zd, %d)", n_out, nch);
         goto done;
     }
@@ -318,20 +363,21 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
     if (atol_in) {
         if (n_atol != n) { PyErr_Format(PyExc_ValueError, "atol must have %d values", n); goto done; }
         memcpy(atol, atol_in, sizeof(double) * n);
-    } else { /* default: rtol times each state's characteristic magnitude */
-        tf_model_state_scale(&m, atol);
-        for (int i = 0; i < n; i++) atol[i] *= rtol;
+    } else {
+        tf_model_default_atol(&m, rtol, atol);
     }
     if (check_model(&m)) goto done;
     double y[TF_MAX_STATES];
     tf_model_initial_state(&m, y);
-    tf_ode ode = tf_model_ode(&m);
+    tf_model_data md; /* the run's mutable part: parameter cache, GMS modes */
+    tf_model_data_init(&md, &m);
+    tf_ode ode = tf_model_ode(&md);
     double rtol_w[TF_MAX_STATES];
     tf_model_rtol_weights(&m, rtol_w);
     tf_solver_options opt = {.method = method, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
                              .max_steps = max_steps, .rtol_weight = rtol_w};
     tf_solver_stats st;
-    emit_ctx ec = {&m, (double *)outv.buf, nch, columns ? (long)n_out : 0};
+    emit_ctx ec = {&md, (double *)outv->buf, nch, columns ? (long)n_out : 0};
     int raised;
     tf_error e;
     tf_status status = solve_released(&ode, &opt, t_out, n_out, y, emit_outputs, &ec, &st, &e, &raised);
@@ -344,13 +390,12 @@ static PyObject *py_simulate(PyObject *self, PyObject *args)
                            st.decompositions, "method", st.method_used, "switch_time", st.switch_time,
                            "events", st.events);
 done:
-    if (have_out) PyBuffer_Release(&outv);
     arena_free(&a);
     return result;
 }
 
 typedef struct {
-    const tf_model *model;
+    tf_model_data *data;
     double *out, *sens;
     int nch, n, np;
 } sens_emit_ctx;
@@ -358,7 +403,7 @@ typedef struct {
 static void emit_sensitivities(long i, double t, const double *Y, void *ctx)
 {
     sens_emit_ctx *e = (sens_emit_ctx *)ctx;
-    tf_model_outputs(e->model, t, Y, e->out + (size_t)i * e->nch);
+    tf_model_outputs(e->data, t, Y, e->out + (size_t)i * e->nch);
     memcpy(e->sens + (size_t)i * e->n * e->np, Y + e->n, sizeof(double) * e->n * e->np);
 }
 
@@ -375,65 +420,43 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
-    Py_buffer outv = {0}, sensv = {0}, tgv = {0};
-    int have_out = 0, have_sens = 0, have_tg = 0;
-    double *atol = NULL, *Y = NULL;
     if (parse_model(&a, spec, &m)) goto done;
     if (check_model(&m)) goto done; /* a fit must never integrate a model the simulator would refuse */
-    if (PyObject_GetBuffer(tg_obj, &tgv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) goto done;
-    have_tg = 1;
-    if (tgv.itemsize != 4 || tgv.len % 12 != 0 || tgv.len == 0) {
-        PyErr_SetString(PyExc_ValueError, "targets must be an int32 array of shape (np, 3)");
-        goto done;
-    }
-    int np = (int)(tgv.len / 12);
-    if (np > TF_MAX_TARGETS) { PyErr_Format(PyExc_ValueError, "at most %d targets", TF_MAX_TARGETS); goto done; }
+    Py_ssize_t np_rows;
+    const int *ti = in_int32(&a, tg_obj, 3, &np_rows, "targets must be an int32 array of shape (np, 3)");
+    if (!ti) goto done;
+    if (np_rows > TF_MAX_TARGETS) { PyErr_Format(PyExc_ValueError, "at most %d targets", TF_MAX_TARGETS); goto done; }
+    int np = (int)np_rows;
     tf_target targets[TF_MAX_TARGETS];
-    const int *ti = (const int *)tgv.buf;
-    for (int k = 0; k < np; k++) {
-        targets[k] = (tf_target){ti[3 * k], ti[3 * k + 1], ti[3 * k + 2]};
-        const tf_law *law = targets[k].kind == TF_TARGET_DF ? &m.dF
-                            : targets[k].kind == TF_TARGET_LAW && targets[k].param >= 0 && targets[k].param < TF_NPARAM
-                                ? &m.law[targets[k].param] : NULL;
-        int bad = targets[k].kind < 0 || targets[k].kind > TF_TARGET_PLANT || targets[k].param < 0 ||
-                  targets[k].param >= (targets[k].kind == TF_TARGET_HEAT    ? TF_HEAT_NPARAM
-                                       : targets[k].kind == TF_TARGET_PLANT ? TF_PLANT_NPARAM
-                                                                            : TF_NPARAM);
-        if (!bad && law && (targets[k].coef < 0 || targets[k].coef >= tf_law_ncoef(law))) bad = 1;
-        if (bad) { PyErr_Format(PyExc_ValueError, "target %d is not valid for this model", k); goto done; }
+    for (int k = 0; k < np; k++) targets[k] = (tf_target){ti[3 * k], ti[3 * k + 1], ti[3 * k + 2]};
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
+    tf_sensitivity_system sys = {&md, np, targets};
+    tf_error e;
+    if (tf_sensitivity_check(&sys, &e)) {
+        PyErr_Format(PyExc_ValueError, "target %ld is not valid for this model", e.index);
+        goto done;
     }
     Py_ssize_t n_out, n_atol;
     const double *t_out = get_array(&a, t_obj, &n_out, "t_out");
     if (PyErr_Occurred()) goto done;
     if (n_out < 1) { PyErr_SetString(PyExc_ValueError, "t_out is empty"); goto done; }
     int n = tf_model_nstate(&m), nch = tf_model_noutput(&m), N = n * (1 + np);
-    if (PyObject_GetBuffer(out_obj, &outv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
-    have_out = 1;
-    if (PyObject_GetBuffer(sens_obj, &sensv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
-    have_sens = 1;
-    if (outv.len != (Py_ssize_t)(8 * n_out * nch) || sensv.len != (Py_ssize_t)(8 * n_out * n * np)) {
-        PyErr_SetString(PyExc_ValueError, "out or sens has the wrong size");
-        goto done;
-    }
-    atol = PyMem_Malloc(sizeof(double) * N);
-    Y = PyMem_Calloc(N, sizeof(double));
-    if (!atol || !Y) { PyErr_NoMemory(); goto done; }
+    double *out = out_array(&a, out_obj, n_out * nch, "out or sens has the wrong size");
+    double *sens = out ? out_array(&a, sens_obj, n_out * n * np, "out or sens has the wrong size") : NULL;
+    double *atol = sens ? scratch(&a, sizeof(double) * N) : NULL, *Y = atol ? scratch(&a, sizeof(double) * N) : NULL;
+    if (!Y) goto done;
     const double *atol_in = get_array(&a, atol_obj, &n_atol, "atol");
     if (PyErr_Occurred()) goto done;
     if (!atol_in || n_atol != N) { PyErr_Format(PyExc_ValueError, "atol must have %d values", N); goto done; }
     memcpy(atol, atol_in, sizeof(double) * N);
-    tf_model_initial_state(&m, Y); /* and S(0) = 0: the initial state does not depend on theta, */
-    for (int k = 0; k < np; k++)   /* except on the initial temperature */
-        if (targets[k].kind == TF_TARGET_HEAT && targets[k].param == TF_HEAT_T_0 && m.heat.on)
-            Y[n + tf_model_temperature_index(&m) * np + k] = 1.0;
-    tf_sensitivity_system sys = {&m, np, targets};
+    tf_sensitivity_initial_state(&sys, Y);
     tf_ode ode = tf_sensitivity_ode(&sys);
     tf_solver_options opt = {.method = TF_METHOD_DOPRI5, .rtol = rtol, .atol = atol, .h0 = h0, .hmax = hmax,
                              .max_steps = max_steps};
     tf_solver_stats st;
-    sens_emit_ctx ec = {&m, (double *)outv.buf, (double *)sensv.buf, nch, n, np};
+    sens_emit_ctx ec = {&md, out, sens, nch, n, np};
     int raised;
-    tf_error e;
     tf_status status = solve_released(&ode, &opt, t_out, n_out, Y, emit_sensitivities, &ec, &st, &e, &raised);
     if (status != TF_OK) {
         if (!raised) raise_solver_error(&e, &st, Y, n);
@@ -441,11 +464,6 @@ static PyObject *py_simulate_sensitivities(PyObject *self, PyObject *args)
     }
     result = Py_BuildValue("{s:l,s:l,s:l}", "steps", st.steps, "rejected", st.rejected, "rhs_evals", st.rhs_evals);
 done:
-    PyMem_Free(atol);
-    PyMem_Free(Y);
-    if (have_out) PyBuffer_Release(&outv);
-    if (have_sens) PyBuffer_Release(&sensv);
-    if (have_tg) PyBuffer_Release(&tgv);
     arena_free(&a);
     return result;
 }
@@ -459,28 +477,21 @@ static PyObject *py_rhs_jac(PyObject *self, PyObject *args)
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
-    Py_buffer dyv = {0}, Jv = {0};
-    int have_dy = 0, have_J = 0;
     if (parse_model(&a, spec, &m)) goto done;
     int n = tf_model_nstate(&m);
     Py_ssize_t ny;
     const double *y = get_array(&a, y_obj, &ny, "y");
     if (PyErr_Occurred()) goto done;
     if (ny != n) { PyErr_Format(PyExc_ValueError, "y must have %d values", n); goto done; }
-    if (PyObject_GetBuffer(dy_obj, &dyv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-    have_dy = 1;
-    if (dyv.len != 8 * n) { PyErr_SetString(PyExc_ValueError, "dy has the wrong size"); goto done; }
-    tf_model_rhs(t, y, (double *)dyv.buf, &m);
-    if (J_obj != Py_None) {
-        if (PyObject_GetBuffer(J_obj, &Jv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-        have_J = 1;
-        if (Jv.len != 8 * n * n) { PyErr_SetString(PyExc_ValueError, "J has the wrong size"); goto done; }
-        tf_model_jac(t, y, (double *)Jv.buf, &m);
-    }
-    result = PyFloat_FromDouble(tf_model_friction(&m, t, y));
+    double *dy = out_array(&a, dy_obj, n, "dy has the wrong size");
+    double *J = J_obj == Py_None || !dy ? NULL : out_array(&a, J_obj, (Py_ssize_t)n * n, "J has the wrong size");
+    if (!dy || (J_obj != Py_None && !J)) goto done;
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
+    tf_model_rhs(t, y, dy, &md);
+    if (J) tf_model_jac(t, y, J, &md);
+    result = PyFloat_FromDouble(tf_model_friction(&md, t, y));
 done:
-    if (have_dy) PyBuffer_Release(&dyv);
-    if (have_J) PyBuffer_Release(&Jv);
     arena_free(&a);
     return result;
 }
@@ -502,11 +513,13 @@ static PyObject *py_time_rhs(PyObject *self, PyObject *args)
     if (PyErr_Occurred()) goto done;
     if (ny != n || n_evals < 1) { PyErr_Format(PyExc_ValueError, "y must have %d values, n_evals >= 1", n); goto done; }
     double dy[TF_MAX_STATES], sink = 0.0;
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
     struct timespec t0, t1;
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (long i = 0; i < n_evals; i++) {
-        tf_model_rhs(t + 1e-12 * (double)(i & 1023), y, dy, &m);
+        tf_model_rhs(t + 1e-12 * (double)(i & 1023), y, dy, &md);
         sink += dy[n - 1];
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);
@@ -526,22 +539,16 @@ static PyObject *py_law_eval(PyObject *self, PyObject *args)
     arena a = {0};
     tf_law law;
     PyObject *result = NULL;
-    Py_buffer vv = {0}, dv = {0};
-    int hv = 0, hd = 0;
     Py_ssize_t nT;
     if (parse_law(&a, law_obj, &law)) goto done;
     const double *T = get_array(&a, T_obj, &nT, "T");
     if (PyErr_Occurred()) goto done;
-    if (PyObject_GetBuffer(v_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-    hv = 1;
-    if (PyObject_GetBuffer(d_obj, &dv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-    hd = 1;
-    if (vv.len != 8 * nT || dv.len != 8 * nT) { PyErr_SetString(PyExc_ValueError, "output sizes differ from T"); goto done; }
-    for (Py_ssize_t i = 0; i < nT; i++) ((double *)vv.buf)[i] = tf_law_eval(&law, T[i], (double *)dv.buf + i);
+    double *value = out_array(&a, v_obj, nT, "output sizes differ from T");
+    double *slope = value ? out_array(&a, d_obj, nT, "output sizes differ from T") : NULL;
+    if (!slope) goto done;
+    for (Py_ssize_t i = 0; i < nT; i++) value[i] = tf_law_eval(&law, T[i], slope + i);
     result = Py_NewRef(Py_None);
 done:
-    if (hv) PyBuffer_Release(&vv);
-    if (hd) PyBuffer_Release(&dv);
     arena_free(&a);
     return result;
 }
@@ -554,33 +561,24 @@ static PyObject *py_waveform_eval(PyObject *self, PyObject *args)
     arena a = {0};
     tf_waveform w;
     PyObject *result = NULL;
-    Py_buffer vv = {0};
-    int hv = 0;
     Py_ssize_t nt;
     if (parse_waveform(&a, w_obj, &w)) goto done;
     const double *t = get_array(&a, t_obj, &nt, "t");
     if (PyErr_Occurred()) goto done;
-    if (PyObject_GetBuffer(v_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-    hv = 1;
-    if (vv.len != 8 * nt) { PyErr_SetString(PyExc_ValueError, "output size differs from t"); goto done; }
-    for (Py_ssize_t i = 0; i < nt; i++) ((double *)vv.buf)[i] = tf_waveform_value(&w, t[i]);
-    result = PyList_New(0);
-    if (nt > 0 && result) {
-        /* start a little before t[0]: next_corner skips corners within 1e-12 (relative) of its
-           argument, and a corner exactly at t[0] belongs in [t[0], t[-1]] */
-        double margin = 1e-12 * fmax(1.0, fabs(t[0]));
-        double c = t[0] - 3.0 * margin;
-        for (int guard = 0; guard < 1000000; guard++) {
-            c = tf_waveform_next_corner(&w, c);
-            if (!(c <= t[nt - 1])) break;
-            if (c < t[0] - margin) continue;
-            PyObject *f = PyFloat_FromDouble(c);
-            PyList_Append(result, f);
-            Py_DECREF(f);
-        }
+    double *value = out_array(&a, v_obj, nt, "output size differs from t");
+    if (!value) goto done;
+    for (Py_ssize_t i = 0; i < nt; i++) value[i] = tf_waveform_value(&w, t[i]);
+    long nc = nt > 0 ? tf_waveform_corners(&w, t[0], t[nt - 1], NULL, 0) : 0;
+    double *corners = scratch(&a, sizeof(double) * (size_t)nc);
+    if (!corners) goto done;
+    if (nc) tf_waveform_corners(&w, t[0], t[nt - 1], corners, nc);
+    result = PyList_New(nc);
+    for (long i = 0; i < nc && result; i++) {
+        PyObject *f = PyFloat_FromDouble(corners[i]);
+        if (!f) { Py_CLEAR(result); break; }
+        PyList_SET_ITEM(result, i, f);
     }
 done:
-    if (hv) PyBuffer_Release(&vv);
     arena_free(&a);
     return result;
 }
@@ -623,11 +621,9 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     int substeps = (int)(substeps_in < 0 ? 0 : substeps_in);
     arena a = {0}, b = {0};
     tf_model pm, cm;
-    tf_rt_friction *rt = PyMem_Malloc(2 * sizeof(tf_rt_friction)); /* ~3 kB each: not on the stack */
+    tf_rt_friction *rt = scratch(&a, 2 * sizeof(tf_rt_friction)); /* ~5 kB each: not on the stack */
     PyObject *result = NULL;
-    Py_buffer views[3];
-    int nviews = 0;
-    if (!rt) { PyErr_NoMemory(); goto done; }
+    if (!rt) goto done;
     if (parse_model(&a, plant_spec, &pm)) goto done;
     if (comp_spec != Py_None && parse_model(&b, comp_spec, &cm)) goto done;
     Py_ssize_t n, nv;
@@ -637,12 +633,8 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     if (PyErr_Occurred()) goto done;
     if (n < 1 || nv != n) { PyErr_SetString(PyExc_ValueError, "x_ref and v_ref: same length, >= 1"); goto done; }
     double *out[3];
-    for (int k = 0; k < 3; k++) {
-        if (PyObject_GetBuffer(outs[k], &views[k], PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-        nviews++;
-        if (views[k].len != 8 * n) { PyErr_SetString(PyExc_ValueError, "outputs: one float64 per period"); goto done; }
-        out[k] = (double *)views[k].buf;
-    }
+    for (int k = 0; k < 3; k++)
+        if (!(out[k] = out_array(&a, outs[k], n, "outputs: one float64 per period"))) goto done;
     tf_error e;
     int plant_bad = 0;
     if ((plant_bad = tf_rt_from_model(&rt[0], &pm, &e) != TF_OK) ||
@@ -665,8 +657,6 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     else
         result = PyLong_FromLong(status);
 done:
-    for (int k = 0; k < nviews; k++) PyBuffer_Release(&views[k]);
-    PyMem_Free(rt);
     arena_free(&a);
     arena_free(&b);
     return result;
@@ -682,17 +672,14 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
-    Py_buffer Fv;
-    int have_F = 0;
-    tf_rt_friction *f = PyMem_Malloc(sizeof *f);
-    if (!f) { PyErr_NoMemory(); goto done; }
+    tf_rt_friction *f = scratch(&a, sizeof *f);
+    if (!f) goto done;
     if (parse_model(&a, spec, &m)) goto done;
     Py_ssize_t n;
     const double *v = get_array(&a, v_obj, &n, "v");
     if (PyErr_Occurred()) goto done;
-    if (PyObject_GetBuffer(F_obj, &Fv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0) goto done;
-    have_F = 1;
-    if (Fv.len != 8 * n) { PyErr_SetString(PyExc_ValueError, "F_out: one float64 per velocity"); goto done; }
+    double *F = out_array(&a, F_obj, n, "F_out: one float64 per velocity");
+    if (!F) goto done;
     double T_const = NAN;
     const double *T = NULL;
     if (PyFloat_Check(T_obj)) {
@@ -705,7 +692,6 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     }
     tf_error e;
     if (tf_rt_from_model(f, &m, &e)) { PyErr_Format(PyExc_ValueError, "friction model: %s", e.what); goto done; }
-    double *F = (double *)Fv.buf;
     struct timespec t0, t1;
     Py_ssize_t i = 0;
     Py_BEGIN_ALLOW_THREADS
@@ -721,8 +707,6 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     else
         result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
 done:
-    if (have_F) PyBuffer_Release(&Fv);
-    PyMem_Free(f);
     arena_free(&a);
     return result;
 }
@@ -775,14 +759,72 @@ static const tf_constant constants[] = {
     C("heat_parameter", "C_th", TF_HEAT_C_TH), C("heat_parameter", "R_th", TF_HEAT_R_TH),
     C("heat_parameter", "eta", TF_HEAT_ETA), C("heat_parameter", "T_amb", TF_HEAT_T_AMB),
     C("heat_parameter", "T_0", TF_HEAT_T_0),
+    C("domain_rule", "positive", TF_DOMAIN_POSITIVE), C("domain_rule", "non-negative", TF_DOMAIN_NON_NEGATIVE),
+    C("domain_rule", "at-least", TF_DOMAIN_AT_LEAST), C("domain_rule", "below-deflection", TF_DOMAIN_BELOW_DEFLECTION),
+    C("domain_rule", "positive-or-absent", TF_DOMAIN_POSITIVE_OR_ABSENT),
+    C("domain_when", "always", TF_DOMAIN_ALWAYS), C("domain_when", "stribeck", TF_DOMAIN_STRIBECK),
+    C("domain_when", "offset-form", TF_DOMAIN_OFFSET_FORM),
     C("compensation", "none", TF_COMP_NONE), C("compensation", "feedforward", TF_COMP_FEEDFORWARD),
     C("compensation", "observer", TF_COMP_OBSERVER),
     /* counts and capacities */
     C("limit", "parameters", TF_NPARAM), C("limit", "fixed_outputs", TF_OUT_NFIXED),
     C("limit", "heat_parameters", TF_HEAT_NPARAM), C("limit", "plant_parameters", TF_PLANT_NPARAM), C("limit", "friction_states", TF_MAX_FRICTION_STATES),
     C("limit", "states", TF_MAX_STATES), C("limit", "targets", TF_MAX_TARGETS),
+    C("limit", "domain_rules", TF_DOMAIN_NRULE), C("limit", "domain_conditions", TF_DOMAIN_NWHEN),
 };
 #undef C
+
+/* The name of the constant of a group with a value (NULL if none). */
+static const char *constant_name(const char *group, long value)
+{
+    for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
+        if (constants[i].value == value && strcmp(constants[i].group, group) == 0) return constants[i].name;
+    return NULL;
+}
+
+/* FRICTION_DOMAINS: {model: ((parameter, rule, other or None, when), ...)}, domains.h's table in its order
+ * (the order the C checks follow), every code by its name in CONSTANTS. */
+typedef struct {
+    int model, param, rule, other, when;
+} domain_row;
+#define DOMAIN_ROW(model, param, rule, other, when) \
+    {TF_FRICTION_##model, TF_P_##param, TF_DOMAIN_##rule, TF_P_##other, TF_DOMAIN_##when},
+static const domain_row domain_rows[] = {TF_FRICTION_DOMAINS(DOMAIN_ROW)};
+#undef DOMAIN_ROW
+
+static PyObject *friction_domains(void)
+{
+    PyObject *lists = PyDict_New(), *result = NULL, *key, *list;
+    if (!lists) return NULL;
+    for (size_t i = 0; i < sizeof domain_rows / sizeof domain_rows[0]; i++) {
+        const domain_row *r = &domain_rows[i];
+        const char *model = constant_name("friction", r->model);
+        list = PyDict_GetItemString(lists, model); /* borrowed */
+        if (!list) {
+            list = PyList_New(0);
+            if (!list || PyDict_SetItemString(lists, model, list) < 0) { Py_XDECREF(list); goto done; }
+            Py_DECREF(list); /* the dict holds it */
+        }
+        PyObject *other = r->other < 0 ? Py_NewRef(Py_None) : PyUnicode_FromString(constant_name("parameter", r->other));
+        PyObject *row = other ? Py_BuildValue("(ssNs)", constant_name("parameter", r->param),
+                                              constant_name("domain_rule", r->rule), other,
+                                              constant_name("domain_when", r->when))
+                              : NULL;
+        int bad = !row || PyList_Append(list, row) < 0;
+        Py_XDECREF(row);
+        if (bad) goto done;
+    }
+    result = PyDict_New();
+    Py_ssize_t pos = 0;
+    while (result && PyDict_Next(lists, &pos, &key, &list)) {
+        PyObject *rows = PyList_AsTuple(list);
+        if (!rows || PyDict_SetItem(result, key, rows) < 0) Py_CLEAR(result);
+        Py_XDECREF(rows);
+    }
+done:
+    Py_DECREF(lists);
+    return result;
+}
 
 /* CONSTANTS: {group: {name: value}}; C_NAMES: {C symbol: value} (for the contract test). */
 static int add_constants(PyObject *mod)
@@ -814,6 +856,8 @@ static int add_constants(PyObject *mod)
 #undef UNIT_ARGS
     );
     if (!units || PyModule_AddObject(mod, "PARAMETER_UNITS", units) < 0) { Py_XDECREF(units); goto fail; }
+    PyObject *domains = friction_domains();
+    if (!domains || PyModule_AddObject(mod, "FRICTION_DOMAINS", domains) < 0) { Py_XDECREF(domains); goto fail; }
     if (PyModule_AddObject(mod, "CONSTANTS", groups) < 0) goto fail;
     groups = NULL;
     if (PyModule_AddObject(mod, "C_NAMES", c_names) < 0) goto fail;
@@ -835,8 +879,7 @@ static PyObject *py_prescribed_force(PyObject *self, PyObject *args)
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
-    Py_buffer Fv = {0}, dFv = {0};
-    int have_F = 0, have_dF = 0, params[TF_NPARAM];
+    int params[TF_NPARAM];
     if (parse_model(&a, spec, &m)) goto done;
     Py_ssize_t n_out;
     const double *t_out = get_array(&a, t_obj, &n_out, "t_out");
@@ -850,27 +893,15 @@ static PyObject *py_prescribed_force(PyObject *self, PyObject *args)
         params[j] = (int)PyLong_AsLong(PyTuple_GET_ITEM(p_obj, j));
         if (PyErr_Occurred()) goto done;
     }
-    if (PyObject_GetBuffer(F_obj, &Fv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
-    have_F = 1;
-    if (Fv.itemsize != 8 || strcmp(Fv.format, "d") != 0 || Fv.len != 8 * n_out) {
-        PyErr_SetString(PyExc_ValueError, "F_out: one float64 per output time");
+    double *F = out_array(&a, F_obj, n_out, "F_out: one float64 per output time"), *dF = NULL;
+    if (!F) goto done;
+    if (np > 0 && !(dF = out_array(&a, dF_obj, n_out * np, "dF_out: a C-ordered float64 array of shape (n_out, np)")))
         goto done;
-    }
-    double *dF = NULL;
-    if (np > 0) {
-        if (PyObject_GetBuffer(dF_obj, &dFv, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0) goto done;
-        have_dF = 1;
-        if (dFv.itemsize != 8 || strcmp(dFv.format, "d") != 0 || dFv.len != 8 * n_out * np) {
-            PyErr_SetString(PyExc_ValueError, "dF_out: a C-ordered float64 array of shape (n_out, np)");
-            goto done;
-        }
-        dF = (double *)dFv.buf;
-    }
     if (check_model(&m)) goto done;
     tf_error e;
     tf_status status;
     Py_BEGIN_ALLOW_THREADS
-    status = tf_prescribed_force(&m, (long)n_out, t_out, (double *)Fv.buf, np, params, dF, &e);
+    status = tf_prescribed_force(&m, (long)n_out, t_out, F, np, params, dF, &e);
     Py_END_ALLOW_THREADS
     if (status != TF_OK) {
         PyObject *exc_args = Py_BuildValue("(siddNi)", e.what, (int)e.code, e.t, 0.0, PyTuple_New(0), 0);
@@ -879,8 +910,6 @@ static PyObject *py_prescribed_force(PyObject *self, PyObject *args)
     }
     result = Py_BuildValue("i", tf_prescribed_applies(&m));
 done:
-    if (have_F) PyBuffer_Release(&Fv);
-    if (have_dF) PyBuffer_Release(&dFv);
     arena_free(&a);
     return result;
 }

@@ -4,6 +4,8 @@
 #ifndef THERMOFRICTION_FRICTION_H
 #define THERMOFRICTION_FRICTION_H
 
+#include "domains.h"
+
 #include <math.h>
 
 #ifdef __cplusplus
@@ -23,7 +25,7 @@ extern "C" {
     X(FS, "fs", "N", "static (stiction) level; fs = fc turns the Stribeck effect off")                  \
     X(VS, "vs", "m/s", "Stribeck velocity")                                                             \
     X(DELTA, "delta", "-", "Stribeck exponent")                                                         \
-    X(VD, "vd", "m/s", "sigma1 velocity scale; <= 0: sigma1 constant")                                  \
+    X(VD, "vd", "m/s", "sigma1 velocity scale; 0: none, sigma1 constant")                                  \
     X(VSMOOTH, "v_smooth", "m/s", "velocity band of smoothed signs")                                    \
     X(ZBA, "z_ba", "m", "elasto-plastic break-away deflection")                                         \
     X(C, "C", "N/s", "GMS: rate at which a slipping element's force approaches its capacity")             \

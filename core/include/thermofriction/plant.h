@@ -50,7 +50,7 @@ typedef struct {
 
     int friction;               /* tf_friction_kind */
     double p[TF_NPARAM];        /* parameters (temperature-independent values) */
-    tf_gms_elements gms;        /* GMS elements and their modes (changed by the integrator's events) */
+    tf_gms_elements gms;        /* GMS elements; their modes here are a run's first (tf_model_data holds the run's) */
     int fs_follows_fc;          /* fs = fc at every temperature: no Stribeck effect */
 
     int thermal;                /* tf_thermal_kind */
@@ -71,17 +71,32 @@ typedef struct {
        W = integral of |F' v_r| dt [J] (heat.on or work set): per-cycle dissipation to solver
        tolerance, for energy balances and the two-time-scale method. */
     int work;
-
-    /* Parameters at the last temperature seen, so a constant temperature costs no law
-     * evaluations per step. Zero-initialise the struct (or call tf_model_prepare). */
-    int cache_valid;
-    double cache_T, cache_p[TF_NPARAM], cache_lambda, cache_dF;
-    int cache_plain; /* cache_p symmetric and without a position ripple: the plant's plain evaluation */
-    unsigned long cache_laws; /* tf_thermal_law_mask of law, taken when the cache is filled after a prepare */
 } tf_model;
 
-/* Invalidate the cached parameters after changing a model's fields. */
-void tf_model_prepare(tf_model *model);
+/* The parameters at the last temperature a run evaluated them at, so that a constant temperature costs no
+ * law evaluations per step. */
+typedef struct {
+    int valid;                  /* 0: filled at the next use */
+    double T, p[TF_NPARAM], lambda, dF;
+    int plain;                  /* p symmetric and without a position ripple: the plant's plain evaluation */
+    unsigned long laws;         /* tf_thermal_law_mask of the model's laws, taken when the cache is filled */
+} tf_params_cache;
+
+/* What changes while a model runs (MuJoCo's mjData beside tf_model's mjModel): the model, which a run only
+ * reads, and its mutable part -- the parameter cache and the GMS elements' modes (the integrator's events
+ * switch them). Caller-owned (a plain struct, no allocation); one per run, or per thread: runs of one model
+ * on several threads each take their own. The evaluation functions below take it (the ODE's ctx is one). */
+typedef struct {
+    const tf_model *model;
+    tf_params_cache cache;
+    tf_gms_elements gms;        /* the model's GMS elements with the run's modes */
+} tf_model_data;
+
+/* A run's data for model: the cache empty, the GMS modes the model's (its gms.mode). */
+void tf_model_data_init(tf_model_data *data, const tf_model *model);
+/* After the model's fields changed between two uses of data (the real-time API's setters): the cache is
+ * refilled at its next use; the modes are kept. */
+void tf_model_data_changed(tf_model_data *data);
 
 /* Checks a model before it is simulated: every number the plant, friction model, thermal
  * extension, input and temperature use is finite and in its domain (docs/models.md#plants,
@@ -117,12 +132,14 @@ void tf_model_params_at(const tf_model *model, double T, double *p);
 /* The thermal factor lambda(T) of Model II's scale form (1 otherwise). */
 double tf_model_lambda(const tf_model *model, double T);
 /* Parameters at T (as tf_model_params_at), Model II's *lambda and offset force *dF_offset, cached
- * in the model for the last T: a constant temperature costs no law evaluation. The pointer is into
- * the model's cache, valid until the next call with another T. */
-const double *tf_model_params_cached(tf_model *model, double T, double *lambda, double *dF_offset);
+ * in the run's data for the last T: a constant temperature costs no law evaluation. The pointer is into
+ * the data's cache, valid until the next call with another T. */
+const double *tf_model_params_cached(tf_model_data *data, double T, double *lambda, double *dF_offset);
 /* Friction force F' at (t, state). */
-double tf_model_friction(const tf_model *model, double t, const double *y);
+double tf_model_friction(tf_model_data *data, double t, const double *y);
 void tf_model_initial_state(const tf_model *model, double *y);
+/* The default absolute tolerances: rtol times each state's characteristic magnitude (tf_model_state_scale). */
+void tf_model_default_atol(const tf_model *model, double rtol, double *atol);
 /* The weights of the relative tolerance per state for tf_solver_options.rtol_weight: 0 for positions. */
 void tf_model_rtol_weights(const tf_model *model, double *w);
 /* What a sensitivity is taken with respect to. */
@@ -157,32 +174,33 @@ typedef struct {
 
 /* Right-hand side, and, where the pointers are not NULL, its Jacobian (n x n, row-major) and
  * its derivatives with respect to the np targets (n x np, row-major). */
-tf_status tf_model_derivatives(tf_model *model, double t, const double *y, double *dy, double *J,
+tf_status tf_model_derivatives(tf_model_data *data, double t, const double *y, double *dy, double *J,
                                const tf_target *targets, int np, double *fp);
 
 /* Characteristic magnitude of each state, for default absolute tolerances. */
 void tf_model_state_scale(const tf_model *model, double *scale);
 
-tf_status tf_model_rhs(double t, const double *y, double *dy, void *model);
+/* The ODE's functions: data is a tf_model_data (tf_model_ode). */
+tf_status tf_model_rhs(double t, const double *y, double *dy, void *data);
 /* Jacobian d(rhs)/dy, row-major n x n. */
-tf_status tf_model_jac(double t, const double *y, double *J, void *model);
+tf_status tf_model_jac(double t, const double *y, double *J, void *data);
 /* Earliest time after t where the input or the temperature signal has a corner. */
-double tf_model_next_corner(double t, void *model);
-/* Discrete modes of the friction model (GMS): event functions and the update at restarts. */
+double tf_model_next_corner(double t, void *data);
+/* Discrete modes of the friction model (GMS): event functions and the update at restarts (the data's modes). */
 int tf_model_nevent(const tf_model *model);
-void tf_model_events(double t, const double *y, double *g, void *model);
-void tf_model_on_restart(double t, const double *y, void *model);
+void tf_model_events(double t, const double *y, double *g, void *data);
+void tf_model_on_restart(double t, const double *y, void *data);
 /* The same for a sensitivity run, Y = [y, S (n x np, row-major)]: sets the modes and, for each
  * GMS element whose mode changed at an event of the state, applies the sensitivities' jump
  * S+ = S- + (f- - f+) dtau/dtheta, dtau/dtheta = -(dg/dy S + dg/dtheta) / (dg/dt), g the
  * element's event function (docs/identification.md#friction-models). */
-void tf_model_sensitivity_restart(tf_model *model, double t, double *Y, const tf_target *targets, int np);
-/* The model as an ODE system for tf_solve (right-hand side, Jacobian, corners, events). */
-tf_ode tf_model_ode(tf_model *model);
+void tf_model_sensitivity_restart(tf_model_data *data, double t, double *Y, const tf_target *targets, int np);
+/* The model of data as an ODE system for tf_solve (right-hand side, Jacobian, corners, events), ctx the data. */
+tf_ode tf_model_ode(tf_model_data *data);
 /* Writes the output channels at (t, y). */
-void tf_model_outputs(const tf_model *model, double t, const double *y, double *out);
+void tf_model_outputs(tf_model_data *data, double t, const double *y, double *out);
 /* The same, channel j written to out[j * stride] (a column-major block with stride samples per column). */
-void tf_model_outputs_strided(const tf_model *model, double t, const double *y, double *out, long stride);
+void tf_model_outputs_strided(tf_model_data *data, double t, const double *y, double *out, long stride);
 
 #ifdef __cplusplus
 }

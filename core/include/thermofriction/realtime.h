@@ -24,8 +24,8 @@
  * The force is the model's at the new state and v. GMS elements switch stick/slip after each step
  * (tf_friction_update_modes).
  *
- * No allocation, no dependency beyond libm; a tf_rt_friction is a plain struct (about 3 kB with
- * its 64 GMS slots) that the caller owns. Laws point to caller-owned breakpoint arrays. */
+ * No allocation, no dependency beyond libm; a tf_rt_friction is a plain struct (about 5 kB with
+ * its 64 GMS slots, twice: the model's and the run's) that the caller owns. Laws point to caller-owned breakpoint arrays. */
 #ifndef THERMOFRICTION_REALTIME_H
 #define THERMOFRICTION_REALTIME_H
 
@@ -40,8 +40,10 @@ extern "C" {
 
 typedef struct {
     /* the friction model and its thermal extension, as the simulator holds them (plant.h; the
-       plant fields are unused), with its per-temperature parameter cache */
+       plant fields are unused), and its run's data: the per-temperature parameter cache and the
+       GMS elements' modes (data.model points to model: the functions below set it on every call) */
     tf_model model;
+    tf_model_data data;
     double z[TF_MAX_FRICTION_STATES]; /* internal states */
     double x; /* the sliding position (the ripple's argument): v dt summed per step, or set */
 } tf_rt_friction;

@@ -15,12 +15,18 @@ extern "C" {
 #define TF_MAX_TARGETS 32
 
 typedef struct {
-    tf_model *model;
+    tf_model_data *data; /* the model's run (plant.h): tf_model_data_init before */
     int np;
     const tf_target *targets;
     int n; /* the model's states: set on the first evaluation (0 before) */
 } tf_sensitivity_system;
 
+/* Refuses (TF_ERR_BAD_ARGUMENT, err->index the target) a target that the model has not: a kind, parameter
+ * or coefficient out of range (where "sensitivity"). */
+tf_status tf_sensitivity_check(const tf_sensitivity_system *system, tf_error *err);
+/* The augmented initial state: the model's (tf_model_initial_state) and S(0) = 0, except the initial
+ * temperature's column (a heat model's T_0 target), which is 1 in the temperature's row. */
+void tf_sensitivity_initial_state(const tf_sensitivity_system *system, double *Y);
 /* Augmented right-hand side: Y = [y (n), S (n x np, row-major)]. */
 tf_status tf_sensitivity_rhs(double t, const double *Y, double *dY, void *system);
 double tf_sensitivity_next_corner(double t, void *system);

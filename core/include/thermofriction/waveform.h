@@ -35,6 +35,9 @@ double tf_waveform_value(const tf_waveform *w, double t);
 double tf_waveform_slope(const tf_waveform *w, double t);
 /* Smallest corner strictly later than t (by more than a rounding margin); INFINITY if none. */
 double tf_waveform_next_corner(const tf_waveform *w, double t);
+/* The corners in [a, b] (a corner within 1e-12, relative, before a counts as at a), in order: the first
+ * min(count, cap) into out (may be NULL with cap 0); returns their count (at most 1e6). */
+long tf_waveform_corners(const tf_waveform *w, double a, double b, double *out, long cap);
 /* First time > t (by more than the corner margin) at which a smooth waveform's slope changes
  * sign (the sine's extrema); INFINITY for the piecewise-linear ones, whose slope changes sign
  * only at corners. A prescribed motion restarts the integration there: v(t) is then no state

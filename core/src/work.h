@@ -1,12 +1,13 @@
-/* Private to the integrators (dopri5.c, rodas4.c, lu.c, events.c, solve.c, auto.c): the work space
- * of one integration and the small helpers every method's stages use, inlined where they are called.
+/* Private to the integrators (work.c, dopri5.c, rodas4.c, lu.c, events.c, auto.c, solve.c): the work space
+ * of one integration (set up by work.c) and the small helpers every method's stages use, inlined where they
+ * are called.
  *
  * The step functions take the system size (and Rodas4 its reduced sizes) as an argument and are
  * inlined into dispatchers that pass constants for the common models (5 states: the stick-slip
  * actuator with LuGre; 3: the mass with LuGre), so that their loops over five numbers compile to
  * straight-line code; any other size runs the same code with the runtime value. */
-#ifndef THERMOFRICTION_SOLVER_H
-#define THERMOFRICTION_SOLVER_H
+#ifndef THERMOFRICTION_WORK_H
+#define THERMOFRICTION_WORK_H
 
 #include "thermofriction/integrator.h"
 #include "inline.h" /* TF_SIZED */
@@ -31,6 +32,10 @@ typedef struct {
     double *block; /* one allocation for all of the above */
 } work;
 
+/* The work space of an integration of ode with the options opt: one allocation for all of the methods'
+ * vectors (TF_ERR_NO_MEMORY if it fails), released by tf_work_free. */
+tf_status tf_work_setup(work *w, const tf_ode *ode, const tf_solver_options *opt, tf_solver_stats *st);
+void tf_work_free(work *w);
 
 TF_SIZED int rhs_n(work *w, double t, const double *y, double *dy, const int n)
 {
@@ -67,7 +72,7 @@ static inline double wnorm(const work *w, const double *e, const double *ya, con
 
 /* A step's error inside it: its dense output yd at mid-step against the cubic Hermite interpolant of its ends
  * (y, w->y1) and their slopes (f0, f1), which an error estimated at the step's end misses where the step
- * crosses a fast transition or a kink (Rodas4's steps, rodas4.c; Dormand-Prince's across reversals, solve.c). */
+ * crosses a fast transition or a kink (Rodas4's steps, rodas4.c; Dormand-Prince's across reversals, auto.c). */
 static inline double mid_step_error(work *w, double h, const double *y, const double *f0, const double *f1,
                                     const double *yd)
 {
@@ -85,63 +90,5 @@ TF_SIZED int all_finite(const double *v, const int n)
     for (int i = 0; i < n; i++) sum += v[i];
     return isfinite(sum);
 }
-
-
-/* ---- dopri5.c: Dormand-Prince 5(4) ---- */
-
-/* One attempted step from (t, y) with f0 = f(t, y): w->y1, the dense coefficients and the stiffness
- * test's stages; returns the error norm, or a negative value when the step produced non-finite numbers. */
-double tf_dopri5_step(work *w, double t, double h, const double *y, const double *f0);
-/* The dense output at the fraction s of the last step. */
-void tf_dopri5_dense(const work *w, double s, double *y);
-/* Dormand-Prince's dense-output polynomial at the fraction s, from its five coefficients (one component's, or a
- * difference of components' taken coefficient by coefficient) */
-static inline double tf_dopri5_dense_poly(const double c[5], double s)
-{
-    double s1 = 1.0 - s;
-    return c[0] + s * (c[1] + s1 * (c[2] + s * (c[3] + s1 * c[4])));
-}
-/* ... and of its component i alone */
-static inline double tf_dopri5_dense_component(const work *w, int i, double s)
-{
-    const double c[5] = {w->cont[0][i], w->cont[1][i], w->cont[2][i], w->cont[3][i], w->cont[4][i]};
-    return tf_dopri5_dense_poly(c, s);
-}
-/* PI step-size control after an accepted step of error err; *facold is the controller's memory. */
-double tf_dopri5_next_h(double err, double h, double *facold);
-/* The step after a rejected one. */
-double tf_dopri5_rejected_h(double err, double h);
-/* Hairer's stiffness test after an accepted step: h |lambda| from the last two stages near the
- * stability boundary; returns 1 when it fired in 15 steps in a row (counters in *iasti, *nonsti). */
-int tf_dopri5_stiff(const work *w, const tf_solver_options *opt, double h, int *iasti, int *nonsti);
-
-/* ---- rodas4.c: Rodas4 ---- */
-
-typedef struct {
-    int first;            /* no step accepted yet since the last (re)start of the method */
-    double hold, errold;  /* the last accepted step and its error (predictive control) */
-} tf_rodas4_control;
-
-/* The state Jacobian and the time derivative at (t, y), once per accepted step; nonzero if not finite. */
-int tf_rodas4_jacobian(work *w, double t, double seg_end, const double *y, const double *f0);
-/* One attempted step, with the mid-step check of its dense output (yd: n doubles of scratch):
- * returns the error norm, -1 for non-finite numbers, -2 for a singular iteration matrix. On an
- * accepted step w->k[6] holds f(t + h, y1). */
-double tf_rodas4_step(work *w, double t, double h, const double *y, const double *f0, double *yd);
-void tf_rodas4_dense(const work *w, double s, double *y);
-/* Predictive (Gustafsson) step-size control after an accepted step. */
-double tf_rodas4_next_h(double err, double h, tf_rodas4_control *c);
-double tf_rodas4_rejected_h(double err, double h);
-
-/* The dense output of the method that made the last step. */
-static inline void dense(const work *w, int method, double s, double *y)
-{
-    if (method == TF_METHOD_RODAS4) tf_rodas4_dense(w, s, y);
-    else tf_dopri5_dense(w, s, y);
-}
-
-/* ---- events.c ---- */
-double tf_locate_event(work *w, int method, int ne, double t, double h, const double *g0, double t_new,
-                       const double *y1, double *g1, double *gm, double *ym);
 
 #endif

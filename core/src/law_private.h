@@ -1,0 +1,10 @@
+/* Private header of law.c: its check (tf_model_check, plant.h). */
+#ifndef THERMOFRICTION_LAW_PRIVATE_H
+#define THERMOFRICTION_LAW_PRIVATE_H
+
+#include "thermofriction/law.h"
+
+/* A law's kind and breakpoints: 1 if valid. */
+int tf_law_ok(const tf_law *L);
+
+#endif
