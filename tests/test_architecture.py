@@ -356,16 +356,20 @@ def _claims(doc: str):
                 if path is not None and PACKAGE in (path, *path.parents):
                     files.append(path)
                     base = path if path.is_dir() else path.parent
-        if not line.startswith("|") or not files:
-            continue
         _, python, _ = _named_in(" ".join(f"`{t}`" for t in tokens if not re.search(r"\.(c|h|py): ", t)))
         for n in sorted(python):
             head = n.split(".")[0]
-            if head in ("thermofriction", "tf") or NOT_CODE.match(n):
-                continue  # the package's own names (thermofriction.identify: a name it keeps, not a definition)
+            if head in ("thermofriction", "tf") or re.search(r"\.(xml|json|so|dll|toml|csv|html)$", n) or \
+                    NOT_CODE.match(n) and not re.fullmatch(r"[A-Z][A-Z_]+_[A-Z]+", n):
+                continue  # the package's own names (thermofriction.identify: a name it keeps), files, file keys
             module = _resolve(f"{head}.py") if "." in n and not head[:1].isupper() else None
-            claims.append((line.split("|")[1].strip(), [module] if module else files,
-                           n.split(".", 1)[1] if module else n))
+            where = line.split("|")[1].strip() if line.startswith("|") else n
+            if module is not None:  # control.friction_steps: in control.py
+                claims.append((where, [module], n.split(".", 1)[1]))
+            elif line.startswith("|") and files:  # a row of the package's files: in one of them
+                claims.append((where, files, n))
+            elif "." in n and head[:1].isupper():  # Model.parameters_at: in the class, wherever it is
+                claims.append((where, [PACKAGE], n))
     return claims
 
 
