@@ -1,6 +1,6 @@
-"""The architecture as docs/architecture.md states it, checked against the code: no import cycle (function-level
-imports included), modules and functions of a readable size, and every file, Python name and C symbol the
-document names exists."""
+"""The architecture as docs/architecture.md states it, checked against the code: no import cycle and no import of a
+higher layer (function-level imports included), modules and functions of a readable size, and every file, Python
+name and C symbol the document names exists, in the file it names."""
 
 from __future__ import annotations
 
