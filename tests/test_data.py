@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
-from thermofriction.data import Experiment, add_synth_command, read_experiment_csv
+from thermofriction.cli.synth import add_synth_command
+from thermofriction.data import Experiment, read_experiment_csv
 
 
 @pytest.fixture(scope="module")

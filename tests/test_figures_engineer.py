@@ -13,7 +13,7 @@ import pytest
 
 import thermofriction as tf
 from thermofriction.identification.laws import fit_law, segmented_fit
-from thermofriction.reporting import fit_plots, plots
+from thermofriction.figures import fit_plots, plots
 from thermofriction.reporting.page import Figures, page_html
 
 from lookalike import lookalike_dataset

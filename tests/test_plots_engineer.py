@@ -1,4 +1,4 @@
-"""Figures an engineer keeps (reporting/units.py, friction_plots.py, plots.py): units chosen from the data with the
+"""Figures an engineer keeps (figures/units.py, friction_plots.py, plots.py): units chosen from the data with the
 unit in the axis label and no offset text, titles on every figure and none overlapping another, the friction axis
 cut (and saying so) where a sawtooth's flyback spikes would set it, the hysteresis views (friction against
 displacement) drawing exactly the result's arrays, and the paper's 7-8 % band only where the errors are on its
@@ -13,9 +13,9 @@ import pytest
 import thermofriction as tf
 from thermofriction.errors import InputError
 from thermofriction.reporting import Entry, report
-from thermofriction.reporting import plots
-from thermofriction.reporting.fit_plots import fit_figure, model_ii_figure
-from thermofriction.reporting.units import unit_scale
+from thermofriction.figures import plots
+from thermofriction.figures.fit_plots import fit_figure, model_ii_figure
+from thermofriction.figures.units import unit_scale
 
 
 def _drawn(fig):

@@ -1,4 +1,4 @@
-"""The HTML report and the figures behind it (reporting/plots.py, shared with the results' .plot()):
+"""The HTML report and the figures behind it (figures/plots.py, shared with the results' .plot()):
 size, the error-against-temperature figure, fit and held-out temperatures told apart, AICc
 differences and weights, every metric defined, the laws at a reference temperature, and the page
 as Chromium renders it (legible legends, figures at the card's width)."""
@@ -18,8 +18,8 @@ import thermofriction as tf
 from thermofriction.demo import FIT_TEMPERATURES, HELD_OUT
 from thermofriction.models import Exp, ModelI
 from thermofriction.reporting import Entry, report
-from thermofriction.reporting import plots
-from thermofriction.reporting.figures import DEFINITIONS
+from thermofriction.figures import plots
+from thermofriction.reporting.captions import DEFINITIONS
 
 
 def _truth():

@@ -24,6 +24,7 @@ from . import _bridge
 from ._bridge import model_spec
 from . import _args
 from .errors import InputError, SolverError, shorten
+from .figures.study_plots import loop_figure
 from .models import MassPlant, Model
 from .results import Result
 
@@ -331,7 +332,6 @@ class LoopResult(Result):
 
     def plot(self):
         """A matplotlib figure: reference and position, and the tracking error, against time."""
-        from .reporting.study_plots import loop_figure
         return loop_figure(self)
 
 

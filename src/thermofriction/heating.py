@@ -28,6 +28,7 @@ import numpy as np
 
 from ._lazy import lazy
 from .errors import InputError, SolverError, TemperatureRangeWarning
+from .figures.study_plots import heating_figure
 from . import _args
 from .models import Model
 from .results import Result
@@ -191,7 +192,6 @@ class HeatingResult(Result):
 
     def plot(self):
         """A matplotlib figure: the interface temperature and the step per cycle against time."""
-        from .reporting.study_plots import heating_figure
         return heating_figure(self)
 
 

@@ -12,6 +12,8 @@ from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from . import _args
 from .data.experiments import Dataset, run_label
 from .data.motion import check_motion_option, driven_by
+from .figures.friction_plots import force_hysteresis_figure
+from .figures.plots import error_figure
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
@@ -201,13 +203,11 @@ class ValidationResult(Result):
         (force data): measured and predicted friction against the measured position per experiment."""
         label = label or self.model.name or "model"
         if what == "hysteresis":
-            from .reporting.friction_plots import force_hysteresis_figure
             if self.measurement.name != "force":
                 raise InputError(f"what='hysteresis' needs force (torque) data; these are {self.measurement.name} data")
             return force_hysteresis_figure(self, label=label)
         if what != "errors":
             raise InputError(f"what must be 'errors' or 'hysteresis', got {what!r}")
-        from .reporting.plots import error_figure
         if paper is None and self.measurement.name != "displacement":
             paper = False  # the paper's errors are of displacement
         return error_figure([(label, self)], metric, ax=ax, paper=paper)

@@ -20,7 +20,7 @@ from .parser import MAX_STARTS, build_parser
 
 def _run(args):
     """The command's function, looked up here when it is called (so that it can be replaced, e.g. in tests);
-    synth's lives with the datasets."""
+    the others' (synth, presets, ...) are the ``run`` their parsers set."""
     return globals().get(f"cmd_{args.command}", args.run)
 
 

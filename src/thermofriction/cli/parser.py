@@ -16,6 +16,7 @@ from .outputs import formats_text
 from .init import add_init_command
 from .presets import add_presets_command
 from .propagate import add_propagate_command
+from .synth import add_synth_command
 
 
 def _number(positive):
@@ -243,7 +244,6 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_fmu_command(sub)
 
-    from ..data import add_synth_command  # dataset tools (synth) live with the data module
     add_synth_command(sub)
     _add_sweep_command(sub)
     add_presets_command(sub)

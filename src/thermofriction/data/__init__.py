@@ -13,8 +13,8 @@ from .experiments import (MAX_ROWS, MAX_ROWS_ENV, MIN_SAMPLES, REQUIRED, ROLES, 
 from .files import load_dataset
 from .save import save_dataset
 from .matlab import read_experiment_mat
-from .synth import add_synth_command, cmd_synth, synthesize
+from .synth import synthesize
 
 __all__ = ["Experiment", "Dataset", "read_experiment_csv", "read_experiment_mat", "load_dataset", "save_dataset", "synthesize",
-           "add_synth_command", "cmd_synth", "max_rows", "MAX_ROWS", "MAX_ROWS_ENV", "MIN_SAMPLES", "REQUIRED", "ROLES",
+           "max_rows", "MAX_ROWS", "MAX_ROWS_ENV", "MIN_SAMPLES", "REQUIRED", "ROLES",
            "SAMPLING_TOLERANCE", "TEMPERATURE_RANGE", "TEMPERATURE_VARIES"]

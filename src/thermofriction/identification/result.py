@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from .._io import dump_json, jsonable
+from ..figures.fit_plots import fit_figure
 from ..measurements import amount
 from ..models import Model
 from ..results import Result
@@ -347,7 +348,6 @@ class FitResult(Result):
         this model on it) measured against predicted displacement and the residuals' RMS; for Model
         I and II the laws with the per-temperature estimates and their 95 % intervals (``paper``:
         the paper's Eqs. (9)-(11) and (13) beside them)."""
-        from ..reporting.fit_plots import fit_figure
         validation = data
         if data is not None and not hasattr(data, "predictions"):
             from ..validation import validate

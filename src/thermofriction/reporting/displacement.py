@@ -13,7 +13,7 @@ from ..models import ModelI, ModelII
 from ..plausible import SUSPICIOUS
 from ..validation import validate
 from .entries import COMPARISON_COLUMNS, EXPERIMENT_COLUMNS, akaike, comparison_rows, parameter_section
-from .figures import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
+from .captions import (definitions, fig_displacement, fig_errors, fig_model_i, fig_model_ii, fig_residuals,
                       fig_steps)
 from .page import Figures, fmt_number, html_table, page_html
 

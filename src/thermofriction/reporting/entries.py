@@ -13,7 +13,7 @@ from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
 from ..validation import ValidationResult
 from .page import fmt_number, html_table
 from ..identification.shown import cells
-from .fit_plots import as_float, law_outside_intervals, per_temperature_estimates
+from ..figures.fit_plots import as_float, law_outside_intervals, per_temperature_estimates
 
 @dataclasses.dataclass
 class Entry:

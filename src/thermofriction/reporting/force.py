@@ -19,9 +19,9 @@ from ..plausible import SUSPICIOUS
 from ..validation import validate
 from .entries import akaike_scaled
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
-from .plots import legend
-from .plots import thin as _thin
-from .units import scaled_axis
+from ..figures.plots import legend
+from ..figures.plots import thin as _thin
+from ..figures.units import scaled_axis
 
 
 def _colors(temps):

@@ -10,8 +10,8 @@ import numpy as np
 from .. import _args
 from .._lazy import lazy
 from .page import Figures, fmt_number, html_table, page_styled, subplots, write_page
-from .plots import legend
-from .units import scaled_axis
+from ..figures.plots import legend
+from ..figures.units import scaled_axis
 
 matplotlib = lazy("matplotlib")
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write
-from ..reporting.plots import legend
-from ..reporting.units import scaled_axis
+from ..figures.plots import legend
+from ..figures.units import scaled_axis
 
 
 def bands_figure(result):

@@ -8,6 +8,7 @@ import numpy as np
 
 from .._bridge import OUTPUTS
 from .._io import atomic_write
+from ..figures.friction_plots import simulation_figure
 from ..results import Result
 
 
@@ -135,7 +136,6 @@ class SimulationResult(Result):
         chosen from the data; a friction axis whose scale short flyback spikes would set is cut to
         its 1-99 % percentiles, as the panel says. The figure is not pyplot's: a notebook shows it
         once, ``fig.savefig(path)`` writes it."""
-        from ..reporting.friction_plots import simulation_figure
         return simulation_figure(self, what, title)
 
     def summary(self) -> list:

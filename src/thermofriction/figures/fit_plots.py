@@ -4,10 +4,13 @@
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
-from ..models import PARAMETER_UNITS, ModelII, load_model
+from ..models import PARAMETER_UNITS, Model, ModelII, load_model
+from ..models.laws import law_from_dict
+from ..models.model import model_from_dict
 from .friction_plots import force_overview
 from .units import scaled_axis, scaled_ticks
 from .plots import (HALF, MODEL_COLOURS, PAPER, WIDE, draw_displacement, draw_residuals, hide_unused, is_held_out,
@@ -23,7 +26,6 @@ def from_the_paper(model) -> bool:
     """Whether ``model`` is one of the paper's presets (li2009-*) or was identified starting from one (its
     provenance's ``initial_model``): the paper's laws then describe the same actuator. A user's own actuator,
     started from a model of its own or from the data, is not compared with them."""
-    import os
     names = [getattr(model, "name", None), ((getattr(model, "provenance", None) or {}).get("initial_model"))]
     return any(os.path.basename(str(n)).startswith(PAPER_PRESETS) for n in names if n)
 
@@ -88,7 +90,6 @@ def draw_law(ax, fit, model, name, held_out=(), paper=True):
     chosen = (((fit or {}).get("details") or {}).get("laws") or {}).get(name, {})
     first = (chosen.get("candidates") or {}).get(chosen.get("chosen"), {}).get("law")
     if first:
-        from ..models.laws import law_from_dict
         try:
             before = law_from_dict(first, name)
             ax.plot(grid, before(grid), ":", color=MODEL_COLOURS[0], lw=1.4, label="law through the estimates")
@@ -265,8 +266,6 @@ def fit_figure(fit, validation=None, paper=False):
     """An identification result (FitResult or its dict with ``model``): measured vs predicted and
     residual RMS (when ``validation`` of its model on the data is given), and its thermal law(s)
     with the per-temperature estimates and intervals."""
-    from ..models import Model
-    from ..models.model import model_from_dict
     d = fit.to_dict() if hasattr(fit, "to_dict") else fit
     model = fit.model if isinstance(getattr(fit, "model", None), Model) else model_from_dict(d["model"])
     laws = list(model.laws)

@@ -1,11 +1,13 @@
-"""The figures of the main report, as HTML: each figure of plots.py (the one implementation, shared
+"""The figures of the main report, as HTML: each figure of figures/ (the one implementation, shared
 with the results' ``.plot()``) rendered with a caption that says how to read it, and the
 definitions of the metrics the report shows."""
 
 from __future__ import annotations
 
+import html
+
 from ..models import ModelII
-from . import fit_plots, plots
+from ..figures import fit_plots, plots
 
 #: every metric the report shows, defined where it is shown (docs/formats.md#validation-metrics);
 #: e = x_sim − x_meas at each sample, x_meas zeroed so that the first 1 % of the run agrees on average
@@ -33,7 +35,6 @@ DEFINITIONS = {
 
 def definitions(*names) -> str:
     """The definitions of ``names`` as a definition list."""
-    import html
     return ('<dl class="defs">' + "".join(f"<dt>{html.escape(n)}</dt><dd>{html.escape(DEFINITIONS[n])}</dd>"
                                           for n in names) + "</dl>")
 
