@@ -122,8 +122,9 @@ class Model:
 
     def _number_values(self):
         v = self.friction.values()
-        if "fs" not in v and "fc" in v:
-            v["fs"] = v["fc"]
+        level, coulomb = STATIC_LEVELS[0]  # fs not given: fs = fc (no Stribeck effect)
+        if level not in v and coulomb in v:
+            v[level] = v[coulomb]
         return v
 
     # -- parameters at a temperature ------------------------------------------------------
@@ -136,8 +137,9 @@ class Model:
         v = self.friction.values()
         for pname, law in self.laws.items():
             v[pname] = law(float(T))
-        if "fs" not in v:
-            v["fs"] = v["fc"]
+        level, coulomb = STATIC_LEVELS[0]
+        if level not in v:
+            v[level] = v[coulomb]
         return v
 
     def reference_force(self) -> float:
