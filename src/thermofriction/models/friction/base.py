@@ -45,7 +45,7 @@ class Description:
     title : str
         The model's name in reports and figures (``"LuGre"``, ``"elasto-plastic"``).
     c_id : str
-        The name of its code in the binding's constants (``_core.CONSTANTS["friction"]``; friction.h,
+        The name of its code in the binding's constants (the friction group, ``_bridge.FRICTION_CODES``; friction.h,
         ``tf_friction_kind``).
     states : tuple of (str, str), default ()
         Its states' names and units, in the core's order (a model with a state per element, GMS, says so itself).
