@@ -660,3 +660,23 @@ def test_the_checks_from_the_rules_say_what_they_said(values, message):
     with pytest.raises(tf.InputError) as e:
         tf.models.check_friction_values(values, "[friction]")
     assert str(e.value) == message
+
+
+def test_the_descriptions_say_what_the_lists_elsewhere_say():
+    """Until each is derived from the descriptions, the lists of friction models written elsewhere agree with them:
+    the observer's models (bristle), the static maps through a smoothed sign, the passivity test's, the models with
+    a Stribeck curve (fs among their parameters), the command line's choices."""
+    from thermofriction import control
+    from thermofriction.cli import build_parser
+    models = tf.models.FRICTION_MODELS
+
+    def having(flag):
+        return tuple(n for n, c in models.items() if getattr(c.description, flag))
+    assert control.OBSERVED_MODELS == having("bristle") == ("lugre", "dahl", "elastoplastic")
+    assert having("smoothed_sign") == ("coulomb", "stribeck") and having("dissipativity") == ("lugre", "elastoplastic")
+    assert {n for n, c in models.items() if "fs" in c.law_targets} == {"stribeck", "gms", "lugre", "elastoplastic"}
+    identify = next(a for a in build_parser()._subparsers._group_actions[0].choices["identify"]._actions
+                    if "--friction" in a.option_strings)
+    assert set(identify.choices) == set(models)
+    assert [c.description.title for c in models.values()] == ["LuGre", "Coulomb", "Stribeck", "Dahl",
+                                                              "elasto-plastic", "GMS"]
