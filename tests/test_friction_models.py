@@ -533,3 +533,150 @@ def test_cli_simulates_every_friction_model_on_every_plant(tmp_path):
     """Interface (docs/formats.md#model-files, docs/cli.md): the full matrix, 6 friction models x
     3 plants (18 interpreters)."""
     run_matrix([(m, p) for m in MODELS for p in PLANTS], tmp_path)
+
+
+# ---------------------------------------------------------------------------------------------
+# One description per friction model (issue 39): what the model file, the checks, the FMU and the
+# reports derive from; the domain rules, one per parameter
+# ---------------------------------------------------------------------------------------------
+
+_RIPPLE = dict(ripple_period=2e-3, ripple_cos1=0.01, ripple_sin2=-0.02)
+#: one friction model of each kind with every kind of parameter it takes (sides, ripple, arrays)
+EXAMPLES = {
+    "lugre": tf.LuGre(sigma0=1e5, sigma1=300.0, fc=0.5, fs=0.7, vs=1e-3, sigma2=2.0, vd=1e-3, fc_neg=0.45,
+                      fs_neg=0.8, vs_neg=2e-3, sigma2_neg=1.0, **_RIPPLE),
+    "coulomb": tf.Coulomb(fc=0.5, sigma2=1.0, fc_neg=0.6, **_RIPPLE),
+    "stribeck": tf.Stribeck(fc=0.5, fs=0.8, vs=1e-3, delta=1.5, sigma2=1.0, sigma2_neg=0.0),
+    "dahl": tf.Dahl(sigma0=1e5, fc=0.5, fc_neg=0.4),
+    "elastoplastic": tf.ElastoPlastic(sigma0=1e5, sigma1=300.0, fc=0.5, z_ba=2e-6, fs=0.6, vs=1e-3),
+    "gms": tf.GMS(k=(1e5, 5e4, 2e4), w=(0.5, 0.3, 0.2), C=1e4, fc=0.5, fs=0.6, vs=1e-3, sigma2=0.5),
+}
+#: sha256 (first 16 hex digits) of each kind's model files, FMU resource files and modelDescription.xml (FMI 2
+#: and 3; date and version masked) over two plants and three thermal extensions, as written before the friction
+#: models were described once (commit 582d816): derived now, byte for byte the same
+WRITTEN_BEFORE = {"lugre": "cc4199da46602808", "coulomb": "e2a73172a23053c5", "stribeck": "9be385da8a6f97dd",
+                  "dahl": "15fa678faf505eba", "elastoplastic": "a01dd627627029ff", "gms": "59d7c11b73133054"}
+
+
+def _written(name):
+    import hashlib
+    import re
+    import tomllib
+    from thermofriction import _bridge
+    from thermofriction.fmu_description import description_xml2, description_xml3, resource_text, variables_of
+    out = {}
+    for plant in (tf.MassPlant(mass=1.0), tf.PrescribedMotion()):
+        for thermal in (None, "I", "II"):
+            friction, th = EXAMPLES[name], None
+            if thermal == "I":
+                th, friction = tf.ModelI({"fc": tf.Linear(a=0.5, b=-0.001, range=(20.0, 60.0))}), friction.with_values(fc=None)
+            elif thermal == "II":
+                th = tf.ModelII(tf.PWL(T=(20.0, 40.0, 60.0), values=(0.0, 0.01, 0.03)))
+            m = tf.Model(plant, friction, th, tf.Sine(amplitude=1.0, frequency=2.0), name=f"{name}-{plant.type}-{thermal}")
+            assert tf.models.model_from_dict(tomllib.loads(m.to_toml())) == m  # the file round trip
+            spec = _bridge.model_spec(m)
+            v = variables_of(m, spec, 30.0 if thermal else None)
+            key = f"{name}/{plant.type}/{thermal}"
+            out.update({f"{key}/toml": m.to_toml(), f"{key}/res": resource_text(m, spec, v),
+                        f"{key}/xml2": description_xml2(m, v, "id", "guid", "src", sources=("a.c",)),
+                        f"{key}/xml3": description_xml3(m, v, "id", "guid", "src")})
+    text = "\n".join(re.sub(r'generationDateAndTime="[^"]*"', "", out[k]).replace(tf.__version__, "VERSION")
+                     for k in sorted(out))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def test_every_friction_model_has_an_example_here():
+    assert set(EXAMPLES) == set(tf.models.FRICTION_MODELS) == set(WRITTEN_BEFORE)
+
+
+@pytest.mark.parametrize("name", list(WRITTEN_BEFORE))
+def test_model_files_and_fmu_descriptions_are_written_as_before(name):
+    """Byte for byte: the model file (TOML), the FMU's resource file and modelDescription.xml (FMI 2.0 and 3.0) of
+    each friction model, its sides, ripple and arrays included, on two plants, without a thermal extension, with a
+    Model I law and with Model II -- as the code wrote them before each friction model was described once."""
+    assert _written(name) == WRITTEN_BEFORE[name]
+
+
+@pytest.mark.parametrize("name", list(EXAMPLES))
+def test_a_friction_models_facts_come_from_its_description(name):
+    """The class's name, required parameters (the fields without a default), arrays, states, law targets, sides and
+    domains are its description's and the domain table's; its id is the core's."""
+    import dataclasses
+    from thermofriction import _bridge
+    from thermofriction.models.domains import NEGATIVE_SIDE, PARAMETER_DOMAIN
+    cls = tf.models.FRICTION_MODELS[name]
+    d = cls.description
+    assert cls.model == d.name == name and d.c_id in _bridge.FRICTION_CODES
+    fields = [f.name for f in dataclasses.fields(cls)]
+    assert cls.required == tuple(f.name for f in dataclasses.fields(cls) if f.default is dataclasses.MISSING)
+    assert cls.arrays == tuple(d.arrays) and set(cls.law_targets) == set(fields) - set(d.arrays)
+    assert set(cls.law_targets) <= set(_bridge.PARAMETERS)
+    assert cls.sides == tuple(n for n in cls.law_targets if n in NEGATIVE_SIDE)
+    assert cls.domains == {n: PARAMETER_DOMAIN[n] for n in cls.law_targets}
+    if d.states:
+        assert EXAMPLES[name].state_names == tuple(n for n, _ in d.states) == cls.state_names
+    assert EXAMPLES[name].nstate == len(EXAMPLES[name].state_names) == len(EXAMPLES[name].state_units)
+    for fitted in d.fitted.values():
+        assert set(fitted) <= set(cls.law_targets)
+
+
+def test_the_measurements_default_fits_are_the_descriptions():
+    """What each measurement fits by default per friction model (its FIT_PARAMETERS) is the description's."""
+    from thermofriction.measurements import displacement, force
+    for module, measurement in ((displacement, "displacement"), (force, "force")):
+        assert module.FIT_PARAMETERS == {n: c.description.fitted[measurement]
+                                         for n, c in tf.models.FRICTION_MODELS.items()}
+
+
+def test_one_domain_rule_per_parameter_of_a_small_vocabulary():
+    """Every core parameter has one rule, of RULES (a table a test compares with the core's at merge); the sides
+    and static levels are the rules'."""
+    from thermofriction import _bridge
+    from thermofriction.models import domains
+    assert list(domains.PARAMETER_DOMAIN) == list(_bridge.PARAMETERS)
+    assert {r.partition(":")[0] for r in domains.PARAMETER_DOMAIN.values()} <= set(domains.RULES)
+    assert domains.STATIC_LEVELS == (("fs", "fc"), ("fs_neg", "fc_neg"))
+    assert domains.NEGATIVE_SIDE == {"fc_neg": "fc", "fs_neg": "fs", "vs_neg": "vs", "sigma2_neg": "sigma2"}
+    assert domains.in_domain("vd", [0.0, 1e-3]).tolist() == [False, True]  # Python refuses vd = 0 (C: sigma1 constant)
+    assert domains.in_domain("z_ba", [-1e-9, 0.0]).tolist() == [False, True]
+    assert domains.in_domain("fs", [-1.0, np.inf]).tolist() == [True, False]  # fs: relative to fc, checked with it
+
+
+@pytest.mark.parametrize("values, message", [
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, vd=0.0), "[friction]: 'vd' must be positive and finite, got 0.0"),
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, fs=1.5), "[friction]: 'vs' must be positive when fs != fc (the Stribeck "
+     "velocity), got None"),
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, fs=0.5), "[friction]: 'fs' (0.5) must be at least 'fc' (1.0)"),
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, z_ba=1e-4), "[friction]: 'z_ba' (0.0001 m) must be below the steady "
+     "deflection fc/sigma0 (1e-05 m): the elasto-plastic model breaks away before it"),
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, fs=2.0, vs=1.0, fc_neg=0.5, vs_neg=-1.0), "[friction]: 'vs_neg' must be "
+     "positive and finite, got -1.0"),
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, fs_neg=0.5), "[friction]: the negative side's static level fs_neg (0.5; fs "
+     "where not given) must be at least its Coulomb level fc_neg (1.0)"),
+    (dict(sigma0=1e5, sigma1=1.0, fc=1.0, fs=2.0, vs=1.0, fc_neg=1.5, fs_neg=1.5, vs_neg=1.0, sigma2_neg=1.0,
+          delta=-1.0), "[friction]: 'delta' must be positive and finite, got -1.0"),
+])
+def test_the_checks_from_the_rules_say_what_they_said(values, message):
+    with pytest.raises(tf.InputError) as e:
+        tf.models.check_friction_values(values, "[friction]")
+    assert str(e.value) == message
+
+
+def test_the_descriptions_say_what_the_lists_elsewhere_say():
+    """Until each is derived from the descriptions, the lists of friction models written elsewhere agree with them:
+    the observer's models (bristle), the static maps through a smoothed sign, the passivity test's, the models with
+    a Stribeck curve (fs among their parameters), the command line's choices."""
+    from thermofriction import control
+    from thermofriction.cli import build_parser
+    models = tf.models.FRICTION_MODELS
+
+    def having(flag):
+        return tuple(n for n, c in models.items() if getattr(c.description, flag))
+    assert control.OBSERVED_MODELS == having("bristle") == ("lugre", "dahl", "elastoplastic")
+    assert having("smoothed_sign") == ("coulomb", "stribeck") and having("dissipativity") == ("lugre", "elastoplastic")
+    assert {n for n, c in models.items() if "fs" in c.law_targets} == {"stribeck", "gms", "lugre", "elastoplastic"}
+    identify = next(a for a in build_parser()._subparsers._group_actions[0].choices["identify"]._actions
+                    if "--friction" in a.option_strings)
+    assert set(identify.choices) == set(models)
+    assert [c.description.title for c in models.values()] == ["LuGre", "Coulomb", "Stribeck", "Dahl",
+                                                              "elasto-plastic", "GMS"]

@@ -115,11 +115,10 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
         if name in numbers:
             add(f"friction.{name}", _bridge.PARAMETER_UNITS[name], f"{friction.model} parameter {name}",
                 spec["params"][_bridge.PARAMETERS.index(name)], "p", _bridge.PARAMETERS.index(name))
-    if friction.model == "gms":
-        for e, (k, w) in enumerate(zip(friction.k, friction.w)):
-            add(f"friction.k[{e + 1}]", "N/m", f"stiffness of GMS element {e + 1}", k, "gms_k", e)
-            add(f"friction.w[{e + 1}]", "", f"capacity fraction of GMS element {e + 1} (the fractions sum to 1)", w,
-                "gms_w", e)
+    arrays = friction.description.arrays  # (GMS: each element's k and w, element by element)
+    for e, row in enumerate(zip(*(getattr(friction, name) for name in arrays))):
+        for (name, array), value in zip(arrays.items(), row):
+            add(f"friction.{name}[{e + 1}]", array.unit, array.element.format(e=e + 1), value, array.role, e)
 
     # the laws' coefficients (breakpoints fixed: settable before initialisation only)
     laws = [(name, _bridge.PARAMETERS.index(name), law, _bridge.PARAMETER_UNITS[name])
@@ -160,12 +159,17 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
     return variables
 
 
+def _elements(friction) -> int:
+    """How many elements a friction model with arrays has (GMS's), else 0."""
+    return len(getattr(friction, friction.arrays[0])) if friction.arrays else 0
+
+
 def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive") -> str:
     """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
              f"plant {spec['plant']} {int(isinstance(model.plant, StickSlipPlant) and model.plant.modal)}",
-             f"friction {spec['friction']} {0 if spec['gms_k'] is None else len(spec['gms_k'])}",
+             f"friction {spec['friction']} {_elements(model.friction)}",
              f"thermal {spec['thermal']} {spec['dF_form']} {spec['fs_follows_fc']}",
              f"heat {int(model.heat is not None)}",
              f"temperature_input {int(model.thermal is not None and model.heat is None)}",

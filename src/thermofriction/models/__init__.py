@@ -4,6 +4,9 @@ file (docs/models.md, docs/formats.md#model-files).
 A :class:`Model` is one actuator: a plant, a friction model, an optional thermal extension, an
 optional input waveform and an optional self-heating model. It loads from and saves to a model
 file (TOML); ``load_model`` also takes the name of a shipped preset (``li2009-model-i``, ...).
+
+Each friction model is described once (``models/friction/``, a module each, registered in ``FRICTION_MODELS``);
+each friction parameter's domain is one rule (``models/domains.py``).
 """
 
 from .friction import (FRICTION_MODELS, GMS, PARAMETER_UNITS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,

@@ -7,7 +7,7 @@ from __future__ import annotations
 import difflib
 import os
 import tomllib
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 
@@ -19,8 +19,9 @@ from .._reading import read_text
 from .. import _args
 from ..errors import InputError, shorten, unknown_keys
 from ..waveforms import Waveform, waveform_from_dict
-from .friction import (FRICTION_MODELS, GMS, PARAMETER_DOMAIN, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,
-                       Stribeck, check_friction_values, in_domain)
+from .domains import in_domain, own_domain
+from .friction import (FRICTION_MODELS, GMS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre, Stribeck,
+                       check_friction_values)
 from .fit_record import check_fit_record
 from .laws import PWL, Law, law_from_dict
 from .sides import STATIC_LEVELS
@@ -96,7 +97,7 @@ class Model:
         laws = self.thermal.laws if isinstance(self.thermal, ModelI) else {}
         given = self.friction.values()
         for pname, law in laws.items():
-            if pname not in PARAMETERS or pname not in [f.name for f in fields(self.friction)]:
+            if pname not in self.friction.law_targets:
                 raise InputError(f"[thermal]: '{pname}' is not a parameter of {self.friction.model}")
             if pname in given:
                 raise InputError(f"'{pname}' is given both as a number in [friction] and as a law in "
@@ -121,8 +122,9 @@ class Model:
 
     def _number_values(self):
         v = self.friction.values()
-        if "fs" not in v and "fc" in v:
-            v["fs"] = v["fc"]
+        level, coulomb = STATIC_LEVELS[0]  # fs not given: fs = fc (no Stribeck effect)
+        if level not in v and coulomb in v:
+            v[level] = v[coulomb]
         return v
 
     # -- parameters at a temperature ------------------------------------------------------
@@ -135,8 +137,9 @@ class Model:
         v = self.friction.values()
         for pname, law in self.laws.items():
             v[pname] = law(float(T))
-        if "fs" not in v:
-            v["fs"] = v["fc"]
+        level, coulomb = STATIC_LEVELS[0]
+        if level not in v:
+            v[level] = v[coulomb]
         return v
 
     def reference_force(self) -> float:
@@ -174,7 +177,7 @@ class Model:
             ok = in_domain(name, law(T))
             if not ok.all():
                 i = int(np.argmin(ok))
-                return f"'{name}' is {float(law(T[i])):.4g} at {T[i]:.4g} C ({PARAMETER_DOMAIN.get(name, 'finite')} required)"
+                return f"'{name}' is {float(law(T[i])):.4g} at {T[i]:.4g} C ({own_domain(name) or 'finite'} required)"
         if isinstance(self.thermal, ModelII) and self.thermal.form == "scale" and self.thermal.dF.range is not None:
             T = np.linspace(self.thermal.dF.range[0], self.thermal.dF.range[1], points)
             lam = np.atleast_1d(self.thermal_factor(T))
@@ -365,8 +368,7 @@ def model_from_dict(d: dict, source: str = "<model>", base_dir=None, friction_fr
             raise InputError(f"[thermal]: 'model' must be \"none\", \"I\" or \"II\", got {tkind!r}")
         friction = FRICTION_MODELS[fmodel].from_dict(d["friction"])
         if isinstance(thermal, ModelI):  # a law replaces the parameter's default (e.g. sigma2 = 0)
-            names = [f.name for f in fields(friction)]
-            friction = replace(friction, **{k: None for k in thermal.laws if k in names})
+            friction = replace(friction, **{k: None for k in thermal.laws if k in friction.law_targets})
         inp = waveform_from_dict(d["input"], "[input]", base_dir) if "input" in d else None
         heat = Heat.from_dict(d["heat"], "[heat]", base_dir) if "heat" in d else None
         for key in ("name", "description"):

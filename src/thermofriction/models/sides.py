@@ -1,6 +1,6 @@
 """Direction-dependent friction levels and the position ripple (docs/models.md#direction-and-position):
 the names, the model file's ripple table, the values that act in negative sliding, and their checks. Every
-friction model of models/friction.py takes them."""
+friction model of models/friction/ takes them; the sides and static levels are the domain rules' (models/domains.py)."""
 
 from __future__ import annotations
 
@@ -8,11 +8,8 @@ import math
 
 from ..errors import InputError, shorten
 from ._parse import num, num_array
+from .domains import NEGATIVE_SIDE, STATIC_LEVELS, own_domain
 
-#: The negative side's parameters (docs/models.md#direction-and-position), each with its positive one.
-NEGATIVE_SIDE = {"fc_neg": "fc", "fs_neg": "fs", "vs_neg": "vs", "sigma2_neg": "sigma2"}
-#: Each side's static level and the Coulomb level it must not fall below (fs >= fc, fs_neg >= fc_neg).
-STATIC_LEVELS = (("fs", "fc"), ("fs_neg", "fc_neg"))
 #: The ripple's harmonics (friction.h, TF_RIPPLE_ORDER) and its amplitudes' names, in N or N m.
 RIPPLE_ORDER = 3
 RIPPLE_AMPLITUDES = tuple(f"ripple_{f}{k}" for k in range(1, RIPPLE_ORDER + 1) for f in ("cos", "sin"))
@@ -72,13 +69,13 @@ def side_values(values: dict) -> dict:
     """The parameter values that act in negative sliding: each given ``*_neg`` in its positive
     slot (fs_neg absent: fs, or fc_neg where fs = fc)."""
     out = dict(values)
-    fc, fs = values.get("fc"), values.get("fs")
-    no_stribeck = fs is None or fs == fc
+    (level, coulomb), (level_neg, coulomb_neg) = STATIC_LEVELS
+    no_stribeck = values.get(level) is None or values.get(level) == values.get(coulomb)
     for neg, pos in NEGATIVE_SIDE.items():
         if values.get(neg) is not None:
             out[pos] = values[neg]
-    if values.get("fs_neg") is None and values.get("fc_neg") is not None and no_stribeck:
-        out["fs"] = out["fc"]
+    if values.get(level_neg) is None and values.get(coulomb_neg) is not None and no_stribeck:
+        out[level] = out[coulomb]
     return out
 
 
@@ -86,15 +83,16 @@ def check_sides(values: dict, where: str, check_side):
     """The negative side's values checked as the positive ones are (``check_side(values, where, note)``), fs_neg
     against fc_neg, and the ripple: finite amplitudes, none without a period."""
     if any(values.get(n) is not None for n in NEGATIVE_SIDE):
-        for name in ("fs_neg", *RIPPLE_AMPLITUDES):
+        for name in (*(n for n in NEGATIVE_SIDE if own_domain(n) is None), *RIPPLE_AMPLITUDES):
             v = values.get(name)
             if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
                 raise InputError(f"{where}: '{name}' must be a number and finite, got {shorten(v)}")
         neg = side_values(values)
-        if neg.get("fs") is not None and neg.get("fc") is not None and neg["fs"] < neg["fc"]:
-            raise InputError(f"{where}: the negative side's static level fs_neg ({neg['fs']!r}; fs where not given) "
-                             f"must be at least its Coulomb level fc_neg ({neg['fc']!r})")
-        check_side(neg, where, " (negative side: fc_neg, fs_neg, vs_neg, sigma2_neg)")
+        (level, coulomb), (level_neg, coulomb_neg) = STATIC_LEVELS
+        if neg.get(level) is not None and neg.get(coulomb) is not None and neg[level] < neg[coulomb]:
+            raise InputError(f"{where}: the negative side's static level {level_neg} ({neg[level]!r}; {level} where not "
+                             f"given) must be at least its Coulomb level {coulomb_neg} ({neg[coulomb]!r})")
+        check_side(neg, where, f" (negative side: {', '.join(NEGATIVE_SIDE)})")
     amps = [n for n in RIPPLE_AMPLITUDES if values.get(n) is not None]
     for name in amps:
         if not (isinstance(values[name], (int, float)) and math.isfinite(values[name])):

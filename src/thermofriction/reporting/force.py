@@ -31,15 +31,13 @@ def _colors(temps):
     cmap = matplotlib.colormaps["viridis"]
     return {T: cmap(0.05 + 0.8 * ((T - lo) / (hi - lo) if hi > lo else 0.5)) for T in temps}
 
-_NAMES = {"lugre": "LuGre", "stribeck": "Stribeck", "coulomb": "Coulomb", "dahl": "Dahl",
-          "elastoplastic": "elasto-plastic", "gms": "GMS"}
 #: At most this many experiments get their own panel of force over time, and this many reversals a loop.
 MAX_PANELS = 4
 MAX_LOOPS = 4
 
 
 def _label(model) -> str:
-    name = _NAMES.get(model.friction.model, model.friction.model)
+    name = model.friction.description.title
     if isinstance(model.thermal, ModelI):
         return f"{name}, Model I"
     if isinstance(model.thermal, ModelII):
