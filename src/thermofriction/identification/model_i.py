@@ -12,15 +12,16 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
+from ..models.transforms import base_model
 from .law_kinds import Refined, checked_kinds
 from .laws import at_shared, fit_law, laws_on_information
-from .optimiser import fit
-from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
-from .problem import make_traces
+from ..fitting.optimiser import fit
+from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
+from ..measurements import make_traces
 from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
                       profiled, settled_constants, widened)
-from .procedures import (along_temperatures, base_model, fit_friction, fit_result, held_at, levels_held_as_ratios,
-                         fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
+from .procedures import (along_temperatures, fit_friction, fit_result, held_at, levels_held_as_ratios, fitted_names,
+                         stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
