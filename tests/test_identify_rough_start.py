@@ -10,7 +10,7 @@ import numpy as np
 import thermofriction as tf
 from thermofriction import _bridge
 from thermofriction.identification import laws, optimiser, problem
-from thermofriction.identification.parameters import Parameters
+from thermofriction.fitting.parameters import Parameters
 from thermofriction.identification.procedures import fit_friction
 
 
