@@ -31,7 +31,7 @@ from ..drive import drive
 from ..errors import InputError, SolverError
 from ..data.experiments import run_label
 from ..data.force import ForceExperiment
-from ..models import Model, ModelI
+from ..models import Model, ModelI, PrescribedMotion
 from ..models.sides import RIPPLE_AMPLITUDES
 from . import ripple
 from ..simulation import StepSizeController, simulate
@@ -432,7 +432,8 @@ class ForcePrediction:
                 "fit_quality": self.fit_quality}
 
 
-def force_start(experiments, kind: str = "lugre", plant=None, screen: bool = True, progress=None) -> dict:
+def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None, screen: bool = True,
+                progress=None) -> dict:
     """A [friction] section of ``kind`` with starting values read off the data (measurements/force_start.py:
     read_start), screened.
 
