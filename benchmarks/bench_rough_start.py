@@ -161,7 +161,7 @@ def as_lugre(model):
 def exact_force_time(model, data, repeat=5):
     """The C core's exact stepping of every fit experiment (no sensitivities)."""
     from thermofriction.measurements import measurement_of
-    from thermofriction.identification.problem import make_traces
+    from thermofriction.measurements import make_traces
     traces = make_traces(list(data.fit), model, measurement_of(data))
     specs = [(_bridge.model_spec(model, float(tr.temperature), tr.waveform), tr.time) for tr in traces]
     def once():

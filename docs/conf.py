@@ -161,7 +161,7 @@ def _keep_as_written(app, what, name, obj, options, lines):
 _NUMPYDOC = re.compile(r"^\s*(Parameters|Returns|Attributes)\n\s*-{3,}\s*$", re.M)
 
 # --- Repository paths in the docstrings as links ---------------------------------------------------------
-# "docs/models.md#friction-models" links to that guide's page and heading, "identification/start.py" (a path
+# "docs/models.md#friction-models" links to that guide's page and heading, "identification/front.py" (a path
 # in src/thermofriction) to its source page (viewcode's, generated for every module so named). Paths in
 # ``literals`` and in literal blocks stay text.
 

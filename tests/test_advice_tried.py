@@ -14,7 +14,7 @@ import thermofriction as tf
 from lookalike import lookalike_experiments
 from stribeck_truths import reference_experiments
 from thermofriction.identification import held
-from thermofriction.identification.problem import make_traces
+from thermofriction.measurements import make_traces
 from thermofriction.measurements import measurement_of
 from thermofriction.data.motion import motion_waveform
 from thermofriction.measurements.force import SAMPLING_CHECK

@@ -216,10 +216,10 @@ def test_attribute_comments_are_not_read_as_type_and_text():
 
 def test_repository_paths_become_links_outside_literals():
     conf = _conf()
-    out = conf["_linked_paths"](["See docs/models.md#friction-models and identification/start.py; not ``docs/cli.md``",
+    out = conf["_linked_paths"](["See docs/models.md#friction-models and identification/front.py; not ``docs/cli.md``",
                                  "or docs/no-such-guide.md.", "Code::", "", "    x = |v|  # docs/models.md"],
                                 bars=True)
-    assert out[0] == ("See :tfpath:`docs/models.md#friction-models` and :tfpath:`identification/start.py`; "
+    assert out[0] == ("See :tfpath:`docs/models.md#friction-models` and :tfpath:`identification/front.py`; "
                       "not ``docs/cli.md``")
     assert out[1] == "or docs/no-such-guide.md."  # names no guide: left as text
     assert out[4] == "    x = |v|  # docs/models.md"  # a literal block: as written

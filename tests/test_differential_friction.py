@@ -580,7 +580,7 @@ def sensitivity_model(kind):
 
 def x_e_and_sensitivities(model, names, t, rtol=1e-10):
     """x_e(t) and dx_e/dtheta by the core's forward sensitivities (as identification/engine.py runs them)."""
-    from thermofriction.identification.parameters import target_of
+    from thermofriction.fitting.parameters import target_of
     spec = _bridge.model_spec(model, 30.0, model.input)
     theta = np.array([model.friction.values()[n] for n in names], float)
     targets = np.array([target_of(model, n) for n in names], dtype=np.int32).reshape(-1, 3)

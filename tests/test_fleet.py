@@ -126,7 +126,7 @@ def test_monte_carlo_spread_equals_the_delta_method(fit_two):
     (delta-method) one, sqrt(g' C g), g the prediction's gradient by central differences: an
     independent computation. Tolerance: the Monte Carlo error of a standard deviation from 300 draws
     (1/sqrt(2 x 300) = 4.1 %), times 3."""
-    from thermofriction.identification.parameters import with_values
+    from thermofriction.fitting.parameters import with_values
 
     T, draws = 38.0, 300
     tight = tf.StepSizeController(rtol=1e-10)  # the differences below must not see the integration error

@@ -181,7 +181,7 @@ def _python(*args, code=None):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
 
 
-@pytest.mark.parametrize("old, new, sub", [("identify", "identification", "problem"),
+@pytest.mark.parametrize("old, new, sub", [("identify", "identification", "procedures"),
                                            ("simulate", "simulation", "solvers"),
                                            ("report", "reporting", "entries")])
 def test_old_submodule_names_in_every_import_form(old, new, sub):
@@ -217,7 +217,7 @@ def test_import_of_an_old_name_as_says_it_is_the_function(old, new):
 
 
 @pytest.mark.parametrize("name", ["thermofriction.simulate", "thermofriction.identify", "thermofriction.validate",
-                                  "thermofriction.report", "thermofriction.identify.problem"])
+                                  "thermofriction.report", "thermofriction.identify.procedures"])
 def test_python_m_with_an_old_name_names_the_new_module_and_the_command(name):
     """`python -m thermofriction.simulate --help` was an AttributeError traceback (no get_code); the modules are
     no programs: one line naming the new module and the command line."""

@@ -13,8 +13,9 @@ import pytest
 import thermofriction as tf
 from stribeck_truths import reference_experiments, start_from, stribeck_truth
 from thermofriction.identification.held import _score
-from thermofriction.identification.parameters import get_value
-from thermofriction.identification.problem import Problem, make_traces
+from thermofriction.fitting.parameters import get_value
+from thermofriction.fitting.problem import Problem
+from thermofriction.measurements import make_traces
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -123,7 +124,7 @@ def test_the_consider_covariance_widens_by_the_held_directions_share__analytic()
     from types import SimpleNamespace
 
     from thermofriction.identification.held import PRIOR_FACTOR, _consider
-    from thermofriction.identification.parameters import Parameters
+    from thermofriction.fitting.parameters import Parameters
     from thermofriction.models import Linear
 
     params = Parameters()

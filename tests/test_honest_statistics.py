@@ -18,8 +18,8 @@ from lookalike import ar1  # noqa: E402
 import thermofriction as tf  # noqa: E402
 from thermofriction.data.experiments import Dataset  # noqa: E402
 from thermofriction.data.force import force_experiment  # noqa: E402
-from thermofriction.identification.uncertainty import integrated_autocorrelation  # noqa: E402
-from thermofriction.measurements.quality import fit_quality, noise_check, noise_level  # noqa: E402
+from thermofriction.fitting.uncertainty import integrated_autocorrelation  # noqa: E402
+from thermofriction.fitting.quality import fit_quality, noise_check, noise_level  # noqa: E402
 
 TRUE = dict(fc=0.4, fs=0.55, vs=0.1, sigma2=0.12)
 

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
-from thermofriction.identification.identifiability import dependencies
-from thermofriction.identification.shown import cells, shown
+from thermofriction.fitting.identifiability import dependencies
+from thermofriction.fitting.shown import cells, shown
 
 FC, SIGMA2, OFFSET, NOISE = 1.604, 0.3, 0.2, 0.01
 

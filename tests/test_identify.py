@@ -9,10 +9,11 @@ import pytest
 import thermofriction as tf
 from conftest import synthetic_experiments
 from thermofriction.identification import Parameters, fit_friction, identify
-from thermofriction.identification.optimiser import compressed as compress_residuals
-from thermofriction.identification.optimiser import (Transform, gauss_newton_length, linearized_step,
-                                                residual_scale)
-from thermofriction.identification.problem import Problem, make_traces
+from thermofriction.fitting.optimiser import compressed as compress_residuals
+from thermofriction.fitting.optimiser import (Transform, gauss_newton_length, linearized_step,
+                                              residual_scale)
+from thermofriction.fitting.problem import Problem
+from thermofriction.measurements import make_traces
 
 
 def base_at(T, model_i):
@@ -128,7 +129,7 @@ def test_model_ii_direct_and_paper_procedures__synthetic_truth(model_ii):
 def test_law_coefficient_jacobian_matches_finite_differences__independent_derivative(model_i):
     """Model I's law coefficients: their Jacobian columns (the sensitivities to the parameters at each
     run's temperature times the laws' derivatives) against central differences of whole simulations."""
-    from thermofriction.identification.parameters import get_value
+    from thermofriction.fitting.parameters import get_value
     exps = synthetic_experiments(model_i, [31.0, 40.0], duration=0.4, noise=20e-9)
     names = ["sigma0.a", "sigma0.b", "sigma1.a", "fc.b"]
     problem = Problem(model_i, names, make_traces(exps, model_i), rtol=1e-11, parallel=False)
@@ -148,7 +149,7 @@ def test_law_coefficient_jacobian_matches_finite_differences__independent_deriva
 def test_dF_value_jacobian_matches_finite_differences__independent_derivative(model_ii):
     """Model II's dF knot values: their columns (the sensitivity to dF at each run's temperature times
     the law's weights there) against central differences of whole simulations."""
-    from thermofriction.identification.parameters import get_value
+    from thermofriction.fitting.parameters import get_value
     exps = synthetic_experiments(model_ii, [32.0, 39.0], duration=0.4, noise=20e-9)
     names = [f"dF.{c}" for c in model_ii.thermal.dF.coefficient_names()] + ["fc"]
     problem = Problem(model_ii, names, make_traces(exps, model_ii), rtol=1e-11, parallel=False)

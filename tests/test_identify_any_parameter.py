@@ -11,8 +11,9 @@ import pytest
 import thermofriction as tf
 from stribeck_truths import FIT_T, friction_level_errors, reference_experiments, start_from, stribeck_truth
 from thermofriction.identification import model_i as model_i_module
-from thermofriction.identification.parameters import EXCESS, get_value, with_values
-from thermofriction.identification.problem import Problem, make_traces
+from thermofriction.fitting.parameters import EXCESS, get_value, with_values
+from thermofriction.fitting.problem import Problem
+from thermofriction.measurements import make_traces
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

@@ -9,8 +9,10 @@ import numpy as np
 
 import thermofriction as tf
 from thermofriction import _bridge
-from thermofriction.identification import laws, optimiser, problem
-from thermofriction.identification.parameters import Parameters
+from thermofriction.fitting import optimiser, problem
+from thermofriction.identification import laws
+from thermofriction.measurements import make_traces
+from thermofriction.fitting.parameters import Parameters
 from thermofriction.identification.procedures import fit_friction
 
 
@@ -23,7 +25,7 @@ def test_a_trial_run_gets_twenty_times_the_steps_of_its_first_run(monkeypatch, m
     MAX_STEPS, every later one STEP_FACTOR times the first's steps (at least STEP_FLOOR)."""
     base = tf.Model(model_i.plant, tf.LuGre(**{n: model_i.parameters_at(35.0)[n] for n in ("sigma0", "sigma1", "fc")}),
                     input=model_i.input)
-    traces = problem.make_traces(list(_data(base).fit), base)
+    traces = make_traces(list(_data(base).fit), base)
     seen = []
     real = _bridge.run_sensitivities
 

@@ -12,7 +12,7 @@ import pytest
 
 import thermofriction as tf
 from thermofriction.identification.laws import fit_law
-from thermofriction.measurements.quality import noise_level
+from thermofriction.fitting.quality import noise_level
 from thermofriction.models import ModelI, ModelII, PWL, Linear
 
 from conftest import run_cli
@@ -104,8 +104,9 @@ def test_model_ii_paper_procedure_says_when_its_assumptions_fail():
 def test_breakpoint_sensitivity_matches_finite_differences__independent_derivative(temperatures):
     """The breakpoint's Jacobian column (the chain rule on the knot values' exact sensitivities)
     against central differences of whole simulations, on either side of the break."""
-    from thermofriction.identification.problem import Problem, make_traces
-    from thermofriction.identification.parameters import get_value
+    from thermofriction.fitting.problem import Problem
+    from thermofriction.measurements import make_traces
+    from thermofriction.fitting.parameters import get_value
 
     from conftest import synthetic_experiments
     truth = model_ii_truth(break_T=36.0, mid=-0.2, top=-0.45)
@@ -328,8 +329,9 @@ def test_synth_noise_takes_units_and_refuses_metres_meant_as_nanometres(tmp_path
 def test_plant_sensitivities_match_finite_differences__independent_derivative(name):
     """The C core's exact sensitivities to the plant's parameters (modal form: changing m holds xi, wn
     and K) against central differences of whole simulations, through the identification's residuals."""
-    from thermofriction.identification.problem import Problem, make_traces
-    from thermofriction.identification.parameters import get_value
+    from thermofriction.fitting.problem import Problem
+    from thermofriction.measurements import make_traces
+    from thermofriction.fitting.parameters import get_value
 
     from conftest import synthetic_experiments
     truth = _base()

@@ -39,7 +39,7 @@ def test_whole_simulate_command_loads_no_heavy_module(tmp_path):
 
 def test_heavy_module_loads_when_first_used():
     """The lazy stand-in imports the real module at its first use, and answers as it does."""
-    code = ("import importlib, sys\nengine = importlib.import_module('thermofriction.identification.optimiser')\n"
+    code = ("import importlib, sys\nengine = importlib.import_module('thermofriction.fitting.optimiser')\n"
             "assert 'scipy.stats' not in sys.modules\n"
             "assert abs(engine.stats.norm.cdf(0.0) - 0.5) < 1e-15\n"
             "assert 'scipy.stats' in sys.modules")

@@ -32,7 +32,7 @@ def test_validation_result_by_its_module_path():
 def test_old_module_names_import_the_same_module_with_a_warning(old, new):
     """In a fresh interpreter (the first import is the one that warns): the old name gives the same module
     object, submodules included, and the package's function is not replaced by the module."""
-    sub = {"identify": "problem", "validate": None, "simulate": "solvers", "report": "entries"}[old]
+    sub = {"identify": "procedures", "validate": None, "simulate": "solvers", "report": "entries"}[old]
     lines = ["import warnings, importlib, types",
              "warnings.simplefilter('error', DeprecationWarning)",
              "import thermofriction as tf",

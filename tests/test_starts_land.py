@@ -15,9 +15,10 @@ import pytest
 import thermofriction as tf
 from thermofriction.data.motion import MotionWarning
 from thermofriction.errors import ComputationError
-from thermofriction.identification.parameters import EXCESS
-from thermofriction.identification.problem import Problem, make_traces
-from thermofriction.identification.start import force_start
+from thermofriction.fitting.parameters import EXCESS
+from thermofriction.fitting.problem import Problem
+from thermofriction.measurements import make_traces
+from thermofriction.measurements.force import force_start
 from thermofriction.measurements import Force
 
 import lookalike_laws as L
@@ -174,7 +175,8 @@ def test_the_screening_keeps_the_start_whose_short_fit_ends_lowest():
     reading, the screening keeps the one whose short fit ends lowest, whichever comes first: sigma2 within 5 % of the
     truth's (0.25 N m s/rad at 40 C) and vs within a factor 3 of its 0.1 rad/s (the wrong start's short fit reaches
     fc but ends with vs 57 rad/s and sigma2 0.215)."""
-    from thermofriction.identification.start import read_start, screened
+    from thermofriction.measurements.force import screened
+    from thermofriction.measurements.force_start import read_start
 
     exps = _joint(temperatures=(40.0, 40.0)).experiments
     good = read_start(exps)[0]

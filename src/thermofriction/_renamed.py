@@ -4,7 +4,7 @@
 the package exports, so the function shadowed its module (``thermofriction.validate.ValidationResult`` raised
 AttributeError). The modules are now ``identification``, ``validation``, ``simulation`` and ``reporting``;
 an import under an old name (``from thermofriction.identify import Parameter``, ``import
-thermofriction.identify.problem as p``) still works, warns, and returns the new module, while
+thermofriction.identify.procedures as p``) still works, warns, and returns the new module, while
 ``thermofriction.identify`` stays the function -- so ``import thermofriction.identify as m``, which binds that
 attribute, gives the function, and the warning says so. ``python -m`` with an old name names the new one (the
 modules are no programs)."""
@@ -58,7 +58,7 @@ class _OldNames(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         package, _, name = old.rpartition(".")
         function = sys.modules["thermofriction"].__dict__.get(package.rpartition(".")[2])
         if package.count(".") == 1 and callable(function) and not isinstance(function, types.ModuleType):
-            # ``import thermofriction.identify.problem as p`` takes p from attributes: thermofriction.identify
+            # ``import thermofriction.identify.procedures as p`` takes p from attributes: thermofriction.identify
             # (the function), then its ``problem``
             setattr(function, name, module)
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._reading import read_input_json
 from ..errors import InputError, shorten
-from ..identification.parameters import get_value
+from ..fitting.parameters import get_value
 from ..measurements import REGISTRY
 from ..models.model import model_from_dict
 
@@ -98,7 +98,7 @@ def _parameter(name, p, model, where):
 
 
 def _parameters(d, model, path):
-    from ..identification.parameters import Parameter, Parameters
+    from ..fitting.parameters import Parameter, Parameters
 
     params = Parameters()
     if not isinstance(d, dict) or not d:

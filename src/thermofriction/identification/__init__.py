@@ -3,27 +3,28 @@
     fit = tf.identify(data, method="model-i", init=model)
     fit.model, fit.report(), fit.to_json()
 
-Layers, each importing only those below it (docs/architecture.md#identification): ``parameters``; ``problem``
-(traces and residuals, formed by the data's measurement, thermofriction.measurements); ``optimiser``;
-``uncertainty``; the procedures (``procedures``, ``model_i``, ``model_ii``, ``start``, ``laws``, ``plant``,
-``setup``, ``compare``) and the front door ``front``.
+The procedures (``procedures``, ``model_i``, ``model_ii``, ``laws``, ``law_kinds``, ``held``, ``profile``,
+``plant``, ``compare``) and the front door ``front`` (docs/architecture.md#identification), over the fitting
+engine (thermofriction.fitting: parameters, problem, optimiser, uncertainty) and the measurements
+(thermofriction.measurements: what the residuals are, each one's initial model and completion of the result).
 """
 
 from __future__ import annotations
 
+from ..fitting.optimiser import fit
+from ..fitting.parameters import Parameter, Parameters
+from ..fitting.uncertainty import uncertainty
+from ..measurements import make_traces
+from ..measurements.force import force_start
+from ..models.transforms import base_model, with_friction_model
 from .compare import compare_friction_models
 from .front import MAX_STARTS, METHODS, identify
 from .laws import fit_law, segmented_fit
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
-from .optimiser import fit
-from .parameters import Parameter, Parameters
 from .plant import PlantFit, fit_plant, step_response
-from .problem import make_traces
-from .procedures import base_model, fit_friction, identify_heat
+from .procedures import fit_friction, identify_heat
 from .result import FitResult
-from .start import force_start, with_friction_model
-from .uncertainty import uncertainty
 
 __all__ = ["with_friction_model", "fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter",
            "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit", "identify_model_i", "identify_model_ii",

@@ -15,8 +15,8 @@ import numpy as np
 
 from ..errors import ThermofrictionError
 from ..models import ModelI
-from .optimiser import fit
-from .parameters import EXCESS, Parameters, fitted_positive, get_value, unit_of
+from ..fitting.optimiser import fit
+from ..fitting.parameters import EXCESS, Parameters, fitted_positive, get_value, unit_of
 
 #: the most evaluations a tried refit may take: it starts at the optimum and needs only to show the gain
 TRY_EVALUATIONS = 12

@@ -21,16 +21,16 @@ from .held import with_held_tests
 from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
-from .optimiser import one_blas_thread
+from ..fitting.optimiser import one_blas_thread
 from ..models import Model
 from ..models.sides import needs_period
 from ..simulation import StepSizeController
-from .parameters import PLANT_UNITS, Parameters, target_of
+from ..fitting.parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
-from .procedures import base_model, default_fit_parameters, fit_friction, identify_heat
+from ..models.transforms import base_model
+from .procedures import default_fit_parameters, fit_friction, identify_heat
 from .provenance import stamped
 from .result import FitResult
-from .setup import SETUP
 from ..validation import validate
 from ..unit_scale import model_unit_warnings
 
@@ -109,7 +109,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     After the fit, every value it held (masses, fs, vs, sigma2, a law held whole) is tested against the data
     (identification/held.py: ``fit_quality["held"]``); a contradicted one makes the fit not adequate. What was
     measured (displacement, force, a drive's command) is the dataset's measurement (thermofriction.measurements):
-    it forms the residuals and their offsets; the steps particular to it are in identification/setup.py.
+    it forms the residuals and their offsets, and owns the steps particular to it: the initial model
+    (``Measurement.initial_model``) and the result completed at the optimum (``Measurement.complete``).
 
     Parameters
     ----------
@@ -123,7 +124,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     init : Model or str or os.PathLike, optional
         The initial model (its plant, masses and input are kept): a model, a model file or a preset name.
         Default: the paper's preset for the method. A file with a ``[plant]`` and no ``[friction]`` section
-        starts LuGre from values taken from the data (identification/start.py).
+        starts LuGre from values taken from the data (measurements/displacement_start.py, force_start.py).
     friction : str, optional
         The friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb); default the
         initial model's. When it differs, the initial friction model is built from the initial model's values
@@ -214,10 +215,9 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         *most, last = measurement.methods
         raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
     experiments = list(getattr(data, "fit", data))
-    initial, finish = SETUP[measurement.name]
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
-    init = initial(init, method, data, experiments, friction=friction, free=free, procedure=procedure,
-                   **({"delay": measurement.delay} if measurement.name == "command" else {}))
+    init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
+                                     procedure=procedure)
     _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
@@ -235,7 +235,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         return res
     res = _fit(method, experiments, init, parameters, free, procedure, reference_temperature, laws, refine, progress,
                measurement, opts)
-    res = finish(res, experiments, init, measurement)
+    res = measurement.complete(res, experiments, init)
     res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
     held = list(getattr(data, "validate", None) or [])
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res

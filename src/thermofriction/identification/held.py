@@ -22,8 +22,9 @@ from .._lazy import lazy
 from ..models import ModelI
 from ..measurements import amount
 from .advice import TRY_AT_MOST, tried
-from .parameters import EXCESS, PLANT_UNITS, get_value
-from .problem import Problem, make_traces
+from ..fitting.parameters import EXCESS, PLANT_UNITS, get_value
+from ..fitting.problem import Problem
+from ..measurements import make_traces
 
 special = lazy("scipy.special")
 

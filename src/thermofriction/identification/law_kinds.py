@@ -16,9 +16,9 @@ import numpy as np
 from ..errors import ComputationError, InputError
 from ..models import ModelI
 from .laws import fit_law
-from .optimiser import fit
-from .problem import make_traces
-from .uncertainty import inflation_of, residual_variance
+from ..fitting.optimiser import fit
+from ..measurements import make_traces
+from ..fitting.uncertainty import inflation_of, residual_variance
 
 #: the laws' misfit above the per-temperature fits', in chi-square less the coefficients it has fewer, beyond which
 #: the other kinds are tried: this many standard deviations of that chi-square (sqrt(2 dof))

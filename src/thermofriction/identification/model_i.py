@@ -12,15 +12,16 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
+from ..models.transforms import base_model
 from .law_kinds import Refined, checked_kinds
 from .laws import at_shared, fit_law, laws_on_information
-from .optimiser import fit
-from .parameters import EXCESS, Parameters, get_value, unit_of, with_values
-from .problem import make_traces
+from ..fitting.optimiser import fit
+from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
+from ..measurements import make_traces
 from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
                       profiled, settled_constants, widened)
-from .procedures import (along_temperatures, base_model, fit_friction, fit_result, held_at, levels_held_as_ratios,
-                         fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
+from .procedures import (along_temperatures, fit_friction, fit_result, held_at, levels_held_as_ratios, fitted_names,
+                         stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 optimize = lazy("scipy.optimize")
@@ -314,6 +315,31 @@ def _above_fc(new_laws, per_T, Ts):
             f"ratio {ratio:.4g} instead, as the joint refinement's start")
 
 
+@dataclasses.dataclass
+class ModelIDetails:
+    """What Model I's pipeline records besides the fit, written as the result's ``details`` (:meth:`as_dict`, the
+    results JSON's keys in this order): the parameters held for lack of information, those fitted as one constant on
+    all experiments, the held ones whose profile reached its range's end, each temperature's fit, each law's choice;
+    where constants were settled by a profile (a joint refinement with a shape constant), their held ranges and the
+    profile's secants (``_secants``, internal to the held values' tests, which remove it)."""
+
+    held_for_lack_of_information: list
+    fitted_as_constant: list
+    per_temperature: list
+    held_where_reached: list = dataclasses.field(default_factory=list)
+    laws: dict = dataclasses.field(default_factory=dict)
+    held_ranges: dict | None = None
+    secants: dict | None = None
+
+    def as_dict(self) -> dict:
+        out = {"held_for_lack_of_information": self.held_for_lack_of_information,
+               "fitted_as_constant": self.fitted_as_constant, "held_where_reached": self.held_where_reached,
+               "per_temperature": self.per_temperature, "laws": self.laws}
+        if self.held_ranges is not None:
+            out.update(held_ranges=self.held_ranges, _secants=self.secants)
+        return out
+
+
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
                      parameters=None, **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
@@ -367,19 +393,17 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     held, warns, joint = per_temperature.held, per_temperature.warnings, per_temperature.joint
     if not refine:  # without a joint refinement nothing fits the constants: they stay held
         joint = []
-    details = {"held_for_lack_of_information": [n for n in held if n not in joint], "fitted_as_constant": joint,
-               "held_where_reached": [],
-               "per_temperature": [
+    details = ModelIDetails([n for n in held if n not in joint], joint, per_temperature=[
         {"temperature": T, "files": [x["file"] for x in r.experiments], "rmse_offset_removed": r.rmse,
-         "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T]}
+         "parameters": r.parameters.to_dict(), "warnings": r.warnings, "wall_time": r.wall_time} for T, r in per_T])
     # one plant for all temperatures: the median of the per-temperature estimates, each temperature's estimates
     # moved to it before the laws are drawn through them
     shared = {n: float(np.median([r.parameters[n].value for _, r in per_T])) for n in free}
     estimates = at_shared(per_T, free, shared) if free else per_T
-    new_laws, details["laws"] = _laws_through(estimates, names, held, init, laws)
+    new_laws, details.laws = _laws_through(estimates, names, held, init, laws)
     for n in joint:  # from the value the per-temperature fits were made at (profiled_constant's)
         new_laws[n] = Const(float(per_T[0][1].model.friction.values()[n]))
-        details["laws"][n] = {"chosen": "a constant fitted on all experiments together", "law": new_laws[n].to_dict()}
+        details.laws[n] = {"chosen": "a constant fitted on all experiments together", "law": new_laws[n].to_dict()}
     Ts = np.array([T for T, _ in per_T])
     warns += [w for w in [_above_fc(new_laws, estimates, Ts)] if w]
     kept = {**{n: law for n, law in init.laws.items() if n not in names},  # held with their laws
@@ -393,7 +417,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     if not refine:
         params = _law_parameters(new_laws, held, free, model)
         return unrefined_result("model-i", model, params, experiments, measurement, t0, [r for _, r in per_T],
-                                "per-temperature fits and laws (no joint refinement)", warns, details,
+                                "per-temperature fits and laws (no joint refinement)", warns, details.as_dict(),
                                 rtol=opts.get("rtol", 1e-8))
     if progress:
         progress("Model I: joint refinement of the law coefficients on all experiments")
@@ -406,7 +430,7 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
     outcome = fit(model, params, traces, near=True, **ropts)
     checkable = [] if joint else [n for n in names if n not in held and n not in (laws or {})]  # (law_kinds.py)
     checked = checked_kinds(Refined(model, params, outcome, traces), per_T, checkable, experiments, measurement,
-                            _parameters_of(held, free), ropts, details["laws"], warns)
+                            _parameters_of(held, free), ropts, details.laws, warns)
     model, params, outcome, traces = checked.model, checked.params, checked.outcome, checked.traces
     prof = Profiled(model, params, outcome, traces)
     if free:  # a plant parameter's step can be blocked where a law meets its domain's edge (profile.py)
@@ -416,13 +440,13 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         kept_open, undetermined, secants, ranges = settled_constants(
             prof, joint, per_temperature.region, lambda m, hold: _law_parameters(
                 dict(m.thermal.laws), held + hold, free, m), experiments, measurement, ropts)
-        details["held_for_lack_of_information"] += undetermined
-        details["held_where_reached"] = kept_open
-        details["held_ranges"] = {n: {**span, "free_in_profile": list(per_temperature.free_in_region)}
-                                  if span["from"] == "profile" else span for n, span in ranges.items()}
-        details["_secants"] = secants
-        details["fitted_as_constant"] = [n for n in joint if n not in undetermined]
-    res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details)
+        details.held_for_lack_of_information += undetermined
+        details.held_where_reached = kept_open
+        details.held_ranges = {n: {**span, "free_in_profile": list(per_temperature.free_in_region)}
+                               if span["from"] == "profile" else span for n, span in ranges.items()}
+        details.secants = secants
+        details.fitted_as_constant = [n for n in joint if n not in undetermined]
+    res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details.as_dict())
     widened(res, prof.widen)
     res.nfev += sum(r.nfev for _, r in per_T) + prof.nfev + per_temperature.nfev + checked.nfev
     res.njev += sum(r.njev for _, r in per_T) + prof.njev + checked.njev

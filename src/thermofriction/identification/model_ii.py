@@ -13,13 +13,15 @@ import numpy as np
 from ..drive import experiment_waveform
 from ..errors import ComputationError, InputError
 from ..models import PWL, Const, Model, ModelII
+from ..models.transforms import base_model
 from ..simulation import simulate
-from .optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
-from .problem import Problem, make_traces, pool
+from ..fitting.optimiser import AT_NOISE, COARSE_RTOL, COARSE_STEP, fit, residual_scale
+from ..fitting.problem import Problem, pool
+from ..measurements import make_traces
 from .laws import aicc, fit_range, segmented_fit
-from .parameters import Parameters
-from .procedures import (along_temperatures, base_model, default_fit_parameters, fit_friction, fit_result,
-                         fitted_names, friction_parameters, stribeck_start, temperature_groups, unrefined_result)
+from ..fitting.parameters import Parameters, friction_parameters
+from .procedures import (along_temperatures, default_fit_parameters, fit_friction, fit_result, fitted_names,
+                         stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
 

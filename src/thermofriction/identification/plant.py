@@ -28,7 +28,7 @@ import numpy as np
 
 from .._lazy import lazy
 from ..errors import InputError
-from .parameters import Parameters
+from ..fitting.parameters import Parameters
 from .plant_response import is_uniform, step_response, unit_gain_response
 
 optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")

@@ -15,15 +15,17 @@ import numpy as np
 from ..errors import ComputationError, InputError
 from ..models import Model, ModelI
 from ..models.sides import STATIC_LEVELS
+from ..models.transforms import base_model
 from ..measurements import REGISTRY, amount
 from ..measurements.displacement import FIT_PARAMETERS as FRICTION_FIT_PARAMETERS
-from ..measurements.quality import fit_quality, pooled
+from ..fitting.quality import fit_quality, pooled
 from .laws import SAME_TEMPERATURE
-from .optimiser import FitOutcome, fit
-from .parameters import EXCESS, Parameters, fitted_positive, get_value, unit_of, with_values
-from .problem import Problem, make_traces
+from ..fitting.optimiser import FitOutcome, fit
+from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
+from ..fitting.problem import Problem
+from ..measurements import make_traces
 from .result import FitResult
-from .uncertainty import uncertainty
+from ..fitting.uncertainty import uncertainty
 
 DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")  # LuGre's (the paper's)
 
@@ -132,21 +134,6 @@ def unrefined_result(method, model, params, experiments, measurement, t0, per_fi
         dict(details or {}, refined=False))
 
 
-def friction_parameters(model: Model, names, fixed=(), excess=False) -> Parameters:
-    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term, a law's
-    coefficient or a ripple amplitude. ``excess``: fs fitted as the excess fs - fc (EXCESS, in log space: fs >= fc
-    by construction) where the start has one (:func:`stribeck_start`)."""
-    params = Parameters()
-    for name in names:
-        if name == "fs" and excess and get_value(model, EXCESS) > 0:
-            name = EXCESS
-        v = get_value(model, name)
-        positive = fitted_positive(name)
-        params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
-                   unit=unit_of(model, name))
-    return params
-
-
 def fitted_names(init: Model, parameters) -> list:
     """The friction parameters Model I or II fits: ``parameters`` (names of the initial model's friction
     parameters, with a law or not), default :func:`default_fit_parameters`."""
@@ -198,36 +185,6 @@ def levels_held_as_ratios(init, names, new_laws, Ts) -> dict:
             for level, coulomb in STATIC_LEVELS
             if level not in names and level not in init.laws and coulomb in new_laws
             and start.get(level) is not None and start.get(coulomb)}
-
-
-def base_model(model: Model, temperature=None) -> Model:
-    """The model without its thermal extension: a Model I's laws evaluated at ``temperature``.
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-    temperature : float, optional
-        The temperature [C] Model I's laws are evaluated at; default the middle of their range (35 C without
-        one).
-
-    Returns
-    -------
-    Model
-
-    Raises
-    ------
-    InputError
-        A law whose value is outside the parameter's physical domain there.
-    """
-    if isinstance(model.thermal, ModelI):
-        if temperature is None:
-            lo_hi = model.temperature_range()
-            temperature = 0.5 * (lo_hi[0] + lo_hi[1]) if lo_hi else 35.0
-        p = model.parameters_at(temperature)
-        fr = dataclasses.replace(model.friction, **{k: p[k] for k in model.laws})
-        return dataclasses.replace(model, friction=fr, thermal=None)
-    return dataclasses.replace(model, thermal=None)
 
 
 def fit_friction(experiments, model: Model, parameters=None, *, method="base", measurement=None, **opts) -> FitResult:

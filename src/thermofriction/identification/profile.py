@@ -25,10 +25,10 @@ import numpy as np
 from ..errors import ComputationError, InputError
 from ..models import Model
 from .held import PRIOR_FACTOR
-from .optimiser import fit
-from .parameters import with_values
-from .problem import make_traces
-from .uncertainty import inflation_of, residual_variance, uncertainty
+from ..fitting.optimiser import fit
+from ..fitting.parameters import with_values
+from ..measurements import make_traces
+from ..fitting.uncertainty import inflation_of, residual_variance, uncertainty
 
 #: [standard errors] where each freed plant parameter is held
 PROFILE_STEP = 2.0

@@ -16,7 +16,7 @@ from ..data.experiments import run_label
 from ..data.files import dataset_sha256 as data_sha256
 from ..measurements import measurement_of
 from ..models import Model
-from .parameters import Parameters
+from ..fitting.parameters import Parameters
 from .record import fit_record
 from .result import FitResult
 

@@ -14,8 +14,8 @@ from ..figures.fit_plots import fit_figure
 from ..measurements import amount
 from ..models import Model
 from ..results import Result
-from .shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
-from .parameters import Parameters
+from ..fitting.shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
+from ..fitting.parameters import Parameters
 
 
 @dataclasses.dataclass
@@ -127,7 +127,7 @@ class FitResult(Result):
         coefficients). Returns (value, lower, upper) arrays."""
         from scipy import stats
 
-        from .parameters import with_values
+        from ..fitting.parameters import with_values
         T = np.atleast_1d(np.asarray(temperatures, float))
         law_of = (lambda m: m.thermal.dF) if name == "dF" else (lambda m: m.laws[name])
         value = np.asarray(law_of(self.model)(T), float)

@@ -10,6 +10,7 @@ implements :class:`Measurement` and an entry in :data:`REGISTRY`.
 from __future__ import annotations
 
 from ..errors import InputError, shorten
+from ..models import Model
 from .base import OFFSETS, Measurement, MetricWarning, Trace, amount, center  # (MetricWarning: validate's)
 from .displacement import Displacement, Prediction, step_sizes  # (Prediction, step_sizes: validate's)
 from .force import Force, ForcePrediction, steady_state_curve
@@ -90,6 +91,32 @@ def _measurement_of(data, offset) -> Measurement:
     if offset not in OFFSETS:
         raise InputError(f"offset must be one of {', '.join(OFFSETS)}, got {shorten(offset)}")
     return cls(offset)
+
+
+def make_traces(experiments, model: Model, measurement=None):
+    """One trace per experiment, made by their measurement (default: the experiments' own, with its default
+    offset policy).
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The experiments.
+    model : Model
+        The model the traces are driven as (its input and temperature handling).
+    measurement : Measurement, optional
+        How the residuals are formed; default the experiments' own, with its default offset policy.
+
+    Returns
+    -------
+    list of Trace
+
+    Raises
+    ------
+    InputError
+        An experiment the measurement cannot drive the model with.
+    """
+    measurement = measurement or measurement_of(experiments)
+    return [measurement.make_trace(exp, model) for exp in experiments]
 
 
 __all__ = ["Measurement", "Trace", "OFFSETS", "Displacement", "Force", "Command", "ForcePrediction", "REGISTRY",

@@ -8,76 +8,11 @@ when validating. ``identify``, ``validate`` and ``report`` ask the dataset's mea
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
 
-from ..waveforms import Sampled, Waveform
-
-
-@dataclasses.dataclass
-class Trace:
-    """One measured run, ready to fit: the model is driven by ``waveform`` at ``temperature``; ``measured``
-    is the record the residuals are taken against, in SI units, and ``measurement`` says how.
-
-    With a heat model (docs/models.md#self-heating) ``temperature`` is the ambient one, the run starts at
-    ``initial_temperature``, and ``measured_temperature`` (the record) is fitted too: its residuals
-    are multiplied by ``temperature_weight`` [m/K] to share the displacement residuals' scale.
-
-    Parameters
-    ----------
-    name : str
-        The experiment's file.
-    time : numpy.ndarray
-        The sample times [s].
-    measured : numpy.ndarray
-        The record, in ``unit``.
-    temperature : float or Sampled
-        The temperature [C] the model is driven at (the ambient one with a heat model).
-    waveform : Waveform
-        The drive.
-    role : {"fit", "validate"}, default "fit"
-        The experiment's role.
-    nominal_temperature : float, default nan
-        The manifest's temperature [C].
-    measurement : Measurement, optional
-        How the residuals are formed.
-    measured_temperature : numpy.ndarray, optional
-        The recorded temperature [C], fitted too with a heat model.
-    initial_temperature : float, default nan
-        The run's start temperature [C] with a heat model.
-    temperature_weight : float, default 1.0
-        The temperature residuals' weight [m/K].
-    held_offset : float, default 0.0
-        The offset held where the measurement's policy is "none" (a force sensor's, from the model), in ``unit``.
-    unit : str, default "m"
-        The SI unit of ``measured``.
-    angle : numpy.ndarray, optional
-        The recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py).
-    """
-
-    name: str
-    time: np.ndarray
-    measured: np.ndarray
-    temperature: float | Sampled
-    waveform: Waveform
-    role: str = "fit"
-    nominal_temperature: float = math.nan
-    measurement: "Measurement" = None
-    measured_temperature: np.ndarray | None = None
-    initial_temperature: float = math.nan
-    temperature_weight: float = 1.0
-    #: the offset held where the measurement's policy is "none" (a force sensor's, from the model)
-    held_offset: float = 0.0
-    #: the SI unit of ``measured``
-    unit: str = "m"
-    #: the recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py)
-    angle: np.ndarray | None = None
-
-    @property
-    def n_residuals(self) -> int:
-        return len(self.time) * (1 if self.measured_temperature is None else 2)
+from ..fitting.problem import Trace
 
 
 class MetricWarning(UserWarning):
@@ -117,6 +52,17 @@ class Measurement:
             return [None] * len(problem.traces)
         edges = np.cumsum([0] + [tr.n_residuals for tr in problem.traces])
         return [r[a:b] for a, b in zip(edges[:-1], edges[1:])]
+
+    def initial_model(self, init, method, data, experiments, **options):
+        """The model a fit of ``experiments`` starts from: ``init`` (a Model, a preset's name, a model file, or
+        None) made ready for this measurement and ``method``, with values read off the data where it gives none.
+        ``options``: identify's ``friction``, ``free`` and ``procedure``."""
+        raise NotImplementedError
+
+    def complete(self, res, experiments, init):
+        """The result of a fit of ``experiments`` from ``init`` completed at its optimum: what this measurement
+        estimates besides the fitted parameters (an offset, an inertia, a delay); by default the result as it is."""
+        return res
 
     def offsets_in(self, traces) -> int:
         """Offsets fitted besides the parameters (the degrees of freedom they take)."""
@@ -172,6 +118,13 @@ class Measurement:
             if ps:
                 yield role, ps
 
+
+#: Relative step of the forward differences (a measurement without closed-form sensitivities, force data's
+#: integrated runs), and the tolerance of the runs they difference: the solver's
+#: error over the step (1e-9 / 1e-5) and the truncation error (~1e-5) make the Jacobian good to ~1e-4, ample
+#: for Gauss-Newton steps and for the intervals (1e-10 costs half as much again for nothing visible).
+FD_STEP = 1e-5
+FD_RTOL = 1e-9
 
 #: the offset policies, by the names the API, the command line (--offset) and the JSON use
 OFFSETS = ("shared", "per-experiment", "none")
@@ -257,4 +210,4 @@ def center_each(r, S, sizes):
     return r, S
 
 
-__all__ = ["center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center", "reverses", "thermal_check"]
+__all__ = ["FD_STEP", "FD_RTOL", "center_each", "Measurement", "MetricWarning", "Trace", "OFFSETS", "amount", "center", "reverses", "thermal_check"]

@@ -1,6 +1,6 @@
 """What the data allow without a model: a smooth map of friction over velocity, travel and position, fitted by linear least
 squares on the fit runs and scored on the held-out ones. Where the noise cannot be estimated from the data (noise
-correlated from sample to sample: measurements/quality.py), a fit's error has nothing to be held against; this map
+correlated from sample to sample: fitting/quality.py), a fit's error has nothing to be held against; this map
 is that yardstick. A friction model that predicts the held-out runs many times worse than such a map of the same
 runs misses something the data show, whatever the noise.
 

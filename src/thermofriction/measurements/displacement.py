@@ -17,7 +17,8 @@ from ..errors import InputError
 from ..models import require_actuator
 from ..simulation import StepSizeController, simulate
 from .base import Measurement, MetricWarning, Trace, center, thermal_check
-from .quality import fit_quality
+from .displacement_start import displacement_initial
+from ..fitting.quality import fit_quality
 
 #: The parameters fitted by default for each friction model (docs/identification.md#friction-models):
 #: what sets the level and the presliding stiffness, which displacement data determine; the shape
@@ -69,6 +70,11 @@ class Displacement(Measurement):
 
     def unit(self, experiments=()) -> str:
         return "m"
+
+    def initial_model(self, init, method, data, experiments, **options):
+        """The method's preset, or a model file's plant with a LuGre start read off the data
+        (measurements/displacement_start.py)."""
+        return displacement_initial(init, method, data, experiments, measurement=self, **options)
 
     def make_trace(self, exp, model) -> Trace:
         d = drive(exp, model, start="record")

@@ -31,19 +31,16 @@ from ..drive import drive
 from ..errors import InputError, SolverError
 from ..data.experiments import run_label
 from ..data.force import ForceExperiment
-from ..models import Model, ModelI
+from ..models import Model, ModelI, PrescribedMotion
 from ..models.sides import RIPPLE_AMPLITUDES
 from . import ripple
 from ..simulation import StepSizeController, simulate
 from ..waveforms import Sampled
-from .base import OFFSETS, Measurement, Trace, center, center_each, reverses, thermal_check
-from .quality import fit_quality
+from ..fitting.quality import fit_quality
+from .base import FD_RTOL, FD_STEP, OFFSETS, Measurement, Trace, center, center_each, reverses, thermal_check
+from .force_finish import force_finish
+from .force_start import force_initial, screen_starts, start_section
 
-#: Relative step of the forward differences, and the tolerance of the runs they difference: the solver's
-#: error over the step (1e-9 / 1e-5) and the truncation error (~1e-5) make the Jacobian good to ~1e-4, ample
-#: for Gauss-Newton steps and for the intervals (1e-10 costs half as much again for nothing visible).
-FD_STEP = 1e-5
-FD_RTOL = 1e-9
 #: What to check when a fit to force data is not adequate, where it applies (Force.checks)
 UNITS_CHECK = "check the units in the files' headers"
 SAMPLING_CHECK = "check that the sampling resolves the force's swing after each reversal (a few samples at least)"
@@ -121,6 +118,16 @@ class Force(Measurement):
         exps = list(getattr(experiments, "experiments", experiments))
         return "N m" if exps and exps[0].rotary else "N"
 
+    def initial_model(self, init, method, data, experiments, **options):
+        """A prescribed-motion model of the data's kind, with starting values read off the data where ``init``
+        gives none (measurements/force_start.py)."""
+        return force_initial(init, method, data, experiments, force=Force, **options)
+
+    def complete(self, res, experiments, init):
+        """The sensor offset estimated at the optimum as the policy says, a rotary joint's units
+        (measurements/force_finish.py)."""
+        return force_finish(res, experiments, init, self, force=Force)
+
     def make_trace(self, exp, model) -> Trace:
         if model.plant.type != "prescribed":
             raise InputError(f"{exp.file}: force data are fitted with a prescribed-motion model ([plant] type = "
@@ -152,7 +159,7 @@ class Force(Measurement):
         core does not step exactly (``_bridge.prescribed_applies``; a ripple it steps at the waveform's position)."""
         if model.thermal is not None and not isinstance(model.thermal, ModelI):
             return None
-        # a Stribeck excess fs - fc fitted as such (identification/parameters.py: EXCESS) is fs to the core, its
+        # a Stribeck excess fs - fc fitted as such (fitting/parameters.py: EXCESS) is fs to the core, its
         # column moved into fc's by Problem.in_names (integrated instead, Model I's per-temperature fits took 2x)
         names = problem.chain if problem.chain is not None else [
             "fs" if n == "fs_excess" else n for n in problem.names]
@@ -425,6 +432,47 @@ class ForcePrediction:
                 "fit_quality": self.fit_quality}
 
 
+def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None, screen: bool = True,
+                progress=None) -> dict:
+    """A [friction] section of ``kind`` with starting values read off the data (measurements/force_start.py:
+    read_start), screened.
+
+    Of the data-derived starts, the one whose short fit on the data ends lowest (:func:`screened`): a fit from the
+    wrong one ended at half the Coulomb level (issue 40). A rough start: the fit's multi-start spans a decade
+    either way.
+
+    Parameters
+    ----------
+    experiments : list of ForceExperiment
+        The force experiments (a Dataset's fit experiments where a Dataset is given).
+    kind : str, default "lugre"
+        The friction model.
+    plant : PrescribedMotion, optional
+        The plant (its motion: linear or rotary).
+    screen : bool, default True
+        Whether to screen the starts by short fits (else the first, from the static map).
+    progress : callable, optional
+        Called with a line saying what is done.
+
+    Returns
+    -------
+    dict
+        The [friction] section: "model" and the starting values, in SI units.
+
+    Raises
+    ------
+    InputError
+        No experiment; a record at rest; an unknown friction model.
+    """
+    return start_section(experiments, kind, plant, screen, progress, force=Force)
+
+
+def screened(experiments, candidates, plant=None, progress=None) -> dict:
+    """The candidate [friction] section whose short fit on the data ends with the least misfit
+    (measurements/force_start.py: screen_starts, each run's own offset profiled out)."""
+    return screen_starts(experiments, candidates, plant, progress, force=Force)
+
+
 def steady_state_curve(model: Model, velocities, temperature=None) -> np.ndarray:
     """The model's friction force in steady sliding at each of ``velocities``, by simulation (any friction model,
     any thermal form): a constant velocity held over thirty presliding lengths (g/stiffness), where the
@@ -468,4 +516,4 @@ def steady_state_curve(model: Model, velocities, temperature=None) -> np.ndarray
     return np.array(out)
 
 
-__all__ = ["Force", "ForcePrediction", "steady_state_curve", "FD_STEP", "FD_RTOL", "UNITS_CHECK", "SAMPLING_CHECK", "FIT_PARAMETERS"]
+__all__ = ["Force", "ForcePrediction", "steady_state_curve", "force_start", "screened", "FD_STEP", "FD_RTOL", "UNITS_CHECK", "SAMPLING_CHECK", "FIT_PARAMETERS"]

@@ -12,7 +12,7 @@ import numpy as np
 from ..models import PARAMETER_UNITS, Model, ModelI, ModelII
 from ..validation import ValidationResult
 from .page import fmt_number, html_table
-from ..identification.shown import cells
+from ..fitting.shown import cells
 from ..figures.fit_plots import as_float, law_outside_intervals, per_temperature_estimates
 
 @dataclasses.dataclass
@@ -234,7 +234,7 @@ def _parameter_table(entry, keep):
     for name, p in ((entry.fit or {}).get("parameters") or {}).items():
         if not keep(name):
             continue
-        rows.append([name, *cells(p), _unit(p.get("unit", ""))])  # (the one display: identification/shown.py)
+        rows.append([name, *cells(p), _unit(p.get("unit", ""))])  # (the one display: fitting/shown.py)
     return rows
 
 

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from ..identification.shown import cells
+from ..fitting.shown import cells
 from ..measurements import steady_state_curve
 from ..measurements.command import implied_friction
 from ..models import ModelI, ModelII
@@ -343,7 +343,7 @@ def _parameters_section(entries, unit) -> str:
     for e in entries:
         f = e.fit or {}
         for name, p in (f.get("parameters") or {}).items():
-            param_rows.append([e.label, name, *cells(p), p.get("unit", "")])  # (identification/shown.py)
+            param_rows.append([e.label, name, *cells(p), p.get("unit", "")])  # (fitting/shown.py)
         o = f.get("sensor_offset")
         if o:
             param_rows.append([e.label, "sensor offset" + ("" if o.get("fitted") else " (held)"),

@@ -137,7 +137,7 @@ def draw_parameters(result, draws: int, seed: int = 0):
 def _run_draws(model, names, thetas, temperatures, waveform, sim):
     """Runs on a worker: displacement (draws, temperatures, samples), mean steps (draws,
     temperatures), and {row: reason} for draws that could not be simulated (all NaN)."""
-    from ..identification.parameters import with_values
+    from ..fitting.parameters import with_values
     from ..simulation import simulate
 
     disp = steps = None

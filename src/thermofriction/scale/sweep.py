@@ -131,7 +131,7 @@ def _as_axis(name, values):
 
 def _kinds(model: Model, waveform, names):
     """Each grid name's kind ("temperature", "input", "parameter") and unit, checked against the model."""
-    from ..identification.parameters import target_of, unit_of  # loads SciPy: only when a sweep runs
+    from ..fitting.parameters import target_of, unit_of  # loads SciPy: only when a sweep runs
 
     fields = {f.name for f in dataclasses.fields(waveform)} if dataclasses.is_dataclass(waveform) else set()
     kinds, units = {}, {}
@@ -160,7 +160,7 @@ def _kinds(model: Model, waveform, names):
 def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim):
     """Simulates each row of ``coords``; returns (values (n, len(metrics)), errors {row: reason},
     warnings). A point that fails is NaN with its reason; the others go on."""
-    from ..identification.parameters import with_values
+    from ..fitting.parameters import with_values
     from ..simulation import simulate
 
     values = np.full((coords.shape[0], len(metrics)), np.nan)

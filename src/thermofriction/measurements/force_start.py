@@ -1,18 +1,7 @@
-"""Starting values from the data, for an initial model that gives only its plant (a model file with a
-[plant] section and no [friction]): :func:`lugre_start` for displacement data, :func:`force_start` for force
-data; and :func:`with_friction_model`, another friction model built from a model's values.
-
-For displacement data:
-
-A stick-slip actuator slips when the stage's acceleration times the end-effector mass exceeds the
-friction level, so the friction level is of the order of ``m_e`` times the stage's acceleration. That
-scale comes from the plant alone (the stage driven by the recorded input, nothing on it); a scan of the
-friction level over four decades around it, each with bristles whose steady deflection is from 3 % to
-3 times the stage's stroke (their stiffness is otherwise unknown to two decades) and lightly damped,
-keeps the three starts with the lowest misfit. A short fit of the friction level, the stiffness and the
-damping from each (on the shortest run) picks the start; the fit then starts from there with its
-multi-start spanning a decade either way of each parameter.
-"""
+"""Force data's initial model (``Force.initial_model``): a prescribed-motion model of the data's kind, with
+starting values read off the data where the initial model gives none (:func:`read_start`, screened by short fits:
+:func:`screen_starts`), and the records at rest refused (:func:`moving_speed`). The force measurement's class is
+passed in (``force``): this module sits below measurements/force.py, which calls it."""
 
 from __future__ import annotations
 
@@ -21,123 +10,13 @@ import math
 
 import numpy as np
 
-from ..drive import experiment_waveform
+from ..data.force import units_of
+from ..data.motion import with_v_smooth
 from ..errors import ComputationError, InputError
-from ..models import FRICTION_MODELS, Coulomb, LuGre, Model, ModelI, PrescribedMotion
-from ..measurements.force import Force
-from ..simulation import simulate
-from .optimiser import fit
-from .parameters import Parameters
-from .problem import Problem, make_traces
-from .procedures import base_model, friction_parameters
-
-#: the scan, in units of m_e times the stage's acceleration scale
-SCAN = np.logspace(-3, 1, 13)
-DEFLECTIONS = (0.03, 0.1, 0.3, 1.0, 3.0)   # steady bristle deflection fc/sigma0, in units of the stage's stroke
-DAMPING = 0.01     # sigma1 as a fraction of 2 sqrt(sigma0 m_e) (critical damping of the stuck end effector)
-
-
-def lugre_start(plant, experiments, input=None) -> dict:
-    """A [friction] section (LuGre) with starting values from ``experiments`` for ``plant``."""
-    if plant.type != "stick-slip":
-        raise InputError("starting values from the data need the stick-slip actuator's plant")
-    experiments = list(experiments)
-    if not experiments:
-        raise InputError("no experiment to take starting values from")
-    exp = min(experiments, key=lambda e: len(e.time))  # the shortest run: the scan costs one run per point
-    probe = Model(plant, Coulomb(fc=1e-12, v_smooth=1e-3), input=input)
-    waveform = experiment_waveform(exp, probe)
-    stage = simulate(probe, t_eval=exp.time, input=waveform)
-    accel = np.gradient(stage.stage_velocity, stage.time)
-    a_scale = float(np.quantile(np.abs(accel), 0.999))
-    stroke = float(np.ptp(stage.stage_displacement))
-    if not (a_scale > 0 and stroke > 0):
-        raise InputError(f"{exp.file}: the input does not move the stage: no starting values can be taken from it")
-    m_e = plant.end_effector_mass
-    scan = []
-    for f, deflection in ((f, d) for f in SCAN for d in DEFLECTIONS):
-        fc = float(f * m_e * a_scale)
-        sigma0 = fc / (deflection * stroke)
-        sigma1 = DAMPING * 2.0 * math.sqrt(sigma0 * m_e)
-        model = Model(plant, LuGre(sigma0=sigma0, sigma1=sigma1, fc=fc), input=input)
-        problem = Problem(model, ["fc"], make_traces([exp], model), rtol=1e-6, parallel=False)
-        r, _ = problem.evaluate(np.array([fc]))
-        cost = math.inf if r is None else float(r @ r)
-        scan.append((cost, {"sigma0": sigma0, "sigma1": sigma1, "fc": fc}))
-    scan = sorted((c for c in scan if math.isfinite(c[0])), key=lambda c: c[0])
-    if not scan:
-        raise InputError(f"{exp.file}: no friction level between {SCAN[0]:g} and {SCAN[-1]:g} x m_e x the stage's "
-                         f"acceleration could be simulated: check the plant")
-    # a scan point's misfit says little about where a fit from it ends (stiffness and friction level
-    # trade off): a few steps of the fit from each of the best three decide
-    best = None
-    for _, start in scan[:3]:
-        model = Model(plant, LuGre(**start), input=input)
-        params = Parameters()
-        for name, value in start.items():
-            params.add(name, value, min=0.0)
-        try:
-            outcome = fit(model, params, make_traces([exp], model), rtol=1e-6, starts=1, max_nfev=15)
-        except (ComputationError, InputError):  # a start whose fit cannot run is simply not chosen
-            continue
-        cost = float(outcome.r @ outcome.r)
-        if best is None or cost < best[0]:
-            best = (cost, dict(zip(start, (float(v) for v in outcome.theta))))
-    values = best[1] if best is not None else scan[0][1]
-    return {"model": "lugre", **values}
-
-
-
-
-def with_friction_model(model: Model, kind: str) -> Model:
-    """``model`` with a ``kind`` friction model (docs/identification.md#friction-models), built from
-    its own friction's values where the two share a parameter (a Model I law goes with its
-    parameter; laws of parameters the new model lacks are dropped). What the new model requires
-    and the old one lacks is derived from the level fc and the presliding stiffness sigma0 (a GMS
-    model's sum of k_i; else fc over 1 um): sigma1 = 1e-6 s x sigma0, z_ba = fc / (2 sigma0),
-    C = 1e4 /s x fc, and GMS elements k_i proportional to 1/i summing to sigma0, w_i = 1/4 (four
-    elements breaking loose one after the other).
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-    kind : str
-        The friction model wanted (``FRICTION_MODELS``: lugre, dahl, elastoplastic, gms, stribeck, coulomb).
-
-    Returns
-    -------
-    Model
-
-    Raises
-    ------
-    InputError
-        An unknown friction model.
-    """
-    if kind not in FRICTION_MODELS:
-        raise InputError(f"unknown friction model '{kind}' (one of: {', '.join(FRICTION_MODELS)})")
-    if model.friction.model == kind:
-        return model
-    cls = FRICTION_MODELS[kind]
-    names = {f.name for f in dataclasses.fields(cls)} - set(cls.arrays)
-    laws = {k: v for k, v in model.laws.items() if k in names}
-    kw = {k: v for k, v in model.friction.values().items() if k in names}
-    kw.update({k: None for k in laws})
-    at = base_model(model).friction.values()  # numbers (laws at mid-range), to derive the rest from
-    fc = at["fc"]
-    sigma0 = at.get("sigma0") or (sum(at["k"]) if "k" in at else fc / 1e-6)
-    derived = {"sigma0": sigma0, "sigma1": 1e-6 * sigma0, "z_ba": 0.5 * fc / sigma0, "C": 1e4 * fc}
-    if kind == "gms":
-        h = sum(1.0 / i for i in range(1, 5))
-        derived.update(k=tuple(sigma0 / (i * h) for i in range(1, 5)), w=(0.25,) * 4)
-    for name in cls.required:
-        if name not in kw:
-            kw[name] = derived[name]
-    thermal = model.thermal
-    if isinstance(thermal, ModelI):
-        thermal = ModelI(laws) if laws else None
-    return dataclasses.replace(model, friction=cls(**kw), thermal=thermal)
-
+from ..fitting.optimiser import fit
+from ..fitting.parameters import friction_parameters
+from ..models import LuGre, Model, PrescribedMotion, load_model
+from ..models.transforms import with_friction_model
 
 #: a position that stays within this many steps of its resolution dithers at rest (an encoder's last count
 #: flickering): its "motion" is quantisation noise, and a fit to it determines nothing (issue 41)
@@ -283,12 +162,12 @@ SCREEN_EVALUATIONS = 8
 SCREEN_RUNS = 2
 
 
-def screened(experiments, candidates, plant=None, progress=None) -> dict:
+def screen_starts(experiments, candidates, plant=None, progress=None, *, force) -> dict:
     """The candidate [friction] section whose short fit (SCREEN_EVALUATIONS evaluations at the coarse tolerance,
     each run's own offset profiled out, on the SCREEN_RUNS runs nearest the middle temperature) ends with the least
     misfit, as read (not the short fit's values: on a drive's command recorded 0.5 s late they walked to fc ~ 0, and
     the delay's misalignment was no longer seen). A start whose fit cannot run is not chosen; the first where none
-    can."""
+    can. ``force``: the force measurement's class (the short fits' residuals; measurements/force.py: screened)."""
     if len(candidates) < 2:
         return candidates[0]
     exps = list(getattr(experiments, "fit", experiments))
@@ -298,9 +177,11 @@ def screened(experiments, candidates, plant=None, progress=None) -> dict:
     for k, section in enumerate(candidates):
         model = Model(plant or PrescribedMotion(), LuGre.from_dict(section))
         names = [n for n in ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2") if n in section]
+        per_run = force("per-experiment")
         try:
-            outcome = fit(model, friction_parameters(model, names, excess=True), make_traces(
-                exps, model, Force("per-experiment")), rtol=1e-6, starts=1, max_nfev=SCREEN_EVALUATIONS)
+            outcome = fit(model, friction_parameters(model, names, excess=True),
+                          [per_run.make_trace(e, model) for e in exps], rtol=1e-6, starts=1,
+                          max_nfev=SCREEN_EVALUATIONS)
         except (ComputationError, InputError):
             continue
         cost = float(outcome.r @ outcome.r)
@@ -311,43 +192,79 @@ def screened(experiments, candidates, plant=None, progress=None) -> dict:
     return best[1]
 
 
-def force_start(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None, screen: bool = True,
-                progress=None) -> dict:
-    """A [friction] section of ``kind`` with starting values read off the data (:func:`read_start`), screened.
-
-    Of the data-derived starts, the one whose short fit on the data ends lowest (:func:`screened`): a fit from the
-    wrong one ended at half the Coulomb level (issue 40). A rough start: the fit's multi-start spans a decade
-    either way.
-
-    Parameters
-    ----------
-    experiments : list of ForceExperiment
-        The force experiments (a Dataset's fit experiments where a Dataset is given).
-    kind : str, default "lugre"
-        The friction model.
-    plant : PrescribedMotion, optional
-        The plant (its motion: linear or rotary).
-    screen : bool, default True
-        Whether to screen the starts by short fits (else the first, from the static map).
-    progress : callable, optional
-        Called with a line saying what is done.
-
-    Returns
-    -------
-    dict
-        The [friction] section: "model" and the starting values, in SI units.
-
-    Raises
-    ------
-    InputError
-        No experiment; a record at rest; an unknown friction model.
-    """
+def start_section(experiments, kind: str = "lugre", plant: PrescribedMotion | None = None, screen: bool = True,
+                  progress=None, *, force) -> dict:
+    """A [friction] section of ``kind`` with starting values read off the data (:func:`read_start`), screened by
+    short fits (:func:`screen_starts`, with the force measurement's class ``force``): measurements/force.py
+    force_start, which documents it."""
     candidates = read_start(experiments)
-    section = screened(experiments, candidates, plant, progress) if screen else candidates[0]
+    section = screen_starts(experiments, candidates, plant, progress, force=force) if screen else candidates[0]
     if kind == "lugre":
         return section
     start = Model(plant or PrescribedMotion(), LuGre.from_dict(section))
     return with_friction_model(start, kind).friction.to_dict()
 
 
-__all__ = ["lugre_start", "force_start", "read_start", "screened", "moving_speed", "MIN_TRAVEL_STEPS", "with_friction_model"]
+def force_initial(init, method, data, experiments, *, force, friction=None, free=(), procedure="direct"):
+    """The initial model for force data (``Force.initial_model``; ``force`` the force measurement's class): a
+    prescribed-motion model of the data's kind (linear or rotary); a plant-only file (or one naming only the
+    friction model), or none, gets its friction values from the data."""
+    if free:
+        raise InputError("free= frees plant parameters; a prescribed-motion model has none to fit")
+    if method == "model-ii" and procedure != "direct":
+        raise InputError("Model II's paper procedure reads stick-slip displacements; force data use the direct one")
+    if not experiments:
+        raise InputError("the dataset has no experiment with role 'fit'")
+    rotary = units_of(getattr(data, "experiments", experiments))
+    init = _from_plant_only(init, experiments, rotary, force)
+    if init.plant.type != "prescribed":
+        raise InputError(f"force data are fitted with a prescribed-motion model ([plant] type = \"prescribed\"); "
+                         f"the initial model's plant is '{init.plant.type}'")
+    if init.plant.rotary != rotary:
+        want = "rotary" if rotary else "linear"
+        raise InputError(f"the data are {want} ({'rad, N m' if rotary else 'm, N'}) but the initial model's motion is "
+                         f"{init.plant.motion}: set motion = \"{want}\" in its [plant]")
+    if friction is not None:
+        init = with_friction_model(init, friction)
+        if friction == "stribeck":  # asked for: a Stribeck map, not the Coulomb map a start without an excess fits
+            init = _with_excess(init, experiments)
+    if init.heat is not None:
+        raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet")
+    moving_speed(experiments)  # a record at rest is refused whatever the initial model (it determines nothing)
+    return _v_smooth_from_data(init, experiments)
+
+
+def _with_excess(init, experiments):
+    """A Stribeck map whose start has no excess (fs = fc: none seen in the data's slowest sliding) gets one to fit
+    from: fs a tenth above fc, vs a tenth of the data's moving speed (the fit's defaults drop fs and vs where there
+    is no excess, which made --friction stribeck a plain Coulomb map)."""
+    values = init.friction.values()
+    if "fs" in init.laws or values.get("fc") is None or (values.get("fs") or 0.0) > values["fc"]:
+        return init
+    return init.with_friction(fs=1.1 * values["fc"], vs=0.1 * moving_speed(experiments))
+
+
+def _v_smooth_from_data(init, experiments):
+    """A friction model whose ``v_smooth`` is left at its default gets one velocity step of the data where the
+    velocity is quantised (a firmware's fixed steps): far below a step, a static model chatters at rest."""
+    default = {f.name: f.default for f in dataclasses.fields(init.friction)}.get("v_smooth")
+    if default is None or getattr(init.friction, "v_smooth", None) != default:
+        return init
+    return with_v_smooth(init, experiments)
+
+
+def _from_plant_only(init, experiments, rotary, force):
+    def start(plant, inp, model="lugre"):
+        if plant.type != "prescribed":
+            raise InputError("force data are fitted with a prescribed-motion model: [plant] type = \"prescribed\"")
+        return start_section(experiments, model, plant, force=force)
+
+    if init is None:
+        plant = PrescribedMotion(motion="rotary" if rotary else "linear")
+        return Model(plant, LuGre.from_dict(start_section(experiments, "lugre", plant, force=force)))
+    if isinstance(init, Model):
+        return init
+    return load_model(init, friction_from=start)
+
+
+__all__ = ["read_start", "screen_starts", "start_section", "moving_speed", "MIN_TRAVEL_STEPS", "force_initial"]

@@ -1,13 +1,15 @@
-"""The identification problem (the lowest layer of identification): measured traces, the residuals of a model
-against them and their Jacobian. What a residual is -- displacement about each run's zero, force about a sensor
-offset -- belongs to the trace's measurement (thermofriction/measurements/); the problem turns parameter values
-into a model once per evaluation, runs the traces side by side, and supplies what every measurement shares:
-simulation with forward sensitivities, and the chain rule from the values a run sees at its temperature to the
-coefficients of temperature laws."""
+"""The fitting problem (the lowest layer of the fitting engine, thermofriction/fitting/): measured traces, the
+residuals of a model against them and their Jacobian. What a residual is -- displacement about each run's zero,
+force about a sensor offset -- belongs to the trace's measurement, an object the trace carries (its ``residuals``
+and ``per_trace``; thermofriction/measurements/ implements them): the engine never imports what it measures. The
+problem turns parameter values into a model once per evaluation, runs the traces side by side, and supplies what
+every measurement shares: simulation with forward sensitivities, and the chain rule from the values a run sees at
+its temperature to the coefficients of temperature laws."""
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -16,8 +18,9 @@ import numpy as np
 
 from .. import _bridge
 from ..errors import InputError
-from ..models import Const, Model, ModelII
-from ..measurements import Trace, measurement_of
+from ..models import Model, ModelII
+from ..models.transforms import at_temperature
+from ..waveforms import Sampled, Waveform
 from .parameters import EXCESS, KNOT, TARGET_DF, TARGET_LAW, get_value, split_name, target_of, with_values
 
 #: the most integration steps of one run during a fit
@@ -28,6 +31,71 @@ MAX_STEPS = 2_000_000
 #: the whole fit at one temperature -- only to be refused, as a failed run is
 STEP_FACTOR = 20
 STEP_FLOOR = 100_000
+
+
+@dataclasses.dataclass
+class Trace:
+    """One measured run, ready to fit: the model is driven by ``waveform`` at ``temperature``; ``measured``
+    is the record the residuals are taken against, in SI units, and ``measurement`` says how (any object with
+    the measurement's ``residuals`` and ``per_trace``: the engine never asks what it measures).
+
+    With a heat model (docs/models.md#self-heating) ``temperature`` is the ambient one, the run starts at
+    ``initial_temperature``, and ``measured_temperature`` (the record) is fitted too: its residuals
+    are multiplied by ``temperature_weight`` [m/K] to share the displacement residuals' scale.
+
+    Parameters
+    ----------
+    name : str
+        The experiment's file.
+    time : numpy.ndarray
+        The sample times [s].
+    measured : numpy.ndarray
+        The record, in ``unit``.
+    temperature : float or Sampled
+        The temperature [C] the model is driven at (the ambient one with a heat model).
+    waveform : Waveform
+        The drive.
+    role : {"fit", "validate"}, default "fit"
+        The experiment's role.
+    nominal_temperature : float, default nan
+        The manifest's temperature [C].
+    measurement : Measurement, optional
+        How the residuals are formed.
+    measured_temperature : numpy.ndarray, optional
+        The recorded temperature [C], fitted too with a heat model.
+    initial_temperature : float, default nan
+        The run's start temperature [C] with a heat model.
+    temperature_weight : float, default 1.0
+        The temperature residuals' weight [m/K].
+    held_offset : float, default 0.0
+        The offset held where the measurement's policy is "none" (a force sensor's, from the model), in ``unit``.
+    unit : str, default "m"
+        The SI unit of ``measured``.
+    angle : numpy.ndarray, optional
+        The recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py).
+    """
+
+    name: str
+    time: np.ndarray
+    measured: np.ndarray
+    temperature: float | Sampled
+    waveform: Waveform
+    role: str = "fit"
+    nominal_temperature: float = math.nan
+    measurement: object = None
+    measured_temperature: np.ndarray | None = None
+    initial_temperature: float = math.nan
+    temperature_weight: float = 1.0
+    #: the offset held where the measurement's policy is "none" (a force sensor's, from the model)
+    held_offset: float = 0.0
+    #: the SI unit of ``measured``
+    unit: str = "m"
+    #: the recorded position at each sample (force data: the position ripple's angle, measurements/ripple.py)
+    angle: np.ndarray | None = None
+
+    @property
+    def n_residuals(self) -> int:
+        return len(self.time) * (1 if self.measured_temperature is None else 2)
 
 
 _POOL = None
@@ -202,42 +270,6 @@ class Problem:
         return M
 
 
-def make_traces(experiments, model: Model, measurement=None):
-    """One trace per experiment, made by their measurement (default: the experiments' own, with its default
-    offset policy).
-
-    Parameters
-    ----------
-    experiments : list of Experiment
-        The experiments.
-    model : Model
-        The model the traces are driven as (its input and temperature handling).
-    measurement : Measurement, optional
-        How the residuals are formed; default the experiments' own, with its default offset policy.
-
-    Returns
-    -------
-    list of Trace
-
-    Raises
-    ------
-    InputError
-        An experiment the measurement cannot drive the model with.
-    """
-    measurement = measurement or measurement_of(experiments)
-    return [measurement.make_trace(exp, model) for exp in experiments]
-
-
-def at_temperature(model: Model, T: float) -> Model:
-    """The model at one constant temperature: Model I's laws' values there as plain parameters,
-    Model II's dF as a constant."""
-    if isinstance(model.thermal, ModelII):
-        return dataclasses.replace(model, thermal=ModelII(Const(float(model.thermal.dF(T)))))
-    values = model.parameters_at(T)
-    return dataclasses.replace(model, friction=dataclasses.replace(model.friction, **{n: values[n] for n in model.laws}),
-                               thermal=None)
-
-
 def knot_derivative(law, k, T) -> float:
     """d law(T) / d T[k] of a piecewise-linear law (extrapolated with its end segments)."""
     knots, values = law.T, law.values
@@ -251,5 +283,5 @@ def knot_derivative(law, k, T) -> float:
     return 0.0
 
 
-__all__ = ["Trace", "Problem", "make_traces", "pool", "at_temperature", "knot_derivative", "MAX_STEPS", "STEP_FACTOR",
+__all__ = ["Trace", "Problem", "pool", "knot_derivative", "MAX_STEPS", "STEP_FACTOR",
            "STEP_FLOOR"]

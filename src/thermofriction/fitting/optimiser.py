@@ -17,7 +17,7 @@ from ..errors import ComputationError, InputError
 from ..models import Model
 from .parameters import Parameters
 from .problem import Problem, pool
-from ..measurements.quality import ADEQUATE_RATIO, noise_level
+from .quality import ADEQUATE_RATIO, noise_level
 
 optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
 

@@ -18,7 +18,7 @@ from ..models.sides import NEGATIVE_SIDE, RIPPLE_AMPLITUDES, SIGNED, side_values
 TARGET_PARAM, TARGET_LAW, TARGET_DF, TARGET_HEAT, TARGET_PLANT = (
     _bridge.TARGET_CODES[k] for k in ("param", "law", "dF", "heat", "plant"))
 #: Not a C core target: a breakpoint temperature of a piecewise-linear dF. Its sensitivity is the chain
-#: rule on the knot values' sensitivities (identification/problem.py), exact on constant-temperature runs.
+#: rule on the knot values' sensitivities (fitting/problem.py), exact on constant-temperature runs.
 KNOT = -1
 #: Not a parameter of the model: the Stribeck excess fs - fc, fitted in place of fs (in log space, so that fs >= fc
 #: holds by construction, never as a refused step); setting it sets fs = fc + excess.
@@ -279,4 +279,19 @@ def unit_of(model: Model, name: str) -> str:
     return unit if law is None else law.coefficient_unit(coef, unit)
 
 
-__all__ = ["EXCESS", "KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of", "fitted_positive"]
+def friction_parameters(model: Model, names, fixed=(), excess=False) -> Parameters:
+    """``names`` of ``model`` as Parameters to fit (``fixed`` held): positive unless a Model II term, a law's
+    coefficient or a ripple amplitude. ``excess``: fs fitted as the excess fs - fc (EXCESS, in log space: fs >= fc
+    by construction) where the start has one (identification/procedures.py: stribeck_start)."""
+    params = Parameters()
+    for name in names:
+        if name == "fs" and excess and get_value(model, EXCESS) > 0:
+            name = EXCESS
+        v = get_value(model, name)
+        positive = fitted_positive(name)
+        params.add(name, v, min=0.0 if positive else -math.inf, vary=name not in fixed,
+                   unit=unit_of(model, name))
+    return params
+
+
+__all__ = ["EXCESS", "KNOT", "TARGET_PARAM", "TARGET_LAW", "TARGET_DF", "TARGET_HEAT", "TARGET_PLANT", "split_name", "PLANT_UNITS", "HEAT_PARAMETERS", "Parameter", "Parameters", "target_of", "get_value", "with_values", "unit_of", "fitted_positive", "friction_parameters"]
