@@ -25,7 +25,7 @@ from ._bridge import model_spec
 from . import _args
 from .errors import InputError, SolverError, shorten
 from .models import MassPlant, Model
-from .results import Result
+from .results import Result, Summary
 
 
 # -- argument checks: the package's InputError naming the argument, before the C core sees it -----
@@ -317,9 +317,10 @@ class LoopResult(Result):
 
     title = "closed-loop run"
 
-    def summary(self) -> list:
-        return [("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
-                ("RMS error", f"{self.rms_error * 1e6:.4g} um"), ("max error", f"{self.max_error * 1e6:.4g} um")]
+    def summary(self) -> Summary:
+        return Summary([("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
+                        ("RMS error", f"{self.rms_error * 1e6:.4g} um"),
+                        ("max error", f"{self.max_error * 1e6:.4g} um")])
 
     def _frame(self) -> dict:
         return {"time": self.time, "reference": self.reference, "position": self.position, "error": self.error,

@@ -30,7 +30,7 @@ from ._lazy import lazy
 from .errors import InputError, SolverError, TemperatureRangeWarning
 from . import _args
 from .models import Model
-from .results import Result
+from .results import Result, Summary
 from .drive import input_of
 from .simulation import MAX_SAMPLES, StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
@@ -173,13 +173,13 @@ class HeatingResult(Result):
 
     title = "heated run"
 
-    def summary(self) -> list:
-        return [("method", self.method), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
-                ("temperature", f"{self.temperature[0]:.4g} -> {self.temperature[-1]:.4g} C "
-                                f"(max {np.max(self.temperature):.4g} C)"),
-                ("displacement", f"{self.displacement[-1] * 1e3:.6g} mm"),
-                ("step per cycle", f"{self.step_size[0] * 1e6:.4g} -> {self.step_size[-1] * 1e6:.4g} um"),
-                ("friction work", f"{self.friction_work[-1]:.4g} J")]
+    def summary(self) -> Summary:
+        return Summary([("method", self.method), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
+                        ("temperature", f"{self.temperature[0]:.4g} -> {self.temperature[-1]:.4g} C "
+                                        f"(max {np.max(self.temperature):.4g} C)"),
+                        ("displacement", f"{self.displacement[-1] * 1e3:.6g} mm"),
+                        ("step per cycle", f"{self.step_size[0] * 1e6:.4g} -> {self.step_size[-1] * 1e6:.4g} um"),
+                        ("friction work", f"{self.friction_work[-1]:.4g} J")])
 
     def _frame(self) -> dict:
         return {"time": self.time, "temperature": self.temperature, "displacement": self.displacement,

@@ -15,7 +15,7 @@ from .data.motion import check_motion_option, driven_by
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
-from .results import Result
+from .results import Result, Summary, table
 from .unit_scale import unit_warnings
 
 
@@ -130,12 +130,13 @@ class ValidationResult(Result):
 
     title = "validation"
 
-    def summary(self) -> dict:
+    def summary(self) -> Summary:
         """Per role (fit, validate): the errors over its experiments (the measurement's metrics)."""
-        return self.measurement.summary(self.predictions)
+        return Summary(self.measurement.summary(self.predictions))
 
-    def report(self) -> str:
-        return self.table()
+    def _blocks(self) -> list:
+        """The report: the table of the experiments' metrics (the measurement's columns)."""
+        return [table([c[0] for c in self._COLUMNS], self.rows(), indent="")]
 
     def _frame(self) -> dict:
         """One row per experiment: its metrics."""
@@ -166,12 +167,8 @@ class ValidationResult(Result):
             yield [fmt.format(m[key] * scale[key] if key in scale else m[key]) for _, key, fmt in self._COLUMNS]
 
     def table(self) -> str:
-        head = [c[0] for c in self._COLUMNS]
-        rows = list(self.rows())
-        w = [max(len(r[i]) for r in rows + [head]) for i in range(len(head))]
-        lines = ["  ".join(h.ljust(w[i]) for i, h in enumerate(head))]
-        lines += ["  ".join(c.ljust(w[i]) for i, c in enumerate(r)) for r in rows]
-        return "\n".join(lines)
+        """The experiments' metrics as a text table (the report)."""
+        return self.report()
 
     def print_table(self, title=None):
         """A rich table on the terminal."""

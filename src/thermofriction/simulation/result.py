@@ -8,7 +8,7 @@ import numpy as np
 
 from .._bridge import OUTPUTS
 from .._io import atomic_write
-from ..results import Result
+from ..results import Result, Summary
 
 
 @dataclass(eq=False)
@@ -138,7 +138,7 @@ class SimulationResult(Result):
         from ..reporting.friction_plots import simulation_figure
         return simulation_figure(self, what, title)
 
-    def summary(self) -> list:
+    def summary(self) -> Summary:
         rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
                 ("final displacement", f"{self.displacement[-1] * 1e6:.6g} µm"),
                 ("peak friction force", f"{np.max(np.abs(self.friction_force)):.4g} N")]
@@ -147,7 +147,7 @@ class SimulationResult(Result):
                      ("mean step per cycle", f"{self.step_sizes.mean() * 1e6:.6g} µm"),
                      ("mean velocity", f"{self.mean_velocity * 1e6:.6g} µm/s")]
         rows.append(("solver", f"{self.stats.get('solver', '?')}: {self.stats.get('steps', '?')} steps"))
-        return rows
+        return Summary(rows)
 
     def __repr__(self):
         return (f"SimulationResult({len(self.time)} samples over {self.time[-1] - self.time[0]:.6g} s, "
