@@ -65,7 +65,7 @@ def _fleet():
 
 
 def _propagation():
-    data = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.1, seed=1)
+    data = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.3, sample_rate=5000, seed=3)
     fit = tf.identify(data, "base", starts=1, parameters=["sigma0", "fc"])
     res = tf.propagate(fit, [35.0], draws=3, duration=0.04, scheduler="sequential")
     return res, "nominal_step", res.nominal_step

@@ -191,8 +191,12 @@ class Result:
         """The report as text (the one formatter, :func:`as_text`)."""
         return as_text(self._blocks())
 
+    def _html_blocks(self) -> list:
+        """The blocks of the notebook's table: the report's, unless a result shows more there."""
+        return self._blocks()
+
     def _repr_html_(self) -> str:
-        return as_html(self._blocks())
+        return as_html(self._html_blocks())
 
     def plot(self, *args, **kwargs):
         raise NotImplementedError

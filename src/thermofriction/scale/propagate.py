@@ -25,7 +25,7 @@ from .. import _io
 from .. import _args
 from ..waveforms import Waveform
 from ..errors import InputError, ThermofrictionError, shorten
-from ..results import Result, Summary, heading, lines
+from ..results import Result, Summary, fields, heading, lines
 from .cluster import Runner
 from .sweep import check_run_options
 
@@ -285,6 +285,10 @@ class PropagationResult(Result):
                       f"[{self.step_lower[j] * 1e6:.5g}, {self.step_upper[j] * 1e6:.5g}]; final displacement "
                       f"{self.nominal[j, -1] * 1e6:.5g} um [{self.lower[j, -1] * 1e6:.5g}, "
                       f"{self.upper[j, -1] * 1e6:.5g}]" for j, T in enumerate(self.temperatures))]
+
+    def _html_blocks(self) -> list:
+        blocks = self._blocks()
+        return blocks[:1] + [fields(self.summary().rows())] + blocks[1:]
 
     def __repr__(self):
         return (f"PropagationResult({self.draws} draws at {', '.join(f'{T:g}' for T in self.temperatures)} C, "
