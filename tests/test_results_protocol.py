@@ -113,7 +113,7 @@ def test_findings_are_values_and_warnings_at_the_edge():
     from thermofriction.errors import TemperatureRangeWarning
     from thermofriction.results import Finding
     with pytest.warns(TemperatureRangeWarning, match="outside the calibrated range") as caught:
-        res = tf.simulate(tf.load_model("li2009-model-i"), 0.02, temperature=60.0)
+        res = tf.simulate(tf.load_model("li2009-model-i"), 0.02, temperature=42.0)
     assert [(f.category, f.message) for f in res.findings] == [(w.category, str(w.message)) for w in caught
                                                                 if w.category is TemperatureRangeWarning]
     assert all(isinstance(f, Finding) for f in res.findings)

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import re
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,6 +25,7 @@ from . import _args
 from .errors import InputError, SolverError, shorten
 from .models import MassPlant, Model
 from .results import Result, Summary
+from .simulation.checks import temperature_findings
 
 
 # -- argument checks: the package's InputError naming the argument, before the C core sees it -----
@@ -59,12 +59,9 @@ def _samples(where: str, name: str, values, n=None) -> np.ndarray:
 
 def _check_at(where: str, model: Model, temperature: float):
     """The model's domain at one temperature (Model I parameters, Model II's lambda), with the
-    simulator's messages; its warnings (calibrated range, passivity) are the simulator's business."""
-    from .simulation.checks import check_temperatures
+    simulator's messages; its findings (calibrated range, passivity) are the simulator's business."""
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            check_temperatures(model, temperature)
+        temperature_findings(model, temperature)
     except InputError as e:
         raise InputError(f"{where}: {e}") from None
 

@@ -30,7 +30,7 @@ from ._lazy import lazy
 from .errors import InputError, SolverError, TemperatureRangeWarning
 from . import _args
 from .models import Model
-from .results import Result, Summary
+from .results import Result, Summary, collecting, emit
 from .drive import input_of
 from .simulation import MAX_SAMPLES, StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
@@ -249,15 +249,18 @@ def cycle_table(model: Model, input: Waveform, temperatures, warmup_cycles: int 
     period = input.period
     n = warmup_cycles + measure_cycles
     steps, works, startup = [], [], []
-    with warnings.catch_warnings():  # the range the run really visits is checked once, afterwards
-        warnings.simplefilter("ignore", TemperatureRangeWarning)
-        for T in temperatures:
-            res = simulate(fast, t_eval=np.arange(n + 1) * period, input=input, temperature=float(T),
-                           friction_work=True)
-            s = float(np.mean(res.step_sizes[warmup_cycles:]))
-            steps.append(s)
-            works.append(float(res.friction_work[-1] - res.friction_work[warmup_cycles]) / measure_cycles)
-            startup.append(float(res.displacement[warmup_cycles] - res.displacement[0]) - warmup_cycles * s)
+    found = []
+    try:
+        with collecting() as found:  # the range the run really visits is checked once, afterwards
+            for T in temperatures:
+                res = simulate(fast, t_eval=np.arange(n + 1) * period, input=input, temperature=float(T),
+                               friction_work=True)
+                s = float(np.mean(res.step_sizes[warmup_cycles:]))
+                steps.append(s)
+                works.append(float(res.friction_work[-1] - res.friction_work[warmup_cycles]) / measure_cycles)
+                startup.append(float(res.displacement[warmup_cycles] - res.displacement[0]) - warmup_cycles * s)
+    finally:  # the other findings (passivity) as the runs said them
+        emit([f for f in found if not issubclass(f.category, TemperatureRangeWarning)])
     return CycleTable(np.asarray(temperatures, float), np.array(steps), np.array(works), 1.0 / period,
                       np.array(startup))
 

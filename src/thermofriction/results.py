@@ -12,11 +12,14 @@ and the same views of it everywhere.
 - ``plot()``: a matplotlib Figure (each result implements it; never pyplot's);
 - ``findings``: what the reader should know (a temperature outside a law's range, a model that may create
   energy) as values, :class:`Finding`, turned into Python warnings where the public function returns
-  (:func:`emit`), never sent through the warnings module on the way.
+  (:func:`emit`), or kept as values by a caller that collects them (:func:`collecting`: validation, a sweep),
+  never sent through the warnings module on the way.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import html
 import warnings
@@ -61,8 +64,32 @@ class Finding:
         return self.message
 
 
+#: the findings' list of the innermost :func:`collecting` block open in this context (a thread, a task), or None
+_collector: contextvars.ContextVar = contextvars.ContextVar("thermofriction_findings", default=None)
+
+
+@contextlib.contextmanager
+def collecting():
+    """Collects, as values, the findings that the functions called in the block emit (:func:`emit`), instead of
+    warning: validation keeps its predictions' findings on its result, a sweep its points'. Blocks nest (an inner
+    block's list is its own), and each thread or task has its own (a context variable: no global state, no lock).
+
+    Yields
+    ------
+    list of Finding
+        The findings emitted in the block, in order.
+    """
+    found = []
+    token = _collector.set(found)
+    try:
+        yield found
+    finally:
+        _collector.reset(token)
+
+
 def emit(findings, stacklevel: int = 2):
-    """Turns ``findings`` into Python warnings, in order: what a public function does with them as it returns.
+    """Turns ``findings`` into Python warnings, in order: what a public function does with them as it returns
+    (the edge), unless a caller collects them (:func:`collecting`): then they go into its list.
 
     Parameters
     ----------
@@ -75,6 +102,10 @@ def emit(findings, stacklevel: int = 2):
     -------
     None
     """
+    sink = _collector.get()
+    if sink is not None:
+        sink.extend(findings)
+        return
     for f in findings:
         warnings.warn(f.message, f.category, stacklevel=stacklevel + 1)
 
@@ -205,5 +236,5 @@ class Result:
         return self.report()
 
 
-__all__ = ["Result", "Summary", "Finding", "emit", "Block", "heading", "fields", "table", "lines", "as_text",
+__all__ = ["Result", "Summary", "Finding", "emit", "collecting", "Block", "heading", "fields", "table", "lines", "as_text",
            "as_html"]

@@ -7,7 +7,6 @@ import dataclasses
 import html
 
 from ._io import dump_json, jsonable
-from ._warning_routes import recorded_warnings
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
 from . import _args
 from .data.experiments import Dataset, run_label
@@ -15,7 +14,7 @@ from .data.motion import check_motion_option, driven_by
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
-from .results import Result, Summary, table
+from .results import Result, Summary, collecting, table
 from .unit_scale import unit_warnings
 
 
@@ -318,7 +317,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     measurement.check_model(model, exps)
     caught, preds, failures, pairs = [], [], [], []
     for exp in exps:
-        with recorded_warnings() as w:  # this experiment's own, also where fits run side by side on threads
+        with collecting() as w:  # this experiment's findings, as values (also where fits run side by side)
             try:
                 preds.append(measurement.predict(model, exp))
                 pairs.append((exp, preds[-1].measured, preds[-1].predicted))

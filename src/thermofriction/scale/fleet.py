@@ -383,8 +383,7 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
         if progress:
             progress(base)
         outs = runner.map(_identify_one, [(loaded[n], method, init, identify_options) for n in todo],
-                          progress=report, on_error=lambda i, reason: ("failed", reason),
-                          records_warnings=True)  # each fit's held-out warnings in its own list (_warning_routes)
+                          progress=report, on_error=lambda i, reason: ("failed", reason))
         where = runner.describe()
     for name, (status, value) in zip(todo, outs):
         if status == "ok":

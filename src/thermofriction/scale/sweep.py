@@ -26,8 +26,8 @@ from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
 from ..waveforms import Sampled, Waveform
-from ..results import Result, Summary, heading, lines
-from .cluster import Runner, check_options, recorded_warnings
+from ..results import Result, Summary, collecting, heading, lines
+from .cluster import Runner, check_options
 from .figures import sweep_figure
 
 #: the most points of one sweep (their coordinates and metrics are held in memory: ~100 bytes each)
@@ -169,7 +169,7 @@ def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim)
     errors, seen = {}, {}
     for i, row in enumerate(coords):
         point = dict(zip(names, (float(v) for v in row)))
-        with recorded_warnings() as caught:
+        with collecting() as caught:  # the point's findings, as values
             try:
                 T = point.get("temperature", temperature)
                 inp = {n: v for n, v in point.items() if kinds[n] == "input"}
@@ -451,7 +451,7 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
             return np.full((b - a, len(metrics)), np.nan), {k: reason for k in range(b - a)}, []
         spans, outs = runner.map_chunks(
             _run_batch, n, lambda a, b: (model, waveform, temperature, names, kinds, coords[a:b], metrics, sim),
-            batch_size=batch_size, progress=progress, on_error=lost, records_warnings=True)
+            batch_size=batch_size, progress=progress, on_error=lost)
         where = runner.describe()
     values = np.vstack([o[0] for o in outs]) if outs else np.empty((0, len(metrics)))
     errors, seen = {}, {}

@@ -62,6 +62,9 @@ class SimulationResult(Result):
         The simulated model's name (the figures' titles).
     rotary : bool, default False
         Whether the motion is a rotary joint's (rad, N m).
+    findings : list of Finding, default []
+        What the checks found (a temperature outside a law's calibrated range, a model that may create energy),
+        as values; ``simulate`` warned each as it returned.
     """
 
     time: np.ndarray
@@ -86,6 +89,8 @@ class SimulationResult(Result):
     #: the simulated model's name (the figures' titles) and whether its motion is rotary (rad, N m)
     model_name: str | None = None
     rotary: bool = False
+    #: what the checks found (results.Finding: a temperature outside a law's range, ...), warned as simulate returned
+    findings: list = field(default_factory=list)
 
     def columns(self) -> dict:
         """The CSV columns (docs/formats.md#simulation-output), header -> array."""
