@@ -156,10 +156,18 @@ def check_temperature_coverage(temperature, t0: float, t1: float):
     emit(coverage_findings(temperature, t0, t1), stacklevel=3)
 
 
+#: a model (frozen) keeps the findings of each constant temperature it was checked at, in its instance's own
+#: dictionary (not a field: not compared, not copied by dataclasses.replace, gone with the model): a model run
+#: again and again at one temperature (identification, sweeps, a benchmark) is checked once. Findings are values,
+#: so a temperature with findings is cached as well as one without
+_MEMO = "_thermofriction_findings"
+
+
 def temperature_findings(model: Model, temperature) -> list:
     """What a run at ``temperature`` should say, as findings: temperatures outside a law's calibrated range, a
     LuGre-type model that is not dissipative there, Model II's offset form anti-damped; raises where the model is
-    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
+    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain). A constant
+    temperature's are computed once per model.
 
     Parameters
     ----------
@@ -178,8 +186,13 @@ def temperature_findings(model: Model, temperature) -> list:
     InputError
         The model is invalid at the temperature, named with the parameter and the temperature.
     """
+    memo = None if isinstance(temperature, Sampled) else model.__dict__.setdefault(_MEMO, {})
+    if memo is not None and temperature in memo:
+        return list(memo[temperature])
     found = []
     _check_temperatures(model, temperature, found)
+    if memo is not None:
+        memo[temperature] = tuple(found)
     return found
 
 
