@@ -30,7 +30,13 @@ from ._io import dump_json, jsonable
 class Summary(dict):
     """What ``summary()`` returns for every result: an ordered mapping of label -> plain JSON value (text, a
     number, or a mapping of them: a validation's metrics per role, a fleet's per parameter). It is a dict, so it is
-    its own JSON; ``rows()`` gives it as (label, text) for the formatter."""
+    its own JSON; ``rows()`` gives it as (label, text) for the formatter.
+
+    Parameters
+    ----------
+    items : mapping or iterable of (str, object), optional
+        The labels and their values, in order (as for ``dict``).
+    """
 
     def rows(self) -> list:
         """The summary as (label, text) rows (a mapping value as "key value; key value")."""
@@ -78,6 +84,11 @@ def collecting():
     ------
     list of Finding
         The findings emitted in the block, in order.
+
+    Raises
+    ------
+    Exception
+        Whatever the block raises, passed on (the collector is closed first).
     """
     found = []
     token = _collector.set(found)
@@ -101,6 +112,11 @@ def emit(findings, stacklevel: int = 2):
     Returns
     -------
     None
+
+    Raises
+    ------
+    Warning
+        A finding's category, where the warnings filters turn it into an error (``-W error``).
     """
     sink = _collector.get()
     if sink is not None:
@@ -114,9 +130,28 @@ def emit(findings, stacklevel: int = 2):
 
 @dataclasses.dataclass(frozen=True)
 class Block:
-    """A piece of a report: ``kind`` "heading" (``text`` and a ``note`` after it), "fields" (``rows`` of (label, text), labels padded to
-    ``width`` or to the longest), "table" (``head`` and ``rows`` of cells, columns padded; ``strip`` the lines'
-    trailing blanks) or "lines" (``rows`` of text); in text each line but a heading's after ``indent``."""
+    """A piece of a report, as :func:`heading`, :func:`fields`, :func:`table` and :func:`lines` make them; the one
+    formatter writes it as text (:func:`as_text`) or HTML (:func:`as_html`).
+
+    Parameters
+    ----------
+    kind : {"heading", "fields", "table", "lines"}
+        What it is.
+    text : str, default ""
+        A heading's text.
+    note : str, default ""
+        What follows a heading on its line.
+    rows : tuple, default ()
+        Fields: (label, text) pairs; a table: rows of text cells; lines: the lines.
+    head : tuple, default ()
+        A table's column headings.
+    width : int, optional
+        Fields: the labels' width; default the longest label's.
+    strip : bool, default False
+        A table: without its lines' trailing blanks.
+    indent : str, default "    "
+        In text, before each line of fields, a table or lines.
+    """
 
     kind: str
     text: str = ""
@@ -129,27 +164,107 @@ class Block:
 
 
 def heading(text: str, note: str = "") -> Block:
-    """A heading: ``[[text]] note`` in text, bold (and the note plain) in HTML."""
+    """A heading: ``[[text]] note`` in text, bold (and the note plain) in HTML.
+
+    Parameters
+    ----------
+    text : str
+        The heading.
+    note : str, default ""
+        What follows it on its line.
+
+    Returns
+    -------
+    Block
+
+    Raises
+    ------
+    None
+    """
     return Block("heading", text=text, note=note)
 
 
 def fields(rows, width: int | None = None) -> Block:
-    """Label = value rows (labels padded to ``width``, default the longest)."""
+    """Label = value rows.
+
+    Parameters
+    ----------
+    rows : iterable of (str, str)
+        The labels and their values, as text.
+    width : int, optional
+        The labels' width; default the longest label's.
+
+    Returns
+    -------
+    Block
+
+    Raises
+    ------
+    None
+    """
     return Block("fields", rows=tuple(rows), width=width)
 
 
 def table(head, rows, strip: bool = False, indent: str = "    ") -> Block:
-    """A table of text cells under ``head`` (each line after ``indent``; ``strip``: without trailing blanks)."""
+    """A table of text cells under column headings.
+
+    Parameters
+    ----------
+    head : sequence of str
+        The column headings.
+    rows : iterable of sequence of str
+        The rows, a text cell per column.
+    strip : bool, default False
+        In text, the lines without their trailing blanks.
+    indent : str, default "    "
+        In text, before each line.
+
+    Returns
+    -------
+    Block
+
+    Raises
+    ------
+    None
+    """
     return Block("table", rows=tuple(tuple(r) for r in rows), head=tuple(head), strip=strip, indent=indent)
 
 
 def lines(rows) -> Block:
-    """Lines of text (a note, a warning each)."""
+    """Lines of text (a note, a warning each): indented lines in text, a list in HTML.
+
+    Parameters
+    ----------
+    rows : iterable of str
+        The lines.
+
+    Returns
+    -------
+    Block
+
+    Raises
+    ------
+    None
+    """
     return Block("lines", rows=tuple(rows))
 
 
 def as_text(blocks) -> str:
-    """The report's text: headings as ``[[...]]``, everything else indented (by the block's ``indent``)."""
+    """The report's text: headings as ``[[...]]``, everything else indented (by the block's ``indent``).
+
+    Parameters
+    ----------
+    blocks : iterable of Block
+        The report's pieces, in order.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    None
+    """
     out = []
     for b in blocks:
         indent = b.indent
@@ -169,7 +284,22 @@ def as_text(blocks) -> str:
 
 
 def as_html(blocks) -> str:
-    """The same blocks as HTML for a notebook: headings bold, fields and tables as tables, lines as a list."""
+    """The same blocks as HTML for a notebook: headings bold, fields and tables as tables, lines as a list.
+
+    Parameters
+    ----------
+    blocks : iterable of Block
+        The report's pieces, in order.
+
+    Returns
+    -------
+    str
+        One ``<div>``, every text escaped.
+
+    Raises
+    ------
+    None
+    """
     e, out = html.escape, []
     for b in blocks:
         if b.kind == "heading":
