@@ -25,8 +25,7 @@ from ..models import Model, PrescribedMotion, StickSlipPlant
 from ..waveforms import Sampled, Waveform
 from ..results import emit
 from .checks import (as_temperature, check_heated_temperatures, check_passivity, check_prescribed_motion,
-                     check_temperature_coverage, check_temperatures, coverage_findings, heated_findings,
-                     temperature_findings)
+                     check_temperatures, coverage_findings, heated_findings, temperature_findings)
 from .result import SimulationResult
 from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 
