@@ -117,3 +117,42 @@ def test_findings_are_values_and_warnings_at_the_edge():
     assert [(f.category, f.message) for f in res.findings] == [(w.category, str(w.message)) for w in caught
                                                                 if w.category is TemperatureRangeWarning]
     assert all(isinstance(f, Finding) for f in res.findings)
+
+
+def test_validation_keeps_its_findings_as_values_with_their_categories():
+    """validate's warnings are its findings' texts; the findings keep the category; validate warns none of a
+    prediction's (they are on the result), as before."""
+    import warnings as W
+
+    from thermofriction.errors import TemperatureRangeWarning
+    model = tf.load_model("li2009-model-i")
+    data = tf.synthesize(model, [29.0], duration=0.05, sample_rate=2000.0, noise=0.0, seed=1)
+    with W.catch_warnings(record=True) as caught:
+        W.simplefilter("always")
+        res = tf.validate(model, data)
+    assert res.warnings == [f.message for f in res.findings]
+    assert [f.category for f in res.findings] == [TemperatureRangeWarning]
+    assert "temperature 29 C is outside" in res.findings[0].message
+    assert not [w for w in caught if w.category is TemperatureRangeWarning]
+
+
+def test_collecting_is_per_thread():
+    """Two threads inside their collecting blocks at once (a barrier) each get their own findings."""
+    import threading
+
+    from thermofriction.results import Finding, collecting, emit
+    barrier, out = threading.Barrier(2), {}
+
+    def task(i):
+        with collecting() as found:
+            barrier.wait(timeout=30)
+            emit([Finding(UserWarning, f"task {i}")])
+            barrier.wait(timeout=30)
+        out[i] = [f.message for f in found]
+
+    threads = [threading.Thread(target=task, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert out == {0: ["task 0"], 1: ["task 1"]}

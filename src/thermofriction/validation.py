@@ -7,14 +7,14 @@ import dataclasses
 import html
 
 from ._io import dump_json, jsonable
-from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
+from .errors import InputError, TemperatureRangeWarning, ThermofrictionError, UnitWarning
 from . import _args
 from .data.experiments import Dataset, run_label
 from .data.motion import check_motion_option, driven_by
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
-from .results import Result, Summary, collecting, table
+from .results import Finding, Result, Summary, collecting, table
 from .unit_scale import unit_warnings
 
 
@@ -90,6 +90,9 @@ class ValidationResult(Result):
     scored_as : dict, default {}
         How the model was scored: the offset policy and the motion, each with where it came from ("the fit
         record", "asked", "the default").
+    findings : list of Finding, default []
+        The same as ``warnings``, as values with their categories (UnitWarning, TemperatureRangeWarning,
+        MetricWarning).
     """
 
     model: Model
@@ -102,6 +105,8 @@ class ValidationResult(Result):
     #: how the model was scored: the offset policy and the motion, each with where it came from ("the fit record",
     #: "asked", "the default")
     scored_as: dict = dataclasses.field(default_factory=dict)
+    #: the warnings as values, with their categories (results.Finding)
+    findings: list = dataclasses.field(default_factory=list)
 
     @property
     def scoring(self) -> str:
@@ -315,7 +320,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     measurement = measurement_of(exps, offset=offset, ripple_phase=ripple_phase)  # asked once
     how["offset"] = measurement.offset
     measurement.check_model(model, exps)
-    caught, preds, failures, pairs = [], [], [], []
+    found, preds, failures, pairs = [], [], [], []
     for exp in exps:
         with collecting() as w:  # this experiment's findings, as values (also where fits run side by side)
             try:
@@ -323,10 +328,12 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
                 pairs.append((exp, preds[-1].measured, preds[-1].predicted))
             except ThermofrictionError as e:  # one experiment the model cannot run: say why, go on
                 failures.append(Failure(run_label(exp), float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
-        caught += [f"{run_label(exp)}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
-        caught += [str(x.message) for x in w if issubclass(x.category, MetricWarning)]
-    caught = unit_warnings(pairs) + caught  # (first: a unit off by 1000 explains every error after it)
-    return ValidationResult(model, preds, caught, failures, measurement, how)
+        found += [Finding(x.category, f"{run_label(exp)}: {x.message}") for x in w
+                  if issubclass(x.category, TemperatureRangeWarning)]
+        found += [x for x in w if issubclass(x.category, MetricWarning)]
+    # first: a unit off by 1000 explains every error after it (unit_warnings also warns: validate's edge)
+    found = [Finding(UnitWarning, m) for m in unit_warnings(pairs)] + found
+    return ValidationResult(model, preds, [f.message for f in found], failures, measurement, how, found)
 
 
 __all__ = ["MetricWarning", "validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]
