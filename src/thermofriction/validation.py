@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError, UnitWarning
@@ -14,7 +13,7 @@ from .data.motion import check_motion_option, driven_by
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
-from .results import Finding, Result, Summary, collecting, table
+from .results import Finding, Result, Summary, collecting, heading, lines, table
 from .unit_scale import unit_warnings
 
 
@@ -213,18 +212,16 @@ class ValidationResult(Result):
             paper = False  # the paper's errors are of displacement
         return error_figure([(label, self)], metric, ax=ax, paper=paper)
 
-    def _repr_html_(self):
-        head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)
-        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.rows())
+    def _html_blocks(self) -> list:
+        """The notebook's table: the headline with the errors per role, the experiments' metrics, what the errors
+        mean and how the model was scored, the warnings and the experiments not predicted."""
         summary = "; ".join(f"{role}: max error {s['max_error_pct']:.3g} %, RMSE "
                             f"{amount(s['rmse_offset_removed'], self.unit)} ({s['n']} run{'s' if s['n'] != 1 else ''})"
                             for role, s in self.summary().items())
-        notes = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
-        notes += "".join(f"<li>{html.escape(f.file)}: not predicted: {html.escape(f.reason)}</li>" for f in self.failures)
-        return (f"<div><b>Validation of {html.escape(self.model.name or 'the model')}</b> — {html.escape(summary)}"
-                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-                f"<small>{html.escape(self.measurement.footer)} {html.escape(self.scoring)}.</small>"
-                + (f"<ul>{notes}</ul>" if notes else "") + "</div>")
+        notes = list(self.warnings) + [f"{f.file}: not predicted: {f.reason}" for f in self.failures]
+        return [heading(f"Validation of {self.model.name or 'the model'}", f"— {summary}"),
+                table([c[0] for c in self._COLUMNS], self.rows()),
+                lines([f"{self.measurement.footer} {self.scoring}."]), lines(notes)]
 
 
 def scoring_note(scored_as: dict) -> str:

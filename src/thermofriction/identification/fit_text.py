@@ -1,10 +1,9 @@
-"""A fit's report as text and HTML (FitResult holds the data; this module writes it out): the structured
-blocks of :mod:`thermofriction.results` for the text, the compact notebook table, and the fit-quality verdict in
-words."""
+"""A fit's report and its notebook table (FitResult holds the data; this module says it): the structured blocks
+of :mod:`thermofriction.results`, which its one formatter writes as text and HTML, and the fit-quality verdict
+in words."""
 
 from __future__ import annotations
 
-import html
 import math
 
 import numpy as np
@@ -131,23 +130,19 @@ def fit_blocks(fit) -> list:
     return blocks
 
 
-def fit_html(fit) -> str:
-    """A fit as a compact HTML table for notebooks: the headline, the parameters, the warnings."""
-    head = "".join(f"<th>{h}</th>" for h in HEAD)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in parameter_rows(fit))
-    warn = "".join(f"<li>{html.escape(w)}</li>" for w in fit.warnings)
+def fit_html_blocks(fit) -> list:
+    """A fit's notebook table as blocks: the headline (converged, RMSE, the noise and the verdict, the time), where
+    the model came from, the parameters, the warnings."""
     q = fit.fit_quality
     quality = "" if q is None else (f", noise {amount(q['noise'], fit.unit)}: rmse/noise {q['ratio']:.3g}, "
-                                    f"{html.escape(verdict(q)).replace('NOT adequate', '<b>NOT adequate</b>')}")
+                                    f"{verdict(q)}")
     rmse = "" if fit.n_points == 0 else f", rmse {amount(fit.rmse, fit.unit)}"
     prov = fit.model.provenance or {}
-    origin = (f"<br><small>{html.escape(fit.model.name or '')}: data sha256 {html.escape(prov['data_sha256'][:12])}…, "
-              f"{html.escape(prov.get('date', ''))}, thermofriction {html.escape(prov.get('thermofriction', ''))}"
-              f"</small>") if prov.get("data_sha256") else ""
-    return (f"<div><b>Fit: {html.escape(fit.method)}</b> — {'converged' if fit.success else 'not converged'}"
-            f"{rmse}{quality}, {fit.wall_time:.3g} s{origin}"
-            f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-            + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
+    origin = [f"{fit.model.name or ''}: data sha256 {prov['data_sha256'][:12]}…, {prov.get('date', '')}, "
+              f"thermofriction {prov.get('thermofriction', '')}"] if prov.get("data_sha256") else []
+    return [heading(f"Fit: {fit.method}", f"— {'converged' if fit.success else 'not converged'}{rmse}{quality}, "
+                                          f"{fit.wall_time:.3g} s"),
+            lines(origin), table(HEAD, parameter_rows(fit)), lines(fit.warnings)]
 
 
-__all__ = ["fit_blocks", "fit_html", "verdict", "parameter_rows", "HEAD"]
+__all__ = ["fit_blocks", "fit_html_blocks", "verdict", "parameter_rows", "HEAD"]

@@ -13,7 +13,7 @@ from .._io import dump_json, jsonable
 from ..measurements import amount
 from ..models import Model
 from ..results import Result, Summary
-from .fit_text import fit_blocks, fit_html, verdict
+from .fit_text import fit_blocks, fit_html_blocks, verdict
 from .parameters import Parameters
 
 
@@ -274,5 +274,6 @@ class FitResult(Result):
             validation = validate(self.model, data)
         return fit_figure(self, validation, paper=paper)
 
-    def _repr_html_(self):
-        return fit_html(self)
+    def _html_blocks(self) -> list:
+        """The notebook's table: the headline, the parameters, the warnings (identification/fit_text.py)."""
+        return fit_html_blocks(self)
