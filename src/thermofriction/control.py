@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import re
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,7 +25,8 @@ from . import _args
 from .errors import InputError, SolverError, shorten
 from .figures.study_plots import loop_figure
 from .models import MassPlant, Model
-from .results import Result
+from .results import Result, Summary
+from .simulation.checks import temperature_findings
 
 
 # -- argument checks: the package's InputError naming the argument, before the C core sees it -----
@@ -60,12 +60,9 @@ def _samples(where: str, name: str, values, n=None) -> np.ndarray:
 
 def _check_at(where: str, model: Model, temperature: float):
     """The model's domain at one temperature (Model I parameters, Model II's lambda), with the
-    simulator's messages; its warnings (calibrated range, passivity) are the simulator's business."""
-    from .simulation.checks import check_temperatures
+    simulator's messages; its findings (calibrated range, passivity) are the simulator's business."""
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            check_temperatures(model, temperature)
+        temperature_findings(model, temperature)
     except InputError as e:
         raise InputError(f"{where}: {e}") from None
 
@@ -318,9 +315,10 @@ class LoopResult(Result):
 
     title = "closed-loop run"
 
-    def summary(self) -> list:
-        return [("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
-                ("RMS error", f"{self.rms_error * 1e6:.4g} um"), ("max error", f"{self.max_error * 1e6:.4g} um")]
+    def summary(self) -> Summary:
+        return Summary([("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
+                        ("RMS error", f"{self.rms_error * 1e6:.4g} um"),
+                        ("max error", f"{self.max_error * 1e6:.4g} um")])
 
     def _frame(self) -> dict:
         return {"time": self.time, "reference": self.reference, "position": self.position, "error": self.error,

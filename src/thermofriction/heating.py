@@ -31,7 +31,7 @@ from .errors import InputError, SolverError, TemperatureRangeWarning
 from .figures.study_plots import heating_figure
 from . import _args
 from .models import Model
-from .results import Result
+from .results import Result, Summary, collecting, emit
 from .drive import input_of
 from .simulation import MAX_SAMPLES, StepSizeController, check_heated_temperatures, simulate
 from .waveforms import Waveform
@@ -174,13 +174,13 @@ class HeatingResult(Result):
 
     title = "heated run"
 
-    def summary(self) -> list:
-        return [("method", self.method), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
-                ("temperature", f"{self.temperature[0]:.4g} -> {self.temperature[-1]:.4g} C "
-                                f"(max {np.max(self.temperature):.4g} C)"),
-                ("displacement", f"{self.displacement[-1] * 1e3:.6g} mm"),
-                ("step per cycle", f"{self.step_size[0] * 1e6:.4g} -> {self.step_size[-1] * 1e6:.4g} um"),
-                ("friction work", f"{self.friction_work[-1]:.4g} J")]
+    def summary(self) -> Summary:
+        return Summary([("method", self.method), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
+                        ("temperature", f"{self.temperature[0]:.4g} -> {self.temperature[-1]:.4g} C "
+                                        f"(max {np.max(self.temperature):.4g} C)"),
+                        ("displacement", f"{self.displacement[-1] * 1e3:.6g} mm"),
+                        ("step per cycle", f"{self.step_size[0] * 1e6:.4g} -> {self.step_size[-1] * 1e6:.4g} um"),
+                        ("friction work", f"{self.friction_work[-1]:.4g} J")])
 
     def _frame(self) -> dict:
         return {"time": self.time, "temperature": self.temperature, "displacement": self.displacement,
@@ -249,15 +249,18 @@ def cycle_table(model: Model, input: Waveform, temperatures, warmup_cycles: int 
     period = input.period
     n = warmup_cycles + measure_cycles
     steps, works, startup = [], [], []
-    with warnings.catch_warnings():  # the range the run really visits is checked once, afterwards
-        warnings.simplefilter("ignore", TemperatureRangeWarning)
-        for T in temperatures:
-            res = simulate(fast, t_eval=np.arange(n + 1) * period, input=input, temperature=float(T),
-                           friction_work=True)
-            s = float(np.mean(res.step_sizes[warmup_cycles:]))
-            steps.append(s)
-            works.append(float(res.friction_work[-1] - res.friction_work[warmup_cycles]) / measure_cycles)
-            startup.append(float(res.displacement[warmup_cycles] - res.displacement[0]) - warmup_cycles * s)
+    found = []
+    try:
+        with collecting() as found:  # the range the run really visits is checked once, afterwards
+            for T in temperatures:
+                res = simulate(fast, t_eval=np.arange(n + 1) * period, input=input, temperature=float(T),
+                               friction_work=True)
+                s = float(np.mean(res.step_sizes[warmup_cycles:]))
+                steps.append(s)
+                works.append(float(res.friction_work[-1] - res.friction_work[warmup_cycles]) / measure_cycles)
+                startup.append(float(res.displacement[warmup_cycles] - res.displacement[0]) - warmup_cycles * s)
+    finally:  # the other findings (passivity) as the runs said them
+        emit([f for f in found if not issubclass(f.category, TemperatureRangeWarning)])
     return CycleTable(np.asarray(temperatures, float), np.array(steps), np.array(works), 1.0 / period,
                       np.array(startup))
 

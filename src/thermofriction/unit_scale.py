@@ -21,7 +21,6 @@ variable) and the unit that would explain the ratio."""
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 
@@ -29,6 +28,7 @@ from .data.experiments import _UNITS as _ACTUATOR_UNITS
 from .data.force import _UNITS as _FORCE_UNITS
 from .errors import ThermofrictionError, UnitWarning
 from .plausible import SUSPICIOUS
+from .results import Finding, collecting, emit
 
 #: the ratio of spans (measured / predicted, or its inverse) at or above which a unit is suspected
 TRUST_RATIO = 10 ** 2.5
@@ -155,8 +155,7 @@ def unit_warnings(pairs, what="the model", stacklevel=3) -> list:
             f"{label}'s values (in {unit})"
         out.append(f"{PREFIX}{files}: {where} are {_factor(ratio)} {what} produces for {these} ({detail})"
                    f"{_advice(label, unit, ratio)}")
-    for m in out:
-        warnings.warn(m, UnitWarning, stacklevel=stacklevel)
+    emit([Finding(UnitWarning, m) for m in out], stacklevel=stacklevel)  # (kept as values where a caller collects)
     return out
 
 
@@ -166,8 +165,7 @@ def model_unit_warnings(model, experiments, measurement, rtol=1e-6) -> list:
     is left out (the fit says why)."""
     pairs = []
     for exp in experiments:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with collecting():  # the simulations' findings: the fit's to say
             try:
                 measured, predicted = measurement.spans(model, exp, rtol)
             except (ThermofrictionError, ArithmeticError):

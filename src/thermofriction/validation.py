@@ -4,11 +4,9 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 
 from ._io import dump_json, jsonable
-from ._warning_routes import recorded_warnings
-from .errors import InputError, TemperatureRangeWarning, ThermofrictionError
+from .errors import InputError, TemperatureRangeWarning, ThermofrictionError, UnitWarning
 from . import _args
 from .data.experiments import Dataset, run_label
 from .data.motion import check_motion_option, driven_by
@@ -17,7 +15,7 @@ from .figures.plots import error_figure
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
-from .results import Result
+from .results import Finding, Result, Summary, collecting, heading, lines, table
 from .unit_scale import unit_warnings
 
 
@@ -93,6 +91,9 @@ class ValidationResult(Result):
     scored_as : dict, default {}
         How the model was scored: the offset policy and the motion, each with where it came from ("the fit
         record", "asked", "the default").
+    findings : list of Finding, default []
+        The same as ``warnings``, as values with their categories (UnitWarning, TemperatureRangeWarning,
+        MetricWarning).
     """
 
     model: Model
@@ -105,6 +106,8 @@ class ValidationResult(Result):
     #: how the model was scored: the offset policy and the motion, each with where it came from ("the fit record",
     #: "asked", "the default")
     scored_as: dict = dataclasses.field(default_factory=dict)
+    #: the warnings as values, with their categories (results.Finding)
+    findings: list = dataclasses.field(default_factory=list)
 
     @property
     def scoring(self) -> str:
@@ -132,12 +135,13 @@ class ValidationResult(Result):
 
     title = "validation"
 
-    def summary(self) -> dict:
+    def summary(self) -> Summary:
         """Per role (fit, validate): the errors over its experiments (the measurement's metrics)."""
-        return self.measurement.summary(self.predictions)
+        return Summary(self.measurement.summary(self.predictions))
 
-    def report(self) -> str:
-        return self.table()
+    def _blocks(self) -> list:
+        """The report: the table of the experiments' metrics (the measurement's columns)."""
+        return [table([c[0] for c in self._COLUMNS], self.rows(), indent="")]
 
     def _frame(self) -> dict:
         """One row per experiment: its metrics."""
@@ -168,12 +172,8 @@ class ValidationResult(Result):
             yield [fmt.format(m[key] * scale[key] if key in scale else m[key]) for _, key, fmt in self._COLUMNS]
 
     def table(self) -> str:
-        head = [c[0] for c in self._COLUMNS]
-        rows = list(self.rows())
-        w = [max(len(r[i]) for r in rows + [head]) for i in range(len(head))]
-        lines = ["  ".join(h.ljust(w[i]) for i, h in enumerate(head))]
-        lines += ["  ".join(c.ljust(w[i]) for i, c in enumerate(r)) for r in rows]
-        return "\n".join(lines)
+        """The experiments' metrics as a text table (the report)."""
+        return self.report()
 
     def print_table(self, title=None):
         """A rich table on the terminal."""
@@ -212,18 +212,16 @@ class ValidationResult(Result):
             paper = False  # the paper's errors are of displacement
         return error_figure([(label, self)], metric, ax=ax, paper=paper)
 
-    def _repr_html_(self):
-        head = "".join(f"<th>{html.escape(c[0])}</th>" for c in self._COLUMNS)
-        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.rows())
+    def _html_blocks(self) -> list:
+        """The notebook's table: the headline with the errors per role, the experiments' metrics, what the errors
+        mean and how the model was scored, the warnings and the experiments not predicted."""
         summary = "; ".join(f"{role}: max error {s['max_error_pct']:.3g} %, RMSE "
                             f"{amount(s['rmse_offset_removed'], self.unit)} ({s['n']} run{'s' if s['n'] != 1 else ''})"
                             for role, s in self.summary().items())
-        notes = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
-        notes += "".join(f"<li>{html.escape(f.file)}: not predicted: {html.escape(f.reason)}</li>" for f in self.failures)
-        return (f"<div><b>Validation of {html.escape(self.model.name or 'the model')}</b> — {html.escape(summary)}"
-                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-                f"<small>{html.escape(self.measurement.footer)} {html.escape(self.scoring)}.</small>"
-                + (f"<ul>{notes}</ul>" if notes else "") + "</div>")
+        notes = list(self.warnings) + [f"{f.file}: not predicted: {f.reason}" for f in self.failures]
+        return [heading(f"Validation of {self.model.name or 'the model'}", f"— {summary}"),
+                table([c[0] for c in self._COLUMNS], self.rows()),
+                lines([f"{self.measurement.footer} {self.scoring}."]), lines(notes)]
 
 
 def scoring_note(scored_as: dict) -> str:
@@ -319,18 +317,20 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     measurement = measurement_of(exps, offset=offset, ripple_phase=ripple_phase)  # asked once
     how["offset"] = measurement.offset
     measurement.check_model(model, exps)
-    caught, preds, failures, pairs = [], [], [], []
+    found, preds, failures, pairs = [], [], [], []
     for exp in exps:
-        with recorded_warnings() as w:  # this experiment's own, also where fits run side by side on threads
+        with collecting() as w:  # this experiment's findings, as values (also where fits run side by side)
             try:
                 preds.append(measurement.predict(model, exp))
                 pairs.append((exp, preds[-1].measured, preds[-1].predicted))
             except ThermofrictionError as e:  # one experiment the model cannot run: say why, go on
                 failures.append(Failure(run_label(exp), float(exp.temperature), getattr(exp, "role", "fit"), str(e)))
-        caught += [f"{run_label(exp)}: {x.message}" for x in w if issubclass(x.category, TemperatureRangeWarning)]
-        caught += [str(x.message) for x in w if issubclass(x.category, MetricWarning)]
-    caught = unit_warnings(pairs) + caught  # (first: a unit off by 1000 explains every error after it)
-    return ValidationResult(model, preds, caught, failures, measurement, how)
+        found += [Finding(x.category, f"{run_label(exp)}: {x.message}") for x in w
+                  if issubclass(x.category, TemperatureRangeWarning)]
+        found += [x for x in w if issubclass(x.category, MetricWarning)]
+    # first: a unit off by 1000 explains every error after it (unit_warnings also warns: validate's edge)
+    found = [Finding(UnitWarning, m) for m in unit_warnings(pairs)] + found
+    return ValidationResult(model, preds, [f.message for f in found], failures, measurement, how, found)
 
 
 __all__ = ["MetricWarning", "validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]

@@ -5,15 +5,15 @@ from __future__ import annotations
 import math
 import sys
 import time
-import warnings
 
 import numpy as np
 
 from .. import _io
 from .._progress import Progress
-from ..errors import InputError, UnitWarning
+from ..errors import InputError
 from ..measurements.delay import parse_delay
 from ..models import PRESETS, MassPlant, load_model
+from ..results import collecting
 from ..simulation import SOLVERS, StepSizeController, simulate
 from ..waveforms import Sampled, parse_waveform
 from .outputs import _dataset_inputs, _model_inputs, _refuse_inputs, _target, _waveform_inputs
@@ -209,7 +209,7 @@ def cmd_validate(args) -> int:
         data = load_dataset(args.dataset, motion=args.motion)
         _refuse_inputs(args, _model_inputs(args.model, model), _dataset_inputs(data))
         progress.stage(f"predicting {len(data.experiments)} experiments")
-        with warnings.catch_warnings(action="ignore", category=UnitWarning):  # in res.warnings, printed below
+        with collecting():  # the findings are in res.warnings, printed below
             res = validate(model, data, offset=args.offset, motion=args.motion, ripple_phase=args.ripple_phase)
     if args.json and not res.failures:  # a .mat name writes the same metrics for MATLAB
         (res.to_mat if str(args.json).lower().endswith(".mat") else res.to_json)(_target(args, "json"))

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import _args
 from ..data.experiments import TEMPERATURE_RANGE, Dataset, run_label
-from ..errors import InputError, ThermofrictionError, UnitWarning, shorten
+from ..errors import InputError, ThermofrictionError, shorten
 from ..measurements import amount, measurement_of
 from ..measurements.baseline import baseline_verdict, model_free
 from ..measurements.delay import parse_delay
@@ -24,6 +24,7 @@ from .model_ii import identify_model_ii
 from ..fitting.optimiser import one_blas_thread
 from ..models import Model
 from ..models.sides import needs_period
+from ..results import collecting
 from ..simulation import StepSizeController
 from ..fitting.parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
@@ -299,8 +300,7 @@ def _with_generalisation(res, data, held, measurement):
     ``fit_quality["generalisation"]``, and a warning where it is large. It says what the noise estimate
     cannot when the residuals are correlated."""
     try:
-        with warnings.catch_warnings():  # (the units were checked against the initial model: identify)
-            warnings.simplefilter("ignore", UnitWarning)
+        with collecting():  # its findings are values here (the units were checked against the initial model)
             v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None,
                          ripple_phase=getattr(measurement, "ripple_phase", "auto"))
     except ThermofrictionError as e:

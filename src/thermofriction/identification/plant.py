@@ -28,7 +28,9 @@ import numpy as np
 
 from .._lazy import lazy
 from ..errors import InputError
+from ..results import Result, Summary, fields, heading, lines, table
 from ..fitting.parameters import Parameters
+
 from .plant_response import is_uniform, step_response, unit_gain_response
 
 optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
@@ -38,7 +40,7 @@ UNITS = {"damping_ratio": "", "natural_frequency": "rad/s", "gain": "m/V"}
 
 
 @dataclasses.dataclass
-class PlantFit:
+class PlantFit(Result):
     """The fitted plant: values, standard errors and 95 % intervals (in ``parameters``, and as
     ``stderr`` / ``ci95`` dicts), the correlation matrix of (xi, wn, K), and the fit statistics.
 
@@ -126,17 +128,22 @@ class PlantFit:
                          "hold": self.hold, "wall_time": self.wall_time, "warnings": self.warnings,
                          "statistics": self.statistics})
 
-    def report(self) -> str:
-        """A table like lmfit's fit report."""
-        lines = ["[[Plant fit]]",
-                 f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
-                 f"    data points      = {self.n_points}",
-                 f"    rmse             = {self.rmse * 1e9:.4g} nm",
-                 f"    sensor offset    = {self.offset * 1e9:.4g} nm (profiled)",
-                 f"    input hold       = {self.hold}",
-                 f"    evaluations      = {self.nfev}",
-                 f"    wall time        = {self.wall_time:.3g} s",
-                 "[[Parameters]]"]
+    title = "Plant fit"
+
+    def summary(self) -> Summary:
+        return Summary([("converged", str(self.success)), ("damping ratio", f"{self.damping_ratio:.6g}"),
+                        ("natural frequency", f"{self.natural_frequency:.6g} rad/s"), ("gain", f"{self.gain:.6g} m/V"),
+                        ("rmse", f"{self.rmse * 1e9:.4g} nm"), ("evaluations", str(self.nfev))])
+
+    def _frame(self) -> dict:
+        """One row per parameter: value, standard error, 95 % interval, unit."""
+        ps = list(self.parameters.values())
+        return {"name": [p.name for p in ps], "value": [p.value for p in ps], "stderr": [p.stderr for p in ps],
+                "ci95_low": [None if p.ci95 is None else p.ci95[0] for p in ps],
+                "ci95_high": [None if p.ci95 is None else p.ci95[1] for p in ps], "unit": [p.unit for p in ps]}
+
+    def _blocks(self) -> list:
+        """The report like lmfit's fit report: the fit, the parameters, the correlations above 0.1."""
         head = ("name", "value", "stderr", "rel", "95 % interval", "unit")
         rows = []
         for p in self.parameters.values():
@@ -146,22 +153,33 @@ class PlantFit:
             rel = f"{100 * p.stderr / abs(p.value):.2g} %" if p.value and math.isfinite(p.stderr) else ""
             rows.append((p.name, f"{p.value:.7g}", f"{p.stderr:.4g}", rel,
                          f"[{p.ci95[0]:.6g}, {p.ci95[1]:.6g}]", p.unit))
-        w = [max(len(r[i]) for r in rows + [head]) for i in range(len(head))]
-        lines.append("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(head)).rstrip())
-        lines.extend("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)).rstrip() for r in rows)
+        blocks = [heading(self.title), lines([f"{'converged' if self.success else 'NOT CONVERGED'}: {self.message}"]),
+                  fields([("data points", str(self.n_points)), ("rmse", f"{self.rmse * 1e9:.4g} nm"),
+                          ("sensor offset", f"{self.offset * 1e9:.4g} nm (profiled)"), ("input hold", self.hold),
+                          ("evaluations", str(self.nfev)), ("wall time", f"{self.wall_time:.3g} s")], 16),
+                  heading("Parameters"), table(head, rows, strip=True)]
         if self.correlation is not None:
             pairs = [(NAMES[i], NAMES[j], self.correlation[i, j]) for i in range(3) for j in range(i + 1, 3)
                      if np.isfinite(self.correlation[i, j]) and abs(self.correlation[i, j]) > 0.1]
             if pairs:
-                lines.append("[[Correlations]] (|C| > 0.1)")
-                lines.extend(f"    C({a}, {b}) = {c:+.3f}" for a, b, c in sorted(pairs, key=lambda x: -abs(x[2])))
+                blocks += [heading("Correlations", "(|C| > 0.1)"),
+                           lines(f"C({a}, {b}) = {c:+.3f}" for a, b, c in sorted(pairs, key=lambda x: -abs(x[2])))]
         if self.warnings:
-            lines.append("[[Warnings]]")
-            lines.extend(f"    {w}" for w in self.warnings)
-        return "\n".join(lines)
+            blocks += [heading("Warnings"), lines(self.warnings)]
+        return blocks
 
-    def __str__(self):
-        return self.report()
+    def plot(self, duration=None):
+        """A matplotlib figure of the fitted stage's response to a unit step of its input (K x wn^2 / (s^2 + 2 xi
+        wn s + wn^2)), over ``duration`` [s] (default ten of its time constants 1/(xi wn))."""
+        from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
+        xi, wn, K = self.modal_parameters()
+        t = np.linspace(0.0, duration or 10.0 / max(xi * wn, 1e-12), 500)
+        fig = Figure(figsize=(6, 3.5))
+        ax = fig.subplots()
+        ax.plot(t, step_response(t, xi, wn, K, 1.0) * 1e6)
+        ax.set(xlabel="time [s]", ylabel="displacement [um per V]",
+               title=f"fitted stage: xi {xi:.3g}, wn {wn:.4g} rad/s, K {K * 1e6:.4g} um/V")
+        return fig
 
 
 def _initial(initial):

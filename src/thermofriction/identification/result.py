@@ -1,10 +1,10 @@
-"""What a fit returns: the fitted model, parameters with errors and intervals, a readable
-report, the results JSON (docs/formats.md#results-json), and an HTML table for notebooks."""
+"""What a fit returns: the fitted model, parameters with errors and intervals, the fit's quality and
+statistics, and the results JSON (docs/formats.md#results-json); its text report and notebook table are written
+by identification/fit_text.py."""
 
 from __future__ import annotations
 
 import dataclasses
-import html
 import math
 
 import numpy as np
@@ -13,9 +13,9 @@ from .._io import dump_json, jsonable
 from ..figures.fit_plots import fit_figure
 from ..measurements import amount
 from ..models import Model
-from ..results import Result
-from ..fitting.shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
+from ..results import Result, Summary
 from ..fitting.parameters import Parameters
+from .fit_text import fit_blocks, fit_html_blocks, verdict
 
 
 @dataclasses.dataclass
@@ -240,11 +240,11 @@ class FitResult(Result):
 
     title = "fit"
 
-    def summary(self) -> list:
+    def summary(self) -> Summary:
         q = self.fit_quality or {}
-        return [("method", self.method), ("converged", str(self.success)),
-                ("rmse", amount(self.rmse, self.unit) if self.n_points else "-"),
-                ("adequate", "-" if not q else _verdict(q)), ("evaluations", str(self.nfev))]
+        return Summary([("method", self.method), ("converged", str(self.success)),
+                        ("rmse", amount(self.rmse, self.unit) if self.n_points else "-"),
+                        ("adequate", "-" if not q else verdict(q)), ("evaluations", str(self.nfev))])
 
     def _frame(self) -> dict:
         """One row per parameter: value, standard error, 95 % interval, unit, fitted or held."""
@@ -259,89 +259,9 @@ class FitResult(Result):
         from ..data.matlab_results import save_results_mat
         save_results_mat(self.to_dict(), path)
 
-    def _rows(self):
-        for p in self.parameters.values():
-            yield (p.name, *shown(p.to_dict()), p.unit)
-
-    def report(self) -> str:
-        """A table like lmfit's fit report."""
-        lines = [f"[[Fit: {self.method}]]"]
-        held = [h for h in (self.fit_quality or {}).get("held") or [] if h["contradicted"]]
-        if self.adequate is False:  # first, in plain words: the one verdict (fit_quality), as the warnings say it
-            basis, b = self.fit_quality.get("verdict_basis"), self.fit_quality.get("baseline") or {}
-            lines.append("    NOT ADEQUATE: " + (
-                f"{len(held)} held value(s) contradicted by the data (the noise cannot be estimated from these data: "
-                f"the residuals are not compared with it)" if basis == "held values" else
-                f"held-out RMSE {b.get('ratio', math.nan):.3g} x a model-free map's on the same runs (the noise cannot "
-                f"be estimated from these data)" if basis == "baseline" else
-                f"residuals {self.fit_quality['ratio']:.3g} x the measurement noise"
-                + (f", {len(held)} held value(s) contradicted by the data" if held else "")) + " (see the first warnings)")
-        if self.n_points == 0 and "paper" in self.details:  # no trajectory fit: say what was done instead
-            lines += [f"    {'done' if self.success else 'REFUSED'}: {self.message}"] + self._paper_lines()
-        else:
-            lines += [f"    {'converged' if self.success else 'NOT CONVERGED'}: {self.message}",
-                      f"    data points      = {self.n_points}",
-                      f"    rmse             = {amount(self.rmse, self.unit)} ({self.removed} removed)"]
-            o = self.sensor_offset
-            if o.get("per_experiment"):
-                lines += [f"    sensor offset    = {r['value']:.6g} +- {r['stderr']:.3g} {self.unit} ({r['file']}, "
-                          f"its own)" for r in o["per_experiment"]]
-            elif o:
-                how = "fitted, shared by all experiments" if o.get("fitted") else "held (--offset none)"
-                err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
-                if err and not math.isfinite(o["stderr"]):
-                    err, how = "", how + "; not determined: see the warnings"
-                lines.append(f"    sensor offset    = {o['value']:.6g}{err} {self.unit} ({how})")
-            lines += _plant_lines(self.details.get("plant"))
-        if self.fit_quality is not None:
-            q = self.fit_quality
-            lines.append(f"    noise (data)     = {amount(q['noise'], self.unit)}; rmse/noise = {q['ratio']:.3g}, "
-                         f"lag-1 autocorrelation {q['autocorrelation']:.2f}, "
-                         f"{_verdict(q)}")
-        lines += [
-                 f"    evaluations      = {self.nfev} (Jacobians {self.njev}), starts = {self.starts}",
-                 f"    fit time         = {self.wall_time:.3g} s (the least-squares fits; not the checks after them)",
-                 "[[Parameters]]"]
-        rows = list(self._rows())
-        w = [max(len(r[i]) for r in rows + [("name", "value", "stderr", "rel", "95 % interval", "unit")])
-             for i in range(6)]
-        head = ("name", "value", "stderr", "rel", "95 % interval", "unit")
-        lines.append("    " + "  ".join(h.ljust(w[i]) for i, h in enumerate(head)))
-        for r in rows:
-            lines.append("    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)))
-        names = [p.name for p in self.parameters.varying]
-        if np.shape(self.correlation) != (len(names), len(names)):  # no joint fit, no correlations
-            names = []
-        pairs = [(names[i], names[j], self.correlation[i, j]) for i in range(len(names))
-                 for j in range(i + 1, len(names)) if np.isfinite(self.correlation[i, j])
-                 and abs(self.correlation[i, j]) > 0.5]
-        if pairs:
-            lines.append("[[Correlations]] (|C| > 0.5)")
-            for a, b, c in sorted(pairs, key=lambda x: -abs(x[2])):
-                lines.append(f"    C({a}, {b}) = {c:+.3f}")
-        if self.warnings:
-            lines.append("[[Warnings]]")
-            lines.extend(f"    {w}" for w in self.warnings)
-        return "\n".join(lines)
-
-    def _paper_lines(self) -> list:
-        """What the paper's procedure of Model II did, step by step, with its numbers."""
-        p = self.details["paper"]
-        lin = p.get("linear_fit", {})
-        Ts = ", ".join(f"{t:.4g}" for t in np.atleast_1d(p.get("temperatures", [])))
-        law = p.get("dF_law", {})
-        knots = ", ".join(f"{v:+.4g} N at {t:.4g} C" for t, v in zip(law.get("T", []), law.get("values", [])))
-        return [f"    1. base model fitted at the reference temperature "
-                f"{self.details.get('reference_temperature', math.nan):.4g} C",
-                f"    2. final displacement against temperature ({Ts} C): two straight segments, breakpoint "
-                f"{p.get('breakpoint', math.nan):.4g} C, R^2 = {p.get('segmented_r2', math.nan):.3f}",
-                f"    3. final displacement against a constant dF, simulated: linear, slope "
-                f"{lin.get('slope', math.nan) * 1e6:.4g} um/N, R^2 = {lin.get('r2', math.nan):.3f}",
-                f"    4. dF(T) read through that line: {knots}",
-                "    no trajectory fit: no RMSE and no intervals here; `validate` gives this model's errors"]
-
-    def __str__(self):
-        return self.report()
+    def _blocks(self) -> list:
+        """The report like lmfit's fit report (identification/fit_text.py writes it)."""
+        return fit_blocks(self)
 
     def plot(self, data=None, paper=False):
         """A matplotlib figure of the fit: with ``data`` (the dataset, or a ValidationResult of
@@ -354,44 +274,6 @@ class FitResult(Result):
             validation = validate(self.model, data)
         return fit_figure(self, validation, paper=paper)
 
-    def _repr_html_(self):
-        head = "".join(f"<th>{h}</th>" for h in ("name", "value", "stderr", "rel", "95 % interval", "unit"))
-        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self._rows())
-        warn = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
-        q = self.fit_quality
-        quality = "" if q is None else (f", noise {amount(q['noise'], self.unit)}: rmse/noise {q['ratio']:.3g}, "
-                                        f"{html.escape(_verdict(q)).replace('NOT adequate', '<b>NOT adequate</b>')}")
-        rmse = "" if self.n_points == 0 else f", rmse {amount(self.rmse, self.unit)}"
-        prov = self.model.provenance or {}
-        origin = (f"<br><small>{html.escape(self.model.name or '')}: data sha256 {html.escape(prov['data_sha256'][:12])}…, "
-                  f"{html.escape(prov.get('date', ''))}, thermofriction {html.escape(prov.get('thermofriction', ''))}"
-                  f"</small>") if prov.get("data_sha256") else ""
-        return (f"<div><b>Fit: {html.escape(self.method)}</b> — {'converged' if self.success else 'not converged'}"
-                f"{rmse}{quality}, {self.wall_time:.3g} s{origin}"
-                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-                + (f"<ul>{warn}</ul>" if warn else "") + "</div>")
-
-
-def _plant_lines(plant) -> list:
-    """A drive's inertia and delay (command data: identification/setup.py command_finish), as the report says them."""
-    if not plant:
-        return []
-    J, d = plant["inertia"], plant["delay"]
-    lines = [f"    inertia J        = {J['value']:.6g} +- {J['stderr']:.3g} {J['unit']} (95 %: [{J['ci95'][0]:.5g}, "
-             f"{J['ci95'][1]:.5g}])"]
-    est = f"estimate {d['estimate'] * 1e3:.4g} +- {d['stderr'] * 1e3:.2g} ms"
-    lines.append(f"    delay            = {d['value'] * 1e3:.4g} ms ({est}; {d['note']})")
-    return lines
-
-
-def _verdict(q) -> str:
-    if q["adequate"] is False and q.get("verdict_basis") == "held values":
-        return f"NOT adequate (held values contradicted; the noise cannot be estimated: {q.get('why')})"
-    if q.get("verdict_basis") == "baseline":  # the noise unknown: the model against a model-free map (baseline.py)
-        b = q["baseline"]
-        return (f"{'adequate' if q['adequate'] else 'NOT adequate'} relative to a model-free map of the same runs "
-                f"(held-out RMSE {b['ratio']:.3g} x the map's, at most {b['factor']:g}; the noise cannot be estimated: "
-                f"{q.get('why')})")
-    if q["adequate"] is None:
-        return f"adequacy unknown ({q.get('why') or 'the noise cannot be estimated from the data'})"
-    return "adequate" if q["adequate"] else "NOT adequate"
+    def _html_blocks(self) -> list:
+        """The notebook's table: the headline, the parameters, the warnings (identification/fit_text.py)."""
+        return fit_html_blocks(self)

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 
@@ -15,6 +14,7 @@ from ..data.experiments import run_label
 from ..drive import drive
 from ..errors import InputError
 from ..models import require_actuator
+from ..results import Finding, emit
 from ..simulation import StepSizeController, simulate
 from .base import Measurement, MetricWarning, Trace, center, thermal_check
 from .displacement_start import displacement_initial
@@ -160,8 +160,8 @@ class Displacement(Measurement):
         def pct(value, scale, what):
             if scale > 0:
                 return 100 * value / scale
-            warnings.warn(f"{run_label(exp)}: the measured {what} is zero: percentage errors relative to it are "
-                          f"undefined (NaN)", MetricWarning, stacklevel=3)
+            emit([Finding(MetricWarning, f"{run_label(exp)}: the measured {what} is zero: percentage errors "
+                                         f"relative to it are undefined (NaN)")], stacklevel=3)
             return math.nan
 
         max_pct = pct(float(np.max(np.abs(err))), span, "displacement's span (it is constant)")

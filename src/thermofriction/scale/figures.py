@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write
+from ..errors import InputError
 from ..figures.plots import legend
 from ..figures.units import scaled_axis
 
@@ -86,4 +87,52 @@ def save_bands_figure(result, path):
     return path
 
 
-__all__ = ["bands_figure", "save_bands_figure"]
+def sweep_figure(result, metric=None, x=None):
+    """A sweep's ``metric`` (default its first) against the coordinate ``x`` (default the grid's first), one line
+    per combination of the other coordinates (the first eight), failed points left out."""
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
+
+    metric = metric or result.metrics[0]
+    x = x or result.coordinates[0]
+    if metric not in result.metrics or x not in result.coordinates:
+        raise InputError(f"plot: metric one of {', '.join(result.metrics)}, x one of {', '.join(result.coordinates)}")
+    others = [c for c in result.coordinates if c != x]
+    keys = [tuple(float(result[c][i]) for c in others) for i in range(len(result))]
+    fig = Figure(figsize=(6.5, 3.8))
+    ax = fig.subplots()
+    ok = result.ok
+    for key in list(dict.fromkeys(keys))[:8]:
+        rows = np.array([i for i, k in enumerate(keys) if k == key and ok[i]], int)
+        label = ", ".join(f"{c} {v:g}" for c, v in zip(others, key)) or None
+        ax.plot(result[x][rows], result[metric][rows], "o-", markersize=3, linewidth=0.9, label=label)
+    ax.set_xlabel(result.header(x))
+    ax.set_ylabel(result.header(metric))
+    if others:
+        legend(ax, fontsize=8, frameon=False)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def fleet_figure(result):
+    """Each fitted parameter across a fleet, relative to its median (one column per parameter, one point per
+    dataset), the outliers named."""
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
+
+    s = result.summary()
+    params, rows = result.parameter_table()
+    fig = Figure(figsize=(max(4.0, 1.2 * len(params) + 2), 3.8))
+    ax = fig.subplots()
+    for j, p in enumerate(params):
+        med = s["parameters"][p]["median"] or 1.0
+        names = [n for n in rows if p in rows[n]]
+        ax.plot(np.full(len(names), j), [rows[n][p] / med for n in names], "o", color="#1d2433", markersize=4)
+        for o in s["parameters"][p]["outliers"]:
+            ax.annotate(o["dataset"], (j, o["value"] / med), textcoords="offset points", xytext=(6, 0), fontsize=7)
+    ax.set_xticks(range(len(params)), params)
+    ax.set_ylabel("value / fleet median")
+    ax.set_title(f"{s['identified']} of {s['datasets']} datasets identified ({result.method})", fontsize=9)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+__all__ = ["bands_figure", "save_bands_figure", "sweep_figure", "fleet_figure"]

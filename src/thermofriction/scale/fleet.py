@@ -26,7 +26,9 @@ from .. import _io
 from .. import _args
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import PRESETS, Model, load_model
+from ..results import Result, Summary, heading, lines, table
 from .cluster import Runner, check_options
+from .figures import fleet_figure
 
 #: modified z-score above which a value is an outlier (Iglewicz & Hoaglin 1993: 0.6745 (x - median) / MAD)
 OUTLIER_Z = 3.5
@@ -139,7 +141,7 @@ def _identify_one(data, method, init, kw):
 
 
 @dataclasses.dataclass(eq=False)
-class FleetResult:
+class FleetResult(Result):
     """``names`` in the order given; ``fits`` name -> FitResult; ``failures`` name -> reason;
     ``paths`` name -> the dataset's folder.
 
@@ -182,14 +184,16 @@ class FleetResult:
                 order.setdefault(k, None)
         return list(order), rows
 
-    def summary(self) -> dict:
+    title = "Fleet"
+
+    def summary(self) -> Summary:
         """Each fitted parameter's distribution across the fleet (median, MAD, quartiles, extremes,
         mean and standard deviation), its outliers by a robust modified z-score above 3.5 (named),
         the law kinds chosen per parameter, the fits not adequate to their noise, and the failures."""
         params, rows = self.parameter_table()
-        out = {"method": self.method, "datasets": len(self.names), "identified": len(self.fits),
-               "failed": len(self.failures), "parameters": {}, "laws": {}, "not_adequate": [],
-               "failures": [{"dataset": n, "reason": r} for n, r in self.failures.items()]}
+        out = Summary({"method": self.method, "datasets": len(self.names), "identified": len(self.fits),
+                       "failed": len(self.failures), "parameters": {}, "laws": {}, "not_adequate": [],
+                       "failures": [{"dataset": n, "reason": r} for n, r in self.failures.items()]})
         for p in params:
             names = [n for n in rows if p in rows[n]]
             x = np.array([rows[n][p] for n in names], float)
@@ -218,29 +222,43 @@ class FleetResult:
                 return fit.parameters[p].unit
         return ""
 
-    def report(self) -> str:
-        """The summary as text: one line per parameter, then outliers, laws and failures."""
+    def _blocks(self) -> list:
+        """The summary as a report: one line per parameter, then outliers, laws and failures."""
         s = self.summary()
-        lines = [f"[[Fleet: {self.method}]] {s['identified']} of {s['datasets']} datasets identified"
-                 + (f", {s['failed']} failed" if s["failed"] else "")]
+        blocks = [heading(f"Fleet: {self.method}", f"{s['identified']} of {s['datasets']} datasets identified"
+                          + (f", {s['failed']} failed" if s["failed"] else ""))]
         if s["parameters"]:
             head = ("parameter", "median", "MAD", "min", "max", "unit", "outliers")
-            rows = [(p, f"{d['median']:.5g}", f"{d['mad']:.3g}", f"{d['min']:.5g}", f"{d['max']:.5g}", d["unit"],
-                     ", ".join(o["dataset"] for o in d["outliers"])) for p, d in s["parameters"].items()]
-            w = [max(len(r[i]) for r in rows + [head]) for i in range(len(head))]
-            lines.append("    " + "  ".join(h.ljust(w[i]) for i, h in enumerate(head)).rstrip())
-            lines += ["    " + "  ".join(c.ljust(w[i]) for i, c in enumerate(r)).rstrip() for r in rows]
-        for p, d in s["parameters"].items():
-            for o in d["outliers"]:
-                lines.append(f"    outlier: {o['dataset']}: {p} = {o['value']:.5g} {d['unit']} "
-                             f"(modified z {o['z']:+.1f})")
-        for p, counts in s["laws"].items():
-            lines.append(f"    law of {p}: " + ", ".join(f"{k} x{c}" for k, c in sorted(counts.items())))
-        for q in s["not_adequate"]:
-            lines.append(f"    not adequate: {q['dataset']} (residuals {q['ratio']:.3g} x its noise)")
-        for f in s["failures"]:
-            lines.append(f"    FAILED: {f['dataset']}: {f['reason']}")
-        return "\n".join(lines)
+            blocks.append(table(head, [(p, f"{d['median']:.5g}", f"{d['mad']:.3g}", f"{d['min']:.5g}",
+                                        f"{d['max']:.5g}", d["unit"], ", ".join(o["dataset"] for o in d["outliers"]))
+                                       for p, d in s["parameters"].items()], strip=True))
+        notes = [f"outlier: {o['dataset']}: {p} = {o['value']:.5g} {d['unit']} (modified z {o['z']:+.1f})"
+                 for p, d in s["parameters"].items() for o in d["outliers"]]
+        notes += [f"law of {p}: " + ", ".join(f"{k} x{c}" for k, c in sorted(counts.items()))
+                  for p, counts in s["laws"].items()]
+        notes += [f"not adequate: {q['dataset']} (residuals {q['ratio']:.3g} x its noise)" for q in s["not_adequate"]]
+        notes += [f"FAILED: {f['dataset']}: {f['reason']}" for f in s["failures"]]
+        return blocks + [lines(notes)]
+
+    def to_dict(self) -> dict:
+        """The fleet as plain JSON types: the method, the summary (fleet.json's content), each dataset's folder and
+        status, the fits' results JSON (docs/formats.md#results-json) by name, the failures' reasons."""
+        return _io.jsonable({"method": self.method, "summary": self.summary(), "paths": self.paths,
+                             "fits": {n: f.to_dict() for n, f in self.fits.items()}, "failures": self.failures,
+                             "wall_time": self.wall_time, "where": self.where})
+
+    def _frame(self) -> dict:
+        """One row per dataset: its name, status, RMSE and each fitted parameter's value (None where failed)."""
+        params, rows = self.parameter_table()
+        frame = {"dataset": list(self.names),
+                 "status": ["ok" if n in self.fits else "failed" for n in self.names],
+                 "rmse": [float(self.fits[n].rmse) if n in self.fits else None for n in self.names]}
+        frame.update({p: [rows.get(n, {}).get(p) for n in self.names] for p in params})
+        return frame
+
+    def plot(self):
+        """A matplotlib figure: each fitted parameter across the fleet, relative to its median, outliers named."""
+        return fleet_figure(self)
 
     def to_csv_text(self) -> str:
         """One row per dataset: name, status, rmse, then each parameter's value (empty where failed)."""
@@ -365,8 +383,7 @@ def identify_fleet(datasets, method="model-i", init=None, *, scheduler=None, wor
         if progress:
             progress(base)
         outs = runner.map(_identify_one, [(loaded[n], method, init, identify_options) for n in todo],
-                          progress=report, on_error=lambda i, reason: ("failed", reason),
-                          records_warnings=True)  # each fit's held-out warnings in its own list (_warning_routes)
+                          progress=report, on_error=lambda i, reason: ("failed", reason))
         where = runner.describe()
     for name, (status, value) in zip(todo, outs):
         if status == "ok":

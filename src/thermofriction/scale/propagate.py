@@ -25,6 +25,7 @@ from .. import _io
 from .. import _args
 from ..waveforms import Waveform
 from ..errors import InputError, ThermofrictionError, shorten
+from ..results import Result, Summary, fields, heading, lines
 from .cluster import Runner
 from .sweep import check_run_options
 
@@ -169,7 +170,7 @@ def _run_draws(model, names, thetas, temperatures, waveform, sim):
 
 
 @dataclasses.dataclass(eq=False)
-class PropagationResult:
+class PropagationResult(Result):
     """Bands over draws, per temperature (rows) and output time (columns), SI units.
 
     Parameters
@@ -265,14 +266,29 @@ class PropagationResult:
         name = str(getattr(path, "path", path)).lower()
         return (self.to_csv if name.endswith(".csv") else self.to_mat if name.endswith(".mat") else self.to_json)(path)
 
-    def report(self) -> str:
-        lines = [f"[[Propagation]] {self.draws} draws ({len(self.failures)} failed), {100 * self.level:g} % bands"]
-        for j, T in enumerate(self.temperatures):
-            lines.append(f"    {T:g} C: step per cycle {self.nominal_step[j] * 1e6:.5g} um "
-                         f"[{self.step_lower[j] * 1e6:.5g}, {self.step_upper[j] * 1e6:.5g}]; final displacement "
-                         f"{self.nominal[j, -1] * 1e6:.5g} um [{self.lower[j, -1] * 1e6:.5g}, "
-                         f"{self.upper[j, -1] * 1e6:.5g}]")
-        return "\n".join(lines)
+    title = "Propagation"
+
+    def summary(self) -> Summary:
+        return Summary([("draws", self.draws), ("failed", len(self.failures)), ("level", f"{100 * self.level:g} %"),
+                        ("temperatures", ", ".join(f"{T:g}" for T in self.temperatures) + " C"),
+                        ("noise", f"{self.noise * 1e9:.4g} nm")])
+
+    def _frame(self) -> dict:
+        """One row per temperature: the mean step per cycle and the final displacement, nominal and band [m]."""
+        return {"temperature": self.temperatures, "nominal_step": self.nominal_step, "step_lower": self.step_lower,
+                "step_upper": self.step_upper, "final_displacement": self.nominal[:, -1],
+                "final_lower": self.lower[:, -1], "final_upper": self.upper[:, -1]}
+
+    def _blocks(self) -> list:
+        return [heading(self.title, f"{self.draws} draws ({len(self.failures)} failed), {100 * self.level:g} % bands"),
+                lines(f"{T:g} C: step per cycle {self.nominal_step[j] * 1e6:.5g} um "
+                      f"[{self.step_lower[j] * 1e6:.5g}, {self.step_upper[j] * 1e6:.5g}]; final displacement "
+                      f"{self.nominal[j, -1] * 1e6:.5g} um [{self.lower[j, -1] * 1e6:.5g}, "
+                      f"{self.upper[j, -1] * 1e6:.5g}]" for j, T in enumerate(self.temperatures))]
+
+    def _html_blocks(self) -> list:
+        blocks = self._blocks()
+        return blocks[:1] + [fields(self.summary().rows())] + blocks[1:]
 
     def __repr__(self):
         return (f"PropagationResult({self.draws} draws at {', '.join(f'{T:g}' for T in self.temperatures)} C, "

@@ -26,7 +26,9 @@ from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
 from ..waveforms import Sampled, Waveform
-from .cluster import Runner, check_options, recorded_warnings
+from ..results import Result, Summary, collecting, heading, lines
+from .cluster import Runner, check_options
+from .figures import sweep_figure
 
 #: the most points of one sweep (their coordinates and metrics are held in memory: ~100 bytes each)
 MAX_POINTS = 50_000_000
@@ -167,7 +169,7 @@ def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim)
     errors, seen = {}, {}
     for i, row in enumerate(coords):
         point = dict(zip(names, (float(v) for v in row)))
-        with recorded_warnings() as caught:
+        with collecting() as caught:  # the point's findings, as values
             try:
                 T = point.get("temperature", temperature)
                 inp = {n: v for n, v in point.items() if kinds[n] == "input"}
@@ -190,7 +192,7 @@ def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim)
 # -- the result -------------------------------------------------------------------------------
 
 @dataclasses.dataclass(eq=False)
-class SweepResult:
+class SweepResult(Result):
     """One row per point: the coordinates, then the metrics (NaN where the point failed).
 
     ``res[name]`` is a column (coordinates and metrics by name), ``units[name]`` its unit;
@@ -253,14 +255,37 @@ class SweepResult:
         rec["error"] = [self.errors.get(i, "") for i in range(len(self))]
         return rec
 
-    def to_dataframe(self):
-        try:
-            import pandas as pd
-        except ImportError:  # pragma: no cover - depends on the environment
-            raise ImportError("to_dataframe() needs pandas: pip install 'thermofriction[dataframe]'") from None
+    title = "Sweep"
+
+    def summary(self) -> Summary:
+        return Summary([("points", len(self)), ("failed", self.failed), ("grid", ", ".join(self.coordinates)),
+                        ("metrics", ", ".join(self.metrics)), ("wall time", f"{self.wall_time:.3g} s"),
+                        ("where", self.where)])
+
+    def _frame(self) -> dict:
+        """One column per coordinate and metric, headed with its unit, then ``error`` (empty where the point ran)."""
         data = {self.header(n): self.columns[n] for n in self.coordinates + self.metrics}
         data["error"] = [self.errors.get(i, "") for i in range(len(self))]
-        return pd.DataFrame(data)
+        return data
+
+    def to_dict(self) -> dict:
+        """The sweep as plain JSON types: the grid's and the metrics' names, their units and columns (SI), the
+        failed points' reasons by row, the warnings."""
+        return _io.jsonable({"coordinates": list(self.coordinates), "metrics": list(self.metrics),
+                             "units": self.units, "columns": self.columns,
+                             "errors": {str(k): v for k, v in self.errors.items()}, "warnings": self.warnings,
+                             "wall_time": self.wall_time, "where": self.where})
+
+    def _blocks(self) -> list:
+        blocks = super()._blocks()
+        if self.warnings:
+            blocks += [heading("Warnings"), lines(self.warnings)]
+        return blocks
+
+    def plot(self, metric=None, x=None):
+        """A matplotlib figure of ``metric`` (default the first) against the grid coordinate ``x`` (default the
+        first), one line per value of the other coordinates (at most a few)."""
+        return sweep_figure(self, metric, x)
 
     def to_csv(self, path):
         """Writes the table atomically: a header with units, numbers exact to the last bit (repr),
@@ -426,7 +451,7 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
             return np.full((b - a, len(metrics)), np.nan), {k: reason for k in range(b - a)}, []
         spans, outs = runner.map_chunks(
             _run_batch, n, lambda a, b: (model, waveform, temperature, names, kinds, coords[a:b], metrics, sim),
-            batch_size=batch_size, progress=progress, on_error=lost, records_warnings=True)
+            batch_size=batch_size, progress=progress, on_error=lost)
         where = runner.describe()
     values = np.vstack([o[0] for o in outs]) if outs else np.empty((0, len(metrics)))
     errors, seen = {}, {}

@@ -23,8 +23,9 @@ from .. import _args
 from ..errors import InputError, SolverError, shorten
 from ..models import Model, PrescribedMotion, StickSlipPlant
 from ..waveforms import Sampled, Waveform
+from ..results import emit
 from .checks import (as_temperature, check_heated_temperatures, check_passivity, check_prescribed_motion,
-                     check_temperature_coverage, check_temperatures)
+                     check_temperatures, coverage_findings, heated_findings, temperature_findings)
 from .result import SimulationResult
 from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 
@@ -313,19 +314,20 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
                              "temperature as a number (--temperature C), not a temperature signal")
         heat = model.heat.resolved(temperature)
         T_start = sorted({heat.initial_temperature, heat.ambient_temperature})
-        check_temperatures(model, T_start[0] if len(T_start) == 1 else Sampled(np.array([0.0, 1.0]),
-                                                                                np.array(T_start)))
+        found = temperature_findings(model, T_start[0] if len(T_start) == 1 else Sampled(np.array([0.0, 1.0]),
+                                                                                          np.array(T_start)))
     else:
-        check_temperatures(model, temperature)
+        found = temperature_findings(model, temperature)
     friction_work = bool(friction_work) or heat is not None
     waveform = input_of(model, input)
     grid = (_Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period, max_samples)
             if t_eval is not None or not (isinstance(duration, numbers.Real) and isinstance(sample_rate, numbers.Real))
             else _uniform_grid(float(duration), float(sample_rate), waveform.period, max_samples))
     if model.thermal is not None and heat is None:
-        check_temperature_coverage(temperature, float(grid.requested[0]), float(grid.requested[-1]))
+        found += coverage_findings(temperature, float(grid.requested[0]), float(grid.requested[-1]))
     if isinstance(model.plant, PrescribedMotion):
         check_prescribed_motion(waveform)
+    emit(found)  # the checks' findings, as warnings (before the run, which may fail), and on the result
 
     # run
     state_names = (_bridge.MECHANICAL_STATES[model.plant.type] + tuple(model.friction.state_names)
@@ -347,7 +349,10 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     except _bridge.CoreFailure as e:
         raise _explain(e, model, solver, controller, waveform, state_names) from None
     stats["solver"] = stats.pop("method")
-    return _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period)
+    res = _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period)
+    emit(res.findings)  # self-heating's, known after the run
+    res.findings[:0] = found
+    return res
 
 
 @functools.lru_cache(maxsize=16)
@@ -387,8 +392,8 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
         cols["stage_displacement"] = cols["stage_velocity"] = None
     if temperature is None and heat is None:
         cols["temperature"][:] = math.nan
-    if heat is not None and model.thermal is not None:
-        check_heated_temperatures(model, cols["time"], cols["temperature"])
+    found = heated_findings(model, cols["time"], cols["temperature"]) if heat is not None and \
+        model.thermal is not None else []
     nfric = model.friction.nstate
     return SimulationResult(
         **cols,
@@ -403,6 +408,7 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
         stats=stats,
         model_name=model.name,
         rotary=bool(getattr(model.plant, "rotary", False)),
+        findings=found,
     )
 
 

@@ -1,20 +1,18 @@
 """Checks before (and, with self-heating, after) a run: the temperature against the laws'
 ranges and the model's physical domain, dissipativity, and prescribed motion's continuity.
-Warnings for what may be wrong, InputError for what is."""
+Findings (results.Finding: values) for what may be wrong, which ``simulate`` turns into warnings as it returns;
+InputError for what is. The ``check_*`` functions emit the findings of their ``*_findings`` counterparts."""
 
 from __future__ import annotations
 
 import math
-import threading
-import warnings
-import weakref
 
 import numpy as np
 
-from .._warning_routes import recorded_warnings
 from ..errors import ConditioningWarning, InputError, PassivityWarning, SolverError, TemperatureRangeWarning
 from ..models import Model, ModelI, ModelII, check_friction_values, dissipativity_violation
 from ..plausible import check_temperature
+from ..results import Finding, emit
 from ..waveforms import Sampled, Sawtooth, Step, Waveform, Zero
 
 
@@ -81,9 +79,38 @@ def check_prescribed_motion(waveform: Waveform):
         raise InputError("prescribed motion: a sawtooth with rise 0 or 1 jumps; use 0 < rise < 1")
 
 
+def passivity_findings(model: Model, temperatures=(math.nan,)) -> list:
+    """A PassivityWarning finding where a LuGre-type model can create energy at these temperatures
+    (``dissipativity_violation``): at the first such temperature, else none.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    temperatures : sequence of float, default (nan,)
+        The temperatures [C] tested (a model without laws: any value).
+
+    Returns
+    -------
+    list of Finding
+        At most one.
+
+    Raises
+    ------
+    KeyError
+        A friction model without a parameter the test requires (the model is not checked here).
+    """
+    for T in temperatures:
+        found = dissipativity_violation(model.friction.model, model.parameters_at(T))
+        if found:
+            where = f" at {T:g} C" if isinstance(model.thermal, ModelI) else ""
+            return [Finding(PassivityWarning, f"{model.friction.model}{where}: {found[1]}")]
+    return []
+
+
 def check_passivity(model: Model, temperatures=(math.nan,)):
     """Warns (PassivityWarning) when a LuGre-type model can create energy at these temperatures
-    (``dissipativity_violation``).
+    (:func:`passivity_findings`).
 
     Parameters
     ----------
@@ -106,48 +133,73 @@ def check_passivity(model: Model, temperatures=(math.nan,)):
     PassivityWarning
         At the first temperature where the model may create energy.
     """
-    for T in temperatures:
-        found = dissipativity_violation(model.friction.model, model.parameters_at(T))
-        if found:
-            where = f" at {T:g} C" if isinstance(model.thermal, ModelI) else ""
-            warnings.warn(f"{model.friction.model}{where}: {found[1]}", PassivityWarning, stacklevel=5)
-            return
+    emit(passivity_findings(model, temperatures))
 
 
-def check_temperature_coverage(temperature, t0: float, t1: float):
-    """Warns when a temperature signal does not cover the run [t0, t1]: beyond its ends it is
+def coverage_findings(temperature, t0: float, t1: float) -> list:
+    """A finding when a temperature signal does not cover the run [t0, t1]: beyond its ends it is
     held constant, which is rarely what a file starting at t = 5 s for a 0-0.1 s run meant."""
     if not isinstance(temperature, Sampled):
-        return
+        return []
     a, b = float(temperature.time[0]), float(temperature.time[-1])
     tol = 1e-9 * max(1.0, abs(t0), abs(t1))
     if a > t0 + tol or b < t1 - tol:
         where = f" ({temperature.file})" if temperature.file else ""
-        warnings.warn(f"the temperature signal{where} covers {a:g}..{b:g} s, the run {t0:g}..{t1:g} s: outside "
-                      f"it the temperature is held at its first or last value", TemperatureRangeWarning,
-                      stacklevel=3)
+        return [Finding(TemperatureRangeWarning, f"the temperature signal{where} covers {a:g}..{b:g} s, the run "
+                        f"{t0:g}..{t1:g} s: outside it the temperature is held at its first or last value")]
+    return []
 
 
-# Models (frozen) checked without a warning at a constant temperature, by identity (a model holds dicts:
-# it is not hashable): a model run again and again at one temperature (identification, sweeps, a
-# benchmark) is checked once. The entry goes with its model (a weak reference's callback).
-_PASSED: dict = {}
-# catch_warnings changes the warnings module's global state: threads that simulate side by side (tf.sweep's)
-# take turns here, or one would restore the state another had set and the warnings after it would be lost (a
-# Runner's pool threads record into their own lists instead: _warning_routes.py)
-_RECORDING = threading.RLock()
+def check_temperature_coverage(temperature, t0: float, t1: float):
+    """Warns (TemperatureRangeWarning) when a temperature signal does not cover the run [t0, t1]
+    (:func:`coverage_findings`)."""
+    emit(coverage_findings(temperature, t0, t1), stacklevel=3)
 
 
-def _passed(model) -> set:
-    entry = _PASSED.get(id(model))
-    return entry[1] if entry is not None and entry[0]() is model else set()
+#: a model (frozen) keeps the findings of each constant temperature it was checked at, in its instance's own
+#: dictionary (not a field: not compared, not copied by dataclasses.replace, gone with the model): a model run
+#: again and again at one temperature (identification, sweeps, a benchmark) is checked once. Findings are values,
+#: so a temperature with findings is cached as well as one without
+_MEMO = "_thermofriction_findings"
+
+
+def temperature_findings(model: Model, temperature) -> list:
+    """What a run at ``temperature`` should say, as findings: temperatures outside a law's calibrated range, a
+    LuGre-type model that is not dissipative there, Model II's offset form anti-damped; raises where the model is
+    invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain). A constant
+    temperature's are computed once per model.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    temperature : float or Sampled or None
+        The temperature [C], or a temperature signal (its range is tested).
+
+    Returns
+    -------
+    list of Finding
+        TemperatureRangeWarning, PassivityWarning and ConditioningWarning findings, in that order.
+
+    Raises
+    ------
+    InputError
+        The model is invalid at the temperature, named with the parameter and the temperature.
+    """
+    memo = None if isinstance(temperature, Sampled) else model.__dict__.setdefault(_MEMO, {})
+    if memo is not None and temperature in memo:
+        return list(memo[temperature])
+    found = []
+    _check_temperatures(model, temperature, found)
+    if memo is not None:
+        memo[temperature] = tuple(found)
+    return found
 
 
 def check_temperatures(model: Model, temperature):
     """Warns for temperatures outside a law's calibrated range; raises where the model is
     invalid there (Model II's lambda <= 0, a Model I parameter out of its physical domain).
-    Warns where a LuGre-type model is not dissipative. A constant temperature that passed once is not tested
-    again for the same model.
+    Warns where a LuGre-type model is not dissipative (:func:`temperature_findings`, emitted).
 
     Parameters
     ----------
@@ -172,27 +224,12 @@ def check_temperatures(model: Model, temperature):
     PassivityWarning
         A LuGre-type model that may create energy there.
     """
-    key = None if isinstance(temperature, Sampled) else temperature
-    if key is not None and key in _passed(model):
-        return
-    with _RECORDING, recorded_warnings() as caught:
-        _check_temperatures(model, temperature)
-    for w in caught:  # passed on as they came (stacklevel as the checks set it)
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
-    if key is not None and not caught:
-        known = _passed(model)
-        if not known:
-            try:
-                ref = weakref.ref(model, lambda _, k=id(model): _PASSED.pop(k, None))
-            except TypeError:  # a model that cannot be weakly referenced: no cache
-                return
-            _PASSED[id(model)] = (ref, known)
-        known.add(key)
+    emit(temperature_findings(model, temperature), stacklevel=3)  # (the caller's caller: simulate's, as before)
 
 
-def _check_temperatures(model: Model, temperature):
+def _check_temperatures(model: Model, temperature, found: list):
     if model.thermal is None:
-        check_passivity(model)
+        found += passivity_findings(model)
         return
     if temperature is None:
         raise InputError("the model depends on temperature: give a temperature (e.g. --temperature 35)")
@@ -214,8 +251,8 @@ def _check_temperatures(model: Model, temperature):
                if not law.in_range(Ts)]
     if outside:
         span = f"{Ts[0]:g} C" if len(Ts) == 1 else f"{Ts.min():g}..{Ts.max():g} C"
-        warnings.warn(f"temperature {span} is outside the calibrated range of the law(s) for "
-                      f"{', '.join(outside)}", TemperatureRangeWarning, stacklevel=4)
+        found.append(Finding(TemperatureRangeWarning, f"temperature {span} is outside the calibrated range of the "
+                                                      f"law(s) for {', '.join(outside)}"))
     if isinstance(model.thermal, ModelI):
         for T in (Ts.min(), Ts.max()) if len(Ts) > 1 else Ts:
             check_friction_values(model.parameters_at(T), f"Model I at {T:g} C")
@@ -225,7 +262,7 @@ def _check_temperatures(model: Model, temperature):
                 if name in ("sigma0", "fc") and np.any(vals <= 0):
                     T_bad = Ts[np.argmax(vals <= 0)]
                     raise InputError(f"Model I: '{name}' is not positive at {T_bad:g} C ({law(T_bad):g})")
-    check_passivity(model, (Ts.min(), Ts.max()) if isinstance(model.thermal, ModelI) else (math.nan,))
+    found += passivity_findings(model, (Ts.min(), Ts.max()) if isinstance(model.thermal, ModelI) else (math.nan,))
     if isinstance(model.thermal, ModelII) and model.thermal.form == "scale":
         lam = np.atleast_1d(model.thermal_factor(Ts))
         if np.any(lam <= 0):
@@ -249,15 +286,48 @@ def _check_temperatures(model: Model, temperature):
             damping += p["fs"] / p["v_smooth"]
             what = "sigma2 + fs/v_smooth"
         if dF[i] < 0 and -dF[i] / p["v_smooth"] > damping:
-            warnings.warn(f"Model II offset form: dF = {dF[i]:.4g} N at {Ts[i]:g} C is anti-damped near v = 0 "
-                          f"(dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against {what} = "
-                          f"{damping:.3g} N s/m); the solution is ill-conditioned: use Dopri5 with rtol <= 1e-8, "
-                          f"or the scale form", ConditioningWarning, stacklevel=4)
+            found.append(Finding(ConditioningWarning, f"Model II offset form: dF = {dF[i]:.4g} N at {Ts[i]:g} C is "
+                                 f"anti-damped near v = 0 (dF/v_smooth = {dF[i] / p['v_smooth']:.3g} N s/m against "
+                                 f"{what} = {damping:.3g} N s/m); the solution is ill-conditioned: use Dopri5 with "
+                                 f"rtol <= 1e-8, or the scale form"))
+
+
+def heated_findings(model: Model, time, temperature) -> list:
+    """With self-heating the temperature range is known only after the run: findings where it left a
+    law's calibrated range; refuses a run that crossed a temperature where the model is invalid.
+
+    Parameters
+    ----------
+    model : Model
+        The model simulated.
+    time : numpy.ndarray
+        The run's output times [s].
+    temperature : numpy.ndarray
+        The run's temperature [C] at those times.
+
+    Returns
+    -------
+    list of Finding
+        As :func:`temperature_findings` over the range the run visited.
+
+    Raises
+    ------
+    SolverError
+        The temperature reached values where the model is invalid (Model II's factor <= 0, a Model I
+        parameter out of its physical domain).
+    """
+    lo, hi = float(np.min(temperature)), float(np.max(temperature))
+    try:
+        return temperature_findings(model, Sampled(np.array([0.0, 1.0]), np.array([lo, hi])) if hi > lo else lo)
+    except InputError as e:
+        raise SolverError(f"self-heating took the temperature to {lo:.4g}..{hi:.4g} C, where the model is "
+                          f"invalid: {e}") from None
 
 
 def check_heated_temperatures(model: Model, time, temperature):
     """With self-heating the temperature range is known only after the run: warn where it left a
-    law's calibrated range, refuse a run that crossed a temperature where the model is invalid.
+    law's calibrated range, refuse a run that crossed a temperature where the model is invalid
+    (:func:`heated_findings`, emitted).
 
     Parameters
     ----------
@@ -283,13 +353,9 @@ def check_heated_temperatures(model: Model, time, temperature):
     TemperatureRangeWarning
         The temperature left a law's calibrated range.
     """
-    lo, hi = float(np.min(temperature)), float(np.max(temperature))
-    try:
-        check_temperatures(model, Sampled(np.array([0.0, 1.0]), np.array([lo, hi])) if hi > lo else lo)
-    except InputError as e:
-        raise SolverError(f"self-heating took the temperature to {lo:.4g}..{hi:.4g} C, where the model is "
-                          f"invalid: {e}") from None
+    emit(heated_findings(model, time, temperature))
 
 
 __all__ = ["as_temperature", "check_temperature_coverage", "check_prescribed_motion", "check_passivity", "check_temperatures",
-           "check_heated_temperatures"]
+           "check_heated_temperatures", "temperature_findings", "passivity_findings", "coverage_findings",
+           "heated_findings"]

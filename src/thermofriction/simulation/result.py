@@ -9,7 +9,7 @@ import numpy as np
 from .._bridge import OUTPUTS
 from .._io import atomic_write
 from ..figures.friction_plots import simulation_figure
-from ..results import Result
+from ..results import Result, Summary
 
 
 @dataclass(eq=False)
@@ -63,6 +63,9 @@ class SimulationResult(Result):
         The simulated model's name (the figures' titles).
     rotary : bool, default False
         Whether the motion is a rotary joint's (rad, N m).
+    findings : list of Finding, default []
+        What the checks found (a temperature outside a law's calibrated range, a model that may create energy),
+        as values; ``simulate`` warned each as it returned.
     """
 
     time: np.ndarray
@@ -87,6 +90,8 @@ class SimulationResult(Result):
     #: the simulated model's name (the figures' titles) and whether its motion is rotary (rad, N m)
     model_name: str | None = None
     rotary: bool = False
+    #: what the checks found (results.Finding: a temperature outside a law's range, ...), warned as simulate returned
+    findings: list = field(default_factory=list)
 
     def columns(self) -> dict:
         """The CSV columns (docs/formats.md#simulation-output), header -> array."""
@@ -138,7 +143,7 @@ class SimulationResult(Result):
         once, ``fig.savefig(path)`` writes it."""
         return simulation_figure(self, what, title)
 
-    def summary(self) -> list:
+    def summary(self) -> Summary:
         rows = [("samples", f"{len(self.time)}"), ("duration", f"{self.time[-1] - self.time[0]:.6g} s"),
                 ("final displacement", f"{self.displacement[-1] * 1e6:.6g} µm"),
                 ("peak friction force", f"{np.max(np.abs(self.friction_force)):.4g} N")]
@@ -147,7 +152,7 @@ class SimulationResult(Result):
                      ("mean step per cycle", f"{self.step_sizes.mean() * 1e6:.6g} µm"),
                      ("mean velocity", f"{self.mean_velocity * 1e6:.6g} µm/s")]
         rows.append(("solver", f"{self.stats.get('solver', '?')}: {self.stats.get('steps', '?')} steps"))
-        return rows
+        return Summary(rows)
 
     def __repr__(self):
         return (f"SimulationResult({len(self.time)} samples over {self.time[-1] - self.time[0]:.6g} s, "

@@ -1,0 +1,148 @@
+"""A fit's report and its notebook table (FitResult holds the data; this module says it): the structured blocks
+of :mod:`thermofriction.results`, which its one formatter writes as text and HTML, and the fit-quality verdict
+in words."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..measurements import amount
+from ..results import fields, heading, lines, table
+from ..fitting.shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
+
+#: the parameter table's columns
+HEAD = ("name", "value", "stderr", "rel", "95 % interval", "unit")
+#: the label width of a fit report's fields ("data points      = ...")
+WIDTH = 16
+
+
+def parameter_rows(fit) -> list:
+    """One row of text cells per parameter (HEAD's columns)."""
+    return [(p.name, *shown(p.to_dict()), p.unit) for p in fit.parameters.values()]
+
+
+def verdict(q) -> str:
+    """The fit quality's verdict (``FitResult.fit_quality``) in words."""
+    if q["adequate"] is False and q.get("verdict_basis") == "held values":
+        return f"NOT adequate (held values contradicted; the noise cannot be estimated: {q.get('why')})"
+    if q.get("verdict_basis") == "baseline":  # the noise unknown: the model against a model-free map (baseline.py)
+        b = q["baseline"]
+        return (f"{'adequate' if q['adequate'] else 'NOT adequate'} relative to a model-free map of the same runs "
+                f"(held-out RMSE {b['ratio']:.3g} x the map's, at most {b['factor']:g}; the noise cannot be estimated: "
+                f"{q.get('why')})")
+    if q["adequate"] is None:
+        return f"adequacy unknown ({q.get('why') or 'the noise cannot be estimated from the data'})"
+    return "adequate" if q["adequate"] else "NOT adequate"
+
+
+def _not_adequate(fit) -> list:
+    """The one verdict (fit_quality), first and in plain words, as the warnings say it."""
+    if fit.adequate is not False:
+        return []
+    held = [h for h in (fit.fit_quality or {}).get("held") or [] if h["contradicted"]]
+    basis, b = fit.fit_quality.get("verdict_basis"), fit.fit_quality.get("baseline") or {}
+    return ["NOT ADEQUATE: " + (
+        f"{len(held)} held value(s) contradicted by the data (the noise cannot be estimated from these data: "
+        f"the residuals are not compared with it)" if basis == "held values" else
+        f"held-out RMSE {b.get('ratio', math.nan):.3g} x a model-free map's on the same runs (the noise cannot "
+        f"be estimated from these data)" if basis == "baseline" else
+        f"residuals {fit.fit_quality['ratio']:.3g} x the measurement noise"
+        + (f", {len(held)} held value(s) contradicted by the data" if held else "")) + " (see the first warnings)"]
+
+
+def _offset_rows(fit) -> list:
+    o, unit = fit.sensor_offset, fit.unit
+    if o.get("per_experiment"):
+        return [("sensor offset", f"{r['value']:.6g} +- {r['stderr']:.3g} {unit} ({r['file']}, its own)")
+                for r in o["per_experiment"]]
+    if not o:
+        return []
+    how = "fitted, shared by all experiments" if o.get("fitted") else "held (--offset none)"
+    err = f" +- {o['stderr']:.3g}" if o.get("fitted") and o.get("stderr") is not None else ""
+    if err and not math.isfinite(o["stderr"]):
+        err, how = "", how + "; not determined: see the warnings"
+    return [("sensor offset", f"{o['value']:.6g}{err} {unit} ({how})")]
+
+
+def _plant_rows(plant) -> list:
+    """A drive's inertia and delay (command data: the measurement's completion), as the report says them."""
+    if not plant:
+        return []
+    J, d = plant["inertia"], plant["delay"]
+    est = f"estimate {d['estimate'] * 1e3:.4g} +- {d['stderr'] * 1e3:.2g} ms"
+    return [("inertia J", f"{J['value']:.6g} +- {J['stderr']:.3g} {J['unit']} (95 %: [{J['ci95'][0]:.5g}, "
+                          f"{J['ci95'][1]:.5g}])"),
+            ("delay", f"{d['value'] * 1e3:.4g} ms ({est}; {d['note']})")]
+
+
+def _paper_lines(fit) -> list:
+    """What the paper's procedure of Model II did, step by step, with its numbers."""
+    p = fit.details["paper"]
+    lin = p.get("linear_fit", {})
+    Ts = ", ".join(f"{t:.4g}" for t in np.atleast_1d(p.get("temperatures", [])))
+    law = p.get("dF_law", {})
+    knots = ", ".join(f"{v:+.4g} N at {t:.4g} C" for t, v in zip(law.get("T", []), law.get("values", [])))
+    return [f"1. base model fitted at the reference temperature "
+            f"{fit.details.get('reference_temperature', math.nan):.4g} C",
+            f"2. final displacement against temperature ({Ts} C): two straight segments, breakpoint "
+            f"{p.get('breakpoint', math.nan):.4g} C, R^2 = {p.get('segmented_r2', math.nan):.3f}",
+            f"3. final displacement against a constant dF, simulated: linear, slope "
+            f"{lin.get('slope', math.nan) * 1e6:.4g} um/N, R^2 = {lin.get('r2', math.nan):.3f}",
+            f"4. dF(T) read through that line: {knots}",
+            "no trajectory fit: no RMSE and no intervals here; `validate` gives this model's errors"]
+
+
+def _correlated(fit, above: float = 0.5) -> list:
+    names = [p.name for p in fit.parameters.varying]
+    if np.shape(fit.correlation) != (len(names), len(names)):  # no joint fit, no correlations
+        return []
+    c = fit.correlation
+    pairs = [(names[i], names[j], c[i, j]) for i in range(len(names)) for j in range(i + 1, len(names))
+             if np.isfinite(c[i, j]) and abs(c[i, j]) > above]
+    return [f"C({a}, {b}) = {r:+.3f}" for a, b, r in sorted(pairs, key=lambda x: -abs(x[2]))]
+
+
+def fit_blocks(fit) -> list:
+    """A fit's report (like lmfit's fit report) as the structured blocks of thermofriction.results."""
+    blocks = [heading(f"Fit: {fit.method}"), lines(_not_adequate(fit))]
+    if fit.n_points == 0 and "paper" in fit.details:  # no trajectory fit: say what was done instead
+        blocks.append(lines([f"{'done' if fit.success else 'REFUSED'}: {fit.message}"] + _paper_lines(fit)))
+        rows = []
+    else:
+        blocks.append(lines([f"{'converged' if fit.success else 'NOT CONVERGED'}: {fit.message}"]))
+        rows = [("data points", str(fit.n_points)),
+                ("rmse", f"{amount(fit.rmse, fit.unit)} ({fit.removed} removed)")]
+        rows += _offset_rows(fit) + _plant_rows(fit.details.get("plant"))
+    q = fit.fit_quality
+    if q is not None:
+        rows.append(("noise (data)", f"{amount(q['noise'], fit.unit)}; rmse/noise = {q['ratio']:.3g}, "
+                                     f"lag-1 autocorrelation {q['autocorrelation']:.2f}, {verdict(q)}"))
+    rows += [("evaluations", f"{fit.nfev} (Jacobians {fit.njev}), starts = {fit.starts}"),
+             ("fit time", f"{fit.wall_time:.3g} s (the least-squares fits; not the checks after them)")]
+    blocks += [fields(rows, WIDTH), heading("Parameters"), table(HEAD, parameter_rows(fit))]
+    pairs = _correlated(fit)
+    if pairs:
+        blocks += [heading("Correlations", "(|C| > 0.5)"), lines(pairs)]
+    if fit.warnings:
+        blocks += [heading("Warnings"), lines(fit.warnings)]
+    return blocks
+
+
+def fit_html_blocks(fit) -> list:
+    """A fit's notebook table as blocks: the headline (converged, RMSE, the noise and the verdict, the time), where
+    the model came from, the parameters, the warnings."""
+    q = fit.fit_quality
+    quality = "" if q is None else (f", noise {amount(q['noise'], fit.unit)}: rmse/noise {q['ratio']:.3g}, "
+                                    f"{verdict(q)}")
+    rmse = "" if fit.n_points == 0 else f", rmse {amount(fit.rmse, fit.unit)}"
+    prov = fit.model.provenance or {}
+    origin = [f"{fit.model.name or ''}: data sha256 {prov['data_sha256'][:12]}…, {prov.get('date', '')}, "
+              f"thermofriction {prov.get('thermofriction', '')}"] if prov.get("data_sha256") else []
+    return [heading(f"Fit: {fit.method}", f"— {'converged' if fit.success else 'not converged'}{rmse}{quality}, "
+                                          f"{fit.wall_time:.3g} s"),
+            lines(origin), table(HEAD, parameter_rows(fit)), lines(fit.warnings)]
+
+
+__all__ = ["fit_blocks", "fit_html_blocks", "verdict", "parameter_rows", "HEAD"]
