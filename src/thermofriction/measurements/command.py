@@ -86,16 +86,9 @@ class Command(Force):
                   "per-experiment": "each experiment's own offset"}[self.offset]
         return f"the inertia term J a and {offset} (fitted)"
 
-    @property
-    def caption(self) -> str:
-        return super().caption.replace("the model's sensor offset removed", "the command predicted with the "
-                                       "model's inertia term and offset")
-
-    @property
-    def footer(self) -> str:
-        return super().footer.replace("the model's sensor offset ([plant] sensor_offset) removed", "the command "
-                                      "predicted with the model's inertia term and offset ([plant] inertia, "
-                                      "sensor_offset, at its delay)")
+    held_offset_said = "the command predicted with the model's inertia term and offset"
+    held_offset_said_in_full = ("the command predicted with the model's inertia term and offset ([plant] inertia, "
+                                "sensor_offset, at its delay)")
 
     @property
     def validation_removed(self) -> str:

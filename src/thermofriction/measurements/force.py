@@ -270,10 +270,15 @@ class Force(Measurement):
     def validation_extras(self, model) -> dict:
         return {"sensor_offset": model.plant.sensor_offset}
 
+    #: what validation removes from the model's prediction where the model's own offset is held, in the caption
+    #: and in the footer (a measurement whose prediction holds more, the command's inertia term, says so here)
+    held_offset_said = "the model's sensor offset removed"
+    held_offset_said_in_full = "the model's sensor offset ([plant] sensor_offset) removed"
+
     @property
     def caption(self) -> str:
         removed = "each experiment's own offset removed (estimated on it)" if self.offset == "per-experiment" else \
-            "the model's sensor offset removed (fitted on the fit experiments, never re-fitted)"
+            f"{self.held_offset_said} (fitted on the fit experiments, never re-fitted)"
         return f"RMSE: {removed}{ripple.phases_said(self)}; {RANGE_PCT}"
 
     @property
@@ -281,7 +286,7 @@ class Force(Measurement):
         removed = ("each experiment's own offset removed: a nuisance parameter estimated on every experiment, "
                    "held-out ones included (their errors are then of the friction model's shape, not of its "
                    "offset)" if self.offset == "per-experiment" else
-                   "the model's sensor offset ([plant] sensor_offset) removed, as fitted on the fit experiments and "
+                   f"{self.held_offset_said_in_full}, as fitted on the fit experiments and "
                    "never re-fitted on held-out ones")
         return (f"RMSE: {removed}{ripple.phases_said(self)}; {RANGE_PCT}; max |error|: the largest single error, in the data's unit (on "
                 f"a signal that changes sign it is at a reversal, where a small timing difference shows large); mean "
