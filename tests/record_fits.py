@@ -21,7 +21,8 @@ import sys
 IGNORED = {"wall_time", "created", "date", "data", "path", "file", "folder", "seconds", "elapsed", "time_s"}
 
 _current = {"test": None, "count": 0}
-_TMP = re.compile(r"\S*?/pytest-\d+/")
+_PORT = re.compile(r"tcp://[\w.]+:\d+")  # (a Dask worker's address differs per run)
+_TMP = re.compile(r"\S*?/pytest-\d+/|/tmp/tmp\w+/")
 
 
 def _plain(x):
@@ -104,7 +105,7 @@ def compare(before: str, after: str, rtol: float = 1e-10, subset: bool = False) 
     only the tests the second recording ran (a part of the suite run after a change against all of it before)."""
     def load(p):
         with open(p, encoding="utf-8") as fh:
-            return {(r["test"], r["call"]): r["result"] for r in map(json.loads, fh)}
+            return {(_PORT.sub("tcp://<host>", r["test"]), r["call"]): r["result"] for r in map(json.loads, fh)}
     a, b = load(before), load(after)
     if subset:
         ran = {t for t, _ in b}
