@@ -27,14 +27,22 @@ def header_parameter_list() -> list:
     return re.findall(r'X\((\w+),\s*"([^"]+)",\s*"([^"]+)"', block)
 
 
+def header_friction_model_list() -> list:
+    """The entries X(symbol, "name", ...) of domains.h's TF_FRICTION_MODELS list."""
+    text = (ROOT / "core" / "include" / "thermofriction" / "domains.h").read_text()
+    block = re.search(r"#define TF_FRICTION_MODELS\(X\)(.*?)\n\s*\n", text, flags=re.S).group(1)
+    return re.findall(r'X\((\w+),\s*"([^"]+)"', block)
+
+
 def header_enum_constants() -> dict:
-    """Every enumerator of every ``typedef enum { ... }`` in the public headers (the parameter enum
-    expanded from its list): name -> header."""
+    """Every enumerator of every ``typedef enum { ... }`` in the public headers (the parameter and friction
+    model enums expanded from their lists): name -> header."""
     found = {f"TF_P_{sym}": "friction.h" for sym, _, _ in header_parameter_list()}
+    found.update({f"TF_FRICTION_{sym}": "friction.h" for sym, _ in header_friction_model_list()})
     for h in HEADERS:
         text = re.sub(r"/\*.*?\*/", "", h.read_text(), flags=re.S)  # comments may mention names
         for body in re.findall(r"enum\s*\w*\s*\{(.*?)\}", text, flags=re.S):
-            body = re.sub(r"TF_PARAMETERS\(\w+\)", "", body)  # the parameter list, expanded above
+            body = re.sub(r"TF_(PARAMETERS|FRICTION_MODELS)\(\w+\)", "", body)  # the lists, expanded above
             for item in body.split(","):
                 m = re.match(r"\s*(TF_[A-Z0-9_]+)", item)
                 if m:
@@ -208,3 +216,10 @@ def test_friction_domains_are_the_header_table_and_cover_every_model():
     for model, rows in _bridge.FRICTION_DOMAINS.items():
         fields = set(tf.models.FRICTION_MODELS[model].__dataclass_fields__)
         assert {row[0] for row in rows} <= fields | {"v_smooth"}, model  # v_smooth: Model II's offset form too
+
+
+def test_friction_model_codes_come_from_the_header_list():
+    """The friction models' ids and the binding's names are domains.h's TF_FRICTION_MODELS, in its order."""
+    entries = header_friction_model_list()
+    assert len(entries) == _core.CONSTANTS["limit"]["friction_models"] >= 6
+    assert _bridge.FRICTION_CODES == {name: code for code, (_, name) in enumerate(entries)}

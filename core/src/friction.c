@@ -14,15 +14,10 @@ static double sgn(double v) { return (v > 0) - (v < 0); }
 
 int tf_friction_nstate(int kind, int n_elements)
 {
-    switch (kind) {
-    case TF_FRICTION_LUGRE:
-    case TF_FRICTION_DAHL:
-    case TF_FRICTION_ELASTOPLASTIC: return 1;
-    case TF_FRICTION_COULOMB:
-    case TF_FRICTION_STRIBECK: return 0;
-    case TF_FRICTION_GMS: return (n_elements >= 1 && n_elements <= TF_MAX_FRICTION_STATES) ? n_elements : -1;
-    default: return -1;
-    }
+    if (kind < 0 || kind >= TF_NFRICTION) return -1;
+    int n = tf_friction_states(kind);
+    if (n != TF_STATES_PER_ELEMENT) return n;
+    return (n_elements >= 1 && n_elements <= TF_MAX_FRICTION_STATES) ? n_elements : -1;
 }
 
 double tf_friction_reference_force(int kind, const double *p)
@@ -372,7 +367,7 @@ void tf_friction_update_modes(int kind, const double *p, tf_gms_elements *el, do
 /* The friction model's kind and its GMS elements. */
 const char *tf_friction_structure_problem(int kind, const tf_gms_elements *gms)
 {
-    if (kind < TF_FRICTION_LUGRE || kind > TF_FRICTION_GMS) return "friction";
+    if (kind < 0 || kind >= TF_NFRICTION) return "friction";
     if (kind != TF_FRICTION_GMS) return 0;
     double sum = 0.0;
     if (gms->n < 1 || gms->n > TF_MAX_FRICTION_STATES) return "gms.n (1 to 64 elements)";

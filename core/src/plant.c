@@ -198,7 +198,7 @@ void tf_model_state_scale(const tf_model *model, double *scale)
        1e-3 of that band, otherwise the default atol lets the solver step across it (0.2 % error
        found by the differential tests on the offset form). */
     double band = Vs;
-    int static_map = model->friction == TF_FRICTION_COULOMB || model->friction == TF_FRICTION_STRIBECK;
+    int static_map = tf_friction_states(model->friction) == 0;
     if (((model->thermal == TF_THERMAL_MODEL_II && model->dF_form == TF_DF_OFFSET) || static_map) &&
         p[TF_P_VSMOOTH] > 0.0)
         band = fmin(band, p[TF_P_VSMOOTH]);

@@ -218,11 +218,8 @@ tf_status tf_rt_advance(int kind, const double *p, tf_gms_elements *gms, double 
 /* Internal states of a checked model (tf_friction_nstate without the call: it is on every step). */
 static inline int nstate(const tf_model *m)
 {
-    switch (m->friction) {
-    case TF_FRICTION_COULOMB: case TF_FRICTION_STRIBECK: return 0;
-    case TF_FRICTION_GMS: return m->gms.n;
-    default: return 1;
-    }
+    int n = tf_friction_states(m->friction);
+    return n == TF_STATES_PER_ELEMENT ? m->gms.n : n;
 }
 
 /* One checked step: the states advance in place from a backup, restored unless the force F' (and

@@ -63,6 +63,10 @@ LIMITS = dict(_GROUPS["limit"])
 #: "positive-or-absent" (None in a model, 0 in the core); where: "always", "stribeck" (fs != fc),
 #: "offset-form" (Model II's offset form).
 FRICTION_DOMAINS = dict(_core.FRICTION_DOMAINS)
+#: The static level a model leaves unset follows its Coulomb level (fs = fc; the core's ``fs_follows_fc``): the
+#: positive side's "at-least" rule of the core's table (the negative side's, ``*_neg``, has the core's own default).
+_STATIC, _COULOMB = next((p, other) for rows in FRICTION_DOMAINS.values() for p, rule, other, _ in rows
+                         if rule == "at-least" and not p.endswith("_neg"))
 
 
 def n_outputs(model, friction_work: bool) -> int:
@@ -121,7 +125,7 @@ def model_spec(model, temperature=None, input=None, friction_work: bool = False)
         m, k_s, v_0 = plant.mass, plant.spring_stiffness, plant.pull_velocity
     friction = model.friction
     values = {name: v for name, v in friction.values().items() if name not in friction.arrays}
-    values.setdefault("fs", values.get("fc", 0.0))
+    values.setdefault(_STATIC, values.get(_COULOMB, 0.0))
     values.setdefault("vs", 1e-3)
     if values.get("sigma2_neg") == 0.0:  # 0 is "not given" in the core (friction.h, tf_side_given)
         values["sigma2_neg"] = _SMALLEST
@@ -141,13 +145,13 @@ def model_spec(model, temperature=None, input=None, friction_work: bool = False)
     elif temperature is not None:
         T_const = float(temperature)
     waveform = input if input is not None else model.input
-    gms = friction.model == "gms"
+    # the arrays (GMS's k and w) by their roles, the binding's keys ("gms_k", "gms_w")
+    arrays = {a.role: np.array(getattr(friction, n), float) for n, a in friction.description.arrays.items()}
     return {
         "plant": PLANT_CODES[plant.type], "m": m, "c": c, "k": k, "T_em": T_em, "m_e": m_e, "k_s": k_s, "v_0": v_0,
         "friction": FRICTION_CODES[friction.model], "params": params,
-        "gms_k": np.array(friction.k, float) if gms else None,
-        "gms_w": np.array(friction.w, float) if gms else None,
-        "fs_follows_fc": int(getattr(friction, "fs", None) is None and "fs" not in model.laws),
+        **arrays,
+        "fs_follows_fc": int(getattr(friction, _STATIC, None) is None and _STATIC not in model.laws),
         "thermal": THERMAL_CODES[thermal],
         "laws": laws,
         "dF": law_tuple(model.thermal.dF) if thermal == "model-ii" else None,

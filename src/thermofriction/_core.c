@@ -726,9 +726,9 @@ static const tf_constant constants[] = {
 #undef PARAMETER
     C("plant", "stick-slip", TF_PLANT_STICK_SLIP), C("plant", "mass", TF_PLANT_MASS),
     C("plant", "prescribed", TF_PLANT_PRESCRIBED),
-    C("friction", "lugre", TF_FRICTION_LUGRE), C("friction", "coulomb", TF_FRICTION_COULOMB),
-    C("friction", "stribeck", TF_FRICTION_STRIBECK), C("friction", "dahl", TF_FRICTION_DAHL),
-    C("friction", "elastoplastic", TF_FRICTION_ELASTOPLASTIC), C("friction", "gms", TF_FRICTION_GMS),
+#define FRICTION(symbol, name, states, equations) C("friction", name, TF_FRICTION_##symbol),
+    TF_FRICTION_MODELS(FRICTION)
+#undef FRICTION
     C("law", "none", TF_LAW_NONE), C("law", "const", TF_LAW_CONST), C("law", "linear", TF_LAW_LINEAR),
     C("law", "exp", TF_LAW_EXP), C("law", "poly", TF_LAW_POLY), C("law", "pwl", TF_LAW_PWL),
     C("law", "table", TF_LAW_TABLE),
@@ -767,7 +767,8 @@ static const tf_constant constants[] = {
     C("compensation", "none", TF_COMP_NONE), C("compensation", "feedforward", TF_COMP_FEEDFORWARD),
     C("compensation", "observer", TF_COMP_OBSERVER),
     /* counts and capacities */
-    C("limit", "parameters", TF_NPARAM), C("limit", "fixed_outputs", TF_OUT_NFIXED),
+    C("limit", "parameters", TF_NPARAM), C("limit", "friction_models", TF_NFRICTION),
+    C("limit", "fixed_outputs", TF_OUT_NFIXED),
     C("limit", "heat_parameters", TF_HEAT_NPARAM), C("limit", "plant_parameters", TF_PLANT_NPARAM), C("limit", "friction_states", TF_MAX_FRICTION_STATES),
     C("limit", "states", TF_MAX_STATES), C("limit", "targets", TF_MAX_TARGETS),
     C("limit", "domain_rules", TF_DOMAIN_NRULE), C("limit", "domain_conditions", TF_DOMAIN_NWHEN),

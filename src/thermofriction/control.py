@@ -24,7 +24,7 @@ from ._bridge import model_spec
 from . import _args
 from .errors import InputError, SolverError, shorten
 from .figures.study_plots import loop_figure
-from .models import MassPlant, Model
+from .models import FRICTION_MODELS, MassPlant, Model
 from .results import Result, Summary
 from .simulation.checks import temperature_findings
 
@@ -68,7 +68,7 @@ def _check_at(where: str, model: Model, temperature: float):
 
 
 #: The friction models with a bristle state for the observer to estimate.
-OBSERVED_MODELS = ("lugre", "dahl", "elastoplastic")
+OBSERVED_MODELS = tuple(n for n, c in FRICTION_MODELS.items() if c.description.bristle)
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@
  * binding exports it (thermofriction._core.FRICTION_DOMAINS), so that both sides read one rule per
  * parameter. A model's rows are checked in their order, and the first refused names the parameter.
  *
- * X(model, parameter, rule, other, when): the friction model (TF_FRICTION_<model>), the parameter
+ * X(model, parameter, rule, other, when): the friction model (TF_FRICTION_<model>, TF_FRICTION_MODELS below), the parameter
  * (TF_P_<parameter>), its rule (TF_DOMAIN_<rule>), the parameter the rule compares with (TF_P_<other>,
  * NONE: none), and where the rule applies (TF_DOMAIN_<when>). Every value is a parameter at one temperature
  * (laws evaluated), on each side of a direction-dependent model. */
@@ -32,6 +32,19 @@ typedef enum {
 
 /* The parameter a rule compares with, where there is none. */
 #define TF_P_NONE (-1)
+
+/* The friction models, one line each: X(symbol, name in model files, states, equations). Their ids
+ * (friction.h, tf_friction_kind: TF_FRICTION_<symbol>, in this order from 0), their number of states
+ * (0: a static map; TF_STATES_PER_ELEMENT: one per element) and the Python binding's friction constants come from
+ * this list; a new model is a line here, its rows below and its step in friction.c. */
+#define TF_STATES_PER_ELEMENT (-1)
+#define TF_FRICTION_MODELS(X)                                                                           \
+    X(LUGRE, "lugre", 1, "z' = v - sigma0 |v| z / g(v); F = sigma0 z + sigma1(v) z' + sigma2 v")        \
+    X(COULOMB, "coulomb", 0, "F = fc s(v) + sigma2 v; s = tanh(v / v_smooth)")                          \
+    X(STRIBECK, "stribeck", 0, "F = g(v) s(v) + sigma2 v")                                              \
+    X(DAHL, "dahl", 1, "z' = v - sigma0 |v| z / fc; F = sigma0 z")                                      \
+    X(ELASTOPLASTIC, "elastoplastic", 1, "LuGre with alpha(z, v) on the relaxation term (Dupont et al. 2002)") \
+    X(GMS, "gms", TF_STATES_PER_ELEMENT, "N Maxwell-slip elements, each stuck or slipping (Al-Bender et al. 2005)")
 
 #define TF_FRICTION_DOMAINS(X)                                                                          \
     X(LUGRE, FC, POSITIVE, NONE, ALWAYS)                                                                \

@@ -45,14 +45,19 @@ extern "C" {
 typedef enum { TF_PARAMETERS(TF_PARAMETER_ENUM_) TF_NPARAM } tf_param;
 #undef TF_PARAMETER_ENUM_
 
-typedef enum {
-    TF_FRICTION_LUGRE = 0,         /* z' = v - sigma0 |v| z / g(v); F = sigma0 z + sigma1(v) z' + sigma2 v */
-    TF_FRICTION_COULOMB = 1,       /* F = fc s(v) + sigma2 v; s = tanh(v / v_smooth) */
-    TF_FRICTION_STRIBECK = 2,      /* F = g(v) s(v) + sigma2 v */
-    TF_FRICTION_DAHL = 3,          /* z' = v - sigma0 |v| z / fc; F = sigma0 z */
-    TF_FRICTION_ELASTOPLASTIC = 4, /* LuGre with alpha(z, v) on the relaxation term (Dupont et al. 2002) */
-    TF_FRICTION_GMS = 5            /* N Maxwell-slip elements, each stuck or slipping (Al-Bender et al. 2005) */
-} tf_friction_kind;
+/* The friction models' ids (TF_FRICTION_<symbol>, from 0 in the order of domains.h's TF_FRICTION_MODELS). */
+#define TF_FRICTION_ENUM_(symbol, name, states, equations) TF_FRICTION_##symbol,
+typedef enum { TF_FRICTION_MODELS(TF_FRICTION_ENUM_) TF_NFRICTION } tf_friction_kind;
+#undef TF_FRICTION_ENUM_
+
+/* A model's states (TF_FRICTION_MODELS' states column; TF_STATES_PER_ELEMENT: one per GMS element), kind valid. */
+static inline int tf_friction_states(int kind)
+{
+#define TF_FRICTION_STATES_(symbol, name, states, equations) states,
+    static const int states[] = {TF_FRICTION_MODELS(TF_FRICTION_STATES_)};
+#undef TF_FRICTION_STATES_
+    return states[kind];
+}
 
 #define TF_MAX_FRICTION_STATES 64
 /* Harmonics of the position ripple (TF_P_RIPPLE_COS1 ... TF_P_RIPPLE_SIN3, interleaved cos, sin). */

@@ -8,7 +8,7 @@ import math
 from .._reading import strict_float
 from .._version import __version__
 from ..errors import shorten
-from ..models import PRESETS
+from ..models import FRICTION_MODELS, PRESETS
 from ..simulation import MAX_SAMPLES, SOLVERS
 from .commands import cmd_demo, cmd_identify, cmd_simulate, cmd_validate
 from .report_command import cmd_report
@@ -112,8 +112,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser(
         "simulate", help="simulate a model file (or a preset) and write the simulation CSV (docs/formats.md#simulation-output)",
         description="Simulate a model from rest -- a stick-slip actuator, a single mass (force-driven or "
-                    "spring-pulled) or prescribed motion, with any friction model (lugre, coulomb, stribeck, "
-                    "dahl, elastoplastic, gms) -- and write time, input, displacements, velocity, friction "
+                    f"spring-pulled) or prescribed motion, with any friction model ({', '.join(FRICTION_MODELS)}) "
+                    "-- and write time, input, displacements, velocity, friction "
                     "force, temperature and internal states (SI units, temperature in C) on a uniform grid. "
                     "Without -o, prints a summary.",
         epilog=f"MODEL is a model file (TOML) or a preset name: {', '.join(PRESETS)}. "
@@ -163,7 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
                         "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
                         "[heat] section's C_th, R_th, eta from recorded temperature[C] columns)")
-    i.add_argument("--friction", choices=("lugre", "dahl", "elastoplastic", "gms", "stribeck", "coulomb"),
+    i.add_argument("--friction", choices=tuple(FRICTION_MODELS),
                    help="friction model to identify (default: the initial model's); built from the initial model's "
                         "values where they share a parameter (docs/identification.md#friction-models)")
     i.add_argument("--init", metavar="MODEL.toml",

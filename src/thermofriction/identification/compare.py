@@ -8,11 +8,16 @@ import math
 import numpy as np
 
 from ..errors import ThermofrictionError
+from ..models import FRICTION_MODELS, LuGre
 from ..validation import validate
 from .front import identify
 
+#: The friction models compared by default: the static maps through a smoothed sign (their descriptions'
+#: ``smoothed_sign``), then LuGre, the paper's.
+COMPARED = (*(n for n, c in FRICTION_MODELS.items() if c.description.smoothed_sign), LuGre.model)
 
-def compare_friction_models(data, kinds=("coulomb", "stribeck", "lugre"), init=None, *, offset=True, **opts) -> dict:
+
+def compare_friction_models(data, kinds=COMPARED, init=None, *, offset=True, **opts) -> dict:
     """Fits each friction model of ``kinds`` (method base) to the fit experiments and predicts the held-out ones.
     ``delta_aicc`` is against the best, divided by the residuals' integrated autocorrelation time where they are
     correlated; ``rank`` by ``basis``: AICc, or the held-out RMSE where the residuals are far from white (an
@@ -23,8 +28,9 @@ def compare_friction_models(data, kinds=("coulomb", "stribeck", "lugre"), init=N
     ----------
     data : Dataset
         The measurements.
-    kinds : sequence of str, default ("coulomb", "stribeck", "lugre")
-        The friction models compared.
+    kinds : sequence of str, default ``COMPARED``
+        The friction models compared; default ("coulomb", "stribeck", "lugre"): the static maps through a smoothed
+        sign, then LuGre.
     init : Model or str or os.PathLike, optional
         The initial model, as for ``identify``.
     offset : str or bool, default True
@@ -76,4 +82,4 @@ def compare_friction_models(data, kinds=("coulomb", "stribeck", "lugre"), init=N
         e["rank"] = ranked.index(k) + 1
     return out
 
-__all__ = ["compare_friction_models"]
+__all__ = ["compare_friction_models", "COMPARED"]

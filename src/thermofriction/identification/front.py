@@ -127,7 +127,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         Default: the paper's preset for the method. A file with a ``[plant]`` and no ``[friction]`` section
         starts LuGre from values taken from the data (measurements/displacement_start.py, force_start.py).
     friction : str, optional
-        The friction model to identify (lugre, dahl, elastoplastic, gms, stribeck, coulomb); default the
+        The friction model to identify (a name of ``FRICTION_MODELS``: lugre, coulomb, ...); default the
         initial model's. When it differs, the initial friction model is built from the initial model's values
         (``with_friction_model``).
     parameters : list of str or Parameters, optional

@@ -13,7 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ..errors import ComputationError, InputError
-from ..models import Model, ModelI
+from ..models import LuGre, Model, ModelI
 from ..models.sides import STATIC_LEVELS
 from ..models.transforms import base_model
 from ..measurements import REGISTRY, amount
@@ -27,7 +27,7 @@ from ..measurements import make_traces
 from .result import FitResult
 from ..fitting.uncertainty import uncertainty
 
-DEFAULT_FRICTION_PARAMETERS = ("sigma0", "sigma1", "fc")  # LuGre's (the paper's)
+DEFAULT_FRICTION_PARAMETERS = LuGre.description.fitted["displacement"]  # LuGre's (the paper's)
 
 
 def default_fit_parameters(model: Model) -> list:
@@ -40,10 +40,9 @@ def default_fit_parameters(model: Model) -> list:
     names = table.get(model.friction.model, DEFAULT_FRICTION_PARAMETERS)
     laws = model.laws if isinstance(model.thermal, ModelI) else {}
     values = model.friction.values()
-    if model.friction.model in ("stribeck", "gms", "lugre", "elastoplastic") and \
-            values.get("fs") in (None, values.get("fc")) and "fs" not in laws:
+    if "fs" in model.friction.law_targets and values.get("fs") in (None, values.get("fc")) and "fs" not in laws:
         values = {k: v for k, v in values.items() if k not in ("fs", "vs")}  # no Stribeck effect to fit
-        values.pop("C" if model.friction.model == "gms" else "", None)  # (no_stribeck_rate)
+        values.pop("C", None)  # GMS's rate towards the Stribeck curve (no_stribeck_rate)
     names = [n for n in names if n in laws or (values.get(n) or 0.0) > 0.0]
     with_law = [n for n in names if n in laws]
     return with_law or names
@@ -55,7 +54,7 @@ def no_stribeck_rate(model, params) -> list:
     (a fit of it runs off, to 1e-10 or 6e17, issue 40 item 7). The default holds it; a warning naming C says
     so, whether it was held or fitted."""
     values = model.friction.values()
-    if model.friction.model != "gms" or values.get("fs") not in (None, values.get("fc")) or "fs" in model.laws:
+    if "C" not in model.friction.law_targets or values.get("fs") not in (None, values.get("fc")) or "fs" in model.laws:
         return []
     fitted = "C" in params and params["C"].vary
     how = "was fitted, but" if fitted else f"is held at {values['C']:.4g} N m/s:"

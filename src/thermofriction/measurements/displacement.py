@@ -13,28 +13,22 @@ from .. import _bridge
 from ..data.experiments import run_label
 from ..drive import drive
 from ..errors import InputError
-from ..models import require_actuator
+from ..models import FRICTION_MODELS, require_actuator
 from ..results import Finding, emit
 from ..simulation import StepSizeController, simulate
 from .base import Measurement, MetricWarning, Trace, center, thermal_check
 from .displacement_start import displacement_initial
 from ..fitting.quality import fit_quality
 
-#: The parameters fitted by default for each friction model (docs/identification.md#friction-models):
+#: The parameters fitted by default for each friction model (docs/identification.md#friction-models; each
+#: description's ``fitted``):
 #: what sets the level and the presliding stiffness, which displacement data determine; the shape
 #: parameters (delta, vd, v_smooth, GMS's element stiffnesses k and capacities w) are kept. A
 #: parameter the initial model leaves unset or at zero (vs, sigma2) is kept too: fitted in log
 #: space it needs a positive start, and zero means "not in the model". fs and z_ba are bound to
 #: other parameters (fs >= fc, z_ba < fc/sigma0), which a step of the fit may break, and the engine
 #: does not yet treat such a step as unphysical (it stops): they are kept unless named.
-FIT_PARAMETERS = {
-    "lugre": ("sigma0", "sigma1", "fc"),
-    "elastoplastic": ("sigma0", "sigma1", "fc"),
-    "dahl": ("sigma0", "fc"),
-    "coulomb": ("fc", "sigma2"),
-    "stribeck": ("fc", "vs", "sigma2"),
-    "gms": ("C", "fc"),
-}
+FIT_PARAMETERS = {name: cls.description.fitted["displacement"] for name, cls in FRICTION_MODELS.items()}
 
 
 class Displacement(Measurement):

@@ -31,7 +31,7 @@ from ..drive import drive
 from ..errors import InputError, SolverError
 from ..data.experiments import run_label
 from ..data.force import ForceExperiment
-from ..models import Model, ModelI, PrescribedMotion
+from ..models import FRICTION_MODELS, Model, ModelI, PrescribedMotion
 from ..models.sides import RIPPLE_AMPLITUDES
 from . import ripple
 from ..simulation import StepSizeController, simulate
@@ -45,15 +45,9 @@ from .force_start import force_initial, screen_starts, start_section
 UNITS_CHECK = "check the units in the files' headers"
 SAMPLING_CHECK = "check that the sampling resolves the force's swing after each reversal (a few samples at least)"
 
-#: Force data see the whole friction-velocity map: the Stribeck and viscous parameters are fitted too.
-FIT_PARAMETERS = {
-    "lugre": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
-    "elastoplastic": ("sigma0", "sigma1", "fc", "fs", "vs", "sigma2"),
-    "dahl": ("sigma0", "fc"),
-    "coulomb": ("fc", "sigma2"),
-    "stribeck": ("fc", "fs", "vs", "sigma2"),
-    "gms": ("C", "fc", "fs", "vs", "sigma2"),
-}
+#: Force data see the whole friction-velocity map: the Stribeck and viscous parameters are fitted too (each
+#: description's ``fitted``).
+FIT_PARAMETERS = {name: cls.description.fitted["force"] for name, cls in FRICTION_MODELS.items()}
 
 
 def _steps(model, names, theta):

@@ -226,7 +226,8 @@ def force_initial(init, method, data, experiments, *, force, friction=None, free
                          f"{init.plant.motion}: set motion = \"{want}\" in its [plant]")
     if friction is not None:
         init = with_friction_model(init, friction)
-        if friction == "stribeck":  # asked for: a Stribeck map, not the Coulomb map a start without an excess fits
+        if init.friction.description.smoothed_sign and "fs" in init.friction.law_targets:
+            # asked for: a Stribeck map, not the Coulomb map a start without an excess fits
             init = _with_excess(init, experiments)
     if init.heat is not None:
         raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet")

@@ -83,17 +83,16 @@ def with_friction_model(model: Model, kind: str) -> Model:
     if model.friction.model == kind:
         return model
     cls = FRICTION_MODELS[kind]
-    names = {f.name for f in dataclasses.fields(cls)} - set(cls.arrays)
+    names = set(cls.law_targets)
     laws = {k: v for k, v in model.laws.items() if k in names}
     kw = {k: v for k, v in model.friction.values().items() if k in names}
     kw.update({k: None for k in laws})
     at = base_model(model).friction.values()  # numbers (laws at mid-range), to derive the rest from
     fc = at["fc"]
     sigma0 = at.get("sigma0") or (sum(at["k"]) if "k" in at else fc / 1e-6)
-    derived = {"sigma0": sigma0, "sigma1": 1e-6 * sigma0, "z_ba": 0.5 * fc / sigma0, "C": 1e4 * fc}
-    if kind == "gms":
-        h = sum(1.0 / i for i in range(1, 5))
-        derived.update(k=tuple(sigma0 / (i * h) for i in range(1, 5)), w=(0.25,) * 4)
+    h = sum(1.0 / i for i in range(1, 5))
+    derived = {"sigma0": sigma0, "sigma1": 1e-6 * sigma0, "z_ba": 0.5 * fc / sigma0, "C": 1e4 * fc,
+               "k": tuple(sigma0 / (i * h) for i in range(1, 5)), "w": (0.25,) * 4}
     for name in cls.required:
         if name not in kw:
             kw[name] = derived[name]

@@ -282,7 +282,7 @@ def _check_temperatures(model: Model, temperature, found: list):
         # sigma1 have none), and for a static map the slope of its smoothed sign, fs / v_smooth
         damping = p.get("sigma1", 0.0) + p.get("sigma2", 0.0)
         what = "sigma1 + sigma2"
-        if model.friction.model in ("coulomb", "stribeck"):
+        if model.friction.description.smoothed_sign:
             damping += p["fs"] / p["v_smooth"]
             what = "sigma2 + fs/v_smooth"
         if dF[i] < 0 and -dF[i] / p["v_smooth"] > damping:
