@@ -61,10 +61,14 @@ class Finding:
         The Warning subclass it is emitted as (``TemperatureRangeWarning``, ``PassivityWarning``, ...).
     message : str
         What was found, in words.
+    warning : Warning, optional
+        The warning object emitted, where it carries more than its text (a ``MotionWarning``'s file and outcome,
+        which the dataset's loader groups by); default None: a ``category`` made of ``message``.
     """
 
     category: type
     message: str
+    warning: Warning | None = dataclasses.field(default=None, compare=False)
 
     def __str__(self) -> str:
         return self.message
@@ -123,7 +127,7 @@ def emit(findings, stacklevel: int = 2):
         sink.extend(findings)
         return
     for f in findings:
-        warnings.warn(f.message, f.category, stacklevel=stacklevel + 1)
+        warnings.warn(f.message if f.warning is None else f.warning, f.category, stacklevel=stacklevel + 1)
 
 
 # -- the one formatter: structured blocks -> text or HTML ------------------------------------------------------

@@ -13,7 +13,7 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 
 from .._reading import read_text
-from .._warning_routes import recorded_warnings
+from ..results import collecting, emit
 from .. import _args
 from ..errors import InputError, UnitWarning, shorten, unknown_keys
 from ..waveforms import parse_waveform
@@ -142,10 +142,9 @@ def load_dataset(path, *, motion: str | None = None) -> Dataset:
         raise InputError(f"{manifest}: not UTF-8 text ({e.reason} at byte {e.start})") from None
     except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
         raise InputError(f"{manifest}: TOML nested too deeply") from None
-    with recorded_warnings() as caught:
+    with collecting() as found:
         data = manifest_dataset(meta, folder, manifest, motion=motion)
-    for w in one_motion_warning(caught):  # the files whose velocity columns lag alike: said once
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    emit(one_motion_warning(found))  # the files whose velocity columns lag alike: said once
     data.sha256 = dataset_sha256(data)
     return data
 

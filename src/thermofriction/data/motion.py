@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 
 from ..errors import InputError, shorten
+from ..results import Finding, emit
 from ..waveforms import Sampled
 
 #: What drives the model: "auto" (the velocity column where it is the position's derivative, else the
@@ -61,20 +61,25 @@ class MotionWarning(SamplingWarning):
         self.path, self.problems, self.outcome = path, problems, outcome
 
 
-def one_motion_warning(caught) -> list:
-    """``caught`` (recorded warnings) with the MotionWarnings that share an outcome said once, each file with its
+def _finding(warning: MotionWarning) -> Finding:
+    return Finding(MotionWarning, str(warning), warning)
+
+
+def one_motion_warning(found) -> list:
+    """``found`` (collected findings) with the MotionWarnings that share an outcome said once, each file with its
     numbers: a dataset of 20 runs whose velocity columns lag gave 20 warnings on every command."""
-    motion = [w.message for w in caught if isinstance(w.message, MotionWarning) and w.message.outcome]
-    out = [w for w in caught if not (isinstance(w.message, MotionWarning) and w.message.outcome)]
+    def grouped(f):
+        return isinstance(f.warning, MotionWarning) and f.warning.outcome
+    motion = [f.warning for f in found if grouped(f)]
+    out = [f for f in found if not grouped(f)]
     for outcome in dict.fromkeys(m.outcome for m in motion):
         same = [m for m in motion if m.outcome == outcome]
         if len(same) == 1:
-            out.append(warnings.WarningMessage(same[0], MotionWarning, __file__, 0))
+            out.append(_finding(same[0]))
             continue
         files = "; ".join(f"{m.path}: {m.problems}" for m in same)
-        out.append(warnings.WarningMessage(MotionWarning(
-            f"the velocity column is not the position's derivative in {len(same)} files ({files}); {outcome}"),
-            MotionWarning, __file__, 0))
+        out.append(_finding(MotionWarning(
+            f"the velocity column is not the position's derivative in {len(same)} files ({files}); {outcome}")))
     return out
 
 
@@ -252,21 +257,22 @@ def choose_motion(path, time, position, velocity, motion: str = "auto", headers=
         finer = _position_finer(t, x, v, check) if motion == "auto" else None
         if finer is None:
             return "velocity", check
-        warnings.warn(f"{path}: the velocity column {vname} lags the position's derivative by {check.lag * 1e3:.3g} ms "
-                      f"({check.lag_samples:.3g} sampling intervals) and the position resolves the velocity more "
-                      f"finely ({finer}): the position drives the model (motion = \"auto\"; motion = \"velocity\" "
-                      f"uses the column)", MotionWarning, stacklevel=3)
+        emit([_finding(MotionWarning(
+            f"{path}: the velocity column {vname} lags the position's derivative by {check.lag * 1e3:.3g} ms "
+            f"({check.lag_samples:.3g} sampling intervals) and the position resolves the velocity more finely "
+            f"({finer}): the position drives the model (motion = \"auto\"; motion = \"velocity\" uses the column)"))],
+             stacklevel=3)
         return "position", check
     problems = "; ".join(check.problems)
     if motion == "velocity":
         outcome = "it drives the model as asked (motion = \"velocity\")"
-        warnings.warn(MotionWarning(f"{path}: the velocity column {vname} is not the position's derivative: "
-                                    f"{problems}; {outcome}", str(path), problems, outcome), stacklevel=3)
+        emit([_finding(MotionWarning(f"{path}: the velocity column {vname} is not the position's derivative: "
+                                     f"{problems}; {outcome}", str(path), problems, outcome))], stacklevel=3)
         return "velocity", check
     outcome = ("the position drives the model (motion = \"auto\"; motion = \"velocity\" uses the column as it "
                "is)")
-    warnings.warn(MotionWarning(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; "
-                                f"{outcome}", str(path), problems, outcome), stacklevel=3)
+    emit([_finding(MotionWarning(f"{path}: the velocity column {vname} is not the position's derivative: {problems}; "
+                                 f"{outcome}", str(path), problems, outcome))], stacklevel=3)
     return "position", check
 
 
