@@ -174,7 +174,7 @@ class PlantFit(Result):
         from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
         xi, wn, K = self.modal_parameters()
         t = np.linspace(0.0, duration or 10.0 / max(xi * wn, 1e-12), 500)
-        fig = Figure(figsize=(6, 3.5))
+        fig = Figure(figsize=(6, 3.5), layout="constrained")  # (the axis labels inside the figure)
         ax = fig.subplots()
         ax.plot(t, step_response(t, xi, wn, K, 1.0) * 1e6)
         ax.set(xlabel="time [s]", ylabel="displacement [um per V]",

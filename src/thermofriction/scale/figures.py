@@ -88,17 +88,19 @@ def save_bands_figure(result, path):
 
 
 def sweep_figure(result, metric=None, x=None):
-    """A sweep's ``metric`` (default its first) against the coordinate ``x`` (default the grid's first), one line
+    """A sweep's ``metric`` (default the first with a finite value) against the coordinate ``x`` (default the grid's first), one line
     per combination of the other coordinates (the first eight), failed points left out."""
     from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's) is left alone
 
-    metric = metric or result.metrics[0]
+    # default: the first metric with a finite value (a run shorter than a cycle has no mean step)
+    finite = [m for m in result.metrics if np.isfinite(np.asarray(result[m], float)[result.ok]).any()]
+    metric = metric or (finite or list(result.metrics))[0]
     x = x or result.coordinates[0]
     if metric not in result.metrics or x not in result.coordinates:
         raise InputError(f"plot: metric one of {', '.join(result.metrics)}, x one of {', '.join(result.coordinates)}")
     others = [c for c in result.coordinates if c != x]
     keys = [tuple(float(result[c][i]) for c in others) for i in range(len(result))]
-    fig = Figure(figsize=(6.5, 3.8))
+    fig = Figure(figsize=(6.5, 3.8), layout="constrained")
     ax = fig.subplots()
     ok = result.ok
     for key in list(dict.fromkeys(keys))[:8]:
@@ -107,6 +109,9 @@ def sweep_figure(result, metric=None, x=None):
         ax.plot(result[x][rows], result[metric][rows], "o-", markersize=3, linewidth=0.9, label=label)
     ax.set_xlabel(result.header(x))
     ax.set_ylabel(result.header(metric))
+    if metric not in finite:  # an empty axis says why
+        ax.text(0.5, 0.5, f"no finite value of {metric} at any point", transform=ax.transAxes, ha="center",
+                va="center", color="#8a4b00")
     if others:
         legend(ax, fontsize=8, frameon=False)
     ax.grid(alpha=0.3)
