@@ -72,12 +72,7 @@ ON_THE_PROTOCOL = sorted({c.__name__ for c in _subclasses(Result) if not c.__nam
 KINDS = ON_THE_PROTOCOL + [n for n in NOT_YET_ON_THE_PROTOCOL if n not in ON_THE_PROTOCOL]
 
 #: (kind, aspect) -> why it does not conform yet (found by this suite; strict: the day it does, the mark goes)
-KNOWN = {
-    ("ValidationResult", "report"): "issue 39: ValidationResult.report() is the metrics table alone, without the "
-                                    "result's title ('validation')",
-    ("FitResult", "html"): "issue 39: FitResult._repr_html_() is a formatter of its own and shows neither the "
-                           "'method' nor the 'evaluations' row of its summary()",
-}
+KNOWN = {}
 
 
 def _params(aspect):

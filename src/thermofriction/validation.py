@@ -15,7 +15,7 @@ from .figures.plots import error_figure
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
 from .models import Model
 from .models.fit_record import fit_record_of
-from .results import Finding, Result, Summary, collecting, heading, lines, table
+from .results import Finding, Result, Summary, as_text, collecting, heading, lines, table
 from .unit_scale import unit_warnings
 
 
@@ -140,8 +140,11 @@ class ValidationResult(Result):
         return Summary(self.measurement.summary(self.predictions))
 
     def _blocks(self) -> list:
-        """The report: the table of the experiments' metrics (the measurement's columns)."""
-        return [table([c[0] for c in self._COLUMNS], self.rows(), indent="")]
+        """The report: its title, then the table of the experiments' metrics (the measurement's columns)."""
+        return [heading(self.title), self._table_block()]
+
+    def _table_block(self):
+        return table([c[0] for c in self._COLUMNS], self.rows(), indent="")
 
     def _frame(self) -> dict:
         """One row per experiment: its metrics."""
@@ -172,8 +175,8 @@ class ValidationResult(Result):
             yield [fmt.format(m[key] * scale[key] if key in scale else m[key]) for _, key, fmt in self._COLUMNS]
 
     def table(self) -> str:
-        """The experiments' metrics as a text table (the report)."""
-        return self.report()
+        """The experiments' metrics as a text table (the report without its title)."""
+        return as_text([self._table_block()])
 
     def print_table(self, title=None):
         """A rich table on the terminal."""

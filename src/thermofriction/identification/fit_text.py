@@ -132,7 +132,7 @@ def fit_blocks(fit) -> list:
 
 def fit_html_blocks(fit) -> list:
     """A fit's notebook table as blocks: the headline (converged, RMSE, the noise and the verdict, the time), where
-    the model came from, the parameters, the warnings."""
+    the model came from, then the text report's blocks (its fields, parameters, correlations and warnings)."""
     q = fit.fit_quality
     quality = "" if q is None else (f", noise {amount(q['noise'], fit.unit)}: rmse/noise {q['ratio']:.3g}, "
                                     f"{verdict(q)}")
@@ -140,9 +140,10 @@ def fit_html_blocks(fit) -> list:
     prov = fit.model.provenance or {}
     origin = [f"{fit.model.name or ''}: data sha256 {prov['data_sha256'][:12]}…, {prov.get('date', '')}, "
               f"thermofriction {prov.get('thermofriction', '')}"] if prov.get("data_sha256") else []
+    # the headline and the model's origin, then the report's own blocks: the notebook shows what the text does
     return [heading(f"Fit: {fit.method}", f"— {'converged' if fit.success else 'not converged'}{rmse}{quality}, "
                                           f"{fit.wall_time:.3g} s"),
-            lines(origin), table(HEAD, parameter_rows(fit)), lines(fit.warnings)]
+            lines(origin)] + fit_blocks(fit)[1:]
 
 
 __all__ = ["fit_blocks", "fit_html_blocks", "verdict", "parameter_rows", "HEAD"]
