@@ -144,6 +144,7 @@ class ValidationResult(Result):
         return [heading(self.title), self._table_block()]
 
     def _table_block(self):
+        """The experiments' metrics as a table block (the report's and the notebook's: HTML has no indent)."""
         return table([c[0] for c in self._COLUMNS], self.rows(), indent="")
 
     def _frame(self) -> dict:
@@ -223,7 +224,7 @@ class ValidationResult(Result):
                             for role, s in self.summary().items())
         notes = list(self.warnings) + [f"{f.file}: not predicted: {f.reason}" for f in self.failures]
         return [heading(f"Validation of {self.model.name or 'the model'}", f"— {summary}"),
-                table([c[0] for c in self._COLUMNS], self.rows()),
+                self._table_block(),
                 lines([f"{self.measurement.footer} {self.scoring}."]), lines(notes)]
 
 
