@@ -218,7 +218,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     experiments = list(getattr(data, "fit", data))
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
     init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
-                                     procedure=procedure)
+                                     procedure=procedure, parameters=parameters)
     _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")

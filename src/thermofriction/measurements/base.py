@@ -56,7 +56,7 @@ class Measurement:
     def initial_model(self, init, method, data, experiments, **options):
         """The model a fit of ``experiments`` starts from: ``init`` (a Model, a preset's name, a model file, or
         None) made ready for this measurement and ``method``, with values read off the data where it gives none.
-        ``options``: identify's ``friction``, ``free`` and ``procedure``."""
+        ``options``: identify's ``friction``, ``free``, ``procedure`` and ``parameters`` (the fitted names)."""
         raise NotImplementedError
 
     def complete(self, res, experiments, init):

@@ -99,9 +99,9 @@ class Command(Force):
     def offsets_in(self, traces) -> int:
         return super().offsets_in(traces) + 1  # the inertia
 
-    def initial_model(self, init, method, data, experiments, **options):
+    def initial_model(self, init, method, data, experiments, *, parameters=(), **options):
         """The delay, the inertia and a first offset read off the data, then force data's initial model
-        (measurements/command_start.py)."""
+        (measurements/command_start.py); ``parameters`` (the fitted names) are not needed here."""
         return command_initial(init, method, data, experiments, self.delay, force=Force, **options)
 
     def complete(self, res, experiments, init):

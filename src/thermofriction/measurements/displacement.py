@@ -65,9 +65,9 @@ class Displacement(Measurement):
     def unit(self, experiments=()) -> str:
         return "m"
 
-    def initial_model(self, init, method, data, experiments, **options):
+    def initial_model(self, init, method, data, experiments, *, parameters=(), **options):
         """The method's preset, or a model file's plant with a LuGre start read off the data
-        (measurements/displacement_start.py)."""
+        (measurements/displacement_start.py); ``parameters`` (the fitted names) are not needed here."""
         return displacement_initial(init, method, data, experiments, measurement=self, **options)
 
     def make_trace(self, exp, model) -> Trace:

@@ -112,10 +112,12 @@ class Force(Measurement):
         exps = list(getattr(experiments, "experiments", experiments))
         return "N m" if exps and exps[0].rotary else "N"
 
-    def initial_model(self, init, method, data, experiments, **options):
+    def initial_model(self, init, method, data, experiments, *, parameters=(), **options):
         """A prescribed-motion model of the data's kind, with starting values read off the data where ``init``
-        gives none (measurements/force_start.py)."""
-        return force_initial(init, method, data, experiments, force=Force, **options)
+        gives none (measurements/force_start.py), and fitted ripple amplitudes it starts at zero solved from the
+        data (measurements/ripple.py: ``started``)."""
+        model = force_initial(init, method, data, experiments, force=Force, **options)
+        return ripple.started(self, model, experiments, parameters or ())
 
     def complete(self, res, experiments, init):
         """The sensor offset estimated at the optimum as the policy says, a rotary joint's units
