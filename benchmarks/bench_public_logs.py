@@ -24,7 +24,9 @@ What is fitted, as a user would (no hand-written start):
   report points at on joint 2: the negative side's level ``fc_neg`` and a once-per-revolution ripple in the
   recorded angle (a rigid-body model's gravity error is ``a cos q + b sin q``).
 - **FAIRINO, the last part of each run held out**: one run per joint, so the first 60 % is fitted and the last
-  40 % predicted (a blocked split: the held-out samples come after every fitted one).
+  40 % predicted (a blocked split: the held-out samples come after every fitted one). A second way adds the
+  negative side's level and a cogging ripple (two harmonics) whose period is read off the first fit's residuals
+  over the recorded angle (a periodogram; 0.0012445 rad on all four joints, 5049 periods a turn).
 
 The source's physical models are scored in-sample (identified on the runs they predict); ours out of sample, with a
 sensor offset per run. The ratio column is ours over the source's best physical model on that run.
@@ -93,15 +95,33 @@ def _load(folder):
         return tf.load_dataset(folder, motion="position")
 
 
+def _cogging_period(fit, data) -> float:
+    """The period of the strongest ripple in the fit runs' residuals over the recorded angle (a Lomb-Scargle
+    periodogram, SciPy's, over periods from 1/400 to 1/2 of the travel): read off the data as a user would read it
+    off the drive (a gear ratio times the motor's cogging periods)."""
+    from scipy.signal import lombscargle
+
+    v = tf.validate(fit.model, data)
+    x = np.concatenate([p.position for p in v.predictions if p.role == "fit"])
+    r = np.concatenate([p.measured - p.predicted for p in v.predictions if p.role == "fit"])
+    periods = np.geomspace(np.ptp(x) / 400, np.ptp(x) / 2, 4000)
+    return float(periods[np.argmax(lombscargle(x, r - r.mean(), 2 * np.pi / periods))])
+
+
+RIPPLE_WAYS = {"asymmetric + gravity ripple": (2 * np.pi, 1), "asymmetric + cogging ripple": (None, 2)}
+
+
 def _fit_and_score(folder, held, way):
     data = _load(folder)
     t0 = time.perf_counter()
     fit = tf.identify(data, "base", offset="per-experiment")
-    if way == "asymmetric + gravity ripple":
-        init = fit.model.with_friction(fc_neg=fit.model.friction.values()["fc"], ripple_period=2 * np.pi)
+    if way in RIPPLE_WAYS:  # one harmonic per revolution (a gravity model's error), or the periodogram's cogging
+        period, harmonics = RIPPLE_WAYS[way]
+        period = period or _cogging_period(fit, data)
+        init = fit.model.with_friction(fc_neg=fit.model.friction.values()["fc"], ripple_period=period)
+        amplitudes = [f"ripple_{c}{k}" for k in range(1, harmonics + 1) for c in ("cos", "sin")]
         fit = tf.identify(data, "base", init=init, offset="per-experiment", ripple_phase="recorded",
-                          parameters=["sigma0", "sigma1", "fc", "fc_neg", "fs", "vs", "sigma2", "ripple_cos1",
-                                      "ripple_sin1"])
+                          parameters=["sigma0", "sigma1", "fc", "fc_neg", "fs", "vs", "sigma2", *amplitudes])
     seconds = time.perf_counter() - t0
     v = tf.validate(fit.model, data)
     rmse = {p.file: p.rmse for p in v.predictions}
@@ -141,9 +161,9 @@ def fairino(gitdir, work):
         _write_run(folder, "last.csv", t[cut:] - t[cut], q[cut:], dq[cut:], tau[cut:])
         _manifest(folder, {"first.csv": "fit", "last.csv": "validate"})
         theirs = {m: _rmse(p[cut:], tau[cut:]) for m, p in source.items()}
-        seconds, ours, verdict = _fit_and_score(folder, "last.csv", "data's own start")
-        rows.append((f"FAIRINO {name}", "last 40 % (first 60 % fitted)", "data's own start", ours, theirs, seconds,
-                     verdict))
+        for way in ("data's own start", "asymmetric + cogging ripple"):
+            seconds, ours, verdict = _fit_and_score(folder, "last.csv", way)
+            rows.append((f"FAIRINO {name}", "last 40 % (first 60 % fitted)", way, ours, theirs, seconds, verdict))
     return rows
 
 
@@ -164,8 +184,18 @@ def main(argv=None):
         print(f"{log:16s} {run:32s} {way:28s} {ours:8.4f} "
               + " ".join(f"{theirs.get(m, float('nan')):8.4f}" for m in SOURCE_MODELS)
               + f" {ours / best:6.2f} {seconds:5.1f}s  {said}")
-    print(f"ratio to the source's best physical model: median {np.median(ratios):.2f}, worst {max(ratios):.2f} "
-          f"over {len(ratios)} held-out runs (RMSE in N m; the source's models in sample, ours held out)")
+    for label, keep in (("every way", lambda w: True), ("the data's own start", lambda w: w == "data's own start"),
+                        ("the best way per run", None)):
+        if keep is None:
+            best = {}
+            for (log, run, way, *_), ratio in zip(rows, ratios):
+                best[log, run] = min(best.get((log, run), np.inf), ratio)
+            chosen = list(best.values())
+        else:
+            chosen = [r for row, r in zip(rows, ratios) if keep(row[2])]
+        print(f"ratio to the source's best physical model, {label}: median {np.median(chosen):.2f}, "
+              f"worst {max(chosen):.2f} over {len(chosen)} fits")
+    print("(RMSE in N m; the source's models scored in sample, ours on held-out samples)")
 
 
 if __name__ == "__main__":
