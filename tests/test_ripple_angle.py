@@ -239,3 +239,22 @@ def test_a_large_ripple_is_started_where_the_data_put_it(seed, monkeypatch):
     monkeypatch.setattr(ripple, "started", lambda measurement, model, experiments, names: model)
     before = _fit(data, init=_init(period)).model.friction
     assert abs(before.ripple_sin1 - 0.36) > 0.05 * 0.36  # the failure this start removes (the test is not vacuous)
+
+
+def test_the_ripple_angle_travels_in_the_fit_record(homed, tmp_path):
+    """A fit forced to a phase per run (on homed runs, where "auto" would take the recorded angle) writes that
+    choice into its fit record, and validate, asked nothing, scores the model the same way and says so (before:
+    validate decided "auto" again from the data, so the model was scored unlike its fit)."""
+    data, runs = homed
+    fit = _fit(data, ripple_phase="per-run")
+    assert fit.model.provenance["fit_record"]["ripple_phase"] == "per-run"
+    path = tmp_path / "fitted.toml"
+    fit.model.save(path)
+    model = tf.load_model(path)
+    v = tf.validate(model, data)
+    assert v.scored_as["ripple_phase"] == "per-run" and v.scored_as["ripple_phase_from"] == "the fit record"
+    assert "ripple phase per-run (the fit record)" in v.scoring
+    asked = tf.validate(model, data, ripple_phase="per-run")
+    other = tf.validate(model, data, ripple_phase="recorded")
+    assert [p.rmse for p in v.predictions] == [p.rmse for p in asked.predictions]
+    assert [p.rmse for p in v.predictions] != [p.rmse for p in other.predictions]

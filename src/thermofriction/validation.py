@@ -13,6 +13,7 @@ from .data.motion import check_motion_option, driven_by
 from .figures.friction_plots import force_hysteresis_figure
 from .figures.plots import error_figure
 from .measurements import Measurement, MetricWarning, Prediction, amount, measurement_of, step_sizes
+from .measurements.ripple import check_phase_option
 from .models import Model
 from .models.fit_record import fit_record_of
 from .results import Finding, Result, Summary, as_text, collecting, heading, lines, table
@@ -233,10 +234,23 @@ def scoring_note(scored_as: dict) -> str:
     position"."""
     if not scored_as:
         return ""
-    parts = [f"{k} {scored_as[k]} ({scored_as[k + '_from']})" for k in ("offset", "motion") if k in scored_as]
-    sources = {scored_as.get(k + "_from") for k in ("offset", "motion") if k in scored_as}
+    keys = [k for k in ("offset", "motion", "ripple_phase") if k in scored_as]
+    parts = [f"{k.replace('_', ' ')} {scored_as[k]} ({scored_as[k + '_from']})" for k in keys]
+    sources = {scored_as.get(k + "_from") for k in keys}
     lead = "scored as fitted" if sources == {"the fit record"} else "scored with"
     return f"{lead}: " + ", ".join(parts)
+
+
+def _ripple_phase(record, ripple_phase, how):
+    """The ripple's angle: as asked, else the fit record's (said in ``how``), else "auto"."""
+    if ripple_phase is None and record.get("ripple_phase"):
+        ripple_phase, how["ripple_phase_from"] = record["ripple_phase"], "the fit record"
+        check_phase_option(ripple_phase, "the model's [provenance.fit_record] 'ripple_phase'")
+    elif ripple_phase is not None and ripple_phase != "auto":
+        how["ripple_phase_from"] = "asked"
+    if "ripple_phase_from" in how:
+        how["ripple_phase"] = ripple_phase
+    return ripple_phase or "auto"
 
 
 def _scoring(model, exps, offset, motion):
@@ -265,7 +279,7 @@ def _scoring(model, exps, offset, motion):
 
 
 def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
-             ripple_phase="auto") -> ValidationResult:
+             ripple_phase=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
     errors (docs/formats.md#validation-metrics) as the data's measurement says.
 
@@ -287,15 +301,16 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
         scored the way ``identify`` scored it), else the model's own offset.
     motion : {"position", "velocity", "auto"}, optional
         Force data: what drives the experiments; default the model's fit record, else "auto".
-    ripple_phase : {"auto", "recorded", "per-run"}, default "auto"
+    ripple_phase : {"auto", "recorded", "per-run"}, optional
         Force data's position ripple at the recorded angle ("recorded"), at each run's own phase, estimated on it
-        ("per-run"), or per-run where every run starts at 0 ("auto").
+        ("per-run"), or per-run where every run starts at 0 ("auto"); default the model's fit record (the angle its
+        fit took), else "auto".
 
     Returns
     -------
     ValidationResult
         One prediction per experiment with its metrics (RMSE in the data's unit, relative errors), the
-        warnings, and ``scored_as``: how the offset and motion were chosen.
+        warnings, and ``scored_as``: how the offset, the motion and a ripple's angle were chosen.
 
     Raises
     ------
@@ -318,6 +333,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     if not exps:
         raise InputError("the dataset has no experiments")
     exps, offset, how = _scoring(model, exps, offset, motion)
+    ripple_phase = _ripple_phase(fit_record_of(model) or {}, ripple_phase, how)
     measurement = measurement_of(exps, offset=offset, ripple_phase=ripple_phase)  # asked once
     how["offset"] = measurement.offset
     measurement.check_model(model, exps)

@@ -86,10 +86,11 @@ def _force_options(p, scoring=False):
                    help="force data: what drives the model, overriding the dataset's 'motion'" + record +
                         " the dataset's, else auto: the velocity column where it is the position's derivative, else "
                         "the position)")
-    p.add_argument("--ripple-phase", choices=("auto", "recorded", "per-run"), default="auto",
+    p.add_argument("--ripple-phase", choices=("auto", "recorded", "per-run"), default=None if scoring else "auto",
                    help="force data with a position ripple: its angle, the recorded position (recorded), or a phase "
-                        "estimated per run where positions are relative to each run (per-run); default auto: per-run "
-                        "where every run starts at position 0, else recorded (said among the fit's warnings)")
+                        "estimated per run where positions are relative to each run (per-run)"
+                        + (", as the model was fitted (its fit record), else auto:" if scoring else "; default auto:")
+                        + " per-run where every run starts at position 0, else recorded (said among the fit's warnings)")
 
 
 def _writes(command, dest, what):

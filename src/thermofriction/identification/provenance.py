@@ -68,6 +68,9 @@ def stamp(fit, data, method: str, init, options: dict):
     date = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
     init_name = init.name or "a Model object" if isinstance(init, Model) else str(init)
     policy = measurement_of(fit_runs or experiments, offset=options.get("offset")).offset
+    # the ripple's angle as identify decided it (on the whole dataset, as identify asks measurement_of)
+    phase = getattr(measurement_of(experiments, offset=options.get("offset"),
+                                   ripple_phase=options.get("ripple_phase") or "auto"), "ripple_phase", None)
 
     def one(f, how):
         prov = {"method": f.method, "data": where, "data_sha256": digest,
@@ -75,7 +78,7 @@ def stamp(fit, data, method: str, init, options: dict):
                 "date": date, "thermofriction": __version__, "initial_model": init_name,
                 "options": {**opts, **how}}
         if isinstance(f, FitResult):  # how it was scored: validate and report score it the same way
-            prov["fit_record"] = fit_record(f, fit_runs, policy)
+            prov["fit_record"] = fit_record(f, fit_runs, policy, phase)
         description = (f"{METHOD_NAMES.get(f.method, f.method)} identified by thermofriction {__version__} "
                        f"from {len(fit_runs)} experiment{'s' if len(fit_runs) != 1 else ''} of {label} "
                        f"at {temps} C" + (f" ({len(held)} held out)" if held else "")

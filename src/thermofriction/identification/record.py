@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 from ..data.experiments import run_label
+from ..measurements.ripple import has_ripple
 
 
 def motion_policy(experiments) -> str:
@@ -35,8 +36,9 @@ def _experiment_entry(exp, offsets: dict) -> dict:
     return entry
 
 
-def fit_record(fit, experiments, offset_policy: str) -> dict:
-    """The record of ``fit`` made on ``experiments`` (the fit runs) with the measurement's ``offset_policy``."""
+def fit_record(fit, experiments, offset_policy: str, ripple_phase: str | None = None) -> dict:
+    """The record of ``fit`` made on ``experiments`` (the fit runs) with the measurement's ``offset_policy``, and
+    its ``ripple_phase`` ("recorded" or "per-run", as decided) where the fitted model has a ripple."""
     offsets = {r["file"]: float(r["value"]) for r in (fit.sensor_offset or {}).get("per_experiment", [])
                if r.get("value") is not None and math.isfinite(r["value"])}
     record = {"measurement": fit.measurement, "offset": offset_policy,
@@ -44,6 +46,8 @@ def fit_record(fit, experiments, offset_policy: str) -> dict:
               "held": [p.name for p in fit.parameters.values() if not p.vary]}
     if any(getattr(e, "force", None) is not None for e in experiments):
         record["motion"] = motion_policy(experiments)
+        if ripple_phase in ("recorded", "per-run") and has_ripple(fit.model):
+            record["ripple_phase"] = ripple_phase
     noise = (fit.fit_quality or {}).get("noise")
     if noise is not None and math.isfinite(noise) and noise > 0:
         record.update(noise=float(noise), noise_unit=fit.unit)

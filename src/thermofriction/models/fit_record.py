@@ -1,7 +1,7 @@
 """A fitted model's fit record (docs/formats.md#the-fit-record): how ``identify`` scored the data it fitted -- the
 measured quantity, the sensor offset policy and each run's offset, what drove each run (the position or the
-velocity column) and how that column compared with the position's derivative, the names fitted and held, and the
-noise the verdict compared with. It travels in the model file (``[provenance.fit_record]``) so that ``validate``,
+velocity column) and how that column compared with the position's derivative, a ripple's angle (the recorded one
+or a phase per run), the names fitted and held, and the noise the verdict compared with. It travels in the model file (``[provenance.fit_record]``) so that ``validate``,
 ``report`` and ``propagate`` score the model the way it was fitted unless told otherwise, and say which.
 
 Here the table's form is checked; what its values mean (an offset policy, a motion) is checked where they are used
@@ -14,10 +14,11 @@ import math
 from ..errors import InputError, shorten, unknown_keys
 
 #: the record's keys: strings, but for the name lists, the noise (a number) and the experiments' table
-FIT_RECORD_KEYS = ("measurement", "offset", "motion", "fitted", "held", "noise", "noise_unit", "experiments")
+FIT_RECORD_KEYS = ("measurement", "offset", "motion", "ripple_phase", "fitted", "held", "noise", "noise_unit",
+                   "experiments")
 #: one experiment's entry (by file name): what drove it, its offset, its velocity column against the position
 EXPERIMENT_KEYS = ("motion", "offset", "velocity_lag", "velocity_scale")
-_STRINGS = ("measurement", "offset", "motion", "noise_unit")
+_STRINGS = ("measurement", "offset", "motion", "ripple_phase", "noise_unit")
 _NUMBERS = ("noise", "offset", "velocity_lag", "velocity_scale")
 
 

@@ -43,7 +43,7 @@ def _check_report_arguments(models, data, path, figures_dir, command, title, tru
 
 
 def report(models, data, path, *, figures_dir=None, command=None, title=None, truth=None, bands=None, offset=None,
-           motion=None, ripple_phase="auto") -> str:
+           motion=None, ripple_phase=None) -> str:
     """Writes the HTML report comparing ``models`` on ``data`` and returns its HTML.
 
     Each model is scored as it was fitted (its fit record: the offset policy, the motion), unless ``offset`` or
@@ -74,8 +74,9 @@ def report(models, data, path, *, figures_dir=None, command=None, title=None, tr
         Force data: how the sensor offset is taken, for every model (``validate``'s ``offset``).
     motion : {"position", "velocity", "auto"}, optional
         Force data: what drives the experiments, for every model (``validate``'s ``motion``).
-    ripple_phase : {"auto", "recorded", "per-run"}, default "auto"
-        Force data with a position ripple: its angle, for every model (``validate``'s ``ripple_phase``).
+    ripple_phase : {"auto", "recorded", "per-run"}, optional
+        Force data with a position ripple: its angle, for every model (``validate``'s ``ripple_phase``); default
+        each model's fit record, else "auto".
 
     Returns
     -------
