@@ -24,9 +24,9 @@ What is fitted, as a user would (no hand-written start):
   report points at on joint 2: the negative side's level ``fc_neg`` and a once-per-revolution ripple in the
   recorded angle (a rigid-body model's gravity error is ``a cos q + b sin q``).
 - **FAIRINO, the last part of each run held out**: one run per joint, so the first 60 % is fitted and the last
-  40 % predicted (a blocked split: the held-out samples come after every fitted one). A second way adds the
-  negative side's level and a cogging ripple (two harmonics) whose period is read off the first fit's residuals
-  over the recorded angle (a periodogram; 0.0012445 rad on all four joints, 5049 periods a turn).
+  40 % predicted (a blocked split: the held-out samples come after every fitted one). A second way follows the
+  first fit's own advice where it finds a ripple in its residuals (identification/ripple_advice.py): the negative
+  side's level and a ripple of the advised period (two harmonics).
 
 The source's physical models are scored in-sample (identified on the runs they predict); ours out of sample, with a
 sensor offset per run. The ratio column is ours over the source's best physical model on that run.
@@ -95,29 +95,23 @@ def _load(folder):
         return tf.load_dataset(folder, motion="position")
 
 
-def _cogging_period(fit, data) -> float:
-    """The period of the strongest ripple in the fit runs' residuals over the recorded angle (a Lomb-Scargle
-    periodogram, SciPy's, over periods from 1/400 to 1/2 of the travel): read off the data as a user would read it
-    off the drive (a gear ratio times the motor's cogging periods)."""
-    from scipy.signal import lombscargle
-
-    v = tf.validate(fit.model, data)
-    x = np.concatenate([p.position for p in v.predictions if p.role == "fit"])
-    r = np.concatenate([p.measured - p.predicted for p in v.predictions if p.role == "fit"])
-    periods = np.geomspace(np.ptp(x) / 400, np.ptp(x) / 2, 4000)
-    return float(periods[np.argmax(lombscargle(x, r - r.mean(), 2 * np.pi / periods))])
+def _advised_period(fit):
+    """The ripple period the fit's own advice names (identification/ripple_advice.py), or None where it says none."""
+    found = (fit.fit_quality or {}).get("ripple") or {}
+    return found["period"] if found.get("said") else None
 
 
-RIPPLE_WAYS = {"asymmetric + gravity ripple": (2 * np.pi, 1), "asymmetric + cogging ripple": (None, 2)}
+RIPPLE_WAYS = {"asymmetric + gravity ripple": (2 * np.pi, 1), "asymmetric + advised ripple": (None, 2)}
 
 
 def _fit_and_score(folder, held, way):
     data = _load(folder)
     t0 = time.perf_counter()
     fit = tf.identify(data, "base", offset="per-experiment")
-    if way in RIPPLE_WAYS:  # one harmonic per revolution (a gravity model's error), or the periodogram's cogging
+    advised = _advised_period(fit)
+    if way in RIPPLE_WAYS and (RIPPLE_WAYS[way][0] or advised):  # once a turn (a gravity model's error), or advised
         period, harmonics = RIPPLE_WAYS[way]
-        period = period or _cogging_period(fit, data)
+        period = period or advised
         init = fit.model.with_friction(fc_neg=fit.model.friction.values()["fc"], ripple_period=period)
         amplitudes = [f"ripple_{c}{k}" for k in range(1, harmonics + 1) for c in ("cos", "sin")]
         fit = tf.identify(data, "base", init=init, offset="per-experiment", ripple_phase="recorded",
@@ -126,7 +120,7 @@ def _fit_and_score(folder, held, way):
     v = tf.validate(fit.model, data)
     rmse = {p.file: p.rmse for p in v.predictions}
     verdict = fit.fit_quality.get("adequate")
-    return seconds, rmse[held], verdict
+    return seconds, rmse[held], verdict, advised
 
 
 def franka(gitdir, work, ways):
@@ -145,8 +139,8 @@ def franka(gitdir, work, ways):
             t, q, dq, tau, source = runs[held]
             theirs = {m: _rmse(p, tau) for m, p in source.items()}
             for way in ways if case == "case3" else ways[:1]:
-                seconds, ours, verdict = _fit_and_score(folder, f"{held}.csv", way)
-                rows.append((joint, f"{held} (other two fitted)", way, ours, theirs, seconds, verdict))
+                seconds, ours, verdict, advised = _fit_and_score(folder, f"{held}.csv", way)
+                rows.append((joint, f"{held} (other two fitted)", way, ours, theirs, seconds, verdict, advised))
     return rows
 
 
@@ -161,9 +155,10 @@ def fairino(gitdir, work):
         _write_run(folder, "last.csv", t[cut:] - t[cut], q[cut:], dq[cut:], tau[cut:])
         _manifest(folder, {"first.csv": "fit", "last.csv": "validate"})
         theirs = {m: _rmse(p[cut:], tau[cut:]) for m, p in source.items()}
-        for way in ("data's own start", "asymmetric + cogging ripple"):
-            seconds, ours, verdict = _fit_and_score(folder, "last.csv", way)
-            rows.append((f"FAIRINO {name}", "last 40 % (first 60 % fitted)", way, ours, theirs, seconds, verdict))
+        for way in ("data's own start", "asymmetric + advised ripple"):
+            seconds, ours, verdict, advised = _fit_and_score(folder, "last.csv", way)
+            rows.append((f"FAIRINO {name}", "last 40 % (first 60 % fitted)", way, ours, theirs, seconds, verdict,
+                         advised))
     return rows
 
 
@@ -177,13 +172,14 @@ def main(argv=None):
     print(f"{'log':16s} {'held-out run':32s} {'fit':28s} {'ours':>8s} "
           + " ".join(f"{m:>8s}" for m in SOURCE_MODELS) + f" {'ratio':>6s} {'time':>6s}  verdict")
     ratios = []
-    for log, run, way, ours, theirs, seconds, verdict in rows:
+    for log, run, way, ours, theirs, seconds, verdict, advised in rows:
         best = min(theirs.values())
         ratios.append(ours / best)
         said = "adequate" if verdict else "not adequate" if verdict is False else "unknown"
         print(f"{log:16s} {run:32s} {way:28s} {ours:8.4f} "
               + " ".join(f"{theirs.get(m, float('nan')):8.4f}" for m in SOURCE_MODELS)
-              + f" {ours / best:6.2f} {seconds:5.1f}s  {said}")
+              + f" {ours / best:6.2f} {seconds:5.1f}s  {said}"
+              + (f"; ripple advised, period {advised:.5g}" if advised and way == "data's own start" else ""))
     for label, keep in (("every way", lambda w: True), ("the data's own start", lambda w: w == "data's own start"),
                         ("the best way per run", None)):
         if keep is None:

@@ -25,6 +25,9 @@ def parameter_rows(fit) -> list:
 
 def verdict(q) -> str:
     """The fit quality's verdict (``FitResult.fit_quality``) in words."""
+    if q["adequate"] is False and q.get("verdict_basis") == "ripple":
+        return (f"NOT adequate (a position ripple in the residuals: a refit with it removes "
+                f"{100 * q['ripple']['gain']:.2g} % of the misfit)")
     if q["adequate"] is False and q.get("verdict_basis") == "held values":
         return f"NOT adequate (held values contradicted; the noise cannot be estimated: {q.get('why')})"
     if q.get("verdict_basis") == "baseline":  # the noise unknown: the model against a model-free map (baseline.py)
@@ -48,6 +51,8 @@ def _not_adequate(fit) -> list:
         f"the residuals are not compared with it)" if basis == "held values" else
         f"held-out RMSE {b.get('ratio', math.nan):.3g} x a model-free map's on the same runs (the noise cannot "
         f"be estimated from these data)" if basis == "baseline" else
+        f"the residuals hold a position ripple ({100 * fit.fit_quality['ripple']['gain']:.2g} % of the misfit)"
+        if basis == "ripple" else
         f"residuals {fit.fit_quality['ratio']:.3g} x the measurement noise"
         + (f", {len(held)} held value(s) contradicted by the data" if held else "")) + " (see the first warnings)"]
 

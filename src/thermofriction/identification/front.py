@@ -18,6 +18,7 @@ from ..measurements.baseline import baseline_verdict, model_free
 from ..measurements.delay import parse_delay
 from ..measurements.ripple import check_per_run, has_ripple
 from .held import with_held_tests
+from .ripple_advice import with_ripple_advice
 from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
@@ -240,6 +241,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
     held = list(getattr(data, "validate", None) or [])
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
+    res = with_ripple_advice(res, experiments, held, measurement, rtol)  # a ripple the residuals hold, tried
     res.warnings[:0] = units + _ripple_note(measurement, res.model)
     return res
 

@@ -1,0 +1,164 @@
+"""A position ripple the residuals hold, found and tried before it is said (docs/force-data.md, "A ripple the
+residuals hold"). A joint's cogging or gear mesh is a torque periodic in its angle; a model without a ripple leaves
+it in the residuals, where no statistic of the fit names it. After a force fit whose model has no ripple, the
+residuals of each fit run are searched over the recorded angle (a Lomb-Scargle periodogram, SciPy's, the runs'
+powers summed, so runs whose angles do not line up still add up); the strongest period is then tried: a short refit
+from the optimum with that period and its first harmonic's amplitudes (started where the data put them:
+measurements/ripple.py ``started``), scored on the fit runs and, where the dataset holds runs out, on those. Only
+a refit that lowers the error by MATERIAL of the misfit (and does not raise the held-out error) is said, with its
+measured gains; the period is then one a user can give (``ripple_period``)."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+
+from .._lazy import lazy
+from ..errors import ThermofrictionError
+from ..fitting.optimiser import fit
+from ..fitting.parameters import get_value, unit_of, with_values
+from ..measurements import amount, make_traces
+from ..measurements.ripple import additive, has_ripple, started
+from ..validation import validate
+
+signal = lazy("scipy.signal")
+
+#: the share of the misfit a tried ripple must remove to be said (as a freed held value must: advice.py)
+MATERIAL = 0.05
+#: a tried ripple that removes this share of the misfit makes the fit not adequate, whatever else said it was
+INADEQUATE = 0.25
+#: the most evaluations the tried refit may take (it starts at the optimum with the amplitudes solved)
+TRY_EVALUATIONS = 12
+#: periods searched: from this many samples' travel (a period the sampling resolves) to half the travel
+SAMPLES_PER_PERIOD = 4
+PERIODS = 3000
+AMPLITUDES = ("ripple_cos1", "ripple_sin1")
+
+
+def _residuals(res, experiments, measurement):
+    """[(angle, residual about its mean)] of each fit run at the optimum, as validate scores them."""
+    with_phase = getattr(measurement, "ripple_phase", "recorded")
+    v = validate(res.model, experiments, experiments, offset=measurement.offset if measurement.offset != "shared"
+                 else None, ripple_phase=with_phase)
+    out = []
+    for p in v.predictions:
+        r = np.asarray(p.measured, float) - np.asarray(p.predicted, float)
+        ok = np.isfinite(r) & np.isfinite(p.position)
+        if ok.sum() > 8:
+            out.append((np.asarray(p.position, float)[ok], r[ok] - r[ok].mean()))
+    return out
+
+
+def strongest_period(runs) -> float | None:
+    """The period (in the angle's unit) with the most summed Lomb-Scargle power over ``runs`` [(angle,
+    residual)], searched between SAMPLES_PER_PERIOD samples' median travel and half the largest run's travel;
+    None where the runs do not move enough to see two periods."""
+    steps = np.concatenate([np.abs(np.diff(x)) for x, _ in runs])
+    steps = steps[steps > 0]
+    travel = max(float(np.ptp(x)) for x, _ in runs)
+    if steps.size == 0 or not travel > 0:
+        return None
+    shortest, longest = SAMPLES_PER_PERIOD * float(np.median(steps)), travel / 2
+    if not shortest < longest:
+        return None
+    periods = np.geomspace(shortest, longest, PERIODS)
+    best = None
+    for _ in range(2):  # the grid, then a finer one between the best point's neighbours
+        power = sum(signal.lombscargle(x, r, 2 * math.pi / periods) for x, r in runs)
+        k = int(np.argmax(power))
+        best = float(periods[k])
+        periods = np.linspace(periods[max(k - 1, 0)], periods[min(k + 1, periods.size - 1)], 201)
+    return best
+
+
+def _share(runs, period) -> float:
+    """The share of the residuals' sum of squares one harmonic of ``period`` explains, each run with its own phase
+    (a linear least-squares fit per run: the test that decides whether a refit is worth trying)."""
+    total = explained = 0.0
+    for x, r in runs:
+        w = 2 * math.pi * x / period
+        A = np.column_stack([np.cos(w), np.sin(w), np.ones_like(w)])
+        fitted = A @ np.linalg.lstsq(A, r, rcond=None)[0]
+        total += float(r @ r)
+        explained += float(r @ r) - float((r - fitted) @ (r - fitted))
+    return explained / total if total > 0 else 0.0
+
+
+def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
+    """``res`` with a tried position ripple said where its residuals hold one (``fit_quality["ripple"]``: the period,
+    the gains measured; a warning), for force data fitted without a ripple; ``held``: the dataset's held-out runs."""
+    model = res.model
+    if res.fit_quality is None or res.method not in ("base", "model-i") or has_ripple(model) or \
+            getattr(measurement, "ripple_phase", None) is None or not res.rmse > 0 or not experiments:
+        return res
+    if not additive(model.with_friction(ripple_period=1.0)):  # Model II scales a ripple: not a plain term here
+        return res
+    try:
+        runs = _residuals(res, experiments, measurement)
+        period = strongest_period(runs) if runs else None
+        if period is None or _share(runs, period) < MATERIAL:  # not worth a refit: nothing to say
+            return res
+        refit, nfev = _refit(res, experiments, measurement, period, rtol)
+        before, after = (_pooled_rmse(m, experiments, measurement) for m in (model, refit))
+        out = {"period": period, "gain": max(1.0 - (after / before) ** 2, 0.0), "rmse_before": before,
+               "rmse_after": after, "evaluations": nfev}
+        if held:
+            out.update(heldout_before=_pooled_rmse(model, held, measurement),
+                       heldout_after=_pooled_rmse(refit, held, measurement))
+    except ThermofrictionError:
+        return res
+    gain = out["gain"]
+    res.fit_quality["ripple"] = out
+    out["said"] = gain >= MATERIAL and not (held and not out["heldout_after"] < out["heldout_before"])
+    if out["said"]:
+        message = _message(out, res.unit, measurement, bool(getattr(experiments[0], "rotary", False)))
+        q = res.fit_quality
+        if gain >= INADEQUATE and q["adequate"] is not False:  # one verdict: the model misses what the data hold
+            q["adequate"], q["verdict_basis"] = False, "ripple"
+            res.warnings[:] = [w for w in res.warnings if not w.startswith(("adequacy unknown", "adequate relative"))]
+            res.warnings.insert(0, "the fit is not adequate: " + message)
+        else:
+            res.warnings.append(message)
+    return res
+
+
+def _pooled_rmse(model, runs, measurement) -> float:
+    """The RMSE of ``model`` over ``runs`` pooled over their samples, each run scored as validate scores it."""
+    v = validate(model, runs, runs, offset=measurement.offset if measurement.offset != "shared" else None,
+                 ripple_phase=getattr(measurement, "ripple_phase", "recorded"))
+    n = np.array([np.size(p.measured) for p in v.predictions], float)
+    return float(np.sqrt(np.sum(n * np.array([p.rmse for p in v.predictions]) ** 2) / np.sum(n)))
+
+
+def _refit(res, experiments, measurement, period, rtol):
+    """(the refit model, evaluations): the fit's varying parameters and the first harmonic of a ripple of
+    ``period`` fitted from the optimum, the amplitudes solved first (ripple.started)."""
+    start = started(measurement, res.model.with_friction(ripple_period=period), experiments, AMPLITUDES)
+    params = copy.deepcopy(res.parameters)
+    for p in params.values():  # from the optimum's values
+        try:
+            p.value = get_value(start, p.name)
+        except ThermofrictionError:
+            pass
+    for n in AMPLITUDES:
+        params.add(n, get_value(start, n), unit=unit_of(start, n))
+    names = [p.name for p in params.varying]
+    outcome = fit(start, params, make_traces(experiments, start, measurement), rtol=rtol, starts=1, near=True,
+                  max_nfev=TRY_EVALUATIONS)
+    return with_values(start, dict(zip(names, outcome.theta))), int(outcome.nfev)
+
+
+def _message(out, unit, measurement, rotary) -> str:
+    per_turn = f" rad ({2 * math.pi / out['period']:.4g} a turn)" if rotary else " m"
+    held = (f"; on the held-out runs {amount(out['heldout_before'], unit)} -> {amount(out['heldout_after'], unit)}"
+            if "heldout_after" in out else "; no held-out runs to confirm it")
+    return (f"the residuals hold a position ripple of period {out['period']:.5g}{per_turn} in the "
+            f"{'recorded angle' if measurement.ripple_phase == 'recorded' else 'angle of each run'}: a refit with it "
+            f"(ripple_period = {out['period']:.5g}, ripple_cos1 and ripple_sin1 fitted; {out['evaluations']} "
+            f"evaluations) lowers the RMSE {amount(out['rmse_before'], unit)} -> {amount(out['rmse_after'], unit)} "
+            f"({100 * out['gain']:.2g} % of the misfit){held}")
+
+
+__all__ = ["with_ripple_advice", "strongest_period", "MATERIAL"]
