@@ -33,7 +33,10 @@ INADEQUATE = 0.25
 TRY_EVALUATIONS = 12
 #: periods searched: from this many samples' travel (a period the sampling resolves) to half the travel
 SAMPLES_PER_PERIOD = 4
+#: at most this many periods on the log-spaced grid (fewer where the travel holds fewer cycles)
 PERIODS = 3000
+#: the periodogram runs on the residuals averaged in bins of the angle this many to the shortest period
+BINS_PER_PERIOD = 8
 AMPLITUDES = ("ripple_cos1", "ripple_sin1")
 
 
@@ -51,6 +54,17 @@ def _residuals(res, experiments, measurement):
     return out
 
 
+def _binned(x, r, width):
+    """The residuals averaged in bins of the angle ``width`` wide (the bins a run visits): a run that passes the same
+    angles again and again adds its samples to the same bins, so the periodogram's cost is the travel's, not the
+    record's (a bin an eighth of the shortest period searched changes no peak)."""
+    k = np.floor((x - x.min()) / width).astype(np.int64)
+    n = np.bincount(k)
+    seen = n > 0
+    centres = x.min() + width * (np.nonzero(seen)[0] + 0.5)
+    return centres, (np.bincount(k, weights=r)[seen] / n[seen])
+
+
 def strongest_period(runs) -> float | None:
     """The period (in the angle's unit) with the most summed Lomb-Scargle power over ``runs`` [(angle,
     residual)], searched between SAMPLES_PER_PERIOD samples' median travel and half the largest run's travel;
@@ -63,10 +77,13 @@ def strongest_period(runs) -> float | None:
     shortest, longest = SAMPLES_PER_PERIOD * float(np.median(steps)), travel / 2
     if not shortest < longest:
         return None
-    periods = np.geomspace(shortest, longest, PERIODS)
+    # a peak is 1/(cycles over the travel) wide, relatively: four points across the narrowest one (the shortest's)
+    count = int(np.clip(math.ceil(4 * travel / shortest * math.log(longest / shortest)), 200, PERIODS))
+    periods = np.geomspace(shortest, longest, count)
+    binned = [_binned(x, r, shortest / BINS_PER_PERIOD) for x, r in runs]
     best = None
     for _ in range(2):  # the grid, then a finer one between the best point's neighbours
-        power = sum(signal.lombscargle(x, r, 2 * math.pi / periods) for x, r in runs)
+        power = sum(signal.lombscargle(x, r, 2 * math.pi / periods) for x, r in binned)
         k = int(np.argmax(power))
         best = float(periods[k])
         periods = np.linspace(periods[max(k - 1, 0)], periods[min(k + 1, periods.size - 1)], 201)
