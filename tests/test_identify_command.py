@@ -6,6 +6,15 @@ solve_ivp (Radau, rtol 1e-10) from rest, the command ``u(t) = J a + F + offset +
 realises it, recorded ``delay`` earlier (a drive that acts 8 ms after its command records ``u(t + 8 ms)`` at t).
 Fits start from values read off the data, not from the truth.
 
+These are point samples of a continuous torque, the other case than a drive's held command (tests/test_delay.py,
+the servo): the measurement compares the command with the mean of J a + F over the sample after it
+(measurements/command.py), which is the point value half a sample later to second order, so the delay it finds is
+the transport delay less half a sample: 8 ms - 0.5 ms, and -0.5 ms without a delay. (Before the model took the mean,
+it found 8 ms: 7.92-8.00 ms on seeds 0-4, with sigma0's and sigma1's intervals missing 60 and 0.04 on seed 4, and
+no delay as none, not applied; with the mean, 7.43-7.51 ms, intervals covering 7.5 ms, sigma0's and sigma1's
+covering the truth on seeds 0-4, and no delay as -0.47 ms +- 0.05: the mean is the point value half a sample
+later only to second order, dt^2/24 times the second derivative of F + J a.)
+
 Tolerance: J, fc and the offset (and the delay) within twice the half-width of their own 95 % interval (about
 four standard errors) of the truth: an honest interval passes, a biased fit or a falsely tight one fails.
 """
@@ -99,6 +108,8 @@ def within(est: dict, truth: float):
 
 
 def check_fit(res, delay):
+    """J, fc, the offset and the delay (``delay`` the transport delay of these point samples: read as ``delay -
+    DT/2``, the module's docstring) within twice their intervals' half-widths of the truth."""
     assert res.measurement == "command" and res.unit == "N m"
     plant = res.details["plant"]
     within(plant["inertia"], J_TRUE)
@@ -110,17 +121,15 @@ def check_fit(res, delay):
     assert res.model.plant.sensor_offset == pytest.approx(res.sensor_offset["value"])
     assert res.rmse < 1.3 * NOISE, res.rmse
     d = plant["delay"]
-    if delay:
-        assert d["applied"] and abs(d["value"] - delay) < 0.5 * DT, d
-        within({"value": d["estimate"], "ci95": d["ci95"]}, delay)
-    else:
-        assert not d["applied"] and d["value"] == 0.0 and "not applied" in d["note"], d
+    assert d["applied"] and abs(d["value"] - (delay - 0.5 * DT)) < 0.25 * DT, d
+    within({"value": d["estimate"], "ci95": d["ci95"]}, delay - 0.5 * DT)
     return plant
 
 
 def test_inertia_friction_offset_and_delay_recovered(tmp_path):
     """The delayed command of a joint whose initial model is a plant-only file with twice the true inertia: J, fc,
-    the offset and the 8 ms delay recovered within their intervals, and said in the text report."""
+    the offset and the 8 ms delay (read as 7.5 ms off point samples) recovered within their intervals, and said in
+    the text report."""
     data = make_command_dataset(tmp_path / "d", delay=DELAY)
     assert measurement_of(data).name == "command"
     init = tmp_path / "joint.toml"
@@ -129,12 +138,12 @@ def test_inertia_friction_offset_and_delay_recovered(tmp_path):
     plant = check_fit(res, DELAY)
     text = res.report()
     assert f"inertia J        = {plant['inertia']['value']:.6g} +- " in text and "kg m^2" in text
-    assert re.search(r"delay            = (7\.9|8\.0)\d* ms \(estimate", text), text
+    assert re.search(r"delay            = 7\.[45]\d* ms \(estimate", text), text
 
 
 def test_current_times_torque_constant_without_delay(tmp_path):
-    """A motor current read with the manifest's torque constant: the same joint, no delay (reported as 0, not
-    applied); held out under another motion, the model predicts the command at the noise; the report's page."""
+    """A motor current read with the manifest's torque constant: the same joint, no delay (point samples: read as
+    -0.5 ms); held out under another motion, the model predicts the command at the noise; the report's page."""
     data = make_command_dataset(tmp_path / "d", current=True, validate=True)
     exp = data.experiments[0]
     assert exp.measured_quantity == "command" and exp.column == "current[A]"
