@@ -19,9 +19,9 @@ reversal, a few ms, is not its mean). The residuals are ``mean(F + J a) + offset
 - **J and the offset** enter linearly: they are profiled out, as the force sensor's offset is -- the residuals
   and the Jacobian's columns projected onto the complement of the columns ``[a, 1]`` (per-experiment offsets:
   one column of ones per run; none: ``[a]`` and the model's own offset) -- and estimated with their standard
-  errors at the optimum (measurements/command_start.py: command_finish). The fitted model keeps its prescribed motion and
-  holds J, the offset and the delay in its ``[plant]`` (``inertia``, ``sensor_offset``, ``delay``), so that
-  validation predicts a command from a model file alone.
+  errors at the optimum (measurements/command_start.py: command_finish). The fitted model keeps its prescribed
+  motion and holds J, the offset and the delay in its ``[plant]`` (``inertia``, ``sensor_offset``, ``delay``), so
+  that validation predicts a command from a model file alone.
 - **The acceleration's mean** over a held sample is the velocity's change over it over its length
   (:func:`held_acceleration`), the velocity smoothed by Savitzky-Golay (SciPy's ``savgol_filter``: a quadratic
   fitted by least squares over a window of samples, its value at the centre; zero-phase: it delays nothing, so
@@ -37,9 +37,12 @@ reversal, a few ms, is not its mean). The residuals are ``mean(F + J a) + offset
   out at every evaluation of the fit (:class:`DelaySearch`); a range is searched within its bounds; a value is
   held; ``none`` is 0. The model's side is shifted (linear interpolation, the end values held beyond the record).
 
-A drive that logs point samples of a continuous torque (a measured current, say) is read the same way: the mean
-over a sample is the point value half a sample later to second order, so its delay comes out half a sample less
-than its transport delay (-T/2 without one).
+How the command is read is the model's ``[plant] command_hold`` (:func:`held`): ``"zero-order"`` (the default)
+as above; ``"none"`` for point samples of a continuous torque (a current measured at each sample, say), compared
+with ``F + J a`` at the samples (``u(t - delay) = F(t) + J a(t) + offset``, a: the Savitzky-Golay slope at the
+centre of the window). The fitted model keeps it, so that validation reads the command as the fit did. Point
+samples read as held take a delay half a sample short (the mean over a sample is the point value half a sample
+later to second order) and lose the presliding's fast change after a reversal (tests/test_identify_command.py).
 """
 
 from __future__ import annotations
@@ -60,15 +63,23 @@ from .command_terms import (ACCEL_BIAS, MIN_DELAY_SAMPLES, CommandTrace, DelaySe
 from .delay import AUTO
 from .force import Force
 
+
 def implied_friction(model, exp):
     """(velocity, friction) that a command record implies with ``model``'s inertia and delay: ``u(t) - J a(t +
-    delay)`` (a: the mean over each held sample) against ``v(t + delay)`` (the offset left in, as a force
-    sensor's is); a friction record as it is."""
+    delay)`` (a: the mean over each held sample, or at the sample: :func:`held`) against ``v(t + delay)`` (the
+    offset left in, as a force sensor's is); a friction record as it is."""
     if not Command.recognises(exp):
         return exp.drive_velocity, exp.force
     d = model.plant.delay
+    a = held_acceleration(exp) if held(model) else acceleration(exp)
     return (shifted(exp.time, exp.drive_velocity, -d),
-            np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, held_acceleration(exp), -d))
+            np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, a, -d))
+
+
+def held(model) -> bool:
+    """Whether ``model`` reads a drive's command as held for a sample (``[plant] command_hold = "zero-order"``: the
+    mean over the sample), not as point samples ("none")."""
+    return getattr(model.plant, "command_hold", "zero-order") == "zero-order"
 
 
 def _at_nodes(problem):
@@ -158,18 +169,27 @@ class Command(Force):
     def make_trace(self, exp, model) -> CommandTrace:
         tr = super().make_trace(exp, model)
         fields = {f.name: getattr(tr, f.name) for f in dataclasses.fields(tr)}
-        fields["angle"] = midpoints(tr.angle)  # (a ripple's angle: the middle of each held sample)
-        return CommandTrace(**fields, acceleration=held_acceleration(exp), command=np.asarray(exp.force, float),
-                            delay=model.plant.delay,
-                            velocity=np.asarray(exp.drive_velocity, float), nodes=hold_nodes(exp.time))
+        hold = held(model)
+        if hold:
+            fields["angle"] = midpoints(tr.angle)  # (a ripple's angle: the middle of each held sample)
+        return CommandTrace(**fields, acceleration=held_acceleration(exp) if hold else acceleration(exp),
+                            command=np.asarray(exp.force, float), delay=model.plant.delay,
+                            velocity=np.asarray(exp.drive_velocity, float),
+                            nodes=hold_nodes(exp.time) if hold else None)
 
     def _exact(self, problem, model, names, jac):
-        """The friction's means over the held samples by the exact stepping (Force's, at the hold nodes)."""
+        """The friction's means over the held samples by the exact stepping (Force's, at the hold nodes); at the
+        samples for point samples."""
+        if problem.traces[0].nodes is None:
+            return super()._exact(problem, model, names, jac)
         F, J = super()._exact(_at_nodes(problem), model, names, jac)
         return _held(F, J, problem.traces)
 
     def _integrated(self, problem, model, theta, jac, skip=(), outside=False):
-        """The friction's means over the held samples, integrated (Force's, at the hold nodes)."""
+        """The friction's means over the held samples, integrated (Force's, at the hold nodes); at the samples for
+        point samples."""
+        if problem.traces[0].nodes is None:
+            return super()._integrated(problem, model, theta, jac, skip, outside)
         F, J = super()._integrated(_at_nodes(problem), model, theta, jac, skip, outside)
         return _held(F, J, problem.traces)
 
@@ -216,10 +236,13 @@ class Command(Force):
         return F
 
     def predicted(self, model, exp, rtol=1e-8, fast=False):
-        """(predicted, measured): the mean of ``F + J a`` over each held sample plus the offset, at ``t + delay``,
-        and the command as recorded."""
-        pred = (self.held_friction(model, exp, rtol, fast) + model.plant.inertia * held_acceleration(exp)
-                + model.plant.sensor_offset)
+        """(predicted, measured): the mean of ``F + J a`` over each held sample (point samples: its value at the
+        sample, :func:`held`) plus the offset, at ``t + delay``, and the command as recorded."""
+        if held(model):
+            side = self.held_friction(model, exp, rtol, fast) + model.plant.inertia * held_acceleration(exp)
+        else:
+            side = self.friction_of(model, exp, rtol, fast) + model.plant.inertia * acceleration(exp)
+        pred = side + model.plant.sensor_offset
         return shifted(exp.time, pred, -model.plant.delay), np.asarray(exp.force, float)
 
     def validation_extras(self, model) -> dict:
@@ -227,7 +250,7 @@ class Command(Force):
                 "delay": model.plant.delay}
 
 
-__all__ = ["Command", "CommandTrace", "DelaySearch", "delay_search", "implied_friction", "acceleration",
+__all__ = ["Command", "CommandTrace", "DelaySearch", "delay_search", "implied_friction", "held", "acceleration",
            "held_acceleration", "hold_nodes", "hold_means", "shifted",
            "delay_scan", "linear_fit", "coulomb_columns", "applied_delay", "nuisance_columns", "accel_window",
            "velocity_noise", "ACCEL_BIAS", "MIN_DELAY_SAMPLES"]

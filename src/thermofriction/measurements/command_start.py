@@ -31,8 +31,9 @@ def command_initial(init, method, data, experiments, delay=AUTO, *, force, **opt
     delay_scan; ``delay`` a DelaySpec: auto or a range scanned, a value or none held); force data's initial model
     (:func:`force_initial`) with friction values read off ``u(t - delay) - J0 a``; then the delay again with that
     model's friction as one more column (its Stribeck curve); the acceleration and the friction as their means over
-    each held sample (measurements/command.py). The model's [plant] gets J0 and the delay (auto: applied only
-    beyond MIN_DELAY_SAMPLES of a sample)."""
+    each held sample (measurements/command.py; at the samples where the initial model's [plant] command_hold is
+    "none", there only), the first scan's over held samples either way (a start). The model's [plant] gets J0 and
+    the delay (auto: applied only beyond MIN_DELAY_SAMPLES of a sample)."""
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     moving_speed(experiments)
@@ -51,21 +52,31 @@ def command_initial(init, method, data, experiments, delay=AUTO, *, force, **opt
     adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * held_acceleration(e))
                 for e in experiments]
     init = force_initial(init, method, data, adjusted, force=force, **options)
-    d, coef = scan([np.column_stack([coulomb_columns(e), hold_means(force().friction_of(init, node_experiment(e)),
-                                                                    len(e.time))]) for e in experiments])
+    held = init.plant.command_hold == "zero-order"
+    d, coef = scan([np.column_stack([coulomb_columns(e, held), _friction_column(force(), init, e, held)])
+                    for e in experiments])
     if delay.kind == "auto":
         d = applied_delay(d, grid[0])
     plant = dataclasses.replace(init.plant, inertia=max(float(coef[0]), 0.0), delay=d)
     return dataclasses.replace(init, plant=plant)
 
 
+def _friction_column(measurement, model, exp, held: bool):
+    """The initial model's friction along ``exp``: its mean over each held sample, or at the samples."""
+    if not held:
+        return measurement.friction_of(model, exp)
+    return hold_means(measurement.friction_of(model, node_experiment(exp)), len(exp.time))
+
+
 def command_finish(res, experiments, init, measurement, *, friction):
-    """The fit completed for a drive's command (``Command.complete``; ``friction("none")`` a measurement whose residuals are the friction's means over the held samples minus the
-    record, nothing profiled out: ``Command.unprofiled``): the inertia J and the offsets (as the policy says) estimated
+    """The fit completed for a drive's command (``Command.complete``; ``friction("none")`` a measurement whose
+    residuals are the friction's means over the held samples minus the record, nothing profiled out:
+    ``Command.unprofiled``): the inertia J and the offsets (as the policy says) estimated
     together at the optimum with their standard errors (:func:`estimate_linear` on the acceleration's and the
     offsets' columns, at the delay), the delay at the fitted friction with its standard error (the curvature of
     the cost over the delay, the friction held: measurements/command.py DelaySearch) where it is searched, all
-    written into the fitted model's [plant] and ``details["plant"]``."""
+    written into the fitted model's [plant] and ``details["plant"]`` (with how the command was read, its
+    ``command_hold``)."""
     traces = [measurement.make_trace(e, res.model) for e in experiments]
     unit, policy, spec = traces[0].unit, measurement.offset, measurement.delay
     names = [p.name for p in res.parameters.varying] if res.n_points else []
@@ -92,7 +103,8 @@ def command_finish(res, experiments, init, measurement, *, friction):
     offset = _offset_estimate(policy, offsets, traces, init)
     offset.update(unit=unit, fitted=policy != "none", policy=policy)
     plant = {"inertia": dict(inertia, unit="kg m^2" if unit == "N m" else "kg"),
-             "delay": _delay_record(spec, delay, estimate, se, searched, search, traces)}
+             "delay": _delay_record(spec, delay, estimate, se, searched, search, traces),
+             "command_hold": res.model.plant.command_hold}
     _check_inertia(inertia, plant["inertia"]["unit"])
     model = dataclasses.replace(res.model, plant=dataclasses.replace(
         res.model.plant, inertia=inertia["value"], sensor_offset=offset["value"], delay=delay))
@@ -126,8 +138,9 @@ def _delay_record(spec, delay, estimate, se, searched, search, traces) -> dict:
     if searched:
         lo, hi = search.ks[0] * search.dt, search.ks[-1] * search.dt
         out["searched"] = {"min": lo, "max": hi, "why": _range_reason(spec, traces)}
-        out["note"] = (f"fitted with the friction (the means of the model's friction and acceleration over each "
-                       f"held sample, taken at t + delay); searched {lo * 1e3:.4g} to {hi * 1e3:.4g} ms ({out['searched']['why']})")
+        how = ("the means of the model's friction and acceleration over each held sample" if traces[0].nodes is not None
+               else "the model's friction and acceleration at the samples")
+        out["note"] = (f"fitted with the friction ({how}, taken at t + delay); searched {lo * 1e3:.4g} to {hi * 1e3:.4g} ms ({out['searched']['why']})")
     elif spec.kind == "value":
         out["note"] = "held at the value given (--delay VALUE), not fitted"
     elif spec.kind == "none":

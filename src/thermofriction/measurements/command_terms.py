@@ -48,14 +48,16 @@ HOLD_WEIGHTS = np.tile(np.array([5.0, 8.0, 5.0]) / 36.0, 2)
 class CommandTrace(Trace):
     """A trace of a drive's command: ``measured`` is the command as recorded, ``acceleration`` the motion's mean
     over each held sample [m/s^2 or rad/s^2] (:func:`held_acceleration`), ``angle`` the recorded position at the
-    middle of each held sample (a position ripple's, :func:`midpoints`)."""
+    middle of each held sample (a position ripple's, :func:`midpoints`); for point samples (``nodes`` None) both
+    at the samples."""
 
     acceleration: np.ndarray | None = None
     #: the command as recorded, and the delay of the model it was made with (auto: the fit searches where it is not 0)
     command: np.ndarray | None = None
     delay: float = 0.0
     velocity: np.ndarray | None = None
-    #: the times the friction is evaluated at, HOLD_FRACTIONS of each held sample (:func:`hold_nodes`)
+    #: the times the friction is evaluated at, HOLD_FRACTIONS of each held sample (:func:`hold_nodes`); None: the
+    #: samples (point samples of a continuous torque, ``[plant] command_hold = "none"``)
     nodes: np.ndarray | None = None
 
 
@@ -168,9 +170,12 @@ def sign_of(velocity) -> np.ndarray:
     return np.clip(v / (SIGN_FRACTION * top), -1.0, 1.0) if top > 0 else np.zeros_like(v)
 
 
-def coulomb_columns(exp) -> np.ndarray:
-    """The regressors of the linear first estimate ``u = J a + b + fc sgn(v) + sigma2 v``, over each held sample
-    (a: :func:`held_acceleration`; v at its middle)."""
+def coulomb_columns(exp, held: bool = True) -> np.ndarray:
+    """The regressors of the linear first estimate ``u = J a + b + fc sgn(v) + sigma2 v``: over each held sample
+    (a: :func:`held_acceleration`; v at its middle), else at the samples (point samples)."""
+    if not held:
+        v = exp.drive_velocity
+        return np.column_stack([acceleration(exp), np.ones(v.size), sign_of(v), v])
     v = midpoints(exp.drive_velocity)
     return np.column_stack([held_acceleration(exp), np.ones(v.size), sign_of(v), v])
 
