@@ -57,9 +57,9 @@ from ..errors import InputError
 from .command_start import command_finish, command_initial
 from . import ripple
 from .command_terms import (ACCEL_BIAS, MIN_DELAY_SAMPLES, CommandTrace, DelaySearch, accel_window, acceleration,
-                            applied_delay, coulomb_columns, delay_scan, delay_search, held_acceleration, hold_means,
-                            hold_nodes, linear_fit, midpoints, node_experiment, nuisance_columns, shifted,
-                            velocity_noise)
+                            applied_delay, coulomb_columns, delay_scan, delay_search, held, held_acceleration,
+                            hold_means, hold_nodes, linear_fit, midpoints, node_experiment, nuisance_columns,
+                            shifted, velocity_noise)
 from .delay import AUTO
 from .force import Force
 
@@ -75,11 +75,6 @@ def implied_friction(model, exp):
     return (shifted(exp.time, exp.drive_velocity, -d),
             np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, a, -d))
 
-
-def held(model) -> bool:
-    """Whether ``model`` reads a drive's command as held for a sample (``[plant] command_hold = "zero-order"``: the
-    mean over the sample), not as point samples ("none")."""
-    return getattr(model.plant, "command_hold", "zero-order") == "zero-order"
 
 
 def _at_nodes(problem):

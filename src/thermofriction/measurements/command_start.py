@@ -15,7 +15,7 @@ from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..fitting.problem import Problem
 from .base import FD_RTOL
-from .command_terms import (MIN_DELAY_SAMPLES, applied_delay, coulomb_columns, delay_scan, delay_search,
+from .command_terms import (MIN_DELAY_SAMPLES, applied_delay, coulomb_columns, delay_scan, delay_search, held,
                             held_acceleration, hold_means, linear_fit, node_experiment, nuisance_columns, shifted,
                             sliding)
 from .delay import AUTO, check_not_at_end, search_range
@@ -52,8 +52,8 @@ def command_initial(init, method, data, experiments, delay=AUTO, *, force, **opt
     adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * held_acceleration(e))
                 for e in experiments]
     init = force_initial(init, method, data, adjusted, force=force, **options)
-    held = init.plant.command_hold == "zero-order"
-    d, coef = scan([np.column_stack([coulomb_columns(e, held), _friction_column(force(), init, e, held)])
+    hold = held(init)
+    d, coef = scan([np.column_stack([coulomb_columns(e, hold), _friction_column(force(), init, e, hold)])
                     for e in experiments])
     if delay.kind == "auto":
         d = applied_delay(d, grid[0])
@@ -61,9 +61,9 @@ def command_initial(init, method, data, experiments, delay=AUTO, *, force, **opt
     return dataclasses.replace(init, plant=plant)
 
 
-def _friction_column(measurement, model, exp, held: bool):
+def _friction_column(measurement, model, exp, hold: bool):
     """The initial model's friction along ``exp``: its mean over each held sample, or at the samples."""
-    if not held:
+    if not hold:
         return measurement.friction_of(model, exp)
     return hold_means(measurement.friction_of(model, node_experiment(exp)), len(exp.time))
 

@@ -107,6 +107,12 @@ def acceleration(exp, window: int | None = None) -> np.ndarray:
     return np.interp(t, t[0] + dt * np.arange(v.size), a)
 
 
+def held(model) -> bool:
+    """Whether ``model`` reads a drive's command as held for a sample (``[plant] command_hold = "zero-order"``: the
+    mean over the sample), not as point samples ("none")."""
+    return getattr(model.plant, "command_hold", "zero-order") == "zero-order"
+
+
 def held_acceleration(exp, window: int | None = None) -> np.ndarray:
     """The mean of the acceleration over each held sample [t_k, t_k+1]: ``(v(t_k+1) - v(t_k)) / (t_k+1 - t_k)``
     of the driving velocity smoothed by Savitzky-Golay (degree ACCEL_ORDER; ``window`` None: ``accel_window(exp,
@@ -335,4 +341,4 @@ def delay_search(traces, policy: str, spec, model_delay: float) -> DelaySearch:
 
 
 __all__ = ["CommandTrace", "DelaySearch", "delay_search", "acceleration", "held_acceleration", "hold_nodes",
-           "hold_means", "node_experiment", "midpoints", "HOLD_FRACTIONS", "HOLD_WEIGHTS", "shifted", "sign_of", "sliding", "delay_scan", "linear_fit", "coulomb_columns", "applied_delay", "nuisance_columns", "accel_window", "velocity_noise", "ACCEL_ORDER", "MIN_ACCEL_WINDOW", "MAX_ACCEL_WINDOW", "ACCEL_BIAS", "MIN_DELAY_SAMPLES", "SCAN_SPEED_FRACTION", "SIGN_FRACTION"]
+           "hold_means", "held", "node_experiment", "midpoints", "HOLD_FRACTIONS", "HOLD_WEIGHTS", "shifted", "sign_of", "sliding", "delay_scan", "linear_fit", "coulomb_columns", "applied_delay", "nuisance_columns", "accel_window", "velocity_noise", "ACCEL_ORDER", "MIN_ACCEL_WINDOW", "MAX_ACCEL_WINDOW", "ACCEL_BIAS", "MIN_DELAY_SAMPLES", "SCAN_SPEED_FRACTION", "SIGN_FRACTION"]
