@@ -66,14 +66,14 @@ from .force import Force
 
 def implied_friction(model, exp):
     """(velocity, friction) that a command record implies with ``model``'s inertia and delay: ``u(t) - J a(t +
-    delay)`` (a: the mean over each held sample, or at the sample: :func:`held`) against ``v(t + delay)`` (the
-    offset left in, as a force sensor's is); a friction record as it is."""
+    delay)`` against ``v(t + delay)`` (a: the mean over each held sample and v at its middle, or both at the
+    sample: :func:`held`; the offset left in, as a force sensor's is); a friction record as it is."""
     if not Command.recognises(exp):
         return exp.drive_velocity, exp.force
-    d = model.plant.delay
-    a = held_acceleration(exp) if held(model) else acceleration(exp)
-    return (shifted(exp.time, exp.drive_velocity, -d),
-            np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, a, -d))
+    d, hold = model.plant.delay, held(model)
+    a = held_acceleration(exp) if hold else acceleration(exp)
+    v = midpoints(exp.drive_velocity) if hold else exp.drive_velocity
+    return shifted(exp.time, v, -d), np.asarray(exp.force, float) - model.plant.inertia * shifted(exp.time, a, -d)
 
 
 
