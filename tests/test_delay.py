@@ -10,9 +10,11 @@ sample (zero-order hold): the torque on [t_k + 5 ms, t_k + 6 ms) is u_k. The log
 (4 mN m: a current measurement's noise; the realised torque carries none) and an offset of 0.03 N m. The loop
 runs 1 s before the log starts (the record begins mid-motion). Position and velocity are sampled at t_k.
 
-Seen as point samples of the torque, a held command acts half a sample later on average: the delay in
-``u(t - delay) = F + J a`` of this drive is 5 ms + 0.5 ms = 5.5 ms (the mean of J a + F over the hold interval is
-J (v(t_k+6ms) - v(t_k+5ms))/dt + mean F; this test checks that relation to 1e-3 of the command's range)."""
+The command is the mean of J a + F over its hold interval, J (v(t_k+6ms) - v(t_k+5ms))/dt + mean F (the momentum
+integrated over it; this test checks that relation to 1e-3 of the command's range), and that is what the
+measurement compares it with (measurements/command.py): the delay it finds is the transport delay, 5 ms. (Before it
+took the mean it compared point samples of J a + F, which a held command matches half a sample later on average:
+it found 5.5 ms, and sigma1 biased, below.)"""
 
 from __future__ import annotations
 
@@ -38,7 +40,7 @@ from thermofriction.measurements.delay import DelaySpec, parse_delay  # noqa: E4
 J = 0.01
 LUGRE = dict(sigma0=60.0, sigma1=0.04, fc=0.2, fs=0.28, vs=0.3, sigma2=0.02)
 DT, HOLD_DELAY, NOISE, OFFSET = 1e-3, 5, 0.004, 0.03
-EFFECTIVE = (HOLD_DELAY + 0.5) * DT  # the transport delay and half the hold
+EFFECTIVE = HOLD_DELAY * DT  # the transport delay: the measurement compares the mean over the hold
 
 
 def reference(t):
@@ -103,8 +105,9 @@ def test_delay_is_parsed_and_bad_values_are_refused():
 
 
 def test_api_none_value_range_and_the_model_file(tmp_path):
-    """The joint of test_identify_command (point samples, 8 ms): none fits 0, a value is held and travels in the
-    model file, a range is searched within it and said; a range whose end holds the least residuals is refused."""
+    """The joint of test_identify_command (point samples, 8 ms: read as 7.5 ms, that module's docstring): none fits
+    0, a value is held and travels in the model file, a range is searched within it and said; a range whose end
+    holds the least residuals is refused."""
     data = make_command_dataset(tmp_path / "d", delay=0.008)
     with pytest.raises(InputError, match="delay must be"):
         tf.identify(data, method="base", starts=1, delay="soon")
@@ -116,7 +119,7 @@ def test_api_none_value_range_and_the_model_file(tmp_path):
     assert tf.load_model(tmp_path / "held.toml").plant.delay == pytest.approx(0.007)
     ranged = tf.identify(data, method="base", starts=1, delay=(0.002, 0.02))
     d = ranged.details["plant"]["delay"]
-    assert covers(d["ci95"], 0.008) and d["searched"]["min"] == pytest.approx(0.002) and "range given" in d["note"]
+    assert covers(d["ci95"], 0.008 - 0.5 * DT) and d["searched"]["min"] == pytest.approx(0.002) and "range given" in d["note"]
     with pytest.raises(ComputationError, match=r"end of the range given \(0ms:5ms"):
         tf.identify(data, method="base", starts=1, delay="0:5ms")
     with pytest.raises(InputError, match="delay applies to a drive's command"):
@@ -157,7 +160,8 @@ def test_cli_delay_option(tmp_path):
 
 def test_hold_relation_of_the_truth():
     """The truth's own check: the command is the mean of J a + F over its hold interval (the exact discrete
-    relation, J dv/dt integrated), so its effective delay as point samples is 5.5 ms."""
+    relation, J dv/dt integrated), the relation the measurement compares at the transport delay (5 ms; as point
+    samples the command would act 5.5 ms late on average)."""
     t, x, v, u, F = servo()
     k = HOLD_DELAY
     mean = J * (v[k + 1:] - v[k:-1]) / DT + 0.5 * (F[k + 1:] + F[k:-1])
@@ -167,10 +171,11 @@ def test_hold_relation_of_the_truth():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_servo_with_a_held_command(tmp_path, seed):
-    """From the data's own start (no --init): the delay, J and fc within a few % of the truth (the delay: of 5 ms
-    plus half the hold), and their 95 % intervals cover it. (Failed with the fixed 9-sample acceleration, which
-    blurred the presliding ringing after reversals: 5.58-5.62 ms +- 0.025; the window chosen from the record, 3
-    samples on this noise-free velocity, gives 5.49-5.52 ms +- 0.009.)"""
+    """From the data's own start (no --init): the delay (the transport delay, 5 ms), J and fc within a few % of the
+    truth, and their 95 % intervals cover it. (Failed with the fixed 9-sample acceleration, which blurred the
+    presliding ringing after reversals: 5.58-5.62 ms +- 0.025 for 5.5; the window chosen from the record, 3 samples
+    on this noise-free velocity, gave 5.49-5.52 ms +- 0.009 for 5.5 with point samples of J a + F; their means over
+    the hold give 4.99-5.02 ms +- 0.009 on seeds 0-4.)"""
     res = tf.identify(tf.load_dataset(servo_dataset(tmp_path / "d", seed)), method="base", starts=1)
     plant = res.details["plant"]
     d, inertia, fc = plant["delay"], plant["inertia"], res.parameters["fc"]
@@ -181,12 +186,25 @@ def test_servo_with_a_held_command(tmp_path, seed):
     assert covers(fc.ci95, LUGRE["fc"]), fc.ci95
 
 
-@pytest.mark.xfail(strict=True, reason="open (issue 40 item 6): with the 3-sample acceleration sigma1 comes out "
-                   "0.043-0.049 (95 % intervals 0.041-0.052, missing 0.04 in 5 of 5 seeds), sigma0 59.1-59.8 "
-                   "(60): the bristles' fast change after a reversal (a time scale g/(sigma0 |v|) of a few ms) is "
-                   "modelled at point samples while the drive realises the mean of each held sample")
-@pytest.mark.parametrize("seed", [0, 1])
-def test_servo_sigma1(tmp_path, seed):
-    """The presliding damping sigma1 of the servo truth within its 95 % interval."""
-    res = tf.identify(tf.load_dataset(servo_dataset(tmp_path / "d", seed)), method="base", starts=1)
-    assert covers(res.parameters["sigma1"].ci95, LUGRE["sigma1"]), res.parameters["sigma1"]
+#: the noise seeds of the presliding test, and the share of them whose 95 % intervals must cover the truth
+SEEDS, COVERAGE = range(20), 0.9
+
+
+def test_servo_presliding(tmp_path):
+    """The presliding parameters sigma1 and sigma0 of the servo truth over 20 noise seeds: their 95 % intervals
+    cover the truth in at least 90 % of the seeds, and every estimate lies within twice its interval's half-width
+    of it. Issue 40 item 6: when the model compared point samples of J a + F with the held command (the bristles'
+    fast change after a reversal, a time scale g/(sigma0 |v|) of a few ms, at point samples where the drive
+    realises each sample's mean), sigma1 came out 0.042-0.049 (intervals covering 0.04 in 1 of 25 seeds) and sigma0
+    59.1-59.9 (5 of 25). With the means over the hold: sigma1 0.038-0.044 (24 of 25), sigma0 59.6-60.4 (24 of 25),
+    the delay 4.98-5.02 ms (covering 5 ms in 24 of 25), fc 25 of 25, J 21 of 25 (as before), on seeds 0-24; a fit
+    takes 0.5 s, as before."""
+    covered = {"sigma1": 0, "sigma0": 0}
+    for seed in SEEDS:
+        res = tf.identify(tf.load_dataset(servo_dataset(tmp_path / f"d{seed}", seed)), method="base", starts=1)
+        for name in covered:
+            p = res.parameters[name]
+            half = 0.5 * (p.ci95[1] - p.ci95[0])
+            assert math.isfinite(half) and abs(p.value - LUGRE[name]) <= 2 * half, (seed, name, p.value, p.ci95)
+            covered[name] += covers(p.ci95, LUGRE[name])
+    assert all(n >= COVERAGE * len(SEEDS) for n in covered.values()), covered

@@ -1,7 +1,8 @@
 """A drive's command's initial model and result (``Command.initial_model``, ``Command.complete``): the delay, the
 inertia and a first offset read off the data before the fit (:func:`command_initial`), and the inertia, the offsets
 and the delay estimated with their standard errors at the optimum (:func:`command_finish`). The force measurement's
-class is passed in (``force``): this module sits below measurements/command.py, which calls it."""
+class is passed in (``force``), and the command's measurement of the friction's means (``friction``): this module
+sits below measurements/command.py, which calls it."""
 
 from __future__ import annotations
 
@@ -14,8 +15,9 @@ from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..fitting.problem import Problem
 from .base import FD_RTOL
-from .command_terms import (MIN_DELAY_SAMPLES, acceleration, applied_delay, coulomb_columns, delay_scan, delay_search,
-                            linear_fit, nuisance_columns, shifted, sliding)
+from .command_terms import (MIN_DELAY_SAMPLES, applied_delay, coulomb_columns, delay_scan, delay_search, held,
+                            held_acceleration, hold_means, linear_fit, node_experiment, nuisance_columns, shifted,
+                            sliding)
 from .delay import AUTO, check_not_at_end, search_range
 from .force_finish import completed, estimate_linear
 from .force_start import force_initial, moving_speed
@@ -28,14 +30,16 @@ def command_initial(init, method, data, experiments, delay=AUTO, *, force, **opt
     squares ``u(t - delay) = J0 a + b + fc sgn(v) + sigma2 v`` on a scan of delays (measurements/command.py:
     delay_scan; ``delay`` a DelaySpec: auto or a range scanned, a value or none held); force data's initial model
     (:func:`force_initial`) with friction values read off ``u(t - delay) - J0 a``; then the delay again with that
-    model's friction as one more column (its Stribeck curve). The model's [plant] gets J0 and the delay (auto:
-    applied only beyond about a sample)."""
+    model's friction as one more column (its Stribeck curve); the acceleration and the friction as their means over
+    each held sample (measurements/command.py; at the samples where the initial model's [plant] command_hold is
+    "none", there only), the first scan's over held samples either way (a start). The model's [plant] gets J0 and
+    the delay (auto: applied only beyond MIN_DELAY_SAMPLES of a sample)."""
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     moving_speed(experiments)
     grid = (None if delay.kind in ("none", "value") else
             search_range(delay, [e.time for e in experiments], [e.drive_velocity for e in experiments],
-                         [acceleration(e) for e in experiments]))
+                         [held_acceleration(e) for e in experiments]))
 
     def scan(columns):
         if grid is None:
@@ -45,22 +49,34 @@ def command_initial(init, method, data, experiments, delay=AUTO, *, force, **opt
         return d, coef
 
     d0, coef = scan([coulomb_columns(e) for e in experiments])
-    adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * acceleration(e))
+    adjusted = [dataclasses.replace(e, force=shifted(e.time, e.force, d0) - coef[0] * held_acceleration(e))
                 for e in experiments]
     init = force_initial(init, method, data, adjusted, force=force, **options)
-    d, coef = scan([np.column_stack([coulomb_columns(e), force().friction_of(init, e)]) for e in experiments])
+    hold = held(init)
+    d, coef = scan([np.column_stack([coulomb_columns(e, hold), _friction_column(force(), init, e, hold)])
+                    for e in experiments])
     if delay.kind == "auto":
         d = applied_delay(d, grid[0])
     plant = dataclasses.replace(init.plant, inertia=max(float(coef[0]), 0.0), delay=d)
     return dataclasses.replace(init, plant=plant)
 
 
-def command_finish(res, experiments, init, measurement, *, force):
-    """The fit completed for a drive's command (``Command.complete``; ``force`` the force measurement's class): the inertia J and the offsets (as the policy says) estimated
+def _friction_column(measurement, model, exp, hold: bool):
+    """The initial model's friction along ``exp``: its mean over each held sample, or at the samples."""
+    if not hold:
+        return measurement.friction_of(model, exp)
+    return hold_means(measurement.friction_of(model, node_experiment(exp)), len(exp.time))
+
+
+def command_finish(res, experiments, init, measurement, *, friction):
+    """The fit completed for a drive's command (``Command.complete``; ``friction("none")`` a measurement whose
+    residuals are the friction's means over the held samples minus the record, nothing profiled out:
+    ``Command.unprofiled``): the inertia J and the offsets (as the policy says) estimated
     together at the optimum with their standard errors (:func:`estimate_linear` on the acceleration's and the
     offsets' columns, at the delay), the delay at the fitted friction with its standard error (the curvature of
     the cost over the delay, the friction held: measurements/command.py DelaySearch) where it is searched, all
-    written into the fitted model's [plant] and ``details["plant"]``."""
+    written into the fitted model's [plant] and ``details["plant"]`` (with how the command was read, its
+    ``command_hold``)."""
     traces = [measurement.make_trace(e, res.model) for e in experiments]
     unit, policy, spec = traces[0].unit, measurement.offset, measurement.delay
     names = [p.name for p in res.parameters.varying] if res.n_points else []
@@ -68,26 +84,27 @@ def command_finish(res, experiments, init, measurement, *, force):
         traces = [dataclasses.replace(tr, measured=tr.measured - tr.held_offset) for tr in traces]
     search = delay_search(traces, "shared", spec, res.model.plant.delay)
     m = np.concatenate([tr.measured for tr in traces])
-    plain = [dataclasses.replace(tr, measurement=force("none"), held_offset=0.0) for tr in traces]
+    plain = [dataclasses.replace(tr, measurement=friction("none"), held_offset=0.0) for tr in traces]
     r, _ = Problem(res.model, [], plain, rtol=FD_RTOL, parallel=len(plain) > 1).evaluate(np.array([]), jac=False)
     estimate, _, se = search.best(r + m) if r is not None else (math.nan, None, math.nan)
-    searched = search.ks.size > 1 and math.isfinite(estimate)
+    searched = search.searched and math.isfinite(estimate)
     delay = estimate if searched or spec.kind == "value" else 0.0
     if searched:  # the fitted friction's delay too: not at the search's end
         check_not_at_end(spec, search.at, search.ks, search.dt, _range_reason(spec, traces))
     X = search.shift(nuisance_columns(traces, policy), delay)
     if searched:  # the delay's column, so that its error has the friction's in it: d(model at t + delay)/d delay
-        X = np.column_stack([X, _delay_column(search, r + m, X, m, delay)])
+        X = np.column_stack([X, search.slope(r + m, delay)])
     ests, _ = estimate_linear(res.model, names, traces, X, res.statistics.get("variance_inflation", 1.0),
                               at=lambda r, J: (search.shift(r + m, delay) - m, None if J is None else search.shift(J, delay)),
-                              force=force)
+                              force=friction)
     if searched:
         se = ests.pop()["stderr"]
     inertia, offsets = ests[0], ests[1:]
     offset = _offset_estimate(policy, offsets, traces, init)
     offset.update(unit=unit, fitted=policy != "none", policy=policy)
     plant = {"inertia": dict(inertia, unit="kg m^2" if unit == "N m" else "kg"),
-             "delay": _delay_record(spec, delay, estimate, se, searched, search, traces)}
+             "delay": _delay_record(spec, delay, estimate, se, searched, search, traces),
+             "command_hold": res.model.plant.command_hold}
     _check_inertia(inertia, plant["inertia"]["unit"])
     model = dataclasses.replace(res.model, plant=dataclasses.replace(
         res.model.plant, inertia=inertia["value"], sensor_offset=offset["value"], delay=delay))
@@ -121,14 +138,15 @@ def _delay_record(spec, delay, estimate, se, searched, search, traces) -> dict:
     if searched:
         lo, hi = search.ks[0] * search.dt, search.ks[-1] * search.dt
         out["searched"] = {"min": lo, "max": hi, "why": _range_reason(spec, traces)}
-        out["note"] = (f"fitted with the friction (the model's friction and acceleration taken at t + delay); "
-                       f"searched {lo * 1e3:.4g} to {hi * 1e3:.4g} ms ({out['searched']['why']})")
+        how = ("the means of the model's friction and acceleration over each held sample" if traces[0].nodes is not None
+               else "the model's friction and acceleration at the samples")
+        out["note"] = (f"fitted with the friction ({how}, taken at t + delay); searched {lo * 1e3:.4g} to {hi * 1e3:.4g} ms ({out['searched']['why']})")
     elif spec.kind == "value":
         out["note"] = "held at the value given (--delay VALUE), not fitted"
     elif spec.kind == "none":
         out["note"] = "none fitted (--delay none)"
     else:
-        out["note"] = (f"not applied: the estimate before the fit was within {MIN_DELAY_SAMPLES:g} sampling "
+        out["note"] = (f"not applied: the estimate before the fit was within {MIN_DELAY_SAMPLES:g} of a sampling "
                        f"interval ({search.dt * 1e3:.3g} ms)")
     return out
 
@@ -143,15 +161,6 @@ def _check_inertia(inertia: dict, unit: str) -> None:
             f"motion's acceleration does not explain the command. Check that the position resolves the acceleration "
             f"(a velocity column helps), the command's sign and torque constant, and that the command and the motion "
             f"are recorded on the same clock (docs/force-data.md#drives-without-a-torque-sensor)")
-
-
-def _delay_column(search, F, X, m, delay):
-    """The derivative of the model's side ``F + J a`` at ``t + delay`` by the delay (J by least squares first;
-    central differences over half a sampling interval either way)."""
-    J = float(np.linalg.lstsq(X, m - search.shift(F, delay), rcond=None)[0][0])
-    model_side = F + J * search.X[:, 0]
-    h = 0.5 * search.dt
-    return (search.shift(model_side, delay + h) - search.shift(model_side, delay - h)) / (2 * h)
 
 
 __all__ = ["command_initial", "command_finish"]

@@ -200,8 +200,10 @@ class PrescribedMotion:
     with the friction from measured force (docs/force-data.md) and added to the predicted measurement; it is
     not part of the friction. ``inertia`` [kg, or kg m^2 for a joint] and ``delay`` [s]: what a drive's
     command adds to the friction (docs/force-data.md#drives-without-a-torque-sensor): the command recorded at
-    ``t - delay`` is ``F + inertia * a + sensor_offset`` at ``t``; both are fitted from command data and
-    used to predict a command; a simulation of prescribed motion does not use them.
+    ``t - delay`` is ``F + inertia * a + sensor_offset`` at ``t`` -- with ``command_hold = "zero-order"`` (a
+    drive that holds each command for a sample) its mean over the sample from ``t``, with ``"none"`` (point
+    samples of a continuous torque) its value at ``t``; inertia and delay are fitted from command data and used
+    to predict a command; a simulation of prescribed motion does not use them.
 
     Parameters
     ----------
@@ -213,24 +215,33 @@ class PrescribedMotion:
         A drive's moved inertia J [kg, or kg m^2 for a joint], for command data.
     delay : float, default 0.0
         A drive's command delay [s], for command data.
+    command_hold : {"zero-order", "none"}, default "zero-order"
+        How a drive's command data are read: held for a sample (its mean over it) or point samples.
 
     Raises
     ------
     InputError
-        An unknown ``motion``; a value that is not a finite number, or a negative inertia, named.
+        An unknown ``motion`` or ``command_hold``; a value that is not a finite number, or a negative inertia,
+        named.
     """
 
     motion: str = "linear"
     sensor_offset: float = 0.0
     inertia: float = 0.0
     delay: float = 0.0
+    command_hold: str = "zero-order"
 
     type = "prescribed"
     MOTIONS = ("linear", "rotary")
+    #: how a drive's command is read (docs/force-data.md#drives-without-a-torque-sensor)
+    COMMAND_HOLDS = ("zero-order", "none")
 
     def __post_init__(self):
         if self.motion not in self.MOTIONS:
             raise InputError(f"[plant]: 'motion' must be \"linear\" or \"rotary\", got {self.motion!r}")
+        if self.command_hold not in self.COMMAND_HOLDS:
+            raise InputError(f"[plant]: 'command_hold' must be \"zero-order\" or \"none\", got "
+                             f"{self.command_hold!r}")
         for key in ("sensor_offset", "inertia", "delay"):
             object.__setattr__(self, key, num(getattr(self, key), "[plant]", key))
         if self.inertia < 0:
@@ -251,11 +262,13 @@ class PrescribedMotion:
         for key in ("sensor_offset", "inertia", "delay"):
             if getattr(self, key):
                 d[key] = getattr(self, key)
+        if self.command_hold != "zero-order":
+            d["command_hold"] = self.command_hold
         return d
 
     @classmethod
     def from_dict(cls, d: dict, where="[plant]"):
-        keys = ["type", "motion", "sensor_offset", "inertia", "delay"]
+        keys = ["type", "motion", "sensor_offset", "inertia", "delay", "command_hold"]
         unknown = set(d) - set(keys)
         if unknown:
             raise InputError(f"{where}: {unknown_keys(unknown, keys, 'prescribed motion')}")
