@@ -20,11 +20,11 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from force_truths import make_dataset  # noqa: E402
-from law_intervals import law_interval  # noqa: E402
 
 import thermofriction as tf  # noqa: E402
 from thermofriction.models import PrescribedMotion  # noqa: E402
@@ -169,9 +169,9 @@ def test_model_i_from_torque_at_several_temperatures(tmp_path):
     """Model I on force data as on displacements: fc and fs follow linear laws of temperature (truth:
     fc = 1.25 - 0.01 T, fs = 1.9 - 0.012 T N m); fitted per temperature, laws through the estimates, a joint
     refinement; the held-out temperature is predicted at the noise. The laws are checked by their values at the
-    fit temperatures, within twice the half-width of the 95 % intervals their coefficients imply
-    (tests/law_intervals.py): on three temperatures the estimates may choose an exponential fs law by AICc, whose
-    coefficients are not the linear truth's (they did once the motion's velocity was linear between samples)."""
+    fit temperatures, within twice the half-width of their 95 % intervals there (FitResult.law_interval): on three
+    temperatures the estimates may choose an exponential fs law by AICc, whose coefficients are not the linear
+    truth's (they did once the motion's velocity was linear between samples)."""
     laws = {"fc": Linear(a=-0.01, b=1.25), "fs": Linear(a=-0.012, b=1.9)}
     base = {k: v for k, v in ROT.items() if k not in laws}
     truth = tf.Model(JOINT, tf.LuGre(**base, fc=None, fs=None), ModelI(laws))
@@ -182,9 +182,9 @@ def test_model_i_from_torque_at_several_temperatures(tmp_path):
     fit = tf.identify(data, "model-i", init=start)
     assert fit.adequate, fit.fit_quality
     for name, law in laws.items():
-        for T in (30.0, 35.0, 40.0):
-            value, half = law_interval(fit, name, T)
-            assert 0 < half and abs(value - float(law(T))) <= 2 * half, (name, T, value, float(law(T)), half)
+        value, lo, hi = fit.law_interval(name, [30.0, 35.0, 40.0])
+        half = 0.5 * (hi - lo)
+        assert np.all(half > 0) and np.all(np.abs(value - law([30.0, 35.0, 40.0])) <= 2 * half), (name, value, half)
     check_offset(fit, OFFSET)
     v = tf.validate(fit.model, data)
     assert all(p.rmse < 1.3 * sd for p in v.predictions), [p.rmse for p in v.predictions]
