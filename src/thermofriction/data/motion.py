@@ -136,8 +136,8 @@ def motion_waveform(time, velocity, start: float = 0.0) -> Sampled:
     half an interval beyond the last sample at its velocity. (One step per half-interval, the sample's velocity
     held up to the midpoints, biased a Stribeck fit: at 66.7 Hz on a smooth joint's reversals fs came out 5 %
     high and vs 5 % low on noise-free data; with 2 steps 1 %, with 4 0.03 %, but from 3 steps on the core's exact
-    stepping of GMS departs from its integrator where the velocity dips without reversing: tests/
-    test_prescribed_exact.py.)"""
+    stepping of GMS departs from its integrator where the velocity dips without reversing, as
+    tests/test_prescribed_exact.py finds.)"""
     t = np.asarray(time, float)
     v = np.asarray(velocity, float)
     dt = np.diff(t)

@@ -266,7 +266,7 @@ def _laws_through(per_T, names, held, init, laws):
     the constant a parameter that does not change with temperature got a slope from its estimates' scatter: on a
     10 ms-lag joint from a plant-only file the Stribeck velocity's slope traded with fs's along their valley, fs up
     to 32 % off at 60 C; with the constant but no preference, five noisy fs estimates chose a constant fs, 52 % off
-    at 60 C. Over 16 seeds the 95 % intervals at each temperature covered 460 of 480, vs 70 of 80, and now 466 of
+    at 60 C. Over 16 seeds the 95 % intervals at each temperature covered 457 of 480, vs 68 of 80, and now 466 of
     480, vs 73 of 80: tests/test_joint_coverage.py.)"""
     Ts = np.array([T for T, _ in per_T])
     new_laws, law_tables = {}, {}
