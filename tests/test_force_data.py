@@ -13,6 +13,7 @@ import tomli_w
 
 import thermofriction as tf
 from thermofriction.data.force import ForceExperiment, SamplingWarning, motion_waveform, read_force_csv
+from thermofriction.data.motion import SUBSTEPS
 from thermofriction.errors import InputError
 from thermofriction.models import PrescribedMotion
 from thermofriction.models.plants import rotary_unit
@@ -60,13 +61,14 @@ def test_units_convert_to_si(tmp_path):
 
 def test_the_drive_gives_the_model_each_samples_own_velocity():
     """The motion waveform's slope on both sides of every sample is that sample's velocity (no half-sample
-    lag), and its position at the samples is the trapezoidal integral of the velocity."""
+    lag), and its position at the samples is the trapezoidal integral of the velocity (the waveform's velocity is
+    linear between samples, in SUBSTEPS steps: tests/test_joint_coverage.py)."""
     rng = np.random.default_rng(3)
     t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 200))
     t -= t[0]
     v = np.sin(7 * t) + 0.3 * rng.normal(size=t.size)
     w = motion_waveform(t, v)
-    eps = 0.25 * np.min(np.diff(t))  # inside the half-intervals, where the slope is constant
+    eps = 0.25 * np.min(np.diff(t)) / SUBSTEPS  # inside the step around each sample, where the slope is constant
     inner = t[1:]  # the last sample too: the motion goes on half an interval beyond it
     right = (w(inner + eps) - w(inner)) / eps
     left = (w(inner) - w(inner - eps)) / eps

@@ -95,8 +95,9 @@ def _base_fit(seed, plant_only):
 
 def test_a_base_fit_from_the_data_start_lands(plant_only):
     """Three runs at 40 C from a plant-only file, three noise seeds: fc, sigma2 and sigma0 within 3 % of the truth,
-    the 95 % intervals of all six parameters cover the truth in at least 90 % of cases (17 of 18 measured: one fs
-    9.8 % high); before, driven by the late column: sigma0 +50 %, fs -20 %, 8 of 18 covered."""
+    the 95 % intervals of all six parameters cover the truth in at least 90 % of cases (18 of 18 measured; fs +3.9,
+    -0.9, -0.1 %); before, driven by the late column: sigma0 +50 %, fs -20 %, 8 of 18 covered; then with the
+    velocity held to the midpoints between samples, 17 of 18, fs +9.8 % (eight seeds: tests/test_joint_coverage.py)."""
     truth = L.true_values(40.0)
     covered = []
     for seed in (0, 1, 2):
@@ -116,7 +117,7 @@ def _model_i_errors(fit):
 
 def test_model_i_on_five_temperatures_lands_in_seconds(plant_only):
     """Model I from the plant-only file on five temperatures of the joint (offsets per run): fc(T), sigma2(T) and
-    sigma0(T) within 3 % of the truth at every temperature, in under 60 s (measured 0.5-3 s on the shared machine).
+    sigma0(T) within 3 % of the truth at every temperature, in under 60 s (measured 0.3-1 s on the shared machine).
     Before (driven by the late column, fs held at fc: the pooled start had no Stribeck excess): at 20 C fc +2.2 %,
     sigma2 -5.6 %, sigma0 +24 %, fs -29 %."""
     data = _joint(seed=0)
@@ -130,12 +131,13 @@ def test_model_i_on_five_temperatures_lands_in_seconds(plant_only):
 
 @pytest.mark.slow
 def test_model_i_lands_on_three_seeds(plant_only):
-    """The same on three noise seeds: the levels fc(T) and sigma2(T) within 3 % everywhere (sigma0 too on two of them:
-    on seed 2 the Stribeck pair fs, vs wanders along its valley and takes sigma0 with it, up to 36 % at 60 C)."""
+    """The same on three noise seeds: fc(T), sigma2(T) and sigma0(T) within 3 % everywhere (measured 0.7 %, 1.8 %,
+    0.5 %; before, on seed 2 the 60 C run was driven by the 10 ms-late column and sigma0 was 36 % off there, fs
+    193 %: tests/test_joint_coverage.py measures eight seeds with the intervals)."""
     for seed in (0, 1, 2):
         fit = tf.identify(_joint(seed=seed), "model-i", init=plant_only, offset="per-experiment")
         for T, errors in _model_i_errors(fit).items():
-            assert abs(errors["fc"]) < 0.03 and abs(errors["sigma2"]) < 0.03, (seed, T, errors)
+            assert all(abs(e) < 0.03 for e in errors.values()), (seed, T, errors)
 
 
 def test_a_per_temperature_fit_that_cannot_start_names_its_temperature(plant_only, monkeypatch):
