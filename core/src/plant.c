@@ -290,6 +290,42 @@ double tf_model_next_corner(double t, void *ctx)
     return c;
 }
 
+/* The Stribeck band: the smaller Stribeck velocity of the two sides where fs differs from fc (INFINITY if
+ * neither side has a Stribeck effect). */
+static double stribeck_band(const double *p)
+{
+    double q[TF_NPARAM], band = INFINITY;
+    for (int side = 0; side < 2; side++) {
+        const double *s = side ? tf_friction_side(p, -1.0, q) : p;
+        if (isfinite(s[TF_P_FS]) && s[TF_P_FS] != s[TF_P_FC] && s[TF_P_VS] > 0.0) band = fmin(band, s[TF_P_VS]);
+    }
+    return band;
+}
+
+/* Under a prescribed motion the velocity is the input's, no state, so no error estimate sees how it
+ * changes within a step -- only what it does to the friction states (the sine's reversals are corners for
+ * the same reason). Across the Stribeck band before a reversal the bristles' relaxation rate
+ * sigma0 |v| / g(v) falls by orders of magnitude within ~10 ms; Rodas4, whose Jacobian is the step's
+ * start's, took one step across it with z frozen at fc/sigma0 and a small error estimate: 3-9 % of the
+ * force's range at every rtol (docs/limits.md). So a step may change the velocity by at most
+ * PRESCRIBED_STEP_FRACTION of the larger of |v| at its start and the band, bounded with the waveform's peak
+ * acceleration: the friction's coefficients then change little within it. The whole of it (1.0) still
+ * left 1.5 % on a 20 mm, 1 Hz sine; the steps this adds per quarter period grow with log(v_peak / vs). */
+static const double PRESCRIBED_STEP_FRACTION = 0.5;
+
+double tf_model_max_step(double t, const double *y, void *ctx)
+{
+    tf_model_data *d = (tf_model_data *)ctx;
+    const tf_model *m = d->model;
+    double a = tf_waveform_peak_slope_rate(&m->input); /* a bound on the whole step's acceleration */
+    if (!(a > 0.0)) return INFINITY; /* piecewise linear: constant velocity between corners */
+    double lambda, dF;
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
+    double band = stribeck_band(p);
+    if (!isfinite(band)) return INFINITY;
+    return PRESCRIBED_STEP_FRACTION * fmax(fabs(tf_waveform_slope(&m->input, t)), band) / a;
+}
+
 int tf_model_nevent(const tf_model *model) { return tf_friction_nevent(model->friction, &model->gms); }
 
 void tf_model_events(double t, const double *y, double *g, void *ctx)
@@ -324,7 +360,7 @@ tf_ode tf_model_ode(tf_model_data *data)
     const tf_model *model = data->model;
     tf_ode ode = {tf_model_nstate(model), data, tf_plant_fast(model) ? tf_plant_rhs_fast : tf_model_rhs,
                   tf_model_jac, tf_model_next_corner, tf_model_nevent(model), tf_model_events, model_restart,
-                  0.0, 0, -1};
+                  0.0, 0, -1, model->plant == TF_PLANT_PRESCRIBED ? tf_model_max_step : 0};
     if (!ode.nevent) ode.events = 0, ode.on_restart = 0;
     if ((model->plant == TF_PLANT_STICK_SLIP || model->plant == TF_PLANT_MASS) && !ode.nevent) {
         /* the friction's relative velocity (relative_velocity), at the scale its tolerance is rtol times;

@@ -281,6 +281,7 @@ static tf_status segment(tf_driver *d, double seg_end, double corner)
             if (opt->interrupt(opt->interrupt_ctx)) return fail(d->st, d->err, TF_ERR_INTERRUPTED, d->t, d->h, -1, 0);
         }
         if (opt->hmax > 0) d->h = fmin(d->h, opt->hmax);
+        if (d->ode->max_step) d->h = fmin(d->h, d->ode->max_step(d->t, d->y, d->ode->ctx)); /* the problem's */
         int last = 0, at_event = 0;
         tf_status status;
         if (d->t + 1.01 * d->h >= seg_end) { d->h = seg_end - d->t; last = 1; }

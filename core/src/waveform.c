@@ -147,6 +147,13 @@ double tf_waveform_slope(const tf_waveform *w, double t)
     return d;
 }
 
+double tf_waveform_peak_slope_rate(const tf_waveform *w)
+{
+    if (w->kind != TF_WAVE_SINE) return 0.0; /* piecewise linear: the slope changes only at corners */
+    double om = 2.0 * M_PI * w->frequency;
+    return fabs(w->amplitude) * om * om;
+}
+
 /* Smallest of the per-period corners (k + c_j)/f over this and the next period, > t. */
 static double periodic_next(double t, double f, const double *c, int nc)
 {

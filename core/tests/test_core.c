@@ -577,6 +577,55 @@ static double ep_rate(double y, double zss, double zba)
     return 1.0 - alpha * y / zss;
 }
 
+/* The largest change of a sine motion's velocity A w cos(w t) within [t, t + h] (sampled at 200 points), in units
+ * of the larger of |v(t)| and vs. */
+static double sine_velocity_change(double A, double w, double t, double h, double vs)
+{
+    double v0 = A * w * cos(w * t), dv = 0.0;
+    for (int k = 1; k <= 200; k++) dv = fmax(dv, fabs(A * w * cos(w * (t + k * h / 200.0)) - v0));
+    return dv / fmax(fabs(v0), vs);
+}
+
+static void test_prescribed_sine_step_limit(void)
+{
+    /* A prescribed motion's velocity is no state, so that no error estimate sees it: tf_model_max_step holds every
+     * step to a change of the velocity of at most half the larger of |v| at its start and the Stribeck velocity
+     * (analytic: the sine's velocity, sampled within each step), and no tighter than that near a reversal, where
+     * the acceleration peaks (the change reaches 0.45 of vs); the narrower band where the two sides' differ; no limit for a piecewise-linear motion (constant velocity between corners) or without a Stribeck effect. */
+    tf_model m;
+    memset(&m, 0, sizeof m);
+    m.plant = TF_PLANT_PRESCRIBED;
+    m.friction = TF_FRICTION_LUGRE;
+    m.p[TF_P_SIGMA0] = 1e5, m.p[TF_P_SIGMA1] = 316.0, m.p[TF_P_FC] = 1.0, m.p[TF_P_FS] = 1.5;
+    m.p[TF_P_VS] = 1e-3, m.p[TF_P_DELTA] = 2.0;
+    m.T_const = 25.0;
+    const double A = 2e-3, w = 2.0 * M_PI, vs = 1e-3;
+    m.input = (tf_waveform){TF_WAVE_SINE, A, 1.0, 0, 0, 0, 0, 0, 0, 0, 0};
+    tf_model_data md;
+    tf_model_data_init(&md, &m);
+    tf_ode ode = tf_model_ode(&md);
+    CHECK(ode.max_step == tf_model_max_step, "a prescribed motion's ODE limits its steps");
+    double y[1] = {0.0}, worst = 0.0, near_reversal = 0.0;
+    for (int i = 0; i < 1000; i++) {
+        double t = 1e-3 * i, h = tf_model_max_step(t, y, &md), r = sine_velocity_change(A, w, t, h, vs);
+        worst = fmax(worst, r);
+        if (fabs(A * w * cos(w * t)) < vs) near_reversal = fmax(near_reversal, r);
+    }
+    CHECK(worst <= 0.5 * (1.0 + 1e-12) && near_reversal > 0.45,
+          "sine step limit: velocity change %g of max(|v|, vs) (at most 0.5), %g near a reversal", worst, near_reversal);
+    m.p[TF_P_VS_NEG] = 2e-4, m.p[TF_P_FS_NEG] = 1.3; /* the negative side: a narrower band */
+    tf_model_data_changed(&md);
+    double h_neg = tf_model_max_step(0.75, y, &md);
+    CHECK(fabs(h_neg - 0.5 * 2e-4 / (A * w * w)) < 1e-9 * h_neg, "the narrower side's band: %g s", h_neg);
+    m.p[TF_P_VS_NEG] = m.p[TF_P_FS_NEG] = 0.0, m.p[TF_P_FS] = m.p[TF_P_FC];
+    tf_model_data_changed(&md);
+    CHECK(isinf(tf_model_max_step(0.75, y, &md)), "no Stribeck effect: no limit");
+    m.p[TF_P_FS] = 1.5;
+    m.input = (tf_waveform){TF_WAVE_SAWTOOTH, A, 1.0, 0.5, 0.0, 1.0, 0, 0, 0, 0, 0};
+    tf_model_data_changed(&md);
+    CHECK(isinf(tf_model_max_step(0.2, y, &md)), "a piecewise-linear motion: no limit");
+}
+
 static void test_prescribed_exact_stepping_elastoplastic(void)
 {
     /* tf_prescribed_force on the elasto-plastic bristle from rest at a constant velocity v (sigma1 = sigma2 = 0,
@@ -1128,6 +1177,7 @@ int main(void)
     test_gms_element_breaks_loose_exactly_at_its_capacity();
     test_prescribed_exact_stepping_gms_and_its_record();
     test_prescribed_exact_stepping_elastoplastic();
+    test_prescribed_sine_step_limit();
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

@@ -30,6 +30,10 @@ typedef struct {
      * steps end at its reversals (solve.c), whose kink their error estimate does not see. */
     double kink_scale;
     int kink_plus, kink_minus;
+    /* Optional (may be NULL): the longest step the problem allows from (t, y), for a time scale of its
+     * input that no state carries, so that no error estimate sees it (a prescribed motion's velocity,
+     * tf_model_max_step); every method's steps are held to it, as to the caller's hmax. */
+    double (*max_step)(double t, const double *y, void *ctx);
 } tf_ode;
 
 typedef enum {

@@ -186,6 +186,10 @@ tf_status tf_model_rhs(double t, const double *y, double *dy, void *data);
 tf_status tf_model_jac(double t, const double *y, double *J, void *data);
 /* Earliest time after t where the input or the temperature signal has a corner. */
 double tf_model_next_corner(double t, void *data);
+/* The longest step from (t, y) (tf_ode.max_step): under a prescribed motion with a Stribeck effect, the time
+ * in which the input's velocity changes by half of the larger of |v| and the Stribeck velocity; else
+ * INFINITY. */
+double tf_model_max_step(double t, const double *y, void *data);
 /* Discrete modes of the friction model (GMS): event functions and the update at restarts (the data's modes). */
 int tf_model_nevent(const tf_model *model);
 void tf_model_events(double t, const double *y, double *g, void *data);

@@ -33,6 +33,9 @@ typedef struct {
 double tf_waveform_value(const tf_waveform *w, double t);
 /* Right-hand slope d/dt at t (the slope of the segment that starts at or contains t). */
 double tf_waveform_slope(const tf_waveform *w, double t);
+/* The largest |d^2/dt^2| at any time (a prescribed motion's peak acceleration; the sine's A (2 pi f)^2): 0 for
+ * the piecewise-linear waveforms, whose slope changes only at corners. */
+double tf_waveform_peak_slope_rate(const tf_waveform *w);
 /* Smallest corner strictly later than t (by more than a rounding margin); INFINITY if none. */
 double tf_waveform_next_corner(const tf_waveform *w, double t);
 /* The corners in [a, b] (a corner within 1e-12, relative, before a counts as at a), in order: the first
