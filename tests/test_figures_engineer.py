@@ -120,8 +120,9 @@ def test_force_tables_give_the_rmse_against_the_measured_range_not_max_error_per
         e = p.predicted - p.measured
         assert np.min(p.measured) < 0 < np.max(p.measured)  # signed data
         pct = 100 * math.sqrt(float(np.mean(e ** 2))) / float(np.ptp(p.measured))
-        assert float(row[head.index("RMSE [% of range]")]) == pytest.approx(pct, rel=2e-3)
-        assert float(row[head.index("max |error| [N m]")]) == pytest.approx(float(np.max(np.abs(e))), rel=2e-3)
+        # the cells hold 3 significant digits: within half a unit of the last one (5e-3 relative at most)
+        assert float(row[head.index("RMSE [% of range]")]) == pytest.approx(pct, rel=5e-3)
+        assert float(row[head.index("max |error| [N m]")]) == pytest.approx(float(np.max(np.abs(e))), rel=5e-3)
     s = v.summary()["validate"]
     assert s["nrmse"] == pytest.approx(v.predictions[-1].nrmse)
     assert "RMSE [% of range] = 100 RMSE / (max F_meas - min F_meas)" in v.measurement.caption
