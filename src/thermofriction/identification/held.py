@@ -211,9 +211,11 @@ def _gain_text(trial, res, what) -> str:
     if "heldout_gain" not in trial:
         return f"freeing {what} lowers the RMSE on the fit runs {fit_runs} (a refit of {n} evaluations; " \
                f"{trial['basis']})"
-    where = "held-out" if trial["basis"] == HELD_OUT else "cross-validated"
-    return (f"freeing {what} lowers the {where} RMSE {_rmses(trial['heldout_before'], trial['heldout_after'], res.unit)} "
-            f"(fit runs {fit_runs}; a refit of {n} evaluations{'' if where == 'held-out' else '; ' + trial['basis']})")
+    changed = _rmses(trial["heldout_before"], trial["heldout_after"], res.unit)
+    if trial["basis"] == HELD_OUT:
+        return f"freeing {what} lowers the held-out RMSE {changed} (fit runs {fit_runs}; a refit of {n} evaluations)"
+    return (f"freeing {what} lowers the cross-validated RMSE {changed} (fit runs {fit_runs}; a refit of {n} "
+            f"evaluations; {trial['basis']}; a run held out, role validate, would check it on other runs)")
 
 
 def _not_worth(trial, res) -> str:
