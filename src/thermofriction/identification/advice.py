@@ -43,7 +43,8 @@ MATERIAL = 0.01
 #: the smallest share of its in-sample gain a refit must keep on held-out runs. Measured (truths by the reference
 #: implementation, two seeds each; tests/test_advice_holds.py): a missing parameter keeps 0.65-1.17 of it (a 2x wrong
 #: mass: m_e 0.65-0.70, wn 0.73-0.82; a Stribeck effect held at fc: 1.06-1.14), a parameter absorbing another misfit
-#: 0.32 at most (fs on the 2x mass 0.06-0.32; Model II on Model I data: fs 0.32 in the demo, -0.15 to -0.14)
+#: 0.32 at most (fs on the 2x mass 0.06-0.32; Model II on Model I data: fs in the demo 0.07, 0.32 by the direct
+#: procedure alone, -0.15 to -0.14 on reference runs)
 HOLDS = 0.5
 #: a blocked cross-validation (where the dataset holds no runs out) cuts every fit run into BLOCKS blocks, FOLDS
 #: folds of them (fold_of_rows), each refitted without and scored on: FOLDS refits of the fit and of each value tried
