@@ -142,3 +142,26 @@ def test_the_cross_validation_folds_cover_every_row_once_at_irregular_spacing():
     for f in range(advice.FOLDS):
         gaps = np.diff(np.flatnonzero(blocks == f))
         assert len(set(gaps.tolist())) > 1, (f, gaps)
+
+
+@pytest.mark.parametrize("offset", ["shared", "per-experiment"])
+def test_a_refit_is_scored_on_held_out_runs_as_the_fit_is__force_data(offset):
+    """Force data (look-alike joint, tests/lookalike.py; its last run held out): a refit is scored on the held-out runs
+    with its offset estimated on the fit runs as the fit's was (Measurement.complete), not the one of the model it
+    started from. The refit that frees nothing, at the fit's own values from a model whose offset is 0.1 N m off,
+    must score exactly the fit's held-out RMSE, which front.py's generalisation reports."""
+    from lookalike import lookalike_experiments
+    from thermofriction.fitting.parameters import get_value
+    from thermofriction.measurements import make_traces, measurement_of
+
+    data, _ = lookalike_experiments(offsets=(0.02, -0.015, 0.03, 0.01))
+    res = tf.identify(data, "base", starts=1, offset=offset)
+    measurement = measurement_of(data, offset=offset)
+    outside = advice.OutOfSample(res, data.fit, make_traces(data.fit, res.model, measurement), measurement, 1e-8,
+                                 data, data.validate)
+    before = outside.before()
+    assert before == pytest.approx(res.fit_quality["generalisation"]["heldout_rmse"], rel=1e-9)
+    theta = [get_value(res.model, p.name) for p in res.parameters.varying]
+    off = dataclasses.replace(res.model, plant=dataclasses.replace(res.model.plant,
+                                                                   sensor_offset=res.model.plant.sensor_offset + 0.1))
+    assert outside.after(off, res.parameters, theta) == pytest.approx(before, rel=1e-6)
