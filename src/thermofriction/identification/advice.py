@@ -136,7 +136,18 @@ def fold_of_rows(traces) -> np.ndarray:
     """The fold of every row in a blocked cross-validation: every run cut into BLOCKS blocks of consecutive samples,
     block k in fold floor(FOLDS frac(k g)), g the golden ratio's fractional part: each fold's blocks spaced
     irregularly over the run, so that whatever the period of its motion they fall at different phases of it (every
-    4th block of a run at 10 Hz is one phase only), and every row held out once."""
+    4th block of a run at 10 Hz is one phase only), and every row held out once.
+
+    Parameters
+    ----------
+    traces : list of Trace
+        The fit's traces (their ``n_residuals``), in the order of the fit's residuals.
+
+    Returns
+    -------
+    numpy.ndarray
+        The fold (0 to FOLDS - 1) of each residual, the traces' concatenated.
+    """
     folds = np.floor((np.arange(BLOCKS) * GOLDEN) % 1.0 * FOLDS).astype(int)
     rows = []
     for tr in traces:
@@ -150,7 +161,25 @@ class OutOfSample:
     policy); else by a blocked cross-validation over the fit runs (``experiments``, whose ``traces`` the fit made):
     for each fold of :func:`fold_of_rows`, the fit and the refit both refitted without its rows and scored on them
     (the residuals as the fit forms them), so that every row is predicted once by a fit that did not see it.
-    ``basis`` says which, in the words the advice and the JSON use."""
+    ``basis`` says which, in the words the advice and the JSON use.
+
+    Parameters
+    ----------
+    res : FitResult
+        The fit, completed (its model's offset as fitted).
+    experiments : list of Experiment
+        Its fit runs.
+    traces : list of Trace
+        Their traces, as the fit forms its residuals.
+    measurement : Measurement
+        The data's measurement, with the fit's offset policy.
+    rtol : float
+        The simulations' relative tolerance.
+    data : Dataset, optional
+        The dataset, for validate.
+    heldout : list of Experiment, default ()
+        The held-out runs (role "validate"); none: the cross-validation.
+    """
 
     def __init__(self, res, experiments, traces, measurement, rtol, data=None, heldout=()):
         self.res, self.measurement, self.rtol, self.data = res, measurement, rtol, data
@@ -247,7 +276,18 @@ def holds(trial) -> bool:
     it was scored out of sample, at least MATERIAL of the misfit there and, on held-out runs (scored against the fit
     itself, not a refit), HOLDS of the in-sample gain. (A cross-validation's "before" is the fit refitted without
     each fold, whose error a wrong model inflates: 24.6 nm in sample, 27.9 nm cross-validated for a 2x wrong mass;
-    its gain is no measure of the in-sample one.)"""
+    its gain is no measure of the in-sample one.)
+
+    Parameters
+    ----------
+    trial : dict or None
+        A tried refit (:func:`tried`).
+
+    Returns
+    -------
+    bool
+        Whether the advice to free it may be given.
+    """
     if trial is None or trial["gain"] < MATERIAL:
         return False
     if "heldout_gain" not in trial:
