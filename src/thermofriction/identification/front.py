@@ -238,8 +238,8 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = _fit(method, experiments, init, parameters, free, procedure, reference_temperature, laws, refine, progress,
                measurement, opts)
     res = measurement.complete(res, experiments, init)
-    res = with_held_tests(res, experiments, measurement, rtol)  # the held values against the data (held.py)
-    held = list(getattr(data, "validate", None) or [])
+    held = list(getattr(data, "validate", None) or [])  # the held-out runs: the advice's refits are scored there too
+    res = with_held_tests(res, experiments, measurement, rtol, data, held)  # the held values against the data (held.py)
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
     res = with_ripple_advice(res, experiments, held, measurement, rtol)  # a ripple the residuals hold, tried
     res.warnings[:0] = units + _ripple_note(measurement, res.model)
