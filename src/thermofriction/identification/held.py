@@ -21,7 +21,7 @@ import numpy as np
 from .._lazy import lazy
 from ..models import ModelI
 from ..measurements import amount
-from .advice import HELD_OUT, MATERIAL, TRY_AT_MOST, OutOfSample, holds, tried
+from .advice import MATERIAL, TRY_AT_MOST, OutOfSample, holds, tried
 from ..fitting.parameters import EXCESS, PLANT_UNITS, get_value
 from ..fitting.problem import Problem
 from ..measurements import make_traces
@@ -136,7 +136,7 @@ def held_tests(res, experiments, measurement, rtol=1e-8, inadequate=False, data=
     contradicted, message, tried}], most contradicted first. Empty where the model cannot be evaluated there. The
     contradicted values are tried (a refit with each freed: advice.py), and where the fit is ``inadequate`` the
     held values whose direction explains most of the misfit too, up to TRY_AT_MOST refits in all; each refit is
-    scored out of sample on ``heldout`` (runs of ``data``), else by a cross-validation over ``experiments``."""
+    scored out of sample on ``heldout`` (runs of ``data``) where there are any."""
     varying = [p.name for p in res.parameters.varying]
     if not res.n_points:
         return []
@@ -179,7 +179,7 @@ def held_tests(res, experiments, measurement, rtol=1e-8, inadequate=False, data=
     if inadequate:
         to_try += sorted((t for t in out if t["same_as"] is None and not t["contradicted"]),
                          key=lambda t: -t["misfit_share"])
-    outside = OutOfSample(res, experiments, traces, measurement, rtol, data, heldout) if to_try else None
+    outside = OutOfSample(res, experiments, measurement, rtol, data, heldout) if to_try and heldout else None
     for i, t in enumerate(to_try):
         # the advice is tried before it is said (advice.py): a refit from the optimum with the value freed, scored
         # on the fit runs and out of sample
@@ -212,10 +212,7 @@ def _gain_text(trial, res, what) -> str:
         return f"freeing {what} lowers the RMSE on the fit runs {fit_runs} (a refit of {n} evaluations; " \
                f"{trial['basis']})"
     changed = _rmses(trial["heldout_before"], trial["heldout_after"], res.unit)
-    if trial["basis"] == HELD_OUT:
-        return f"freeing {what} lowers the held-out RMSE {changed} (fit runs {fit_runs}; a refit of {n} evaluations)"
-    return (f"freeing {what} lowers the cross-validated RMSE {changed} (fit runs {fit_runs}; a refit of {n} "
-            f"evaluations; {trial['basis']}; a run held out, role validate, would check it on other runs)")
+    return f"freeing {what} lowers the held-out RMSE {changed} (fit runs {fit_runs}; a refit of {n} evaluations)"
 
 
 def _not_worth(trial, res) -> str:
@@ -225,8 +222,9 @@ def _not_worth(trial, res) -> str:
     if trial["gain"] < MATERIAL:
         return f"a refit with it free lowers the RMSE on the fit runs only {fit_runs}, less than {100 * MATERIAL:g} " \
                f"%: not contradicted"
-    where = "held-out" if trial["basis"] == HELD_OUT else f"cross-validated ({trial['basis']})"
-    return (f"a refit with it free, which lowers the RMSE on the fit runs {fit_runs}, changes the {where} RMSE "
+    if "heldout_gain" not in trial:  # (tried because the fit is not adequate; the score test does not single it out)
+        return f"a refit with it free lowers the RMSE on the fit runs {fit_runs} ({trial['basis']})"
+    return (f"a refit with it free, which lowers the RMSE on the fit runs {fit_runs}, changes the held-out RMSE "
             f"{_rmses(trial['heldout_before'], trial['heldout_after'], res.unit)} ({100 * trial['heldout_gain']:.2g} "
             f"% of its misfit): the gain does not hold out of sample; not contradicted")
 
@@ -330,9 +328,8 @@ def _tried_text(tests, res) -> str:
             out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit (less than "
                        f"{100 * MATERIAL:g} %: not worth a parameter)")
         else:
-            where = "held-out runs" if trial["basis"] == HELD_OUT else f"blocks held out ({trial['basis']})"
             out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit on the fit runs but only "
-                       f"{100 * trial['heldout_gain']:.2g} % on the {where} (RMSE "
+                       f"{100 * trial['heldout_gain']:.2g} % on the held-out runs (RMSE "
                        f"{_rmses(trial['heldout_before'], trial['heldout_after'], res.unit)}): the gain does not hold "
                        f"out of sample, not worth a parameter")
     return ", ".join(out)
