@@ -18,6 +18,7 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ThermofrictionError
 from ..fitting.optimiser import fit
+from ..fitting.problem import Problem
 from ..fitting.parameters import get_value, unit_of, with_values
 from ..measurements import amount, make_traces
 from ..measurements.ripple import additive, has_ripple, started
@@ -40,18 +41,32 @@ BINS_PER_PERIOD = 8
 AMPLITUDES = ("ripple_cos1", "ripple_sin1")
 
 
-def _residuals(res, experiments, measurement):
-    """[(angle, residual about its mean)] of each fit run at the optimum, as validate scores them."""
-    with_phase = getattr(measurement, "ripple_phase", "recorded")
-    v = validate(res.model, experiments, experiments, offset=measurement.offset if measurement.offset != "shared"
-                 else None, ripple_phase=with_phase)
+def _at(model, traces):
+    """The residuals of ``model`` on ``traces`` as the fit forms them (the exact stepping, offsets as the policy fits
+    them), split per trace; None where the model cannot be run."""
+    r, _ = Problem(model, [], traces, parallel=len(traces) > 1).evaluate(np.array([]), jac=False)
+    if r is None:
+        return None
+    edges = np.cumsum([0] + [tr.n_residuals for tr in traces])
+    return [r[i:j] for i, j in zip(edges[:-1], edges[1:])]
+
+
+def _runs(traces, residuals):
+    """[(angle, residual about its mean)] of each trace with a recorded angle."""
     out = []
-    for p in v.predictions:
-        r = np.asarray(p.measured, float) - np.asarray(p.predicted, float)
-        ok = np.isfinite(r) & np.isfinite(p.position)
+    for tr, r in zip(traces, residuals):
+        x = getattr(tr, "angle", None)
+        if x is None or np.size(x) != np.size(r):
+            continue
+        ok = np.isfinite(r) & np.isfinite(x)
         if ok.sum() > 8:
-            out.append((np.asarray(p.position, float)[ok], r[ok] - r[ok].mean()))
+            out.append((np.asarray(x, float)[ok], r[ok] - r[ok].mean()))
     return out
+
+
+def _rms(residuals) -> float:
+    r = np.concatenate(residuals)
+    return float(np.sqrt(np.mean(r ** 2)))
 
 
 def _binned(x, r, width):
@@ -113,12 +128,14 @@ def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
     if not additive(model.with_friction(ripple_period=1.0)):  # Model II scales a ripple: not a plain term here
         return res
     try:
-        runs = _residuals(res, experiments, measurement)
+        traces = make_traces(experiments, model, measurement)
+        residuals = _at(model, traces)
+        runs = _runs(traces, residuals) if residuals is not None else []
         period = strongest_period(runs) if runs else None
         if period is None or _share(runs, period) < MATERIAL:  # not worth a refit: nothing to say
             return res
-        refit, nfev = _refit(res, experiments, measurement, period, rtol)
-        before, after = (_pooled_rmse(m, experiments, measurement) for m in (model, refit))
+        refit, after, nfev = _refit(res, experiments, measurement, period, rtol)
+        before = _rms(residuals)
         out = {"period": period, "gain": max(1.0 - (after / before) ** 2, 0.0), "rmse_before": before,
                "rmse_after": after, "evaluations": nfev}
         if held:
@@ -142,7 +159,8 @@ def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
 
 
 def _pooled_rmse(model, runs, measurement) -> float:
-    """The RMSE of ``model`` over ``runs`` pooled over their samples, each run scored as validate scores it."""
+    """The RMSE of ``model`` over the held-out ``runs`` pooled over their samples, each run scored as validate
+    scores it (as front.py scores the fit's generalisation)."""
     v = validate(model, runs, runs, offset=measurement.offset if measurement.offset != "shared" else None,
                  ripple_phase=getattr(measurement, "ripple_phase", "recorded"))
     n = np.array([np.size(p.measured) for p in v.predictions], float)
@@ -150,8 +168,8 @@ def _pooled_rmse(model, runs, measurement) -> float:
 
 
 def _refit(res, experiments, measurement, period, rtol):
-    """(the refit model, evaluations): the fit's varying parameters and the first harmonic of a ripple of
-    ``period`` fitted from the optimum, the amplitudes solved first (ripple.started)."""
+    """(the refit model, its RMSE on the fit runs, evaluations): the fit's varying parameters and the first harmonic
+    of a ripple of ``period`` fitted from the optimum, the amplitudes solved first (ripple.started)."""
     start = started(measurement, res.model.with_friction(ripple_period=period), experiments, AMPLITUDES)
     params = copy.deepcopy(res.parameters)
     for p in params.values():  # from the optimum's values
@@ -164,7 +182,8 @@ def _refit(res, experiments, measurement, period, rtol):
     names = [p.name for p in params.varying]
     outcome = fit(start, params, make_traces(experiments, start, measurement), rtol=rtol, starts=1, near=True,
                   max_nfev=TRY_EVALUATIONS)
-    return with_values(start, dict(zip(names, outcome.theta))), int(outcome.nfev)
+    rmse = float(np.sqrt(np.mean(outcome.r ** 2)))
+    return with_values(start, dict(zip(names, outcome.theta))), rmse, int(outcome.nfev)
 
 
 def _message(out, unit, measurement, rotary) -> str:
