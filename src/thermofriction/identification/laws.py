@@ -45,7 +45,7 @@ def fit_range(T) -> tuple:
 FIT_LAW_KINDS = ("linear", "exp", "const")
 
 
-def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parameter=None):
+def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parameter=None, over_const=None):
     """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
     lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
     kind is better by more than 2 (a difference the data support). A law that leaves the physical
@@ -63,6 +63,9 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
         The law kinds tried.
     prefer : str, optional
         A kind kept unless another is better by more than 2 in AICc.
+    over_const : str, optional
+        A kind kept over a constant unless the constant is better by more than 2 in AICc (the other kinds
+        compete by AICc alone): a constant wins only where the data say so, not where a slope is lost in noise.
     parameter : str, optional
         The parameter's name, for its physical domain.
 
@@ -128,6 +131,8 @@ def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parame
     if best is None:
         raise InputError("no law could be fitted" + (f" that keeps {parameter} physical over "
                                                        f"{rng[0]:g}..{rng[1]:g} C" if parameter else ""))
+    if best[0] == "const" and over_const is not None and prefer is None:
+        prefer = over_const
     if (prefer in table and prefer != best[0] and "excluded" not in table[prefer]
             and table[prefer]["aicc"] - table[best[0]]["aicc"] <= 2.0):
         from ..models import law_from_dict
