@@ -139,6 +139,7 @@ def _logged_least_squares(ledger, least_squares):
         move = np.abs(np.asarray(res.x) - np.asarray(phi0))
         i = int(np.argmax(move))
         ledger.runs.append({"stage": ledger.stack[-1], "parameters": len(prob.names), "rtol": prob.rtol,
+                            "temperatures": sorted({round(float(t.nominal_temperature), 2) for t in prob.traces}),
                             "limit": max_nfev, "evaluations": prob.nfev - before, "status": int(res.status),
                             "moved_most": prob.names[i], "move": float(move[i])})
         return res
@@ -274,7 +275,7 @@ def stage_shares(rows):
 def summarise(rows):
     """Prints, per kind, the cost's median, 90th percentile and worst, and where the slowest fits spend."""
     print(f"{'kind':14s} {'n':>3s} {'cost median':>11s} {'p90':>7s} {'worst':>7s} | {'CPU median':>10s} {'p90':>7s} "
-          f"{'worst':>7s} | {'nfev median':>11s} {'worst':>6s} | {'wall med. [s]':>13s} | recovered (2 half-w.)")
+          f"{'worst':>7s} | {'eval. median':>11s} {'worst':>6s} | {'wall med. [s]':>13s} | recovered (2 half-w.)")
     for kind in KINDS:
         rs = [r for r in rows if r["kind"] == kind]
         if not rs:
@@ -293,6 +294,13 @@ def summarise(rows):
         for s in every:
             w = worst.get(s, (0.0, 0.0))
             print(f"  {s:22s} {every[s][0]:6.0%} {every[s][1]:6.0%}   |  {w[0]:6.0%} {w[1]:6.0%}")
+        runs = [x for r in rs for x in r["runs"]]
+        spent = max(sum(x["evaluations"] for x in runs), 1)
+        limit = [x for x in runs if x["status"] == 0]
+        far = collections.Counter(x["moved_most"] for x in runs if x["move"] > 5.0)
+        print(f"  least-squares runs at their evaluation limit: {len(limit)} of {len(runs)}, "
+              f"{sum(x['evaluations'] for x in limit) / spent:.0%} of the runs' evaluations; runs moving a parameter "
+              f"by more than e^5 (log) or 5 starts: {dict(far)}")
         for r in slow:
             print(f"  slow: seed {r['seed']}, cost {r['cost']:.0f}, {r['evaluations']} evaluations, "
                   f"{r['message'][:90]}")
