@@ -1,21 +1,26 @@
 """Model I's first fit from the initial model on the records' first periods (identification/model_i.py,
-record_heads; issue 42): what is cut, where it applies, and that the fit on the whole records then ends where it
+_PerTemperature.from_heads, data/experiments.py first_periods; issue 42): what is cut, where it applies, and that the fit on the whole records then ends where it
 ends without it. The data: truths integrated by SciPy through tests/reference (benchmarks/study_cost.py), not by
 the package."""
 
 import math
 import sys
-import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import thermofriction as tf
+from thermofriction.data.experiments import first_periods
 from thermofriction.identification import model_i
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import study_cost as S  # noqa: E402
+
+
+def heads(experiments, input):
+    """What Model I's first fit runs on."""
+    return first_periods(experiments, model_i.HEAD_PERIODS, model_i.HEAD_MIN_PERIODS, input)
 
 
 def _experiment(duration, rate=5000.0, input=S.SAW):
@@ -27,7 +32,7 @@ def _experiment(duration, rate=5000.0, input=S.SAW):
 def test_the_heads_are_the_first_two_periods_of_every_column():
     """A 2 s record of the 5 Hz sawtooth: every sampled column cut to t <= 0.4 s (two periods), the same values."""
     e = _experiment(2.0)
-    (h,) = model_i.record_heads([e], types.SimpleNamespace(input=S.SAW))
+    (h,) = heads([e], S.SAW)
     n = int(np.sum(e.time <= 2 * S.SAW.period + 1e-12))
     assert n == 2001
     for column in ("time", "voltage", "displacement", "temperature_signal"):
@@ -37,11 +42,10 @@ def test_the_heads_are_the_first_two_periods_of_every_column():
 
 def test_no_heads_on_short_records_or_an_input_without_a_period():
     """Fewer than HEAD_MIN_PERIODS periods in any record of the temperature, or a sampled input: None."""
-    model = types.SimpleNamespace(input=S.SAW)
     short = _experiment(model_i.HEAD_MIN_PERIODS * S.SAW.period * 0.95)
-    assert model_i.record_heads([_experiment(2.0), short], model) is None
+    assert heads([_experiment(2.0), short], S.SAW) is None
     sampled = _experiment(2.0, input=tf.Sampled(np.array([0.0, 2.0]), np.array([0.0, 1.0])))
-    assert model_i.record_heads([sampled], types.SimpleNamespace(input=None)) is None
+    assert heads([sampled], None) is None
 
 
 @pytest.mark.slow
@@ -52,7 +56,7 @@ def test_a_fit_with_heads_ends_where_the_fit_without_them_ends(monkeypatch):
     stops within SMALL_STEP, 0.2 standard errors, of the optimum)."""
     truth, temps, start, opts = S.case("model-i", 1, False)
     data = S.dataset(truth, temps, 2.0, 5000.0, 1)
-    assert model_i.record_heads(data.fit[:1], start) is not None  # the records are long enough for the heads
+    assert heads(data.fit[:1], start.input) is not None  # the records are long enough for the heads
     with_heads = tf.identify(data, init=start, **opts)
     monkeypatch.setattr(model_i, "HEAD_MIN_PERIODS", math.inf)
     without = tf.identify(data, init=start, **opts)

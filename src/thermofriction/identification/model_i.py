@@ -10,6 +10,7 @@ import time
 import numpy as np
 
 from .._lazy import lazy
+from ..data.experiments import first_periods
 from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
 from ..models.transforms import base_model
@@ -106,7 +107,7 @@ class _PerTemperature:
         first = dict(self.opts)
         if previous is not None and neighbour:  # continuation from the neighbouring temperature
             first["starts"] = 1
-        head = record_heads(group, init) if first_of_all else None
+        head = first_periods(group, HEAD_PERIODS, HEAD_MIN_PERIODS, init.input) if first_of_all else None
         res = self.from_heads(group, head, T, base, first) if head else self.fit_one(group, T, base, self.held, first)
         if first_of_all:
             undetermined = self.undetermined(res)
@@ -133,10 +134,13 @@ class _PerTemperature:
         return T, res, (T, self.carried(res, T))
 
     def from_heads(self, group, head, T, base, opts):
-        """The first fit from the initial model on the records' first periods (record_heads), then on the whole
+        """The first fit from the initial model on the records' first periods (``head``), then on the whole
         records from its optimum; where that does not reach the noise (AT_NOISE), the whole records from the
         initial model too, as without the heads (the heads' optimum can be another basin: a freed m_e traded
-        against the levels on two periods), and the better of the two. Every evaluation is counted."""
+        against the levels on two periods), and the better of the two. Every evaluation is counted. The first fit
+        from a rough start was most of a Model I fit's evaluations (benchmarks/study_cost.py: a poorly determined
+        sigma1 walking to its bound, the multi-start after it); on a periodic input the first periods carry the
+        friction levels."""
         spent, tried = [0, 0], []
         try:
             rough = self.fit_one(head, T, base, self.held, opts)
@@ -255,26 +259,8 @@ class _PerTemperature:
 
 
 #: the first fit from the initial model runs on each record's first HEAD_PERIODS periods of its input, where every
-#: record of the temperature holds at least HEAD_MIN_PERIODS of them
+#: record of the temperature holds HEAD_MIN_PERIODS (_PerTemperature.from_heads; data.experiments.first_periods)
 HEAD_PERIODS, HEAD_MIN_PERIODS = 2, 8
-
-
-def record_heads(group, init) -> list | None:
-    """The experiments cut to their first HEAD_PERIODS periods of the input, or None where a record is shorter
-    than HEAD_MIN_PERIODS periods or its input is not periodic. The first fit from a rough start spends most of
-    a Model I fit's evaluations (benchmarks/study_cost.py: a poorly determined sigma1 walking to its bound, the
-    multi-start after it), and on a periodic input the first periods carry the friction levels: fitted on them,
-    the fit on the whole records starts near their optimum (_PerTemperature.from_heads)."""
-    heads = []
-    for e in group:
-        period = getattr(e.input or init.input, "period", None)
-        if not period or e.duration < HEAD_MIN_PERIODS * period:
-            return None
-        n = int(np.searchsorted(e.time, e.time[0] + HEAD_PERIODS * period, side="right"))
-        heads.append(dataclasses.replace(e, **{f.name: getattr(e, f.name)[:n] for f in dataclasses.fields(e)
-                                               if isinstance(getattr(e, f.name), np.ndarray)
-                                               and len(getattr(e, f.name)) == len(e.time)}))
-    return heads
 
 
 def _fitted(res, name):
