@@ -193,4 +193,36 @@ class Dataset:
         return [e.temperature for e in self.experiments]
 
 
+def first_periods(experiments, periods, at_least, input=None) -> list | None:
+    """The experiments cut to their first ``periods`` periods of their input.
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        The runs (each's own ``input``, else ``input``).
+    periods : float
+        How many periods each cut keeps.
+    at_least : float
+        The periods every record must hold for the cut to be made.
+    input : Waveform, optional
+        The input of the runs that do not carry their own.
+
+    Returns
+    -------
+    list of Experiment or None
+        Copies with every sampled column cut; None where a run is shorter than ``at_least`` periods, its input
+        has no period, or it is not an Experiment.
+    """
+    cut = []
+    for e in experiments:
+        period = getattr(getattr(e, "input", None) or input, "period", None)
+        if not isinstance(e, Experiment) or not period or e.duration < at_least * period:
+            return None
+        n = int(np.searchsorted(e.time, e.time[0] + periods * period, side="right"))
+        cut.append(dataclasses.replace(e, **{f.name: getattr(e, f.name)[:n] for f in dataclasses.fields(e)
+                                             if isinstance(getattr(e, f.name), np.ndarray)
+                                             and len(getattr(e, f.name)) == len(e.time)}))
+    return cut
+
+
 # -- experiment files -------------------------------------------------------------------------

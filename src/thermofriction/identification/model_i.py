@@ -10,12 +10,13 @@ import time
 import numpy as np
 
 from .._lazy import lazy
+from ..data.experiments import first_periods
 from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
 from ..models.transforms import base_model
 from .law_kinds import Refined, checked_kinds
 from .laws import at_shared, fit_law, laws_on_information
-from ..fitting.optimiser import fit
+from ..fitting.optimiser import AT_NOISE, fit
 from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
 from ..measurements import make_traces
 from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
@@ -106,7 +107,8 @@ class _PerTemperature:
         first = dict(self.opts)
         if previous is not None and neighbour:  # continuation from the neighbouring temperature
             first["starts"] = 1
-        res = self.fit_one(group, T, base, self.held, first)
+        head = first_periods(group, HEAD_PERIODS, HEAD_MIN_PERIODS, init.input) if first_of_all else None
+        res = self.from_heads(group, head, T, base, first) if head else self.fit_one(group, T, base, self.held, first)
         if first_of_all:
             undetermined = self.undetermined(res)
             # a shape constant (no law in the initial model: vs, sigma2, ...) that one temperature cannot separate
@@ -130,6 +132,28 @@ class _PerTemperature:
                                      f"error above 100 % at {T:.4g} C): held at the initial model's law")
                 res = self.fit_one(group, T, held_at(init, T, base, undetermined), undetermined, self.opts)
         return T, res, (T, self.carried(res, T))
+
+    def from_heads(self, group, head, T, base, opts):
+        """The first fit from the initial model on the records' first periods (``head``), then on the whole
+        records from its optimum; where that does not reach the noise (AT_NOISE), the whole records from the
+        initial model too, as without the heads (the heads' optimum can be another basin: a freed m_e traded
+        against the levels on two periods), and the better of the two. Every evaluation is counted. The first fit
+        from a rough start was most of a Model I fit's evaluations (benchmarks/study_cost.py: a poorly determined
+        sigma1 walking to its bound, the multi-start after it); on a periodic input the first periods carry the
+        friction levels."""
+        spent, tried = [0, 0], []
+        try:
+            rough = self.fit_one(head, T, base, self.held, opts)
+            spent = [rough.nfev, rough.njev]
+            tried.append(self.fit_one(group, T, rough.model, self.held, {**opts, "starts": 1}))
+        except ComputationError:  # the whole records decide, from the initial model, as without the heads
+            pass
+        if not tried or not tried[0].fit_quality.get("ratio", math.inf) <= AT_NOISE:
+            tried.append(self.fit_one(group, T, base, self.held, opts))
+        res = min(tried, key=lambda r: r.cost)
+        res.nfev = sum(r.nfev for r in tried) + spent[0]
+        res.njev = sum(r.njev for r in tried) + spent[1]
+        return res
 
     def carried(self, res, T):
         """What a fit continues from: ``res``'s model with only what this temperature determined. A parameter the
@@ -232,6 +256,11 @@ class _PerTemperature:
             raise ComputationError(f"Model I: the fit at {T:.4g} C of {', '.join(n for n in names if n not in fixed)} "
                                    f"failed, from {start} (continued from the neighbouring temperature's fit along the "
                                    f"initial model's laws, with {opts.get('starts', 8)} start(s)): {e}") from e
+
+
+#: the first fit from the initial model runs on each record's first HEAD_PERIODS periods of its input, where every
+#: record of the temperature holds HEAD_MIN_PERIODS (_PerTemperature.from_heads; data.experiments.first_periods)
+HEAD_PERIODS, HEAD_MIN_PERIODS = 2, 8
 
 
 def _fitted(res, name):
