@@ -45,6 +45,26 @@ def fit_range(T) -> tuple:
 FIT_LAW_KINDS = ("linear", "exp", "const")
 
 
+#: the law kinds a Model I parameter's estimates choose from by AICc (unless the user names them; the initial model's
+#: kind kept unless another is better by more than 2)
+KINDS = ("linear", "exp")
+#: the shape constants: the Stribeck velocity, which the initial model gives no law, may take a constant law too (it
+#: must beat linear by more than 2 in AICc: identification/model_i.py, _laws_through)
+SHAPE_CONSTANTS = ("vs", "vs_neg")
+KINDS_OF_A_SHAPE_CONSTANT = ("linear", "exp", "const")
+
+
+def law_kinds_for(name, prior, asked):
+    """(the kinds ``name``'s law is chosen among, the kind kept over a constant or None): ``asked`` (a kind or
+    kinds, the user's) as asked; else KINDS, and for a shape constant without a law in the initial model (``prior``
+    None) KINDS_OF_A_SHAPE_CONSTANT with linear kept over the constant unless it is better by more than 2."""
+    if asked:
+        return ((asked,) if isinstance(asked, str) else tuple(asked)), None
+    if name in SHAPE_CONSTANTS and not prior:
+        return KINDS_OF_A_SHAPE_CONSTANT, "linear"
+    return KINDS, None
+
+
 def fit_law(T, values, stderr=None, kinds=("linear", "exp"), prefer=None, parameter=None, over_const=None):
     """Weighted least-squares fits of each law kind to (T, value +- stderr); the one with the
     lowest AICc wins, except that ``prefer`` (e.g. the initial model's kind) is kept unless another
@@ -307,4 +327,4 @@ def at_shared(per_T, free, shared):
     return out
 
 
-__all__ = ["fit_law", "FIT_LAW_KINDS", "segmented_fit", "aicc", "laws_on_information", "at_shared", "LOG_SPACE_BELOW"]
+__all__ = ["fit_law", "law_kinds_for", "KINDS", "SHAPE_CONSTANTS", "FIT_LAW_KINDS", "segmented_fit", "aicc", "laws_on_information", "at_shared", "LOG_SPACE_BELOW"]

@@ -15,7 +15,7 @@ from ..errors import ComputationError, InputError
 from ..models import Const, Model, ModelI
 from ..models.transforms import base_model
 from .law_kinds import Refined, checked_kinds
-from .laws import at_shared, fit_law, laws_on_information
+from .laws import at_shared, fit_law, law_kinds_for, laws_on_information
 from ..fitting.optimiser import AT_NOISE, fit
 from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
 from ..measurements import make_traces
@@ -281,19 +281,12 @@ def _estimate(res, name):
     return x.value + fc.value, math.sqrt(max(se_x ** 2 + se_fc ** 2 + 2 * rho * se_x * se_fc, 0.0))
 
 
-#: the law kinds a parameter's estimates choose from by AICc (unless ``laws`` names them; the initial model's kind
-#: kept unless another is better by more than 2)
-KINDS = ("linear", "exp")
-#: the shape constants: the Stribeck velocity, which the initial model gives no law, may take a constant law too (it
-#: must beat linear by more than 2 in AICc)
-SHAPE_CONSTANTS = ("vs", "vs_neg")
-KINDS_OF_A_SHAPE_CONSTANT = ("linear", "exp", "const")
 
 
 def _laws_through(per_T, names, held, init, laws):
     """A law per parameter through the per-temperature estimates (by AICc among KINDS, the initial model's kind
-    preferred; a shape constant the initial model gives no law among KINDS_OF_A_SHAPE_CONSTANT, linear preferred over
-    the constant; unless ``laws`` names the kinds), refitted on the estimates' covariances; a held parameter keeps the
+    preferred; a shape constant the initial model gives no law a constant too: laws.law_kinds_for; unless ``laws``
+    names the kinds), refitted on the estimates' covariances; a held parameter keeps the
     initial model's. (Without the constant the Stribeck velocity got a slope from its estimates' scatter: on a 10
     ms-lag joint from a plant-only file it traded with fs's along their valley, fs up to 32 % off at 60 C. A constant
     for every parameter without a law cost displacement truths their slopes: Model I on 20 random truths covered 256
@@ -308,11 +301,8 @@ def _laws_through(per_T, names, held, init, laws):
             continue
         vals = np.array([_estimate(r, n)[0] for _, r in per_T])
         ses = np.array([_estimate(r, n)[1] for _, r in per_T])
-        kinds = (laws or {}).get(n)
         prior = init.laws[n].kind if n in init.laws else None
-        shape = n in SHAPE_CONSTANTS and not prior
-        kinds = (kinds,) if isinstance(kinds, str) else (kinds or (KINDS_OF_A_SHAPE_CONSTANT if shape else KINDS))
-        over_const = "linear" if shape and not (laws or {}).get(n) else None
+        kinds, over_const = law_kinds_for(n, prior, (laws or {}).get(n))
         law, table = fit_law(Ts, vals, ses, kinds, prefer=prior, parameter=n, over_const=over_const)
         new_laws[n] = law
         law_tables[n] = {"chosen": law.kind, "candidates": table, "temperatures": Ts, "values": vals,
