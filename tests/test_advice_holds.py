@@ -142,7 +142,7 @@ def test_a_refit_is_scored_on_held_out_runs_as_the_fit_is__force_data(offset):
     data, _ = lookalike_experiments(offsets=(0.02, -0.015, 0.03, 0.01))
     res = tf.identify(data, "base", starts=1, offset=offset)
     measurement = measurement_of(data, offset=offset)
-    outside = advice.OutOfSample(res, data.fit, measurement, 1e-8, data, data.validate)
+    outside = advice.OutOfSample(res, data.fit, measurement, data, data.validate)
     before = outside.before()
     assert before == pytest.approx(res.fit_quality["generalisation"]["heldout_rmse"], rel=1e-9)
     theta = [get_value(res.model, p.name) for p in res.parameters.varying]

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
+
 from ._io import dump_json, jsonable
 from .errors import InputError, TemperatureRangeWarning, ThermofrictionError, UnitWarning
 from . import _args
@@ -351,6 +353,38 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     # first: a unit off by 1000 explains every error after it (unit_warnings also warns: validate's edge)
     found = [Finding(UnitWarning, m) for m in unit_warnings(pairs)] + found
     return ValidationResult(model, preds, [f.message for f in found], failures, measurement, how, found)
+
+
+def heldout_score(model: Model, data, runs, measurement):
+    """``model`` scored on ``runs`` as a fit's generalisation is (identify: the fit's offset policy and ripple angle,
+    its findings kept as values), the one definition of a fit's held-out RMSE.
+
+    Parameters
+    ----------
+    model : Model
+        The model to score.
+    data : Dataset or list of Experiment
+        The dataset the runs belong to.
+    runs : list of Experiment
+        The held-out runs.
+    measurement : Measurement
+        The fit's measurement (its ``offset`` policy and, for force data, its ``ripple_phase``).
+
+    Returns
+    -------
+    tuple
+        (the root mean square of the runs' RMSEs, NaN where none was predicted; the ValidationResult).
+
+    Raises
+    ------
+    ThermofrictionError
+        As :func:`validate`.
+    """
+    with collecting():
+        v = validate(model, data, runs, offset=measurement.offset if measurement.offset != "shared" else None,
+                     ripple_phase=getattr(measurement, "ripple_phase", "auto"))
+    rms = float(np.sqrt(np.mean([p.rmse ** 2 for p in v.predictions]))) if v.predictions else float("nan")
+    return rms, v
 
 
 __all__ = ["MetricWarning", "validate", "ValidationResult", "Prediction", "Failure", "predict", "step_sizes"]

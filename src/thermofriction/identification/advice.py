@@ -24,8 +24,7 @@ import numpy as np
 
 from ..errors import ThermofrictionError
 from ..models import ModelI
-from ..results import collecting
-from ..validation import validate
+from ..validation import heldout_score
 from ..fitting.optimiser import fit
 from ..fitting.parameters import EXCESS, Parameters, fitted_positive, get_value, unit_of, with_values
 
@@ -110,18 +109,15 @@ class OutOfSample:
         Its fit runs.
     measurement : Measurement
         The data's measurement, with the fit's offset policy.
-    rtol : float
-        The simulations' relative tolerance.
     data : Dataset, optional
         The dataset, for validate.
     heldout : list of Experiment
         The held-out runs (role "validate").
     """
 
-    def __init__(self, res, experiments, measurement, rtol, data, heldout):
-        self.res, self.measurement, self.rtol, self.data = res, measurement, rtol, data
+    def __init__(self, res, experiments, measurement, data, heldout):
+        self.res, self.measurement, self.data = res, measurement, data
         self.experiments, self.heldout = list(experiments), list(heldout)
-        self.basis = HELD_OUT
         self._before = None
 
     def before(self) -> float | None:
@@ -136,15 +132,11 @@ class OutOfSample:
         return self._validated(_completed(self.res, fitted, self.experiments, self.measurement))
 
     def _validated(self, model) -> float | None:
-        """The RMS of the held-out runs' RMSEs as validate scores them (front.py: _with_generalisation)."""
-        m = self.measurement
-        with collecting():
-            v = validate(model, self.data if self.data is not None else self.heldout, self.heldout,
-                         offset=m.offset if m.offset != "shared" else None,
-                         ripple_phase=getattr(m, "ripple_phase", "auto"))
-        if len(v.predictions) != len(self.heldout):
-            return None
-        return float(np.sqrt(np.mean([p.rmse ** 2 for p in v.predictions])))
+        """The held-out RMSE as the fit's generalisation has it (validation.heldout_score); None where a run could
+        not be predicted."""
+        rms, v = heldout_score(model, self.data if self.data is not None else self.heldout, self.heldout,
+                               self.measurement)
+        return rms if len(v.predictions) == len(self.heldout) else None
 
 
 
@@ -181,7 +173,7 @@ def _out_of_sample(model, params, outcome, outside) -> dict:
         return {"basis": NOT_SCORED}
     if before is None or after is None or not before > 0:
         return {"basis": NOT_SCORED}
-    return {"basis": outside.basis, "heldout_before": before, "heldout_after": after,
+    return {"basis": HELD_OUT, "heldout_before": before, "heldout_after": after,
             "heldout_gain": 1.0 - (after / before) ** 2}
 
 

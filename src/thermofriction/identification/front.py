@@ -25,7 +25,6 @@ from .model_ii import identify_model_ii
 from ..fitting.optimiser import one_blas_thread
 from ..models import Model
 from ..models.sides import needs_period
-from ..results import collecting
 from ..simulation import StepSizeController
 from ..fitting.parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
@@ -33,7 +32,7 @@ from ..models.transforms import base_model
 from .procedures import default_fit_parameters, fit_friction, identify_heat
 from .provenance import stamped
 from .result import FitResult
-from ..validation import validate
+from ..validation import heldout_score
 from ..unit_scale import model_unit_warnings
 
 METHODS = ("plant", "base", "model-i", "model-ii", "heat")
@@ -301,16 +300,13 @@ def _with_generalisation(res, data, held, measurement):
     over fit RMS, each run's error as validate measures it, with the fit's offset policy) in
     ``fit_quality["generalisation"]``, and a warning where it is large. It says what the noise estimate
     cannot when the residuals are correlated."""
-    try:
-        with collecting():  # its findings are values here (the units were checked against the initial model)
-            v = validate(res.model, data, held, offset=measurement.offset if measurement.offset != "shared" else None,
-                         ripple_phase=getattr(measurement, "ripple_phase", "auto"))
+    try:  # (its findings are values here: the units were checked against the initial model)
+        heldout, v = heldout_score(res.model, data, held, measurement)
     except ThermofrictionError as e:
         res.warnings.append(f"the held-out experiments could not be predicted: {e}")
         return res
     if not v.predictions:
         return res
-    heldout = float(np.sqrt(np.mean([p.rmse ** 2 for p in v.predictions])))
     ratio = heldout / res.rmse if res.rmse > 0 else math.inf
     q = res.fit_quality
     gen = q["generalisation"] = {"heldout_rmse": heldout, "fit_rmse": res.rmse, "ratio": ratio,

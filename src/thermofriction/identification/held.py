@@ -179,7 +179,7 @@ def held_tests(res, experiments, measurement, rtol=1e-8, inadequate=False, data=
     if inadequate:
         to_try += sorted((t for t in out if t["same_as"] is None and not t["contradicted"]),
                          key=lambda t: -t["misfit_share"])
-    outside = OutOfSample(res, experiments, measurement, rtol, data, heldout) if to_try and heldout else None
+    outside = OutOfSample(res, experiments, measurement, data, heldout) if to_try and heldout else None
     for i, t in enumerate(to_try):
         # the advice is tried before it is said (advice.py): a refit from the optimum with the value freed, scored
         # on the fit runs and out of sample

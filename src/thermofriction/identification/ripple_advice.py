@@ -22,7 +22,7 @@ from ..fitting.problem import Problem
 from ..fitting.parameters import get_value, unit_of, with_values
 from ..measurements import amount, make_traces
 from ..measurements.ripple import additive, has_ripple, started
-from ..validation import validate
+from ..validation import heldout_score
 
 signal = lazy("scipy.signal")
 
@@ -139,8 +139,8 @@ def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
         out = {"period": period, "gain": max(1.0 - (after / before) ** 2, 0.0), "rmse_before": before,
                "rmse_after": after, "evaluations": nfev}
         if held:
-            out.update(heldout_before=_pooled_rmse(model, held, measurement),
-                       heldout_after=_pooled_rmse(refit, held, measurement))
+            out.update(heldout_before=heldout_score(model, held, held, measurement)[0],
+                       heldout_after=heldout_score(refit, held, held, measurement)[0])
     except ThermofrictionError:
         return res
     gain = out["gain"]
@@ -156,15 +156,6 @@ def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
         else:
             res.warnings.append(message)
     return res
-
-
-def _pooled_rmse(model, runs, measurement) -> float:
-    """The RMSE of ``model`` over the held-out ``runs`` pooled over their samples, each run scored as validate
-    scores it (as front.py scores the fit's generalisation)."""
-    v = validate(model, runs, runs, offset=measurement.offset if measurement.offset != "shared" else None,
-                 ripple_phase=getattr(measurement, "ripple_phase", "recorded"))
-    n = np.array([np.size(p.measured) for p in v.predictions], float)
-    return float(np.sqrt(np.sum(n * np.array([p.rmse for p in v.predictions]) ** 2) / np.sum(n)))
 
 
 def _refit(res, experiments, measurement, period, rtol):
