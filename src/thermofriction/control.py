@@ -403,7 +403,7 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
     try:
         status = _bridge.loop(model_spec(stage, temperature), temperature, comp_spec, T_comp, kind, gain,
                               stage.plant.mass, (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps), x_ref, v_ref,
-                              *outs)
+                              outs + [None] * 4)
     except ValueError as e:  # the core's own checks (a backstop for the ones above)
         raise InputError(f"{where}: the C core refused the loop: {e}") from None
     if status != "ok":
