@@ -6,9 +6,11 @@
 #include <math.h>
 #include <string.h>
 
-/* The temperature step [K] of the central differences of the friction step over Tc: small against
- * every law's curvature scale (tens of K), large against the round-off (F ~ 1e-16 relative). */
-#define TF_ESTIMATOR_DT 1e-2
+/* The temperature step [K] of the forward difference of the friction step over Tc: its truncation error,
+ * d/2 of a law's curvature over its slope (0.159 / K for Li et al.'s exp laws: 8e-6 relative), and its
+ * round-off, 1e-16 F / d, both far below what a temperature estimate resolves. One-sided: two friction
+ * steps per estimator step, not three (a third of the cost). */
+#define TF_ESTIMATOR_DT 1e-4
 /* The gate on the friction update: skipped where h^2 P_cc < GATE r_F (it would move Tc by less than
  * GATE of the way to the measurement's temperature). */
 #define TF_ESTIMATOR_GATE 1e-9
@@ -57,6 +59,7 @@ tf_status tf_temperature_init(tf_temperature_estimator *e, const tf_temperature_
     e->n = 1;
     e->i_housing = c->C_2 > 0.0 ? e->n++ : -1;
     e->i_proxy = c->proxy != TF_PROXY_NONE ? e->n++ : -1;
+    e->g_dt = NAN;
     for (int i = 0; i < e->n; i++) {
         e->x[i] = T0;
         e->P[i][i] = var0;
@@ -72,6 +75,7 @@ tf_status tf_temperature_configure(tf_temperature_estimator *e, const tf_tempera
     if ((c->C_2 > 0.0) != (e->i_housing >= 0)) return est_done(err, TF_ERR_BAD_ARGUMENT, "config.C_2 (nodes as at init)");
     if (c->proxy != e->c.proxy) return est_done(err, TF_ERR_BAD_ARGUMENT, "config.proxy (as at init)");
     e->c = *c;
+    e->g_dt = NAN;
     return est_done(err, TF_OK, 0);
 }
 
@@ -105,58 +109,72 @@ static void restore(tf_rt_friction *f, int nz, const rt_backup *b)
     f->x = b->x;
 }
 
-/* A trial step from z0 + sign d s at Tc + sign d: its force, and its states into z (f restored). */
-static tf_status trial(tf_rt_friction *f, int nz, const rt_backup *b, const double *s, double sign, double v,
-                       double Tc, double dt, double *F, double *z)
+/* A trial step from z0 + d s at Tc + d: its force, and its states into z (f restored). */
+static tf_status trial(tf_rt_friction *f, int nz, const rt_backup *b, const double *s, double v, double Tc,
+                       double dt, double *F, double *z)
 {
-    for (int j = 0; j < nz; j++) f->z[j] = b->z[j] + sign * TF_ESTIMATOR_DT * s[j];
-    tf_status st = tf_rt_step(f, v, Tc + sign * TF_ESTIMATOR_DT, dt, F, 0);
+    for (int j = 0; j < nz; j++) f->z[j] = b->z[j] + TF_ESTIMATOR_DT * s[j];
+    tf_status st = tf_rt_step(f, v, Tc + TF_ESTIMATOR_DT, dt, F, 0);
     memcpy(z, f->z, sizeof(double) * nz);
     restore(f, nz, b);
     return st;
 }
 
 /* Step 1: f advanced at Tc (tf_rt_step), its force into *F; h = dF/dTc and the new s into s_new (the
- * directional central difference along (s, 1): z follows Tc). A refused trial step (a law's domain
+ * directional forward difference along (s, 1): z follows Tc). A refused trial step (a law's domain
  * edge within TF_ESTIMATOR_DT): h = 0 and s kept. */
 static tf_status friction_step(const tf_temperature_estimator *e, tf_rt_friction *f, int nz, const rt_backup *b,
                                double v, double dt, double *F, double *h, double *s_new, tf_error *err)
 {
-    double Fp, Fm, zp[TF_MAX_FRICTION_STATES], zm[TF_MAX_FRICTION_STATES];
+    double Fp, zp[TF_MAX_FRICTION_STATES];
     double Tc = e->x[0];
-    int ok = trial(f, nz, b, e->s, 1.0, v, Tc, dt, &Fp, zp) == TF_OK &&
-             trial(f, nz, b, e->s, -1.0, v, Tc, dt, &Fm, zm) == TF_OK;
+    int ok = trial(f, nz, b, e->s, v, Tc, dt, &Fp, zp) == TF_OK;
     tf_status st = tf_rt_step(f, v, Tc, dt, F, err);
     if (st) return st;
-    *h = ok ? (Fp - Fm) / (2.0 * TF_ESTIMATOR_DT) : 0.0;
-    for (int j = 0; j < nz; j++) s_new[j] = ok ? (zp[j] - zm[j]) / (2.0 * TF_ESTIMATOR_DT) : e->s[j];
+    *h = ok ? (Fp - *F) / TF_ESTIMATOR_DT : 0.0;
+    for (int j = 0; j < nz; j++) s_new[j] = ok ? (zp[j] - f->z[j]) / TF_ESTIMATOR_DT : e->s[j];
     return TF_OK;
 }
 
+/* The step's decay factors g = 1 - exp(-a dt) of the contact, housing and proxy (a: their rates) into g:
+ * e's, kept for the last dt (a constant control period computes them once; tf_temperature_configure
+ * forgets them), or computed (the step keeps them when it succeeds). */
+static const double *decays(const tf_temperature_estimator *e, double dt, double *g)
+{
+    const tf_temperature_config *c = &e->c;
+    if (dt == e->g_dt) return e->g;
+    g[0] = -expm1(-dt / (c->C_th * c->R_th));
+    g[1] = e->i_housing >= 0 ? -expm1(-dt * (1.0 / c->R_th + 1.0 / c->R_2) / c->C_2) : 0.0;
+    g[2] = e->i_proxy >= 0 ? -expm1(-dt / c->tau_p) : 0.0;
+    return g;
+}
+
 /* Step 2: the nodes' exponential-Euler step (x in place) and its Jacobian A, at friction power Pw and
- * dPw/dTc = dP. */
-static void heat_predict(const tf_temperature_config *c, int ih, int ip, double *x, double A[3][3], double Pw,
-                         double dP, double T_amb, double dt)
+ * dPw/dTc = dP, with decay factors g (decays): each node moves the share g of the way to the temperature
+ * its neighbours and its heat input hold it at. */
+static void heat_predict(const tf_temperature_config *c, int ih, int ip, const double *g, double *x, double A[3][3],
+                         double Pw, double dP, double T_amb)
 {
     double Tc = x[0], Th = ih >= 0 ? x[ih] : T_amb;
-    double a_c = 1.0 / (c->C_th * c->R_th), phi_c = -expm1(-a_c * dt) / a_c;
+    /* phi = (1 - exp(-a dt)) / a: the contact's a = 1 / (C_th R_th) */
+    double phi_c = g[0] * c->C_th * c->R_th;
     double rate_c = (c->eta * Pw - (Tc - Th) / c->R_th) / c->C_th;
-    A[0][0] = exp(-a_c * dt) + c->eta * dP / c->C_th * phi_c;
+    A[0][0] = 1.0 - g[0] + c->eta * dP / c->C_th * phi_c;
     x[0] = Tc + rate_c * phi_c;
     if (ih >= 0) {
-        double a_h = (1.0 / c->R_th + 1.0 / c->R_2) / c->C_2, phi_h = -expm1(-a_h * dt) / a_h;
+        double phi_h = g[1] * c->C_2 / (1.0 / c->R_th + 1.0 / c->R_2);
         double rate_h = ((Tc - Th) / c->R_th - (Th - T_amb) / c->R_2) / c->C_2;
-        A[0][ih] = a_c * phi_c;
+        A[0][ih] = g[0];
         A[ih][0] = phi_h / (c->C_2 * c->R_th);
-        A[ih][ih] = exp(-a_h * dt);
+        A[ih][ih] = 1.0 - g[1];
         x[ih] = Th + rate_h * phi_h;
     }
     if (ip >= 0) {
         int is = c->proxy == TF_PROXY_HOUSING ? ih : 0;
-        double src = is == 0 ? Tc : Th, g = -expm1(-dt / c->tau_p);
-        A[ip][is] = g;
-        A[ip][ip] = 1.0 - g;
-        x[ip] += (src - x[ip]) * g;
+        double src = is == 0 ? Tc : Th;
+        A[ip][is] = g[2];
+        A[ip][ip] = 1.0 - g[2];
+        x[ip] += (src - x[ip]) * g[2];
     }
 }
 
@@ -236,7 +254,9 @@ tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, do
     double x[3] = {e->x[0], e->x[1], e->x[2]}, P[3][3], A[3][3] = {{0}};
     memcpy(P, e->P, sizeof P);
     double Fv = F * v, dP = (Fv > 0.0 ? 1.0 : Fv < 0.0 ? -1.0 : 0.0) * v * h;
-    heat_predict(c, e->i_housing, e->i_proxy, x, A, fabs(Fv), dP, T_amb, dt);
+    double g_new[3];
+    const double *g = decays(e, dt, g_new);
+    heat_predict(c, e->i_housing, e->i_proxy, g, x, A, fabs(Fv), dP, T_amb);
     int qi[3] = {0, 1, 2};
     if (e->i_housing < 0 && e->i_proxy >= 0) qi[1] = 2;
     cov_predict(n, P, A, c->q, qi, dt);
@@ -258,6 +278,7 @@ tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, do
     memcpy(e->P, P, sizeof P);
     memcpy(e->s, s, sizeof(double) * nz);
     e->h = h, e->gated = gated;
+    if (g == g_new) memcpy(e->g, g_new, sizeof g_new), e->g_dt = dt;
     *F_hat = F;
     return est_done(err, TF_OK, 0);
 }

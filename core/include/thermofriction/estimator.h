@@ -22,9 +22,9 @@
  *
  * One step (dt [s] > 0):
  *   1. the friction: f advances over dt at v and Tc^ (as tf_rt_step), F^ its force; the sensitivity
- *      s = dz/dTc of its internal states is carried along (central differences of the step over
- *      Tc^ +- d with z +- d s), and h = dF^/dTc, so that a bristle model's force, which carries the
- *      temperature in its state, is not taken as independent of it;
+ *      s = dz/dTc of its internal states is carried along (the forward difference of the step over
+ *      Tc^ + d with z + d s, d = 1e-4 K), and h = dF^/dTc, so that a bristle model's force, which
+ *      carries the temperature in its state, is not taken as independent of it;
  *   2. predict: each node's exponential-Euler step (its own decay exact, its neighbours held: stable
  *      for any dt), P <- A P A' + diag(q) dt with A the step's Jacobian (the power's dP/dTc in it);
  *   3. update with F_measured (NaN: none): scalar Kalman update, H = [h, 0, 0], noise r_F [N^2],
@@ -81,6 +81,7 @@ typedef struct {
     double s[TF_MAX_FRICTION_STATES]; /* dz/dTc of the friction's internal states */
     double h;     /* dF^/dTc at the last step [N/K] */
     int gated;    /* 1 if the last step's friction measurement was given but not used (gated) */
+    double g[TF_ESTIMATOR_MAX_STATES], g_dt; /* the nodes' decay factors 1 - exp(-dt / tau) at dt = g_dt */
 } tf_temperature_estimator;
 
 /* Checks the configuration (TF_ERR_BAD_ARGUMENT naming the field, e.g. "config.R_2 (> 0 with a housing
