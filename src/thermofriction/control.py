@@ -161,8 +161,11 @@ def _estimator_inputs(where, comp, n, T_plant, *, ambient, start, start_variance
     if proxy_temperature is not None:
         if est.proxy == "none":
             raise InputError(f"{where}: proxy_temperature given, but the estimator has no proxy (proxy='none')")
-        T_p = np.ascontiguousarray(proxy_temperature, float)
-        if T_p.shape != (n,) or np.any(np.isinf(T_p)):
+        try:
+            T_p = np.ascontiguousarray(proxy_temperature, float)
+        except (TypeError, ValueError, OverflowError):
+            T_p = None
+        if T_p is None or T_p.shape != (n,) or np.any(np.isinf(T_p)):
             raise InputError(f"{where}: proxy_temperature must have one value per period ({n}), finite or NaN")
     _check_at(f"{where}: the estimator's start", comp.model, T0)
     return (model_spec(comp.model, T0), est.config(), T0, var0, T_amb, T_p, friction_measurement.noise(n),
