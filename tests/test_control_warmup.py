@@ -73,6 +73,14 @@ def test_the_loops_estimator_is_the_estimator_on_the_disturbance_observers_frict
                   start_variance=4.0)
     np.testing.assert_array_equal(res.compensation_temperature, run.temperature)
     np.testing.assert_array_equal(res.temperature_variance, run.variance)
+    # with the low-pass filter: the reference's first-order filter from the first measurement
+    dob = C.DisturbanceObserver(position_noise=1e-9, filter_time=5e-4, seed=3)
+    res = C.simulate_loop(STAGE, ref, temperature=ramp(ref.time), ambient=30.0,
+                          compensation=C.Observer(STAGE, temperature=est), friction_measurement=dob)
+    _, F = R.disturbance_observer(res.position, res.control, dob.noise(ref.time.size), 1.0, 1e-4, tau=5e-4)
+    np.testing.assert_allclose(res.measured_friction[2:], F[2:], rtol=0, atol=1e-9 * 0.24)
+    assert np.std(np.diff(F[2:])) < 0.2 * np.std(np.diff(R.disturbance_observer(
+        res.position, res.control, dob.noise(ref.time.size), 1.0, 1e-4)[1][2:]))  # the filter filters
 
 
 def test_estimator_compensation_over_a_warm_up_meets_the_issues_targets():

@@ -65,13 +65,18 @@ def reference_closed_loop(stage, ref, T, pid, gain=100.0, substeps=10, T_comp=No
     return (xs, Fs) if friction else xs
 
 
-def disturbance_observer(x, u, noise, mass, dt):
-    """The friction the loop's disturbance observer measures (control.h, no low-pass), from the positions at
-    the period starts x, the controls u and the encoder's noise: (velocity, force) per period, the force NaN
-    in the first two periods. Written again from the documented formula."""
+def disturbance_observer(x, u, noise, mass, dt, tau=0.0):
+    """The friction the loop's disturbance observer measures (control.h), from the positions at the period
+    starts x, the controls u and the encoder's noise, low-passed with time constant tau (0: none; the filter
+    starts at the first measurement): (velocity, force) per period, the force NaN in the first two periods.
+    Written again from the documented formula."""
     xe = x + (0.0 if noise is None else noise)
     v, F = np.zeros(x.size), np.full(x.size, np.nan)
     v[1] = (xe[1] - xe[0]) / dt
     v[2:] = (xe[2:] - xe[:-2]) / (2.0 * dt)
     F[2:] = 0.5 * (u[1:-1] + u[:-2]) - mass * (xe[2:] - 2.0 * xe[1:-1] + xe[:-2]) / (dt * dt)
+    if tau > 0.0:
+        a = -math.expm1(-dt / tau)
+        for i in range(3, x.size):
+            F[i] = F[i - 1] + a * (F[i] - F[i - 1])
     return v, F
