@@ -136,7 +136,8 @@ static tf_status temperature_check(tf_loop *L, long n, tf_error *err)
             return status;
     } else if (tf_rt_params_at(L->plant, L->T_plant, 0, 0, 0, err))
         return stop_in(err, B, "plant", -1);
-    if (L->position_noise && (status = series_check(0, L->position_noise, n, "loop", "position_noise (not finite)", err)))
+    if (L->position_noise &&
+        (status = series_check(0, L->position_noise, n, "loop", "position_noise (not finite)", err)))
         return status;
     if (!(isfinite(L->dob_tau) && L->dob_tau >= 0.0)) return stop(err, B, "loop", "dob_tau (finite, >= 0)", -1);
     if (L->estimator) {
@@ -146,7 +147,8 @@ static tf_status temperature_check(tf_loop *L, long n, tf_error *err)
             if (isinf(L->T_proxy[i])) return stop(err, B, "estimator", "T_proxy (infinite)", i);
         return TF_OK;
     }
-    if (L->T_comp_series) return series_check(comp, L->T_comp_series, n, "compensation", "T_comp_series (not finite)", err);
+    if (L->T_comp_series)
+        return series_check(comp, L->T_comp_series, n, "compensation", "T_comp_series (not finite)", err);
     if (comp && tf_rt_params_at(comp, L->T_comp, 0, 0, 0, err)) return stop_in(err, B, "compensation", -1);
     return TF_OK;
 }
@@ -236,7 +238,8 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
     dob_memory d = {x, x, 0.0, 0.0, 0.0};
     const tf_loop_trace *tr = &L->trace;
     for (long i = 0; i < n; i++) {
-        double e = x_ref[i] - x, u, Fc = 0.0, Tc, var, Fm, T_plant = L->T_plant_series ? L->T_plant_series[i] : L->T_plant;
+        double e = x_ref[i] - x, u, Fc = 0.0, Tc, var, Fm;
+        double T_plant = L->T_plant_series ? L->T_plant_series[i] : L->T_plant;
         if ((status = told_temperature(L, i, x, &d, &Tc, &var, &Fm, err))) return status;
         if ((status = tf_pid_step(&L->pid, e, L->dt, &u, 0)))
             return stop(err, status, "pid", "u (not finite: the loop is unstable)", i);
