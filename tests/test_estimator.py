@@ -200,8 +200,8 @@ def _run_c(exe, v, F, T_amb, tmp_path):
     return np.frombuffer((tmp_path / "out.bin").read_bytes(), dtype=np.float64).reshape(n, 3).T
 
 
-def _fmu_run(path, fmi, tmp_path, drive, T_plant, T_amb, T0, h):
-    """The FMU through fmpy: the drive force set at each communication point and, every other one, the stage's
+def _fmu_run(path, fmi, tmp_path, drive, T_plant, T_amb, T0, h, every=2):
+    """The FMU through fmpy: the drive force set at each communication point and, every ``every`` one, the stage's
     friction force there as the measured one; returns the velocity at each step's start, the measured force, and
     the estimate and variance at the step's end."""
     from fmpy import extract, read_model_description
@@ -226,7 +226,7 @@ def _fmu_run(path, fmi, tmp_path, drive, T_plant, T_amb, T0, h):
     v, measured, T, var = np.empty(n), np.full(n, np.nan), np.empty(n), np.empty(n)
     for k in range(n):
         v[k], F = get([vr["velocity"], vr["friction_force"]])
-        if k % 2 == 0:
+        if k % every == 0:
             measured[k] = F
         set_([vr["force"], vr["measured_friction_force"]], [drive[k], measured[k]])
         fmu.doStep(k * h, h)
@@ -295,3 +295,46 @@ def test_bad_arguments_are_refused_with_their_names():
         with pytest.raises(tf.InputError, match=word):
             run(**kw)
     assert np.isnan(run(measured_force=np.full(10, np.nan)).temperature).sum() == 0
+
+
+def test_the_windows_dll_runs_the_estimator_as_the_linux_binary(tmp_path):
+    """The FMU's win64 DLL under Wine (core/fmu/harness, the estimator's inputs and outputs by value reference) on
+    the inputs the Linux binary was given through fmpy (the stage at 38 C under a sine force, its friction measured
+    every step, the estimate started at 33 C): the estimate and its variance agree to 1e-9 of their ranges (two
+    compilers' and C libraries' rounding; not bit for bit across platforms)."""
+    pytest.importorskip("fmpy")
+    from fmpy import read_model_description
+    from thermofriction.fmu import binary_path, export_fmu
+    wine, dll = shutil.which("wine") or shutil.which("wine64"), binary_path("win64")
+    if not wine or not dll.is_file():
+        pytest.skip("needs Wine and the package's win64 DLL (built with MinGW-w64)")
+    import os
+    import zipfile
+    model = tf.load_model("stage-model-i")
+    est = tf.control.TemperatureEstimator(C_th=1.0, R_th=30.0, C_2=8.0, R_2=300.0, r_F=0.01, v_min=1e-3)
+    h, n, T_plant, T_amb, T0 = 1e-3, 400, 38.0, 30.0, 33.0
+    path = tmp_path / "w.fmu"
+    export_fmu(model, path, estimator=est, temperature=T0)
+    drive = 3.0 * np.sin(2 * np.pi * 2.0 * h * np.arange(n))
+    _, measured, T_lin, var_lin = _fmu_run(path, 2, tmp_path, drive, T_plant, T_amb, T0, h, every=1)
+    unzip = tmp_path / "w"
+    with zipfile.ZipFile(path) as z:
+        z.extractall(unzip)
+    md = read_model_description(str(path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    ins = ",".join(str(vr[k]) for k in ("force", "temperature", "measured_friction_force", "ambient_temperature"))
+    outs = ",".join(str(vr[k]) for k in ("temperature_estimate", "temperature_variance"))
+    rows = "".join(f"{float(d)!r} {T_plant!r} {float(F)!r} {T_amb!r}\n" for d, F in zip(drive, measured))
+    env = dict(os.environ, WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=",
+               WINEPREFIX=os.environ.get("WINEPREFIX", os.path.expanduser("~/.wine-thermofriction")))
+    uri = "file:///Z:" + str(unzip / "resources").replace(os.sep, "/")
+    harness = dll.parent / "fmu_harness.exe"
+    binary = unzip / "binaries" / "win64" / f"{md.coSimulation.modelIdentifier}.dll"
+    out = subprocess.run([wine, str(harness), "Z:" + str(binary), uri, md.guid, repr(h), ins, outs], input=rows, capture_output=True, text=True, env=env,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    got = np.loadtxt(out.stdout.splitlines())
+    assert got.shape == (n, 3)
+    for k, ref in ((1, T_lin), (2, var_lin)):
+        np.testing.assert_allclose(got[:, k], ref, rtol=0, atol=1e-9 * np.ptp(ref))
+    assert np.ptp(T_lin) > 1.0  # the estimate moved: the comparison is not of constants
