@@ -149,7 +149,8 @@ class TemperatureEstimator:
             _series(w, "ambient", ambient, n)
         T0 = _args.number(start, f"{w}: start", "C")
         var0 = _args.number(start_variance, f"{w}: start_variance", "K^2", positive=True)
-        F_m = np.full(n, math.nan) if measured_force is None else _series(w, "measured_force", measured_force, n, nan=True)
+        F_m = np.full(n, math.nan) if measured_force is None else \
+            _series(w, "measured_force", measured_force, n, nan=True)
         if proxy_temperature is not None and self.proxy == "none":
             raise InputError(f"{w}: proxy_temperature given, but the estimator has no proxy (proxy='none')")
         T_p = None if proxy_temperature is None else _series(w, "proxy_temperature", proxy_temperature, n, nan=True)
@@ -172,7 +173,8 @@ def _series(where: str, name: str, values, n, *, nan: bool = False) -> np.ndarra
     except (TypeError, ValueError, OverflowError):
         raise InputError(f"{where}: {name} must be an array of numbers") from None
     if a.ndim != 1 or (n is not None and a.size != n) or a.size == 0:
-        raise InputError(f"{where}: {name} must be one-dimensional with " + (f"{n} values" if n else "one value or more")
+        raise InputError(f"{where}: {name} must be one-dimensional with "
+                         + (f"{n} values" if n else "one value or more")
                          + f", got shape {a.shape}")
     bad = np.flatnonzero(np.isinf(a) if nan else ~np.isfinite(a))
     if bad.size:
