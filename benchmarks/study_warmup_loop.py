@@ -131,6 +131,8 @@ def cases(system: System, proxy_reading, start: float):
                 (f"{kind}, estimator + proxy", kind, estimator(system, True),
                  {"proxy_temperature": proxy_reading} if proxy_reading is not None else None),
                 (f"{kind}, blind", kind, start, {})]
+    out.append(("observer, estimator started 5 C off", "observer", estimator(system, False),
+                {"start": start + 5.0, "start_variance": 25.0}))
     return [c for c in out if c[3] is not None]
 
 
@@ -234,10 +236,13 @@ def figure(system: System, series, temps):
     a.plot(t[s], Th[s], color="0.6", lw=1.5, label="housing (truth)")
     a.plot(t[s], proxy[s], color="0.6", lw=0.6, ls=":", label="proxy reading (30 s lag)")
     styles = {"true T": ("k", "-"), "estimator": ("#1f77b4", "-"), "estimator + proxy": ("#2ca02c", "--"),
+              "estimator started 5 C off": ("#ff7f0e", "-."),
               "blind": ("#d62728", "-"), "none": ("0.5", ":")}
-    for name in ("observer, estimator", "observer, estimator + proxy"):
+    for name, label in (("observer, estimator", "estimate (no sensor)"),
+                        ("observer, estimator + proxy", "estimate (with the proxy)"),
+                        ("observer, estimator started 5 C off", "estimate (started 5 °C off)")):
         c, ls = styles[name.split(", ", 1)[1]]
-        a.plot(series[name]["t"], series[name]["told"], color=c, ls=ls, label=name.replace("observer, ", "estimate, "))
+        a.plot(series[name]["t"], series[name]["told"], color=c, ls=ls, label=label)
     a.set(xlabel="time [s]", ylabel="temperature [°C]", title=f"{system.name}: the warm-up and its estimates")
     a.legend(fontsize=8, frameon=False)
     for name, b in series.items():
