@@ -72,8 +72,9 @@ typedef struct {
  *   - T_plant_series: n values, the plant's temperature in each period (NULL: T_plant throughout);
  *   - the compensation's temperature, in this order of precedence: the estimator's (estimator not
  *     NULL), a perfect sensor's (T_comp_series, n values), or T_comp throughout (blind or soaked);
- *   - estimator: stepped once per period before the control is computed, on its own friction model
- *     est_friction (not the compensation's, whose states the observer corrects), with the ambient
+ *   - estimator (initialised by the caller, tf_temperature_init; its start is the loop's): stepped once
+ *     per period before the control is computed, on its own friction model est_friction (initialised
+ *     like comp; not the compensation's, whose states the observer corrects), with the ambient
  *     temperature T_amb, a proxy temperature T_proxy[i] (NULL: none) and the friction measured by a
  *     disturbance observer. That observer reads the encoder, x + position_noise[i] (NULL: no noise),
  *     and knows the mass and the control: at period i >= 2 it measures the friction around t_{i-1},
