@@ -260,7 +260,7 @@ def figure(system: System, series, temps):
     ax[1, 0].set(xlabel="time [s]", ylabel="RMS friction-estimate error per cycle [N" +
                  (" m]" if system.unit == "urad" else "]"), title="friction-estimate error (observer)")
     ax[1, 1].set(xlabel="time [s]", ylabel="told minus true temperature, per cycle [K]",
-                 title="temperature-estimate error (blind: minus the whole warm-up)")
+                 title="temperature-estimate error (the estimators)")
     ax[1, 1].axhline(0, color="0.8", lw=0.8)
     for a in (ax[0, 1], ax[1, 0], ax[1, 1]):
         a.legend(fontsize=8, frameon=False)
