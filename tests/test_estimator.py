@@ -125,6 +125,10 @@ def test_estimate_from_a_lagging_proxy_only_follows_the_warm_up(truth):
     out = est.run(truth["model"], truth["v_meas"], dt=DT, ambient=AMBIENT, start=35.0,
                   proxy_temperature=truth["Tp_meas"])
     _check_against_truth(out, truth, "proxy")
+    # the result's views say the same numbers (the results protocol)
+    summary = out.summary()
+    assert summary["samples"] == str(truth["t"].size) and f"{out.temperature[-1]:.4g} C" in summary["final estimate"]
+    assert len(out.plot().axes) == 2
 
 
 def test_a_step_costs_under_a_microsecond(truth):
@@ -338,3 +342,53 @@ def test_the_windows_dll_runs_the_estimator_as_the_linux_binary(tmp_path):
     for k, ref in ((1, T_lin), (2, var_lin)):
         np.testing.assert_allclose(got[:, k], ref, rtol=0, atol=1e-9 * np.ptp(ref))
     assert np.ptp(T_lin) > 1.0  # the estimate moved: the comparison is not of constants
+
+
+def test_the_fmu_refuses_bad_estimator_inputs_and_parameters(tmp_path):
+    """The FMU (fmpy's FMU2Slave as the importer): an infinite measured force, an implausible proxy temperature, a
+    tunable estimator parameter the estimator refuses (R_th = 0) or one that changes its nodes (C_2 to 0, which its
+    housing proxy needs) are each refused with an error naming it, the old value kept and the next step unchanged; NaN (not measured) is taken.
+    Checked against a twin instance given only the accepted calls."""
+    pytest.importorskip("fmpy")
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+    from thermofriction.fmu import binary_path, export_fmu
+    if not binary_path().is_file():
+        pytest.skip("no FMU binary (Linux x86-64 only)")
+    est = tf.control.TemperatureEstimator(C_th=1.0, R_th=30.0, C_2=8.0, R_2=300.0, r_F=0.01, proxy="housing",
+                                          tau_p=10.0)
+    path = tmp_path / "e.fmu"
+    export_fmu("stage-model-i", path, estimator=est, temperature=35.0)
+    md = read_model_description(str(path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    messages, runs = [], []
+    for k in range(2):
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path), unzipdir=str(tmp_path / f"u{k}")),
+                        modelIdentifier=md.coSimulation.modelIdentifier, instanceName=f"e{k}")
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: messages.append(m.decode()))
+        cb.allocateMemory, cb.freeMemory = defaultCallbacks.allocateMemory, defaultCallbacks.freeMemory
+        fmu.instantiate(callbacks=cb, loggingOn=True)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        runs.append((fmu, cb))
+    (fmu, _), (twin, _) = runs
+    for name, value, word in (("measured_friction_force", math.inf, "measurement input"),
+                              ("proxy_temperature", 400.0, "proxy temperature"),
+                              ("estimator.R_th", 0.0, "R_th"), ("estimator.C_2", 0.0, "housing")):
+        before = len(messages)
+        with pytest.raises(Exception):
+            fmu.setReal([vr[name]], [value])
+        assert len(messages) > before and word in messages[-1], messages[before:]
+    for f in (fmu, twin):
+        f.setReal([vr["force"], vr["measured_friction_force"], vr["proxy_temperature"]], [2.0, math.nan, 36.0])
+        f.doStep(0.0, 1e-3)
+        f.setReal([vr["measured_friction_force"], vr["proxy_temperature"]], [0.5, math.nan])
+        f.doStep(1e-3, 1e-3)
+    out = [vr[n] for n in ("temperature_estimate", "temperature_variance", "estimator.R_th", "estimator.C_2")]
+    assert fmu.getReal(out) == twin.getReal(out)
+    assert fmu.getReal([vr["estimator.R_th"]]) == [30.0]
+    for f, _ in runs:
+        f.terminate()
+        f.freeInstance()
