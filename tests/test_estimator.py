@@ -348,7 +348,7 @@ def test_the_fmu_refuses_bad_estimator_inputs_and_parameters(tmp_path):
     """The FMU (fmpy's FMU2Slave as the importer): an infinite measured force, an implausible proxy temperature, a
     tunable estimator parameter the estimator refuses (R_th = 0) or one that changes its nodes (C_2 to 0, which its
     housing proxy needs) are each refused with an error naming it, the old value kept and the next step unchanged; NaN (not measured) is taken.
-    Checked against a twin instance given only the accepted calls."""
+    Checked against a twin instance given only the accepted calls; and a saved FMU state restores the estimator."""
     pytest.importorskip("fmpy")
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
@@ -389,6 +389,20 @@ def test_the_fmu_refuses_bad_estimator_inputs_and_parameters(tmp_path):
     out = [vr[n] for n in ("temperature_estimate", "temperature_variance", "estimator.R_th", "estimator.C_2")]
     assert fmu.getReal(out) == twin.getReal(out)
     assert fmu.getReal([vr["estimator.R_th"]]) == [30.0]
+    # fmi2GetFMUstate / fmi2SetFMUstate carry the estimator (its state and its friction's): the same steps again
+    # from a restored state give the same estimates, bit for bit
+    state = fmu.getFMUstate()
+    estimates = []
+    for rep in range(2):
+        got = []
+        for k in range(2, 12):
+            fmu.setReal([vr["force"], vr["measured_friction_force"]], [2.0 - 0.3 * k, 0.4 + 0.01 * k])
+            fmu.doStep(k * 1e-3, 1e-3)
+            got += fmu.getReal(out[:2])
+        estimates.append(got)
+        fmu.setFMUstate(state)
+    assert estimates[0] == estimates[1] and len(set(estimates[0][::2])) > 5
+    fmu.freeFMUstate(state)
     for f, _ in runs:
         f.terminate()
         f.freeInstance()
