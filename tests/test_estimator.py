@@ -10,6 +10,7 @@ here, and the FMU run by fmpy, for bit-identity with Python."""
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import shutil
 import sys
@@ -406,3 +407,20 @@ def test_the_fmu_refuses_bad_estimator_inputs_and_parameters(tmp_path):
     for f, _ in runs:
         f.terminate()
         f.freeInstance()
+
+
+@pytest.mark.skipif(shutil.which("cc") is None or shutil.which("nm") is None, reason="needs cc and nm")
+def test_the_estimator_allocates_nothing(tmp_path):
+    """No allocation in the estimator (the core's rule for step functions): its object file, compiled from the
+    package's sources, calls no allocator -- its undefined symbols are the core's own functions, libm's and
+    memcpy/memset -- and the struct is a fixed-size value the caller owns."""
+    root = sources_dir()
+    obj = tmp_path / "estimator.o"
+    subprocess.run(["cc", "-std=c99", "-O2", "-c", "-I", str(root), "-o", str(obj), str(root / "estimator.c")],
+                   check=True, capture_output=True)
+    out = subprocess.run(["nm", "-u", str(obj)], check=True, capture_output=True, text=True).stdout
+    undefined = {line.split()[-1] for line in out.splitlines() if line.strip()}
+    assert undefined, "nm listed nothing: the check would prove nothing"
+    assert not {s for s in undefined if re.search(r"alloc|free|^_?Znw|^_?Zdl", s)}, undefined
+    allowed = re.compile(r"^(tf_\w+|memcpy|memset|expm1|exp|fabs|__\w+)$")
+    assert all(allowed.match(s) for s in undefined), sorted(s for s in undefined if not allowed.match(s))
