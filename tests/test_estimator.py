@@ -10,6 +10,7 @@ here, and the FMU run by fmpy, for bit-identity with Python."""
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import shutil
 import sys
@@ -125,6 +126,10 @@ def test_estimate_from_a_lagging_proxy_only_follows_the_warm_up(truth):
     out = est.run(truth["model"], truth["v_meas"], dt=DT, ambient=AMBIENT, start=35.0,
                   proxy_temperature=truth["Tp_meas"])
     _check_against_truth(out, truth, "proxy")
+    # the result's views say the same numbers (the results protocol)
+    summary = out.summary()
+    assert summary["samples"] == str(truth["t"].size) and f"{out.temperature[-1]:.4g} C" in summary["final estimate"]
+    assert len(out.plot().axes) == 2
 
 
 def test_a_step_costs_under_a_microsecond(truth):
@@ -338,3 +343,84 @@ def test_the_windows_dll_runs_the_estimator_as_the_linux_binary(tmp_path):
     for k, ref in ((1, T_lin), (2, var_lin)):
         np.testing.assert_allclose(got[:, k], ref, rtol=0, atol=1e-9 * np.ptp(ref))
     assert np.ptp(T_lin) > 1.0  # the estimate moved: the comparison is not of constants
+
+
+def test_the_fmu_refuses_bad_estimator_inputs_and_parameters(tmp_path):
+    """The FMU (fmpy's FMU2Slave as the importer): an infinite measured force, an implausible proxy temperature, a
+    tunable estimator parameter the estimator refuses (R_th = 0) or one that changes its nodes (C_2 to 0, which its
+    housing proxy needs) are each refused with an error naming it, the old value kept and the next step unchanged; NaN (not measured) is taken.
+    Checked against a twin instance given only the accepted calls; and a saved FMU state restores the estimator."""
+    pytest.importorskip("fmpy")
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+    from thermofriction.fmu import binary_path, export_fmu
+    if not binary_path().is_file():
+        pytest.skip("no FMU binary (Linux x86-64 only)")
+    est = tf.control.TemperatureEstimator(C_th=1.0, R_th=30.0, C_2=8.0, R_2=300.0, r_F=0.01, proxy="housing",
+                                          tau_p=10.0)
+    path = tmp_path / "e.fmu"
+    export_fmu("stage-model-i", path, estimator=est, temperature=35.0)
+    md = read_model_description(str(path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    messages, runs = [], []
+    for k in range(2):
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path), unzipdir=str(tmp_path / f"u{k}")),
+                        modelIdentifier=md.coSimulation.modelIdentifier, instanceName=f"e{k}")
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: messages.append(m.decode()))
+        cb.allocateMemory, cb.freeMemory = defaultCallbacks.allocateMemory, defaultCallbacks.freeMemory
+        fmu.instantiate(callbacks=cb, loggingOn=True)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        runs.append((fmu, cb))
+    (fmu, _), (twin, _) = runs
+    for name, value, word in (("measured_friction_force", math.inf, "measurement input"),
+                              ("proxy_temperature", 400.0, "proxy temperature"),
+                              ("estimator.R_th", 0.0, "R_th"), ("estimator.C_2", 0.0, "housing")):
+        before = len(messages)
+        with pytest.raises(Exception):
+            fmu.setReal([vr[name]], [value])
+        assert len(messages) > before and word in messages[-1], messages[before:]
+    for f in (fmu, twin):
+        f.setReal([vr["force"], vr["measured_friction_force"], vr["proxy_temperature"]], [2.0, math.nan, 36.0])
+        f.doStep(0.0, 1e-3)
+        f.setReal([vr["measured_friction_force"], vr["proxy_temperature"]], [0.5, math.nan])
+        f.doStep(1e-3, 1e-3)
+    out = [vr[n] for n in ("temperature_estimate", "temperature_variance", "estimator.R_th", "estimator.C_2")]
+    assert fmu.getReal(out) == twin.getReal(out)
+    assert fmu.getReal([vr["estimator.R_th"]]) == [30.0]
+    # fmi2GetFMUstate / fmi2SetFMUstate carry the estimator (its state and its friction's): the same steps again
+    # from a restored state give the same estimates, bit for bit
+    state = fmu.getFMUstate()
+    estimates = []
+    for rep in range(2):
+        got = []
+        for k in range(2, 12):
+            fmu.setReal([vr["force"], vr["measured_friction_force"]], [2.0 - 0.3 * k, 0.4 + 0.01 * k])
+            fmu.doStep(k * 1e-3, 1e-3)
+            got += fmu.getReal(out[:2])
+        estimates.append(got)
+        fmu.setFMUstate(state)
+    assert estimates[0] == estimates[1] and len(set(estimates[0][::2])) > 5
+    fmu.freeFMUstate(state)
+    for f, _ in runs:
+        f.terminate()
+        f.freeInstance()
+
+
+@pytest.mark.skipif(shutil.which("cc") is None or shutil.which("nm") is None, reason="needs cc and nm")
+def test_the_estimator_allocates_nothing(tmp_path):
+    """No allocation in the estimator (the core's rule for step functions): its object file, compiled from the
+    package's sources, calls no allocator -- its undefined symbols are the core's own functions, libm's and
+    memcpy/memset -- and the struct is a fixed-size value the caller owns."""
+    root = sources_dir()
+    obj = tmp_path / "estimator.o"
+    subprocess.run(["cc", "-std=c99", "-O2", "-c", "-I", str(root), "-o", str(obj), str(root / "estimator.c")],
+                   check=True, capture_output=True)
+    out = subprocess.run(["nm", "-u", str(obj)], check=True, capture_output=True, text=True).stdout
+    undefined = {line.split()[-1] for line in out.splitlines() if line.strip()}
+    assert undefined, "nm listed nothing: the check would prove nothing"
+    assert not {s for s in undefined if re.search(r"alloc|free|^_?Znw|^_?Zdl", s)}, undefined
+    allowed = re.compile(r"^(tf_\w+|memcpy|memset|expm1|exp|fabs|__\w+)$")
+    assert all(allowed.match(s) for s in undefined), sorted(s for s in undefined if not allowed.match(s))

@@ -518,7 +518,7 @@ static int est_start(instance *c)
     if (tf_rt_from_model(&c->est_rt, &c->model, &e) != TF_OK)
         return (fmu_fail(c, "the estimator's friction model was refused ('%s')", e.what), -1);
     if (tf_temperature_init(&c->est, &k, c->est_p[EST_T_0], c->est_p[EST_VAR_0], &e) != TF_OK)
-        return (fmu_fail(c, "estimator: '%s' refused", e.what), -1);
+        return (fmu_fail(c, "fmi2ExitInitializationMode: the estimator refuses its parameters: '%s'", e.what), -1);
     return 0;
 }
 
@@ -528,7 +528,8 @@ static int est_configure(instance *c)
     if (!c->estimator || c->mode != S_STEP) return 0;
     tf_error e;
     tf_temperature_config k = est_config(c);
-    if (tf_temperature_configure(&c->est, &k, &e) != TF_OK) return (fmu_fail(c, "estimator: '%s' refused", e.what), -1);
+    if (tf_temperature_configure(&c->est, &k, &e) != TF_OK)
+        return (fmu_fail(c, "fmi2SetReal: the estimator refuses its parameters: '%s'", e.what), -1);
     return 0;
 }
 

@@ -104,6 +104,29 @@ static void test_h_is_the_steady_sliding_slope(void)
     CHECK(fabs(e.h - slope) < 1e-6 * fabs(slope), "h %.10g vs dF/dT %.10g", e.h, slope);
 }
 
+static void test_h_of_a_static_model_ii(void)
+{
+    /* Oracle (analytic): Stribeck (no internal state) with Model II in the scale form, F' = (1 + dF(T)/fc) F_base,
+     * dF(T) = 0.02 (T - 30) N: dF'/dT = 0.02 / fc F_base = 0.02 / fc F' / lambda(T), whatever v. */
+    static tf_rt_friction f;
+    tf_temperature_estimator e;
+    double p[TF_NPARAM] = {0};
+    p[TF_P_SIGMA2] = 0.4, p[TF_P_FC] = 1.0, p[TF_P_FS] = 1.5, p[TF_P_VS] = 1e-3, p[TF_P_DELTA] = 2.0;
+    p[TF_P_VSMOOTH] = 1e-5;
+    tf_law dF = {TF_LAW_LINEAR, 0.02, -0.6, 0, 0, 0, 0};
+    CHECK(tf_rt_init(&f, TF_FRICTION_STRIBECK, p, NULL, &E) == TF_OK, "stribeck");
+    CHECK(tf_rt_set_model_ii(&f, &dF, TF_DF_SCALE, &E) == TF_OK, "Model II");
+    tf_temperature_config c = config(0.0, TF_PROXY_NONE);
+    c.eta = 0.0;
+    CHECK(tf_temperature_init(&e, &c, 45.0, 1.0, &E) == TF_OK, "init: %s", E.what);
+    double vs[3] = {-2e-3, 7e-4, 0.3};
+    for (int k = 0; k < 3; k++) {
+        double F = step(&e, &f, vs[k], NAN, NAN, 45.0, 1e-3), lambda = 1.0 + 0.02 * 15.0;
+        double want = 0.02 / 1.0 * F / lambda;
+        CHECK(fabs(e.h - want) < 1e-8 * fabs(want), "v = %g: h %.12g vs %.12g", vs[k], e.h, want);
+    }
+}
+
 static void test_converges_from_five_kelvin_off(void)
 {
     /* Oracle: a truth made by a second friction object stepped at a known constant T = 40 C (the ambient,
@@ -191,6 +214,7 @@ int main(void)
     test_one_node_relaxes_exactly();
     test_two_nodes_reach_the_analytic_steady_state();
     test_h_is_the_steady_sliding_slope();
+    test_h_of_a_static_model_ii();
     test_converges_from_five_kelvin_off();
     test_refusals_name_the_argument_and_change_nothing();
     printf("%d passed, %d failed\n", passed, failed);
