@@ -53,6 +53,7 @@ TARGET_CODES = dict(_GROUPS["target"])
 HEAT_PARAMETER_INDEX = dict(_GROUPS["heat_parameter"])
 PLANT_PARAMETER_INDEX = dict(_GROUPS["plant_parameter"])
 COMPENSATION_CODES = dict(_GROUPS["compensation"])
+PROXY_CODES = dict(_GROUPS["proxy"])
 #: Output channels, in column order; after them come the friction states, then the friction work.
 OUTPUTS = _ordered("output")
 OUTPUT_COLUMN = {name: i for i, name in enumerate(OUTPUTS)}
@@ -288,7 +289,15 @@ def rt_steps(spec, T, v, dt, F_out) -> float:
     return _core.rt_steps(spec, T, v, float(dt), F_out)
 
 
+def temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy, T_amb, dt, T_out, var_out, F_out) -> float:
+    """The temperature estimator of estimator.h over whole arrays (config: tf_temperature_config's fields in
+    order; T_proxy None or one per sample); the outputs written in place; seconds, timed in C."""
+    return _core.temperature_estimate(spec, config,
+                                      float(T0), float(var0), v, F_measured, T_proxy, T_amb, float(dt), T_out,
+                                      var_out, F_out)
+
+
 __all__ = ["PARAMETERS", "PLANT_CODES", "FRICTION_CODES", "LAW_CODES", "OUTPUTS", "OUTPUT_COLUMN", "MECHANICAL_STATES",
            "model_spec", "law_tuple", "waveform_tuple", "run", "run_sensitivities", "prescribed_force", "prescribed_applies", "CoreFailure", "target", "loop",
-           "rt_steps", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
+           "rt_steps", "temperature_estimate", "PROXY_CODES", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
            "n_outputs", "state_index"]

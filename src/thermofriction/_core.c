@@ -711,6 +711,68 @@ done:
     return result;
 }
 
+/* temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy|None, T_amb, dt, T_out, var_out, F_out)
+ * -> seconds: the estimator of estimator.h over n samples (v, F_measured, T_amb: n each; NaN in F_measured:
+ * none; T_proxy: None or n values, NaN: none) with the friction model of spec from rest; writes the contact
+ * temperature estimate, its variance and the friction estimate per sample; the loop timed in C.
+ * config: (C_th, R_th, eta, C_2, R_2, proxy, tau_p, q_contact, q_housing, q_proxy, r_F, r_p, v_min). */
+static PyObject *py_temperature_estimate(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *objs[4], *outs[3];
+    tf_temperature_config c;
+    double T0, var0, dt;
+    if (!PyArg_ParseTuple(args, "O(dddddiddddddd)ddOOOOdOOO", &spec, &c.C_th, &c.R_th, &c.eta, &c.C_2, &c.R_2,
+                          &c.proxy, &c.tau_p, &c.q[0], &c.q[1], &c.q[2], &c.r_F, &c.r_p, &c.v_min, &T0, &var0,
+                          &objs[0], &objs[1], &objs[2], &objs[3], &dt, &outs[0], &outs[1], &outs[2]))
+        return NULL;
+    static const char *names[4] = {"v", "F_measured", "T_proxy", "T_amb"};
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    tf_rt_friction *f = scratch(&a, sizeof *f);
+    if (!f || parse_model(&a, spec, &m)) goto done;
+    const double *in[4];
+    Py_ssize_t n = -1, len;
+    for (int k = 0; k < 4; k++) {
+        in[k] = get_array(&a, objs[k], &len, names[k]);
+        if (PyErr_Occurred()) goto done;
+        if (k == 0) n = len;
+        if ((in[k] || k != 2) && len != n) {
+            PyErr_Format(PyExc_ValueError, "%s: one value per sample (%zd), got %zd", names[k], n, len);
+            goto done;
+        }
+    }
+    double *out[3];
+    for (int k = 0; k < 3; k++)
+        if (!(out[k] = out_array(&a, outs[k], n, "outputs: one float64 per sample"))) goto done;
+    tf_error e;
+    tf_temperature_estimator est;
+    if (tf_rt_from_model(f, &m, &e)) { PyErr_Format(PyExc_ValueError, "friction model: %s", e.what); goto done; }
+    if (tf_temperature_init(&est, &c, T0, var0, &e)) { PyErr_Format(PyExc_ValueError, "%s", e.what); goto done; }
+    struct timespec t0, t1;
+    Py_ssize_t i = 0;
+    tf_status status = TF_OK;
+    Py_BEGIN_ALLOW_THREADS
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (; i < n; i++) {
+        status = tf_temperature_step(&est, f, in[0][i], in[1][i], in[2] ? in[2][i] : NAN, in[3][i], dt, &out[2][i], &e);
+        if (status) break;
+        out[0][i] = est.x[0];
+        out[1][i] = est.P[0][0];
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    Py_END_ALLOW_THREADS
+    /* a refused step: ValueError (an argument or parameter), FloatingPointError (an overflow) */
+    if (status)
+        PyErr_Format(status == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "sample %zd: %s", i,
+                     e.what);
+    else
+        result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+done:
+    arena_free(&a);
+    return result;
+}
+
 /* The contract with Python, from one source: every enum constant of the core's headers with the
  * name Python uses for it, grouped. thermofriction._bridge reads these; tests/test_bridge.py parses
  * the headers and fails if a header constant is missing here or a name here is not in a header. */
@@ -766,6 +828,7 @@ static const tf_constant constants[] = {
     C("domain_when", "offset-form", TF_DOMAIN_OFFSET_FORM),
     C("compensation", "none", TF_COMP_NONE), C("compensation", "feedforward", TF_COMP_FEEDFORWARD),
     C("compensation", "observer", TF_COMP_OBSERVER),
+    C("proxy", "none", TF_PROXY_NONE), C("proxy", "contact", TF_PROXY_CONTACT), C("proxy", "housing", TF_PROXY_HOUSING),
     /* counts and capacities */
     C("limit", "parameters", TF_NPARAM), C("limit", "friction_models", TF_NFRICTION),
     C("limit", "fixed_outputs", TF_OUT_NFIXED),
@@ -933,6 +996,8 @@ static PyMethodDef methods[] = {
      "Friction force (and parameter derivatives) under a prescribed motion, stepped exactly."},
     {"prescribed_applies", py_prescribed_applies, METH_VARARGS, "Whether prescribed_force applies to a model."},
     {"rt_steps", py_rt_steps, METH_VARARGS, "tf_rt_step over an array of velocities; returns seconds (timed in C)."},
+    {"temperature_estimate", py_temperature_estimate, METH_VARARGS,
+     "The temperature estimator of estimator.h over arrays of samples; returns seconds (timed in C)."},
     {"loop", py_loop, METH_VARARGS, "The closed-loop stage simulation of control.h (fixed step)."},
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
     {"simulate_sensitivities", py_simulate_sensitivities, METH_VARARGS,

@@ -23,6 +23,7 @@ from . import _bridge
 from ._bridge import model_spec
 from . import _args
 from .errors import InputError, SolverError, shorten
+from .estimation import TemperatureEstimate, TemperatureEstimator
 from .figures.study_plots import loop_figure
 from .models import FRICTION_MODELS, MassPlant, Model
 from .results import Result, Summary
@@ -537,4 +538,5 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
 
 
 __all__ = ["OBSERVED_MODELS", "PID", "FeedForward", "Observer", "Reference", "sine_reference", "point_to_point", "LoopResult",
-           "simulate_loop", "compare_compensation", "friction_steps", "DEFAULT_PID"]
+           "simulate_loop", "compare_compensation", "friction_steps", "DEFAULT_PID", "TemperatureEstimator",
+           "TemperatureEstimate"]
