@@ -80,6 +80,7 @@ SYSTEMS = [
 ]
 PROXY_LAG, PROXY_NOISE = 30.0, 0.05  # [s], [K]
 DT = 1e-4
+INERTIA_FEEDFORWARD = False  # --inertia-feedforward: every loop adds the reference's inertia force
 
 
 def cycle_power(model, cycle, T) -> float:
@@ -163,7 +164,8 @@ def run_case(system, ref, temperature, kind, told, extra, **kw):
     t0 = time.perf_counter()
     r = C.simulate_loop(system.model, ref, temperature=temperature, pid=system.pid,
                         compensation=compensation(system, kind, told), friction_measurement=C.DisturbanceObserver(
-                            position_noise=system.position_noise), **extra, **kw)
+                            position_noise=system.position_noise), inertia_feedforward=INERTIA_FEEDFORWARD,
+                        **extra, **kw)
     return r, time.perf_counter() - t0
 
 
@@ -279,7 +281,12 @@ def main(argv=None):
     ap.add_argument("--figures", type=Path, help="also save the figures (PNG) in this folder")
     ap.add_argument("--quick", action="store_true", help="20 s warm-ups: a smoke run, not the study")
     ap.add_argument("--systems", default="stage,joint", help="which systems, comma-separated")
+    ap.add_argument("--inertia-feedforward", action="store_true",
+                    help="every loop adds the reference's inertia force (computed torque): what is left of the "
+                         "tracking error is the friction compensation's")
     args = ap.parse_args(argv)
+    global INERTIA_FEEDFORWARD
+    INERTIA_FEEDFORWARD = args.inertia_feedforward
     parts = ["<html><body style='font-family:sans-serif'><h1>Compensation over a warm-up</h1>"]
     for system in SYSTEMS:
         if system.name not in args.systems.split(","):

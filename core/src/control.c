@@ -161,7 +161,7 @@ static tf_status loop_check(tf_loop *L, long n, const double *x_ref, const doubl
     if (!x_ref) return stop(err, B, "reference", "x_ref (NULL)", -1);
     if (L->compensation < TF_COMP_NONE || L->compensation > TF_COMP_OBSERVER)
         return stop(err, B, "loop", "compensation (kind)", -1);
-    int ff = L->compensation == TF_COMP_FEEDFORWARD;
+    int ff = L->compensation == TF_COMP_FEEDFORWARD || L->inertia_feedforward;
     if (ff && !v_ref) return stop(err, B, "reference", "v_ref (NULL)", -1);
     if (!(isfinite(L->mass) && L->mass > 0.0)) return stop(err, B, "loop", "mass (finite, > 0)", -1);
     if (!(isfinite(L->dt) && L->dt > 0.0)) return stop(err, B, "loop", "dt (finite, > 0)", -1);
@@ -249,6 +249,7 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
             status = tf_observer_step(L->comp, v, -e, L->observer_gain, Tc, L->dt, &Fc, err);
         if (status) return stop_in(err, status, "compensation", i);
         u += Fc;
+        if (L->inertia_feedforward && i + 1 < n) u += L->mass * (v_ref[i + 1] - v_ref[i]) / L->dt;
         if (!isfinite(u)) return stop(err, TF_ERR_NONFINITE, "loop", "u (not finite: the loop is unstable)", i);
         d.u2 = d.u1, d.u1 = u;
         put(x_out, i, x), put(u_out, i, u), put(F_out, i, Fc);

@@ -637,8 +637,8 @@ static int loop_estimator(arena *a, PyObject *obj, Py_ssize_t n, tf_loop *L, tf_
 
 /* loop(plant_spec, T_plant, T_plant_series|None, comp_spec|None, T_comp, T_comp_series|None, compensation,
  *      observer_gain, mass, (kp, ki, kd, tau_d), dt, substeps, x_ref, v_ref, estimator|None,
- *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured)): the closed loop of control.h; the outputs
- *      are float64 arrays of n values (the last four may be None). */
+ *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured), inertia_feedforward): the closed loop of
+ *      control.h; the outputs are float64 arrays of n values (the last four may be None). */
 static PyObject *py_loop(PyObject *self, PyObject *args)
 {
     PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *Tp_obj, *Tc_obj, *est_obj, *outs[7];
@@ -646,10 +646,10 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     memset(&L, 0, sizeof L);
     double kp, ki, kd, tau_d;
     long substeps_in;
-    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
+    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)p", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
                           &L.T_comp, &Tc_obj, &L.compensation, &L.observer_gain, &L.mass, &kp, &ki, &kd, &tau_d, &L.dt,
                           &substeps_in, &xr_obj, &vr_obj, &est_obj, &outs[0], &outs[1], &outs[2], &outs[3], &outs[4],
-                          &outs[5], &outs[6]))
+                          &outs[5], &outs[6], &L.inertia_feedforward))
         return NULL;
     if (substeps_in > TF_LOOP_MAX_SUBSTEPS) { /* beyond an int: the core's own bound, in its words */
         PyErr_SetString(PyExc_ValueError, "loop: n x substeps (at most 1e8 plant substeps in one run)");

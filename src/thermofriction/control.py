@@ -213,7 +213,8 @@ def _checked_reference(where: str, reference) -> tuple:
 def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID = DEFAULT_PID,
                   compensation: FeedForward | Observer | None = None, substeps: int = 10, ambient=None, start=None,
                   start_variance: float = 1.0, proxy_temperature=None,
-                  friction_measurement: DisturbanceObserver = DisturbanceObserver()) -> LoopResult:
+                  friction_measurement: DisturbanceObserver = DisturbanceObserver(),
+                  inertia_feedforward: bool = False) -> LoopResult:
     """The closed loop of control.h: the C core runs every control period (fixed step, ``reference``'s
     sampling) and ``substeps`` plant steps within it.
 
@@ -241,6 +242,10 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
         With a ``TemperatureEstimator`` that has a proxy: the proxy sensor's reading per period [C] (NaN: none).
     friction_measurement : DisturbanceObserver, default DisturbanceObserver()
         With a ``TemperatureEstimator``: how the friction it reads is measured.
+    inertia_feedforward : bool, default False
+        Add the reference's inertia force, mass times the reference's mean acceleration over each period
+        (computed-torque feed-forward), to the control. Without it a large, fast move's error is the PID's lag
+        behind the acceleration, which can hide what the friction compensation does.
 
     Returns
     -------
@@ -266,6 +271,8 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
         raise InputError(f"{where}: compensation must be FeedForward, Observer or None, "
                          f"got {type(compensation).__name__}")
     _args.whole(substeps, f"{where}: substeps", low=1)
+    if not isinstance(inertia_feedforward, (bool, np.bool_)):
+        raise InputError(f"{where}: inertia_feedforward must be True or False, got {inertia_feedforward!r}")
     spec, T_comp, T_comp_series, est = _compensation_inputs(
         where, compensation, t.size, T_plant, T_series, ambient=ambient, start=start, start_variance=start_variance,
         proxy_temperature=proxy_temperature, friction_measurement=friction_measurement)
@@ -277,7 +284,8 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
         status = _bridge.loop(model_spec(stage, T_plant), T_plant, spec, T_comp, kind,
                               float(getattr(compensation, "gain", 0.0)), stage.plant.mass,
                               (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps), x_ref, v_ref, outs,
-                              T_plant_series=T_series, T_comp_series=T_comp_series, estimator=est)
+                              T_plant_series=T_series, T_comp_series=T_comp_series, estimator=est,
+                              inertia_feedforward=bool(inertia_feedforward))
     except ValueError as e:  # the core's own checks: the models at a period's temperature, the estimate
         raise InputError(f"{where}: the C core refused the loop: {e}") from None
     if status != "ok":

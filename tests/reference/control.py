@@ -12,10 +12,12 @@ import numpy as np
 from .friction import friction_params
 
 
-def reference_closed_loop(stage, ref, T, pid, gain=100.0, substeps=10, T_comp=None, friction=False):
+def reference_closed_loop(stage, ref, T, pid, gain=100.0, substeps=10, T_comp=None, friction=False,
+                          inertia_feedforward=False):
     """The closed loop of control.h written again as plain scalar Python (LuGre stage, Model I
     parameters at the stage temperature T, PID with a filtered derivative, the Canudas de Wit
-    observer told T_comp, semi-implicit Euler plant substeps, the exponential bristle step). T and
+    observer told T_comp, semi-implicit Euler plant substeps, the exponential bristle step; with
+    inertia_feedforward, the control adds m times the reference velocity's change over the period). T and
     T_comp: one value, or one per control period (a warm-up; what a sensor or an estimator told the
     observer); T_comp None: T. Returns the position at each period start."""
     n = ref.time.size
@@ -54,6 +56,8 @@ def reference_closed_loop(stage, ref, T, pid, gain=100.0, substeps=10, T_comp=No
         e_prev = e
         zh, Fh = step(zh, v, dt, float(T_told[i]), -gain * -e)
         u = kp * e + ki * integ + kd * dfilt + Fh
+        if inertia_feedforward and i + 1 < n:
+            u += m * (ref.velocity[i + 1] - ref.velocity[i]) / dt
         xs[i] = x
         F_sum = 0.0
         for _ in range(substeps):

@@ -103,15 +103,19 @@ typedef struct {
     const double *position_noise;
     double dob_tau;
     tf_loop_trace trace;
+    /* 1: the control adds the reference's inertia force m (v_ref[i+1] - v_ref[i]) / dt (the last period:
+       none), the mean acceleration over the period of a held control (needs v_ref); 0: none. Without it a
+       large move's error is the PID's lag behind the acceleration, which hides the friction's part. */
+    int inertia_feedforward;
 } tf_loop;
 
 /* The most plant substeps (n x substeps) one tf_loop_run takes (~10 s of work): more is refused. */
 #define TF_LOOP_MAX_SUBSTEPS 100000000.0
 
 /* Runs n >= 1 control periods from rest at x = x_ref[0]. x_ref, v_ref: the reference at each
- * period start (v_ref may be NULL without feed-forward). Writes, when not NULL, per period: x
- * (position at the period start), u (the control held over it, compensation included), F_comp
- * (the compensation in it), and the trace's arrays. Returns TF_OK; TF_ERR_BAD_ARGUMENT, before
+ * period start (v_ref may be NULL without feed-forward, friction's or inertia's). Writes, when not
+ * NULL, per period: x (position at the period start), u (the control held over it, compensation and
+ * inertia feed-forward included), F_comp (the friction compensation in it), and the trace's arrays. Returns TF_OK; TF_ERR_BAD_ARGUMENT, before
  * writing anything, for a NULL or non-finite argument (mass, dt > 0, substeps >= 1, n x substeps <=
  * TF_LOOP_MAX_SUBSTEPS, gains, a reference or series sample, dob_tau >= 0, T_amb, an estimator
  * without est_friction), an unknown compensation, an observer on a model without a bristle state,
