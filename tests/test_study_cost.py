@@ -44,12 +44,14 @@ def quick_rows():
 
 def test_every_evaluation_and_core_call_is_in_one_stage(quick_rows):
     """The per-stage evaluations and C core calls add up to the counts made apart (none lost, none twice), and the
-    fit's own nfev is among them (Model II's undercounts: its reference fit is not in nfev)."""
+    fit's own nfev and njev are those counts: every evaluation it made, its Jacobians too (Model II's base fit at
+    the reference temperature, its dF scans and fits, Model I's heads, the held tests)."""
     for row, evaluations, core in quick_rows:
         stages = row["stages"]
         assert sum(s["evaluations"] for s in stages.values()) == evaluations == row["evaluations"]
         assert sum(s["core_calls"] for s in stages.values()) == core > 0
-        assert row["nfev"] <= evaluations
+        assert row["nfev"] == evaluations
+        assert row["njev"] == sum(s["jacobians"] for s in stages.values())
         assert set(stages) <= {stage for _, _, stage in S.STAGES} | {"other"}
 
 

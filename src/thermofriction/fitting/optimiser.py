@@ -16,7 +16,7 @@ from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..models import Model
 from .parameters import Parameters
-from .problem import Problem, pool
+from .problem import Problem, in_context, pool
 from .quality import ADEQUATE_RATIO, noise_level
 
 optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
@@ -355,7 +355,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         chosen, n_screened = _screened_starts(screen, transform, phi0, (lo, hi), starts, seed, one_trace, progress)
         n_candidates += n_screened
         if one_trace and len(chosen) > 1:
-            runs += list(pool().map(run, chosen))
+            runs += list(pool().map(in_context(run), chosen))  # (their evaluations count in the caller's tallies)
         else:
             runs += [run(c) for c in chosen]
     best, best_problem = min(runs, key=lambda rp: rp[0].cost)

@@ -90,6 +90,10 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
         for side in (-PROFILE_STEP, PROFILE_STEP):
             held = with_values(optimum, {name: value + side * se})
             held_params = parameters_of(held, others)
+            shifted = conditional_step(outcome, names, name, side * se, held_params)
+            if shifted:  # the fit starts where the linearization puts the others
+                held = with_values(held, shifted)
+                held_params = parameters_of(held, others)
             trial = fit(held, held_params, make_traces(experiments, held, measurement),
                         **{**once, "max_nfev": HELD_EVALUATIONS})
             out.nfev, out.njev = out.nfev + trial.nfev, out.njev + trial.njev
@@ -108,6 +112,33 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
     out.nfev, out.njev = out.nfev + again.nfev, out.njev + again.njev
     if float(again.r @ again.r) / variance < cost:
         out.model, out.params, out.outcome, out.traces, out.widen = start, again_params, again, again_traces, {}
+    return out
+
+
+def conditional_step(outcome, names, name, step, held_params) -> dict:
+    """The other fitted values where the linearization at the optimum (``outcome``: its theta and Jacobian, columns
+    in ``names``) puts them with ``name`` moved by ``step``: the least-squares shift -J_o^+ J_m step, a positive
+    parameter's by its log (it stays positive; the same to first order). A held fit from there starts at its own
+    optimum where the profile is quadratic, and stops after one evaluation (the Gauss-Newton step below SMALL_STEP
+    standard errors) instead of walking the conditional valley from the optimum in three; where the profile is not
+    quadratic it goes on from there. Only the parameters ``held_params`` fits are moved."""
+    theta = np.asarray(outcome.theta, float)
+    J = np.asarray(outcome.J, float)
+    moved = [i for i, n in enumerate(names) if n != name and n in held_params and held_params[n].vary]
+    if not moved or J.ndim != 2 or J.shape[1] != len(names):
+        return {}
+    Jo = J[:, moved]
+    scale = np.linalg.norm(Jo, axis=0)
+    scale[scale == 0] = 1.0
+    shift = -np.linalg.lstsq(Jo / scale, J[:, names.index(name)] * step, rcond=None)[0] / scale
+    out = {}
+    for i, d in zip(moved, shift):
+        v = theta[i]
+        if not np.isfinite(d):
+            return {}
+        p = held_params[names[i]]
+        out[names[i]] = float(v * math.exp(np.clip(d / v, -1.0, 1.0))) if p.positive and v > 0 \
+            else float(np.clip(v + d, p.min, p.max))
     return out
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ThermofrictionError
 from ..fitting.optimiser import fit
-from ..fitting.problem import Problem
+from ..fitting.problem import Problem, counting
 from ..fitting.parameters import get_value, unit_of, with_values
 from ..measurements import amount, make_traces
 from ..measurements.ripple import additive, has_ripple, started
@@ -127,21 +127,13 @@ def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
         return res
     if not additive(model.with_friction(ripple_period=1.0)):  # Model II scales a ripple: not a plain term here
         return res
-    try:
-        traces = make_traces(experiments, model, measurement)
-        residuals = _at(model, traces)
-        runs = _runs(traces, residuals) if residuals is not None else []
-        period = strongest_period(runs) if runs else None
-        if period is None or _share(runs, period) < MATERIAL:  # not worth a refit: nothing to say
-            return res
-        refit, after, nfev = _refit(res, experiments, measurement, period, rtol)
-        before = _rms(residuals)
-        out = {"period": period, "gain": max(1.0 - (after / before) ** 2, 0.0), "rmse_before": before,
-               "rmse_after": after, "evaluations": nfev}
-        if held:
-            out.update(heldout_before=heldout_score(model, held, held, measurement)[0],
-                       heldout_after=heldout_score(refit, held, held, measurement)[0])
-    except ThermofrictionError:
+    with counting() as spent:  # the search's and the refit's evaluations are the fit's too
+        try:
+            out = _tried(res, experiments, held, measurement, rtol)
+        except ThermofrictionError:
+            out = None
+    res.nfev, res.njev = res.nfev + spent.nfev, res.njev + spent.njev
+    if out is None:
         return res
     gain = out["gain"]
     res.fit_quality["ripple"] = out
@@ -156,6 +148,27 @@ def with_ripple_advice(res, experiments, held, measurement, rtol=1e-8):
         else:
             res.warnings.append(message)
     return res
+
+
+def _tried(res, experiments, held, measurement, rtol):
+    """The strongest period of ``res``'s residuals over the recorded angle, tried by a refit: {period, gain, RMSE
+    before and after, evaluations, and on the held-out runs ``held`` where there are any}; None where no period
+    is worth a refit."""
+    model = res.model
+    traces = make_traces(experiments, model, measurement)
+    residuals = _at(model, traces)
+    runs = _runs(traces, residuals) if residuals is not None else []
+    period = strongest_period(runs) if runs else None
+    if period is None or _share(runs, period) < MATERIAL:  # not worth a refit: nothing to say
+        return None
+    refit, after, nfev = _refit(res, experiments, measurement, period, rtol)
+    before = _rms(residuals)
+    out = {"period": period, "gain": max(1.0 - (after / before) ** 2, 0.0), "rmse_before": before,
+           "rmse_after": after, "evaluations": nfev}
+    if held:
+        out.update(heldout_before=heldout_score(model, held, held, measurement)[0],
+                   heldout_after=heldout_score(refit, held, held, measurement)[0])
+    return out
 
 
 def _refit(res, experiments, measurement, period, rtol):
