@@ -89,13 +89,9 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
         others = [f for f in free if f != name]
         for side in (-PROFILE_STEP, PROFILE_STEP):
             held = with_values(optimum, {name: value + side * se})
-            held_params = parameters_of(held, others)
-            shifted = conditional_step(outcome, names, name, side * se, held_params)
-            if shifted:  # the fit starts where the linearization puts the others
-                held = with_values(held, shifted)
-                held_params = parameters_of(held, others)
-            trial = fit(held, held_params, make_traces(experiments, held, measurement),
-                        **{**once, "max_nfev": HELD_EVALUATIONS})
+            shift = conditional_step(outcome, names, name, side * se, parameters_of(held, others))
+            held, held_params, trial = _held_fit(held, shift, lambda m: parameters_of(m, others), experiments,
+                                                 measurement, {**once, "max_nfev": HELD_EVALUATIONS})
             out.nfev, out.njev = out.nfev + trial.nfev, out.njev + trial.njev
             trial_cost = float(trial.r @ trial.r) / variance
             rises[name] = min(rises.get(name, np.inf), (trial_cost - cost) / inflation)
@@ -140,6 +136,22 @@ def conditional_step(outcome, names, name, step, held_params) -> dict:
         out[names[i]] = float(v * math.exp(np.clip(d / v, -1.0, 1.0))) if p.positive and v > 0 \
             else float(np.clip(v + d, p.min, p.max))
     return out
+
+
+def _held_fit(held, shift, parameters_of, experiments, measurement, opts):
+    """(start, its Parameters, the fit's outcome) of a held fit from ``held`` with the others moved by ``shift``
+    (:func:`conditional_step`), or from ``held`` itself where that start cannot be simulated (a linear law moved
+    through zero, fs below fc) or its fit fails there."""
+    if shift:
+        try:
+            start = with_values(held, shift)
+            if not start.unphysical_over_range():
+                params = parameters_of(start)
+                return start, params, fit(start, params, make_traces(experiments, start, measurement), **opts)
+        except (InputError, ComputationError):
+            pass
+    params = parameters_of(held)
+    return held, params, fit(held, params, make_traces(experiments, held, measurement), **opts)
 
 
 @dataclasses.dataclass
