@@ -32,9 +32,11 @@ the same fit runs with the truth (benchmarks/baseline_dopri5.c, the fastest of 5
 The stages: the study wraps the package's stage functions (STAGES) and counts, per stage, the model evaluations
 (``Problem.evaluate``, what ``FitResult.nfev`` counts), those with a Jacobian, the C core's calls and time and the
 stage's own wall time (the innermost stage running; "other" outside every stage), and logs every least-squares
-run (its stage, evaluations, limit, status and the parameter that moved most). Nothing in src/ changes.
+run (its stage, evaluations, limit, status, samples and the parameter that moved most). Nothing in src/ changes;
+the fit's own ``nfev`` is recorded beside the study's count (they agree: tests/test_study_cost.py).
 
 Run: nice -n 10 python benchmarks/study_cost.py [--quick] [--truths N] [--kinds model-i,...] [--out FILE]
+     (default kinds model-i, model-ii, free-me; the force kinds with --kinds force,force-ripple)
      python benchmarks/study_cost.py --summarise FILE   (the table from a finished or partial run)
 """
 
