@@ -106,3 +106,23 @@ def test_nfev_is_every_evaluation_of_a_force_fit_its_tests_and_advice():
     assert fit.fit_quality.get("ripple") is not None  # the advice ran a refit: its evaluations are in the count
     assert (fit.nfev, fit.njev) == tuple(seen)
     assert fit.nfev > fit.fit_quality["ripple"]["evaluations"] > 0
+
+
+@pytest.mark.parametrize("centred", [True, False])
+def test_the_phase_cost_is_the_ripple_evaluated_at_the_shifted_angle(centred):
+    """measurements/ripple.py's cost of a run's angle offset (the harmonics rotated, a quadratic form) against the
+    ripple evaluated on the whole run at the shifted angle and summed directly, at phases over its period: equal
+    to 1e-12 of the cost (three harmonics, an uneven travel, an offset in the residuals)."""
+    from thermofriction.measurements import ripple
+
+    model = tf.Model(tf.PrescribedMotion(motion="rotary"),
+                     tf.LuGre(sigma0=100.0, sigma1=0.5, fc=0.3, fs=0.4, vs=0.08, sigma2=0.1, ripple_period=0.1,
+                              ripple_cos1=0.02, ripple_sin1=-0.01, ripple_cos2=0.005, ripple_sin3=0.002))
+    rng = np.random.default_rng(2)
+    x = np.cumsum(rng.uniform(0.0, 0.003, 4000))
+    r0 = rng.normal(0.0, 0.01, x.size) + 0.3
+    cost = ripple._phase_cost(model, x, r0, centred)
+    for phi in np.linspace(0.0, 0.1, 7):
+        e = r0 + ripple.evaluate(model, x + phi)[0]
+        direct = float(np.sum((e - e.mean()) ** 2 if centred else e ** 2))
+        assert cost(phi) == pytest.approx(direct, rel=1e-12)
