@@ -7,7 +7,8 @@ differences of whole runs), and each parameter's difference is printed in standa
 The data are look-alike joint logs (tests/lookalike.py: LuGre with direction-dependent levels and a position
 ripple, integrated by SciPy, AR(1) torque noise, quantised encoder and firmware velocity), one run each, the
 model driven by the position (``motion="position"``). Each line prints the wall time of ``identify`` measured in
-one run and its ratio to the target. SciPy's optimisation and statistics modules, which the package imports at
+one run, its CPU time (all threads: on a machine others load, what the fit itself costs) and the wall time's ratio
+to the target. SciPy's optimisation and statistics modules, which the package imports at
 first use (about 1.5 s here), are imported before the clock starts and their import time is printed apart: a
 process pays it once, whatever it fits.
 
