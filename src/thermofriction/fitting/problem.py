@@ -121,6 +121,7 @@ class Tally:
         self._lock = threading.Lock()
 
     def add(self, jac):
+        """One evaluation (with its Jacobian where ``jac``)."""
         with self._lock:
             self.nfev += 1
             self.njev += int(jac)
@@ -132,7 +133,13 @@ _TALLIES = contextvars.ContextVar("thermofriction_tallies", default=())
 @contextlib.contextmanager
 def counting():
     """A :class:`Tally` of the evaluations made inside the block (nested blocks count in each): what a fit spent,
-    its multi-starts, refits and tests included, whichever function made the Problem."""
+    its multi-starts, refits and tests included, whichever function made the Problem.
+
+    Yields
+    ------
+    Tally
+        Its ``nfev`` and ``njev`` grow with every evaluation of a Problem made while the block runs.
+    """
     tally = Tally()
     token = _TALLIES.set(_TALLIES.get() + (tally,))
     try:
@@ -143,7 +150,18 @@ def counting():
 
 def in_context(function):
     """``function`` run, in another thread, in a copy of the calling thread's context: the Problems it makes count
-    in the caller's tallies (a thread pool's threads otherwise keep their own context)."""
+    in the caller's tallies (a thread pool's threads otherwise keep their own context).
+
+    Parameters
+    ----------
+    function : callable
+        What the pool runs.
+
+    Returns
+    -------
+    callable
+        ``function`` with the same arguments, run in a fresh copy of the caller's context at each call.
+    """
     parent = contextvars.copy_context()
     return lambda *args: parent.copy().run(function, *args)
 

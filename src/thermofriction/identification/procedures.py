@@ -67,7 +67,18 @@ def no_stribeck_rate(model, params) -> list:
 def counted(function):
     """``function`` (which returns a FitResult) with the result's ``nfev`` and ``njev`` every model evaluation made
     while it ran: its fits', their multi-starts', the per-temperature and reference fits', scans', profiles', refits'
-    (fitting.problem.counting), not only those of the fit the result was made from."""
+    (fitting.problem.counting), not only those of the fit the result was made from.
+
+    Parameters
+    ----------
+    function : callable
+        A procedure returning a FitResult.
+
+    Returns
+    -------
+    callable
+        ``function`` whose result's ``nfev`` and ``njev`` are what it spent.
+    """
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
         with counting() as spent:

@@ -117,7 +117,26 @@ def conditional_step(outcome, names, name, step, held_params) -> dict:
     parameter's by its log (it stays positive; the same to first order). A held fit from there starts at its own
     optimum where the profile is quadratic, and stops after one evaluation (the Gauss-Newton step below SMALL_STEP
     standard errors) instead of walking the conditional valley from the optimum in three; where the profile is not
-    quadratic it goes on from there. Only the parameters ``held_params`` fits are moved."""
+    quadratic it goes on from there. Only the parameters ``held_params`` fits are moved.
+
+    Parameters
+    ----------
+    outcome : FitOutcome
+        The joint refinement's optimum: its ``theta`` and Jacobian ``J`` (columns in ``names``).
+    names : list of str
+        The fitted parameters' names, in ``theta``'s order.
+    name : str
+        The parameter that is held, moved by ``step``.
+    step : float
+        How far ``name`` is moved [its unit].
+    held_params : Parameters
+        The held fit's parameters (which are fitted, which are positive, their bounds).
+
+    Returns
+    -------
+    dict
+        {name: value} of the moved parameters; empty where the linearization gives none.
+    """
     theta = np.asarray(outcome.theta, float)
     J = np.asarray(outcome.J, float)
     moved = [i for i, n in enumerate(names) if n != name and n in held_params and held_params[n].vary]
