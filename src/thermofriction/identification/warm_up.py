@@ -37,6 +37,8 @@ from .warm_up_result import warm_up_result
 SECOND_NODE_AICC = 10.0
 #: the most bins of the heat balance per record, and the widest [s]
 MAX_BINS, MAX_BIN_WIDTH = 1500, 1.0
+#: the evaluations of the short fits that decide which node a proxy follows
+SCREEN_EVALUATIONS = 8
 #: the lowest noise a block is weighted by, relative to its record's range (a noise-free record)
 NOISE_FLOOR = 1e-4
 
@@ -200,17 +202,22 @@ def _two_nodes(s: Setup, grid_basis, one, progress):
     v = dict(zip(problem1.layout.names, theta1))
     R, tau = v["R_th"], v["R_th"] * v["C_th"]
     proxy = "tau_p" in v
-    best = None
+    tried = []
     for node in ((0, 1) if proxy else (0,)):
         problem = _problem(s, 2, node, grid_basis)
         candidates = [{"R_th": f * R, "C_th": q * tau / (f * R), "R_2": (1 - f) * R, "C_2": 3 * tau / ((1 - f) * R),
                        **({"tau_p": v["tau_p"]} if proxy else {})}
                       for f in (0.2, 0.5) for q in (0.05, 0.2)]
-        progress(f"warm-up: two nodes{', the proxy on the ' + ('housing' if node else 'contact') if proxy else ''}")
-        theta, res = solve(problem, _best_start(problem, s, candidates))
-        if best is None or res.cost < best[2].cost:
-            best = (problem, theta, res)
-    return best
+        theta = _best_start(problem, s, candidates)
+        if proxy:  # which node the proxy follows: a short fit of each, the better one fitted on
+            theta, res = solve(problem, theta, max_nfev=SCREEN_EVALUATIONS)
+            tried.append((res.cost, node, problem, theta))
+        else:
+            tried.append((0.0, node, problem, theta))
+    _, node, problem, theta = min(tried, key=lambda x: x[0])
+    progress(f"warm-up: two nodes{', the proxy on the ' + ('housing' if node else 'contact') if proxy else ''}")
+    theta, res = solve(problem, theta)
+    return problem, theta, res
 
 
 def _aicc(res, k, n_eff) -> float:

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .. import _bridge
 from .._lazy import lazy
 from ..errors import ComputationError, ThermofrictionError
 from ..fitting.identifiability import scaled_svd
@@ -120,9 +121,10 @@ class WarmProblem:
         path = self.path_of(theta)
         return np.full(path.states, T0)
 
-    def run(self, theta):
-        """({label: Track}, {label: soak force}) at ``theta``."""
-        warm_f, soak_f = self.forces(theta)
+    def run(self, theta, forces=None):
+        """({label: Track}, {label: soak force}) at ``theta`` (``forces``: the grid's and the soak runs' forces
+        given, else computed)."""
+        warm_f, soak_f = self.forces(theta) if forces is None else forces
         path = self.path_of(theta)
         tracks, ends = {}, {}
         for rec in self.warm:
@@ -130,10 +132,10 @@ class WarmProblem:
             tracks[rec.label], ends[rec.label] = tr, tr.end
         return tracks, soak_f
 
-    def blocks(self, theta) -> list:
+    def blocks(self, theta, forces=None) -> list:
         """[(block name, raw residuals, measured)] : each run's force error with its own offset removed, and the
         proxy's temperature error."""
-        tracks, soak_f = self.run(theta)
+        tracks, soak_f = self.run(theta, forces)
         out = []
         for s in self.soak:
             e = soak_f[s.label] - s.force
@@ -148,12 +150,52 @@ class WarmProblem:
     def residuals(self, phi):
         """The residuals in noise units at the transformed parameters ``phi``."""
         self.nfev += 1
-        theta = self.layout.to_theta(phi)
+        return self.whitened(self.layout.to_theta(phi))
+
+    def whitened(self, theta, forces=None):
+        """The residuals in noise units at ``theta`` (FAILED everywhere where the model cannot be evaluated)."""
         try:
-            r = np.concatenate([e / self.sigma[name] for name, e, _ in self.blocks(theta)])
+            r = np.concatenate([e / self.sigma[name] for name, e, _ in self.blocks(theta, forces)])
         except (ThermofrictionError, ValueError, np.linalg.LinAlgError, OverflowError):
             return np.full(self.size, FAILED)
         return r if np.all(np.isfinite(r)) else np.full(self.size, FAILED)
+
+    def _force_derivatives(self, theta):
+        """d(forces)/d(each fitted friction name): the grid's (label -> names x nodes x samples) and the soak
+        runs' (label -> names x samples), by the core's exact stepping's closed-form sensitivities to the values at
+        each temperature and the chain rule through the laws there."""
+        model = self.model_of(theta)
+        names = self.layout.friction
+        values = sorted({n.split(".")[0] for n in names})
+
+        def at(waveform, time, T):
+            spec = _bridge.model_spec(model, float(T), waveform)
+            return (_bridge.prescribed_force(spec, time, values)[1] @ law_chain(model, names, values, T)).T
+        warm = {r.label: np.stack([at(r.waveform, r.time, T) for T in self.grid], axis=1) for r in self.warm}
+        soak = {s.label: at(s.waveform, s.time, s.temperature) for s in self.soak}
+        return warm, soak
+
+    def jacobian(self, phi):
+        """The residuals' Jacobian in the transformed parameters: forward differences of the heat balance, with
+        the forces moved along their exact derivatives for the friction's names (no stepping per column)."""
+        theta = self.layout.to_theta(phi)
+        r0 = self.whitened(theta)
+        warm_f, soak_f = self.forces(theta)
+        dwarm, dsoak = self._force_derivatives(theta) if self.layout.friction else ({}, {})
+        J = np.empty((r0.size, theta.size))
+        for j, name in enumerate(self.layout.names):
+            h = STEP * (abs(theta[j]) if self.layout.log[j] or theta[j] != 0 else 1.0)
+            if name in self.layout.friction:
+                k = self.layout.friction.index(name)
+                moved = ({lab: f + h * dwarm[lab][k] for lab, f in warm_f.items()},
+                         {lab: f + h * dsoak[lab][k] for lab, f in soak_f.items()})
+                r = self.whitened(theta, moved)
+            else:
+                t = theta.copy()
+                t[j] += h
+                r = self.whitened(t, (warm_f, soak_f))
+            J[:, j] = (r - r0) / h * (theta[j] if self.layout.log[j] else 1.0)
+        return J
 
     @property
     def size(self) -> int:
@@ -164,7 +206,7 @@ class WarmProblem:
 def solve(problem: WarmProblem, theta0, max_nfev=200):
     """scipy's trust-region least squares from ``theta0``; returns (theta, result)."""
     phi0 = problem.layout.to_phi(theta0)
-    res = optimize.least_squares(problem.residuals, phi0, method="trf", x_scale="jac", diff_step=STEP,
+    res = optimize.least_squares(problem.residuals, phi0, jac=problem.jacobian, method="trf", x_scale="jac",
                                  max_nfev=max_nfev)
     if not np.all(np.isfinite(res.fun)) or float(res.fun @ res.fun) >= FAILED ** 2 * res.fun.size * 0.5:
         raise ComputationError("the warm-up fit failed: the model cannot be evaluated near its start (give "
@@ -207,6 +249,26 @@ def delta_band(G, cov, z=1.959963984540054) -> np.ndarray:
     var = np.einsum("ij,jk,ik->i", G, c, G)
     loose = np.any(np.abs(G[:, ~finite]) > 0, axis=1) if (~finite).any() else np.zeros(G.shape[0], bool)
     return np.where(loose, math.inf, z * np.sqrt(np.maximum(var, 0.0)))
+
+
+def law_chain(model, names, values, T) -> np.ndarray:
+    """d(the friction's ``values`` at T)/d(the fitted ``names``): 1 for a value fitted as itself, a law's
+    derivative in a coefficient by central differences (exact for the laws linear in their coefficients)."""
+    M = np.zeros((len(values), len(names)))
+    for j, name in enumerate(names):
+        base, _, coef = name.partition(".")
+        if not coef:
+            M[values.index(base), j] = 1.0
+            continue
+        law = model.laws[base]
+        c = np.array(law.coefficients(), float)
+        k = law.coefficient_names().index(coef)
+        h = 1e-4 * (abs(c[k]) if c[k] != 0 else max(float(np.max(np.abs(c))), 1e-300))
+        up, down = c.copy(), c.copy()
+        up[k] += h
+        down[k] -= h
+        M[values.index(base), j] = (float(law.with_coefficients(up)(T)) - float(law.with_coefficients(down)(T))) / (2 * h)
+    return M
 
 
 def law_slope_name(model) -> str | None:
