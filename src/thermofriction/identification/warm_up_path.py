@@ -156,7 +156,8 @@ def weights_at(basis, grid, T) -> np.ndarray:
     """The spline's weights of the grid's values at temperatures ``T`` (samples x nodes)."""
     i = np.clip(np.searchsorted(grid, T, side="right") - 1, 0, len(grid) - 2)
     d = (np.asarray(T, float) - np.asarray(grid)[i])[:, None]
-    return ((basis[0][i] * d + basis[1][i]) * d + basis[2][i]) * d + basis[3][i]
+    with np.errstate(over="ignore", invalid="ignore"):  # (a trial step far off: its residuals are refused)
+        return ((basis[0][i] * d + basis[1][i]) * d + basis[2][i]) * d + basis[3][i]
 
 
 def _expm(M) -> np.ndarray:

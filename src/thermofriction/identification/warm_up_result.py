@@ -19,7 +19,7 @@ from .warm_up_fit import HEAT_UNITS, covariance, delta_band, gradient
 from .warm_up_path import interpolation_error
 
 #: the most points of a record's temperature trajectory in the results
-TRAJECTORY_POINTS = 400
+TRAJECTORY_POINTS = 2000
 #: the interpolation's error, relative to the force's noise, above which it is warned about
 INTERPOLATION_SHARE = 0.1
 UNDETERMINED_TEXT = "undetermined"

@@ -1,0 +1,164 @@
+"""The warm-up fit without a contact temperature (issue 45 item 1; docs/self-heating.md#warm-up-without-a-contact-
+temperature), against independent truths (tests/warmup_truth.py: a joint with Stribeck friction whose fc and fs
+follow linear laws of the contact temperature, a two-node heat path with eta = 0.8, integrated by scipy's solve_ivp
+from equations written there; each run's own sensor offset, AR(1) noise of lag-1 correlation 0.7, a quantised
+proxy). The issue's bounds: the heat path (per unit eta, what force data determine) and the laws within 5 %, the
+contact temperature within 0.5 C at every time."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import thermofriction as tf
+from thermofriction.identification.warm_up import identify_warm_up
+
+from warmup_truth import (Truth, experiment, initial_model, measured, proxy_record, soak_runs, warm_up)
+
+TRUTH = Truth()
+
+
+@pytest.fixture(scope="module")
+def record():
+    """The truth's 25-minute warm-up from ambient, at 20 Hz."""
+    return warm_up(TRUTH, duration=1500.0)
+
+
+def _warm(record, rng, proxy=False, offset=0.03):
+    t, v, x, T1, T2, Tp, _ = record
+    F = measured(TRUTH, rng, t, v, T1, offset)
+    return experiment("warm.csv", t, v, x, F, ambient=TRUTH.ambient, proxy=proxy_record(rng, Tp) if proxy else None)
+
+
+def _check_path_and_laws(res):
+    """The heat path per unit eta, the laws' coefficients and the constants within 5 % of the truth's."""
+    p = res.parameters
+    for name, true in TRUTH.per_eta().items():
+        assert p[name].value == pytest.approx(true, rel=0.05), name
+    for name, true in (("fc.a", TRUTH.fc_a), ("fc.b", TRUTH.fc_b), ("fs.a", TRUTH.fs_a), ("fs.b", TRUTH.fs_b),
+                       ("vs", TRUTH.vs), ("sigma2", TRUTH.sigma2)):
+        assert p[name].value == pytest.approx(true, rel=0.05), name
+
+
+def _check_temperature(res, record, label="warm.csv", t_offset=0.0):
+    """The contact temperature within 0.5 C of the truth's at every time of the trajectory (every bin edge of
+    the heat balance: one a second), and its 95 % band covering the truth at most of them."""
+    t, _, _, T1, *_ = record
+    tr = res.details["temperature"][label]
+    true = np.interp(np.asarray(tr["time"]) + t_offset, t, T1)
+    assert np.max(np.abs(np.asarray(tr["contact"]) - true)) < 0.5
+    covered = np.mean((np.asarray(tr["lower"]) <= true) & (true <= np.asarray(tr["upper"])))
+    assert covered > 0.8
+    return tr
+
+
+def test_soak_calibrated_laws_recover_a_two_node_heat_path_and_the_contact_temperature(record):
+    """Soak runs at 25-55 C calibrate the laws; the warm-up record (ambient only) gives the heat path: two nodes
+    chosen (the truth has two), each value within 5 %, the temperature within 0.5 C."""
+    rng = np.random.default_rng(1)
+    res = identify_warm_up([_warm(record, rng)] + soak_runs(TRUTH, rng), initial_model(TRUTH))
+    assert res.details["heat_path"]["nodes"] == 2
+    assert res.details["heat_path"]["scale"].startswith("soak runs at 4")
+    _check_path_and_laws(res)
+    _check_temperature(res, record)
+    assert res.adequate is not False
+    d = json.loads(res.to_json())
+    assert d["method"] == "warm-up" and d["details"]["heat_path"]["nodes"] == 2
+    assert d["parameters"]["R_th"]["ci95"][0] < d["parameters"]["R_th"]["value"] < d["parameters"]["R_th"]["ci95"][1]
+
+
+def test_a_lagging_proxy_alone_sets_the_scale_and_is_found_on_the_housing(record):
+    """No soak run: a housing sensor lagging by 40 s (quantised to 0.1 C) fixes the scale; the fit finds which
+    node it follows and its lag, the heat path and laws within 5 %, the temperature within 0.5 C."""
+    rng = np.random.default_rng(2)
+    res = identify_warm_up([_warm(record, rng, proxy=True)], initial_model(TRUTH))
+    hp = res.details["heat_path"]
+    assert hp["nodes"] == 2 and hp["proxy"]["node"] == "housing"
+    assert res.parameters["tau_p"].value == pytest.approx(TRUTH.tau_p, rel=0.05)
+    _check_path_and_laws(res)
+    _check_temperature(res, record)
+
+
+def test_one_node_where_two_are_needed_is_not_called_adequate(record):
+    """Held at one node on the two-node truth, the fit says it is not adequate (the second node lowers AICc by far
+    more than the threshold) and never claims adequacy."""
+    rng = np.random.default_rng(3)
+    res = identify_warm_up([_warm(record, rng)] + soak_runs(TRUTH, rng), initial_model(TRUTH), nodes=1)
+    assert res.details["heat_path"]["nodes"] == 1
+    assert res.adequate is False
+    assert res.warnings[0].startswith("the fit is not adequate: one node cannot follow")
+    assert res.details["heat_path"]["choice"]["delta"] > res.details["heat_path"]["choice"]["threshold"]
+
+
+def _true_time_constants():
+    """The truth's two-node time constants [s], from its equations' matrix (independent of the package)."""
+    C1, R1, C2, R2 = TRUTH.C1, TRUTH.R1, TRUTH.C2, TRUTH.R2
+    A = np.array([[-1 / (R1 * C1), 1 / (R1 * C1)], [1 / (R1 * C2), -1 / (R1 * C2) - 1 / (R2 * C2)]])
+    return sorted(-1 / np.linalg.eigvals(A).real)
+
+
+@pytest.mark.parametrize("soak_at", [(), (40.0,)])
+def test_without_soak_runs_at_two_temperatures_or_a_proxy_the_scale_is_undetermined(record, soak_at):
+    """Neither soak runs at two temperatures nor a proxy: the heat path's gains and capacities, the laws'
+    coefficients and the temperature are said to be undetermined, none as a number (in the result, its JSON and
+    its report); the scale-free time constants are given, within 10 % of the truth's."""
+    rng = np.random.default_rng(4)
+    soak = soak_runs(TRUTH, rng, temperatures=soak_at) if soak_at else []
+    res = identify_warm_up([_warm(record, rng)] + soak, initial_model(TRUTH))
+    assert res.details["temperature"] == "undetermined"
+    hp = res.details["heat_path"]
+    assert hp["scale"] == "undetermined" and hp["R_th"] == "undetermined" and hp["C_th"] == "undetermined"
+    for name in ("C_th", "R_th", "C_2", "R_2", "T_0", "fc.a", "fc.b", "fs.a", "fs.b"):
+        assert name not in res.parameters
+    assert res.warnings[0].startswith("the temperature scale is undetermined")
+    d = json.loads(res.to_json())
+    assert d["details"]["temperature"] == "undetermined" and "R_th" not in d["parameters"]
+    assert "undetermined" in res.report()
+    taus = [tc["value"] for tc in hp["time_constants"]]
+    assert taus == pytest.approx(_true_time_constants(), rel=0.1)
+
+
+def test_a_record_that_continues_another_starts_where_that_one_ended(record, tmp_path):
+    """The warm-up split into two files, the second marked ``continues`` in the manifest, its clock from zero:
+    loaded from disk and fitted through tf.identify(method="warm-up"), the second record's trajectory starts at
+    the first's end (not at ambient) and follows the truth within 0.5 C throughout."""
+    rng = np.random.default_rng(5)
+    t, v, x, T1, T2, Tp, _ = record
+    cut = 14000  # 700 s
+    F = measured(TRUTH, rng, t, v, T1, 0.0)
+    P = proxy_record(rng, Tp)
+    for name, sl, off in (("a.csv", slice(0, cut), 0.03), ("b.csv", slice(cut, None), -0.02)):
+        tt = t[sl] - t[sl][0]
+        cols = np.column_stack([tt, x[sl], v[sl], F[sl] + off, np.full(tt.size, TRUTH.ambient), P[sl]])
+        np.savetxt(tmp_path / name, cols, delimiter=",", comments="",
+                   header="time[s],position[rad],velocity[rad/s],friction_torque[N*m],ambient_temperature[C],"
+                          "proxy_temperature[C]")
+    (tmp_path / "dataset.toml").write_text('name = "joint"\n[[experiment]]\nfile = "a.csv"\n'
+                                           '[[experiment]]\nfile = "b.csv"\ncontinues = "a.csv"\n')
+    data = tf.load_dataset(tmp_path)
+    assert [e.warm_up for e in data.experiments] == [True, True] and data.experiments[1].continues == "a.csv"
+    res = tf.identify(data, method="warm-up", init=initial_model(TRUTH))
+    assert "T_0" in res.parameters and not any(n.startswith("T_0[") for n in res.parameters)
+    a = _check_temperature(res, record, "a.csv")
+    b = _check_temperature(res, record, "b.csv", t_offset=t[cut])
+    assert b["contact"][0] == pytest.approx(a["contact"][-1], abs=0.05)
+    assert b["contact"][0] - TRUTH.ambient > 10.0
+
+
+def test_warm_up_records_are_refused_by_the_other_methods(record):
+    """A warm-up record has no contact temperature: Model I (or any other method) refuses it by name."""
+    rng = np.random.default_rng(6)
+    data = tf.Dataset(experiments=[_warm(record, rng)])
+    with pytest.raises(tf.InputError, match="warm.csv is a warm-up record.*method 'warm-up'"):
+        tf.identify(data, method="model-i", init=initial_model(TRUTH))
+
+
+def test_the_warm_up_needs_laws_to_start_from(record):
+    """Without laws in the initial model and without soak runs at two temperatures, one message says what to give."""
+    rng = np.random.default_rng(7)
+    data = tf.Dataset(experiments=[_warm(record, rng)])
+    base = tf.Model(plant=tf.PrescribedMotion(motion="rotary"), friction=tf.Stribeck(fc=0.9, fs=1.3, vs=0.08))
+    with pytest.raises(tf.InputError, match="soak runs at two temperatures or more"):
+        tf.identify(data, method="warm-up", init=base)
