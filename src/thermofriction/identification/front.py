@@ -220,6 +220,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
     experiments = list(getattr(data, "fit", data))
     if method == "warm-up":  # docs/self-heating.md#warm-up-without-a-contact-temperature
+        opts = dict(rtol=rtol, starts=starts, seed=seed, **({"max_nfev": max_nfev} if max_nfev else {}))
         return _warm_up(data, experiments, init, measurement, friction, parameters, progress, opts)
     _no_warm_up_records(data, method)
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)

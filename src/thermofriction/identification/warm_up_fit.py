@@ -215,18 +215,21 @@ def solve(problem: WarmProblem, theta0, max_nfev=200):
 
 
 def covariance(problem: WarmProblem, theta, res):
-    """(covariance of theta, residual variance times its inflation, block sizes): from the Jacobian at the
-    optimum (least_squares' own, in the transformed parameters, brought back), the residuals' scatter and their
-    autocorrelation (fitting.uncertainty: inflation_of); a direction the data do not determine gives an infinite
-    variance (fitting.identifiability: scaled_svd). Also returns the SVD for the identifiability groups."""
+    """(covariance of theta, residual variance times its inflation, the SVD (S, Vt, col, bad), statistics): from
+    the Jacobian at the optimum (least_squares' own, in the transformed parameters, brought back), the residuals'
+    scatter and their autocorrelation (fitting.uncertainty: inflation_of); a direction the data do not determine
+    gives an infinite variance (fitting.identifiability: scaled_svd)."""
     J = res.jac * np.array([1.0 / t if lg else 1.0 for t, lg in zip(theta, problem.layout.log)])
     r = res.fun
     sizes = [e.size for _, e, _ in problem.blocks(theta)]
     n, p = J.shape
-    s2 = float(r @ r) / max(n - p - len(sizes), 1)
-    inflation, _ = inflation_of(r, sizes)
+    dof = max(n - p - len(sizes), 1)
+    s2 = float(r @ r) / dof
+    inflation, rho = inflation_of(r, sizes)
     S, Vt, col, bad, cov1 = scaled_svd(J, UNDETERMINED)
-    return cov1 * s2 * inflation, s2 * inflation, (S, Vt, col, bad)
+    stats = {"dof": dof, "residual_std": math.sqrt(s2), "autocorrelation": rho, "variance_inflation": inflation,
+             "effective_samples": n / inflation, "residuals": "in noise units (each block by its own noise)"}
+    return cov1 * s2 * inflation, s2 * inflation, (S, Vt, col, bad), stats
 
 
 def gradient(f, theta, layout: Layout) -> np.ndarray:

@@ -145,7 +145,7 @@ def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
     """The FitResult of a warm-up fit from its setup ``s``, the chosen fit ``final`` (problem, theta, scipy's
     result), the other node count's fit ``other`` and the ``choice`` between them."""
     problem, theta, res = final
-    cov, noise_scale, (S, Vt, col, bad) = covariance(problem, theta, res)
+    cov, noise_scale, (S, Vt, col, bad), stats = covariance(problem, theta, res)
     model = problem.model_of(theta)
     params, kept = _parameters(s, problem, theta, cov, model)
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
@@ -188,7 +188,7 @@ def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
     return FitResult(method="warm-up", model=model, parameters=params, correlation=corr, cost=float(2 * res.cost),
                      rmse=rmse, n_points=int(res.fun.size), nfev=problem.nfev, njev=int(res.njev or 0), starts=1,
                      wall_time=wall_time, success=bool(res.status > 0), message=str(res.message), experiments=rows,
-                     warnings=warnings, statistics={"noise_scale": noise_scale}, details=details,
+                     warnings=warnings, statistics=stats, details=details,
                      fit_quality=overall, unit=s.unit, measurement="force",
                      removed="each record's own sensor offset (fitted)", identifiability=found)
 
