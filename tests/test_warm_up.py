@@ -64,6 +64,7 @@ def test_soak_calibrated_laws_recover_a_two_node_heat_path_and_the_contact_tempe
     _check_path_and_laws(res)
     _check_temperature(res, record)
     assert res.adequate is not False
+    assert not any("poorly determined" in w or "What record would" in w for w in res.warnings)
     d = json.loads(res.to_json())
     assert d["method"] == "warm-up" and d["details"]["heat_path"]["nodes"] == 2
     assert d["parameters"]["R_th"]["ci95"][0] < d["parameters"]["R_th"]["value"] < d["parameters"]["R_th"]["ci95"][1]
@@ -147,6 +148,21 @@ def test_a_record_that_continues_another_starts_where_that_one_ended(record, tmp
     b = _check_temperature(res, record, "b.csv", t_offset=t[cut])
     assert b["contact"][0] == pytest.approx(a["contact"][-1], abs=0.05)
     assert b["contact"][0] - TRUTH.ambient > 10.0
+
+
+def test_a_short_warm_up_says_what_it_cannot_separate_and_what_record_would(record):
+    """The first minute of the warm-up (the slow node's time constant is 8 minutes, the proxy's lag 40 s) with the
+    proxy: the values the data leave loose are said, with the record that would determine them (a longer warm-up,
+    more speeds, soak runs); the full record's fit (test above) says none of this."""
+    rng = np.random.default_rng(8)
+    t, v, x, T1, T2, Tp, _ = record
+    n = 1200
+    F = measured(TRUTH, rng, t[:n], v[:n], T1[:n], 0.03)
+    exp = experiment("short.csv", t[:n], v[:n], x[:n], F, ambient=TRUTH.ambient, proxy=proxy_record(rng, Tp[:n]))
+    res = identify_warm_up([exp], initial_model(TRUTH))
+    assert any("is poorly determined by these data" in w for w in res.warnings)
+    said = [w for w in res.warnings if "What record would: a longer warm-up" in w]
+    assert len(said) == 1 and "at two speeds or more" in said[0] and "a proxy temperature" not in said[0]
 
 
 def test_warm_up_records_are_refused_by_the_other_methods(record):

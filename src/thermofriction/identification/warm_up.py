@@ -21,14 +21,15 @@ import time
 
 import numpy as np
 
+from ..data.experiments import TEMPERATURE_RANGE
 from ..drive import drive
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..fitting.uncertainty import inflation_of
 from ..fitting.quality import noise_level
 from ..models import ModelI
 from ..models.friction import FRICTION_MODELS
 from ..fitting.parameters import get_value
-from .warm_up_fit import Layout, SoakRun, WarmProblem, held_values, law_slope_name, solve
+from .warm_up_fit import Layout, SoakRun, WarmProblem, failed, held_values, law_slope_name, solve
 from .warm_up_path import GRID_NODES, grid_for, spline_basis, warm_record, forces_at
 from .warm_up_result import warm_up_result
 
@@ -170,14 +171,14 @@ def _mean_power(s: Setup) -> float:
     return max(float(np.mean(p)), 1e-12)
 
 
-def _best_start(problem: WarmProblem, s: Setup, candidates) -> np.ndarray:
-    """Of the candidate heat paths, the start whose residuals are least."""
+def _best_start(problem: WarmProblem, s: Setup, candidates) -> np.ndarray | None:
+    """Of the candidate heat paths, the start whose residuals are least (None where none can be evaluated)."""
     best, best_cost = None, np.inf
     for heat in candidates:
         theta = _theta(problem, s, heat)
         r = problem.residuals(problem.layout.to_phi(theta))
         cost = float(r @ r)
-        if cost < best_cost:
+        if cost < best_cost and not failed(r):
             best, best_cost = theta, cost
     return best
 
@@ -209,11 +210,15 @@ def _two_nodes(s: Setup, grid_basis, one, progress):
                        **({"tau_p": v["tau_p"]} if proxy else {})}
                       for f in (0.2, 0.5) for q in (0.05, 0.2)]
         theta = _best_start(problem, s, candidates)
+        if theta is None:
+            continue
         if proxy:  # which node the proxy follows: a short fit of each, the better one fitted on
             theta, res = solve(problem, theta, max_nfev=SCREEN_EVALUATIONS)
             tried.append((res.cost, node, problem, theta))
         else:
             tried.append((0.0, node, problem, theta))
+    if not tried:
+        return None  # (said in the choice: no two-node start could be evaluated)
     _, node, problem, theta = min(tried, key=lambda x: x[0])
     progress(f"warm-up: two nodes{', the proxy on the ' + ('housing' if node else 'contact') if proxy else ''}")
     theta, res = solve(problem, theta)
@@ -230,7 +235,8 @@ def _regridded(s: Setup, fit):
     problem, theta, res = fit
     tracks, _ = problem.run(theta)
     T = np.concatenate([tr.states[:, :problem.nodes].ravel() for tr in tracks.values()])
-    low, high = float(T.min()) - 1.0, float(T.max()) + 1.0
+    low = max(float(T.min()) - 1.0, TEMPERATURE_RANGE[0])
+    high = min(float(T.max()) + 1.0, TEMPERATURE_RANGE[1])
     g = problem.grid
     if g[0] <= low and g[-1] >= high and (g[-1] - g[0]) < 2.0 * (high - low) + 4.0:
         return fit
@@ -286,15 +292,22 @@ def identify_warm_up(experiments, init, *, parameters=None, nodes="auto", progre
     s = setup(experiments, init, parameters)
     grid_basis = _grid(s)
     one = _regridded(s, _one_node(s, grid_basis, progress))
-    two = _regridded(s, _two_nodes(s, (one[0].grid, one[0].basis), one, progress))
-    inflation, _ = inflation_of(two[2].fun, [e.size for _, e, _ in two[0].blocks(two[1])])
-    n_eff = two[2].fun.size / inflation
-    a1, a2 = _aicc(one[2], len(one[1]), n_eff), _aicc(two[2], len(two[1]), n_eff)
+    two = _two_nodes(s, (one[0].grid, one[0].basis), one, progress)
     choice = {"rule": f"two nodes where they lower AICc by more than {SECOND_NODE_AICC:g}", "asked": nodes,
-              "threshold": SECOND_NODE_AICC, "aicc_one": a1, "aicc_two": a2, "effective_samples": n_eff,
-              "delta": a1 - a2}
-    pick_two = nodes == 2 or (nodes == "auto" and a1 - a2 > SECOND_NODE_AICC)
-    chosen, other = (two, one) if pick_two else (one, two)
+              "threshold": SECOND_NODE_AICC}
+    if two is None:
+        if nodes == 2:
+            raise ComputationError("the two-node heat path cannot be evaluated from the one-node fit's optimum")
+        choice["two_nodes"] = "not evaluated: no two-node start from the one-node optimum could be simulated"
+        chosen, other = one, None
+    else:
+        two = _regridded(s, two)
+        inflation, _ = inflation_of(two[2].fun, [e.size for _, e, _ in two[0].blocks(two[1])])
+        n_eff = two[2].fun.size / inflation
+        a1, a2 = _aicc(one[2], len(one[1]), n_eff), _aicc(two[2], len(two[1]), n_eff)
+        choice.update(aicc_one=a1, aicc_two=a2, effective_samples=n_eff, delta=a1 - a2)
+        pick_two = nodes == 2 or (nodes == "auto" and a1 - a2 > SECOND_NODE_AICC)
+        chosen, other = (two, one) if pick_two else (one, two)
     choice["nodes"] = chosen[0].nodes
     progress("warm-up: reweighted by each record's residuals")
     final = _reweighted(chosen)

@@ -206,12 +206,20 @@ class WarmProblem:
 def solve(problem: WarmProblem, theta0, max_nfev=200):
     """scipy's trust-region least squares from ``theta0``; returns (theta, result)."""
     phi0 = problem.layout.to_phi(theta0)
+    if failed(problem.residuals(phi0)):
+        raise ComputationError("the warm-up fit cannot evaluate its model at its start (a law turns invalid at the "
+                               "temperatures the start reaches): give starting values closer to the data (--init)")
     res = optimize.least_squares(problem.residuals, phi0, jac=problem.jacobian, method="trf", x_scale="jac",
                                  max_nfev=max_nfev)
-    if not np.all(np.isfinite(res.fun)) or float(res.fun @ res.fun) >= FAILED ** 2 * res.fun.size * 0.5:
+    if failed(res.fun):
         raise ComputationError("the warm-up fit failed: the model cannot be evaluated near its start (give "
                                "starting values closer to the data: --init with laws and a [heat] section)")
     return problem.layout.to_theta(res.x), res
+
+
+def failed(r) -> bool:
+    """Whether residuals are those of a failed evaluation."""
+    return not np.all(np.isfinite(r)) or float(r @ r) >= 0.5 * FAILED ** 2 * r.size
 
 
 def covariance(problem: WarmProblem, theta, res):
@@ -289,4 +297,4 @@ def held_values(model, name) -> dict:
 
 
 __all__ = ["SoakRun", "Layout", "WarmProblem", "solve", "covariance", "gradient", "delta_band", "law_slope_name",
-           "held_values", "HEAT_UNITS"]
+           "held_values", "failed", "HEAT_UNITS"]

@@ -99,13 +99,20 @@ def _trajectories(problem, theta, cov) -> dict:
     return out
 
 
+def separation_advice(problem, theta) -> str:
+    """What record would separate the laws from the heat path."""
+    slow = problem.path_of(theta).time_constants()[-1]
+    longest = max(r.time[-1] - r.time[0] for r in problem.warm)
+    proxy = "" if any(r.proxy is not None for r in problem.warm) else ", or a proxy temperature"
+    return (f"a longer warm-up (the longest record here lasts {longest:.4g} s; the fitted heat path's slowest time "
+            f"constant is {slow:.4g} s, and a record of three of them at least sees the rise end, while a slower "
+            f"node shows only over a longer one), at two speeds or more, or soak runs at the temperatures it "
+            f"reaches{proxy}")
+
+
 def _separation(found, problem, theta) -> list:
     """The identifiability groups with the heat path among their members, with what record would separate them."""
-    taus = problem.path_of(theta).time_constants()
-    longest = max(r.time[-1] - r.time[0] for r in problem.warm)
-    advice = (f"a warm-up longer than three of its slowest time constants ({3 * taus[-1]:.4g} s; the longest record "
-              f"here lasts {longest:.4g} s), at two speeds or more, or soak runs at the temperatures it reaches, or "
-              f"a proxy temperature")
+    advice = separation_advice(problem, theta)
     for g in found:
         if any(n in HEAT_UNITS or n.startswith("T_0") for n in g["parameters"]):
             g["separate"] = advice if not g.get("separate") else f"{g['separate']}; {advice}"
@@ -113,6 +120,24 @@ def _separation(found, problem, theta) -> list:
                             f"{g['condition_index']:.3g}): the laws and the heat path trade along one direction. "
                             f"What would separate them: {g['separate']}")
     return found
+
+
+def _determination(params, problem, theta, advice) -> list:
+    """Each shown value the data leave poorly determined (standard error above half its value, uncertainty.py's
+    rule), and, where one is the heat path's or a law's, what record would determine them (and whether the
+    warm-up is short for its slowest time constant)."""
+    out = [f"'{p.name}' is poorly determined by these data (standard error "
+           f"{'infinite' if not math.isfinite(p.stderr) else f'{100 * p.stderr / abs(p.value):.0f} % of its value'})"
+           for p in params.values() if p.stderr is not None and p.value and
+           (not math.isfinite(p.stderr) or p.stderr > 0.5 * abs(p.value))]
+    slow = problem.path_of(theta).time_constants()[-1]
+    longest = max(r.time[-1] - r.time[0] for r in problem.warm)
+    loose = [w for w in out if "." in w.split("'")[1] or w.split("'")[1] in HEAT_UNITS]
+    if loose:
+        short = (f" (the longest record lasts {longest:.4g} s, less than three of the heat path's slowest time "
+                 f"constant, {slow:.4g} s: the rise's end is not seen)" if longest < 3.0 * slow else "")
+        out.append(f"the laws and the heat path are not separated by these data{short}. What record would: {advice}")
+    return out
 
 
 def _qualities(s, problem, theta):
@@ -183,7 +208,8 @@ def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
                "interpolation": {"nodes": len(problem.grid), "grid": problem.grid, "max_error": max(errors),
                                  "noise": noise, "unit": s.unit},
                "warm_up_records": [r.label for r in s.warm], "soak_runs": [x.label for x in s.soak]}
-    warnings += [g["warning"] for g in found]
+    warnings += [g["warning"] for g in found] + _determination(params, problem, theta,
+                                                               separation_advice(problem, theta))
     rmse = float(overall["rmse"])
     return FitResult(method="warm-up", model=model, parameters=params, correlation=corr, cost=float(2 * res.cost),
                      rmse=rmse, n_points=int(res.fun.size), nfev=problem.nfev, njev=int(res.njev or 0), starts=1,
