@@ -155,7 +155,8 @@ class WarmProblem:
     def whitened(self, theta, forces=None):
         """The residuals in noise units at ``theta`` (FAILED everywhere where the model cannot be evaluated)."""
         try:
-            r = np.concatenate([e / self.sigma[name] for name, e, _ in self.blocks(theta, forces)])
+            with np.errstate(all="ignore"):  # (a trial step far off overflows: its residuals are refused below)
+                r = np.concatenate([e / self.sigma[name] for name, e, _ in self.blocks(theta, forces)])
         except (ThermofrictionError, ValueError, np.linalg.LinAlgError, OverflowError):
             return np.full(self.size, FAILED)
         return r if np.all(np.isfinite(r)) else np.full(self.size, FAILED)
