@@ -66,3 +66,31 @@ def test_actuator_files_refuse_the_warm_up_keys(tmp_path):
     _manifest(tmp_path, ['file = "s.csv"\ntemperature = 30.0\nambient_temperature = 25.0'])
     with pytest.raises(tf.InputError, match="'ambient_temperature' applies to force experiments only"):
         tf.load_dataset(tmp_path)
+
+
+def test_the_command_line_fits_a_warm_up_and_writes_the_model_and_the_results(tmp_path):
+    """``thermofriction identify DATA --method warm-up --init MODEL``: exit 0, the fitted Model I file and the
+    results JSON with the heat path and the temperature trajectory (five minutes of the independent truth, with a
+    proxy)."""
+    import json
+    import subprocess
+    import sys
+
+    from warmup_truth import Truth, initial_model, measured, proxy_record, warm_up
+    truth = Truth()
+    rng = np.random.default_rng(9)
+    t, v, x, T1, _, Tp, _ = warm_up(truth, duration=300.0)
+    cols = np.column_stack([t, x, v, measured(truth, rng, t, v, T1, 0.03), np.full(t.size, 25.0),
+                            proxy_record(rng, Tp)])
+    np.savetxt(tmp_path / "w.csv", cols, delimiter=",", comments="",
+               header=HEADER + ",ambient_temperature[C],proxy_temperature[C]")
+    _manifest(tmp_path, ['file = "w.csv"'])
+    initial_model(truth).save(tmp_path / "init.toml")
+    run = subprocess.run([sys.executable, "-m", "thermofriction", "identify", str(tmp_path), "--method", "warm-up",
+                          "--init", str(tmp_path / "init.toml"), "-o", str(tmp_path / "fit.toml"), "--json",
+                          str(tmp_path / "fit.json")], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    d = json.loads((tmp_path / "fit.json").read_text())
+    assert d["method"] == "warm-up" and d["details"]["heat_path"]["scale"] == "proxy"
+    assert len(d["details"]["temperature"]["w.csv"]["contact"]) > 100
+    assert tf.load_model(tmp_path / "fit.toml").laws.keys() == {"fc", "fs"}
