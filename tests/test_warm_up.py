@@ -93,6 +93,22 @@ def test_one_node_where_two_are_needed_is_not_called_adequate(record):
     assert res.details["heat_path"]["choice"]["delta"] > res.details["heat_path"]["choice"]["threshold"]
 
 
+def test_a_one_node_truth_keeps_one_node():
+    """On a one-node truth (the contact alone, R = R1 + R2 to ambient), the second node does not lower AICc by the
+    threshold and is not kept: the rule does not call for a node the data do not show; the one-node path within
+    5 % and the temperature within 0.5 C."""
+    rng = np.random.default_rng(21)
+    t, v, x, T1, _, _, _ = rec = warm_up(TRUTH, duration=1500.0, two_nodes=False)
+    F = measured(TRUTH, rng, t, v, T1, 0.03)
+    exp = experiment("warm.csv", t, v, x, F, ambient=TRUTH.ambient)
+    res = identify_warm_up([exp] + soak_runs(TRUTH, rng), initial_model(TRUTH))
+    hp = res.details["heat_path"]
+    assert hp["nodes"] == 1 and hp["choice"]["delta"] < hp["choice"]["threshold"]
+    assert res.parameters["R_th"].value == pytest.approx(TRUTH.eta * (TRUTH.R1 + TRUTH.R2), rel=0.05)
+    assert res.parameters["C_th"].value == pytest.approx(TRUTH.C1 / TRUTH.eta, rel=0.05)
+    _check_temperature(res, rec)
+
+
 def _true_time_constants():
     """The truth's two-node time constants [s], from its equations' matrix (independent of the package)."""
     C1, R1, C2, R2 = TRUTH.C1, TRUTH.R1, TRUTH.C2, TRUTH.R2
