@@ -199,7 +199,9 @@ def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
         warnings.insert(0, "the temperature scale is undetermined: without soak runs at two temperatures or more "
                            "or a proxy temperature, scaling every law's slope by 1/s and the heat path's gains by s "
                            "leaves the forces unchanged; the heat path's resistances and capacities, the laws' "
-                           "slopes and the contact temperature are not given (its time constants are)")
+                           "slopes and the contact temperature are not given (its time constants are); the fitted "
+                           f"model's laws keep the initial model's scale ({', '.join(s.held)} held there): they are "
+                           "no calibration")
         trajectory = UNDETERMINED_TEXT
         heat.update({k: UNDETERMINED_TEXT for k in ("C_th", "R_th") + (("C_2", "R_2") if path.nodes == 2 else ())})
     else:
