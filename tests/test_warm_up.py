@@ -181,6 +181,21 @@ def test_a_short_warm_up_says_what_it_cannot_separate_and_what_record_would(reco
     assert len(said) == 1 and "at two speeds or more" in said[0] and "a proxy temperature" not in said[0]
 
 
+def test_without_laws_the_soak_runs_give_them_first(record):
+    """An initial model without laws (a plain Stribeck map): tf.identify fits Model I on the soak runs first (law
+    kinds chosen by AICc), then the warm-up; the laws of fc and fs and the heat path within 5 % of the truth's."""
+    rng = np.random.default_rng(1)
+    data = tf.Dataset(experiments=[_warm(record, rng)] + soak_runs(TRUTH, rng))
+    init = tf.Model(plant=tf.PrescribedMotion(motion="rotary"),
+                    friction=tf.Stribeck(fc=1.0, fs=1.4, vs=0.1, sigma2=0.2, v_smooth=TRUTH.v_smooth))
+    res = tf.identify(data, method="warm-up", init=init)
+    assert res.model.laws["fc"].kind == res.model.laws["fs"].kind == "linear"
+    for name, true in list(TRUTH.per_eta().items()) + [("fc.a", TRUTH.fc_a), ("fc.b", TRUTH.fc_b),
+                                                       ("fs.a", TRUTH.fs_a), ("fs.b", TRUTH.fs_b)]:
+        assert res.parameters[name].value == pytest.approx(true, rel=0.05), name
+    assert not any("heat path are not separated" in w for w in res.warnings)
+
+
 def test_warm_up_records_are_refused_by_the_other_methods(record):
     """A warm-up record has no contact temperature: Model I (or any other method) refuses it by name."""
     rng = np.random.default_rng(6)

@@ -124,15 +124,15 @@ def _separation(found, problem, theta) -> list:
 
 def _determination(params, problem, theta, advice) -> list:
     """Each shown value the data leave poorly determined (standard error above half its value, uncertainty.py's
-    rule), and, where one is the heat path's or a law's, what record would determine them (and whether the
-    warm-up is short for its slowest time constant)."""
+    rule), and, where one is the heat path's, what record would determine it (and whether the warm-up is short for
+    its slowest time constant)."""
     out = [f"'{p.name}' is poorly determined by these data (standard error "
            f"{'infinite' if not math.isfinite(p.stderr) else f'{100 * p.stderr / abs(p.value):.0f} % of its value'})"
            for p in params.values() if p.stderr is not None and p.value and
            (not math.isfinite(p.stderr) or p.stderr > 0.5 * abs(p.value))]
     slow = problem.path_of(theta).time_constants()[-1]
     longest = max(r.time[-1] - r.time[0] for r in problem.warm)
-    loose = [w for w in out if "." in w.split("'")[1] or w.split("'")[1] in HEAT_UNITS]
+    loose = [w for w in out if w.split("'")[1] in HEAT_UNITS]  # (a law's own looseness is the laws' matter)
     if loose:
         short = (f" (the longest record lasts {longest:.4g} s, less than three of the heat path's slowest time "
                  f"constant, {slow:.4g} s: the rise's end is not seen)" if longest < 3.0 * slow else "")
