@@ -7,7 +7,8 @@ differences of whole runs), and each parameter's difference is printed in standa
 The data are look-alike joint logs (tests/lookalike.py: LuGre with direction-dependent levels and a position
 ripple, integrated by SciPy, AR(1) torque noise, quantised encoder and firmware velocity), one run each, the
 model driven by the position (``motion="position"``). Each line prints the wall time of ``identify`` measured in
-one run and its ratio to the target. SciPy's optimisation and statistics modules, which the package imports at
+one run, its CPU time (all threads: on a machine others load, what the fit itself costs) and the wall time's ratio
+to the target. SciPy's optimisation and statistics modules, which the package imports at
 first use (about 1.5 s here), are imported before the clock starts and their import time is printed apart: a
 process pays it once, whatever it fits.
 
@@ -15,6 +16,7 @@ Run: python benchmarks/bench_force_fit.py [--compare] [--seed 0]
 """
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -33,8 +35,9 @@ CASES = (("120 s joint record at 4 ms", 30_000, 120.0, 3.0), ("84,000-sample rec
 
 
 def fit(data):
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     result = tf.identify(data, "base", friction="lugre")
+    fit.cpu = time.process_time() - c0  # (CPU time of all threads: the load's share of the wall time left out)
     return time.perf_counter() - t0, result
 
 
@@ -47,12 +50,15 @@ def main(argv=None):
     import scipy.optimize  # noqa: F401  (first-use imports, paid once per process)
     import scipy.stats  # noqa: F401
     print(f"SciPy's optimize and stats imported in {time.perf_counter() - t0:.2f} s (once per process, not timed below)")
-    print(f"{'record':30s} {'samples':>8s} {'time [s]':>9s} {'target [s]':>10s} {'ratio':>6s} {'evals':>6s}  earlier path")
+    print(f"load average {os.getloadavg()[0]:.1f}")
+    print(f"{'record':30s} {'samples':>8s} {'time [s]':>9s} {'CPU [s]':>8s} {'target [s]':>10s} {'ratio':>6s} "
+          f"{'evals':>6s}  earlier path")
     for label, n, duration, target in CASES:
         data, _ = lookalike_experiments(motion="position", offsets=(0.02,), roles=["fit"], duration=duration,
                                         rate=(n - 1) / duration, seed=args.seed)
         seconds, new = fit(data)
-        line = f"{label:30s} {n:8d} {seconds:9.2f} {target:10.1f} {seconds / target:6.2f} {new.nfev:6d}"
+        line = (f"{label:30s} {n:8d} {seconds:9.2f} {fit.cpu:8.2f} {target:10.1f} {seconds / target:6.2f} "
+                f"{new.nfev:6d}")
         if args.compare:
             with mock.patch.object(Force, "exact_names", staticmethod(lambda problem, model: None)):
                 old_seconds, old = fit(data)

@@ -44,12 +44,14 @@ def quick_rows():
 
 def test_every_evaluation_and_core_call_is_in_one_stage(quick_rows):
     """The per-stage evaluations and C core calls add up to the counts made apart (none lost, none twice), and the
-    fit's own nfev is among them (Model II's undercounts: its reference fit is not in nfev)."""
+    fit's own nfev and njev are those counts: every evaluation it made, its Jacobians too (Model II's base fit at
+    the reference temperature, its dF scans and fits, Model I's heads, the held tests)."""
     for row, evaluations, core in quick_rows:
         stages = row["stages"]
         assert sum(s["evaluations"] for s in stages.values()) == evaluations == row["evaluations"]
         assert sum(s["core_calls"] for s in stages.values()) == core > 0
-        assert row["nfev"] <= evaluations
+        assert row["nfev"] == evaluations
+        assert row["njev"] == sum(s["jacobians"] for s in stages.values())
         assert set(stages) <= {stage for _, _, stage in S.STAGES} | {"other"}
 
 
@@ -86,3 +88,18 @@ def test_the_truth_data_are_the_truths_own_within_the_noise():
     sim = tf.simulate(truth, 0.4, temperature=exp.temperature, sample_rate=5000.0)
     rms = math.sqrt(np.mean((exp.displacement - sim.displacement) ** 2))
     assert rms == pytest.approx(20e-9, rel=0.15)
+
+
+def test_a_force_truth_is_fitted_and_costed_in_its_own_exact_stepping():
+    """A quick force truth with a ripple (tests/lookalike.py's integration, drawn in the study): the fit's nfev and
+    njev are the evaluations the study counts apart; the cost is the fit's time over the exact stepping of its fit
+    runs (two of three: one is held out); the rough start's fit lands where the same fit from the truth's values
+    does (the look-alike's logger can leave the truth itself outside the intervals)."""
+    row = S.run_case("force-ripple", 1, True, None)
+    stages = row["stages"]
+    assert row["nfev"] == row["evaluations"] == sum(s["evaluations"] for s in stages.values()) > 0
+    assert row["njev"] == sum(s["jacobians"] for s in stages.values())
+    assert row["cost"] == pytest.approx(row["wall"] / row["unit_wall"], rel=1e-12) and row["cost"] > 1
+    assert stages["force fit"]["evaluations"] > 0
+    assert row["same_optimum"] < 1.0
+    assert set(row["values"]) == set(S.FORCE_NAMES) | {"ripple_cos1", "ripple_sin1"}

@@ -51,6 +51,12 @@ enum {
     VR_FRICTION_FORCE = 4,
     VR_TEMPERATURE_OUT = 5,
     VR_STAGE_DISPLACEMENT = 6,
+    /* the temperature estimator (estimator.h), with an "estimator" line in the resources: */
+    VR_TEMPERATURE_ESTIMATE = 7, /* outputs: the contact temperature estimate [degC] */
+    VR_TEMPERATURE_VARIANCE = 8, /* and its variance [K^2] */
+    VR_MEASURED_FORCE = 9,       /* inputs: the measured friction force [N] (NaN: none) */
+    VR_PROXY_TEMPERATURE = 10,   /* the proxy temperature [degC] (NaN: none), with a proxy */
+    VR_AMBIENT = 11,             /* the ambient temperature [degC], without a heat model (with one: VR_TEMPERATURE) */
     VR_FIRST_PARAMETER = 16
 };
 
@@ -58,12 +64,16 @@ enum {
 typedef enum {
     ROLE_NONE = 0, ROLE_M, ROLE_M_E, ROLE_C, ROLE_K, ROLE_T_EM, ROLE_XI, ROLE_WN, ROLE_GAIN, ROLE_K_S, ROLE_V_0,
     ROLE_PARAM, ROLE_LAW_A, ROLE_LAW_B, ROLE_LAW_X, ROLE_LAW_Y, ROLE_GMS_K, ROLE_GMS_W,
-    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0, ROLE_STEP
+    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0, ROLE_STEP, ROLE_ESTIMATOR
 } role_kind;
 
 static const char *const ROLE_NAMES[] = {"", "m", "m_e", "c", "k", "T_em", "xi", "wn", "K", "k_s", "v_0",
                                          "p", "law_a", "law_b", "law_x", "law_y", "gms_k", "gms_w",
-                                         "C_th", "R_th", "eta", "T_0", "step"};
+                                         "C_th", "R_th", "eta", "T_0", "step", "estimator"};
+
+/* The estimator's parameters (role "estimator", index i): tf_temperature_config's numbers, then its start. */
+enum { EST_C_TH, EST_R_TH, EST_ETA, EST_C_2, EST_R_2, EST_TAU_P, EST_Q_CONTACT, EST_Q_HOUSING, EST_Q_PROXY, EST_R_F,
+       EST_R_P, EST_V_MIN, EST_T_0, EST_VAR_0, EST_NPARAM };
 
 typedef struct {
     unsigned char role, fixed; /* fixed: settable before initialisation only (law breakpoints, T_0) */
@@ -108,6 +118,13 @@ struct fmu_instance {
     double rtol;
     double fixed_step;       /* > 0: the fixed-step real-time integrator at this step [s]; 0: adaptive */
     int out_of_range;        /* the last temperature was outside the range (warn once per excursion) */
+
+    /* the temperature estimator: on with an "estimator" line (its proxy kind), stepped once per communication
+       step after the plant, on its own real-time friction object (the model's friction at the estimate) */
+    int estimator, est_proxy;
+    double est_p[EST_NPARAM];
+    tf_temperature_estimator est, est_trial; /* the trial: a step's result until the plant's step succeeded */
+    tf_rt_friction est_rt, est_rt_trial;
 };
 typedef struct fmu_instance instance;
 
@@ -283,6 +300,14 @@ static int read_resources(instance *c, const char *dir, int is_uri)
             char kind[16];
             ok = sscanf(rest, "%15s", kind) == 1 && (strcmp(kind, "adaptive") == 0 || strcmp(kind, "realtime") == 0);
             if (ok) c->fixed_step = strcmp(kind, "realtime") == 0 ? NAN : 0.0; /* NaN until its variable is read */
+        } else if (strcmp(key, "estimator") == 0) { /* the estimator's proxy kind (estimator.h) */
+            double T_amb;
+            ok = sscanf(rest, "%d %lf", &c->est_proxy, &T_amb) == 2 && c->est_proxy >= TF_PROXY_NONE &&
+                 c->est_proxy <= TF_PROXY_HOUSING && plausible_temperature(T_amb);
+            c->estimator = ok;
+            c->r[VR_AMBIENT] = c->r_start[VR_AMBIENT] = T_amb; /* the measurements: none until given */
+            c->r[VR_MEASURED_FORCE] = c->r_start[VR_MEASURED_FORCE] = NAN;
+            c->r[VR_PROXY_TEMPERATURE] = c->r_start[VR_PROXY_TEMPERATURE] = NAN;
         } else if (strcmp(key, "input") == 0) { /* start values of the inputs */
             ok = sscanf(rest, "%lf %lf", &c->r_start[VR_DRIVE], &c->r_start[VR_TEMPERATURE]) == 2;
             c->r[VR_DRIVE] = c->r_start[VR_DRIVE];
@@ -347,6 +372,7 @@ static int build_model(instance *c, tf_model *m)
             if (!(v > 0 && isfinite(v))) return (fmu_fail(c, "integrator.step = %g s: the fixed step must be positive", v), -1);
             c->fixed_step = v;
             break;
+        case ROLE_ESTIMATOR: if (r.i >= 0 && r.i < EST_NPARAM) c->est_p[r.i] = v; break;
         default: break;
         }
         if (r.role && !isfinite(v)) return (fmu_fail(c, "parameter (value reference %d) is not finite", vr), -1);
@@ -472,6 +498,76 @@ static fmu_status check_range(instance *c, double T)
     return s;
 }
 
+/* ---- the temperature estimator (estimator.h) ---- */
+
+static tf_temperature_config est_config(const instance *c)
+{
+    const double *p = c->est_p;
+    tf_temperature_config k = {p[EST_C_TH], p[EST_R_TH], p[EST_ETA], p[EST_C_2], p[EST_R_2], c->est_proxy,
+                               p[EST_TAU_P], {p[EST_Q_CONTACT], p[EST_Q_HOUSING], p[EST_Q_PROXY]}, p[EST_R_F],
+                               p[EST_R_P], p[EST_V_MIN]};
+    return k;
+}
+
+/* The estimator from its parameters and start, on the model's friction at rest: at the initialization. */
+static int est_start(instance *c)
+{
+    if (!c->estimator) return 0;
+    tf_error e;
+    tf_temperature_config k = est_config(c);
+    if (tf_rt_from_model(&c->est_rt, &c->model, &e) != TF_OK)
+        return (fmu_fail(c, "the estimator's friction model was refused ('%s')", e.what), -1);
+    if (tf_temperature_init(&c->est, &k, c->est_p[EST_T_0], c->est_p[EST_VAR_0], &e) != TF_OK)
+        return (fmu_fail(c, "fmi2ExitInitializationMode: the estimator refuses its parameters: '%s'", e.what), -1);
+    return 0;
+}
+
+/* A tunable estimator parameter changed (in step mode): the configuration checked and taken, or refused. */
+static int est_configure(instance *c)
+{
+    if (!c->estimator || c->mode != S_STEP) return 0;
+    tf_error e;
+    tf_temperature_config k = est_config(c);
+    if (tf_temperature_configure(&c->est, &k, &e) != TF_OK)
+        return (fmu_fail(c, "fmi2SetReal: the estimator refuses its parameters: '%s'", e.what), -1);
+    return 0;
+}
+
+/* The estimator's friction object on c->model as now built (its laws in the instance's stores), its states kept. */
+static void est_sync_model(instance *c)
+{
+    if (!c->estimator) return;
+    int modes[TF_MAX_FRICTION_STATES];
+    memcpy(modes, c->est_rt.data.gms.mode, sizeof modes);
+    c->est_rt.model = c->model;
+    tf_model_data_init(&c->est_rt.data, &c->est_rt.model);
+    memcpy(c->est_rt.data.gms.mode, modes, sizeof modes);
+}
+
+/* One estimator step over the communication step h at the sliding velocity v of its start, into the trial
+ * copies (est_commit takes them once the plant's step succeeded): 0, or logs why not and returns -1. */
+static int est_step(instance *c, double v, double h)
+{
+    if (!c->estimator) return 0;
+    c->est_trial = c->est;
+    c->est_rt_trial = c->est_rt;
+    double T_amb = c->heat ? c->r[VR_TEMPERATURE] : c->r[VR_AMBIENT], F;
+    double T_proxy = c->est_proxy != TF_PROXY_NONE ? c->r[VR_PROXY_TEMPERATURE] : NAN;
+    tf_error e;
+    tf_status s = tf_temperature_step(&c->est_trial, &c->est_rt_trial, v, c->r[VR_MEASURED_FORCE], T_proxy, T_amb, h,
+                                      &F, &e);
+    if (s != TF_OK)
+        return (fmu_fail(c, "the temperature estimator's step at %g s (estimate %g C) was refused: %s ('%s')", c->t,
+                         c->est.x[0], tf_status_message(s), e.what), -1);
+    return 0;
+}
+
+static fmu_status est_commit(instance *c, fmu_status status)
+{
+    if (c->estimator && status <= FMU_WARNING) c->est = c->est_trial, c->est_rt = c->est_rt_trial;
+    return status;
+}
+
 /* ---- outputs ---- */
 
 static double output(instance *c, int vr)
@@ -579,6 +675,7 @@ fmu_status fmu_exit_initialization(fmu_instance *c)
     if (check_model(c, &c->model) != 0) return FMU_ERROR;
     tf_model_initial_state(&c->model, c->y);
     tf_model_on_restart(c->t, c->y, &c->data); /* GMS modes consistent with the start */
+    if (est_start(c) != 0) return FMU_ERROR;
     c->mode = S_STEP;
     if (c->temperature_input || c->heat) return check_range(c, output(c, VR_TEMPERATURE_OUT));
     return FMU_OK;
@@ -608,7 +705,7 @@ fmu_status fmu_reset(fmu_instance *c)
 
 static int is_output(fmu_vr vr)
 {
-    return vr >= VR_DISPLACEMENT && vr <= VR_STAGE_DISPLACEMENT;
+    return vr >= VR_DISPLACEMENT && vr <= VR_TEMPERATURE_VARIANCE;
 }
 
 /* The value references the model description declares (fmu.py's _variables): the drive, the
@@ -621,6 +718,9 @@ static int declared(const instance *c, fmu_vr vr)
     case VR_TEMPERATURE: return c->temperature_input || c->heat;
     case VR_TEMPERATURE_OUT: return c->heat;
     case VR_STAGE_DISPLACEMENT: return c->plant == TF_PLANT_STICK_SLIP;
+    case VR_TEMPERATURE_ESTIMATE: case VR_TEMPERATURE_VARIANCE: case VR_MEASURED_FORCE: return c->estimator;
+    case VR_PROXY_TEMPERATURE: return c->estimator && c->est_proxy != TF_PROXY_NONE;
+    case VR_AMBIENT: return c->estimator && !c->heat;
     default: return vr >= VR_FIRST_PARAMETER && vr < MAX_VR && c->role[vr].role != ROLE_NONE;
     }
 }
@@ -631,7 +731,9 @@ fmu_status fmu_get_real(fmu_instance *c, const fmu_vr vr[], size_t n, double val
     if (n > 0 && (!vr || !value)) return fmu_fail(c, "fmi2GetReal: NULL argument");
     for (size_t k = 0; k < n; k++) {
         if (!declared(c, vr[k])) return fmu_fail(c, "fmi2GetReal: value reference %u is not a variable of this FMU", vr[k]);
-        value[k] = is_output(vr[k]) ? output(c, (int)vr[k]) : c->r[vr[k]];
+        value[k] = vr[k] == VR_TEMPERATURE_ESTIMATE ? c->est.x[0]
+                   : vr[k] == VR_TEMPERATURE_VARIANCE ? c->est.P[0][0]
+                   : is_output(vr[k]) ? output(c, (int)vr[k]) : c->r[vr[k]];
     }
     return FMU_OK;
 }
@@ -650,17 +752,22 @@ fmu_status fmu_set_real(fmu_instance *c, const fmu_vr vr[], size_t n, const doub
             memcpy(c->r, before, sizeof before);
             return fmu_fail(c, "fmi2SetReal: value reference %u cannot be set", v);
         }
-        if (!isfinite(value[k])) {
+        int measurement = v == VR_MEASURED_FORCE || v == VR_PROXY_TEMPERATURE; /* NaN: not measured */
+        if (!isfinite(value[k]) && !(measurement && isnan(value[k]))) {
             memcpy(c->r, before, sizeof before);
             return fmu_fail(c, "fmi2SetReal: %s (value reference %u) is not finite (%g): refused",
                          v == VR_DRIVE ? "the drive input" : v == VR_TEMPERATURE ? "the temperature input"
-                                                                                  : "a parameter", v, value[k]);
+                         : measurement ? "a measurement input (NaN: none)" : v == VR_AMBIENT ? "the ambient temperature"
+                                       : "a parameter", v, value[k]);
         }
-        if ((v == VR_TEMPERATURE || c->role[v].role == ROLE_T_0) && !plausible_temperature(value[k])) {
+        int start_T = c->role[v].role == ROLE_T_0 || (c->role[v].role == ROLE_ESTIMATOR && c->role[v].i == EST_T_0);
+        if ((v == VR_TEMPERATURE || v == VR_AMBIENT || v == VR_PROXY_TEMPERATURE || start_T) && !isnan(value[k]) &&
+            !plausible_temperature(value[k])) {
             memcpy(c->r, before, sizeof before);
             return fmu_fail(c, "fmi2SetReal: %s %g C is not a plausible temperature (expected %g to %g C): refused",
                         v == VR_TEMPERATURE ? (c->heat ? "the ambient temperature" : "the temperature input")
-                                            : "the start temperature T_0", value[k], T_MIN, T_MAX);
+                        : v == VR_AMBIENT ? "the ambient temperature" : v == VR_PROXY_TEMPERATURE ? "the proxy temperature"
+                                          : "the start temperature", value[k], T_MIN, T_MAX);
         }
         if (v >= VR_FIRST_PARAMETER && c->role[v].role == ROLE_STEP && !(value[k] > 0)) {
             memcpy(c->r, before, sizeof before);
@@ -681,13 +788,14 @@ fmu_status fmu_set_real(fmu_instance *c, const fmu_vr vr[], size_t n, const doub
         tf_model m = c->model;
         int bad = build_model(c, &m) != 0;
         if (!bad) set_signals(c, &m, c->t, 0.0);
-        if (bad || check_model(c, &m) != 0) {
+        if (bad || check_model(c, &m) != 0 || est_configure(c) != 0) {
             memcpy(c->r, before, sizeof before);
-            rebuild(c); /* the laws' stores back to the old values */
+            rebuild(c); /* the laws' stores (and the estimator's parameters) back to the old values */
             return FMU_ERROR;
         }
         c->model = m;
         data_for_model(c);
+        est_sync_model(c);
     }
     return FMU_OK;
 }
@@ -812,6 +920,7 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
     }
     set_signals(c, &c->model, c->t, h);
     if (check_model(c, &c->model) != 0) return FMU_ERROR;
+    if (est_step(c, sliding_velocity(&c->model, c->t, c->y), h) != 0) return FMU_ERROR;
 
     int n = tf_model_nstate(&c->model);
     double y[TF_MAX_STATES], atol[TF_MAX_STATES];
@@ -823,7 +932,7 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
             tf_model_data_changed(&c->data);
             return FMU_ERROR;
         }
-        return step_done(c, h, y, n, status, &modes);
+        return est_commit(c, step_done(c, h, y, n, status, &modes));
     }
     tf_model_state_scale(&c->model, atol);
     for (int i = 0; i < n; i++) atol[i] *= c->rtol;
@@ -843,7 +952,7 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
         return fmu_fail(c, "the integration from %g s over %g s failed at %g s: %s (%s)", c->t, h, e.t,
                     tf_status_message(s), e.what);
     }
-    return step_done(c, h, y, n, status, &modes);
+    return est_commit(c, step_done(c, h, y, n, status, &modes));
 }
 
 /* After a successful step of h: the new state and time, the inputs advanced along their derivatives; refused,
@@ -920,6 +1029,7 @@ fmu_status fmu_set_state(fmu_instance *c, void *state)
     c->name = name, c->cb = cb, c->logging = logging;
     c->mode = mode, c->stop_defined = stop_defined, c->stop = stop;
     if (rebuild(c) != 0) return FMU_ERROR; /* the laws' pointers and the data's, the modes as saved */
+    est_sync_model(c);
     return FMU_OK;
 }
 

@@ -11,5 +11,6 @@
 #include "thermofriction/sensitivity.h"
 #include "thermofriction/realtime.h"
 #include "thermofriction/control.h"
+#include "thermofriction/estimator.h"
 #include "thermofriction/prescribed.h"
 #endif

@@ -113,6 +113,46 @@ static tf_status stop_in(tf_error *err, tf_status status, const char *where, lon
     return status;
 }
 
+/* A per-period series: every sample finite and, where it changes, the model valid there (f not NULL). */
+static tf_status series_check(tf_rt_friction *f, const double *T, long n, const char *where, const char *what,
+                              tf_error *err)
+{
+    for (long i = 0; i < n; i++) {
+        if (!isfinite(T[i])) return stop(err, TF_ERR_BAD_ARGUMENT, where, what, i);
+        if (f && (i == 0 || T[i] != T[i - 1]) && tf_rt_params_at(f, T[i], 0, 0, 0, err))
+            return stop_in(err, TF_ERR_BAD_ARGUMENT, where, i);
+    }
+    return TF_OK;
+}
+
+/* The temperatures' inputs: the series, the estimator's (its own checks are per step), the noise. */
+static tf_status temperature_check(tf_loop *L, long n, tf_error *err)
+{
+    const int B = TF_ERR_BAD_ARGUMENT;
+    tf_rt_friction *comp = L->compensation != TF_COMP_NONE ? L->comp : 0;
+    tf_status status;
+    if (L->T_plant_series) {
+        if ((status = series_check(L->plant, L->T_plant_series, n, "plant", "T_plant_series (not finite)", err)))
+            return status;
+    } else if (tf_rt_params_at(L->plant, L->T_plant, 0, 0, 0, err))
+        return stop_in(err, B, "plant", -1);
+    if (L->position_noise &&
+        (status = series_check(0, L->position_noise, n, "loop", "position_noise (not finite)", err)))
+        return status;
+    if (!(isfinite(L->dob_tau) && L->dob_tau >= 0.0)) return stop(err, B, "loop", "dob_tau (finite, >= 0)", -1);
+    if (L->estimator) {
+        if (!L->est_friction) return stop(err, B, "estimator", "est_friction (NULL)", -1);
+        if (!isfinite(L->T_amb)) return stop(err, B, "estimator", "T_amb (not finite)", -1);
+        for (long i = 0; L->T_proxy && i < n; i++) /* NaN: not measured in that period */
+            if (isinf(L->T_proxy[i])) return stop(err, B, "estimator", "T_proxy (infinite)", i);
+        return TF_OK;
+    }
+    if (L->T_comp_series)
+        return series_check(comp, L->T_comp_series, n, "compensation", "T_comp_series (not finite)", err);
+    if (comp && tf_rt_params_at(comp, L->T_comp, 0, 0, 0, err)) return stop_in(err, B, "compensation", -1);
+    return TF_OK;
+}
+
 /* Everything tf_loop_run can refuse before it starts, so that a refusal writes nothing. */
 static tf_status loop_check(tf_loop *L, long n, const double *x_ref, const double *v_ref, tf_error *err)
 {
@@ -121,7 +161,7 @@ static tf_status loop_check(tf_loop *L, long n, const double *x_ref, const doubl
     if (!x_ref) return stop(err, B, "reference", "x_ref (NULL)", -1);
     if (L->compensation < TF_COMP_NONE || L->compensation > TF_COMP_OBSERVER)
         return stop(err, B, "loop", "compensation (kind)", -1);
-    int ff = L->compensation == TF_COMP_FEEDFORWARD;
+    int ff = L->compensation == TF_COMP_FEEDFORWARD || L->inertia_feedforward;
     if (ff && !v_ref) return stop(err, B, "reference", "v_ref (NULL)", -1);
     if (!(isfinite(L->mass) && L->mass > 0.0)) return stop(err, B, "loop", "mass (finite, > 0)", -1);
     if (!(isfinite(L->dt) && L->dt > 0.0)) return stop(err, B, "loop", "dt (finite, > 0)", -1);
@@ -135,8 +175,6 @@ static tf_status loop_check(tf_loop *L, long n, const double *x_ref, const doubl
     if (!gains_ok(L->pid.kp, L->pid.ki, L->pid.kd, L->pid.tau_d))
         return stop(err, B, "pid", "gains (finite; tau_d >= 0)", -1);
     if (!L->plant) return stop(err, B, "plant", "plant (NULL)", -1);
-    /* the temperatures are constant over the run: a model valid there at the start stays so */
-    if (tf_rt_params_at(L->plant, L->T_plant, 0, 0, 0, err)) return stop_in(err, B, "plant", -1);
     if (L->compensation != TF_COMP_NONE) {
         if (!L->comp) return stop(err, B, "compensation", "comp (NULL)", -1);
         if (L->compensation == TF_COMP_OBSERVER) {
@@ -146,9 +184,47 @@ static tf_status loop_check(tf_loop *L, long n, const double *x_ref, const doubl
             if (!(isfinite(L->observer_gain) && L->observer_gain >= 0.0))
                 return stop(err, B, "compensation", "observer_gain (finite, >= 0)", -1);
         }
-        if (tf_rt_params_at(L->comp, L->T_comp, 0, 0, 0, err)) return stop_in(err, B, "compensation", -1);
     }
+    /* a model valid at each given temperature before the start stays so; the estimator's is checked per step */
+    return temperature_check(L, n, err);
+}
+
+/* The disturbance observer's memory: the last two encoder positions and controls, the filtered force. */
+typedef struct {
+    double x1, x2, u1, u2, F;
+} dob_memory;
+
+/* The compensation's temperature in period i (and its variance, the measured friction), from the
+ * estimator stepped on the disturbance observer's friction, a sensor's series or the constant. */
+static tf_status told_temperature(tf_loop *L, long i, double x, dob_memory *d, double *T, double *var, double *Fm,
+                                  tf_error *err)
+{
+    double xe = x + (L->position_noise ? L->position_noise[i] : 0.0), dt = L->dt;
+    *var = 0.0, *Fm = NAN;
+    if (!L->estimator) {
+        *T = L->T_comp_series ? L->T_comp_series[i] : L->T_comp;
+        return TF_OK;
+    }
+    double vc = i == 0 ? 0.0 : (xe - d->x1) / dt, F_hat;
+    if (i >= 2) {
+        double Fd = 0.5 * (d->u1 + d->u2) - L->mass * (xe - 2.0 * d->x1 + d->x2) / (dt * dt);
+        double a = L->dob_tau > 0.0 ? -expm1(-dt / L->dob_tau) : 1.0;
+        *Fm = d->F = i == 2 ? Fd : d->F + a * (Fd - d->F);
+        vc = (xe - d->x2) / (2.0 * dt);
+    }
+    double Tp = L->T_proxy ? L->T_proxy[i] : NAN;
+    tf_status status = tf_temperature_step(L->estimator, L->est_friction, vc, *Fm, Tp, L->T_amb, dt, &F_hat, err);
+    if (status) return stop_in(err, status, "estimator", i);
+    d->x2 = d->x1, d->x1 = xe;
+    *T = tf_temperature_estimate(L->estimator);
+    *var = tf_temperature_variance(L->estimator);
     return TF_OK;
+}
+
+/* Writes one period's value to an output array, if asked for. */
+static void put(double *out, long i, double value)
+{
+    if (out) out[i] = value;
 }
 
 tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_ref, double *x_out, double *u_out,
@@ -159,29 +235,37 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
     if (status) return status;
     double x = x_ref[0], v = 0.0;
     double h = L->dt / L->substeps;
+    dob_memory d = {x, x, 0.0, 0.0, 0.0};
+    const tf_loop_trace *tr = &L->trace;
     for (long i = 0; i < n; i++) {
-        double e = x_ref[i] - x, u, Fc = 0.0;
+        double e = x_ref[i] - x, u, Fc = 0.0, Tc, var, Fm;
+        double T_plant = L->T_plant_series ? L->T_plant_series[i] : L->T_plant;
+        if ((status = told_temperature(L, i, x, &d, &Tc, &var, &Fm, err))) return status;
         if ((status = tf_pid_step(&L->pid, e, L->dt, &u, 0)))
             return stop(err, status, "pid", "u (not finite: the loop is unstable)", i);
         if (L->compensation == TF_COMP_FEEDFORWARD)
-            status = tf_rt_step(L->comp, v_ref[i], L->T_comp, L->dt, &Fc, err);
+            status = tf_rt_step(L->comp, v_ref[i], Tc, L->dt, &Fc, err);
         else if (L->compensation == TF_COMP_OBSERVER)
-            status = tf_observer_step(L->comp, v, -e, L->observer_gain, L->T_comp, L->dt, &Fc, err);
+            status = tf_observer_step(L->comp, v, -e, L->observer_gain, Tc, L->dt, &Fc, err);
         if (status) return stop_in(err, status, "compensation", i);
         u += Fc;
+        if (L->inertia_feedforward && i + 1 < n) u += L->mass * (v_ref[i + 1] - v_ref[i]) / L->dt;
         if (!isfinite(u)) return stop(err, TF_ERR_NONFINITE, "loop", "u (not finite: the loop is unstable)", i);
-        if (x_out) x_out[i] = x;
-        if (u_out) u_out[i] = u;
-        if (F_out) F_out[i] = Fc;
+        d.u2 = d.u1, d.u1 = u;
+        put(x_out, i, x), put(u_out, i, u), put(F_out, i, Fc);
+        put(tr->T_comp, i, Tc), put(tr->T_variance, i, var), put(tr->F_measured, i, Fm);
+        double F_sum = 0.0;
         for (int s = 0; s < L->substeps; s++) {
             double F;
-            if ((status = tf_rt_step(L->plant, v, L->T_plant, h, &F, err))) return stop_in(err, status, "plant", i);
+            if ((status = tf_rt_step(L->plant, v, T_plant, h, &F, err))) return stop_in(err, status, "plant", i);
             v += (u - F) / L->mass * h;
             x += v * h;
+            F_sum += F;
             /* here, not after the period: the next substep would refuse a non-finite v as an argument */
             if (!isfinite(x) || !isfinite(v))
                 return stop(err, TF_ERR_NONFINITE, "loop", "position or velocity not finite (the loop is unstable)", i);
         }
+        put(tr->F_plant, i, F_sum / L->substeps);
     }
     return stop(err, TF_OK, 0, 0, -1);
 }

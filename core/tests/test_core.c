@@ -1043,6 +1043,40 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
     tf_rt_reset(&plant, &E), tf_rt_reset(&comp, &E);
     CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == TF_ERR_NONFINITE && E.index >= 0,
           "loop: unstable gains stop the run (at period %ld: %s)", E.index, E.what);
+
+    /* temperatures that change over the run (issue 45): every period's checked before anything is written */
+    L.pid.kp = 4e4;
+    static double T_series[N], T_told[N], F_plant[N];
+    for (int i = 0; i < N; i++) T_series[i] = 30.0 + 0.05 * i, T_told[i] = 30.0, x[i] = -7.0;
+    T_series[120] = 60.0; /* fc of the law above is negative there */
+    L.T_plant_series = T_series;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "plant") && E.index == 120 &&
+              x[0] == -7.0,
+          "loop: a plant series invalid at one period refused before anything is written (%s, %ld)", E.where,
+          E.index);
+    T_series[120] = NAN;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && E.index == 120, "loop: a NaN in the plant series");
+    T_series[120] = 36.0;
+    T_told[50] = 60.0;
+    L.T_comp_series = T_told;
+    tf_rt_set_model_i(&comp, TF_P_FC, &fc, &E);
+    tf_rt_set_model_i(&comp, TF_P_FS, &fc, &E);
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "compensation") && E.index == 50,
+          "loop: a compensation series invalid at one period refused");
+    T_told[50] = 30.0;
+    L.dob_tau = -1.0;
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && strstr(E.what, "dob_tau"), "loop: dob_tau < 0");
+    L.dob_tau = 0.0;
+    tf_temperature_estimator est;
+    L.estimator = &est; /* without its friction model */
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == B && !strcmp(E.where, "estimator"),
+          "loop: an estimator without est_friction");
+    L.estimator = NULL;
+    L.trace.F_plant = F_plant;
+    tf_rt_reset(&plant, &E), tf_rt_reset(&comp, &E), tf_pid_init(&L.pid, 4e4, 4e5, 280.0, 2e-4, &E);
+    CHECK(tf_loop_run(&L, N, x_ref, v_ref, x, 0, 0, &E) == TF_OK && isfinite(F_plant[N - 1]) && F_plant[N - 1] > 0.0,
+          "loop: runs with both series and writes the plant's friction");
+    L.T_plant_series = L.T_comp_series = NULL, L.trace.F_plant = NULL;
 }
 #undef B
 

@@ -53,6 +53,7 @@ TARGET_CODES = dict(_GROUPS["target"])
 HEAT_PARAMETER_INDEX = dict(_GROUPS["heat_parameter"])
 PLANT_PARAMETER_INDEX = dict(_GROUPS["plant_parameter"])
 COMPENSATION_CODES = dict(_GROUPS["compensation"])
+PROXY_CODES = dict(_GROUPS["proxy"])
 #: Output channels, in column order; after them come the friction states, then the friction work.
 OUTPUTS = _ordered("output")
 OUTPUT_COLUMN = {name: i for i, name in enumerate(OUTPUTS)}
@@ -274,12 +275,17 @@ def target(kind: str, index: int = 0, coefficient: int = 0) -> tuple:
 
 
 def loop(plant_spec, T_plant, comp_spec, T_comp, compensation: str, gain, mass, pid, dt, substeps, x_ref, v_ref,
-         x_out, u_out, F_out) -> str:
-    """The fixed-step closed loop of control.h; returns its status name. ``substeps`` beyond any C integer
-    is passed as 2**31, which the core refuses as it does any n x substeps above TF_LOOP_MAX_SUBSTEPS."""
-    status = _core.loop(plant_spec, float(T_plant), comp_spec, float(T_comp), COMPENSATION_CODES[compensation],
-                        float(gain), float(mass), tuple(float(g) for g in pid), float(dt), min(int(substeps), 2**31), x_ref,
-                        v_ref, x_out, u_out, F_out)
+         outputs, *, T_plant_series=None, T_comp_series=None, estimator=None, inertia_feedforward=False) -> str:
+    """The fixed-step closed loop of control.h; returns its status name. ``outputs``: seven arrays of one
+    value per period or None (x, u, F_comp, then the trace: F_plant, T_comp, T_variance, F_measured; the
+    first three required). ``estimator``: None or (est_spec, config, T0, var0, T_amb, T_proxy, position_noise,
+    dob_tau), config the tuple of ``temperature_estimate``. ``inertia_feedforward``: the control adds
+    m (v_ref[i+1] - v_ref[i]) / dt. ``substeps`` beyond any C integer is passed as
+    2**31, which the core refuses as it does any n x substeps above TF_LOOP_MAX_SUBSTEPS."""
+    status = _core.loop(plant_spec, float(T_plant), T_plant_series, comp_spec, float(T_comp), T_comp_series,
+                        COMPENSATION_CODES[compensation], float(gain), float(mass), tuple(float(g) for g in pid),
+                        float(dt), min(int(substeps), 2**31), x_ref, v_ref, estimator, tuple(outputs),
+                        bool(inertia_feedforward))
     return STATUS_NAMES.get(status, f"status {status}")
 
 
@@ -288,7 +294,15 @@ def rt_steps(spec, T, v, dt, F_out) -> float:
     return _core.rt_steps(spec, T, v, float(dt), F_out)
 
 
+def temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy, T_amb, dt, T_out, var_out, F_out) -> float:
+    """The temperature estimator of estimator.h over whole arrays (config: tf_temperature_config's fields in
+    order; T_proxy None or one per sample); the outputs written in place; seconds, timed in C."""
+    return _core.temperature_estimate(spec, config,
+                                      float(T0), float(var0), v, F_measured, T_proxy, T_amb, float(dt), T_out,
+                                      var_out, F_out)
+
+
 __all__ = ["PARAMETERS", "PLANT_CODES", "FRICTION_CODES", "LAW_CODES", "OUTPUTS", "OUTPUT_COLUMN", "MECHANICAL_STATES",
            "model_spec", "law_tuple", "waveform_tuple", "run", "run_sensitivities", "prescribed_force", "prescribed_applies", "CoreFailure", "target", "loop",
-           "rt_steps", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
+           "rt_steps", "temperature_estimate", "PROXY_CODES", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
            "n_outputs", "state_index"]

@@ -602,26 +602,66 @@ static PyObject *py_state_scale(PyObject *self, PyObject *args)
     return result;
 }
 
-/* loop(plant_spec, T_plant, comp_spec|None, T_comp, compensation, observer_gain, mass, (kp, ki, kd, tau_d),
- *      dt, substeps, x_ref, v_ref, x_out, u_out, F_out): the closed loop of control.h */
+/* An optional per-period input of the loop: None (NULL), or n float64 values. */
+static const double *loop_series(arena *a, PyObject *obj, Py_ssize_t n, const char *what)
+{
+    Py_ssize_t len;
+    const double *s = get_array(a, obj, &len, what);
+    if (s && len != n) PyErr_Format(PyExc_ValueError, "%s: one value per period (%zd), got %zd", what, n, len);
+    return PyErr_Occurred() ? NULL : s;
+}
+
+/* The loop's estimator, from (est_spec, config, T0, var0, T_amb, T_proxy|None, position_noise|None, dob_tau):
+ * its friction model in *f, the estimator initialised in *est; 0, or -1 with a Python error set. config is
+ * the tuple of temperature_estimate. */
+static int loop_estimator(arena *a, PyObject *obj, Py_ssize_t n, tf_loop *L, tf_temperature_estimator *est,
+                          tf_rt_friction *f)
+{
+    PyObject *spec, *proxy, *noise;
+    tf_temperature_config c;
+    double T0, var0;
+    tf_model m;
+    tf_error e;
+    if (!PyArg_ParseTuple(obj, "O(dddddiddddddd)dddOOd", &spec, &c.C_th, &c.R_th, &c.eta, &c.C_2, &c.R_2,
+                          &c.proxy, &c.tau_p, &c.q[0], &c.q[1], &c.q[2], &c.r_F, &c.r_p, &c.v_min, &T0, &var0,
+                          &L->T_amb, &proxy, &noise, &L->dob_tau))
+        return -1;
+    if (parse_model(a, spec, &m)) return -1;
+    if (tf_rt_from_model(f, &m, &e)) return PyErr_Format(PyExc_ValueError, "estimator friction model: %s", e.what), -1;
+    if (tf_temperature_init(est, &c, T0, var0, &e)) return PyErr_Format(PyExc_ValueError, "estimator: %s", e.what), -1;
+    L->estimator = est, L->est_friction = f;
+    L->T_proxy = loop_series(a, proxy, n, "T_proxy");
+    if (!PyErr_Occurred()) L->position_noise = loop_series(a, noise, n, "position_noise");
+    return PyErr_Occurred() ? -1 : 0;
+}
+
+/* loop(plant_spec, T_plant, T_plant_series|None, comp_spec|None, T_comp, T_comp_series|None, compensation,
+ *      observer_gain, mass, (kp, ki, kd, tau_d), dt, substeps, x_ref, v_ref, estimator|None,
+ *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured), inertia_feedforward): the closed loop of
+ *      control.h; the outputs are float64 arrays of n values (the last four may be None). */
 static PyObject *py_loop(PyObject *self, PyObject *args)
 {
-    PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *outs[3];
-    double T_plant, T_comp, gain, mass, kp, ki, kd, tau_d, dt;
-    int compensation;
+    PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *Tp_obj, *Tc_obj, *est_obj, *outs[7];
+    tf_loop L;
+    memset(&L, 0, sizeof L);
+    double kp, ki, kd, tau_d;
     long substeps_in;
-    if (!PyArg_ParseTuple(args, "OdOdidd(dddd)dlOOOOO", &plant_spec, &T_plant, &comp_spec, &T_comp, &compensation,
-                          &gain, &mass, &kp, &ki, &kd, &tau_d, &dt, &substeps_in, &xr_obj, &vr_obj, &outs[0], &outs[1],
-                          &outs[2]))
+    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)p", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
+                          &L.T_comp, &Tc_obj, &L.compensation, &L.observer_gain, &L.mass, &kp, &ki, &kd, &tau_d, &L.dt,
+                          &substeps_in, &xr_obj, &vr_obj, &est_obj, &outs[0], &outs[1], &outs[2], &outs[3], &outs[4],
+                          &outs[5], &outs[6], &L.inertia_feedforward))
         return NULL;
     if (substeps_in > TF_LOOP_MAX_SUBSTEPS) { /* beyond an int: the core's own bound, in its words */
         PyErr_SetString(PyExc_ValueError, "loop: n x substeps (at most 1e8 plant substeps in one run)");
         return NULL;
     }
-    int substeps = (int)(substeps_in < 0 ? 0 : substeps_in);
-    arena a = {0}, b = {0};
+    L.substeps = (int)(substeps_in < 0 ? 0 : substeps_in);
+    /* the PID at rest, as tf_pid_init leaves it (bad gains: tf_loop_run refuses them) */
+    L.pid.kp = kp, L.pid.ki = ki, L.pid.kd = kd, L.pid.tau_d = tau_d;
+    arena a = {0}, b = {0}, c = {0};
     tf_model pm, cm;
-    tf_rt_friction *rt = scratch(&a, 2 * sizeof(tf_rt_friction)); /* ~5 kB each: not on the stack */
+    tf_rt_friction *rt = scratch(&a, 3 * sizeof(tf_rt_friction)); /* ~5 kB each: not on the stack */
+    tf_temperature_estimator est;
     PyObject *result = NULL;
     if (!rt) goto done;
     if (parse_model(&a, plant_spec, &pm)) goto done;
@@ -632,9 +672,14 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     const double *v_ref = get_array(&a, vr_obj, &nv, "v_ref");
     if (PyErr_Occurred()) goto done;
     if (n < 1 || nv != n) { PyErr_SetString(PyExc_ValueError, "x_ref and v_ref: same length, >= 1"); goto done; }
-    double *out[3];
-    for (int k = 0; k < 3; k++)
-        if (!(out[k] = out_array(&a, outs[k], n, "outputs: one float64 per period"))) goto done;
+    double *out[7] = {0};
+    for (int k = 0; k < 7; k++)
+        if ((k < 3 || outs[k] != Py_None) && !(out[k] = out_array(&a, outs[k], n, "outputs: one float64 per period")))
+            goto done;
+    L.trace = (tf_loop_trace){out[3], out[4], out[5], out[6]};
+    if (!(L.T_plant_series = loop_series(&a, Tp_obj, n, "T_plant_series")) && PyErr_Occurred()) goto done;
+    if (!(L.T_comp_series = loop_series(&a, Tc_obj, n, "T_comp_series")) && PyErr_Occurred()) goto done;
+    if (est_obj != Py_None && loop_estimator(&c, est_obj, n, &L, &est, &rt[2])) goto done;
     tf_error e;
     int plant_bad = 0;
     if ((plant_bad = tf_rt_from_model(&rt[0], &pm, &e) != TF_OK) ||
@@ -642,12 +687,11 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
         PyErr_Format(PyExc_ValueError, "%s friction model: %s", plant_bad ? "plant" : "compensation", e.what);
         goto done;
     }
-    /* the PID at rest, as tf_pid_init leaves it (bad gains: tf_loop_run refuses them) */
-    tf_loop loop = {mass, &rt[0], T_plant, {kp, ki, kd, tau_d}, comp_spec == Py_None ? TF_COMP_NONE : compensation,
-                    &rt[1], T_comp, gain, dt, substeps};
+    L.plant = &rt[0], L.comp = &rt[1];
+    if (comp_spec == Py_None) L.compensation = TF_COMP_NONE;
     tf_status status;
     Py_BEGIN_ALLOW_THREADS
-    status = tf_loop_run(&loop, (long)n, x_ref, v_ref, out[0], out[1], out[2], &e);
+    status = tf_loop_run(&L, (long)n, x_ref, v_ref, out[0], out[1], out[2], &e);
     Py_END_ALLOW_THREADS
     /* a refusal (ValueError) names the part, the argument and the period; other statuses are returned */
     if (status == TF_ERR_BAD_ARGUMENT && e.index >= 0)
@@ -659,6 +703,7 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
 done:
     arena_free(&a);
     arena_free(&b);
+    arena_free(&c);
     return result;
 }
 
@@ -704,6 +749,68 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     if (i < n && tf_rt_step(f, v[i], T ? T[i] : T_const, dt, &F[i], &e) != TF_OK)
         PyErr_Format(e.code == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "step %zd: %s",
                      i, e.what);
+    else
+        result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+done:
+    arena_free(&a);
+    return result;
+}
+
+/* temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy|None, T_amb, dt, T_out, var_out, F_out)
+ * -> seconds: the estimator of estimator.h over n samples (v, F_measured, T_amb: n each; NaN in F_measured:
+ * none; T_proxy: None or n values, NaN: none) with the friction model of spec from rest; writes the contact
+ * temperature estimate, its variance and the friction estimate per sample; the loop timed in C.
+ * config: (C_th, R_th, eta, C_2, R_2, proxy, tau_p, q_contact, q_housing, q_proxy, r_F, r_p, v_min). */
+static PyObject *py_temperature_estimate(PyObject *self, PyObject *args)
+{
+    PyObject *spec, *objs[4], *outs[3];
+    tf_temperature_config c;
+    double T0, var0, dt;
+    if (!PyArg_ParseTuple(args, "O(dddddiddddddd)ddOOOOdOOO", &spec, &c.C_th, &c.R_th, &c.eta, &c.C_2, &c.R_2,
+                          &c.proxy, &c.tau_p, &c.q[0], &c.q[1], &c.q[2], &c.r_F, &c.r_p, &c.v_min, &T0, &var0,
+                          &objs[0], &objs[1], &objs[2], &objs[3], &dt, &outs[0], &outs[1], &outs[2]))
+        return NULL;
+    static const char *names[4] = {"v", "F_measured", "T_proxy", "T_amb"};
+    arena a = {0};
+    tf_model m;
+    PyObject *result = NULL;
+    tf_rt_friction *f = scratch(&a, sizeof *f);
+    if (!f || parse_model(&a, spec, &m)) goto done;
+    const double *in[4];
+    Py_ssize_t n = -1, len;
+    for (int k = 0; k < 4; k++) {
+        in[k] = get_array(&a, objs[k], &len, names[k]);
+        if (PyErr_Occurred()) goto done;
+        if (k == 0) n = len;
+        if ((in[k] || k != 2) && len != n) {
+            PyErr_Format(PyExc_ValueError, "%s: one value per sample (%zd), got %zd", names[k], n, len);
+            goto done;
+        }
+    }
+    double *out[3];
+    for (int k = 0; k < 3; k++)
+        if (!(out[k] = out_array(&a, outs[k], n, "outputs: one float64 per sample"))) goto done;
+    tf_error e;
+    tf_temperature_estimator est;
+    if (tf_rt_from_model(f, &m, &e)) { PyErr_Format(PyExc_ValueError, "friction model: %s", e.what); goto done; }
+    if (tf_temperature_init(&est, &c, T0, var0, &e)) { PyErr_Format(PyExc_ValueError, "%s", e.what); goto done; }
+    struct timespec t0, t1;
+    Py_ssize_t i = 0;
+    tf_status status = TF_OK;
+    Py_BEGIN_ALLOW_THREADS
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (; i < n; i++) {
+        status = tf_temperature_step(&est, f, in[0][i], in[1][i], in[2] ? in[2][i] : NAN, in[3][i], dt, &out[2][i], &e);
+        if (status) break;
+        out[0][i] = est.x[0];
+        out[1][i] = est.P[0][0];
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    Py_END_ALLOW_THREADS
+    /* a refused step: ValueError (an argument or parameter), FloatingPointError (an overflow) */
+    if (status)
+        PyErr_Format(status == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "sample %zd: %s", i,
+                     e.what);
     else
         result = PyFloat_FromDouble((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
 done:
@@ -766,6 +873,7 @@ static const tf_constant constants[] = {
     C("domain_when", "offset-form", TF_DOMAIN_OFFSET_FORM),
     C("compensation", "none", TF_COMP_NONE), C("compensation", "feedforward", TF_COMP_FEEDFORWARD),
     C("compensation", "observer", TF_COMP_OBSERVER),
+    C("proxy", "none", TF_PROXY_NONE), C("proxy", "contact", TF_PROXY_CONTACT), C("proxy", "housing", TF_PROXY_HOUSING),
     /* counts and capacities */
     C("limit", "parameters", TF_NPARAM), C("limit", "friction_models", TF_NFRICTION),
     C("limit", "fixed_outputs", TF_OUT_NFIXED),
@@ -933,6 +1041,8 @@ static PyMethodDef methods[] = {
      "Friction force (and parameter derivatives) under a prescribed motion, stepped exactly."},
     {"prescribed_applies", py_prescribed_applies, METH_VARARGS, "Whether prescribed_force applies to a model."},
     {"rt_steps", py_rt_steps, METH_VARARGS, "tf_rt_step over an array of velocities; returns seconds (timed in C)."},
+    {"temperature_estimate", py_temperature_estimate, METH_VARARGS,
+     "The temperature estimator of estimator.h over arrays of samples; returns seconds (timed in C)."},
     {"loop", py_loop, METH_VARARGS, "The closed-loop stage simulation of control.h (fixed step)."},
     {"simulate", py_simulate, METH_VARARGS, "Integrate a model on an output grid (see thermofriction.simulate)."},
     {"simulate_sensitivities", py_simulate_sensitivities, METH_VARARGS,

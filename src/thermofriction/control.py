@@ -5,10 +5,12 @@
     loop.rms_error, loop.max_error
 
 A single-mass stage ``m x'' = u - F`` (its friction model, with its thermal extension, at the
-stage's ``temperature``) under a PID at the control period ``dt``, plus optional compensation:
-``FeedForward`` (the friction model driven by the reference velocity) or ``Observer`` (the LuGre
-observer of Canudas de Wit et al. 1995), each told a temperature: the measured one
-(temperature-aware) or a fixed calibration temperature (temperature-blind).
+stage's ``temperature``: one value, or one per control period as it warms) under a PID at the control
+period ``dt``, plus optional compensation: ``FeedForward`` (the friction model driven by the reference
+velocity) or ``Observer`` (the LuGre observer of Canudas de Wit et al. 1995), each told a temperature:
+the stage's (a perfect sensor), a fixed calibration temperature (blind), a sensor's reading per period,
+or an online ``TemperatureEstimator``'s estimate from the friction a ``DisturbanceObserver`` measures.
+The parts are in ``compensation.py``, the references in ``references.py``.
 """
 
 from __future__ import annotations
@@ -19,266 +21,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _bridge
+from . import _args, _bridge
 from ._bridge import model_spec
-from . import _args
+from .compensation import (DEFAULT_PID, OBSERVED_MODELS, PID, DisturbanceObserver, FeedForward, Observer, _check_at,
+                           _model, _number, _samples)
 from .errors import InputError, SolverError, shorten
+from .estimation import TemperatureEstimate, TemperatureEstimator
 from .figures.study_plots import loop_figure
-from .models import FRICTION_MODELS, MassPlant, Model
+from .models import MassPlant, Model
+# MAX_REFERENCE_SAMPLES: its name here, as before the split
+from .references import MAX_REFERENCE_SAMPLES, Reference, duty_cycle, point_to_point, sine_reference  # noqa: F401
 from .results import Result, Summary
-from .simulation.checks import temperature_findings
-
-
-# -- argument checks: the package's InputError naming the argument, before the C core sees it -----
-
-def _number(where: str, name: str, value, *, minimum=None, positive=False) -> float:
-    """A finite real number (not a string, not a bool), optionally > 0 or >= minimum (_args.number)."""
-    return _args.number(value, f"{where}: {name}", minimum=minimum, positive=positive)
-
-
-def _model(where: str, name: str, model) -> Model:
-    if not isinstance(model, Model):
-        raise InputError(f"{where}: {name} must be a thermofriction Model (e.g. tf.load_model(...)), "
-                         f"got {type(model).__name__}")
-    return model
-
-
-def _samples(where: str, name: str, values, n=None) -> np.ndarray:
-    """A 1-D array of finite floats (n of them when given)."""
-    try:
-        a = np.ascontiguousarray(values, float)
-    except (TypeError, ValueError, OverflowError):  # (an int of 10**400 is no float)
-        raise InputError(f"{where}: {name} must be an array of numbers") from None
-    if a.ndim != 1 or (n is not None and a.size != n):
-        raise InputError(f"{where}: {name} must be one-dimensional" + (f" with {n} values" if n is not None else "")
-                         + f", got shape {a.shape}")
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        raise InputError(f"{where}: {name}[{bad[0]}] is {float(a[bad[0]])!r}: every value must be finite")
-    return a
-
-
-def _check_at(where: str, model: Model, temperature: float):
-    """The model's domain at one temperature (Model I parameters, Model II's lambda), with the
-    simulator's messages; its findings (calibrated range, passivity) are the simulator's business."""
-    try:
-        temperature_findings(model, temperature)
-    except InputError as e:
-        raise InputError(f"{where}: {e}") from None
-
-
-#: The friction models with a bristle state for the observer to estimate.
-OBSERVED_MODELS = tuple(n for n, c in FRICTION_MODELS.items() if c.description.bristle)
-
-
-@dataclass(frozen=True)
-class PID:
-    """u = kp e + ki int e + kd de/dt (derivative filtered with time constant ``tau_d``), e = x_ref - x.
-
-    Parameters
-    ----------
-    kp : float
-        The proportional gain [N/m].
-    ki : float
-        The integral gain [N/(m s)].
-    kd : float
-        The derivative gain [N s/m].
-    tau_d : float, default 0.0
-        The derivative filter's time constant [s], >= 0 (0: unfiltered).
-
-    Raises
-    ------
-    InputError
-        A gain that is not a finite number, or a negative ``tau_d``, named.
-    """
-
-    kp: float
-    ki: float
-    kd: float
-    tau_d: float = 0.0
-
-    def __post_init__(self):
-        for name in ("kp", "ki", "kd"):
-            _number("PID", name, getattr(self, name))
-        _number("PID", "tau_d", self.tau_d, minimum=0.0)
-
-
-def _temperature(where: str, temperature):
-    return None if temperature is None else _number(where, "temperature", temperature)
-
-
-@dataclass(frozen=True)
-class FeedForward:
-    """u_ff = F(v_ref, T) from ``model`` told ``temperature`` (None: the stage's, i.e. measured).
-
-    Parameters
-    ----------
-    model : Model
-        The friction model used for compensation.
-    temperature : float, optional
-        The temperature [C] the model is told; None: the stage's (measured).
-
-    Raises
-    ------
-    InputError
-        Not a Model, or a temperature that is not a number, named.
-    """
-
-    model: Model
-    temperature: float | None = None
-    kind = "feedforward"
-
-    def __post_init__(self):
-        _model("FeedForward", "model", self.model)
-        _temperature("FeedForward", self.temperature)
-
-
-@dataclass(frozen=True)
-class Observer:
-    """Canudas de Wit et al. (1995): z^' = v - sigma0 |v| z^/g(v) - gain (x - x_ref),
-    u_c = sigma0 z^ + sigma1 z^' + sigma2 v, from ``model`` told ``temperature`` (None: measured).
-
-    The observer estimates a bristle deflection, so ``model`` must have one: LuGre, Dahl or
-    elasto-plastic. Coulomb and Stribeck have no state to observe (use ``FeedForward``); GMS has one
-    per element and no published observer. ``gain`` [1/s] >= 0 (0: no correction).
-
-    Parameters
-    ----------
-    model : Model
-        The model, with a LuGre, Dahl or elasto-plastic friction model.
-    gain : float, default 100.0
-        The observer gain [1/s], >= 0.
-    temperature : float, optional
-        The temperature [C] the model is told; None: the stage's (measured).
-
-    Raises
-    ------
-    InputError
-        Not a Model, a friction model without a bristle state, a negative gain, named.
-    """
-
-    model: Model
-    gain: float = 100.0
-    temperature: float | None = None
-    kind = "observer"
-
-    def __post_init__(self):
-        _model("Observer", "model", self.model)
-        kind = self.model.friction.model
-        if kind not in OBSERVED_MODELS:
-            raise InputError(f"Observer: the observer estimates a bristle state, which a {kind} model does not have "
-                             f"(it needs a LuGre, Dahl or elasto-plastic model; use FeedForward for {kind})")
-        _number("Observer", "gain", self.gain, minimum=0.0)
-        _temperature("Observer", self.temperature)
-
-
-@dataclass(frozen=True)
-class Reference:
-    """A position reference sampled at the control period: time, position x_ref, velocity v_ref.
-
-    Parameters
-    ----------
-    name : str
-        The reference's name in tables.
-    time : numpy.ndarray
-        The control instants [s].
-    position : numpy.ndarray
-        x_ref [m].
-    velocity : numpy.ndarray
-        v_ref [m/s].
-    """
-
-    name: str
-    time: np.ndarray
-    position: np.ndarray
-    velocity: np.ndarray
-
-
-#: the most samples of a reference (10 million: ~240 MB for its three arrays)
-MAX_REFERENCE_SAMPLES = 10_000_000
-
-
-def _check_length(where, duration, dt):
-    if duration / dt > MAX_REFERENCE_SAMPLES:
-        raise InputError(f"{where}: duration / dt = {duration / dt:.3g} samples, more than the limit of "
-                         f"{MAX_REFERENCE_SAMPLES}: lengthen dt or shorten the reference")
-
-
-def sine_reference(amplitude: float, frequency: float, duration: float, dt: float = 1e-4) -> Reference:
-    """x_ref = amplitude (1 - cos(2 pi f t)): starts at rest at 0, reverses every half period.
-
-    Parameters
-    ----------
-    amplitude : float
-        [m]; the reference spans 0 to 2 amplitude.
-    frequency : float
-        [Hz], > 0.
-    duration : float
-        [s], > 0.
-    dt : float, default 1e-4
-        The control period [s], > 0.
-
-    Returns
-    -------
-    Reference
-
-    Raises
-    ------
-    InputError
-        A value that is not a finite number or out of range, named; more samples than the limit.
-    """
-    where = "sine_reference"
-    amplitude, frequency = _number(where, "amplitude", amplitude), _number(where, "frequency", frequency, positive=True)
-    duration, dt = _number(where, "duration", duration, positive=True), _number(where, "dt", dt, positive=True)
-    _check_length(where, duration, dt)
-    t = np.arange(int(round(duration / dt)) + 1) * dt
-    w = 2 * math.pi * frequency
-    return Reference(f"sine {amplitude * 1e3:g} mm, {frequency:g} Hz", t, amplitude * (1 - np.cos(w * t)),
-                     amplitude * w * np.sin(w * t))
-
-
-def point_to_point(distance: float, move_time: float, dwell: float, dt: float = 1e-4) -> Reference:
-    """A quintic (minimum-jerk) move of ``distance`` in ``move_time``, a dwell, and back the same way.
-
-    Parameters
-    ----------
-    distance : float
-        [m].
-    move_time : float
-        Each move's duration [s], > 0.
-    dwell : float
-        The rest between the moves [s], >= 0.
-    dt : float, default 1e-4
-        The control period [s], > 0.
-
-    Returns
-    -------
-    Reference
-
-    Raises
-    ------
-    InputError
-        A value that is not a finite number or out of range, named; more samples than the limit.
-    """
-    where = "point_to_point"
-    distance, move_time = _number(where, "distance", distance), _number(where, "move_time", move_time, positive=True)
-    dwell, dt = _number(where, "dwell", dwell, minimum=0.0), _number(where, "dt", dt, positive=True)
-    _check_length(where, 2 * (move_time + dwell), dt)
-    n = int(round((2 * (move_time + dwell)) / dt)) + 1
-    t = np.arange(n) * dt
-    period = move_time + dwell
-    x, v = np.zeros(n), np.zeros(n)
-    for k, sign in ((0, 1.0), (1, -1.0)):
-        s = np.clip((t - k * period) / move_time, 0.0, 1.0)
-        inside = (t >= k * period) & (t <= k * period + move_time)
-        x += sign * distance * (10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5)
-        v += np.where(inside, sign * distance * (30 * s ** 2 - 60 * s ** 3 + 30 * s ** 4) / move_time, 0.0)
-    return Reference(f"point-to-point {distance * 1e3:g} mm in {move_time:g} s", t, x, v)
 
 
 @dataclass(eq=False)
 class LoopResult(Result):
-    """One closed-loop run, per control period (plain arrays, SI).
+    """One closed-loop run, per control period (plain arrays, SI, temperatures in C).
 
     Parameters
     ----------
@@ -290,6 +48,16 @@ class LoopResult(Result):
         The controller's force [N], compensation included.
     compensation : numpy.ndarray
         The friction compensation's share [N].
+    plant_friction : numpy.ndarray, optional
+        The stage's friction, mean over each period [N].
+    plant_temperature : numpy.ndarray, optional
+        The stage's temperature [C].
+    compensation_temperature : numpy.ndarray, optional
+        The temperature the compensation was told [C] (NaN without compensation or estimator).
+    temperature_variance : numpy.ndarray, optional
+        The estimator's variance of it [K^2]; None without an estimator.
+    measured_friction : numpy.ndarray, optional
+        The disturbance observer's friction the estimator read [N] (NaN: none); None without an estimator.
     stats : dict, default {}
         The run's costs.
     """
@@ -299,6 +67,11 @@ class LoopResult(Result):
     position: np.ndarray
     control: np.ndarray
     compensation: np.ndarray
+    plant_friction: np.ndarray | None = None
+    plant_temperature: np.ndarray | None = None
+    compensation_temperature: np.ndarray | None = None
+    temperature_variance: np.ndarray | None = None
+    measured_friction: np.ndarray | None = None
     stats: dict = field(default_factory=dict)
 
     @property
@@ -313,67 +86,118 @@ class LoopResult(Result):
     def max_error(self) -> float:
         return float(np.max(np.abs(self.error)))
 
+    @property
+    def friction_error(self) -> np.ndarray | None:
+        """The compensation minus the stage's friction [N] (None when the run did not record the friction)."""
+        return None if self.plant_friction is None else self.compensation - self.plant_friction
+
+    @property
+    def temperature_error(self) -> np.ndarray | None:
+        """The compensation's temperature minus the stage's [C] (NaN without compensation or estimator)."""
+        if self.plant_temperature is None or self.compensation_temperature is None:
+            return None
+        return self.compensation_temperature - self.plant_temperature
+
     title = "closed-loop run"
 
     def summary(self) -> Summary:
-        return Summary([("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
-                        ("RMS error", f"{self.rms_error * 1e6:.4g} um"),
-                        ("max error", f"{self.max_error * 1e6:.4g} um")])
+        rows = [("duration", f"{self.time[-1] - self.time[0]:.6g} s"), ("samples", f"{len(self.time)}"),
+                ("RMS error", f"{self.rms_error * 1e6:.4g} um"), ("max error", f"{self.max_error * 1e6:.4g} um")]
+        if self.friction_error is not None and np.any(self.compensation):
+            rows.append(("RMS friction-estimate error", f"{_rms(self.friction_error):.4g} N"))
+        dT = self.temperature_error
+        if dT is not None and np.all(np.isfinite(dT)):
+            rows += [("RMS temperature-estimate error", f"{_rms(dT):.4g} K"),
+                     ("max temperature-estimate error", f"{np.max(np.abs(dT)):.4g} K")]
+        return Summary(rows)
 
     def _frame(self) -> dict:
-        return {"time": self.time, "reference": self.reference, "position": self.position, "error": self.error,
-                "control": self.control, "compensation": self.compensation}
+        frame = {"time": self.time, "reference": self.reference, "position": self.position, "error": self.error,
+                 "control": self.control, "compensation": self.compensation}
+        for name in ("plant_friction", "plant_temperature", "compensation_temperature", "temperature_variance",
+                     "measured_friction"):
+            if getattr(self, name) is not None:
+                frame[name] = getattr(self, name)
+        return frame
 
     def to_dict(self) -> dict:
         return {"summary": dict(self.summary()), "rms_error": self.rms_error, "max_error": self.max_error,
                 "stats": self.stats, "samples": self._frame()}
 
     def plot(self):
-        """A matplotlib figure: reference and position, and the tracking error, against time."""
+        """A matplotlib figure: reference and position, and the tracking error, against time; with
+        compensation, the friction-estimate error, and the temperature-estimate error where the
+        compensation's temperature was not the stage's."""
         return loop_figure(self)
 
 
-#: Gains for the stage-model-i preset (1 kg): ~30 Hz bandwidth, well damped, at 10 kHz.
-DEFAULT_PID = PID(kp=4e4, ki=4e5, kd=280.0, tau_d=2e-4)
+def _rms(a) -> float:
+    return float(np.sqrt(np.mean(np.square(a))))
 
 
-def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid: PID = DEFAULT_PID,
-                  compensation: FeedForward | Observer | None = None, substeps: int = 10) -> LoopResult:
-    """The closed loop of control.h: the C core runs every control period (fixed step, ``reference``'s
-    sampling) and ``substeps`` plant steps within it.
+def _plant_temperature(where: str, stage: Model, temperature, n: int):
+    """The stage's temperature: (the first value, the per-period array or None); the model checked at the
+    extremes here (the core checks every period's)."""
+    if np.ndim(temperature) == 0:
+        T = _number(where, "temperature", temperature)
+        _check_at(f"{where}: the stage", stage, T)
+        return T, None
+    series = _samples(where, "temperature", temperature, n)
+    for T in sorted({float(series.min()), float(series.max())}):
+        _check_at(f"{where}: the stage", stage, T)
+    return float(series[0]), series
 
-    Parameters
-    ----------
-    stage : Model
-        The stage: a model with a single-mass plant.
-    reference : Reference
-        The position reference.
-    temperature : float
-        The stage's temperature [C].
-    pid : PID, default DEFAULT_PID
-        The feedback controller.
-    compensation : FeedForward or Observer, optional
-        The friction compensation; None: none.
-    substeps : int, default 10
-        Plant steps per control period.
 
-    Returns
-    -------
-    LoopResult
+def _estimator_inputs(where, comp, n, T_plant, *, ambient, start, start_variance, proxy_temperature,
+                      friction_measurement):
+    """The binding's estimator tuple for a compensation told a TemperatureEstimator, and its start."""
+    est = comp.temperature
+    T_amb = T_plant if ambient is None else _number(where, "ambient", ambient)
+    T0 = T_amb if start is None else _number(where, "start", start)
+    var0 = _number(where, "start_variance", start_variance, positive=True)
+    if not isinstance(friction_measurement, DisturbanceObserver):
+        raise InputError(f"{where}: friction_measurement must be a DisturbanceObserver, "
+                         f"got {type(friction_measurement).__name__}")
+    T_p = None
+    if proxy_temperature is not None:
+        if est.proxy == "none":
+            raise InputError(f"{where}: proxy_temperature given, but the estimator has no proxy (proxy='none')")
+        try:
+            T_p = np.ascontiguousarray(proxy_temperature, float)
+        except (TypeError, ValueError, OverflowError):
+            T_p = None
+        if T_p is None or T_p.shape != (n,) or np.any(np.isinf(T_p)):
+            raise InputError(f"{where}: proxy_temperature must have one value per period ({n}), finite or NaN")
+    _check_at(f"{where}: the estimator's start", comp.model, T0)
+    return (model_spec(comp.model, T0), est.config(), T0, var0, T_amb, T_p, friction_measurement.noise(n),
+            friction_measurement.filter_time), T0
 
-    Raises
-    ------
-    InputError
-        A stage that is not a single mass, a reference or argument of the wrong type or value, named.
-    SolverError
-        The closed loop went unstable (a non-finite position).
-    """
-    where = "simulate_loop"
-    _model(where, "stage", stage)
-    if not isinstance(stage.plant, MassPlant):
-        raise InputError("the closed loop drives a single-mass stage: the model's plant must be 'mass'")
+
+def _compensation_inputs(where, comp, n, T_plant, T_series, **estimation):
+    """(spec, T_comp, T_comp_series, estimator tuple) of the compensation for the binding."""
+    if comp is None:
+        return None, math.nan, None, None
+    told, est, series = comp.temperature, None, None
+    name = {"feedforward": "feed-forward"}.get(comp.kind, comp.kind)
+    if isinstance(told, TemperatureEstimator):
+        est, T = _estimator_inputs(where, comp, n, T_plant, **estimation)
+    elif told is None:
+        T, series = T_plant, T_series  # a perfect sensor
+    elif np.ndim(told):
+        if told.size != n:
+            raise InputError(f"{where}: the {name} compensation's temperature must have one value per period "
+                             f"({n}), got {told.size}")
+        T, series = float(told[0]), told
+    else:
+        T = told
+    for Ti in sorted({T} if series is None else {float(series.min()), float(series.max())}):
+        _check_at(f"{where}: the {name} compensation's model", comp.model, Ti)
+    return model_spec(comp.model, T), T, series, est
+
+
+def _checked_reference(where: str, reference) -> tuple:
     if not isinstance(reference, Reference):
-        raise InputError(f"{where}: reference must be a Reference (sine_reference, point_to_point), "
+        raise InputError(f"{where}: reference must be a Reference (sine_reference, point_to_point, duty_cycle), "
                          f"got {type(reference).__name__}")
     t = _samples(where, "reference.time", reference.time)
     if t.size < 2:
@@ -383,32 +207,92 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature: float, pid
     dt = float(t[1] - t[0])
     if not (math.isfinite(dt) and dt > 0):
         raise InputError(f"{where}: reference.time must increase (control period {dt!r})")
-    temperature = _number(where, "temperature", temperature)
+    return t, x_ref, v_ref, dt
+
+
+def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID = DEFAULT_PID,
+                  compensation: FeedForward | Observer | None = None, substeps: int = 10, ambient=None, start=None,
+                  start_variance: float = 1.0, proxy_temperature=None,
+                  friction_measurement: DisturbanceObserver = DisturbanceObserver(),
+                  inertia_feedforward: bool = False) -> LoopResult:
+    """The closed loop of control.h: the C core runs every control period (fixed step, ``reference``'s
+    sampling) and ``substeps`` plant steps within it.
+
+    Parameters
+    ----------
+    stage : Model
+        The stage: a model with a single-mass plant.
+    reference : Reference
+        The position reference.
+    temperature : float or array_like
+        The stage's temperature [C]: one value, or one per control period (a warm-up).
+    pid : PID, default DEFAULT_PID
+        The feedback controller.
+    compensation : FeedForward or Observer, optional
+        The friction compensation; None: none. Its ``temperature`` says what it is told.
+    substeps : int, default 10
+        Plant steps per control period.
+    ambient : float, optional
+        With a ``TemperatureEstimator``: the ambient temperature [C]; None: the stage's first.
+    start : float, optional
+        With a ``TemperatureEstimator``: its start [C]; None: ``ambient`` (a stage started soaked).
+    start_variance : float, default 1.0
+        With a ``TemperatureEstimator``: the start's variance [K^2], > 0.
+    proxy_temperature : array_like, optional
+        With a ``TemperatureEstimator`` that has a proxy: the proxy sensor's reading per period [C] (NaN: none).
+    friction_measurement : DisturbanceObserver, default DisturbanceObserver()
+        With a ``TemperatureEstimator``: how the friction it reads is measured.
+    inertia_feedforward : bool, default False
+        Add the reference's inertia force, mass times the reference's mean acceleration over each period
+        (computed-torque feed-forward), to the control. Without it a large, fast move's error is the PID's lag
+        behind the acceleration, which can hide what the friction compensation does.
+
+    Returns
+    -------
+    LoopResult
+
+    Raises
+    ------
+    InputError
+        A stage that is not a single mass, a reference or argument of the wrong type or value, named; a
+        model refused at a temperature it is told or the estimate (the period named).
+    SolverError
+        The closed loop went unstable (a non-finite position), or the estimator overflowed.
+    """
+    where = "simulate_loop"
+    _model(where, "stage", stage)
+    if not isinstance(stage.plant, MassPlant):
+        raise InputError("the closed loop drives a single-mass stage: the model's plant must be 'mass'")
+    t, x_ref, v_ref, dt = _checked_reference(where, reference)
+    T_plant, T_series = _plant_temperature(where, stage, temperature, t.size)
     if not isinstance(pid, PID):
         raise InputError(f"{where}: pid must be a PID, got {type(pid).__name__}")
     if compensation is not None and not isinstance(compensation, (FeedForward, Observer)):
         raise InputError(f"{where}: compensation must be FeedForward, Observer or None, "
                          f"got {type(compensation).__name__}")
     _args.whole(substeps, f"{where}: substeps", low=1)
-    _check_at(f"{where}: the stage", stage, temperature)
-    outs = [np.empty_like(x_ref) for _ in range(3)]
-    comp_spec, T_comp, kind, gain = None, math.nan, "none", 0.0
-    if compensation is not None:
-        T_comp = temperature if compensation.temperature is None else compensation.temperature
-        name = {"feedforward": "feed-forward"}.get(compensation.kind, compensation.kind)
-        _check_at(f"{where}: the {name} compensation's model", compensation.model, T_comp)
-        comp_spec = model_spec(compensation.model, T_comp)
-        kind = compensation.kind
-        gain = float(getattr(compensation, "gain", 0.0))
+    if not isinstance(inertia_feedforward, (bool, np.bool_)):
+        raise InputError(f"{where}: inertia_feedforward must be True or False, got {inertia_feedforward!r}")
+    spec, T_comp, T_comp_series, est = _compensation_inputs(
+        where, compensation, t.size, T_plant, T_series, ambient=ambient, start=start, start_variance=start_variance,
+        proxy_temperature=proxy_temperature, friction_measurement=friction_measurement)
+    outs = [np.empty_like(x_ref) for _ in range(7)]
+    if est is None:
+        outs[5] = outs[6] = None
+    kind = "none" if compensation is None else compensation.kind
     try:
-        status = _bridge.loop(model_spec(stage, temperature), temperature, comp_spec, T_comp, kind, gain,
-                              stage.plant.mass, (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps), x_ref, v_ref,
-                              *outs)
-    except ValueError as e:  # the core's own checks (a backstop for the ones above)
+        status = _bridge.loop(model_spec(stage, T_plant), T_plant, spec, T_comp, kind,
+                              float(getattr(compensation, "gain", 0.0)), stage.plant.mass,
+                              (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps), x_ref, v_ref, outs,
+                              T_plant_series=T_series, T_comp_series=T_comp_series, estimator=est,
+                              inertia_feedforward=bool(inertia_feedforward))
+    except ValueError as e:  # the core's own checks: the models at a period's temperature, the estimate
         raise InputError(f"{where}: the C core refused the loop: {e}") from None
     if status != "ok":
-        raise SolverError("the closed loop went unstable (non-finite position): lower the gains or the control period")
-    return LoopResult(t, x_ref, outs[0], outs[1], outs[2])
+        raise SolverError("the closed loop went unstable (non-finite position or estimate): lower the gains or the "
+                          "control period")
+    T_stage = np.full(t.size, T_plant) if T_series is None else T_series
+    return LoopResult(t, x_ref, outs[0], outs[1], outs[2], outs[3], T_stage, outs[4], outs[5], outs[6])
 
 
 def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None):
@@ -536,5 +420,6 @@ def compare_compensation(stage: Model, references, temperatures=(30.0, 41.5), ca
     return rows
 
 
-__all__ = ["OBSERVED_MODELS", "PID", "FeedForward", "Observer", "Reference", "sine_reference", "point_to_point", "LoopResult",
-           "simulate_loop", "compare_compensation", "friction_steps", "DEFAULT_PID"]
+__all__ = ["OBSERVED_MODELS", "PID", "FeedForward", "Observer", "DisturbanceObserver", "Reference", "sine_reference",
+           "point_to_point", "duty_cycle", "LoopResult", "simulate_loop", "compare_compensation", "friction_steps",
+           "DEFAULT_PID", "TemperatureEstimator", "TemperatureEstimate"]

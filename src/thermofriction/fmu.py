@@ -45,6 +45,7 @@ from . import _args
 from .fmu_description import (MAX_POINTS, default_experiment, description_xml2, description_xml3, resource_text,
                               variables_of)
 from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_description, c_files, source_files
+from .estimation import TemperatureEstimator
 from .models import MassPlant, Model, StickSlipPlant, load_model
 from .models.fit_record import fit_record_lines
 
@@ -211,7 +212,8 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
 
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
                source: str | None = None, solver: str = "adaptive", step: float | None = None,
-               fmi: int = 2, platforms=None, integrator: str | None = None) -> Path | Target:
+               fmi: int = 2, platforms=None, integrator: str | None = None,
+               estimator: TemperatureEstimator | None = None) -> Path | Target:
     """Writes ``model`` as an FMI 2.0 or FMI 3.0 co-simulation FMU to ``path`` (docs/fmu.md), with its C sources
     (``sources/``: an importer compiles them for its own platform) and binaries.
 
@@ -243,6 +245,11 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         build now with this machine's compilers (cc, x86_64-w64-mingw32-gcc); ``[]`` for the sources only.
     integrator : str, optional
         Deprecated: ``solver``'s earlier name.
+    estimator : TemperatureEstimator, optional
+        Adds the online temperature estimator (docs/fmu.md#temperature-estimator): inputs
+        ``measured_friction_force`` (and ``proxy_temperature`` with a proxy; ``ambient_temperature`` without a
+        heat model), outputs ``temperature_estimate`` and ``temperature_variance``, its parameters as
+        ``estimator.*``; one estimator step per communication step.
 
     Returns
     -------
@@ -267,6 +274,7 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     model, source, temperature, step, platforms = _checked(model, path, temperature, model_identifier, source,
                                                            solver, step, fmi, platforms)
     _check_exportable(model)
+    _args.instance(estimator, TemperatureEstimator, "estimator", "a TemperatureEstimator", none=True)
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
         raise InputError(f"model identifier {model_identifier!r}: letters, digits and '_' only, not starting with a "
@@ -274,8 +282,8 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     heat_temperature = temperature if model.heat is None else (
         temperature if temperature is not None else (model.heat.ambient_temperature or 20.0))
     spec = _bridge.model_spec(model, temperature=heat_temperature if model.heat is not None else None)
-    variables = variables_of(model, spec, temperature, step)
-    tfm = resource_text(model, spec, variables, solver)
+    variables = variables_of(model, spec, temperature, step, estimator)
+    tfm = resource_text(model, spec, variables, solver, estimator)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
     tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
     sources = source_files(fmi)

@@ -24,6 +24,25 @@ FIRST_PARAMETER = 16
 #: Fixed value references of the inputs and outputs (fmu_common.c).
 VR_DRIVE, VR_TEMPERATURE, VR_DISPLACEMENT, VR_VELOCITY, VR_FRICTION_FORCE, VR_TEMPERATURE_OUT, VR_STAGE = range(7)
 
+#: The temperature estimator's outputs and inputs (fmu_common.c), with ``export_fmu(..., estimator=...)``.
+VR_TEMPERATURE_ESTIMATE, VR_TEMPERATURE_VARIANCE, VR_MEASURED_FORCE, VR_PROXY_TEMPERATURE, VR_AMBIENT = range(7, 12)
+
+#: The estimator's parameters in the binary's order (fmu_common.c: EST_*): name, unit, description.
+ESTIMATOR_PARAMETERS = (
+    ("C_th", "J/K", "heat capacity of the contact node"),
+    ("R_th", "K/W", "thermal resistance from the contact to the housing node (or to ambient)"),
+    ("eta", "", "fraction of the friction power that heats the contact"),
+    ("C_2", "J/K", "heat capacity of the housing node (0: one node)"),
+    ("R_2", "K/W", "thermal resistance from the housing node to ambient"),
+    ("tau_p", "s", "lag of the proxy temperature"),
+    ("q_contact", "K2/s", "process noise of the contact temperature"),
+    ("q_housing", "K2/s", "process noise of the housing temperature"),
+    ("q_proxy", "K2/s", "process noise of the proxy temperature"),
+    ("r_F", "N2", "noise variance of the measured friction force"),
+    ("r_p", "K2", "noise variance of the proxy temperature"),
+    ("v_min", "m/s", "no friction update below this sliding speed"),
+)
+
 #: Value reference of FMI 3's independent variable time (fmi3_cs.c, VR_TIME).
 VR_TIME = 15
 
@@ -34,6 +53,7 @@ _BASE_UNITS = {
     "kg": {"kg": 1}, "s": {"s": 1}, "N/m": {"kg": 1, "s": -2}, "N s/m": {"kg": 1, "s": -1}, "N/s": {"kg": 1, "m": 1, "s": -3},
     "rad/s": {"rad": 1, "s": -1}, "m/V": {"kg": -1, "m": -1, "s": 3, "A": 1}, "N/V": {"m": -1, "s": 1, "A": 1},
     "J/K": {"kg": 1, "m": 2, "s": -2, "K": -1}, "K/W": {"kg": -1, "m": -2, "s": 3, "K": 1},
+    "K2": {"K": 2}, "K2/s": {"K": 2, "s": -1}, "N2": {"kg": 2, "m": 2, "s": -4},
 }
 
 
@@ -45,8 +65,26 @@ class _Variable:
         self.causality, self.variability, self.role, self.i, self.j = causality, variability, role, i, j
 
 
-def variables_of(model: Model, spec: dict, temperature: float | None, step: float | None = None):
-    """The FMU's variables: inputs, outputs, then every parameter with its role in the binary."""
+def _estimator_io(model: Model, estimator, ambient: float) -> list:
+    """The estimator's inputs and outputs (its ambient temperature: the heat model's input where there is one)."""
+    out = [_Variable("measured_friction_force", VR_MEASURED_FORCE, "N", "measured friction force for the temperature "
+                     "estimator (NaN: none this step)", float("nan"), "input", "continuous")]
+    if estimator.proxy != "none":
+        out.append(_Variable("proxy_temperature", VR_PROXY_TEMPERATURE, "degC", f"proxy temperature lagging the "
+                             f"{estimator.proxy} (NaN: none this step)", float("nan"), "input", "continuous"))
+    if model.heat is None:
+        out.append(_Variable("ambient_temperature", VR_AMBIENT, "degC", "ambient temperature of the estimator's heat "
+                             "path", ambient, "input", "continuous"))
+    out += [_Variable("temperature_estimate", VR_TEMPERATURE_ESTIMATE, "degC", "estimated contact temperature",
+                      causality="output", variability="continuous"),
+            _Variable("temperature_variance", VR_TEMPERATURE_VARIANCE, "K2", "variance of the estimated contact "
+                      "temperature", causality="output", variability="continuous")]
+    return out
+
+
+def variables_of(model: Model, spec: dict, temperature: float | None, step: float | None = None, estimator=None):
+    """The FMU's variables: inputs, outputs, then every parameter with its role in the binary; with ``estimator``
+    (a TemperatureEstimator) its inputs, outputs and parameters too."""
     plant = model.plant
     drive = {StickSlipPlant: ("voltage", "V", "drive voltage of the actuator"),
              MassPlant: ("force", "N", "force applied to the mass"),
@@ -80,6 +118,9 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
     if isinstance(plant, StickSlipPlant):
         variables.append(_Variable("stage_displacement", VR_STAGE, "m", "displacement of the driving stage",
                                    causality="output", variability="continuous"))
+    est_T0 = variables[1].start if len(variables) > 1 and variables[1].vr == VR_TEMPERATURE else 20.0
+    if estimator is not None:
+        variables += _estimator_io(model, estimator, est_T0)
 
     vr = FIRST_PARAMETER
 
@@ -150,6 +191,12 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
         add("heat.R_th", "K/W", "thermal resistance to ambient", h.thermal_resistance, "R_th")
         add("heat.eta", "", "fraction of the friction power that heats the interface", h.heat_fraction, "eta")
         add("heat.T_0", "degC", "start temperature", h.initial_temperature, "T_0", variability="fixed")
+    if estimator is not None:
+        for i, (name, unit, what) in enumerate(ESTIMATOR_PARAMETERS):
+            add(f"estimator.{name}", unit, what, getattr(estimator, name), "estimator", i)
+        add("estimator.T_0", "degC", "the estimate's start (every node)", est_T0, "estimator", i + 1,
+            variability="fixed")
+        add("estimator.variance_0", "K2", "the start's variance", 25.0, "estimator", i + 2, variability="fixed")
     if step is not None:
         add("integrator.step", "s", "the fixed step of the real-time integrator (several per communication "
             "step; the last shortened to end on the communication point)", step, "step", variability="fixed")
@@ -164,8 +211,9 @@ def _elements(friction) -> int:
     return len(getattr(friction, friction.arrays[0])) if friction.arrays else 0
 
 
-def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive") -> str:
-    """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c)."""
+def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive", estimator=None) -> str:
+    """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c); with ``estimator``
+    its line (the proxy kind, the ambient temperature's start)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
              f"plant {spec['plant']} {int(isinstance(model.plant, StickSlipPlant) and model.plant.modal)}",
@@ -187,10 +235,19 @@ def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive")
             lines.append(f"law {i} {law[0]} {n}")
     temperature_start = next((v.start for v in variables if v.vr == VR_TEMPERATURE), float("nan"))
     lines.append(f"input 0.0 {temperature_start!r}" if temperature_start == temperature_start else "input 0.0 0.0")
+    if estimator is not None:
+        starts = {v.vr: v.start for v in variables if v.causality == "input"}
+        ambient = starts.get(VR_AMBIENT, starts.get(VR_TEMPERATURE, 20.0))
+        lines.append(f"estimator {_bridge.PROXY_CODES[estimator.proxy]} {ambient!r}")
     for v in variables:
         if v.role:
             lines.append(f"var {v.vr} {v.role} {v.i} {v.j} {int(v.variability == 'fixed')} {v.start!r}")
     return "\n".join(lines) + "\n"
+
+
+def _xml_number(x: float) -> str:
+    """A start value as xs:double writes it (NaN: a measurement input's "none")."""
+    return "NaN" if x != x else repr(x)
 
 
 def _default_experiment_xml(model: Model, step: float | None) -> str:
@@ -223,7 +280,7 @@ def description_xml2(model: Model, variables, identifier: str, guid: str, source
             attrs.append('initial="exact"')
             real.append(f'start="{v.start!r}"')
         elif v.causality == "input":
-            real.append(f'start="{v.start!r}"')
+            real.append(f'start="{_xml_number(v.start)}"')
         else:
             outputs.append(index)
         out.append(f'    <ScalarVariable {" ".join(attrs)}><Real {" ".join(real)}/></ScalarVariable>')
@@ -341,7 +398,7 @@ def description_xml3(model: Model, variables, identifier: str, guid: str, source
         if v.unit:
             attrs.append(f"unit={quoteattr(v.unit)}")
         if v.causality in ("parameter", "input"):
-            attrs.append(f'start="{v.start!r}"')
+            attrs.append(f'start="{_xml_number(v.start)}"')
         else:
             outputs.append(v.vr)
         out.append(f'    <Float64 {" ".join(attrs)}/>')
@@ -353,4 +410,4 @@ def description_xml3(model: Model, variables, identifier: str, guid: str, source
 
 
 __all__ = ["variables_of", "resource_text", "description_xml2", "description_xml3", "default_experiment",
-           "FORMAT", "VR_TIME"]
+           "FORMAT", "VR_TIME", "ESTIMATOR_PARAMETERS"]

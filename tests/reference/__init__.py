@@ -17,12 +17,12 @@ them (no ``Law.__call__``/``evaluate``, no ``Waveform.__call__``/``corners``, no
     solve       friction_force, rhs, default_atol, reference_simulate,    solve_ivp, restarted at corners;
                 reference_simulate_system                                 GMS switches as events
     thermal     ReferenceHeatedSystem, reference_simulate_heated          self-heating
-    control     reference_closed_loop                                     the closed loop of control.h
+    control     reference_closed_loop, disturbance_observer               the closed loop of control.h, its friction measurement
 
 ``import reference as R`` (tests/ on sys.path) gives all of them.
 """
 
-from .control import reference_closed_loop
+from .control import disturbance_observer, reference_closed_loop
 from .friction import (FrictionParams, base_friction, elastoplastic_alpha, friction_params, on_side, ripple,
                        stribeck_g, thermal_friction)
 from .laws import law_slope, law_value, temperature_value
@@ -36,4 +36,4 @@ __all__ = ["waveform_value", "waveform_corners", "waveform_slope", "law_value", 
            "FrictionParams", "friction_params", "stribeck_g", "elastoplastic_alpha", "base_friction", "on_side", "ripple",
            "thermal_friction", "ReferenceSystem", "ReferenceModel", "friction_force", "rhs", "default_atol",
            "ReferenceResult", "reference_simulate", "ReferenceSystemResult", "reference_simulate_system",
-           "ReferenceHeatedSystem", "reference_simulate_heated", "reference_closed_loop"]
+           "ReferenceHeatedSystem", "reference_simulate_heated", "reference_closed_loop", "disturbance_observer"]

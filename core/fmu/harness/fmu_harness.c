@@ -2,8 +2,10 @@
  * loads the FMU's win64 DLL with LoadLibrary, instantiates it, and for every line "drive temperature"
  * on standard input sets the inputs and takes one communication step of H seconds, printing
  * "time displacement velocity friction_force" after it. Exit status 0, or 1 with the reason on stderr.
+ * Optional: IN and OUT, comma-separated value references of the inputs each line gives and of the
+ * outputs printed after the time (default 0,1 and 2,3,4), e.g. for the temperature estimator's.
  *
- *   fmu_harness DLL RESOURCE_URI GUID H < inputs.txt */
+ *   fmu_harness DLL RESOURCE_URI GUID H [IN OUT] < inputs.txt */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,10 +37,24 @@ static FARPROC get(HMODULE dll, const char *name)
         }                                                            \
     } while (0)
 
+/* "2,3,4" into vr (at most 16); the count, or 0 if not such a list. */
+static int vr_list(const char *s, fmi2ValueReference *vr)
+{
+    int n = 0;
+    while (*s && n < 16) {
+        char *end;
+        unsigned long v = strtoul(s, &end, 10);
+        if (end == s) return 0;
+        vr[n++] = (fmi2ValueReference)v;
+        s = *end == ',' ? end + 1 : end;
+    }
+    return *s ? 0 : n;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc != 5) {
-        fprintf(stderr, "usage: fmu_harness DLL RESOURCE_URI GUID H < inputs\n");
+    if (argc != 5 && argc != 7) {
+        fprintf(stderr, "usage: fmu_harness DLL RESOURCE_URI GUID H [IN OUT] < inputs\n");
         return 1;
     }
     HMODULE dll = LoadLibraryA(argv[1]);
@@ -62,18 +78,27 @@ int main(int argc, char **argv)
         fprintf(stderr, "fmi2Instantiate failed\n");
         return 1;
     }
-    double h = atof(argv[4]), t = 0.0, in[2];
-    const fmi2ValueReference in_vr[2] = {0, 1}, out_vr[3] = {2, 3, 4};
+    double h = atof(argv[4]), t = 0.0, in[16], out[16];
+    fmi2ValueReference in_vr[16] = {0, 1}, out_vr[16] = {2, 3, 4};
+    int n_in = argc == 7 ? vr_list(argv[5], in_vr) : 2, n_out = argc == 7 ? vr_list(argv[6], out_vr) : 3;
+    if (n_in < 1 || n_out < 1) {
+        fprintf(stderr, "IN and OUT: 1 to 16 comma-separated value references\n");
+        return 1;
+    }
     CHECK(setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0));
     CHECK(enter(c));
     CHECK(exit_init(c));
-    while (scanf("%lf %lf", &in[0], &in[1]) == 2) {
-        double out[3];
-        CHECK(set_real(c, in_vr, 2, in));
+    for (;;) {
+        int k = 0;
+        while (k < n_in && scanf("%lf", &in[k]) == 1) k++;
+        if (k < n_in) break;
+        CHECK(set_real(c, in_vr, n_in, in));
         CHECK(do_step(c, t, h, fmi2True));
         t += h;
-        CHECK(get_real(c, out_vr, 3, out));
-        printf("%.17g %.17g %.17g %.17g\n", t, out[0], out[1], out[2]);
+        CHECK(get_real(c, out_vr, n_out, out));
+        printf("%.17g", t);
+        for (k = 0; k < n_out; k++) printf(" %.17g", out[k]);
+        printf("\n");
     }
     CHECK(terminate(c));
     free_instance(c);

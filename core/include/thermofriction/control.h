@@ -13,6 +13,7 @@
 #ifndef THERMOFRICTION_CONTROL_H
 #define THERMOFRICTION_CONTROL_H
 
+#include "estimator.h"
 #include "realtime.h"
 
 #ifdef __cplusplus
@@ -53,10 +54,35 @@ typedef enum {
     TF_COMP_OBSERVER = 2     /* F^(v, e, T_comp) */
 } tf_compensation_kind;
 
+/* What a loop run writes per period, each pointer NULL or n doubles (all NULL: nothing more). */
+typedef struct {
+    double *F_plant;    /* the plant's friction, mean over the period's substeps [N] */
+    double *T_comp;     /* the temperature the compensation was told [degC] */
+    double *T_variance; /* the estimator's variance of it [K^2] (0 without an estimator) */
+    double *F_measured; /* the disturbance observer's friction, as given to the estimator [N] (NaN: none) */
+} tf_loop_trace;
+
 /* A position-controlled single mass m x'' = u - F(v, z, T_plant): PID on e = x_ref - x at the
  * control period dt, plus compensation from `comp` told the temperature T_comp; the plant's own
  * friction `plant` at T_plant, integrated with `substeps` steps per period (semi-implicit Euler
- * for x, v; tf_rt_step for the friction states), u held over the period (zero-order hold). */
+ * for x, v; tf_rt_step for the friction states), u held over the period (zero-order hold).
+ *
+ * Temperatures that change over the run (the fields after `substeps`; a struct zeroed or initialised
+ * with the first ten fields only has none of them):
+ *   - T_plant_series: n values, the plant's temperature in each period (NULL: T_plant throughout);
+ *   - the compensation's temperature, in this order of precedence: the estimator's (estimator not
+ *     NULL), a perfect sensor's (T_comp_series, n values), or T_comp throughout (blind or soaked);
+ *   - estimator (initialised by the caller, tf_temperature_init; its start is the loop's): stepped once
+ *     per period before the control is computed, on its own friction model est_friction (initialised
+ *     like comp; not the compensation's, whose states the observer corrects), with the ambient
+ *     temperature T_amb, a proxy temperature T_proxy[i] (NULL: none) and the friction measured by a
+ *     disturbance observer. That observer reads the encoder, x + position_noise[i] (NULL: no noise),
+ *     and knows the mass and the control: at period i >= 2 it measures the friction around t_{i-1},
+ *         F_dob = (u_{i-2} + u_{i-1}) / 2 - m (x_i - 2 x_{i-1} + x_{i-2}) / dt^2   (encoder positions),
+ *     low-passed with time constant dob_tau [s] (0: none), at the velocity (x_i - x_{i-2}) / (2 dt),
+ *     which is the velocity the estimator steps its model at (periods 0 and 1: no measurement,
+ *     the velocity by one difference). The estimate after the step is the compensation's temperature.
+ * The PID reads the true position (the noise is the friction measurement's). */
 typedef struct {
     double mass;
     tf_rt_friction *plant;
@@ -68,22 +94,37 @@ typedef struct {
     double observer_gain;
     double dt;
     int substeps;
+    const double *T_plant_series;
+    const double *T_comp_series;
+    tf_temperature_estimator *estimator;
+    tf_rt_friction *est_friction;
+    double T_amb;
+    const double *T_proxy;
+    const double *position_noise;
+    double dob_tau;
+    tf_loop_trace trace;
+    /* 1: the control adds the reference's inertia force m (v_ref[i+1] - v_ref[i]) / dt (the last period:
+       none), the mean acceleration over the period of a held control (needs v_ref); 0: none. Without it a
+       large move's error is the PID's lag behind the acceleration, which hides the friction's part. */
+    int inertia_feedforward;
 } tf_loop;
 
 /* The most plant substeps (n x substeps) one tf_loop_run takes (~10 s of work): more is refused. */
 #define TF_LOOP_MAX_SUBSTEPS 100000000.0
 
 /* Runs n >= 1 control periods from rest at x = x_ref[0]. x_ref, v_ref: the reference at each
- * period start (v_ref may be NULL without feed-forward). Writes, when not NULL, per period: x
- * (position at the period start), u (the control held over it, compensation included), F_comp
- * (the compensation in it). Returns TF_OK; TF_ERR_BAD_ARGUMENT, before writing anything, for a
- * NULL or non-finite argument (mass, dt > 0, substeps >= 1, n x substeps <= TF_LOOP_MAX_SUBSTEPS,
- * gains, a reference sample), an
- * unknown compensation, an observer on a model without a bristle state, or a plant or
- * compensation model refused at its temperature; or TF_ERR_NONFINITE if the loop goes unstable
- * (outputs written up to that period). When it stops short, *err (may be NULL) says which part
- * refused (where: "loop", "reference", "pid", "plant", "compensation"), why (what: the argument or
- * parameter) and the period (index; -1: before the first). */
+ * period start (v_ref may be NULL without feed-forward, friction's or inertia's). Writes, when not
+ * NULL, per period: x (position at the period start), u (the control held over it, compensation and
+ * inertia feed-forward included), F_comp (the friction compensation in it), and the trace's arrays. Returns TF_OK; TF_ERR_BAD_ARGUMENT, before
+ * writing anything, for a NULL or non-finite argument (mass, dt > 0, substeps >= 1, n x substeps <=
+ * TF_LOOP_MAX_SUBSTEPS, gains, a reference or series sample, dob_tau >= 0, T_amb, an estimator
+ * without est_friction), an unknown compensation, an observer on a model without a bristle state,
+ * or a plant or compensation model refused at one of its given temperatures; or, once running,
+ * TF_ERR_NONFINITE if the loop goes unstable, or the estimator's status if it refuses a step or the
+ * compensation is refused at the estimated temperature (outputs written up to that period). When it
+ * stops short, *err (may be NULL) says which part refused (where: "loop", "reference", "pid",
+ * "plant", "compensation", "estimator"), why (what: the argument or parameter) and the period
+ * (index; -1: before the first). */
 tf_status tf_loop_run(tf_loop *loop, long n, const double *x_ref, const double *v_ref, double *x, double *u,
                       double *F_comp, tf_error *err);
 

@@ -8,9 +8,12 @@ its temperature to the coefficients of temperature laws."""
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import math
 import os
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
@@ -109,6 +112,60 @@ def pool() -> ThreadPoolExecutor:
     return _POOL
 
 
+class Tally:
+    """The model evaluations (``nfev``) and those with a Jacobian (``njev``) of every Problem made while it was open
+    (:func:`counting`), in whatever thread the work was carried to (:func:`in_context`)."""
+
+    def __init__(self):
+        self.nfev = self.njev = 0
+        self._lock = threading.Lock()
+
+    def add(self, jac):
+        """One evaluation (with its Jacobian where ``jac``)."""
+        with self._lock:
+            self.nfev += 1
+            self.njev += int(jac)
+
+
+_TALLIES = contextvars.ContextVar("thermofriction_tallies", default=())
+
+
+@contextlib.contextmanager
+def counting():
+    """A :class:`Tally` of the evaluations made inside the block (nested blocks count in each): what a fit spent,
+    its multi-starts, refits and tests included, whichever function made the Problem.
+
+    Yields
+    ------
+    Tally
+        Its ``nfev`` and ``njev`` grow with every evaluation of a Problem made while the block runs.
+    """
+    tally = Tally()
+    token = _TALLIES.set(_TALLIES.get() + (tally,))
+    try:
+        yield tally
+    finally:
+        _TALLIES.reset(token)
+
+
+def in_context(function):
+    """``function`` run, in another thread, in a copy of the calling thread's context: the Problems it makes count
+    in the caller's tallies (a thread pool's threads otherwise keep their own context).
+
+    Parameters
+    ----------
+    function : callable
+        What the pool runs.
+
+    Returns
+    -------
+    callable
+        ``function`` with the same arguments, run in a fresh copy of the caller's context at each call.
+    """
+    parent = contextvars.copy_context()
+    return lambda *args: parent.copy().run(function, *args)
+
+
 class Problem:
     """Residuals r(theta) of ``model`` with ``names`` set to theta against ``traces``, and their Jacobian
     dr/dtheta: formed by the traces' measurement (offsets removed as it says)."""
@@ -142,6 +199,7 @@ class Problem:
         self.n_points = sum(len(t.time) for t in traces)
         self.nfev = 0
         self.njev = 0
+        self._tallies = _TALLIES.get()  # the open tallies this problem's evaluations count in
         self._seconds = {}  # (trace, with sensitivities): its last run's wall time, for run_all
         self._steps = {}  # trace (by id) -> the steps of its first run with sensitivities: the budget's measure
 
@@ -162,6 +220,8 @@ class Problem:
         model = self.model_at(theta)
         self.nfev += 1
         self.njev += int(jac)
+        for tally in self._tallies:
+            tally.add(jac)
         if model is None:
             return None, None
         return self.measurement.residuals(self, model, theta, jac)
@@ -283,5 +343,5 @@ def knot_derivative(law, k, T) -> float:
     return 0.0
 
 
-__all__ = ["Trace", "Problem", "pool", "knot_derivative", "MAX_STEPS", "STEP_FACTOR",
+__all__ = ["Trace", "Problem", "pool", "Tally", "counting", "in_context", "knot_derivative", "MAX_STEPS", "STEP_FACTOR",
            "STEP_FLOOR"]

@@ -23,6 +23,7 @@ from .laws import FIT_LAW_KINDS
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from ..fitting.optimiser import one_blas_thread
+from ..fitting.problem import counting
 from ..models import Model
 from ..models.sides import needs_period
 from ..simulation import StepSizeController
@@ -224,8 +225,9 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         return _warm_up(data, experiments, init, measurement, friction, parameters, progress, opts)
     _no_warm_up_records(data, method)
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
-    init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
-                                     procedure=procedure, parameters=parameters)
+    with counting() as screened:  # a start read off the data is screened by short fits: the fit spent those too
+        init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
+                                         procedure=procedure, parameters=parameters)
     _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
@@ -243,6 +245,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         return res
     res = _fit(method, experiments, init, parameters, free, procedure, reference_temperature, laws, refine, progress,
                measurement, opts)
+    res.nfev, res.njev = res.nfev + screened.nfev, res.njev + screened.njev
     res = measurement.complete(res, experiments, init)
     held = list(getattr(data, "validate", None) or [])  # the held-out runs: the advice's refits are scored there too
     res = with_held_tests(res, experiments, measurement, rtol, data, held)  # the held values against the data (held.py)

@@ -23,7 +23,7 @@ from ..models import ModelI
 from ..measurements import amount
 from .advice import MATERIAL, TRY_AT_MOST, OutOfSample, holds, tried
 from ..fitting.parameters import EXCESS, PLANT_UNITS, get_value
-from ..fitting.problem import Problem
+from ..fitting.problem import Problem, counting
 from ..measurements import make_traces
 
 special = lazy("scipy.special")
@@ -359,7 +359,9 @@ def with_held_tests(res, experiments, measurement, rtol=1e-8, data=None, heldout
         res.fit_quality["held"] = None
         return res
     inadequate = res.fit_quality["adequate"] is False
-    tests = held_tests(res, experiments, measurement, rtol, inadequate, data, heldout)
+    with counting() as spent:  # the tests' evaluations and their refits are the fit's too
+        tests = held_tests(res, experiments, measurement, rtol, inadequate, data, heldout)
+    res.nfev, res.njev = res.nfev + spent.nfev, res.njev + spent.njev
     res.fit_quality["held"] = [{**{k: t[k] for k in ("name", "value", "statistic", "dof", "p_value", "misfit_share",
                                                      "contradicted")}, **_refit_record(t.get("tried"))} for t in tests]
     bad = [t for t in tests if t["contradicted"] and t["same_as"] is None]

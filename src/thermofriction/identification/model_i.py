@@ -21,7 +21,7 @@ from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_va
 from ..measurements import make_traces
 from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
                       profiled, settled_constants, widened)
-from .procedures import (along_temperatures, fit_friction, fit_result, held_at, levels_held_as_ratios, fitted_names,
+from .procedures import (along_temperatures, counted, fit_friction, fit_result, held_at, levels_held_as_ratios, fitted_names,
                          stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
@@ -376,6 +376,7 @@ class ModelIDetails:
         return out
 
 
+@counted
 def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progress=None, free=(), measurement=None,
                      parameters=None, **opts) -> FitResult:
     """Model I: per-temperature fits, a law per parameter (linear or exponential by AICc unless
@@ -484,8 +485,6 @@ def identify_model_i(experiments, init: Model, *, laws=None, refine=True, progre
         details.fitted_as_constant = [n for n in joint if n not in undetermined]
     res = fit_result("model-i", prof.model, prof.params, prof.outcome, prof.traces, t0, warns, details.as_dict())
     widened(res, prof.widen)
-    res.nfev += sum(r.nfev for _, r in per_T) + prof.nfev + per_temperature.nfev + checked.nfev
-    res.njev += sum(r.njev for _, r in per_T) + prof.njev + checked.njev
     return res
 
 

@@ -20,7 +20,7 @@ from ..fitting.problem import Problem, pool
 from ..measurements import make_traces
 from .laws import aicc, fit_range, segmented_fit
 from ..fitting.parameters import Parameters, friction_parameters
-from .procedures import (along_temperatures, default_fit_parameters, fit_friction, fit_result, fitted_names,
+from .procedures import (along_temperatures, counted, default_fit_parameters, fit_friction, fit_result, fitted_names,
                          stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
 
@@ -31,6 +31,7 @@ def _final_displacement(exp):
     return float(np.mean(exp.displacement[-k:]) - np.mean(exp.displacement[:k]))
 
 
+@counted
 def identify_model_ii(experiments, init: Model, *, procedure="direct", reference_temperature=None, refine=True, free=(),
                       progress=None, measurement=None, parameters=None, **opts) -> FitResult:
     """Model II. ``procedure="paper"``: base model at the reference temperature; displacement
@@ -307,9 +308,7 @@ def _model_ii_direct(groups, experiments, base, T_ref, details, t0, refine, prog
     model, params, traces, warns = _refinement(model, law, params, base, T_ref, free, experiments, measurement,
                                                names or default_fit_parameters(base))
     outcome = fit(model, params, traces, **dict(opts, starts=1))
-    res = fit_result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
-    res.nfev += sum(r.nfev for _, r in per_T)
-    return res
+    return fit_result("model-ii (direct)", model, params, outcome, traces, t0, warns, details=details)
 
 
 def _refinement(model, law, params, base, T_ref, free, experiments, measurement, names):

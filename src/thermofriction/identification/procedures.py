@@ -5,6 +5,7 @@ parameters (docs/models.md#thermal-extensions)."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import time
@@ -22,7 +23,7 @@ from ..fitting.quality import fit_quality, pooled
 from .laws import SAME_TEMPERATURE
 from ..fitting.optimiser import FitOutcome, fit
 from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
-from ..fitting.problem import Problem
+from ..fitting.problem import Problem, counting, in_context
 from ..measurements import make_traces
 from .result import FitResult
 from ..fitting.uncertainty import uncertainty
@@ -61,6 +62,30 @@ def no_stribeck_rate(model, params) -> list:
     return [f"'C' (the rate at which slipping GMS elements follow the Stribeck curve) {how} with no Stribeck "
             f"effect (fs = fc) a slipping element stays at its capacity and C changes nothing, so these data "
             f"cannot determine it{'; hold it' if fitted else ''} (fit fs and vs to bring it in)"]
+
+
+def counted(function):
+    """``function`` (which returns a FitResult) with the result's ``nfev`` and ``njev`` every model evaluation made
+    while it ran: its fits', their multi-starts', the per-temperature and reference fits', scans', profiles', refits'
+    (fitting.problem.counting), not only those of the fit the result was made from.
+
+    Parameters
+    ----------
+    function : callable
+        A procedure returning a FitResult.
+
+    Returns
+    -------
+    callable
+        ``function`` whose result's ``nfev`` and ``njev`` are what it spent.
+    """
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        with counting() as spent:
+            res = function(*args, **kwargs)
+        res.nfev, res.njev = spent.nfev, spent.njev
+        return res
+    return wrapper
 
 
 def fit_result(method, model, params, outcome, traces, t0, extra_warnings=(), details=None) -> FitResult:
@@ -186,6 +211,7 @@ def levels_held_as_ratios(init, names, new_laws, Ts) -> dict:
             and start.get(level) is not None and start.get(coulomb)}
 
 
+@counted
 def fit_friction(experiments, model: Model, parameters=None, *, method="base", measurement=None, **opts) -> FitResult:
     """Fits the named friction parameters (default sigma0, sigma1, fc) of ``model`` jointly on
     ``experiments``: one set of values shared by all of them.
@@ -269,6 +295,7 @@ def stribeck_notes(model: Model, params: Parameters) -> list:
 DEFAULT_HEAT_PARAMETERS = ("C_th", "R_th", "eta")
 
 
+@counted
 def identify_heat(experiments, init: Model, parameters=None, free=(), **opts) -> FitResult:
     """Fits the lumped thermal model (docs/models.md#self-heating) -- by default C_th, R_th and eta; friction
     parameters named too are fitted jointly -- to the recorded temperatures and displacements.
@@ -342,8 +369,6 @@ def identify_heat(experiments, init: Model, parameters=None, free=(), **opts) ->
     for p, v in zip(params.varying, first.theta):
         p.value = float(min(max(v, p.min), p.max))
     outcome = fit(model, params, traces, **dict(opts, starts=1))
-    outcome.nfev += first.nfev
-    outcome.njev += first.njev
     return fit_result("heat", init, params, outcome, traces, t0,
                    details={"temperature_weights_m_per_K": [tr.temperature_weight for tr in traces]})
 
@@ -360,7 +385,7 @@ def along_temperatures(chains, step, *, alone):
 
     if len(chains) > 1 and chains[1][0] and (os.cpu_count() or 1) > 1:
         with ThreadPoolExecutor(max_workers=2, thread_name_prefix="thermofriction-continuation") as executor:
-            for future in [executor.submit(run, *chain) for chain in chains]:
+            for future in [executor.submit(in_context(run), *chain) for chain in chains]:
                 future.result()
     else:
         run(*alone)
@@ -378,6 +403,6 @@ def temperature_groups(experiments):
     return groups
 
 
-__all__ = ["held_at", "levels_held_as_ratios", "fit_friction", "fit_result", "unrefined_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes", "stribeck_start", "fitted_names",
+__all__ = ["counted", "held_at", "levels_held_as_ratios", "fit_friction", "fit_result", "unrefined_result", "along_temperatures", "base_model", "default_fit_parameters", "friction_parameters", "stribeck_notes", "stribeck_start", "fitted_names",
            "identify_heat", "temperature_groups", "FRICTION_FIT_PARAMETERS", "DEFAULT_FRICTION_PARAMETERS",
            "DEFAULT_HEAT_PARAMETERS"]

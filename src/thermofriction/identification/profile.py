@@ -89,9 +89,9 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
         others = [f for f in free if f != name]
         for side in (-PROFILE_STEP, PROFILE_STEP):
             held = with_values(optimum, {name: value + side * se})
-            held_params = parameters_of(held, others)
-            trial = fit(held, held_params, make_traces(experiments, held, measurement),
-                        **{**once, "max_nfev": HELD_EVALUATIONS})
+            shift = conditional_step(outcome, names, name, side * se, parameters_of(held, others))
+            held, held_params, trial = _held_fit(held, shift, lambda m: parameters_of(m, others), experiments,
+                                                 measurement, {**once, "max_nfev": HELD_EVALUATIONS})
             out.nfev, out.njev = out.nfev + trial.nfev, out.njev + trial.njev
             trial_cost = float(trial.r @ trial.r) / variance
             rises[name] = min(rises.get(name, np.inf), (trial_cost - cost) / inflation)
@@ -109,6 +109,68 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
     if float(again.r @ again.r) / variance < cost:
         out.model, out.params, out.outcome, out.traces, out.widen = start, again_params, again, again_traces, {}
     return out
+
+
+def conditional_step(outcome, names, name, step, held_params) -> dict:
+    """The other fitted values where the linearization at the optimum (``outcome``: its theta and Jacobian, columns
+    in ``names``) puts them with ``name`` moved by ``step``: the least-squares shift -J_o^+ J_m step, a positive
+    parameter's by its log (it stays positive; the same to first order). A held fit from there starts at its own
+    optimum where the profile is quadratic, and stops after one evaluation (the Gauss-Newton step below SMALL_STEP
+    standard errors) instead of walking the conditional valley from the optimum in three; where the profile is not
+    quadratic it goes on from there. Only the parameters ``held_params`` fits are moved.
+
+    Parameters
+    ----------
+    outcome : FitOutcome
+        The joint refinement's optimum: its ``theta`` and Jacobian ``J`` (columns in ``names``).
+    names : list of str
+        The fitted parameters' names, in ``theta``'s order.
+    name : str
+        The parameter that is held, moved by ``step``.
+    step : float
+        How far ``name`` is moved [its unit].
+    held_params : Parameters
+        The held fit's parameters (which are fitted, which are positive, their bounds).
+
+    Returns
+    -------
+    dict
+        {name: value} of the moved parameters; empty where the linearization gives none.
+    """
+    theta = np.asarray(outcome.theta, float)
+    J = np.asarray(outcome.J, float)
+    moved = [i for i, n in enumerate(names) if n != name and n in held_params and held_params[n].vary]
+    if not moved or J.ndim != 2 or J.shape[1] != len(names):
+        return {}
+    Jo = J[:, moved]
+    scale = np.linalg.norm(Jo, axis=0)
+    scale[scale == 0] = 1.0
+    shift = -np.linalg.lstsq(Jo / scale, J[:, names.index(name)] * step, rcond=None)[0] / scale
+    out = {}
+    for i, d in zip(moved, shift):
+        v = theta[i]
+        if not np.isfinite(d):
+            return {}
+        p = held_params[names[i]]
+        out[names[i]] = float(v * math.exp(np.clip(d / v, -1.0, 1.0))) if p.positive and v > 0 \
+            else float(np.clip(v + d, p.min, p.max))
+    return out
+
+
+def _held_fit(held, shift, parameters_of, experiments, measurement, opts):
+    """(start, its Parameters, the fit's outcome) of a held fit from ``held`` with the others moved by ``shift``
+    (:func:`conditional_step`), or from ``held`` itself where that start cannot be simulated (a linear law moved
+    through zero, fs below fc) or its fit fails there."""
+    if shift:
+        try:
+            start = with_values(held, shift)
+            if not start.unphysical_over_range():
+                params = parameters_of(start)
+                return start, params, fit(start, params, make_traces(experiments, start, measurement), **opts)
+        except (InputError, ComputationError):
+            pass
+    params = parameters_of(held)
+    return held, params, fit(held, params, make_traces(experiments, held, measurement), **opts)
 
 
 @dataclasses.dataclass

@@ -41,7 +41,9 @@ class FitResult(Result):
     n_points : int
         The number of residuals (samples fitted).
     nfev, njev : int
-        The least-squares solver's evaluations of the residuals and of their Jacobian.
+        Every evaluation of the residuals the fit made (its starts' screening, per-temperature, reference and joint
+        fits, profiles, refits, the held values' tests and the ripple advice), and how many of them computed the
+        Jacobian too.
     starts : int
         The multi-start's starting points.
     wall_time : float

@@ -14,7 +14,7 @@ from .._lazy import lazy
 from ..fitting.identifiability import OFFSET, groups, scaled_svd, with_groups
 from ..fitting.optimiser import UNDETERMINED
 from ..fitting.parameters import get_value
-from ..fitting.problem import Problem
+from ..fitting.problem import Problem, counting
 from ..models import Model
 from ..models.plants import rotary_unit
 from .base import FD_RTOL
@@ -31,15 +31,17 @@ def force_finish(res, experiments, init, measurement, *, force):
     names = [p.name for p in res.parameters.varying] if res.n_points else []
     inflation = res.statistics.get("variance_inflation", 1.0)
     found = []
-    if measurement.offset == "shared":
-        est = estimate_offset(res.model, names, traces, inflation, found, force=force)
-    elif measurement.offset == "per-experiment":
-        runs = [dict(estimate_offset(res.model, names, [tr], inflation, found, force=force), file=tr.name)
-                for tr in traces]
-        est = {"value": float(np.mean([r["value"] for r in runs])), "stderr": None, "ci95": None,
-               "per_experiment": runs}
-    else:
-        est = {"value": init.plant.sensor_offset, "stderr": 0.0, "ci95": (init.plant.sensor_offset,) * 2}
+    with counting() as spent:  # the evaluations at the optimum are the fit's too (its nfev)
+        if measurement.offset == "shared":
+            est = estimate_offset(res.model, names, traces, inflation, found, force=force)
+        elif measurement.offset == "per-experiment":
+            runs = [dict(estimate_offset(res.model, names, [tr], inflation, found, force=force), file=tr.name)
+                    for tr in traces]
+            est = {"value": float(np.mean([r["value"] for r in runs])), "stderr": None, "ci95": None,
+                   "per_experiment": runs}
+        else:
+            est = {"value": init.plant.sensor_offset, "stderr": 0.0, "ci95": (init.plant.sensor_offset,) * 2}
+    res.nfev, res.njev = res.nfev + spent.nfev, res.njev + spent.njev
     model = dataclasses.replace(res.model, plant=dataclasses.replace(res.model.plant, sensor_offset=est["value"]))
     est.update(unit=unit, fitted=measurement.offset != "none", policy=measurement.offset)
     if names and measurement.offset != "none":  # the offset's column seen: these groups replace the fit's own
