@@ -160,10 +160,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="dataset folder (with dataset.toml); several, or one folder of dataset folders, identify "
                         "a fleet: each dataset on the Dask cluster, -o DIR gets NAME.toml and NAME.json per "
                         "dataset and the fleet summary fleet.json and fleet.csv (docs/scale.md)")
-    i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat"), default="model-i",
+    i.add_argument("--method", choices=("plant", "base", "model-i", "model-ii", "heat", "warm-up"),
+                   default="model-i",
                    help="what to identify: plant (xi, wn, K from a recorded stage response), base (one friction "
-                        "model for all temperatures), model-i or model-ii (default: model-i), or heat (the "
-                        "[heat] section's C_th, R_th, eta from recorded temperature[C] columns)")
+                        "model for all temperatures), model-i or model-ii (default: model-i), heat (the "
+                        "[heat] section's C_th, R_th, eta from recorded temperature[C] columns), or warm-up "
+                        "(force data: Model I's laws and a one- or two-node heat path from warm-up records with "
+                        "only the ambient temperature known)")
     i.add_argument("--friction", choices=tuple(FRICTION_MODELS),
                    help="friction model to identify (default: the initial model's); built from the initial model's "
                         "values where they share a parameter (docs/identification.md#friction-models)")

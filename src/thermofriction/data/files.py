@@ -28,7 +28,7 @@ from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "torque_constant", "experiment")
 _EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units", "motion", "flip_sign",
-                    "torque_constant")
+                    "torque_constant", "ambient_temperature", "continues")
 #: the manifest's keys that apply to force experiments only (data/force.py), at the top (every experiment)
 #: or in an [[experiment]] entry
 _FORCE_KEYS = ("motion", "flip_sign", "torque_constant")
@@ -85,6 +85,21 @@ def _force_options(table: dict, where: str, defaults: dict) -> dict:
         if not isinstance(table["flip_sign"], bool):
             raise InputError(f"{where}: 'flip_sign' must be true or false, got {shorten(table['flip_sign'])}")
         out["flip_sign"] = table["flip_sign"]
+    return out
+
+
+def _warm_up_keys(e: dict, where: str, before: list) -> dict:
+    """A warm-up record's manifest keys (docs/formats.md#warm-up-records): ``ambient_temperature`` [C] and
+    ``continues`` (the file of an earlier entry whose thermal end state this record starts from)."""
+    out = {}
+    if "ambient_temperature" in e:
+        out["ambient_temperature"] = check_temperature(e["ambient_temperature"], where)
+    if "continues" in e:
+        c = e["continues"]
+        if not isinstance(c, str) or c not in [x.file for x in before]:
+            raise InputError(f"{where}: 'continues' must name the file of an earlier [[experiment]] entry, got "
+                             f"{shorten(c)}")
+        out["continues"] = c
     return out
 
 
@@ -223,12 +238,12 @@ def manifest_dataset(meta: dict, folder: Path, manifest: Path, *, motion: str | 
                                      f"units in its header")
             exps.append(force_experiment(folder / f, f, temperature=T, role=role, description=desc,
                                          from_zero=_from_zero, struct=e.get("struct"), columns=force_cols,
-                                         **opts))
+                                         **_warm_up_keys(e, where, exps), **opts))
             if "torque_constant" in e and not (exps[-1].column or "").startswith("current"):
                 raise InputError(f"{where}: 'torque_constant' applies to a current[A] column; {f} records "
                                  f"{exps[-1].column}")
             continue
-        for key in _FORCE_KEYS:
+        for key in (*_FORCE_KEYS, "ambient_temperature", "continues"):
             if key in e or key in meta:
                 raise InputError(f"{where if key in e else manifest}: '{key}' applies to force experiments only "
                                  f"({f} records a voltage and a displacement)")

@@ -45,11 +45,17 @@ _UNITS = {
     "friction_force": {u: (s, "linear") for u, s in _FORCE.items()},
     "friction_torque": {u: (s, "rotary") for u, s in _TORQUE.items()},
     "temperature": {"C": (1.0, None)},
+    # a warm-up record (docs/formats.md#warm-up-records): the ambient temperature and a proxy's (winding, housing)
+    "ambient_temperature": {"C": (1.0, None)},
+    "proxy_temperature": {"C": (1.0, None)},
     **COMMAND_UNITS,  # a drive's command instead of the friction (data/command.py)
 }
 _UNITS["displacement"] = _UNITS["position"]
 _SI = {"time": "s", "position": "m", "displacement": "m", "velocity": "m/s", "friction_force": "N",
-       "friction_torque": "N*m", "temperature": "C", **COMMAND_SI}
+       "friction_torque": "N*m", "temperature": "C", "ambient_temperature": "C",
+       "proxy_temperature": "C", **COMMAND_SI}
+#: the columns that hold temperatures [C], each checked for plausibility
+TEMPERATURE_COLUMNS = ("temperature", "ambient_temperature", "proxy_temperature")
 #: Header names that mark a force (torque) experiment, as opposed to an actuator's (voltage, displacement).
 MARKERS = ("friction_force", "friction_torque", "position", "velocity", *COMMAND_UNITS)
 #: A sampling interval this many times the median one is a gap in the record (warned about).
@@ -82,6 +88,18 @@ class ForceExperiment(Experiment):
     #: in ``force``: data/command.py), and the header of the column it was read from
     measured_quantity: str = "friction"
     column: str | None = None
+    #: a warm-up record (docs/formats.md#warm-up-records): the ambient temperature [C] per sample, with no
+    #: contact temperature known (``temperature`` is then the ambient's mean, a label only)
+    ambient_temperature: np.ndarray | None = None
+    #: a proxy temperature [C] per sample (a winding's or housing's sensor, lagging the contact), or None
+    proxy_temperature: np.ndarray | None = None
+    #: the record (its manifest file) this one continues: it starts in the thermal state that one ended in
+    continues: str | None = None
+
+    @property
+    def warm_up(self) -> bool:
+        """Whether the run is a warm-up record: an ambient temperature and no contact temperature."""
+        return self.ambient_temperature is not None
 
     @property
     def motion_source(self) -> str:
@@ -274,13 +292,13 @@ def check_force_values(path, out: dict, where, where_row):
                       f"{dt[i] / med:.0f} times the typical interval of {med:.4g} s ({gaps.size} such gap"
                       f"{'s' if gaps.size > 1 else ''}); the motion is interpolated linearly across it",
                       SamplingWarning, stacklevel=3)
-    if "temperature" in out:
+    for key in (k for k in TEMPERATURE_COLUMNS if k in out):
         lo, hi = TEMPERATURE_RANGE
-        T = out["temperature"]
+        T = out[key]
         badT = (T < lo) | (T > hi)
         if badT.any():
             i = int(np.argmax(badT))
-            raise InputError(f"{path}: {where('temperature', i)}: {T[i]:g} C is not a plausible temperature "
+            raise InputError(f"{path}: {where(key, i)}: {T[i]:g} C is not a plausible temperature "
                              f"(expected {lo:g} to {hi:g} C{kelvin_hint(float(T[i]))})")
 
 
@@ -322,20 +340,28 @@ def read_force_csv(path) -> dict:
 
 
 def force_experiment(path, name, *, temperature, role, description, from_zero, motion: str = "auto",
-                     flip_sign: bool = False, struct=None, columns=None, torque_constant=None) -> ForceExperiment:
+                     flip_sign: bool = False, struct=None, columns=None, torque_constant=None,
+                     ambient_temperature=None, continues=None) -> ForceExperiment:
     """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it; ``struct``: the
     MATLAB struct holding the run); ``temperature`` is the manifest's (None: the column's
     mean); ``from_zero`` moves a clock time to start at zero; ``motion`` chooses what drives the model
     (:func:`choose_motion`); ``flip_sign`` negates the friction column (a reaction sensor); the friction's sign
     is then checked (:func:`check_sign`). ``columns``: the file's columns when already read (a MATLAB file's,
     data/matlab.py: read_force_mat); None reads ``path`` as a CSV file. A drive's command (or a current times
-    ``torque_constant``) in place of the friction is read by data/command.py: measured_force."""
+    ``torque_constant``) in place of the friction is read by data/command.py: measured_force. A run with an
+    ambient temperature (an ``ambient_temperature[C]`` column, or the manifest's ``ambient_temperature``) and no
+    contact temperature is a warm-up record (:func:`warm_up_columns`); ``continues``: the manifest file it
+    continues."""
     cols = read_force_csv(path) if columns is None else columns
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
+    ambient, proxy = warm_up_columns(path, cols, temperature, ambient_temperature, continues)
+    if temperature is None and ambient is not None:
+        temperature = float(np.mean(ambient))  # a label: the contact's temperature is what a warm-up fit finds
     if temperature is None:
         if sig is None:
-            raise InputError(f"{path}: no temperature: give 'temperature' in the manifest or a temperature[C] column")
+            raise InputError(f"{path}: no temperature: give 'temperature' in the manifest or a temperature[C] column"
+                             f" (or, for a warm-up record, an ambient_temperature[C] column)")
         temperature = float(np.mean(sig))
     v = cols.get("velocity")
     F, quantity, column = measured_force(path, cols, torque_constant)
@@ -353,7 +379,33 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
                            temperature_signal=sig, role=role, description=description,
                            input=motion_waveform(t, drive_v, cols["position"][0]), force=F, velocity=v,
                            rotary=cols["rotary"], struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
-                           column=column, headers=_headers(path, cols))
+                           column=column, headers=_headers(path, cols), ambient_temperature=ambient,
+                           proxy_temperature=proxy, continues=continues)
+
+
+def warm_up_columns(path, cols: dict, temperature, ambient_temperature, continues) -> tuple:
+    """(ambient, proxy) of a run, each an array [C] or None: the ``ambient_temperature[C]`` column, or the
+    manifest's ``ambient_temperature`` as a constant; the ``proxy_temperature[C]`` column. Refused, naming the
+    file: both an ambient column and the manifest key; an ambient temperature beside a contact temperature (a
+    ``temperature`` column or key: the run is then a soak run, and its ambient says nothing); a proxy or
+    ``continues`` without an ambient."""
+    n = cols["time"].size
+    ambient = cols.get("ambient_temperature")
+    if ambient is not None and ambient_temperature is not None:
+        raise InputError(f"{path}: both an ambient_temperature[C] column and the manifest's 'ambient_temperature': "
+                         f"give one")
+    if ambient is None and ambient_temperature is not None:
+        ambient = np.full(n, float(ambient_temperature))
+    if ambient is not None and (temperature is not None or cols.get("temperature") is not None):
+        raise InputError(f"{path}: an ambient temperature beside the contact's (a 'temperature' key or a "
+                         f"temperature[C] column): a warm-up record has no contact temperature; a soak run at a "
+                         f"known temperature needs no ambient")
+    proxy = cols.get("proxy_temperature")
+    if ambient is None and (proxy is not None or continues is not None):
+        what = "a proxy_temperature[C] column" if proxy is not None else "'continues'"
+        raise InputError(f"{path}: {what} belongs to a warm-up record, which needs the ambient temperature (an "
+                         f"ambient_temperature[C] column or the manifest's 'ambient_temperature')")
+    return ambient, proxy
 
 
 def _headers(path, cols) -> dict:
@@ -390,5 +442,5 @@ def write_force_csv(path, time, position, force, *, velocity=None, temperature=N
 __all__ = ["ForceExperiment", "SamplingWarning", "MotionWarning", "MotionCheck", "MOTIONS", "read_force_csv",
            "force_experiment", "is_force_file", "is_force_data", "units_of", "motion_waveform", "write_force_csv",
            "GAP_RATIO", "velocity_lag", "velocity_scale", "check_motion", "choose_motion", "quantum",
-           "velocity_resolution", "v_smooth_for", "with_v_smooth", "check_sign", "check_motion_option",
+           "velocity_resolution", "v_smooth_for", "warm_up_columns", "TEMPERATURE_COLUMNS", "with_v_smooth", "check_sign", "check_motion_option",
            "POSITION_MISMATCH_ERROR"]

@@ -4,7 +4,7 @@
     fit.model, fit.report(), fit.to_json()
 
 The procedures (``procedures``, ``model_i``, ``model_ii``, ``laws``, ``law_kinds``, ``held``, ``profile``,
-``plant``, ``compare``) and the front door ``front`` (docs/architecture.md#identification), over the fitting
+``plant``, ``compare``, the warm-up fit ``warm_up``) and the front door ``front`` (docs/architecture.md#identification), over the fitting
 engine (thermofriction.fitting: parameters, problem, optimiser, uncertainty) and the measurements
 (thermofriction.measurements: what the residuals are, each one's initial model and completion of the result).
 """
@@ -25,8 +25,9 @@ from .model_ii import identify_model_ii
 from .plant import PlantFit, fit_plant, step_response
 from .procedures import fit_friction, identify_heat
 from .result import FitResult
+from .warm_up import identify_warm_up
 
 __all__ = ["with_friction_model", "fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter",
            "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit", "identify_model_i", "identify_model_ii",
            "identify_heat", "base_model", "make_traces", "uncertainty", "compare_friction_models", "force_start",
-           "METHODS", "MAX_STARTS"]
+           "METHODS", "MAX_STARTS", "identify_warm_up"]

@@ -31,12 +31,13 @@ from ..fitting.parameters import PLANT_UNITS, Parameters, target_of
 from .plant import fit_plant
 from ..models.transforms import base_model
 from .procedures import default_fit_parameters, fit_friction, identify_heat
+from .warm_up import identify_warm_up
 from .provenance import stamped
 from .result import FitResult
 from ..validation import heldout_score
 from ..unit_scale import model_unit_warnings
 
-METHODS = ("plant", "base", "model-i", "model-ii", "heat")
+METHODS = ("plant", "base", "model-i", "model-ii", "heat", "warm-up")
 
 
 #: The most starting points of the multi-start phase: each one simulates every fit experiment
@@ -119,10 +120,12 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     data : Dataset
         The measurements (``load_dataset``); its ``fit`` experiments are fitted, its ``validate`` experiments
         held out and predicted by the fitted model.
-    method : {"model-i", "plant", "base", "model-ii", "heat"}, default "model-i"
+    method : {"model-i", "plant", "base", "model-ii", "heat", "warm-up"}, default "model-i"
         "plant" (xi, wn, K from the experiments that record the stage displacement), "base" (one friction model
         for all experiments, no thermal model), "model-i" (temperature laws of the friction parameters),
-        "model-ii" (a thermal friction term dF(T)) or "heat" (a heat model's parameters).
+        "model-ii" (a thermal friction term dF(T)), "heat" (a heat model's parameters) or "warm-up" (force
+        data: Model I's laws and a heat path from warm-up records without a contact temperature,
+        docs/self-heating.md#warm-up-without-a-contact-temperature).
     init : Model or str or os.PathLike, optional
         The initial model (its plant, masses and input are kept): a model, a model file or a preset name.
         Default: the paper's preset for the method. A file with a ``[plant]`` and no ``[friction]`` section
@@ -217,6 +220,10 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         *most, last = measurement.methods
         raise InputError(f"method '{method}' does not apply to {measurement.name} data ({', '.join(most)} or {last})")
     experiments = list(getattr(data, "fit", data))
+    if method == "warm-up":  # docs/self-heating.md#warm-up-without-a-contact-temperature
+        opts = dict(rtol=rtol, starts=starts, seed=seed, **({"max_nfev": max_nfev} if max_nfev else {}))
+        return _warm_up(data, experiments, init, measurement, friction, parameters, progress, opts)
+    _no_warm_up_records(data, method)
     source = os.fspath(init) if isinstance(init, (str, os.PathLike)) else "the initial model"  # (a file: named)
     with counting() as screened:  # a start read off the data is screened by short fits: the fit spent those too
         init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
@@ -246,6 +253,32 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = with_ripple_advice(res, experiments, held, measurement, rtol)  # a ripple the residuals hold, tried
     res.warnings[:0] = units + _ripple_note(measurement, res.model)
     return res
+
+
+def _no_warm_up_records(data, method):
+    """Warm-up records have no contact temperature: only the warm-up fit reads them."""
+    warm = [e.label for e in getattr(data, "experiments", data) if getattr(e, "warm_up", False)]
+    if warm:
+        raise InputError(f"{warm[0]} is a warm-up record (an ambient temperature, no contact temperature): method "
+                         f"'{method}' needs the contact's temperature; fit it with method 'warm-up'")
+
+
+def _warm_up(data, experiments, init, measurement, friction, parameters, progress, opts):
+    """The warm-up fit (identification/warm_up.py) from the initial model's laws, or from laws fitted first on
+    the dataset's soak runs (Model I) where the initial model has none."""
+    if measurement.name != "force":
+        raise InputError(f"method 'warm-up' takes friction (force or torque) records; these are {measurement.name} "
+                         f"data")
+    soak = [e for e in experiments if not e.warm_up]
+    start = measurement.initial_model(init, "model-i", data, soak or experiments, friction=friction,
+                                      parameters=parameters)
+    if not start.laws:
+        if len({round(e.temperature, 1) for e in soak}) < 2:
+            raise InputError("the warm-up fit starts from the friction's temperature laws: give an initial Model I "
+                             "model (init, --init) or soak runs at two temperatures or more in the dataset")
+        start = identify_model_i(soak, start, progress=progress, measurement=measurement,
+                                 parameters=parameters, **opts).model
+    return identify_warm_up(experiments, start, parameters=parameters, progress=progress)
 
 
 def _ripple_checks(parameters, init, source, measurement, method):

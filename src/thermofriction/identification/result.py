@@ -27,7 +27,7 @@ class FitResult(Result):
     Parameters
     ----------
     method : str
-        The identification method ("plant", "base", "model-i", "model-ii", "heat").
+        The identification method ("plant", "base", "model-i", "model-ii", "heat", "warm-up").
     model : Model
         The fitted model.
     parameters : Parameters

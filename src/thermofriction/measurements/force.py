@@ -82,7 +82,7 @@ class Force(Measurement):
     quantity = "friction force (torque)"
     plants = ("prescribed",)
     fit_parameters = FIT_PARAMETERS
-    methods = ("base", "model-i", "model-ii")
+    methods = ("base", "model-i", "model-ii", "warm-up")
 
     @staticmethod
     def recognises(exp) -> bool:
