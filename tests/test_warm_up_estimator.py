@@ -15,7 +15,7 @@ import pytest
 import thermofriction as tf
 from thermofriction.identification.warm_up import identify_warm_up
 
-from warmup_truth import Truth, experiment, initial_model, measured, soak_runs, warm_up
+from warmup_truth import Truth, experiment, initial_model, measured, proxy_record, soak_runs, warm_up
 
 TRUTH = Truth()
 
@@ -61,6 +61,30 @@ def test_the_estimator_of_a_warm_up_fit_follows_a_held_out_record(fit, held_out)
     blind = est.run(res.model, v, dt=dt, ambient=TRUTH.ambient, start=37.0)
     k = np.searchsorted(out.time, 60.0)
     assert abs(blind.temperature[k] - np.interp(out.time[k], t, T1)) > 1.0
+
+
+def test_the_estimator_of_a_proxy_fit_takes_the_proxy_on_its_node(held_out):
+    """Fitted with a lagging housing sensor and no soak run (test_warm_up.py's second case), from_fit carries the
+    proxy's node (the housing), its lag and its noise (the proxy residuals' RMS squared); on the held-out record
+    with its own proxy (the truth's housing lagged 40 s, AR(1) noise, 0.1 C steps), from 5 C off, the estimate
+    is within 1 C after the first minute with the proxy alone and with the torque and the proxy."""
+    rng = np.random.default_rng(2)
+    t, v, x, T1, _, Tp, _ = warm_up(TRUTH, duration=1500.0)
+    exp = experiment("warm.csv", t, v, x, measured(TRUTH, rng, t, v, T1, 0.03), ambient=TRUTH.ambient,
+                     proxy=proxy_record(rng, Tp))
+    res = identify_warm_up([exp], initial_model(TRUTH))
+    est = tf.control.TemperatureEstimator.from_fit(res)
+    assert est.proxy == "housing" and est.tau_p == res.parameters["tau_p"].value
+    assert est.r_p == pytest.approx(res.experiments[0]["proxy_rmse"] ** 2)
+    block = res.report().split("[[Heat path]]")[1]
+    assert f"proxy: follows the housing node, lag tau_p {est.tau_p:.4g} s" in block
+    th, vh, T1h, F = held_out
+    _, _, _, _, _, Tph, _ = warm_up(TRUTH, duration=900.0, x0=[32.0, 30.0, 30.0], t_start=30.0)
+    Tp_meas = proxy_record(np.random.default_rng(6), Tph)
+    for kw in ({"proxy_temperature": Tp_meas}, {"proxy_temperature": Tp_meas, "measured_force": F}):
+        out = est.run(res.model, vh, dt=th[1] - th[0], ambient=TRUTH.ambient, start=37.0, **kw)
+        err = out.temperature - np.interp(out.time, th, T1h)
+        assert np.abs(err[out.time > 60.0]).max() < 1.0, sorted(kw)
 
 
 def _true_time_constants():

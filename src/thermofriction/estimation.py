@@ -145,10 +145,10 @@ class TemperatureEstimator:
             r_F = result.rmse ** 2 * float(result.statistics.get("variance_inflation", 1.0))
         if r_p is None and proxy:
             r_p = max([row.get("proxy_rmse", 0.0) for row in result.experiments] + [1e-6]) ** 2
-        return cls(C_th=p["C_th"].value, R_th=p["R_th"].value, r_F=r_F, eta=1.0,
-                   C_2=p["C_2"].value if two else 0.0, R_2=p["R_2"].value if two else 0.0,
-                   proxy=proxy["node"] if proxy else "none", tau_p=proxy["tau_p"] if proxy else 0.0,
-                   r_p=r_p if proxy else 0.01, q_contact=q_contact, q_housing=q_housing, q_proxy=q_proxy,
+        return cls(C_th=float(p["C_th"].value), R_th=float(p["R_th"].value), r_F=float(r_F), eta=1.0,
+                   C_2=float(p["C_2"].value) if two else 0.0, R_2=float(p["R_2"].value) if two else 0.0,
+                   proxy=proxy["node"] if proxy else "none", tau_p=float(proxy["tau_p"]) if proxy else 0.0,
+                   r_p=float(r_p) if proxy else 0.01, q_contact=q_contact, q_housing=q_housing, q_proxy=q_proxy,
                    v_min=v_min)
 
     def config(self) -> tuple:
