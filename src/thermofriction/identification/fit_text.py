@@ -132,7 +132,18 @@ def _band_text(tr) -> str:
 
 def heat_path_lines(fit) -> list:
     """A warm-up fit's heat path in words: the node count and why, the time constants, the proxy, the scale and
-    the contact temperature per record ("undetermined" where the scale is)."""
+    the contact temperature per record ("undetermined" where the scale is).
+
+    Parameters
+    ----------
+    fit : FitResult
+        A warm-up fit (method "warm-up": ``details["heat_path"]`` and ``details["temperature"]``).
+
+    Returns
+    -------
+    list of str
+        The report's "Heat path" lines.
+    """
     hp = fit.details["heat_path"]
     taus = ", ".join(f"{t['value']:.4g} s +- {t['ci95_half_width']:.2g}" for t in hp["time_constants"])
     proxy = hp.get("proxy")
