@@ -98,6 +98,59 @@ class TemperatureEstimator:
             for name in ("tau_p", "r_p"):
                 _args.number(getattr(self, name), f"{w}: {name} (with a proxy)", positive=True)
 
+    @classmethod
+    def from_fit(cls, result, *, r_F: float | None = None, r_p: float | None = None, v_min: float = 0.0,
+                 q_contact: float = 1e-3, q_housing: float = 1e-4, q_proxy: float = 0.0) -> TemperatureEstimator:
+        """The estimator of a warm-up fit's heat path (``identify(..., method="warm-up")``,
+        docs/self-heating.md#warm-up-without-a-contact-temperature): its nodes, ``C_th``, ``R_th`` (``C_2``,
+        ``R_2``), the proxy's node and lag, per unit of eta (eta 1, as the fit holds it), and its noises; run it with
+        the fit's model (``result.model``).
+
+        Parameters
+        ----------
+        result : FitResult
+            A warm-up fit whose temperature scale is determined (soak runs or a proxy).
+        r_F : float, optional
+            The force's noise variance [N^2]; default the fit's: its force residuals' RMS squared times their
+            autocorrelation's variance inflation (``statistics["variance_inflation"]``).
+        r_p : float, optional
+            The proxy's noise variance [K^2]; default the fit's largest proxy residual RMS squared (with a proxy).
+        v_min : float, default 0.0
+            No friction update where |v| < v_min [m/s or rad/s].
+        q_contact, q_housing, q_proxy : float, default 1e-3, 1e-4, 0.0
+            The process noise of each state [K^2/s].
+
+        Returns
+        -------
+        TemperatureEstimator
+            The heat path and noises of the fit.
+
+        Raises
+        ------
+        InputError
+            ``result`` is not a warm-up fit, or its temperature scale is undetermined (no heat path as numbers).
+        """
+        w = "TemperatureEstimator.from_fit"
+        heat = (getattr(result, "details", None) or {}).get("heat_path")
+        if getattr(result, "method", None) != "warm-up" or not isinstance(heat, dict):
+            raise InputError(f"{w}: result must be a warm-up fit (method 'warm-up'), got "
+                             f"{getattr(result, 'method', type(result).__name__)!r}")
+        if heat["scale"] == "undetermined":
+            raise InputError(f"{w}: the fit's temperature scale is undetermined (no soak runs at two temperatures or "
+                             f"more, no proxy): its heat path's resistances and capacities are not numbers")
+        p = result.parameters
+        two = heat["nodes"] == 2
+        proxy = heat.get("proxy")
+        if r_F is None:
+            r_F = result.rmse ** 2 * float(result.statistics.get("variance_inflation", 1.0))
+        if r_p is None and proxy:
+            r_p = max([row.get("proxy_rmse", 0.0) for row in result.experiments] + [1e-6]) ** 2
+        return cls(C_th=float(p["C_th"].value), R_th=float(p["R_th"].value), r_F=float(r_F), eta=1.0,
+                   C_2=float(p["C_2"].value) if two else 0.0, R_2=float(p["R_2"].value) if two else 0.0,
+                   proxy=proxy["node"] if proxy else "none", tau_p=float(proxy["tau_p"]) if proxy else 0.0,
+                   r_p=float(r_p) if proxy else 0.01, q_contact=q_contact, q_housing=q_housing, q_proxy=q_proxy,
+                   v_min=v_min)
+
     def config(self) -> tuple:
         """The binding's tuple of tf_temperature_config (its fields in order)."""
         return (self.C_th, self.R_th, self.eta, self.C_2, self.R_2, _bridge.PROXY_CODES[self.proxy], self.tau_p,

@@ -280,6 +280,30 @@ def _scoring(model, exps, offset, motion):
     return exps, offset, how
 
 
+def _refuse_warm_up_records(exps) -> None:
+    """InputError naming the first warm-up record of ``exps`` (an ambient temperature, no contact temperature):
+    a model is scored at each run's contact temperature, which such a record does not have, and the heat path that
+    would give it is not in the model file (docs/self-heating.md#warm-up-without-a-contact-temperature).
+
+    Parameters
+    ----------
+    exps : list of Experiment or ForceExperiment
+        The experiments to be scored.
+
+    Raises
+    ------
+    InputError
+        One of them is a warm-up record, named with how many there are.
+    """
+    warm = [run_label(e) for e in exps if getattr(e, "warm_up", False)]
+    if warm:
+        more = f" (and {len(warm) - 1} more)" if len(warm) > 1 else ""
+        raise InputError(f"{warm[0]}{more}: a warm-up record (an ambient temperature, no contact temperature) cannot "
+                         f"be scored: a model is scored at each record's contact temperature, and a model file "
+                         f"does not hold the heat path that would give it; the warm-up fit's own residuals and "
+                         f"temperature trajectory are in its results (identify --method warm-up)")
+
+
 def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
              ripple_phase=None) -> ValidationResult:
     """Predicts every experiment of ``data`` (or the given ones) with ``model`` and measures the
@@ -319,7 +343,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     InputError
         An argument of the wrong type, named; a dataset without experiments; a model that cannot predict
         these data (a stick-slip actuator for force data, say), or an ``offset`` or ``motion`` that does not
-        apply.
+        apply; a warm-up record among the experiments (no contact temperature to score a model at), named.
 
     Warns
     -----
@@ -334,6 +358,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")
+    _refuse_warm_up_records(exps)
     exps, offset, how = _scoring(model, exps, offset, motion)
     ripple_phase = _ripple_phase(fit_record_of(model) or {}, ripple_phase, how)
     measurement = measurement_of(exps, offset=offset, ripple_phase=ripple_phase)  # asked once

@@ -351,7 +351,8 @@ def read_force_mat(path, struct: str | None = None, units: dict | None = None, *
 def force_mat_variables(e) -> dict:
     """A force experiment as MATLAB variables, SI with the unit a suffix as ``matlab_name`` spells it:
     ``time``, ``position_rad`` (``position_m``), ``velocity_rad_per_s`` (``velocity_m_per_s``) when recorded,
-    ``friction_torque_N_m`` (``friction_force_N``), ``temperature`` when recorded."""
+    ``friction_torque_N_m`` (``friction_force_N``), ``temperature`` when recorded, a warm-up record's
+    ``ambient_temperature`` and ``proxy_temperature`` [C]."""
     rot = e.rotary
     out = {"time": np.asarray(e.time, float),
            "position_rad" if rot else "position_m": np.asarray(e.displacement, float)}
@@ -361,6 +362,9 @@ def force_mat_variables(e) -> dict:
     out[f"{kind}_torque_N_m" if rot else f"{kind}_force_N"] = np.asarray(e.force, float)
     if e.temperature_signal is not None:
         out["temperature"] = np.asarray(e.temperature_signal, float)
+    for key in ("ambient_temperature", "proxy_temperature"):  # a warm-up record's (formats.md#warm-up-records)
+        if getattr(e, key, None) is not None:
+            out[key] = np.asarray(getattr(e, key), float)
     return out
 
 

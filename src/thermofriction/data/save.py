@@ -54,7 +54,9 @@ def _listed_files(folder: Path) -> list[Path]:
 def save_dataset(dataset: Dataset, folder, *, overwrite: bool = False) -> Path:
     """Writes ``folder`` (created if needed): one CSV per experiment (``time[s],voltage[V],
     displacement[um]``, and ``temperature[C]`` and ``stage_displacement[um]`` where present, ten
-    significant digits) and ``dataset.toml``, and sets ``dataset.path`` to it.
+    significant digits; a force experiment's own columns, every digit, a warm-up record's
+    ``ambient_temperature[C]`` and ``proxy_temperature[C]`` among them, and its ``continues`` in the
+    manifest) and ``dataset.toml``, and sets ``dataset.path`` to it.
 
     A folder that already holds a dataset is refused unless ``overwrite``; then the files its old
     manifest lists and the new one does not are removed. The files are published as a set: every
@@ -151,6 +153,9 @@ def _write_experiment(e, folder, mat) -> dict:
         cols[e.force_column] = e.force  # a command read from a current is written in N or N m
         if e.temperature_signal is not None:
             cols["temperature[C]"] = e.temperature_signal
+        for key in ("ambient_temperature", "proxy_temperature"):  # a warm-up record's (formats.md#warm-up-records)
+            if getattr(e, key) is not None:
+                cols[f"{key}[C]"] = getattr(e, key)
         with atomic_write(folder / e.file, "w", newline="") as fh:
             fh.write(",".join(cols) + "\n")
             np.savetxt(fh, np.column_stack([np.asarray(v, float) for v in cols.values()]), delimiter=",",
@@ -218,7 +223,10 @@ def _mat_variables(e) -> dict:
 
 def _entry(e) -> dict:
     """An experiment's [[experiment]] table."""
-    entry = {"file": e.file, "temperature": float(e.temperature), "role": e.role}
+    warm = getattr(e, "warm_up", False)  # no contact temperature: its ambient is in its file, not a key
+    entry = {"file": e.file, **({} if warm else {"temperature": float(e.temperature)}), "role": e.role}
+    if warm and e.continues is not None:
+        entry["continues"] = e.continues
     if getattr(e, "struct", None):
         entry["struct"] = e.struct
     if e.description:

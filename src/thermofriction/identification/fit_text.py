@@ -109,6 +109,54 @@ def _correlated(fit, above: float = 0.5) -> list:
     return [f"C({a}, {b}) = {r:+.3f}" for a, b, r in sorted(pairs, key=lambda x: -abs(x[2]))]
 
 
+def _node_choice(hp) -> str:
+    """The heat path's node count and why (``details["heat_path"]["choice"]``)."""
+    c, n = hp["choice"], hp["nodes"]
+    if "delta" not in c:
+        return f"{n} node ({c.get('two_nodes', 'two nodes not evaluated')})"
+    delta, limit = c["delta"], c["threshold"]
+    if c["asked"] != "auto":
+        return (f"{n} node{'s' * (n > 1)} (held: nodes={c['asked']}; a second node lowers AICc by {delta:.4g}, the "
+                f"rule keeps it above {limit:g}: {'two' if delta > limit else 'one'} by the data)")
+    return (f"{n} node{'s' * (n > 1)} (a second node, the housing, lowers AICc by {delta:.4g}: "
+            f"{'more' if n == 2 else 'not more'} than {limit:g}; on {c['effective_samples']:.4g} effective samples)")
+
+
+def _band_text(tr) -> str:
+    """A record's contact temperature: its start, end and range, and its 95 % band's width."""
+    c = np.asarray(tr["contact"], float)
+    width = np.asarray(tr["upper"], float) - np.asarray(tr["lower"], float)
+    return (f"{c[0]:.4g} -> {c[-1]:.4g} C (range {c.min():.4g} to {c.max():.4g} C), 95 % band {np.median(width):.2g} K "
+            f"wide (median; at most {width.max():.2g} K)")
+
+
+def heat_path_lines(fit) -> list:
+    """A warm-up fit's heat path in words: the node count and why, the time constants, the proxy, the scale and
+    the contact temperature per record ("undetermined" where the scale is).
+
+    Parameters
+    ----------
+    fit : FitResult
+        A warm-up fit (method "warm-up": ``details["heat_path"]`` and ``details["temperature"]``).
+
+    Returns
+    -------
+    list of str
+        The report's "Heat path" lines.
+    """
+    hp = fit.details["heat_path"]
+    taus = ", ".join(f"{t['value']:.4g} s +- {t['ci95_half_width']:.2g}" for t in hp["time_constants"])
+    proxy = hp.get("proxy")
+    out = [f"nodes: {_node_choice(hp)}", f"time constants (95 %): {taus}",
+           "proxy: " + (f"follows the {proxy['node']} node, lag tau_p {proxy['tau_p']:.4g} s" if proxy else "none"),
+           f"temperature scale: {hp['scale']}", f"eta: {hp['eta']}"]
+    if hp["scale"] == "undetermined":
+        return out + ["heat path's resistances and capacities: undetermined",
+                      "contact temperature: undetermined (the time constants above are scale-free)"]
+    traj = fit.details["temperature"]
+    return out + [f"contact temperature, {label}: {_band_text(tr)}" for label, tr in traj.items()]
+
+
 def fit_blocks(fit) -> list:
     """A fit's report (like lmfit's fit report) as the structured blocks of thermofriction.results."""
     blocks = [heading(f"Fit: {fit.method}"), lines(_not_adequate(fit))]
@@ -127,6 +175,8 @@ def fit_blocks(fit) -> list:
     rows += [("evaluations", f"{fit.nfev} (Jacobians {fit.njev}), starts = {fit.starts}"),
              ("fit time", f"{fit.wall_time:.3g} s (the least-squares fits; not the checks after them)")]
     blocks += [fields(rows, WIDTH), heading("Parameters"), table(HEAD, parameter_rows(fit))]
+    if fit.method == "warm-up":  # docs/self-heating.md#warm-up-without-a-contact-temperature
+        blocks += [heading("Heat path"), lines(heat_path_lines(fit))]
     pairs = _correlated(fit)
     if pairs:
         blocks += [heading("Correlations", "(|C| > 0.5)"), lines(pairs)]
@@ -151,4 +201,4 @@ def fit_html_blocks(fit) -> list:
             lines(origin)] + fit_blocks(fit)[1:]
 
 
-__all__ = ["fit_blocks", "fit_html_blocks", "verdict", "parameter_rows", "HEAD"]
+__all__ = ["fit_blocks", "fit_html_blocks", "heat_path_lines", "verdict", "parameter_rows", "HEAD"]
