@@ -200,6 +200,16 @@ def _loop():
                                  temperature=30.0)
 
 
+def _temperature_estimate():
+    from thermofriction import control
+    stage = tf.load_model("stage-model-i")
+    t = np.arange(0.0, 0.2, 1e-3)
+    v = 2e-3 * np.sin(2 * np.pi * 5.0 * t)
+    est = control.TemperatureEstimator(C_th=5e-4, R_th=3e4, r_F=1e-4)
+    F, _ = control.friction_steps(stage, v, 1e-3, temperature=35.0)
+    return est.run(stage, v, dt=1e-3, ambient=30.0, start=33.0, measured_force=F)
+
+
 #: class name -> a small instance of it, made cheaply (short simulations, one-parameter fits)
 RESULT_CASES = {
     "SimulationResult": lambda: tf.simulate(tf.load_model("li2009-base"), 0.02, temperature=35.0),
@@ -209,6 +219,7 @@ RESULT_CASES = {
                                                           seed=2)),
     "HeatingResult": _heating,
     "LoopResult": _loop,
+    "TemperatureEstimate": _temperature_estimate,
     "PlantFit": _plant_fit,
     "SweepResult": lambda: tf.sweep(tf.load_model("li2009-base"), {"fc": [0.8, 0.9]}, duration=0.05,
                                     sample_rate=2000, scheduler="sequential"),
