@@ -48,6 +48,7 @@ from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_d
 from .estimation import TemperatureEstimator
 from .models import MassPlant, Model, StickSlipPlant, load_model
 from .models.fit_record import fit_record_lines
+from .models.load_laws import refuse_load_laws
 
 #: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
 SOLVERS = ("adaptive", "realtime")
@@ -274,6 +275,7 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     model, source, temperature, step, platforms = _checked(model, path, temperature, model_identifier, source,
                                                            solver, step, fmi, platforms)
     _check_exportable(model)
+    refuse_load_laws(model, "the FMU")
     _args.instance(estimator, TemperatureEstimator, "estimator", "a TemperatureEstimator", none=True)
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:

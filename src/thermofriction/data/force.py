@@ -45,6 +45,10 @@ _UNITS = {
     "friction_force": {u: (s, "linear") for u, s in _FORCE.items()},
     "friction_torque": {u: (s, "rotary") for u, s in _TORQUE.items()},
     "temperature": {"C": (1.0, None)},
+    # a run's load (docs/formats.md#loads): constant over the run
+    # (no motion kind: a joint's axial preload in N is a normal force)
+    "normal_force": {u: (s, None) for u, s in _FORCE.items()},
+    "load_torque": {u: (s, None) for u, s in _TORQUE.items()},
     # a warm-up record (docs/formats.md#warm-up-records): the ambient temperature and a proxy's (winding, housing)
     "ambient_temperature": {"C": (1.0, None)},
     "proxy_temperature": {"C": (1.0, None)},
@@ -52,7 +56,7 @@ _UNITS = {
 }
 _UNITS["displacement"] = _UNITS["position"]
 _SI = {"time": "s", "position": "m", "displacement": "m", "velocity": "m/s", "friction_force": "N",
-       "friction_torque": "N*m", "temperature": "C", "ambient_temperature": "C",
+       "friction_torque": "N*m", "normal_force": "N", "load_torque": "N*m", "temperature": "C", "ambient_temperature": "C",
        "proxy_temperature": "C", **COMMAND_SI}
 #: the columns that hold temperatures [C], each checked for plausibility
 TEMPERATURE_COLUMNS = ("temperature", "ambient_temperature", "proxy_temperature")
@@ -61,6 +65,12 @@ MARKERS = ("friction_force", "friction_torque", "position", "velocity", *COMMAND
 #: A sampling interval this many times the median one is a gap in the record (warned about).
 GAP_RATIO = 10.0
 EXAMPLE = "time[s],position[rad],velocity[rad/s],friction_torque[N*m]"
+
+#: the columns that hold a run's load
+LOAD_COLUMNS = ("normal_force", "load_torque")
+#: a load column whose peak-to-peak exceeds this fraction of its mean magnitude varies over the run (refused: a
+#: per-sample load needs the simulator's load input, not there yet)
+LOAD_VARIES = 0.05
 
 #: The sign check: sliding samples are those faster than this fraction of the 95th percentile speed; a
 #: friction column whose sign (the offset removed) opposes the velocity's on at least OPPOSED_FRACTION of them
@@ -341,7 +351,7 @@ def read_force_csv(path) -> dict:
 
 def force_experiment(path, name, *, temperature, role, description, from_zero, motion: str = "auto",
                      flip_sign: bool = False, struct=None, columns=None, torque_constant=None,
-                     ambient_temperature=None, continues=None) -> ForceExperiment:
+                     ambient_temperature=None, continues=None, load=None) -> ForceExperiment:
     """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it; ``struct``: the
     MATLAB struct holding the run); ``temperature`` is the manifest's (None: the column's
     mean); ``from_zero`` moves a clock time to start at zero; ``motion`` chooses what drives the model
@@ -351,7 +361,7 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
     ``torque_constant``) in place of the friction is read by data/command.py: measured_force. A run with an
     ambient temperature (an ``ambient_temperature[C]`` column, or the manifest's ``ambient_temperature``) and no
     contact temperature is a warm-up record (:func:`warm_up_columns`); ``continues``: the manifest file it
-    continues."""
+    continues. ``load``: the manifest's load [N or N m], else a load column's (:func:`run_load`)."""
     cols = read_force_csv(path) if columns is None else columns
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
@@ -380,7 +390,46 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
                            input=motion_waveform(t, drive_v, cols["position"][0]), force=F, velocity=v,
                            rotary=cols["rotary"], struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
                            column=column, headers=_headers(path, cols), ambient_temperature=ambient,
-                           proxy_temperature=proxy, continues=continues)
+                           proxy_temperature=proxy, continues=continues, load=run_load(path, cols, load))
+
+
+def run_load(path, cols: dict, load=None) -> float | None:
+    """A run's load [N or N m]: the manifest's ``load`` or the mean of a ``normal_force[N]`` / ``load_torque[N*m]``
+    column; None with neither. Refused, naming the file: both, two load columns, or a column that varies (its
+    peak-to-peak above LOAD_VARIES of its mean magnitude: a per-sample load needs the simulator's load input).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file, for the messages.
+    cols : dict
+        Its columns read, in SI units.
+    load : float, optional
+        The manifest's load.
+
+    Returns
+    -------
+    float or None
+
+    Raises
+    ------
+    InputError
+        As above.
+    """
+    given = [k for k in LOAD_COLUMNS if cols.get(k) is not None]
+    if len(given) > 1 or (given and load is not None):
+        what = "both a normal_force and a load_torque column" if len(given) > 1 else \
+            f"both a {given[0]} column and the manifest's 'load'"
+        raise InputError(f"{path}: {what}: give the run's load once")
+    if not given:
+        return None if load is None else float(load)
+    L = np.asarray(cols[given[0]], float)
+    mean = float(np.mean(L))
+    if np.ptp(L) > LOAD_VARIES * abs(mean):
+        raise InputError(f"{path}: column {given[0]}: the load varies over the run ({float(np.min(L)):.4g} to "
+                         f"{float(np.max(L)):.4g}); a run's load must be constant (within {100 * LOAD_VARIES:g} % of "
+                         f"its mean): a varying load needs the simulator's load input, not there yet")
+    return mean
 
 
 def warm_up_columns(path, cols: dict, temperature, ambient_temperature, continues) -> tuple:
