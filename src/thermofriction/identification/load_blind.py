@@ -14,11 +14,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._lazy import lazy
+from ..errors import ThermofrictionError
+from ..results import Finding
 from ..models import Const, Model, ModelI
 from ..models.load_laws import LoadLaw, LoadTerm, load_laws
 from .load_fit import BLIND_ALPHA, LEVELS, LoadFit, fit_load_laws, held_out_rmse
 
 stats = lazy("scipy.stats")
+
+
+class LoadBlindWarning(UserWarning):
+    """The runs span loads and the model, without a law of load, is load-blind (its errors follow the load)."""
 
 
 @dataclass
@@ -136,3 +142,30 @@ def check_load_blind(model: Model, experiments, free=(), offset: str = "per-expe
         return float(np.sqrt(np.mean(np.square(list(held_out_rmse(m, scored).values())))))
     return LoadBlindness((loads[0], loads[-1]), blind, loaded, p, rms(blind.model), rms(loaded.model),
                          "held-out runs" if held else "fit runs (none held out)")
+
+
+def load_findings(model: Model, experiments) -> list:
+    """What validation says of the load: where force runs span loads and the model has no law of load, the
+    load-blind check's sentence (a LoadBlindWarning where the model is load-blind, else a note of the same
+    category saying it was tested), or why it could not be tested; nothing otherwise.
+
+    Parameters
+    ----------
+    model : Model
+        The model validated.
+    experiments : list
+        The runs validated.
+
+    Returns
+    -------
+    list of Finding
+    """
+    exps = [e for e in experiments if getattr(e, "load", None) is not None]
+    if load_laws(model) or len({float(e.load) for e in exps}) < 2 or not any(e.role == "fit" for e in exps):
+        return []
+    try:
+        found = check_load_blind(model, experiments)
+    except ThermofrictionError as e:
+        return [Finding(LoadBlindWarning, f"the runs span loads but the model has no law of load, and adding one "
+                                          f"could not be tried: {e}")]
+    return [] if found is None else [Finding(LoadBlindWarning, found.message())]

@@ -69,7 +69,7 @@ def law_derivatives(law, T: float, load: float) -> np.ndarray:
     return LoadLaw(law, _NO_LOAD).coefficient_derivatives(T, 1.0)
 
 
-def model_at(model: Model, T: float, load: float | None) -> Model:
+def model_at(model: Model, T: float, load: float | None, warn: bool = False) -> Model:
     """``model`` with every law replaced by its value at (T, load): a model of numbers, no thermal extension.
 
     Parameters
@@ -80,17 +80,19 @@ def model_at(model: Model, T: float, load: float | None) -> Model:
         The temperature [C].
     load : float or None
         The load [N or N m]; None only for a model without laws of load.
+    warn : bool, default False
+        Warn (LoadRangeWarning) at a load outside a law's range.
 
     Returns
     -------
     Model
     """
-    values = {n: (law.value(T, load, warn=False) if isinstance(law, LoadLaw) else float(law(T)))
+    values = {n: (law.value(T, load, warn=warn) if isinstance(law, LoadLaw) else float(law(T)))
               for n, law in model.laws.items()}
     return dataclasses.replace(model, thermal=None, friction=model.friction.with_values(**values))
 
 
-def stepped_force(model: Model, exp, names=()) -> tuple:
+def stepped_force(model: Model, exp, names=(), warn: bool = False) -> tuple:
     """(friction force on the run's samples, its derivatives in the friction parameters ``names`` at the run's
     conditions) of ``model`` at run ``exp``'s temperature and load, by the core's exact stepping.
 
@@ -102,6 +104,8 @@ def stepped_force(model: Model, exp, names=()) -> tuple:
         The run, carrying its load where the model has laws of load.
     names : sequence of str, default ()
         Friction parameters to differentiate in.
+    warn : bool, default False
+        Warn (LoadRangeWarning) at a load outside a law's range (a prediction's; a fit's steps do not).
 
     Returns
     -------
@@ -118,7 +122,7 @@ def stepped_force(model: Model, exp, names=()) -> tuple:
     if not isinstance(d.temperature, (int, float)):
         raise InputError(f"{exp.file}: the temperature varies over the run; a law of load is fitted on runs at a "
                          f"constant temperature (the simulator takes no load yet)")
-    at = model_at(model, float(d.temperature), load)
+    at = model_at(model, float(d.temperature), load, warn)
     spec = _bridge.model_spec(at, float(d.temperature), d.waveform)
     if not _bridge.prescribed_applies(spec):
         raise InputError(f"{exp.file}: the core's exact stepping does not apply to this model ({model.friction.model});"

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, unknown_keys
+from ..errors import InputError, TemperatureRangeWarning, unknown_keys
 from ._parse import num
 from .laws import Law, _check_range, law_from_dict as temperature_law_from_dict
 
@@ -33,8 +33,9 @@ LOAD_KEYS = ("k", "saturation", "combine", "interaction", "range")
 LOAD_RANGE_TOLERANCE = 0.02
 
 
-class LoadRangeWarning(UserWarning):
-    """A load outside the range a load law was calibrated on: its value there is an extrapolation."""
+class LoadRangeWarning(TemperatureRangeWarning):
+    """A load outside the range a load law was calibrated on: its value there is an extrapolation (a law's range
+    warning, reported wherever a temperature range's is)."""
 
 
 @dataclass(frozen=True)
