@@ -190,6 +190,7 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
         model = load_model(model)
     if not isinstance(model, Model):
         raise InputError(f"export_fmu: model must be a Model, a model file or a preset name, got {shorten(model)}")
+    refuse_load_laws(model, "the FMU")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); "
                          f"this is {platform.system()} {platform.machine()}")
@@ -275,7 +276,6 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     model, source, temperature, step, platforms = _checked(model, path, temperature, model_identifier, source,
                                                            solver, step, fmi, platforms)
     _check_exportable(model)
-    refuse_load_laws(model, "the FMU")
     _args.instance(estimator, TemperatureEstimator, "estimator", "a TemperatureEstimator", none=True)
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:

@@ -57,7 +57,8 @@ class LoadTerm:
     interaction : float, optional
         c: a term c T s added (fitted where given; 0 is a start).
     range : tuple of float, optional
-        The calibrated loads (low, high); a value asked outside it warns (LoadRangeWarning).
+        The calibrated load magnitudes |L| (low, high), 0 <= low < high; a value asked outside it warns
+        (LoadRangeWarning).
 
     Raises
     ------
@@ -90,6 +91,8 @@ class LoadTerm:
         if self.saturation is not None and not self.saturation > 0:
             raise InputError(f"{where}: 'saturation' must be positive, got {self.saturation!r}")
         object.__setattr__(self, "range", _check_range(self.range, where))
+        if self.range is not None and self.range[0] < 0:
+            raise InputError(f"{where}: 'range' is of the load's magnitude |load|: low >= 0, got {list(self.range)}")
 
     def names(self) -> list:
         """The fitted coefficients' names, ``load.k`` and ``load.interaction`` where they apply."""
@@ -111,11 +114,12 @@ class LoadTerm:
         return d
 
     def in_range(self, load) -> bool:
-        """Whether every ``load`` lies in the calibrated range (within LOAD_RANGE_TOLERANCE of its span)."""
+        """Whether every ``load``'s magnitude lies in the calibrated range (within LOAD_RANGE_TOLERANCE of its
+        span)."""
         if self.range is None:
             return True
         tol = LOAD_RANGE_TOLERANCE * (self.range[1] - self.range[0])
-        L = np.atleast_1d(np.asarray(load, float))
+        L = np.abs(np.atleast_1d(np.asarray(load, float)))
         return bool(np.all((L >= self.range[0] - tol) & (L <= self.range[1] + tol)))
 
 
@@ -189,7 +193,7 @@ class LoadLaw(Law):
         """The parameter at temperature ``T`` [C] and ``load`` (scalars or arrays of one shape); warns
         (LoadRangeWarning) at a load outside the calibrated range."""
         if warn and not self.load.in_range(load):
-            warnings.warn(f"load {np.ravel(load)[0]:.4g} outside the range {list(self.load.range)} the load law was "
+            warnings.warn(f"load {np.ravel(load)[0]:.4g} outside the range of |load| {list(self.load.range)} the load law was "
                           "calibrated on: its value there is an extrapolation", LoadRangeWarning, stacklevel=2)
         f = np.asarray(self.base(np.asarray(T, float)), float)
         s = self.load.magnitude(load)
