@@ -33,15 +33,16 @@ def truth_at(T, L) -> Truth:
                  ripple=0.0)
 
 
-def runs(conditions, seed=0, roles=None, rate=100.0, duration=8.0):
-    """A Dataset of one run per (temperature, load) in ``conditions``, and the true offsets."""
+def runs(conditions, seed=0, roles=None, rate=100.0, duration=8.0, load_free=False):
+    """A Dataset of one run per (temperature, load) in ``conditions``, and the true offsets; ``load_free``: the
+    friction at zero load whatever the recorded load (a truth that does not depend on it)."""
     rng = np.random.default_rng(seed)
     exps, offsets = [], []
     for k, (T, L) in enumerate(conditions):
         n = int(duration * rate) + 1
         t = sample_times(n, rate, 0.05, rng)
         A, f = 0.6 * (1 + 0.1 * (k % 3)), 0.25 * (1 + 0.07 * (k % 4))
-        x, _, F = true_friction(truth_at(T, L), t, A, f)
+        x, _, F = true_friction(truth_at(T, 0.0 if load_free else L), t, A, f)
         offset = float(rng.uniform(-0.03, 0.03))
         offsets.append(offset)
         force = F + offset + ar1(n, RHO, NOISE, rng)
