@@ -176,3 +176,12 @@ def test_a_constant_or_exp_base_law_keeps_its_kind():
     m = Model(PrescribedMotion(motion="rotary"), LuGre(sigma0=100.0, sigma1=0.5, sigma2=0.1, vs=0.08, fc=None,
                                                        fs=0.5), ModelI({"fc": law}))
     assert m.laws["fc"] is law
+
+
+def test_save_dataset_keeps_each_run_s_load(tmp_path):
+    """A round trip through save_dataset and load_dataset keeps the load (the manifest's key)."""
+    exps = [_read(_columns(None), load=L, T=T) for L, T in ((5.0, 25.0), (12.5, 40.0))]
+    for k, e in enumerate(exps):
+        e.file = f"r{k}.csv"
+    tf.save_dataset(tf.Dataset(name="d", experiments=exps), tmp_path / "ds")
+    assert [e.load for e in tf.load_dataset(tmp_path / "ds").experiments] == [5.0, 12.5]

@@ -24,6 +24,7 @@ from ..errors import InputError, shorten
 from .command import COMMAND_SI, COMMAND_UNITS, MEASURED_KEYS, column_key_of, measured_force
 from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
 from .experiments import MIN_SAMPLES, Experiment
+from .load import run_load
 from .motion import (MOTIONS, POSITION_MISMATCH_ERROR, MotionCheck, MotionWarning, SamplingWarning, check_motion,
                      check_motion_option, choose_motion, motion_waveform, quantum, v_smooth_for, velocity_lag,
                      velocity_of, velocity_resolution, velocity_scale, with_v_smooth)
@@ -65,12 +66,6 @@ MARKERS = ("friction_force", "friction_torque", "position", "velocity", *COMMAND
 #: A sampling interval this many times the median one is a gap in the record (warned about).
 GAP_RATIO = 10.0
 EXAMPLE = "time[s],position[rad],velocity[rad/s],friction_torque[N*m]"
-
-#: the columns that hold a run's load
-LOAD_COLUMNS = ("normal_force", "load_torque")
-#: a load column whose peak-to-peak exceeds this fraction of its mean magnitude varies over the run (refused: a
-#: per-sample load needs the simulator's load input, not there yet)
-LOAD_VARIES = 0.05
 
 #: The sign check: sliding samples are those faster than this fraction of the 95th percentile speed; a
 #: friction column whose sign (the offset removed) opposes the velocity's on at least OPPOSED_FRACTION of them
@@ -391,45 +386,6 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
                            rotary=cols["rotary"], struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
                            column=column, headers=_headers(path, cols), ambient_temperature=ambient,
                            proxy_temperature=proxy, continues=continues, load=run_load(path, cols, load))
-
-
-def run_load(path, cols: dict, load=None) -> float | None:
-    """A run's load [N or N m]: the manifest's ``load`` or the mean of a ``normal_force[N]`` / ``load_torque[N*m]``
-    column; None with neither. Refused, naming the file: both, two load columns, or a column that varies (its
-    peak-to-peak above LOAD_VARIES of its mean magnitude: a per-sample load needs the simulator's load input).
-
-    Parameters
-    ----------
-    path : str or Path
-        The file, for the messages.
-    cols : dict
-        Its columns read, in SI units.
-    load : float, optional
-        The manifest's load.
-
-    Returns
-    -------
-    float or None
-
-    Raises
-    ------
-    InputError
-        As above.
-    """
-    given = [k for k in LOAD_COLUMNS if cols.get(k) is not None]
-    if len(given) > 1 or (given and load is not None):
-        what = "both a normal_force and a load_torque column" if len(given) > 1 else \
-            f"both a {given[0]} column and the manifest's 'load'"
-        raise InputError(f"{path}: {what}: give the run's load once")
-    if not given:
-        return None if load is None else float(load)
-    L = np.asarray(cols[given[0]], float)
-    mean = float(np.mean(L))
-    if np.ptp(L) > LOAD_VARIES * abs(mean):
-        raise InputError(f"{path}: column {given[0]}: the load varies over the run ({float(np.min(L)):.4g} to "
-                         f"{float(np.max(L)):.4g}); a run's load must be constant (within {100 * LOAD_VARIES:g} % of "
-                         f"its mean): a varying load needs the simulator's load input, not there yet")
-    return mean
 
 
 def warm_up_columns(path, cols: dict, temperature, ambient_temperature, continues) -> tuple:
