@@ -63,15 +63,19 @@ class LoadBlindness:
         """Whether the data show a dependence on the load the model lacks (significant and a gain above 1)."""
         return self.p_value < BLIND_ALPHA and self.gain > 1.0
 
+    @property
+    def p_text(self) -> str:
+        return "p < 1e-16" if self.p_value < 1e-16 else f"p = {self.p_value:.2g}"
+
     def message(self) -> str:
         """The sentence the check says."""
         span = f"the runs span loads {self.loads[0]:.4g} to {self.loads[1]:.4g}"
         if not self.load_blind:
             return (f"{span}; the model has no law of load and needs none here: an affine load term on the level "
                     f"parameters, fitted, changed the RMSE on the {self.scored_on} from {self.rmse_blind:.4g} to "
-                    f"{self.rmse_loaded:.4g} (p = {self.p_value:.2g})")
+                    f"{self.rmse_loaded:.4g} ({self.p_text})")
         return (f"the model is load-blind: {span} and its errors follow the load (F-test corrected for the noise's "
-                f"correlation: p = {self.p_value:.2g}); an affine load term on {', '.join(self.terms)}, fitted, cut "
+                f"correlation: {self.p_text}); an affine load term on {', '.join(self.terms)}, fitted, cut "
                 f"the RMSE on the {self.scored_on} from {self.rmse_blind:.4g} to {self.rmse_loaded:.4g} "
                 f"({self.gain:.3g}x): add a load law ([thermal] fc = {{ ..., load = {{ law = \"affine\", ... }} }})")
 
@@ -120,6 +124,13 @@ def check_load_blind(model: Model, experiments, free=(), offset: str = "per-expe
     Returns
     -------
     LoadBlindness or None
+
+    Raises
+    ------
+    InputError
+        As ``fit_load_laws``: a model or run the joint fit cannot take, named.
+    ComputationError
+        A fit that could not be computed.
     """
     exps = list(getattr(experiments, "experiments", experiments))
     loads = sorted({float(e.load) for e in exps if getattr(e, "load", None) is not None})

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._lazy import lazy
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..measurements.force_load import law_derivatives, run_load, stepped_force
 from ..models import Model, ModelI
 from ..models.load_laws import LoadLaw, LoadTerm, load_laws
@@ -224,6 +224,9 @@ def fit_load_laws(model: Model, experiments, free=(), offset: str = "per-experim
         return cache[key]
     res = optimize.least_squares(lambda x: evaluate(x)[0], x0, jac=lambda x: evaluate(x)[1], x_scale="jac",
                                  method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=200)
+    if res.status <= 0 or np.all(evaluate(res.x)[0] == bad):
+        raise ComputationError(f"the joint fit of the laws did not converge ({res.message}) in {res.nfev} "
+                               f"evaluations; start the laws nearer the data")
     return _result(model, names, res.x, runs, measured, sizes, offset, evaluate)
 
 
