@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
-from thermofriction.identification.load_blind import LoadBlindWarning, check_load_blind
+from thermofriction.identification.load_blind import LoadBlindWarning, check_load_blind, load_findings
 from thermofriction.identification.load_fit import fit_load_laws, held_out_rmse
-from thermofriction.models import LoadLaw, LoadTerm, Linear, LuGre, Model, ModelI, PrescribedMotion
+from thermofriction.models import LoadLaw, LoadRangeWarning, LoadTerm, Linear, LuGre, Model, ModelI, PrescribedMotion
 
 import load_truth as lt
 
@@ -70,9 +70,13 @@ def test_held_out_loads_are_predicted_at_the_noise(fitted, data):
 def test_validate_predicts_each_run_at_its_load(fitted, data):
     """validate: a run at its load; the held-out run beyond the fitted load range warned about; no load-blind note
     for a model with the laws."""
+    assert fitted.model.laws["fc"].load.range == pytest.approx((5.0, 25.0), abs=0.01)
+    assert fitted.model.laws["fc"].range == (20.0, 50.0)
     res = tf.validate(fitted.model, data, offset="per-experiment")
     rmse = {p.file: p.rmse for p in res.predictions}
     assert rmse["run9.csv"] == pytest.approx(lt.NOISE, rel=0.15)
+    outside = [f.message for f in res.findings if issubclass(f.category, LoadRangeWarning)]
+    assert len(outside) == 1 and outside[0].startswith("run9.csv: load 35 is outside") and "'fs' (5..25)" in outside[0]
     assert not any(f.category is LoadBlindWarning for f in res.findings)
 
 
@@ -113,3 +117,13 @@ def test_a_run_without_its_load_is_named(data):
     bare = type(exp)(**{**{k: getattr(exp, k) for k in exp.__dataclass_fields__}, "load": None})
     with pytest.raises(tf.InputError, match=r"run0\.csv: the model's laws depend on the load but the run has none"):
         fit_load_laws(start_model(), [bare])
+
+
+def test_a_model_ii_is_not_checked_as_if_it_were_model_i(data):
+    """A Model II model is not fitted by dropping its term: the check says it could not be tried, and why."""
+    m = Model(PrescribedMotion(motion="rotary"), LuGre(sigma0=100.0, sigma1=0.5, sigma2=0.1, vs=0.08, fc=0.4, fs=0.5),
+              tf.ModelII(Linear(a=-0.001, b=0.03)))
+    with pytest.raises(tf.InputError, match="Model II"):
+        fit_load_laws(m, data)
+    notes = load_findings(m, data.experiments)
+    assert len(notes) == 1 and "could not be tried" in notes[0].message and "Model II" in notes[0].message

@@ -105,7 +105,7 @@ def _names(model: Model, free) -> list:
 
 
 def _with(model: Model, names, x) -> Model:
-    laws, values, k = dict(model.laws), {}, 0
+    laws, k = dict(model.laws), 0
     for p, law in model.laws.items():
         n = len(law.coefficient_names())
         laws[p] = law.with_coefficients(x[k:k + n])
@@ -119,8 +119,8 @@ def _run(model, exp, names):
     params = list(model.laws) + [n for n in names if "." not in n]
     F, dF = stepped_force(model, exp, params)
     T, load = float(exp.temperature), getattr(exp, "load", None)
-    cols, k = [], 0
-    for j, (p, law) in enumerate(model.laws.items()):
+    cols = []
+    for j, law in enumerate(model.laws.values()):
         d = law_derivatives(law, T, 1.0 if load is None else load)
         cols.append(dF[:, j:j + 1] * d[None, :])
     cols.append(dF[:, len(model.laws):])
@@ -190,10 +190,14 @@ def fit_load_laws(model: Model, experiments, free=(), offset: str = "per-experim
     Raises
     ------
     InputError
-        No fit run, a run without the load a law needs, an unknown ``free`` name or ``offset``.
+        No fit run, a run without the load a law needs, an unknown ``free`` name or ``offset``; a Model II or
+        self-heating model.
     ComputationError
         The fit could not be computed.
     """
+    if model.thermal is not None and not isinstance(model.thermal, ModelI) or model.heat is not None:
+        raise InputError("fit_load_laws fits Model I laws (of temperature, or of temperature and load) at constant "
+                         "temperatures; this model has Model II or a self-heating model")
     if offset not in ("per-experiment", "shared", "none"):
         raise InputError(f"offset must be \"per-experiment\", \"shared\" or \"none\", got {offset!r}")
     runs = [e for e in getattr(experiments, "experiments", experiments) if getattr(e, "role", "fit") == "fit"]
@@ -238,11 +242,41 @@ def _result(model, names, x, runs, measured, sizes, offset, evaluate) -> LoadFit
     dof = max(r.size - x.size - n_offsets, 1)
     tau = correlation_time(per_run)
     cov = float(r @ r) / dof * tau * np.linalg.pinv(J.T @ J)
-    fitted = _with(model, names, x)
+    fitted = with_ranges(_with(model, names, x), runs)
     raw = np.concatenate([_run(fitted, e, names)[0] for e in runs]) - measured
     offsets = {e.file: -float(np.mean(raw[a:b])) for e, a, b in zip(runs, edges[:-1], edges[1:])}
     return LoadFit(fitted, names, x, np.sqrt(np.diag(cov)), cov,
                    {e.file: float(np.sqrt(np.mean(q ** 2))) for e, q in zip(runs, per_run)}, offsets, tau)
+
+
+def with_ranges(model: Model, runs) -> Model:
+    """``model`` with each law's ranges those of the fit runs: the temperatures', and for a law of load the loads'
+    magnitudes (as ``identify`` writes a Model I law's), where the runs span more than one value.
+
+    Parameters
+    ----------
+    model : Model
+        The fitted model.
+    runs : list of ForceExperiment
+        The fit runs.
+
+    Returns
+    -------
+    Model
+    """
+    T = [float(e.temperature) for e in runs]
+    L = [abs(float(e.load)) for e in runs if getattr(e, "load", None) is not None]
+    laws = {}
+    for p, law in model.laws.items():
+        base = law.base if isinstance(law, LoadLaw) else law
+        if max(T) > min(T):
+            base = dataclasses.replace(base, range=(min(T), max(T)))
+        if isinstance(law, LoadLaw):
+            load = dataclasses.replace(law.load, range=(min(L), max(L))) if L and max(L) > min(L) else law.load
+            laws[p] = LoadLaw(base, load)
+        else:
+            laws[p] = base
+    return dataclasses.replace(model, thermal=ModelI(laws))
 
 
 def held_out_rmse(model: Model, experiments) -> dict:

@@ -17,7 +17,8 @@ from .. import _bridge
 from ..drive import drive
 from ..errors import InputError
 from ..models import Model
-from ..models.load_laws import LoadLaw, LoadTerm, load_laws
+from ..models.load_laws import LoadLaw, LoadRangeWarning, LoadTerm, load_laws
+from ..results import Finding, emit
 
 #: a temperature law's derivatives through the same code as a load law's (a product with |load| = 1)
 _NO_LOAD = LoadTerm("proportional")
@@ -87,7 +88,12 @@ def model_at(model: Model, T: float, load: float | None, warn: bool = False) -> 
     -------
     Model
     """
-    values = {n: (law.value(T, load, warn=warn) if isinstance(law, LoadLaw) else float(law(T)))
+    outside = [f"'{n}' ({law.load.range[0]:.4g}..{law.load.range[1]:.4g})" for n, law in load_laws(model).items()
+               if not law.load.in_range(load)]
+    if warn and outside:  # one finding for the run, naming every law, as a temperature range's
+        emit([Finding(LoadRangeWarning, f"load {load:.4g} is outside the calibrated range of |load| of the law(s) "
+                                        f"for {', '.join(outside)}: their values there are extrapolations")])
+    values = {n: (law.value(T, load, warn=False) if isinstance(law, LoadLaw) else float(law(T)))
               for n, law in model.laws.items()}
     return dataclasses.replace(model, thermal=None, friction=model.friction.with_values(**values))
 

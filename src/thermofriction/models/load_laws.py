@@ -16,12 +16,12 @@ holding one is refused where it would reach it (the simulator, the FMU, the real
 from __future__ import annotations
 
 import dataclasses
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError, TemperatureRangeWarning, unknown_keys
+from ..results import Finding, emit
 from ._parse import num
 from .laws import Law, _check_range, law_from_dict as temperature_law_from_dict
 
@@ -193,8 +193,9 @@ class LoadLaw(Law):
         """The parameter at temperature ``T`` [C] and ``load`` (scalars or arrays of one shape); warns
         (LoadRangeWarning) at a load outside the calibrated range."""
         if warn and not self.load.in_range(load):
-            warnings.warn(f"load {np.ravel(load)[0]:.4g} outside the range of |load| {list(self.load.range)} the load law was "
-                          "calibrated on: its value there is an extrapolation", LoadRangeWarning, stacklevel=2)
+            lo, hi = self.load.range
+            emit([Finding(LoadRangeWarning, f"load {np.ravel(load)[0]:.4g} outside the range of |load| {lo:.4g}..{hi:.4g} "
+                                            "the load law was calibrated on: its value there is an extrapolation")])
         f = np.asarray(self.base(np.asarray(T, float)), float)
         s = self.load.magnitude(load)
         term = self.load
