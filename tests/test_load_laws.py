@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import thermofriction as tf
+from thermofriction.cli import main
 from thermofriction.data.force import force_experiment
 from thermofriction.models import (Const, Exp, LoadLaw, LoadRangeWarning, LoadTerm, Linear, LuGre, Model, ModelI,
                                    PrescribedMotion, model_from_dict)
@@ -185,3 +186,14 @@ def test_save_dataset_keeps_each_run_s_load(tmp_path):
         e.file = f"r{k}.csv"
     tf.save_dataset(tf.Dataset(name="d", experiments=exps), tmp_path / "ds")
     assert [e.load for e in tf.load_dataset(tmp_path / "ds").experiments] == [5.0, 12.5]
+
+
+def test_the_command_line_refuses_to_simulate_a_law_of_load(tmp_path, capsys):
+    """Exit status 2 and one line naming the law, no traceback."""
+    path = tmp_path / "m.toml"
+    model().save(path)
+    status = main(["simulate", str(path), "--temperature", "30", "--duration", "0.01", "--input",
+                   "sine:amplitude=0.1,frequency=1", "-o", str(tmp_path / "o.csv")])
+    err = capsys.readouterr().err
+    assert status == 2 and "[thermal] fc: a law of the load" in err and "Traceback" not in err
+    assert not (tmp_path / "o.csv").exists()
