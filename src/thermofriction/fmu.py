@@ -48,6 +48,7 @@ from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_d
 from .estimation import TemperatureEstimator
 from .models import MassPlant, Model, StickSlipPlant, load_model
 from .models.fit_record import fit_record_lines
+from .models.load_laws import refuse_load_laws
 
 #: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
 SOLVERS = ("adaptive", "realtime")
@@ -189,6 +190,7 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
         model = load_model(model)
     if not isinstance(model, Model):
         raise InputError(f"export_fmu: model must be a Model, a model file or a preset name, got {shorten(model)}")
+    refuse_load_laws(model, "the FMU")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); "
                          f"this is {platform.system()} {platform.machine()}")

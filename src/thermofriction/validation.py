@@ -18,6 +18,7 @@ from .measurements import Measurement, MetricWarning, Prediction, amount, measur
 from .measurements.ripple import check_phase_option
 from .models import Model
 from .models.fit_record import fit_record_of
+from .identification.load_blind import load_findings
 from .results import Finding, Result, Summary, as_text, collecting, heading, lines, table
 from .unit_scale import unit_warnings
 
@@ -376,7 +377,7 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
                   if issubclass(x.category, TemperatureRangeWarning)]
         found += [x for x in w if issubclass(x.category, MetricWarning)]
     # first: a unit off by 1000 explains every error after it (unit_warnings also warns: validate's edge)
-    found = [Finding(UnitWarning, m) for m in unit_warnings(pairs)] + found
+    found = [Finding(UnitWarning, m) for m in unit_warnings(pairs)] + found + load_findings(model, exps)
     return ValidationResult(model, preds, [f.message for f in found], failures, measurement, how, found)
 
 

@@ -85,6 +85,9 @@ class Experiment:
     headers : dict, optional
         Per column read ("displacement", "force", ...): (where the file holds it, the unit its header
         declared), what a unit warning names; None for an experiment made in memory.
+    load : float, optional
+        The run's constant load, a normal force [N] or a load torque [N m] (docs/formats.md#loads), carried like
+        its temperature; None: not given.
     """
 
     file: str
@@ -102,6 +105,8 @@ class Experiment:
     #: per column read ("displacement", "force", ...): (where the file holds it, the unit its header declared),
     #: what a unit warning names (unit_scale.py); None for an experiment made in memory
     headers: dict | None = dataclasses.field(default=None, repr=False)
+    #: the run's constant load [N or N m] (a normal force, a load torque), None where not given
+    load: float | None = None
 
     @property
     def label(self) -> str:

@@ -28,7 +28,7 @@ from .experiments import ROLES, TEMPERATURE_RANGE, Dataset, Experiment
 
 _MANIFEST_KEYS = ("name", "description", "motion", "flip_sign", "torque_constant", "experiment")
 _EXPERIMENT_KEYS = ("file", "temperature", "role", "description", "input", "struct", "units", "motion", "flip_sign",
-                    "torque_constant", "ambient_temperature", "continues")
+                    "torque_constant", "ambient_temperature", "continues", "load")
 #: the manifest's keys that apply to force experiments only (data/force.py), at the top (every experiment)
 #: or in an [[experiment]] entry
 _FORCE_KEYS = ("motion", "flip_sign", "torque_constant")
@@ -86,6 +86,16 @@ def _force_options(table: dict, where: str, defaults: dict) -> dict:
             raise InputError(f"{where}: 'flip_sign' must be true or false, got {shorten(table['flip_sign'])}")
         out["flip_sign"] = table["flip_sign"]
     return out
+
+
+def _load_key(e: dict, where: str):
+    """A force experiment's ``load`` [N or N m] (docs/formats.md#loads): a finite number, or None."""
+    if "load" not in e:
+        return None
+    v = e["load"]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise InputError(f"{where}: 'load' must be a number [N, or N m for a joint], got {shorten(v)}")
+    return float(v)
 
 
 def _warm_up_keys(e: dict, where: str, before: list) -> dict:
@@ -238,12 +248,12 @@ def manifest_dataset(meta: dict, folder: Path, manifest: Path, *, motion: str | 
                                      f"units in its header")
             exps.append(force_experiment(folder / f, f, temperature=T, role=role, description=desc,
                                          from_zero=_from_zero, struct=e.get("struct"), columns=force_cols,
-                                         **_warm_up_keys(e, where, exps), **opts))
+                                         load=_load_key(e, where), **_warm_up_keys(e, where, exps), **opts))
             if "torque_constant" in e and not (exps[-1].column or "").startswith("current"):
                 raise InputError(f"{where}: 'torque_constant' applies to a current[A] column; {f} records "
                                  f"{exps[-1].column}")
             continue
-        for key in (*_FORCE_KEYS, "ambient_temperature", "continues"):
+        for key in (*_FORCE_KEYS, "ambient_temperature", "continues", "load"):
             if key in e or key in meta:
                 raise InputError(f"{where if key in e else manifest}: '{key}' applies to force experiments only "
                                  f"({f} records a voltage and a displacement)")

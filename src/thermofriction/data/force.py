@@ -24,6 +24,7 @@ from ..errors import InputError, shorten
 from .command import COMMAND_SI, COMMAND_UNITS, MEASURED_KEYS, column_key_of, measured_force
 from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
 from .experiments import MIN_SAMPLES, Experiment
+from .load import run_load
 from .motion import (MOTIONS, POSITION_MISMATCH_ERROR, MotionCheck, MotionWarning, SamplingWarning, check_motion,
                      check_motion_option, choose_motion, motion_waveform, quantum, v_smooth_for, velocity_lag,
                      velocity_of, velocity_resolution, velocity_scale, with_v_smooth)
@@ -45,6 +46,10 @@ _UNITS = {
     "friction_force": {u: (s, "linear") for u, s in _FORCE.items()},
     "friction_torque": {u: (s, "rotary") for u, s in _TORQUE.items()},
     "temperature": {"C": (1.0, None)},
+    # a run's load (docs/formats.md#loads): constant over the run
+    # (no motion kind: a joint's axial preload in N is a normal force)
+    "normal_force": {u: (s, None) for u, s in _FORCE.items()},
+    "load_torque": {u: (s, None) for u, s in _TORQUE.items()},
     # a warm-up record (docs/formats.md#warm-up-records): the ambient temperature and a proxy's (winding, housing)
     "ambient_temperature": {"C": (1.0, None)},
     "proxy_temperature": {"C": (1.0, None)},
@@ -52,7 +57,7 @@ _UNITS = {
 }
 _UNITS["displacement"] = _UNITS["position"]
 _SI = {"time": "s", "position": "m", "displacement": "m", "velocity": "m/s", "friction_force": "N",
-       "friction_torque": "N*m", "temperature": "C", "ambient_temperature": "C",
+       "friction_torque": "N*m", "normal_force": "N", "load_torque": "N*m", "temperature": "C", "ambient_temperature": "C",
        "proxy_temperature": "C", **COMMAND_SI}
 #: the columns that hold temperatures [C], each checked for plausibility
 TEMPERATURE_COLUMNS = ("temperature", "ambient_temperature", "proxy_temperature")
@@ -341,7 +346,7 @@ def read_force_csv(path) -> dict:
 
 def force_experiment(path, name, *, temperature, role, description, from_zero, motion: str = "auto",
                      flip_sign: bool = False, struct=None, columns=None, torque_constant=None,
-                     ambient_temperature=None, continues=None) -> ForceExperiment:
+                     ambient_temperature=None, continues=None, load=None) -> ForceExperiment:
     """A :class:`ForceExperiment` from the file ``path`` (``name`` as the manifest gives it; ``struct``: the
     MATLAB struct holding the run); ``temperature`` is the manifest's (None: the column's
     mean); ``from_zero`` moves a clock time to start at zero; ``motion`` chooses what drives the model
@@ -351,7 +356,7 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
     ``torque_constant``) in place of the friction is read by data/command.py: measured_force. A run with an
     ambient temperature (an ``ambient_temperature[C]`` column, or the manifest's ``ambient_temperature``) and no
     contact temperature is a warm-up record (:func:`warm_up_columns`); ``continues``: the manifest file it
-    continues."""
+    continues. ``load``: the manifest's load [N or N m], else a load column's (:func:`run_load`)."""
     cols = read_force_csv(path) if columns is None else columns
     t, _ = from_zero(cols["time"], None)
     sig = cols.get("temperature")
@@ -380,7 +385,7 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
                            input=motion_waveform(t, drive_v, cols["position"][0]), force=F, velocity=v,
                            rotary=cols["rotary"], struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
                            column=column, headers=_headers(path, cols), ambient_temperature=ambient,
-                           proxy_temperature=proxy, continues=continues)
+                           proxy_temperature=proxy, continues=continues, load=run_load(path, cols, load))
 
 
 def warm_up_columns(path, cols: dict, temperature, ambient_temperature, continues) -> tuple:

@@ -235,6 +235,8 @@ def _entry(e) -> dict:
         entry["input"] = e.input.spec()
     if isinstance(e, ForceExperiment) and e.velocity is not None:  # what drove it, as it was loaded
         entry["motion"] = e.motion_source
+    if isinstance(e, ForceExperiment) and e.load is not None:  # the run's constant load (a column's mean)
+        entry["load"] = float(e.load)
     return entry
 
 

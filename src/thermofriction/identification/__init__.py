@@ -20,6 +20,8 @@ from ..models.transforms import base_model, with_friction_model
 from .compare import compare_friction_models
 from .front import MAX_STARTS, METHODS, identify
 from .laws import fit_law, segmented_fit
+from .load_blind import check_load_blind
+from .load_fit import fit_load_laws
 from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from .plant import PlantFit, fit_plant, step_response
@@ -30,4 +32,4 @@ from .warm_up import identify_warm_up
 __all__ = ["with_friction_model", "fit_plant", "PlantFit", "step_response", "identify", "FitResult", "Parameter",
            "Parameters", "fit", "fit_friction", "fit_law", "segmented_fit", "identify_model_i", "identify_model_ii",
            "identify_heat", "base_model", "make_traces", "uncertainty", "compare_friction_models", "force_start",
-           "METHODS", "MAX_STARTS", "identify_warm_up"]
+           "METHODS", "MAX_STARTS", "identify_warm_up", "fit_load_laws", "check_load_blind"]

@@ -24,6 +24,7 @@ from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from ..fitting.optimiser import one_blas_thread
 from ..fitting.problem import counting
+from ..models.load_laws import refuse_load_laws
 from ..models import Model
 from ..models.sides import needs_period
 from ..simulation import StepSizeController
@@ -229,6 +230,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
                                          procedure=procedure, parameters=parameters)
     _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
+    refuse_load_laws(init, "identify (fit the laws with identification.fit_load_laws, at each run's load)")
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     opts = dict(rtol=rtol, starts=starts, seed=seed)

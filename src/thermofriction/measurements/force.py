@@ -39,6 +39,8 @@ from ..waveforms import Sampled
 from ..fitting.quality import fit_quality
 from .base import FD_RTOL, FD_STEP, OFFSETS, Measurement, Trace, center, center_each, reverses, thermal_check
 from .force_finish import force_finish
+from .force_load import stepped_force
+from ..models.load_laws import load_laws
 from .force_start import force_initial, screen_starts, start_section
 
 #: What to check when a fit to force data is not adequate, where it applies (Force.checks)
@@ -128,6 +130,9 @@ class Force(Measurement):
         if model.plant.type != "prescribed":
             raise InputError(f"{exp.file}: force data are fitted with a prescribed-motion model ([plant] type = "
                              f"\"prescribed\"), not a '{model.plant.type}' plant")
+        if load_laws(model):
+            raise InputError("[thermal]: laws of the load are fitted by identification.fit_load_laws (a joint fit at "
+                             "each run's load), not by identify yet")
         if model.heat is not None:
             raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet; fit Model I or II on "
                              "the measured temperatures instead")
@@ -303,7 +308,10 @@ class Force(Measurement):
         stiff that a fit driven by the exact stepping put them there), by the exact stepping itself, which
         needs no step size. ``fast``: by the exact stepping wherever it applies (no simulation checks: for
         what only needs the values, the unit check). A ripple is added at the recorded angle (measurements/ripple.py;
-        per run: at the angle offset that fits ``measured``)."""
+        per run: at the angle offset that fits ``measured``). A model with laws of load: at the run's load, by the
+        exact stepping (measurements/force_load.py; the simulator takes no load yet)."""
+        if load_laws(model):
+            return stepped_force(model, exp, warn=True)[0]
         if ripple.additive(model):
             base = self.friction_of(ripple.without(model), exp, rtol, fast)
             return base + ripple.for_run(self, model, exp, base, measured)

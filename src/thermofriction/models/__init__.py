@@ -12,6 +12,7 @@ each friction parameter's domain is one rule (``models/domains.py``).
 from .friction import (FRICTION_MODELS, GMS, PARAMETER_UNITS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre,
                        Stribeck, check_friction_values, dissipativity_violation, stribeck_curve)
 from .laws import LAWS, PWL, Const, Exp, Law, Linear, Poly, Table, law_from_dict
+from .load_laws import LoadLaw, LoadRangeWarning, LoadTerm
 from .model import PRESETS, Model, load_model, model_from_dict, preset_path, require_actuator
 from .plants import PLANTS, MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
@@ -20,4 +21,5 @@ __all__ = ["Law", "Const", "Linear", "Exp", "Poly", "PWL", "Table", "LAWS", "law
            "MassPlant", "PrescribedMotion", "PLANTS", "plant_from_dict", "LuGre", "Coulomb", "Stribeck", "Dahl",
            "ElastoPlastic", "GMS", "FRICTION_MODELS", "check_friction_values", "stribeck_curve",
            "dissipativity_violation", "ModelI", "ModelII", "Heat", "Model", "load_model", "model_from_dict",
-           "require_actuator", "preset_path", "PARAMETERS", "PARAMETER_UNITS", "PRESETS"]
+           "require_actuator", "preset_path", "PARAMETERS", "PARAMETER_UNITS", "PRESETS", "LoadLaw", "LoadTerm",
+           "LoadRangeWarning"]

@@ -23,7 +23,8 @@ from .domains import in_domain, own_domain
 from .friction import (FRICTION_MODELS, GMS, PARAMETERS, Coulomb, Dahl, ElastoPlastic, LuGre, Stribeck,
                        check_friction_values)
 from .fit_record import check_fit_record
-from .laws import PWL, Law, law_from_dict
+from .laws import PWL, Law
+from .load_laws import LoadLaw, law_from_dict
 from .sides import STATIC_LEVELS
 from .plants import MassPlant, PrescribedMotion, StickSlipPlant, plant_from_dict
 from .thermal import Heat, ModelI, ModelII
@@ -132,11 +133,15 @@ class Model:
     def laws(self) -> dict:
         return dict(self.thermal.laws) if isinstance(self.thermal, ModelI) else {}
 
-    def parameters_at(self, T: float) -> dict:
-        """Every friction parameter's value at temperature T (Model I laws applied)."""
+    def parameters_at(self, T: float, load: float | None = None) -> dict:
+        """Every friction parameter's value at temperature T (Model I laws applied), at ``load`` for a law of load
+        (models/load_laws.py; required there)."""
         v = self.friction.values()
         for pname, law in self.laws.items():
-            v[pname] = law(float(T))
+            if isinstance(law, LoadLaw) and load is not None:
+                v[pname] = law.value(float(T), float(load))
+            else:
+                v[pname] = law(float(T))
         level, coulomb = STATIC_LEVELS[0]
         if level not in v:
             v[level] = v[coulomb]
@@ -171,7 +176,7 @@ class Model:
         parameter out of its domain, Model II's lambda <= 0), or None. A fitted model must pass this:
         then it simulates anywhere in its range."""
         for name, law in self.laws.items():
-            if law.range is None:
+            if law.range is None or isinstance(law, LoadLaw):  # (a law of load: checked at its fitted conditions)
                 continue
             T = np.linspace(law.range[0], law.range[1], points)
             ok = in_domain(name, law(T))
@@ -196,6 +201,8 @@ class Model:
         T, values = np.linspace(rng[0], rng[1], points), self.friction.values()
 
         def at(name):
+            if isinstance(self.laws.get(name), LoadLaw):
+                return None
             if name in self.laws:
                 return np.atleast_1d(self.laws[name](T))
             return None if values.get(name) is None else np.full(T.shape, float(values[name]))

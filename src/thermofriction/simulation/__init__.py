@@ -22,6 +22,7 @@ from ..drive import input_of
 from .. import _args
 from ..errors import InputError, SolverError, shorten
 from ..models import Model, PrescribedMotion, StickSlipPlant
+from ..models.load_laws import refuse_load_laws
 from ..waveforms import Sampled, Waveform
 from ..results import emit
 from .checks import (as_temperature, check_heated_temperatures, check_passivity, check_prescribed_motion,
@@ -297,6 +298,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     (0.01, 0.0)
     """
     _check_arguments(model, input, controller, max_samples)
+    refuse_load_laws(model, "the simulator")
     _check_types(duration, temperature, sample_rate, t_eval, solver, friction_work)
     solver = solver or AutoSwitch()
     if isinstance(solver, str):

@@ -1,0 +1,56 @@
+"""A joint whose LuGre friction levels follow interacting laws of temperature and load, written here (not with
+thermofriction's laws): runs at several (temperature, load) integrated by SciPy (tests/lookalike.py's LSODA), with
+per-run sensor offsets and AR(1) noise, read as a dataset's force experiments would be (a load_torque[N*m] column)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from thermofriction.data.experiments import Dataset
+from thermofriction.data.force import force_experiment
+from lookalike import Truth, ar1, sample_times, true_friction
+
+NOISE = 0.01      # [N m] AR(1) stationary standard deviation
+RHO = 0.6         # its lag-one correlation
+SIGMA0, SIGMA1, SIGMA2, VS = 100.0, 0.5, 0.10, 0.08
+
+
+def fc_true(T, L):
+    """Coulomb level [N m]: (0.40 - 0.003 T)(1 + 0.02 |L|) + 1e-4 T |L| (a product with interaction)."""
+    return (0.40 - 0.003 * T) * (1.0 + 0.02 * abs(L)) + 1e-4 * T * abs(L)
+
+
+def fs_true(T, L):
+    """Static level [N m]: 0.55 - 0.004 T + 0.012 |L| (a gear's part affine in the load, summed)."""
+    return 0.55 - 0.004 * T + 0.012 * abs(L)
+
+
+def truth_at(T, L) -> Truth:
+    fc, fs = fc_true(T, L), fs_true(T, L)
+    return Truth(fc_pos=fc, fc_neg=fc, fs_pos=fs, fs_neg=fs, vs=VS, sigma0=SIGMA0, sigma1=SIGMA1, sigma2=SIGMA2,
+                 ripple=0.0)
+
+
+def runs(conditions, seed=0, roles=None, rate=100.0, duration=8.0, load_free=False):
+    """A Dataset of one run per (temperature, load) in ``conditions``, and the true offsets; ``load_free``: the
+    friction at zero load whatever the recorded load (a truth that does not depend on it)."""
+    rng = np.random.default_rng(seed)
+    exps, offsets = [], []
+    for k, (T, L) in enumerate(conditions):
+        n = int(duration * rate) + 1
+        t = sample_times(n, rate, 0.05, rng)
+        A, f = 0.6 * (1 + 0.1 * (k % 3)), 0.25 * (1 + 0.07 * (k % 4))
+        x, _, F = true_friction(truth_at(T, 0.0 if load_free else L), t, A, f)
+        offset = float(rng.uniform(-0.03, 0.03))
+        offsets.append(offset)
+        force = F + offset + ar1(n, RHO, NOISE, rng)
+        load = L + rng.normal(0.0, 0.002 * max(abs(L), 1.0), n)  # a load cell's small noise around a constant load
+        columns = {"time": t, "position": np.round(x / 1e-5) * 1e-5, "force": force, "load_torque": load,
+                   "rotary": True, "headers": {"time": "time[s]", "position": "position[rad]",
+                                               "force": "friction_torque[N*m]", "load_torque": "load_torque[N*m]"}}
+        role = "fit" if roles is None else roles[k]
+        exps.append(force_experiment(f"run{k}", f"run{k}.csv", temperature=float(T), role=role, description="",
+                                     from_zero=lambda t, i: (t, i), columns=columns))
+    return Dataset(name="load-truth", experiments=exps), offsets
