@@ -74,11 +74,12 @@ SMALL_STEP = 0.2
 COARSE_STEP = 1.0
 
 
-#: the fine stage after a coarse one stops where its cost fell by less than STALL_COST times the misfit's variance (in units
-#: of the noise's; cost = half the sum of squares in units of the noise) over its last STALL_EVALUATIONS
-#: steps (improvements; refused trials do not count): a chi-square change of 0.2 s^2 in three steps, where one
-#: standard error along any direction is 1 s^2. Look-alike force data (never at the noise) ran the fine stage to its 15 evaluations moving the
-#: parameters by 1e-4 of their values, SciPy's relative ftol (1e-7) under the integration's own noise
+#: the fine stage after a coarse one stops where its cost fell by less than STALL_COST times the misfit's
+#: variance (in units of the noise's; cost = half the sum of squares in units of the noise) over its last
+#: STALL_EVALUATIONS steps (improvements; refused trials do not count): a chi-square change of 0.2 s^2 in three
+#: steps, where one standard error along any direction is 1 s^2. Look-alike force data (never at the noise) ran
+#: the fine stage to its 15 evaluations moving the parameters by 1e-4 of their values, SciPy's relative ftol
+#: (1e-7) under the integration's own noise
 STALL_COST, STALL_EVALUATIONS = 0.1, 3
 #: a run of the multi-start that comes within this many standard errors (the intervals' own, at the optimum's
 #: misfit) of an optimum already found has landed on it: it stops there (_Landed), and that optimum is kept
