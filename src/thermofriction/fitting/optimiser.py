@@ -74,11 +74,44 @@ SMALL_STEP = 0.2
 COARSE_STEP = 1.0
 
 
+#: the fine stage after a coarse one stops where its cost fell by less than STALL_COST times the misfit's
+#: variance (in units of the noise's; cost = half the sum of squares in units of the noise) over its last
+#: STALL_EVALUATIONS steps (improvements; refused trials do not count): a chi-square change of 0.2 s^2 in three
+#: steps, where one standard error along any direction is 1 s^2. Look-alike force data (never at the noise) ran
+#: the fine stage to its 15 evaluations moving the parameters by 1e-4 of their values, SciPy's relative ftol
+#: (1e-7) under the integration's own noise
+STALL_COST, STALL_EVALUATIONS = 0.1, 3
+#: a run of the multi-start that comes within this many standard errors (the intervals' own, at the optimum's
+#: misfit) of an optimum already found has landed on it: it stops there (_Landed), and that optimum is kept
+LANDED = 1.0
+
+
 class _Converged(Exception):
     """Raised inside the least-squares iteration at a point that is already the optimum."""
 
-    def __init__(self, phi, step):
-        self.phi, self.step = phi, step
+    def __init__(self, phi, step, why=None):
+        self.phi, self.step, self.why = phi, step, why
+
+
+class _Landed(Exception):
+    """Raised inside the least-squares iteration at a point within LANDED standard errors of a known optimum."""
+
+    def __init__(self, phi):
+        self.phi = phi
+
+
+@dataclasses.dataclass
+class _Known:
+    """An optimum already found, in fitted coordinates: phi, the R factor of its compressed Jacobian (residuals in
+    units of the noise), and its misfit over the noise (its standard errors are that many times the noise's)."""
+
+    phi: np.ndarray
+    R: np.ndarray
+    ratio: float
+
+    def distance(self, phi) -> float:
+        """How far ``phi`` is from this optimum, in its standard errors (the joint, Mahalanobis, sense)."""
+        return float(np.linalg.norm(self.R @ (phi - self.phi))) / max(self.ratio, 1.0)
 
 
 def gauss_newton_length(qr, R) -> float:
@@ -109,7 +142,7 @@ def compressed(r, J, transform: Transform, theta, scale):
 
 
 def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale,
-                   small_step=SMALL_STEP, stall_step=None):
+                   small_step=SMALL_STEP, stall_step=None, known=(), polish=False):
     """SciPy's trust-region least squares on residuals divided by ``scale`` (the data's noise level):
     its stopping tests then mean the same on every dataset, whatever the units and magnitudes
     (on residuals in metres, an absolute gradient test is met at any start).
@@ -118,12 +151,19 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
     which the Gauss-Newton step is below ``small_step`` standard errors (not when ``tight``), and takes that
     step on the linearized model (linearized_step) instead of simulating it. With ``stall_step``
     (a coarse stage), also where the step is below that and no shorter than half the last one: the
-    stage's own integration error is then what is left, for the next stage to remove. The returned
+    stage's own integration error is then what is left, for the next stage to remove. Where the misfit is above
+    the noise (a model the data contradict, look-alike data), the steps are measured in standard errors at that
+    misfit (the intervals', uncertainty.py: s^2 from the residuals): at 1.5 times the noise, a step of 0.2 of them
+    is 0.3 of the noise's; the fine stage otherwise ran to its limit moving the parameters by 1e-4 of their values.
+    With ``polish`` (the fine stage after a coarse one), also where its cost stalls (STALL_COST).
+    With ``known`` (_Known optima), it stops at the first evaluated point within LANDED standard errors of one
+    of them (``res.landed``): a run of the multi-start that lands on an optimum already found. The returned
     result carries ``evaluated``: the last few points' unscaled (r, J), so that the caller's
     evaluation at the optimum (for the intervals) is not simulated twice."""
     cache = {}
-    best_cost = [math.inf]
+    best_cost, history = [math.inf], []  # history: the cost after each improvement
     last_step = [math.inf]
+    n_residuals = max(sum(t.n_residuals for t in problem.traces), 1)
 
     def both(phi):
         key = phi.tobytes()
@@ -140,13 +180,23 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
                 f, G = compressed(r, J, transform, theta, scale)
             cache[key] = (f, G, r, J)
             cost = 0.5 * float(f @ f)
-            if (r is not None and not tight and cost <= best_cost[0] + 0.5
-                    and math.sqrt(2.0 * cost / max(r.size, 1)) <= AT_NOISE):
-                step = gauss_newton_length(f[:-1], G[:-1])
+            if r is not None and any(k.distance(phi) < LANDED for k in known):
+                raise _Landed(phi.copy())
+            if r is not None and not tight and cost <= best_cost[0] + 0.5:
+                ratio = math.sqrt(2.0 * cost / max(r.size, 1))
+                step = gauss_newton_length(f[:-1], G[:-1]) / (1.0 if ratio <= AT_NOISE else ratio)
                 if step < small_step or (stall_step is not None and last_step[0] / 2 < step < stall_step):
                     raise _Converged(phi.copy(), step)
                 last_step[0] = step
-            best_cost[0] = min(best_cost[0], cost)
+            if r is not None and cost < best_cost[0]:  # an improvement: a step the trust region takes
+                best_cost[0] = cost
+                history.append(cost)
+                # (refused trials do not count: a Model II fine stage with runs of them between real progress
+                # stopped 0.2 % short of its optimum, and a refit downstream saw 0.2 % gain where it saw 4.3 %)
+                if (polish and len(history) > STALL_EVALUATIONS
+                        and history[-1 - STALL_EVALUATIONS] - cost < STALL_COST * max(2 * cost / n_residuals, 1)):
+                    raise _Converged(phi.copy(), math.inf, f"the cost fell by less than {STALL_COST:g} of the "
+                                     f"misfit's variance in {STALL_EVALUATIONS} steps")
         return cache[key]
 
     # stop where the objective's own noise (solver tolerance) starts: tighter only buys wandering
@@ -159,6 +209,7 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
         res = optimize.least_squares(lambda p: both(p)[0], phi0, jac=lambda p: both(p)[1], bounds=bounds,
                                      method="trf", x_scale="jac", ftol=tol, xtol=tol,
                                      gtol=1e-15 if tight else 1e-4, max_nfev=max_nfev)
+        res.landed = False
     except _Converged as stop:
         # the step itself is taken where the linearization holds it (a longer one, where a coarse
         # stage or a fit that only starts another one stops, is left to what follows)
@@ -166,10 +217,25 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
         x, f = linearized_step(cache, transform, stop.phi, bounds) if linear else (stop.phi, cache[stop.phi.tobytes()][0])
         res = optimize.OptimizeResult(
             x=x, fun=f, cost=0.5 * float(f @ f), success=True, status=1,
-            message=f"the Gauss-Newton step is below {small_step:g} standard errors at a misfit at the noise"
-                    + ("; taken on the linearized model" if linear else ""))
+            message=stop.why or (f"the Gauss-Newton step is below {small_step:g} standard errors"
+                                 + ("; taken on the linearized model" if linear else "")))
+        res.landed = False
+    except _Landed as stop:
+        f = cache[stop.phi.tobytes()][0]
+        res = optimize.OptimizeResult(x=stop.phi, fun=f, cost=0.5 * float(f @ f), success=True, status=1,
+                                      message=f"within {LANDED:g} standard errors of an optimum already found")
+        res.landed = True
     res.evaluated = {k: v[2:] for k, v in cache.items()}
+    res.known = _known(cache, res.x)
     return res
+
+
+def _known(cache, phi):
+    """The optimum ``phi`` as a _Known, from its compressed residuals in ``cache`` (None where they are not)."""
+    if phi.tobytes() not in cache or cache[phi.tobytes()][2] is None:
+        return None
+    f, G = cache[phi.tobytes()][:2]
+    return _Known(phi.copy(), G[:-1], float(np.linalg.norm(f)) / math.sqrt(max(len(cache[phi.tobytes()][2]), 1)))
 
 
 def linearized_step(cache, transform: Transform, phi, bounds):
@@ -300,7 +366,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         The start is known to be within a standard error or so of the optimum (a refinement from fits that
         already converged): no coarse stage at rtol 1e-6, whose integration error is of that size.
     small_step : float, default SMALL_STEP
-        The fit stops where the Gauss-Newton step is below this many standard errors at a misfit at the noise
+        The fit stops where the Gauss-Newton step is below this many standard errors (at the fit's own misfit)
         (COARSE_STEP for a fit that only starts another one).
 
     Returns
@@ -331,7 +397,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     scale = residual_scale(traces)
     residual_count = sum(t.n_residuals for t in traces)
 
-    def run(phi_start):
+    def run(phi_start, known=()):
         # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
@@ -340,12 +406,15 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         if rtol < COARSE_RTOL and not near:
             coarse = Problem(model, names, traces, rtol=COARSE_RTOL, parallel=not one_trace)
             first = _least_squares(coarse, transform, phi_start, (lo, hi), 40 if max_nfev is None else max_nfev, False, scale,
-                                   stall_step=COARSE_STEP)
-            phi_start = first.x
+                                   stall_step=COARSE_STEP, known=known)
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
+            if first.landed:
+                first.moved = True
+                return first, problem
+            phi_start = first.x
         fine = max_nfev if max_nfev is not None else 60 if tight or near else 40 if coarse_only else 15
-        res = _least_squares(problem, transform, phi_start, (lo, hi), fine, tight,
-                             scale, small_step)
+        res = _least_squares(problem, transform, phi_start, (lo, hi), fine, tight, scale, small_step, known=known,
+                             polish=rtol < COARSE_RTOL and not near and not tight)
         res.moved = bool(np.any(res.x != phi_first))
         return res, problem
 
@@ -359,11 +428,16 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     if starts > 1 and not at_noise(runs[0][0]):
         chosen, n_screened = _screened_starts(screen, transform, phi0, (lo, hi), starts, seed, one_trace, progress)
         n_candidates += n_screened
-        if one_trace and len(chosen) > 1:
-            runs += list(pool().map(in_context(run), chosen))  # (their evaluations count in the caller's tallies)
+        # a start that lands on the first run's optimum stops there: it would only have found that one again
+        # (only an optimum: a first run stopped by its evaluation limit is still walking, and the start that
+        # walks on past it was the multi-start's better answer)
+        known = [runs[0][0].known] if runs[0][0].known is not None and runs[0][0].status > 0 else []
+        each = functools.partial(run, known=known)
+        if one_trace and len(chosen) > 1:  # (their evaluations count in the caller's tallies)
+            runs += list(pool().map(in_context(each), chosen))
         else:
-            runs += [run(c) for c in chosen]
-    best, best_problem = min(runs, key=lambda rp: rp[0].cost)
+            runs += [each(c) for c in chosen]
+    best, best_problem = min((rp for rp in runs if not rp[0].landed), key=lambda rp: rp[0].cost)
     theta = transform.to_theta(best.x)
     # the residuals and Jacobian at the optimum, on the full data at the requested tolerance: the last
     # iteration's, if it evaluated them there
@@ -386,4 +460,5 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
 
 
 __all__ = ["Transform", "fit", "FitOutcome", "residual_scale", "gauss_newton_length", "compressed",
-           "linearized_step", "one_blas_thread", "AT_NOISE", "COARSE_RTOL", "SMALL_STEP", "COARSE_STEP"]
+           "linearized_step", "one_blas_thread", "AT_NOISE", "COARSE_RTOL", "SMALL_STEP", "COARSE_STEP", "LANDED",
+           "STALL_COST", "STALL_EVALUATIONS"]
