@@ -167,7 +167,9 @@ DOMAIN_START = {"elastoplastic": {"z_ba": 0.0}}
 # -- results -----------------------------------------------------------------------------------------------------
 
 def _fit():
-    data = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.05, seed=1)
+    # 0.2 s: on 0.05 s fc is all but undetermined (its cost flat within one standard error from 0 to 0.24 N), and a
+    # fit that stops anywhere on that plateau has a standard error too large for propagate to draw from
+    data = tf.synthesize(tf.load_model("li2009-base"), [35.0], duration=0.2, seed=1)
     return tf.identify(data, "base", starts=1, parameters=["fc"])
 
 
