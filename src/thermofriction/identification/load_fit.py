@@ -23,6 +23,7 @@ import numpy as np
 
 from .._lazy import lazy
 from ..errors import ComputationError, InputError
+from ..fitting.uncertainty import inflation_of
 from ..measurements.force_load import law_derivatives, run_load, stepped_force
 from ..models import Model, ModelI
 from ..models.load_laws import LoadLaw, LoadTerm, load_laws
@@ -31,8 +32,6 @@ optimize, stats = lazy("scipy.optimize"), lazy("scipy.stats")
 
 #: the level parameters a load acts on first (a Coulomb and a static level, each side)
 LEVELS = ("fc", "fs", "fc_neg", "fs_neg")
-#: the autocorrelation sum stops at the first lag whose correlation falls below this
-ACF_FLOOR = 0.05
 #: the load-blind test's significance level
 BLIND_ALPHA = 0.01
 
@@ -140,34 +139,6 @@ def _centred(r, J, sizes, offset):
     return r, J
 
 
-def correlation_time(residuals) -> float:
-    """The integrated autocorrelation time 1 + 2 sum rho_k of each run's residuals (averaged over runs), the sum up
-    to the first lag below ACF_FLOOR.
-
-    Parameters
-    ----------
-    residuals : list of numpy.ndarray
-        Each run's residuals.
-
-    Returns
-    -------
-    float
-        >= 1.
-    """
-    taus = []
-    for r in residuals:
-        r = np.asarray(r, float) - np.mean(r)
-        var = float(r @ r)
-        tau = 1.0
-        for k in range(1, max(len(r) // 4, 1)):
-            rho = float(r[:-k] @ r[k:]) / var if var > 0 else 0.0
-            if rho < ACF_FLOOR:
-                break
-            tau += 2.0 * rho
-        taus.append(tau)
-    return float(np.mean(taus)) if taus else 1.0
-
-
 def fit_load_laws(model: Model, experiments, free=(), offset: str = "per-experiment") -> LoadFit:
     """Fits the model's laws (of temperature and load, or of temperature alone) jointly to force runs at several
     loads and temperatures (module docstring).
@@ -240,7 +211,7 @@ def _result(model, names, x, runs, measured, sizes, offset, evaluate) -> LoadFit
     per_run = [r[a:b] for a, b in zip(edges[:-1], edges[1:])]
     n_offsets = {"per-experiment": len(runs), "shared": 1, "none": 0}[offset]
     dof = max(r.size - x.size - n_offsets, 1)
-    tau = correlation_time(per_run)
+    tau, _ = inflation_of(r, sizes)  # the engine's integrated autocorrelation time, runs weighted by length
     cov = float(r @ r) / dof * tau * np.linalg.pinv(J.T @ J)
     fitted = with_ranges(_with(model, names, x), runs)
     raw = np.concatenate([_run(fitted, e, names)[0] for e in runs]) - measured
