@@ -20,14 +20,56 @@ from warmup_truth import Truth, experiment, initial_model, measured, proxy_recor
 TRUTH = Truth()
 
 
+#: a joint like the truth whose heat path runs 1.5x hotter (both resistances): a record of it is not this joint's
+HOTTER = dataclasses.replace(TRUTH, R1=1.5 * TRUTH.R1, R2=1.5 * TRUTH.R2)
+
+
+def _held_out_records():
+    """Held out of the fit: ten minutes of warm-up from soaked (another phase of the duty cycle, its own offset and
+    noise), the same of the HOTTER joint, and a soak run at 40 C (between the fit's soak temperatures)."""
+    rng = np.random.default_rng(11)
+    out = []
+    for label, truth in (("held.csv", TRUTH), ("hotter.csv", HOTTER)):
+        t, v, x, T1, *_ = warm_up(truth, duration=600.0, t_start=30.0)
+        out.append(experiment(label, t, v, x, measured(truth, rng, t, v, T1, -0.02), ambient=truth.ambient))
+    soak = soak_runs(TRUTH, rng, temperatures=(40.0,))[0]
+    return out + [dataclasses.replace(soak, file="soak-held.csv")]
+
+
 @pytest.fixture(scope="module")
 def fit():
-    """The soak-calibrated warm-up fit (test_warm_up.py's first case) and its record."""
+    """The soak-calibrated warm-up fit (test_warm_up.py's first case) and its record, with held-out records."""
     rng = np.random.default_rng(1)
     rec = warm_up(TRUTH, duration=1500.0)
     t, v, x, T1, *_ = rec
     exps = [experiment("warm.csv", t, v, x, measured(TRUTH, rng, t, v, T1, 0.03), ambient=TRUTH.ambient)]
-    return identify_warm_up(exps + soak_runs(TRUTH, rng), initial_model(TRUTH)), rec
+    return identify_warm_up(exps + soak_runs(TRUTH, rng), initial_model(TRUTH), held_out=_held_out_records()), rec
+
+
+def test_held_out_records_are_predicted_and_a_hotter_joint_is_told_apart(fit):
+    """The dataset's validate records are predicted by the fitted laws and heat path, not fitted (rows of role
+    "validate"): a warm-up of the same joint from soaked (against the truth's own equations, integrated by
+    solve_ivp) and a soak run at 40 C are adequate, their RMSE within 1.5x the fit's; a warm-up of a joint whose heat
+    path is 1.5x hotter (a contact 7 K warmer at the end) is not, and a warning names it with its ratio to the
+    fit's residual RMSE (the adequacy's reference: this AR(1) noise defeats an estimate from the record itself). The contact's predicted range for the held-out warm-up is within 0.5 C of the truth's."""
+    res, _ = fit
+    rows = {r["file"]: r for r in res.experiments if r["role"] == "validate"}
+    assert set(rows) == {"held.csv", "hotter.csv", "soak-held.csv"}
+    fitted = [r["rmse_offset_removed"] for r in res.experiments if r["role"] == "fit"]
+    for name in ("held.csv", "soak-held.csv"):
+        assert rows[name]["fit_quality"]["adequate"] is True, name
+        assert rows[name]["rmse_offset_removed"] < 1.5 * max(fitted), name
+    assert rows["hotter.csv"]["fit_quality"]["adequate"] is False
+    assert any(w.startswith("held-out hotter.csv: predicted") for w in res.warnings)
+    assert not any(w.startswith("held-out held.csv") for w in res.warnings)
+    T1 = warm_up(TRUTH, duration=600.0, t_start=30.0)[3]
+    assert rows["held.csv"]["contact_range"] == pytest.approx([T1.min(), T1.max()], abs=0.5)
+    assert rows["held.csv"]["start"].startswith("soaked at its ambient's first reading")
+    block = res.report().split("[[Heat path]]")[1].split("[[")[0]
+    assert "held out, held.csv: RMSE" in block and "held out, hotter.csv: RMSE" in block
+    assert block.split("held out, hotter.csv")[1].split("\n")[0].count("NOT adequate") == 1
+    T_hot = warm_up(HOTTER, duration=600.0, t_start=30.0)[3]
+    assert T_hot.max() - T1.max() > 5.0  # the hotter joint is hotter by what the warning is about
 
 
 @pytest.fixture(scope="module")

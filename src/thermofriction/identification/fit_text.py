@@ -154,7 +154,20 @@ def heat_path_lines(fit) -> list:
         return out + ["heat path's resistances and capacities: undetermined",
                       "contact temperature: undetermined (the time constants above are scale-free)"]
     traj = fit.details["temperature"]
-    return out + [f"contact temperature, {label}: {_band_text(tr)}" for label, tr in traj.items()]
+    return out + [f"contact temperature, {label}: {_band_text(tr)}" for label, tr in traj.items()] + \
+        _held_out_lines(fit)
+
+
+def _held_out_lines(fit) -> list:
+    """The held-out records (role "validate"), predicted, not fitted: each one's RMSE against the fit's."""
+    out = []
+    for r in (r for r in fit.experiments if r.get("role") == "validate"):
+        q = r["fit_quality"]
+        verdict_text = "adequate" if q["adequate"] else "NOT adequate"
+        where = f"; predicted contact {r['contact_range'][0]:.4g} to {r['contact_range'][1]:.4g} C" if "contact_range" in r else ""
+        out.append(f"held out, {r['file']}: RMSE {amount(q['rmse'], fit.unit)}, {q['ratio']:.3g}x the fit's "
+                   f"(threshold {q['threshold']:.3g}): {verdict_text} ({r['start']}{where})")
+    return out
 
 
 def fit_blocks(fit) -> list:

@@ -280,7 +280,8 @@ def _warm_up(data, experiments, init, measurement, friction, parameters, progres
                              "model (init, --init) or soak runs at two temperatures or more in the dataset")
         start = identify_model_i(soak, start, progress=progress, measurement=measurement,
                                  parameters=parameters, **opts).model
-    return identify_warm_up(experiments, start, parameters=parameters, progress=progress)
+    return identify_warm_up(experiments, start, parameters=parameters, progress=progress,
+                            held_out=list(getattr(data, "validate", None) or []))
 
 
 def _ripple_checks(parameters, init, source, measurement, method):

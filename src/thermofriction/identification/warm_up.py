@@ -255,7 +255,7 @@ def _reweighted(fit):
     return problem, theta, res
 
 
-def identify_warm_up(experiments, init, *, parameters=None, nodes="auto", progress=None):
+def identify_warm_up(experiments, init, *, parameters=None, nodes="auto", progress=None, held_out=()):
     """Fits the friction's temperature laws and the heat path from warm-up records (docs/self-heating.md).
 
     Parameters
@@ -271,6 +271,9 @@ def identify_warm_up(experiments, init, *, parameters=None, nodes="auto", progre
         The heat path's nodes: chosen by the data ("auto", AICc), or held.
     progress : callable, optional
         Called with a line of text at each stage.
+    held_out : list of ForceExperiment, optional
+        Held-out records (the dataset's validate experiments): predicted by the fitted laws and heat path, not
+        fitted; their rows (role "validate") are in the result's ``experiments``, a misfit among its warnings.
 
     Returns
     -------
@@ -311,7 +314,7 @@ def identify_warm_up(experiments, init, *, parameters=None, nodes="auto", progre
     choice["nodes"] = chosen[0].nodes
     progress("warm-up: reweighted by each record's residuals")
     final = _reweighted(chosen)
-    return warm_up_result(s, final, other, choice, time.perf_counter() - t0)
+    return warm_up_result(s, final, other, choice, time.perf_counter() - t0, held=held_out)
 
 
 __all__ = ["identify_warm_up", "setup", "Setup", "SECOND_NODE_AICC"]

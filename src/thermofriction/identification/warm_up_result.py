@@ -16,6 +16,7 @@ from ..measurements import amount
 from ..models.plants import rotary_unit
 from .result import FitResult
 from .warm_up_fit import HEAT_UNITS, covariance, delta_band, gradient
+from .warm_up_held import score_held_out
 from .warm_up_path import interpolation_error
 
 #: the most points of a record's temperature trajectory in the results
@@ -166,9 +167,10 @@ def _choice_warnings(choice, problem, other) -> list:
     return []
 
 
-def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
+def warm_up_result(s, final, other, choice, wall_time, held=()) -> FitResult:
     """The FitResult of a warm-up fit from its setup ``s``, the chosen fit ``final`` (problem, theta, scipy's
-    result), the other node count's fit ``other`` and the ``choice`` between them."""
+    result), the other node count's fit ``other``, the ``choice`` between them, and the ``held`` experiments
+    (the dataset's validate records: predicted, not fitted, warm_up_held.py)."""
     problem, theta, res = final
     cov, noise_scale, (S, Vt, col, bad), stats = covariance(problem, theta, res)
     model = problem.model_of(theta)
@@ -180,6 +182,7 @@ def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
     np.fill_diagonal(corr, 1.0)
     found = _separation(groups(S, Vt, col, problem.layout.names, theta, se, noise_scale, bad=bad), problem, theta)
     rows, overall = _qualities(s, problem, theta)
+    held_rows, held_warnings = score_held_out(problem, theta, list(held), s.unit, float(overall["rmse"]))
     warnings = _choice_warnings(choice, problem, other)
     if warnings:
         overall = dict(overall, adequate=False)
@@ -211,11 +214,12 @@ def warm_up_result(s, final, other, choice, wall_time) -> FitResult:
                                  "noise": noise, "unit": s.unit},
                "warm_up_records": [r.label for r in s.warm], "soak_runs": [x.label for x in s.soak]}
     warnings += [g["warning"] for g in found] + _determination(params, problem, theta,
-                                                               separation_advice(problem, theta))
+                                                               separation_advice(problem, theta)) + held_warnings
     rmse = float(overall["rmse"])
     return FitResult(method="warm-up", model=model, parameters=params, correlation=corr, cost=float(2 * res.cost),
                      rmse=rmse, n_points=int(res.fun.size), nfev=problem.nfev, njev=int(res.njev or 0), starts=1,
-                     wall_time=wall_time, success=bool(res.status > 0), message=str(res.message), experiments=rows,
+                     wall_time=wall_time, success=bool(res.status > 0), message=str(res.message),
+                     experiments=rows + held_rows,
                      warnings=warnings, statistics=stats, details=details,
                      fit_quality=overall, unit=s.unit, measurement="force",
                      removed="each record's own sensor offset (fitted)", identifiability=found)
