@@ -25,7 +25,7 @@ import numpy as np
 from .._lazy import lazy
 from ..errors import ComputationError, InputError
 from ..fitting.uncertainty import inflation_of
-from ..measurements.force_load import model_at, run_load, stepped_force
+from ..measurements.force_load import run_load, stepped_force
 from ..models import Model, ModelI
 from ..models.load_laws import LoadLaw, load_laws
 from .load_fit import LoadFit, fit_load_laws
@@ -35,6 +35,8 @@ optimize = lazy("scipy.optimize")
 
 #: a per-condition estimate whose standard error exceeds this fraction of its value is not determined
 DETERMINED = 0.1
+#: a static level the start's laws put at or below the Coulomb level starts this factor above it
+STATIC_ABOVE = 1.2
 #: two runs whose temperatures differ by less than this [C] and whose loads by less than LOAD_SAME of the larger are
 #: at one condition
 TEMPERATURE_SAME, LOAD_SAME = 0.05, 1e-3
@@ -76,6 +78,17 @@ def _centred(r, J, sizes, offset):
     return r, J
 
 
+def _start_at(model: Model, T: float, load: float) -> Model:
+    """The model of numbers a condition's fit starts from: the laws' values at (T, load), a static level the laws
+    put below its Coulomb level there raised above it (a start, which the fit then moves)."""
+    values = {n: law_value(law, T, load) for n, law in model.laws.items()}
+    given = {**model.friction.values(), **values}
+    for fs, fc in (("fs", "fc"), ("fs_neg", "fc_neg")):
+        if fs in values and given.get(fc) is not None and values[fs] <= given[fc]:
+            values[fs] = STATIC_ABOVE * given[fc]
+    return dataclasses.replace(model, thermal=None, friction=model.friction.with_values(**values))
+
+
 def fit_condition(model: Model, T: float, load: float, runs, names, offset: str) -> dict:
     """The values of ``names`` fitted as numbers on one condition's runs (module, step 1).
 
@@ -98,7 +111,7 @@ def fit_condition(model: Model, T: float, load: float, runs, names, offset: str)
         ``temperature``, ``load``, ``files``, ``values`` and ``stderr`` (name -> float), ``rmse``, ``nfev`` and
         ``converged``.
     """
-    at = model_at(model, T, load)
+    at = _start_at(model, T, load)
     x0 = np.array([float(at.friction.values()[n]) for n in names])
     measured = np.concatenate([np.asarray(e.force, float) for e in runs])
     sizes = [len(e.time) for e in runs]

@@ -11,16 +11,19 @@ import time
 
 import numpy as np
 
+from .._lazy import lazy
 from ..errors import InputError
 from ..fitting.parameters import Parameters, unit_of
 from ..fitting.quality import fit_quality, pooled
 from ..measurements import amount
-from ..measurements.force_load import stepped_force
+from ..measurements.force_load import law_derivatives, stepped_force
 from ..models.load_laws import LoadLaw
 from ..models.plants import rotary_unit
 from .load_identify import identify_load
-from .load_kinds import form_of
+from .load_kinds import form_of, law_value
 from .result import FitResult
+
+stats = lazy("scipy.stats")
 
 #: a parameter's 95 % interval: value +- this many standard errors
 Z95 = 1.959963984540054
@@ -56,6 +59,42 @@ def coefficient_unit(model, name: str, rotary: bool) -> str:
         return f"{unit}/(C {load})"
     base = unit if law.load.kind == "affine" else ("1" if unit == load else f"{unit}/({load})")
     return law.base.coefficient_unit(c, base)
+
+
+def law_band(fit: FitResult, name: str, T, load, level: float = 0.95) -> tuple:
+    """A law of temperature and load of a fit at conditions (T, load) with its ``level`` interval, by the delta
+    method on the covariance of the law's coefficients (the law's own derivatives).
+
+    Parameters
+    ----------
+    fit : FitResult
+        A fit whose model has the law (``identify`` on runs at several loads).
+    name : str
+        The parameter (``fc``).
+    T, load : float or array_like
+        The conditions [C] and [N or N m], of one shape.
+    level : float, default 0.95
+        The interval's probability.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (value, lower, upper).
+    """
+    law = fit.model.laws[name]
+    T, L = np.broadcast_arrays(np.atleast_1d(np.asarray(T, float)), np.atleast_1d(np.asarray(load, float)))
+    varying = [p.name for p in fit.parameters.varying]
+    own = [varying.index(f"{name}.{c}") if f"{name}.{c}" in varying else None for c in law.coefficient_names()]
+    idx = [i for i in own if i is not None]
+    se = np.array([fit.parameters[varying[i]].stderr or 0.0 for i in idx], float)
+    cov = fit.correlation[np.ix_(idx, idx)] * np.outer(se, se)
+    value, sd = np.empty(T.size), np.empty(T.size)
+    for j, (t, x) in enumerate(zip(T.ravel(), L.ravel())):
+        g = law_derivatives(law, t, x)[[k for k, i in enumerate(own) if i is not None]]
+        value[j] = law_value(law, t, x)
+        sd[j] = math.sqrt(max(float(g @ cov @ g), 0.0))
+    z = float(stats.norm.ppf(0.5 + level / 2))
+    return value, value - z * sd, value + z * sd
 
 
 def _parameters(fit, rotary: bool) -> Parameters:
@@ -103,8 +142,8 @@ def _sensor_offset(fit, offset, unit, runs) -> dict:
 
 def _delta(d: float) -> str:
     """An AICc difference in words; a tie is the same functions (an affine product and sum with an interaction
-    over a linear temperature law), kept in the given form."""
-    return "the same functions: the given form kept" if abs(d) < 1e-6 else f"+{d:.3g}"
+    over a linear temperature law span them)."""
+    return "the same functions" if abs(d) < 1e-6 else f"+{d:.3g}"
 
 
 def _said(details: dict) -> list:
@@ -146,6 +185,9 @@ def load_fit_result(fit, details: dict, runs, offset: str, t0: float) -> FitResu
     residuals, rows = _per_run(fit, runs, offset)
     r = np.concatenate(residuals)
     overall = pooled([x["fit_quality"] for x in rows], [len(e.time) for e in runs])
+    unreliable = [x["fit_quality"] for x in rows if not x["fit_quality"]["noise_reliable"]]
+    if 2 * len(unreliable) > len(rows):  # one sensor: its noise coloured on most runs is coloured on all
+        overall.update(adequate=None, why=f"on {len(unreliable)} of {len(rows)} runs {unreliable[0]['why']}")
     warnings = []
     if overall["adequate"] is False:
         warnings.append(f"the fit is not adequate: its residuals are {overall['ratio']:.3g} times the measurement "
@@ -213,4 +255,4 @@ def identify_with_load(runs, init, measurement, method, parameters, laws, refine
     return res
 
 
-__all__ = ["load_fit_result", "coefficient_unit", "identify_with_load"]
+__all__ = ["load_fit_result", "coefficient_unit", "identify_with_load", "law_band"]
