@@ -59,7 +59,7 @@ def runs(conditions, seed=0, roles=None, rate=100.0, duration=8.0, load_free=Fal
 # -- a preloaded linear stage -------------------------------------------------------------------------------------
 #: the stage's AR(1) force noise [N], its lag-one correlation, and the encoder's step [m]
 STAGE_NOISE, STAGE_RHO, STAGE_ENCODER = 0.05, 0.7, 1e-7
-STAGE_SIGMA0, STAGE_SIGMA1, STAGE_SIGMA2, STAGE_VS = 2e5, 200.0, 40.0, 0.003  # N/m, N s/m, N s/m, m/s
+STAGE_SIGMA0, STAGE_SIGMA1, STAGE_SIGMA2, STAGE_VS = 2e5, 80.0, 40.0, 0.003  # N/m, N s/m, N s/m, m/s
 
 
 def stage_fc(T, N):

@@ -39,6 +39,40 @@ def form_of(law) -> str:
     return f"{t.kind}, {t.combine}" + (", with interaction" if t.interaction is not None else "")
 
 
+def equation(name: str, law) -> str:
+    """A law of temperature and load as one line: ``fc(T, L) = (-0.01 T + 1.5) + 0.05 |L| - 0.0002 T |L|``.
+
+    Parameters
+    ----------
+    name : str
+        The parameter.
+    law : Law or LoadLaw
+        Its law.
+
+    Returns
+    -------
+    str
+    """
+    base = law.base if isinstance(law, LoadLaw) else law
+    if base.kind == "linear":
+        f = f"({base.a:.4g} T + {base.b:.4g})"
+    elif base.kind == "const":
+        f = f"{base.value:.4g}"
+    elif base.kind == "exp":
+        f = f"{base.a:.4g} exp({base.b:.4g} T)"
+    else:
+        f = f"{name}0(T) ({base.kind})"
+    if not isinstance(law, LoadLaw):
+        return f"{name}(T) = {f}"
+    t = law.load
+    s = "|L|" if t.saturation is None else f"{t.saturation:.4g} tanh(|L|/{t.saturation:.4g})"
+    v = f"{f} {s}" if t.kind == "proportional" else f"{f} (1 + {t.k:.4g} {s})" if t.combine == "product" else \
+        f"{f} + {t.k:.4g} {s}"
+    if t.interaction is not None:
+        v += f" {'-' if t.interaction < 0 else '+'} {abs(t.interaction):.4g} T {s}"
+    return f"{name}(T, L) = {v}".replace("+ -", "- ")
+
+
 def law_value(law, T, load):
     """The value of a law of temperature (and load) at (T, load), without a range warning."""
     return law.value(T, load, warn=False) if isinstance(law, LoadLaw) else float(law(T))
@@ -161,4 +195,4 @@ def effective_aicc(rss: float, n: int, k: int, tau: float) -> float:
     return aic + 2 * k * (k + 1) / (n_eff - k - 1) if n_eff - k - 1 > 0 else aic
 
 
-__all__ = ["FORMS", "CHECKED", "form_of", "law_value", "candidates", "fit_through", "ranked", "effective_aicc"]
+__all__ = ["FORMS", "CHECKED", "form_of", "equation", "law_value", "candidates", "fit_through", "ranked", "effective_aicc"]
