@@ -103,3 +103,38 @@ def stage_runs(conditions, seed=0, roles=None, rate=200.0, duration=6.0):
         exps.append(force_experiment(f"stage{k}", f"stage{k}.csv", temperature=float(T), role=role, description="",
                                      from_zero=lambda t, i: (t, i), columns=columns))
     return Dataset(name="stage-truth", experiments=exps), offsets
+
+
+def write_stage(folder, dataset) -> str:
+    """``dataset`` (stage_runs') written as a dataset folder: one CSV per run (time[s], position[m],
+    friction_force[N], normal_force[N]) and dataset.toml; returns the folder."""
+    import tomli_w
+    from pathlib import Path
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    entries = []
+    for e in dataset.experiments:
+        load = np.full(len(e.time), float(e.load))
+        np.savetxt(folder / e.file, np.column_stack([e.time, e.displacement, e.force, load]), delimiter=",",
+                   header="time[s],position[m],friction_force[N],normal_force[N]", comments="", fmt="%.12g")
+        entries.append({"file": e.file, "temperature": float(e.temperature), "role": e.role})
+    (folder / "dataset.toml").write_text(tomli_w.dumps({"name": "stage", "experiment": entries}))
+    return str(folder)
+
+
+STAGE_MODEL = """[plant]
+type = "prescribed"
+motion = "linear"
+
+[friction]
+model = "lugre"
+sigma0 = 2e5
+sigma1 = 80.0
+sigma2 = 30.0
+vs = 0.003
+
+[thermal]
+model = "I"
+fc = { law = "linear", a = -0.005, b = 1.2, load = { law = "affine", k = 0.03 } }
+fs = { law = "linear", a = -0.0002, b = 0.1, load = { law = "proportional" } }
+"""

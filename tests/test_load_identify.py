@@ -175,3 +175,39 @@ def test_options_that_do_not_apply_are_named(data):
         tf.identify(data, init=stage_start(), laws={"fc": "linear"})
     with pytest.raises(tf.InputError, match="method 'model-i'"):
         tf.identify(data, method="model-ii", init=stage_start())
+
+
+def test_the_report_shows_the_laws_over_load(fit, data, tmp_path):
+    """The force report on runs at several loads: the map per load (a panel per load, the held-out ones said), the
+    laws over load with their bands, the table of the laws with the fitted equation, a load column in the errors;
+    FitResult.plot draws the laws over load with a panel per law."""
+    html = tf.report([fit], data, tmp_path / "report.html", figures_dir=tmp_path / "figs")
+    assert 'id="fig-velocity-map-load"' in html and 'id="fig-load-laws"' in html
+    assert "Laws of temperature and load" in html and "load 120 N (held out)" in html
+    assert "<th>load [N]</th>" in html
+    law = fit.model.laws["fc"]
+    assert f"{law.base.a:.4g} T + {law.base.b:.4g}" in html  # the fitted equation, not a placeholder
+    assert (tmp_path / "figs" / "load-laws.png").stat().st_size > 0
+    fig = fit.plot()
+    titles = [a.get_title() for a in fig.axes]
+    assert len(titles) == 2 and titles[0].startswith("fc: affine") and titles[1].startswith("fs: affine")
+
+
+def test_the_command_line_identifies_validates_and_reports(tmp_path, capsys):
+    """thermofriction identify on a dataset folder with a normal_force[N] column and a model file with load tables,
+    then validate and report on the fitted file: exit 0, the fitted file's laws of load, the table's load column."""
+    from thermofriction.cli import main
+    ds, _ = lt.stage_runs(GRID + HELD, seed=2, roles=["fit"] * len(GRID) + ["validate"] * len(HELD), rate=100.0)
+    folder = lt.write_stage(tmp_path / "stage", ds)
+    (tmp_path / "start.toml").write_text(lt.STAGE_MODEL)
+    fitted = tmp_path / "fitted.toml"
+    assert main(["identify", folder, "--init", str(tmp_path / "start.toml"), "--parameters", "sigma2", "--offset",
+                 "per-experiment", "-o", str(fitted), "--json", str(tmp_path / "fitted.json"), "-q"]) == 0
+    model = tf.load_model(fitted)
+    for name, true in TRUE.items():
+        assert model.laws[name].value(42.0, 55.0, warn=False) == pytest.approx(true(42.0, 55.0), rel=0.03)
+    capsys.readouterr()
+    assert main(["validate", str(fitted), folder]) == 0
+    assert "load [N]" in capsys.readouterr().out
+    assert main(["report", str(fitted), folder, "-o", str(tmp_path / "r.html")]) == 0
+    assert 'id="fig-load-laws"' in (tmp_path / "r.html").read_text()

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..models.load_laws import LoadLaw
+
 #: the most loads the map shows a panel for
 MAX_LOAD_PANELS = 5
 
@@ -96,4 +98,56 @@ def laws_over_load(laws, load_label: str, held_loads=()):
     return fig
 
 
-__all__ = ["velocity_map_per_load", "laws_over_load", "temperature_colours", "MAX_LOAD_PANELS"]
+def _covariance_of(fit, names):
+    """The covariance of fitted coefficients ``names`` (zero rows for one held), from the fit's standard errors and
+    correlation."""
+    varying = [p.name for p in fit.parameters.varying]
+    idx = [varying.index(n) if n in varying else None for n in names]
+    se = np.array([0.0 if i is None else (fit.parameters[varying[i]].stderr or 0.0) for i in idx], float)
+    C = np.zeros((len(names), len(names)))
+    for a, i in enumerate(idx):
+        for b, j in enumerate(idx):
+            if i is not None and j is not None:
+                C[a, b] = float(fit.correlation[i, j]) * se[a] * se[b]
+    return np.nan_to_num(C)
+
+
+def fit_laws_figure(fit, points: int = 60):
+    """A fit's laws of temperature and load (``FitResult.plot`` where its details hold ``load``) over the load at
+    each fit temperature, with 95 % bands by the delta method on the coefficients' covariance (the laws' own
+    derivatives) and the per-condition estimates.
+
+    Parameters
+    ----------
+    fit : FitResult
+        The fit (``identify`` on runs at several loads).
+    points : int, default 60
+        The loads each line is drawn at.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    d = fit.details["load"]
+    loads = [abs(x) for x in d["loads"]]
+    grid = np.linspace(0.0, 1.1 * max(loads), points)
+    conditions = d.get("conditions") or []
+    temps = sorted({round(c["temperature"], 3) for c in conditions}) or sorted(
+        {round(e["temperature"], 3) for e in fit.experiments})
+    laws = []
+    for name, law in fit.model.laws.items():
+        if not isinstance(law, LoadLaw):
+            continue
+        C = _covariance_of(fit, [f"{name}.{c}" for c in law.coefficient_names()])
+        lines = []
+        for T in temps:
+            v = np.array([law.value(T, L, warn=False) for L in grid])
+            sd = np.sqrt([max(float(g @ C @ g), 0.0) for g in (law.coefficient_derivatives(T, L) for L in grid)])
+            lines.append((T, grid, v, v - 1.96 * sd, v + 1.96 * sd))
+        laws.append({"title": f"{name}: {law.load.kind}, {law.load.combine}", "ylabel": f"{name} [{fit.unit}]",
+                     "lines": lines, "points": [(c["temperature"], c["load"], c["values"][name],
+                                                 1.96 * c["stderr"][name]) for c in conditions]})
+    return laws_over_load(laws, f"|load| [{fit.unit}]")
+
+
+__all__ = ["velocity_map_per_load", "laws_over_load", "temperature_colours", "fit_laws_figure", "MAX_LOAD_PANELS"]
