@@ -152,9 +152,12 @@ def undetermined(per: list, laws: dict) -> str:
     -------
     str
     """
-    most = max(len(law.coefficients()) + (2 if isinstance(law, LoadLaw) else 0) for law in laws.values())
+    # the largest form's coefficients (the temperature law's, k and the interaction), and two more for its AICc
+    most = max(len(law.base.coefficients()) + 2 if isinstance(law, LoadLaw) else len(law.coefficients())
+               for law in laws.values())
     if len(per) < most + 2:
-        return f"{len(per)} conditions, fewer than the {most + 2} the laws' coefficients and their choice need"
+        return (f"{len(per)} conditions, fewer than the {most + 2} the largest form's {most} coefficients and its "
+                f"AICc need")
     for c in per:
         if not c["converged"]:
             return f"the fit at {c['temperature']:.4g} C, load {c['load']:.4g} did not converge"
