@@ -35,6 +35,9 @@ optimize = lazy("scipy.optimize")
 
 #: a per-condition estimate whose standard error exceeds this fraction of its value is not determined
 DETERMINED = 0.1
+#: a form with more coefficients than the kept one is taken where its AICc on all runs is lower by more than this;
+#: one with fewer, where it is higher by less (the simpler preferred within it, as Model I's kinds: laws.py)
+PREFER_SIMPLER = 2.0
 #: a static level the start's laws put at or below the Coulomb level starts this factor above it
 STATIC_ABOVE = 1.2
 #: two runs whose temperatures differ by less than this [C] and whose loads by less than LOAD_SAME of the larger are
@@ -214,7 +217,8 @@ def _joint(model, laws, runs, free, offset):
 
 def chosen_by_joint_fits(model: Model, ranks: dict, runs, free, offset: str, progress=None) -> tuple:
     """The joint refinement from each law's best candidate, then each law's next CHECKED candidates in turn (the
-    others at the best so far), kept where their AICc on the effective samples is lower (module, step 3).
+    others at the best so far), kept where their AICc on the effective samples is lower (by PREFER_SIMPLER for a
+    form with more coefficients; a simpler one within PREFER_SIMPLER of it is kept) (module, step 3).
 
     Parameters
     ----------
@@ -257,10 +261,14 @@ def chosen_by_joint_fits(model: Model, ranks: dict, runs, free, offset: str, pro
             else:
                 spent += trial.nfev
                 row["aicc_all"] = s = _score(trial, runs, tau, offset)
-                if s < score:
+                more = len(law.coefficients()) - len(best.model.laws[name].coefficients())
+                if s + PREFER_SIMPLER * np.sign(more) < score:
                     for r in table[name]:
                         r["kept"] = False
                     best, score, row["kept"] = trial, s, True
+                    for other, rows in table.items():  # the others' kept forms are now scored with this one
+                        for r in rows:
+                            r["aicc_all"] = s if r["kept"] else r["aicc_all"]
             table[name].append(row)
     return best, table, spent
 

@@ -19,7 +19,7 @@ from ..measurements import amount
 from ..measurements.force_load import law_derivatives, stepped_force
 from ..models.load_laws import LoadLaw
 from ..models.plants import rotary_unit
-from .load_identify import identify_load
+from .load_identify import PREFER_SIMPLER, identify_load
 from .load_kinds import form_of, law_value
 from .result import FitResult
 
@@ -143,7 +143,7 @@ def _sensor_offset(fit, offset, unit, runs) -> dict:
 def _delta(d: float) -> str:
     """An AICc difference in words; a tie is the same functions (an affine product and sum with an interaction
     over a linear temperature law span them)."""
-    return "the same functions" if abs(d) < 1e-6 else f"+{d:.3g}"
+    return "the same functions" if abs(d) < 1e-6 else f"{d:+.3g}"
 
 
 def _said(details: dict) -> list:
@@ -155,7 +155,8 @@ def _said(details: dict) -> list:
         kept = next((r for r in rows if r["kept"]), rows[0])
         others = [r for r in rows if not r["kept"] and math.isfinite(r["aicc_all"])]
         if others:
-            out.append(f"{name}'s law of load: {kept['form']}, chosen by AICc on all runs' effective samples over "
+            out.append(f"{name}'s law of load: {kept['form']}, chosen by AICc on all runs' effective samples (more "
+                       f"coefficients only where lower by more than {PREFER_SIMPLER:g}) over "
                        + ", ".join(f"{r['form']} ({_delta(r['aicc_all'] - kept['aicc_all'])})" for r in others))
     return out
 
