@@ -175,6 +175,8 @@ def test_options_that_do_not_apply_are_named(data):
         tf.identify(data, init=stage_start(), laws={"fc": "linear"})
     with pytest.raises(tf.InputError, match="method 'model-i'"):
         tf.identify(data, method="model-ii", init=stage_start())
+    with pytest.raises(tf.InputError, match="parameters: 'delta_x' is neither a law"):
+        tf.identify(data, init=stage_start(), parameters=["delta_x"])
 
 
 def test_the_report_shows_the_laws_over_load(fit, data, tmp_path):

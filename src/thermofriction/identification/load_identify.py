@@ -311,7 +311,7 @@ def identify_load(runs, init: Model, free=(), offset: str = "per-experiment", pr
             progress(f"Model I with load: fitting {', '.join(names)} at {T:.4g} C, load {L:.4g}")
         try:
             per.append(fit_condition(init, T, L, group, names, offset))
-        except ComputationError as e:
+        except (ComputationError, ValueError, FloatingPointError) as e:  # a start the solver cannot take: not determined
             per.append({"temperature": T, "load": L, "converged": False, "why": str(e), "files": []})
         nfev += per[-1].get("nfev", 0)
     why = undetermined(per, init.laws)

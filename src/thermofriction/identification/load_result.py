@@ -249,6 +249,11 @@ def identify_with_load(runs, init, measurement, method, parameters, laws, refine
     if isinstance(parameters, Parameters):
         raise InputError("parameters: name the constants to fit with the laws (a list of names), not a Parameters")
     free = [p for p in ([parameters] if isinstance(parameters, str) else parameters or ()) if p not in init.laws]
+    values = init.friction.values()
+    for p in free:
+        if values.get(p) is None:
+            raise InputError(f"parameters: '{p}' is neither a law of the initial model nor a friction parameter given "
+                             f"there as a number")
     t0 = time.perf_counter()
     fit, details = identify_load(runs, init, free, measurement.offset, progress)
     res = load_fit_result(fit, details, runs, measurement.offset, t0)
