@@ -213,3 +213,14 @@ def test_the_command_line_identifies_validates_and_reports(tmp_path, capsys):
     assert "load [N]" in capsys.readouterr().out
     assert main(["report", str(fitted), folder, "-o", str(tmp_path / "r.html")]) == 0
     assert 'id="fig-load-laws"' in (tmp_path / "r.html").read_text()
+
+
+def test_identify_tells_a_load_blind_fit(data):
+    """identify without laws of load (method base, LuGre for all runs) on runs spanning 20-120 N: its warnings say
+    the model is load-blind, with the held-out gain of the load terms tried (>= 5x)."""
+    m = Model(PrescribedMotion(motion="linear"), LuGre(sigma0=lt.STAGE_SIGMA0, sigma1=lt.STAGE_SIGMA1, sigma2=30.0,
+                                                       vs=lt.STAGE_VS, fc=3.0, fs=4.0))
+    res = tf.identify(data, method="base", init=m, parameters=["fc", "fs", "sigma2"], offset="per-experiment")
+    said = [w for w in res.warnings if w.startswith("the model is load-blind")]
+    assert len(said) == 1 and "held-out runs" in said[0]
+    assert float(re.search(r"\(([0-9.]+)x\)", said[0]).group(1)) >= 5

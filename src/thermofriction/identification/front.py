@@ -25,6 +25,7 @@ from .model_ii import identify_model_ii
 from ..fitting.optimiser import one_blas_thread
 from ..fitting.problem import counting
 from ..models.load_laws import load_laws
+from .load_blind import load_findings
 from .load_result import identify_with_load
 from ..models import Model
 from ..models.sides import needs_period
@@ -257,6 +258,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = with_held_tests(res, experiments, measurement, rtol, data, held)  # the held values against the data (held.py)
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
     res = with_ripple_advice(res, experiments, held, measurement, rtol)  # a ripple the residuals hold, tried
+    res.warnings += [f.message for f in load_findings(res.model, getattr(data, "experiments", data))]  # load-blind?
     res.warnings[:0] = units + _ripple_note(measurement, res.model)
     return res
 
