@@ -48,7 +48,7 @@ def velocity_map_per_load(panels, labels, vlabel: str, flabel: str):
                                                                          for c in panel["curves"]})
     colour = temperature_colours(temps)
     styles = ["-", "--", ":", "-."]
-    fig, axes = _figure(len(panels), 3.0, 3.4)
+    fig, axes = _figure(len(panels), 2.3, 3.2)
     for ax, panel in zip(axes, panels):
         for T, v, F in panel["points"]:
             ax.plot(v, F, ".", ms=1.5, alpha=0.3, color=colour[T])
@@ -58,7 +58,7 @@ def velocity_map_per_load(panels, labels, vlabel: str, flabel: str):
         ax.set_title(panel["title"], fontsize=9.5)
         ax.set_xlabel(vlabel)
     axes[0].set_ylabel(flabel)
-    fig.legend(fontsize=8.5, frameon=False, loc="outside lower center", ncol=min(4, max(len(temps), 1)))
+    fig.legend(fontsize=9, frameon=False, loc="outside lower center", ncol=min(4, max(len(temps), 1)))
     return fig
 
 
@@ -94,7 +94,7 @@ def laws_over_load(laws, load_label: str, held_loads=()):
         ax.set_title(law["title"], fontsize=9)
         ax.set_xlabel(load_label)
         ax.set_ylabel(law["ylabel"])
-    fig.legend(fontsize=8.5, frameon=False, loc="outside lower center", ncol=min(6, max(len(temps), 1)))
+    fig.legend(fontsize=9, frameon=False, loc="outside lower center", ncol=min(6, max(len(temps), 1)))
     return fig
 
 
