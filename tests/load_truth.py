@@ -54,3 +54,87 @@ def runs(conditions, seed=0, roles=None, rate=100.0, duration=8.0, load_free=Fal
         exps.append(force_experiment(f"run{k}", f"run{k}.csv", temperature=float(T), role=role, description="",
                                      from_zero=lambda t, i: (t, i), columns=columns))
     return Dataset(name="load-truth", experiments=exps), offsets
+
+
+# -- a preloaded linear stage -------------------------------------------------------------------------------------
+#: the stage's AR(1) force noise [N], its lag-one correlation, and the encoder's step [m]
+STAGE_NOISE, STAGE_RHO, STAGE_ENCODER = 0.05, 0.7, 1e-7
+STAGE_SIGMA0, STAGE_SIGMA1, STAGE_SIGMA2, STAGE_VS = 2e5, 80.0, 40.0, 0.003  # N/m, N s/m, N s/m, m/s
+
+
+def stage_fc(T, N):
+    """Coulomb level [N] of the stage: 1.5 - 0.01 T + 0.05 |N| - 2e-4 T |N| (a preload's part summed to the
+    unloaded level, its coefficient falling with temperature: an interaction)."""
+    return 1.5 - 0.01 * T + 0.05 * abs(N) - 2e-4 * T * abs(N)
+
+
+def stage_fs(T, N):
+    """Static level [N]: (2.0 - 0.008 T)(1 + 0.03 |N|) (a product with the load)."""
+    return (2.0 - 0.008 * T) * (1.0 + 0.03 * abs(N))
+
+
+def stage_truth(T, N) -> Truth:
+    fc, fs = stage_fc(T, N), stage_fs(T, N)
+    return Truth(fc_pos=fc, fc_neg=fc, fs_pos=fs, fs_neg=fs, vs=STAGE_VS, sigma0=STAGE_SIGMA0, sigma1=STAGE_SIGMA1,
+                 sigma2=STAGE_SIGMA2, ripple=0.0)
+
+
+def stage_runs(conditions, seed=0, roles=None, rate=200.0, duration=6.0):
+    """A Dataset of a preloaded linear stage, one run per (temperature, normal force) in ``conditions``, integrated
+    by SciPy's LSODA (lookalike.true_friction, the truth's levels from stage_fc and stage_fs), with a per-run
+    offset up to 0.2 N, AR(1) noise (STAGE_NOISE, STAGE_RHO), a position quantised to STAGE_ENCODER and a
+    normal_force[N] column with a load cell's noise; and the true offsets."""
+    rng = np.random.default_rng(seed)
+    exps, offsets = [], []
+    for k, (T, N) in enumerate(conditions):
+        n = int(duration * rate) + 1
+        t = sample_times(n, rate, 0.05, rng)
+        A, f = 0.005 * (1 + 0.1 * (k % 3)), 0.5 * (1 + 0.07 * (k % 4))
+        x, _, F = true_friction(stage_truth(T, N), t, A, f)
+        offset = float(rng.uniform(-0.2, 0.2))
+        offsets.append(offset)
+        force = F + offset + ar1(n, STAGE_RHO, STAGE_NOISE, rng)
+        load = N + rng.normal(0.0, 0.002 * abs(N), n)
+        columns = {"time": t, "position": np.round(x / STAGE_ENCODER) * STAGE_ENCODER, "force": force,
+                   "normal_force": load, "rotary": False,
+                   "headers": {"time": "time[s]", "position": "position[m]", "force": "friction_force[N]",
+                               "normal_force": "normal_force[N]"}}
+        role = "fit" if roles is None else roles[k]
+        exps.append(force_experiment(f"stage{k}", f"stage{k}.csv", temperature=float(T), role=role, description="",
+                                     from_zero=lambda t, i: (t, i), columns=columns))
+    return Dataset(name="stage-truth", experiments=exps), offsets
+
+
+def write_stage(folder, dataset) -> str:
+    """``dataset`` (stage_runs') written as a dataset folder: one CSV per run (time[s], position[m],
+    friction_force[N], normal_force[N]) and dataset.toml; returns the folder."""
+    import tomli_w
+    from pathlib import Path
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    entries = []
+    for e in dataset.experiments:
+        load = np.full(len(e.time), float(e.load))
+        np.savetxt(folder / e.file, np.column_stack([e.time, e.displacement, e.force, load]), delimiter=",",
+                   header="time[s],position[m],friction_force[N],normal_force[N]", comments="", fmt="%.12g")
+        entries.append({"file": e.file, "temperature": float(e.temperature), "role": e.role})
+    (folder / "dataset.toml").write_text(tomli_w.dumps({"name": "stage", "experiment": entries}))
+    return str(folder)
+
+
+STAGE_MODEL = """[plant]
+type = "prescribed"
+motion = "linear"
+
+[friction]
+model = "lugre"
+sigma0 = 2e5
+sigma1 = 80.0
+sigma2 = 30.0
+vs = 0.003
+
+[thermal]
+model = "I"
+fc = { law = "linear", a = -0.005, b = 1.2, load = { law = "affine", k = 0.03 } }
+fs = { law = "linear", a = -0.0002, b = 0.1, load = { law = "proportional" } }
+"""

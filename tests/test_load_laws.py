@@ -163,11 +163,16 @@ def test_dataset_manifest_load_key_and_csv_column(tmp_path):
         tf.load_dataset(tmp_path)
 
 
-def test_identify_refuses_a_law_of_load_with_the_way_to_fit_it():
+def test_identify_takes_a_law_of_load_by_model_i_only():
+    """identify fits laws of load (identification/load_identify.py, tests/test_load_identify.py) by Model I; another
+    method, or a law kind asked for with them, is refused naming what applies."""
     m = model()
     exps = [_read(_columns(None), load=10.0, T=T) for T in (25.0, 45.0)]
-    with pytest.raises(tf.InputError, match="fit_load_laws"):
-        tf.identify(tf.Dataset(name="d", experiments=exps), method="model-i", init=m)
+    data = tf.Dataset(name="d", experiments=exps)
+    with pytest.raises(tf.InputError, match="method 'model-i'"):
+        tf.identify(data, method="model-ii", init=m)
+    with pytest.raises(tf.InputError, match="laws: a law of load keeps the temperature kind"):
+        tf.identify(data, method="model-i", init=m, laws={"fc": "exp"})
 
 
 def test_a_constant_or_exp_base_law_keeps_its_kind():

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -98,6 +99,8 @@ class ValidationResult(Result):
     findings : list of Finding, default []
         The same as ``warnings``, as values with their categories (UnitWarning, TemperatureRangeWarning,
         MetricWarning).
+    loads : dict, default {}
+        Force runs that carry a load: file -> the run's load [N or N m] (the table's load column).
     """
 
     model: Model
@@ -112,6 +115,8 @@ class ValidationResult(Result):
     scored_as: dict = dataclasses.field(default_factory=dict)
     #: the warnings as values, with their categories (results.Finding)
     findings: list = dataclasses.field(default_factory=list)
+    #: file -> the run's load [N or N m], for force runs that carry one (a column of the table)
+    loads: dict = dataclasses.field(default_factory=dict)
 
     @property
     def scoring(self) -> str:
@@ -126,11 +131,18 @@ class ValidationResult(Result):
     @property
     def _COLUMNS(self):  # noqa: N802 - the table's layout: the measurement's, with the unit in the headers
         m = self.measurement
-        return m.columns_for(self.unit) if hasattr(m, "columns_for") else m.columns
+        cols = m.columns_for(self.unit) if hasattr(m, "columns_for") else m.columns
+        if self.loads:  # runs at several loads: each run's load beside its temperature
+            at = 1 + next((i for i, c in enumerate(cols) if c[1] == "temperature"), 0)
+            cols = (*cols[:at], (f"load [{self.unit}]", "load", "{:.4g}"), *cols[at:])
+        return cols
 
     @property
     def experiments(self):
-        return [p.metrics() for p in self.predictions]
+        rows = [p.metrics() for p in self.predictions]
+        if self.loads:
+            rows = [{**r, "load": self.loads.get(r["file"], math.nan)} for r in rows]
+        return rows
 
     @property
     def complete(self) -> bool:
@@ -378,7 +390,8 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
         found += [x for x in w if issubclass(x.category, MetricWarning)]
     # first: a unit off by 1000 explains every error after it (unit_warnings also warns: validate's edge)
     found = [Finding(UnitWarning, m) for m in unit_warnings(pairs)] + found + load_findings(model, exps)
-    return ValidationResult(model, preds, [f.message for f in found], failures, measurement, how, found)
+    loads = {run_label(e): float(e.load) for e in exps if getattr(e, "load", None) is not None}
+    return ValidationResult(model, preds, [f.message for f in found], failures, measurement, how, found, loads)
 
 
 def heldout_score(model: Model, data, runs, measurement):

@@ -4,7 +4,8 @@
     fit.model, fit.report(), fit.to_json()
 
 The procedures (``procedures``, ``model_i``, ``model_ii``, ``laws``, ``law_kinds``, ``held``, ``profile``,
-``plant``, ``compare``, the warm-up fit ``warm_up``) and the front door ``front`` (docs/architecture.md#identification), over the fitting
+``plant``, ``compare``, the warm-up fit ``warm_up``, laws of temperature and load: ``load_identify``, ``load_kinds``,
+``load_result``, ``load_fit``, ``load_blind``) and the front door ``front`` (docs/architecture.md#identification), over the fitting
 engine (thermofriction.fitting: parameters, problem, optimiser, uncertainty) and the measurements
 (thermofriction.measurements: what the residuals are, each one's initial model and completion of the result).
 """

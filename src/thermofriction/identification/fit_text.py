@@ -10,6 +10,7 @@ import numpy as np
 
 from ..measurements import amount
 from ..results import fields, heading, lines, table
+from .load_kinds import equation, form_of
 from ..fitting.shown import shown  # the one display of an interval (at a bound, undetermined, > 1000 %)
 
 #: the parameter table's columns
@@ -170,6 +171,25 @@ def _held_out_lines(fit) -> list:
     return out
 
 
+def load_lines(fit) -> list:
+    """A fit of laws of temperature and load, in lines: how it was made, each law's equation, form and ranges, and
+    the per-condition estimates the laws went through."""
+    d = fit.details["load"]
+    out = [f"procedure: {d['procedure']}" + (f" ({d['why_joint']})" if d.get("why_joint") else ""),
+           f"loads: {', '.join(f'{x:.4g}' for x in d['loads'])}; L in {fit.unit}, T in C"]
+    for name, law in fit.model.laws.items():
+        rng = getattr(getattr(law, "load", None), "range", None)
+        out.append(f"{equation(name, law)}  [{form_of(law)}; T {_span(law.range)} C, |L| {_span(rng)}]")
+    for c in d.get("conditions", []):
+        est = ", ".join(f"{n} = {v:.5g} +- {c['stderr'][n]:.2g}" for n, v in c["values"].items())
+        out.append(f"at {c['temperature']:.4g} C, load {c['load']:.4g}: {est} ({', '.join(c['files'])})")
+    return out
+
+
+def _span(rng) -> str:
+    return "-" if rng is None else f"{rng[0]:.4g}..{rng[1]:.4g}"
+
+
 def fit_blocks(fit) -> list:
     """A fit's report (like lmfit's fit report) as the structured blocks of thermofriction.results."""
     blocks = [heading(f"Fit: {fit.method}"), lines(_not_adequate(fit))]
@@ -190,6 +210,8 @@ def fit_blocks(fit) -> list:
     blocks += [fields(rows, WIDTH), heading("Parameters"), table(HEAD, parameter_rows(fit))]
     if fit.method == "warm-up":  # docs/self-heating.md#warm-up-without-a-contact-temperature
         blocks += [heading("Heat path"), lines(heat_path_lines(fit))]
+    if fit.details.get("load"):  # laws of temperature and load (identification/load_identify.py)
+        blocks += [heading("Laws of temperature and load"), lines(load_lines(fit))]
     pairs = _correlated(fit)
     if pairs:
         blocks += [heading("Correlations", "(|C| > 0.5)"), lines(pairs)]

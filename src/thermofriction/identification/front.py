@@ -24,7 +24,9 @@ from .model_i import identify_model_i
 from .model_ii import identify_model_ii
 from ..fitting.optimiser import one_blas_thread
 from ..fitting.problem import counting
-from ..models.load_laws import refuse_load_laws
+from ..models.load_laws import load_laws
+from .load_blind import load_findings
+from .load_result import identify_with_load
 from ..models import Model
 from ..models.sides import needs_period
 from ..simulation import StepSizeController
@@ -230,9 +232,12 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
         init = measurement.initial_model(init, method, data, experiments, friction=friction, free=free,
                                          procedure=procedure, parameters=parameters)
     _ripple_checks(parameters, init, source, measurement, method)  # before the fit, not as its failure
-    refuse_load_laws(init, "identify (fit the laws with identification.fit_load_laws, at each run's load)")
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
+    if load_laws(init):  # laws of temperature and load (identification/load_identify.py)
+        res = identify_with_load(experiments, init, measurement, method, parameters, laws, refine, progress)
+        held = list(getattr(data, "validate", None) or [])
+        return _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
     opts = dict(rtol=rtol, starts=starts, seed=seed)
     if max_nfev is not None:
         opts["max_nfev"] = max_nfev
@@ -253,6 +258,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     res = with_held_tests(res, experiments, measurement, rtol, data, held)  # the held values against the data (held.py)
     res = _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
     res = with_ripple_advice(res, experiments, held, measurement, rtol)  # a ripple the residuals hold, tried
+    res.warnings += [f.message for f in load_findings(res.model, getattr(data, "experiments", data))]  # load-blind?
     res.warnings[:0] = units + _ripple_note(measurement, res.model)
     return res
 

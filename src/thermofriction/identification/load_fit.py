@@ -56,6 +56,10 @@ class LoadFit:
         Fit run file -> its estimated offset.
     correlation_time : float
         The residuals' integrated autocorrelation time [samples] the errors are inflated by.
+    nfev : int, default 0
+        The evaluations of the residuals the fit made.
+    message : str, default ""
+        The solver's message.
     """
 
     model: Model
@@ -66,6 +70,8 @@ class LoadFit:
     rmse: dict
     offsets: dict
     correlation_time: float
+    nfev: int = 0
+    message: str = ""
 
     def law_interval(self, name: str, T: float, load: float, z: float = 1.96) -> tuple:
         """(value, half-width of the ``z`` interval) of parameter ``name``'s law at (T, load), through the
@@ -202,7 +208,9 @@ def fit_load_laws(model: Model, experiments, free=(), offset: str = "per-experim
     if res.status <= 0 or np.all(evaluate(res.x)[0] == bad):
         raise ComputationError(f"the joint fit of the laws did not converge ({res.message}) in {res.nfev} "
                                f"evaluations; start the laws nearer the data")
-    return _result(model, names, res.x, runs, measured, sizes, offset, evaluate)
+    fitted = _result(model, names, res.x, runs, measured, sizes, offset, evaluate)
+    fitted.nfev, fitted.message = int(res.nfev), str(res.message)
+    return fitted
 
 
 def _result(model, names, x, runs, measured, sizes, offset, evaluate) -> LoadFit:

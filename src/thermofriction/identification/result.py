@@ -11,6 +11,7 @@ import numpy as np
 
 from .._io import dump_json, jsonable
 from ..figures.fit_plots import fit_figure
+from ..figures.load_plots import fit_laws_figure
 from ..measurements import amount
 from ..models import Model
 from ..results import Result, Summary
@@ -269,7 +270,10 @@ class FitResult(Result):
         """A matplotlib figure of the fit: with ``data`` (the dataset, or a ValidationResult of
         this model on it) measured against predicted displacement and the residuals' RMS; for Model
         I and II the laws with the per-temperature estimates and their 95 % intervals (``paper``:
-        the paper's Eqs. (9)-(11) and (13) beside them)."""
+        the paper's Eqs. (9)-(11) and (13) beside them). A fit of laws of temperature and load: the laws over
+        the load at each fit temperature with their 95 % bands and the per-condition estimates."""
+        if self.details.get("load"):  # laws of temperature and load: over the load (figures/load_plots.py)
+            return fit_laws_figure(self)
         validation = data
         if data is not None and not hasattr(data, "predictions"):
             from ..validation import validate

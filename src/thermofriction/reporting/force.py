@@ -18,6 +18,7 @@ from ..models import ModelI, ModelII
 from ..plausible import SUSPICIOUS
 from ..validation import validate
 from .entries import akaike_scaled
+from .load import distinct_loads, load_sections
 from .page import Figures, fmt_number, html_table, page_html, page_styled, subplots
 from ..figures.plots import legend
 from ..figures.plots import thin as _thin
@@ -281,15 +282,18 @@ def render_force(entries, data, *, figures_dir=None, command=None, title=None, t
                  + "</section>")
     parts.append("<section><h2>Friction–velocity map</h2>" + fig_velocity_map(figs, entries, exps, unit, vunit, what)
                  + "</section>")
+    parts.append(load_sections(figs, entries, exps, unit, vunit, what))  # runs at several loads (reporting/load.py)
     parts.append("<section><h2>Hysteresis</h2>" + fig_hysteresis(figs, entries, unit, xunit, what) + "</section>")
     loops = fig_loops(figs, entries, unit, xunit, what)
     if loops:
         parts.append("<section><h2>Presliding hysteresis</h2>" + loops + "</section>")
-    err_rows = [[e.label, m["file"], fmt_number(m["temperature"], "{:.4g}"), m["role"], fmt_number(m["rmse"], "{:.4g}"),
+    loads = len(distinct_loads(exps)) > 1  # a load column where the runs span loads
+    err_rows = [[e.label, m["file"], fmt_number(m["temperature"], "{:.4g}"),
+                 *([fmt_number(m.get("load"), "{:.4g}")] if loads else []), m["role"], fmt_number(m["rmse"], "{:.4g}"),
                  fmt_number(100 * m["nrmse"]), fmt_number(m["max_error"]), fmt_number(m["bias"], "{:+.3g}")]
                 for e in entries for m in e.validation.experiments]
     parts.append("<section><h2>Errors per experiment</h2>" + html_table(
-        ["model", "file", "T [°C]", "role", f"RMSE [{unit}]", "RMSE [% of range]", f"max |error| [{unit}]",
+        ["model", "file", "T [°C]", *([f"load [{unit}]"] if loads else []), "role", f"RMSE [{unit}]", "RMSE [% of range]", f"max |error| [{unit}]",
          f"mean error [{unit}]"], err_rows) + f"<p class='note'>{html.escape(_range_note(what))}</p></section>")
     parameters = _parameters_section(entries, unit)
     if parameters:
