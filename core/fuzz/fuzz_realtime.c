@@ -291,7 +291,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             double T = number(&r), lambda = -1.0, dF = -1.0;
             uint8_t nulls = byte(&r);
             for (int i = 0; i < TF_NPARAM; i++) p[i] = -7.0;
-            status = tf_rt_params_at(f, T, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &lambda, nulls & 4 ? NULL : &dF,
+            status = tf_rt_params_at(f, T, NAN, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &lambda, nulls & 4 ? NULL : &dF,
                                      &err);
             check_object(f, status, f ? &before : NULL);
             if (status != TF_OK && (p[0] != -7.0 || lambda != -1.0 || dF != -1.0)) FAIL("a refused params_at wrote");
@@ -305,7 +305,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 if (f) before = *f;
                 int null_F = (byte(&r) & 1) && byte(&r) < 4; /* (the bytes of the former two variants) */
                 F = 0.0;
-                status = tf_rt_step(f, vi, T, dt, null_F ? NULL : &F, &err);
+                status = tf_rt_step(f, vi, T, NAN, dt, null_F ? NULL : &F, &err);
                 check_object(f, status, f ? &before : NULL);
                 if (status == TF_OK && !isfinite(F)) FAIL("step: TF_OK with a non-finite force");
                 if (!null_F && (status != TF_OK) != isnan(F)) FAIL("tf_rt_step: *F NaN not exactly on a refusal");
@@ -320,7 +320,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 if (f) before = *f;
                 int null_F = (byte(&r) & 1) && byte(&r) < 4;
                 F = 0.0;
-                status = tf_observer_step(f, v, e * i, gain, T, dt, null_F ? NULL : &F, &err);
+                status = tf_observer_step(f, v, e * i, gain, T, NAN, dt, null_F ? NULL : &F, &err);
                 check_object(f, status, f ? &before : NULL);
                 if (status == TF_OK && !isfinite(F)) FAIL("observer: TF_OK with a non-finite force");
                 if (!null_F && (status != TF_OK) != isnan(F)) FAIL("tf_observer_step: *F NaN not exactly on a refusal");
