@@ -133,12 +133,12 @@ def stepped_force(model: Model, exp, names=(), warn: bool = False) -> tuple:
     d = drive(exp, model, start="record")
     if not isinstance(d.temperature, (int, float)):
         raise InputError(f"{exp.file}: the temperature varies over the run; a law of load is fitted on runs at a "
-                         f"constant temperature (the simulator takes no load yet)")
+                         f"constant temperature (each run at one condition, stepped exactly)")
     at = model_at(model, float(d.temperature), load, warn)
     spec = _bridge.model_spec(at, float(d.temperature), d.waveform)
     if not _bridge.prescribed_applies(spec):
         raise InputError(f"{exp.file}: the core's exact stepping does not apply to this model ({model.friction.model});"
-                         f" a law of load needs it (the simulator takes no load yet)")
+                         f" a force fit of a law of load needs it")
     try:
         return _bridge.prescribed_force(spec, np.asarray(exp.time, float), tuple(names))
     except _bridge.CoreFailure as e:

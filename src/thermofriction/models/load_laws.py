@@ -302,8 +302,8 @@ def law_from_dict(d, where: str) -> Law:
 
 
 def refuse_load_laws(model, where: str) -> None:
-    """Refuses a model with a law of load where the load is not an input yet (``where``: the simulator, the FMU,
-    the real-time API), naming the law.
+    """Refuses a model with a law of load where the load is not an input yet (``where``: the FMU, the control
+    loop, the sweeps, ``identify``), naming the law.
 
     Parameters
     ----------
