@@ -226,3 +226,43 @@ def test_the_step_path_allocates_nothing(tmp_path, source):
     undefined = {line.split()[-1] for line in out.splitlines() if line.strip()}
     assert undefined, "nm listed nothing: the check would prove nothing"
     assert not {s for s in undefined if re.search(r"alloc|free|^_?Znw|^_?Zdl", s)}, undefined
+
+
+def _with_law(model, name, law):
+    return tf.Model(model.plant, model.friction, tf.ModelI({**model.laws, name: law}), input=model.input)
+
+
+def test_sensitivities_through_a_law_of_the_load_are_central_differences():
+    """Truth: central differences (relative step 1e-4) of the stage's displacement simulated at rtol 1e-12 under
+    the load ramp, over its breakaway and sliding. The core's forward sensitivities to fc's slope a (times the load's magnitude) and to fs's load
+    gain k and interaction c (tf_law_coef_derivative at the run's (T, L)) agree to 1e-3 of the largest, times the
+    coefficient (the displacement a 100 % change would make, to first order), as the parameters' do
+    (tests/test_differential_friction.py)."""
+    model = preloaded_stage()
+    t = np.linspace(0.0, 12.0, 1201)  # through the breakaway (~7 s, where fs acts) and the sliding after it
+    names = [("fc", 0), ("fs", 2), ("fs", 3)]  # fc: a; fs: load.k, load.interaction
+    spec = _bridge.model_spec(model, 30.0, model.input, load=RAMP)
+    theta = np.array([model.laws[n].coefficients()[k] for n, k in names])
+    targets = np.array([_bridge.target("law", _bridge.PARAMETERS.index(n), k) for n, k in names], np.int32)
+    atol_y = 1e-10 * _bridge.state_scale(spec)
+    atol_s = atol_y[:, None] / np.abs(theta)[None, :]
+    out = np.empty((t.size, _bridge.n_outputs(model, False)))
+    sens = np.empty((t.size, atol_y.size, len(names)))
+    _bridge.run_sensitivities(spec, targets, t, out, sens, rtol=1e-10, atol=np.concatenate([atol_y, atol_s.ravel()]),
+                              max_steps=10_000_000)
+    S = sens[:, _bridge.state_index(model, "x"), :] * theta  # per relative change
+    scale = np.max(np.abs(S))
+    for j, (n, k) in enumerate(names):
+        xs = []
+        for sign in (1.0, -1.0):
+            c = np.array(model.laws[n].coefficients(), float)
+            c[k] *= 1.0 + sign * 1e-4
+            m = _with_law(model, n, model.laws[n].with_coefficients(c))
+            o = np.empty((t.size, _bridge.n_outputs(m, False)))
+            _bridge.run(_bridge.model_spec(m, 30.0, m.input, load=RAMP), t, o, method="dopri5", rtol=1e-12)
+            xs.append(o[:, _bridge.OUTPUT_COLUMN["displacement"]])
+        fd = (xs[0] - xs[1]) / 2e-4
+        err = float(np.max(np.abs(S[:, j] - fd)))
+        print(f"{n} coefficient {k}: max |S - FD| / max |S| = {err / scale:.2e}")
+        assert np.max(np.abs(fd)) > 1e-3 * scale  # each coefficient moves the run
+        assert err <= 1e-3 * scale, (n, k, err / scale)
