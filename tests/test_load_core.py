@@ -105,8 +105,8 @@ RAMP = tf.Sampled(np.array([0.0, 1.0, 9.0, 12.0]), np.array([40.0, 40.0, 120.0, 
 def test_a_preloaded_stage_under_a_load_ramp_matches_the_independent_reference():
     """Truth: the independent reference (tests/reference: its own load law, written from the definition, the
     plant's equations, SciPy's DOP853 at rtol 1e-11, restarted at the ramp's knots). The stage's displacement over
-    12 s (sticking, breaking away near 7 s, slipping) while the normal force ramps 40 -> 120 N agrees to 1e-6 of its range (the issue's
-    done-when); the same run at a constant 40 N is far from it (the ramp is what the run is about), and matches
+    12 s (sticking, breaking away near 7 s, slipping) while the normal force ramps 40 -> 120 N agrees to 1e-6 of
+    its range (the issue's done-when); the same run at a constant 40 N is far from it (the ramp is what the run is about), and matches
     the reference's at that constant load to 1e-6 as well."""
     model = preloaded_stage()
     t = np.linspace(0.0, 12.0, 1201)
@@ -241,10 +241,10 @@ def _with_law(model, name, law):
 
 def test_sensitivities_through_a_law_of_the_load_are_central_differences():
     """Truth: central differences (relative step 1e-4) of the stage's displacement simulated at rtol 1e-12 under
-    the load ramp, over its breakaway and sliding. The core's forward sensitivities to fc's slope a (times the load's magnitude) and to fs's load
-    gain k and interaction c (tf_law_coef_derivative at the run's (T, L)) agree to 1e-3 of the largest, times the
-    coefficient (the displacement a 100 % change would make, to first order), as the parameters' do
-    (tests/test_differential_friction.py)."""
+    the load ramp, over its breakaway and sliding. The core's forward sensitivities to fc's slope a (times the
+    load's magnitude) and to fs's load gain k and interaction c (tf_law_coef_derivative at the run's (T, L)) agree
+    to 1e-3 of the largest, times the coefficient (the displacement a 100 % change would make, to first order), as
+    the parameters' do (tests/test_differential_friction.py); measured 1e-10 to 1e-5."""
     model = preloaded_stage()
     t = np.linspace(0.0, 12.0, 1201)  # through the breakaway (~7 s, where fs acts) and the sliding after it
     names = [("fc", 0), ("fs", 2), ("fs", 3)]  # fc: a; fs: load.k, load.interaction
