@@ -106,8 +106,8 @@ def test_a_preloaded_stage_under_a_load_ramp_matches_the_independent_reference()
     """Truth: the independent reference (tests/reference: its own load law, written from the definition, the
     plant's equations, SciPy's DOP853 at rtol 1e-11, restarted at the ramp's knots). The stage's displacement over
     12 s (sticking, breaking away near 7 s, slipping) while the normal force ramps 40 -> 120 N agrees to 1e-6 of
-    its range (the issue's done-when); the same run at a constant 40 N is far from it (the ramp is what the run is about), and matches
-    the reference's at that constant load to 1e-6 as well."""
+    its range (the issue's done-when; measured ~1e-11); the same run at a constant 40 N is far from it (the ramp is
+    what the run is about), and matches the reference's at that constant load to 1e-6 as well."""
     model = preloaded_stage()
     t = np.linspace(0.0, 12.0, 1201)
     with warnings.catch_warnings():
