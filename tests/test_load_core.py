@@ -7,6 +7,7 @@ the real-time steps; the object files' symbols for the no-allocation rule."""
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shutil
 import subprocess
@@ -139,6 +140,15 @@ def test_a_model_with_a_law_of_the_load_needs_one_and_a_load_free_model_ignores_
         tf.simulate(model, 0.1, temperature=30.0)
     with pytest.raises(tf.InputError, match="load must be a number"):
         tf.simulate(model, 0.1, temperature=30.0, load="heavy")
+    # fc = mu(T) |N| is 0 where the load ramp starts at 0 N: refused there before the run, naming both
+    with pytest.raises(tf.InputError, match=r"Model I at 30 C and load 0: 'fc' must be positive"):
+        tf.simulate(model, 0.1, temperature=30.0, load=(np.array([0.0, 1.0]), np.array([0.0, 50.0])))
+    with warnings.catch_warnings():  # self-heating: the range it reached checked after the run at the load's
+        warnings.simplefilter("ignore", tf.PassivityWarning)
+        heated = tf.simulate(dataclasses.replace(model, heat=tf.models.Heat(heat_capacity=5.0, thermal_resistance=2.0,
+                                                                             heat_fraction=1.0)),
+                             12.0, sample_rate=100.0, temperature=25.0, load=RAMP)
+    assert heated.temperature[-1] > 25.05 and np.ptp(heated.displacement) > 0.1
     free = tf.Model(tf.MassPlant(mass=1.0, spring_stiffness=2.0, pull_velocity=0.1),
                     tf.LuGre(sigma0=1e5, sigma1=316.2, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3))
     with warnings.catch_warnings():
