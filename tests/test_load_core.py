@@ -149,6 +149,14 @@ def test_a_model_with_a_law_of_the_load_needs_one_and_a_load_free_model_ignores_
                                                                              heat_fraction=1.0)),
                              12.0, sample_rate=100.0, temperature=25.0, load=RAMP)
     assert heated.temperature[-1] > 25.05 and np.ptp(heated.displacement) > 0.1
+    # a zero waveform is the load 0 (an affine law's level at zero load), as the number 0 is
+    affine = tf.Model(model.plant, tf.LuGre(sigma0=1e5, sigma1=316.2, sigma2=0.4, fc=0.5, fs=None, vs=1e-3),
+                      tf.ModelI({"fs": model.laws["fs"]}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tf.PassivityWarning)
+        zero = [tf.simulate(affine, 9.0, sample_rate=100.0, temperature=30.0, load=L) for L in (tf.waveforms.Zero(), 0.0, 60.0)]
+    assert np.array_equal(zero[0].displacement, zero[1].displacement)
+    assert np.max(np.abs(zero[2].displacement - zero[1].displacement)) > 1e-2
     free = tf.Model(tf.MassPlant(mass=1.0, spring_stiffness=2.0, pull_velocity=0.1),
                     tf.LuGre(sigma0=1e5, sigma1=316.2, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3))
     with warnings.catch_warnings():
