@@ -154,7 +154,8 @@ def test_a_model_with_a_law_of_the_load_needs_one_and_a_load_free_model_ignores_
                       tf.ModelI({"fs": model.laws["fs"]}))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", tf.PassivityWarning)
-        zero = [tf.simulate(affine, 9.0, sample_rate=100.0, temperature=30.0, load=L) for L in (tf.waveforms.Zero(), 0.0, 60.0)]
+        zero = [tf.simulate(affine, 9.0, sample_rate=100.0, temperature=30.0, load=L)
+                for L in (tf.waveforms.Zero(), 0.0, 60.0)]
     assert np.array_equal(zero[0].displacement, zero[1].displacement)
     assert np.max(np.abs(zero[2].displacement - zero[1].displacement)) > 1e-2
     free = tf.Model(tf.MassPlant(mass=1.0, spring_stiffness=2.0, pull_velocity=0.1),

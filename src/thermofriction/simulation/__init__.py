@@ -280,8 +280,8 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     ------
     InputError
         An argument of the wrong type or out of range, named (``duration must be a number [s], ...``); no
-        temperature for a thermal model; no load for a model with a law of the load, naming the law; a temperature signal for a model with a heat model; an output grid
-        over ``max_samples``.
+        temperature for a thermal model; no load for a model with a law of the load, naming the law; a
+        temperature signal for a model with a heat model; an output grid over ``max_samples``.
     SolverError
         The integrator stopped (too many steps, a non-finite state): its ``time`` and ``state`` say where.
 
