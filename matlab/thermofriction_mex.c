@@ -225,8 +225,10 @@ static void cmd_friction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
     double *F = mxGetPr(out);
     for (size_t i = 0; i < n; i++) {
         tf_error err;
-        tf_status st = observer ? tf_observer_step(&s->rt, v[i], e[i * se], k[i * sk], T[i * sT], dt[i * sd], &F[i], &err)
-                                : tf_rt_step(&s->rt, v[i], T[i * sT], dt[i * sd], &F[i], &err);
+        /* no load yet: a model with a law of the load is refused, one without ignores it */
+        tf_status st = observer ? tf_observer_step(&s->rt, v[i], e[i * se], k[i * sk], T[i * sT], NAN, dt[i * sd],
+                                                   &F[i], &err)
+                                : tf_rt_step(&s->rt, v[i], T[i * sT], NAN, dt[i * sd], &F[i], &err);
         if (st != TF_OK) {
             mxDestroyArray(out);
             fail("thermofriction:refused", "%s: step %d (v = %g m/s, T = %g C, dt = %g s) refused: %s (%s: '%s'); "

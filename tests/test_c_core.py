@@ -67,7 +67,7 @@ def test_c_tests_and_fuzz_corpus_are_clean_under_address_and_undefined_behaviour
     build = tmp_path / "asan"
     build_core(build, "-DCMAKE_BUILD_TYPE=Debug", SANITIZE)
     env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=1", UBSAN_OPTIONS="print_stacktrace=1")
-    for test in ("test_core", "test_estimator"):  # (the temperature estimator's: core/tests/test_estimator.c)
+    for test in ("test_core", "test_estimator", "test_load"):  # (the estimator's and the load's: core/tests/)
         out = subprocess.run([str(build / test)], capture_output=True, text=True, env=env)
         assert out.returncode == 0 and " 0 failed" in out.stdout, out.stdout + out.stderr
     for replay, folder, least in (("fuzz_replay", CORPUS, 100), ("fuzz_replay_realtime", CORPUS_REALTIME, 100),
@@ -84,7 +84,7 @@ def test_c_tests_and_fuzz_corpus_are_valgrind_clean(tmp_path):
     build = tmp_path / "plain"
     build_core(build, "-DCMAKE_BUILD_TYPE=RelWithDebInfo")
     vg = ["valgrind", "--error-exitcode=99", "--leak-check=full", "--errors-for-leak-kinds=definite,indirect", "-q"]
-    for test in ("test_core", "test_estimator"):
+    for test in ("test_core", "test_estimator", "test_load"):
         out = subprocess.run([*vg, str(build / test)], capture_output=True, text=True)
         assert out.returncode == 0 and " 0 failed" in out.stdout, out.stdout + out.stderr
     files = corpus()[::4]  # valgrind is ~50x slower: a quarter of the corpus

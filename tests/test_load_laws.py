@@ -1,5 +1,5 @@
 """Laws of temperature and load (models/load_laws.py), a run's load in force data, and the refusals where the load
-is not an input yet. Values are checked against the formulas written out here (analytic), derivatives against
+is not an input yet (the FMU, identify; the simulator's and the real-time API's load: tests/test_load_core.py). Values are checked against the formulas written out here (analytic), derivatives against
 central differences of the value taken here."""
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import pytest
 import thermofriction as tf
 from thermofriction.cli import main
 from thermofriction.data.force import force_experiment
+from thermofriction.measurements.force_load import run_load
 from thermofriction.models import (Const, Exp, LoadLaw, LoadRangeWarning, LoadTerm, Linear, LuGre, Model, ModelI,
                                    PrescribedMotion, model_from_dict)
 
@@ -105,16 +106,14 @@ def test_bad_load_tables_are_named(table, match):
 
 
 def test_the_load_is_refused_where_it_is_not_an_input_yet(tmp_path):
-    """The simulator, the FMU, the core's spec and identify each refuse a law of load with one clear message."""
+    """The FMU refuses a law of load with one clear message; the simulator asks for the load, naming the law."""
     m = model()
-    with pytest.raises(tf.InputError, match=r"\[thermal\] fc: a law of the load .* not an input of the simulator"):
+    with pytest.raises(tf.InputError, match=r"\[thermal\] fc: a law of the load .* give the run's load"):
         tf.simulate(m, 0.1, temperature=30.0)
     with pytest.raises(tf.InputError, match=r"\[thermal\] fc: a law of the load .* not an input of the FMU"):
         tf.export_fmu(m, tmp_path / "m.fmu", temperature=30.0)
     with pytest.raises(tf.InputError, match="needs the load"):
         m.parameters_at(30.0)
-    with pytest.raises(tf.InputError, match="not an input of the simulator, the FMU or the real-time API"):
-        tf._bridge.model_spec(m, 30.0)
 
 
 def _columns(load):
@@ -138,8 +137,10 @@ def test_a_run_carries_its_load_from_a_column_or_the_manifest():
     assert _read(_columns(np.full(n, 12.0) + 1e-3 * np.sin(np.arange(n)))).load == pytest.approx(12.0, abs=1e-4)
     assert _read(_columns(None), load=7.5).load == 7.5
     assert _read(_columns(None)).load is None
-    with pytest.raises(tf.InputError, match=r"f\.csv: column load_torque: the load varies over the run"):
-        _read(_columns(np.linspace(5.0, 25.0, n)))
+    ramp = _read(_columns(np.linspace(5.0, 25.0, n)))  # read (a simulation is driven by it), refused by a force fit
+    assert ramp.load == pytest.approx(15.0) and isinstance(ramp.load_input(), tf.Sampled)
+    with pytest.raises(tf.InputError, match=r"f\.csv: the load column varies over the run"):
+        run_load(ramp)
     with pytest.raises(tf.InputError, match=r"f\.csv: both a load_torque column and the manifest's 'load'"):
         _read(_columns(np.full(n, 3.0)), load=3.0)
 

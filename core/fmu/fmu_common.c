@@ -870,7 +870,7 @@ static int realtime_steps(instance *c, double h, double *y)
         double ts = c->t + s * dt, hs = s < whole ? dt : last;
         if (s == whole - 1 && last == 0.0) hs = h - s * dt; /* end exactly on the communication point */
         double v = sliding_velocity(m, ts, y), T = tf_model_temperature(m, ts, y), F;
-        tf_status st = tf_rt_step(&rt, v, T, hs, &F, &e);
+        tf_status st = tf_rt_step(&rt, v, T, tf_model_load(m, ts), hs, &F, &e);
         if (st != TF_OK)
             return (fmu_fail(c, "the fixed step at %g s (temperature %g C) was refused: %s ('%s')", ts, T,
                          tf_status_message(st), e.what), -1);

@@ -74,15 +74,15 @@ static const char *observer_problem(const tf_rt_friction *f, double v, double e,
     return 0;
 }
 
-tf_status tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double dt, double *F,
-                           tf_error *err)
+tf_status tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double load, double dt,
+                           double *F, tf_error *err)
 {
     if (F) *F = NAN;
     const char *bad = observer_problem(f, v, e, k, dt, F);
     if (bad) return done(err, TF_ERR_BAD_ARGUMENT, "observer", bad, -1);
     tf_model *m = &f->model;
     double p[TF_NPARAM], lambda, dF, dz[1], Fh;
-    tf_status status = tf_rt_params_at(f, T, p, &lambda, &dF, err); /* checks T and the parameters there */
+    tf_status status = tf_rt_params_at(f, T, load, p, &lambda, &dF, err); /* checks T, load and the parameters */
     if (status) return status;
     double extra[1] = {-k * e}, z[1] = {f->z[0]};
     tf_rt_advance(m->friction, p, &f->data.gms, z, v, dt, extra, dz, &Fh, 0); /* its arguments are valid here */
@@ -114,12 +114,12 @@ static tf_status stop_in(tf_error *err, tf_status status, const char *where, lon
 }
 
 /* A per-period series: every sample finite and, where it changes, the model valid there (f not NULL). */
-static tf_status series_check(tf_rt_friction *f, const double *T, long n, const char *where, const char *what,
-                              tf_error *err)
+static tf_status series_check(tf_rt_friction *f, const double *T, double load, long n, const char *where,
+                              const char *what, tf_error *err)
 {
     for (long i = 0; i < n; i++) {
         if (!isfinite(T[i])) return stop(err, TF_ERR_BAD_ARGUMENT, where, what, i);
-        if (f && (i == 0 || T[i] != T[i - 1]) && tf_rt_params_at(f, T[i], 0, 0, 0, err))
+        if (f && (i == 0 || T[i] != T[i - 1]) && tf_rt_params_at(f, T[i], load, 0, 0, 0, err))
             return stop_in(err, TF_ERR_BAD_ARGUMENT, where, i);
     }
     return TF_OK;
@@ -132,12 +132,13 @@ static tf_status temperature_check(tf_loop *L, long n, tf_error *err)
     tf_rt_friction *comp = L->compensation != TF_COMP_NONE ? L->comp : 0;
     tf_status status;
     if (L->T_plant_series) {
-        if ((status = series_check(L->plant, L->T_plant_series, n, "plant", "T_plant_series (not finite)", err)))
+        if ((status = series_check(L->plant, L->T_plant_series, L->load_plant, n, "plant",
+                                   "T_plant_series (not finite)", err)))
             return status;
-    } else if (tf_rt_params_at(L->plant, L->T_plant, 0, 0, 0, err))
+    } else if (tf_rt_params_at(L->plant, L->T_plant, L->load_plant, 0, 0, 0, err))
         return stop_in(err, B, "plant", -1);
     if (L->position_noise &&
-        (status = series_check(0, L->position_noise, n, "loop", "position_noise (not finite)", err)))
+        (status = series_check(0, L->position_noise, NAN, n, "loop", "position_noise (not finite)", err)))
         return status;
     if (!(isfinite(L->dob_tau) && L->dob_tau >= 0.0)) return stop(err, B, "loop", "dob_tau (finite, >= 0)", -1);
     if (L->estimator) {
@@ -148,8 +149,10 @@ static tf_status temperature_check(tf_loop *L, long n, tf_error *err)
         return TF_OK;
     }
     if (L->T_comp_series)
-        return series_check(comp, L->T_comp_series, n, "compensation", "T_comp_series (not finite)", err);
-    if (comp && tf_rt_params_at(comp, L->T_comp, 0, 0, 0, err)) return stop_in(err, B, "compensation", -1);
+        return series_check(comp, L->T_comp_series, L->load_comp, n, "compensation", "T_comp_series (not finite)",
+                            err);
+    if (comp && tf_rt_params_at(comp, L->T_comp, L->load_comp, 0, 0, 0, err))
+        return stop_in(err, B, "compensation", -1);
     return TF_OK;
 }
 
@@ -244,9 +247,9 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
         if ((status = tf_pid_step(&L->pid, e, L->dt, &u, 0)))
             return stop(err, status, "pid", "u (not finite: the loop is unstable)", i);
         if (L->compensation == TF_COMP_FEEDFORWARD)
-            status = tf_rt_step(L->comp, v_ref[i], Tc, L->dt, &Fc, err);
+            status = tf_rt_step(L->comp, v_ref[i], Tc, L->load_comp, L->dt, &Fc, err);
         else if (L->compensation == TF_COMP_OBSERVER)
-            status = tf_observer_step(L->comp, v, -e, L->observer_gain, Tc, L->dt, &Fc, err);
+            status = tf_observer_step(L->comp, v, -e, L->observer_gain, Tc, L->load_comp, L->dt, &Fc, err);
         if (status) return stop_in(err, status, "compensation", i);
         u += Fc;
         if (L->inertia_feedforward && i + 1 < n) u += L->mass * (v_ref[i + 1] - v_ref[i]) / L->dt;
@@ -257,7 +260,8 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
         double F_sum = 0.0;
         for (int s = 0; s < L->substeps; s++) {
             double F;
-            if ((status = tf_rt_step(L->plant, v, T_plant, h, &F, err))) return stop_in(err, status, "plant", i);
+            if ((status = tf_rt_step(L->plant, v, T_plant, L->load_plant, h, &F, err)))
+                return stop_in(err, status, "plant", i);
             v += (u - F) / L->mass * h;
             x += v * h;
             F_sum += F;

@@ -11,6 +11,9 @@
  * round-off, 1e-16 F / d, both far below what a temperature estimate resolves. One-sided: two friction
  * steps per estimator step, not three (a third of the cost). */
 #define TF_ESTIMATOR_DT 1e-4
+/* The load the estimator steps its friction model at: none yet (a model with a law of the load is refused,
+ * "load (not finite...)"; one without ignores it). */
+#define TF_ESTIMATOR_LOAD NAN
 /* The gate on the friction update: skipped where h^2 P_cc < GATE r_F (it would move Tc by less than
  * GATE of the way to the measurement's temperature). */
 #define TF_ESTIMATOR_GATE 1e-9
@@ -114,7 +117,7 @@ static tf_status trial(tf_rt_friction *f, int nz, const rt_backup *b, const doub
                        double dt, double *F, double *z)
 {
     for (int j = 0; j < nz; j++) f->z[j] = b->z[j] + TF_ESTIMATOR_DT * s[j];
-    tf_status st = tf_rt_step(f, v, Tc + TF_ESTIMATOR_DT, dt, F, 0);
+    tf_status st = tf_rt_step(f, v, Tc + TF_ESTIMATOR_DT, TF_ESTIMATOR_LOAD, dt, F, 0);
     memcpy(z, f->z, sizeof(double) * nz);
     restore(f, nz, b);
     return st;
@@ -129,7 +132,7 @@ static tf_status friction_step(const tf_temperature_estimator *e, tf_rt_friction
     double Fp, zp[TF_MAX_FRICTION_STATES];
     double Tc = e->x[0];
     int ok = trial(f, nz, b, e->s, v, Tc, dt, &Fp, zp) == TF_OK;
-    tf_status st = tf_rt_step(f, v, Tc, dt, F, err);
+    tf_status st = tf_rt_step(f, v, Tc, TF_ESTIMATOR_LOAD, dt, F, err);
     if (st) return st;
     *h = ok ? (Fp - *F) / TF_ESTIMATOR_DT : 0.0;
     for (int j = 0; j < nz; j++) s_new[j] = ok ? (zp[j] - f->z[j]) / TF_ESTIMATOR_DT : e->s[j];

@@ -1,4 +1,4 @@
-/* Temperature laws (see law.h). */
+/* Temperature laws and their load terms (see law.h). */
 #include "thermofriction/law.h"
 #include "law_private.h"
 #include "waveform_private.h" /* tf_knots_ok */
@@ -89,7 +89,8 @@ double tf_law_eval(const tf_law *law, double T, double *dvalue_dT)
     return v;
 }
 
-int tf_law_ncoef(const tf_law *law)
+/* Coefficients of the temperature law alone. */
+static int base_ncoef(const tf_law *law)
 {
     switch (law->kind) {
     case TF_LAW_CONST: return 1;
@@ -99,9 +100,17 @@ int tf_law_ncoef(const tf_law *law)
     }
 }
 
-double tf_law_coef_derivative(const tf_law *law, int coef, double T)
+static int has_load(const tf_law *law) { return law->kind != TF_LAW_NONE && law->load.kind != TF_LOAD_NONE; }
+
+int tf_law_ncoef(const tf_law *law)
 {
-    if (coef < 0 || coef >= tf_law_ncoef(law)) return NAN;
+    int n = base_ncoef(law);
+    if (has_load(law)) n += (law->load.kind == TF_LOAD_AFFINE) + (law->load.interaction != 0);
+    return n;
+}
+
+static double base_coef_derivative(const tf_law *law, int coef, double T)
+{
     switch (law->kind) {
     case TF_LAW_CONST: return 1.0;
     case TF_LAW_LINEAR: return coef == 0 ? T : 1.0;
@@ -121,11 +130,78 @@ double tf_law_coef_derivative(const tf_law *law, int coef, double T)
     }
 }
 
+/* s, the load's magnitude (saturated where the term has a saturation), and ds/dL into *ds. */
+static double magnitude(const tf_load_term *t, double L, double *ds)
+{
+    double a = fabs(L), sg = sgn(L);
+    if (!(t->saturation > 0.0)) { *ds = sg; return a; }
+    double th = tanh(a / t->saturation);
+    *ds = sg * (1.0 - th * th);
+    return t->saturation * th;
+}
+
+/* The temperature law's multiplier in the load term: d p / d f. */
+static double multiplier(const tf_load_term *t, double s)
+{
+    if (t->kind == TF_LOAD_PROPORTIONAL) return s;
+    return t->combine == TF_COMBINE_PRODUCT ? 1.0 + t->k * s : 1.0;
+}
+
+double tf_law_eval_load(const tf_law *law, double T, double L, double *dT, double *dL)
+{
+    double df, f = tf_law_eval(law, T, &df);
+    if (!has_load(law)) {
+        if (dT) *dT = df;
+        if (dL) *dL = 0.0;
+        return f;
+    }
+    const tf_load_term *t = &law->load;
+    double ds, s = magnitude(t, L, &ds), v, dv_ds; /* in models/load_laws.py's order of operations */
+    if (t->kind == TF_LOAD_PROPORTIONAL) v = f * s, dv_ds = f;
+    else if (t->combine == TF_COMBINE_PRODUCT) v = f * (1.0 + t->k * s), dv_ds = f * t->k;
+    else v = f + t->k * s, dv_ds = t->k;
+    double dv_dT = df * multiplier(t, s);
+    if (t->interaction) {
+        v = v + t->c * T * s;
+        dv_dT += t->c * s;
+        dv_ds += t->c * T;
+    }
+    if (dT) *dT = dv_dT;
+    if (dL) *dL = dv_ds * ds;
+    return v;
+}
+
+double tf_law_coef_derivative(const tf_law *law, int coef, double T, double L)
+{
+    if (coef < 0 || coef >= tf_law_ncoef(law) || law->kind == TF_LAW_TABLE) return NAN;
+    int nb = base_ncoef(law);
+    if (!has_load(law)) return base_coef_derivative(law, coef, T);
+    const tf_load_term *t = &law->load;
+    double ds, s = magnitude(t, L, &ds);
+    if (coef < nb) return multiplier(t, s) * base_coef_derivative(law, coef, T);
+    if (coef == nb && t->kind == TF_LOAD_AFFINE)
+        return t->combine == TF_COMBINE_PRODUCT ? tf_law_eval(law, T, 0) * s : s;
+    return T * s; /* the interaction's c */
+}
+
 /* ---- checks (tf_model_check, plant.h) ---- */
+
+int tf_load_term_ok(const tf_load_term *t, int law_kind)
+{
+    if (t->kind < TF_LOAD_NONE || t->kind > TF_LOAD_AFFINE) return 0;
+    if (t->kind == TF_LOAD_NONE) return 1;
+    if (law_kind == TF_LAW_TABLE) return 0; /* no coefficient sensitivities */
+    if (t->combine != TF_COMBINE_PRODUCT && t->combine != TF_COMBINE_SUM) return 0;
+    if (t->kind == TF_LOAD_PROPORTIONAL && t->combine == TF_COMBINE_SUM) return 0;
+    if (t->kind == TF_LOAD_AFFINE && !isfinite(t->k)) return 0;
+    if (!(t->saturation == 0.0 || (t->saturation > 0.0 && isfinite(t->saturation)))) return 0;
+    return !t->interaction || isfinite(t->c);
+}
 
 int tf_law_ok(const tf_law *L)
 {
     if (L->kind < TF_LAW_NONE || L->kind > TF_LAW_TABLE) return 0;
+    if (L->kind != TF_LAW_NONE && L->load.kind != TF_LOAD_NONE && !tf_load_term_ok(&L->load, L->kind)) return 0;
     if (L->kind == TF_LAW_POLY && (L->n < 1 || !L->y)) return 0;
     if (L->kind == TF_LAW_PWL || L->kind == TF_LAW_TABLE)
         return tf_knots_ok(L->n, L->x, L->y) && (L->kind != TF_LAW_TABLE || L->d);

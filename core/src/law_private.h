@@ -6,5 +6,7 @@
 
 /* A law's kind and breakpoints: 1 if valid. */
 int tf_law_ok(const tf_law *L);
+/* A load term's kind, combination and numbers, for a law of kind law_kind: 1 if valid. */
+int tf_load_term_ok(const tf_load_term *t, int law_kind);
 
 #endif

@@ -29,11 +29,46 @@ tf_status tf_model_check_params(const tf_model *m, const double *p, double lambd
     return checked(params_problem(m, p, lambda, dF_offset), err);
 }
 
-static const char *check_at(const tf_model *m, double T)
+static const char *check_TL(const tf_model *m, double T, double L)
 {
     double p[TF_NPARAM];
-    tf_model_params_at(m, T, p);
+    tf_model_params_at(m, T, L, p);
     return params_problem(m, p, tf_model_lambda(m, T), tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T));
+}
+
+/* The load's magnitudes a run reaches, lo..hi (a law is linear in s, monotone in |L|: its checks hold
+ * between if at both ends): the constant; the samples of a sampled load; a periodic or step load on a
+ * fine grid of its first period. "load" if any is not finite. */
+static const char *load_range(const tf_model *m, double *lo, double *hi)
+{
+    const tf_waveform *w = &m->load;
+    *lo = INFINITY, *hi = -INFINITY;
+    if (w->kind == TF_WAVE_ZERO) {
+        *lo = *hi = fabs(m->load_const);
+    } else if (w->kind == TF_WAVE_SAMPLED) {
+        for (int i = 0; i < w->n; i++) *lo = fmin(*lo, fabs(w->v[i])), *hi = fmax(*hi, fabs(w->v[i]));
+    } else {
+        double span = w->kind == TF_WAVE_STEP ? w->t0 + w->slew + 1.0 : 1.0 / w->frequency;
+        for (int j = 0; j <= 256; j++) {
+            double a = fabs(tf_waveform_value(w, span * j / 256.0));
+            *lo = fmin(*lo, a), *hi = fmax(*hi, a);
+        }
+        if (w->kind == TF_WAVE_SINE || w->kind == TF_WAVE_SAWTOOTH || w->kind == TF_WAVE_SQUARE) {
+            double e[2] = {w->offset + w->amplitude, w->offset - w->amplitude}; /* the extremes between samples */
+            for (int j = 0; j < 2; j++) *hi = fmax(*hi, fabs(e[j]));
+        }
+    }
+    return isfinite(*lo) && isfinite(*hi) ? 0 : "load (not finite, or none given to a law of the load)";
+}
+
+/* The parameters at temperature T, over the load's range for a model that reads it. */
+static const char *check_at(const tf_model *m, double T)
+{
+    if (!tf_model_reads_load(m)) return check_TL(m, T, NAN);
+    double lo, hi;
+    const char *bad = load_range(m, &lo, &hi);
+    if (!bad) bad = check_TL(m, T, lo);
+    return bad ? bad : check_TL(m, T, hi);
 }
 
 /* The friction model and its thermal extension, apart from the parameters' values. */
@@ -43,11 +78,13 @@ static const char *check_friction_structure(const tf_model *m)
     return bad ? bad : tf_thermal_structure_problem(m->thermal, m->law, &m->dF, m->dF_form);
 }
 
-tf_status tf_model_check_friction(const tf_model *m, double T, tf_error *err)
+tf_status tf_model_check_friction(const tf_model *m, double T, double L, tf_error *err)
 {
     if (!m) return checked("model (NULL)", err);
     const char *bad = check_friction_structure(m);
-    if (!bad && (m->thermal == TF_THERMAL_NONE || isfinite(T))) bad = check_at(m, m->thermal ? T : NAN);
+    int reads = !bad && tf_model_reads_load(m);
+    if (!bad && (m->thermal == TF_THERMAL_NONE || isfinite(T)) && (!reads || isfinite(L)))
+        bad = check_TL(m, m->thermal ? T : NAN, reads ? L : NAN);
     return checked(bad, err);
 }
 
@@ -76,6 +113,7 @@ tf_status tf_model_check(const tf_model *m, tf_error *err)
     }
     if (!bad) bad = check_friction_structure(m);
     if (!bad) bad = tf_waveform_problem(&m->input, m->plant == TF_PLANT_PRESCRIBED);
+    if (!bad && m->load.kind != TF_WAVE_ZERO && tf_waveform_problem(&m->load, 0)) bad = "load (its waveform)";
     if (!bad && m->heat.on) bad = tf_heat_problem(&m->heat);
     if (!bad && m->T_n > 0 && !tf_knots_ok(m->T_n, m->T_t, m->T_v))
         bad = "temperature (sampled: two or more finite points, times increasing)";

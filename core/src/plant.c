@@ -52,7 +52,7 @@ static int sided_or_ripple(const tf_model *m)
 
 int tf_plant_fast(const tf_model *m)
 {
-    return m->friction == TF_FRICTION_LUGRE && m->T_n == 0 && !has_work(m) &&
+    return m->friction == TF_FRICTION_LUGRE && m->T_n == 0 && m->load.kind == TF_WAVE_ZERO && !has_work(m) &&
            (m->plant == TF_PLANT_STICK_SLIP || m->plant == TF_PLANT_MASS) && !sided_or_ripple(m);
 }
 
@@ -73,9 +73,16 @@ double tf_model_temperature(const tf_model *model, double t, const double *y)
     return model->T_const;
 }
 
-void tf_model_params_at(const tf_model *model, double T, double *p)
+double tf_model_load(const tf_model *model, double t)
 {
-    tf_thermal_params(model->thermal, model->p, model->law, model->fs_follows_fc, T, p);
+    return model->load.kind == TF_WAVE_ZERO ? model->load_const : tf_waveform_value(&model->load, t);
+}
+
+int tf_model_reads_load(const tf_model *model) { return tf_thermal_load_mask(model->thermal, model->law) != 0; }
+
+void tf_model_params_at(const tf_model *model, double T, double L, double *p)
+{
+    tf_thermal_params(model->thermal, model->p, model->law, model->fs_follows_fc, T, L, p);
 }
 
 double tf_model_lambda(const tf_model *model, double T)
@@ -83,19 +90,25 @@ double tf_model_lambda(const tf_model *model, double T)
     return tf_thermal_lambda(model->thermal, model->dF_form, &model->dF, reference_force(model), T);
 }
 
-/* Parameters, scale factor and offset force at temperature T, cached per temperature. */
-const double *tf_model_params_cached(tf_model_data *d, double T, double *lambda, double *dF)
+static int same(double a, double b) { return a == b || (isnan(a) && isnan(b)); }
+
+/* Parameters, scale factor and offset force at temperature T and load L, cached per (T, L). */
+const double *tf_model_params_cached(tf_model_data *d, double T, double L, double *lambda, double *dF)
 {
     const tf_model *m = d->model;
     tf_params_cache *c = &d->cache;
+    /* after a change the laws may have changed: the masks are retaken when the cache is refilled */
+    unsigned long loads = c->valid ? c->loads : tf_thermal_load_mask(m->thermal, m->law);
+    if (!loads) L = NAN; /* a model that reads no load: any L hits the cache */
     /* (a model without a thermal part runs at T = NaN, which must hit the cache too) */
-    if (!c->valid || !(c->T == T || (isnan(T) && isnan(c->T)))) {
-        if (!c->valid) c->laws = tf_thermal_law_mask(m->law); /* after a change: laws may have changed */
-        tf_thermal_params_masked(m->thermal, m->p, m->law, c->laws, m->fs_follows_fc, T, c->p);
+    if (!c->valid || !same(c->T, T) || !same(c->L, L)) {
+        if (!c->valid) c->laws = tf_thermal_law_mask(m->law), c->loads = loads;
+        tf_thermal_params_masked(m->thermal, m->p, m->law, c->laws, m->fs_follows_fc, T, L, c->p);
         c->lambda = tf_model_lambda(m, T);
         c->dF = tf_thermal_offset(m->thermal, m->dF_form, &m->dF, T);
         c->plain = !tf_friction_asymmetric(c->p) && !(c->p[TF_P_RIPPLE_PERIOD] > 0.0);
         c->T = T;
+        c->L = L;
         c->valid = 1;
     }
     *lambda = c->lambda;
@@ -103,15 +116,15 @@ const double *tf_model_params_cached(tf_model_data *d, double T, double *lambda,
     return c->p;
 }
 
-/* F' at temperature T and, when jac is given, its partials (overwriting the base model's
+/* F' at temperature T and load L and, when jac is given, its partials (overwriting the base model's
  * partials). The base model's parameter partials go to dp, untouched by Model II (the caller
  * applies it: tf_thermal_param_partial). */
-double tf_plant_friction_at(tf_model_data *d, double T, double t, const double *y, double *dz,
+double tf_plant_friction_at(tf_model_data *d, double T, double L, double t, const double *y, double *dz,
                             tf_friction_partials *jac, tf_friction_param_partials *dp, double *F_base)
 {
     const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(d, T, &lambda, &dF);
+    const double *p = tf_model_params_cached(d, T, L, &lambda, &dF);
     double v = relative_velocity(m, t, y);
     int nz = nfric(m);
     double F;
@@ -127,15 +140,15 @@ double tf_plant_friction_at(tf_model_data *d, double T, double t, const double *
 }
 
 /* F' and z' of the common case (tf_plant_fast): the same equations as tf_plant_friction_at, with the
- * run's parameters. */
+ * run's parameters (its temperature and load constant). */
 TF_SIZED double lugre_constant_T_friction(tf_model_data *d, double v, double z, double *zd)
 {
     const tf_model *m = d->model;
     const tf_params_cache *c = &d->cache;
     double lambda = c->lambda, dF = c->dF;
     const double *p = c->p;
-    if (!c->valid || !(c->T == m->T_const || (isnan(m->T_const) && isnan(c->T))))
-        p = tf_model_params_cached(d, m->T_const, &lambda, &dF);
+    if (!c->valid || !same(c->T, m->T_const) || (c->loads && !same(c->L, m->load_const)))
+        p = tf_model_params_cached(d, m->T_const, m->load_const, &lambda, &dF);
     double g = p[TF_P_FS] == p[TF_P_FC] ? p[TF_P_FC] : tf_stribeck(p, v, 0);
     double F = tf_lugre_value(p, v, z, g, tf_sigma1(p, v, 0, 0, 0), zd);
     return tf_thermal_force(F, v, p[TF_P_VSMOOTH], lambda, dF, 1, 0);
@@ -170,7 +183,8 @@ static double input_peak(const tf_waveform *w)
 void tf_model_state_scale(const tf_model *model, double *scale)
 {
     double p[TF_NPARAM];
-    tf_model_params_at(model, model->heat.on ? model->heat.T_0 : tf_model_temperature(model, 0.0, 0), p);
+    tf_model_params_at(model, model->heat.on ? model->heat.T_0 : tf_model_temperature(model, 0.0, 0),
+                       tf_model_load(model, 0.0), p);
     const tf_waveform *w = &model->input;
     double upeak = input_peak(w);
     double period = (w->kind == TF_WAVE_SAWTOOTH || w->kind == TF_WAVE_SINE || w->kind == TF_WAVE_SQUARE)
@@ -287,6 +301,7 @@ double tf_model_next_corner(double t, void *ctx)
     } else if (m->T_n > 0) {
         c = fmin(c, tf_pwl_next_knot(m->T_n, m->T_t, t));
     }
+    if (m->load.kind != TF_WAVE_ZERO) c = fmin(c, tf_waveform_next_corner(&m->load, t));
     return c;
 }
 
@@ -320,7 +335,7 @@ double tf_model_max_step(double t, const double *y, void *ctx)
     double a = tf_waveform_peak_slope_rate(&m->input); /* a bound on the whole step's acceleration */
     if (!(a > 0.0)) return INFINITY; /* piecewise linear: constant velocity between corners */
     double lambda, dF;
-    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), model_load(d, t), &lambda, &dF);
     double band = stribeck_band(p);
     if (!isfinite(band)) return INFINITY;
     return PRESCRIBED_STEP_FRACTION * fmax(fabs(tf_waveform_slope(&m->input, t)), band) / a;
@@ -333,7 +348,7 @@ void tf_model_events(double t, const double *y, double *g, void *ctx)
     tf_model_data *d = (tf_model_data *)ctx;
     const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), model_load(d, t), &lambda, &dF);
     tf_friction_events(m->friction, p, &d->gms, relative_velocity(m, t, y), y + nmech(m), g);
 }
 
@@ -342,7 +357,7 @@ void tf_model_on_restart(double t, const double *y, void *ctx)
     tf_model_data *d = (tf_model_data *)ctx;
     const tf_model *m = d->model;
     double lambda, dF;
-    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), &lambda, &dF);
+    const double *p = tf_model_params_cached(d, tf_model_temperature(m, t, y), model_load(d, t), &lambda, &dF);
     double v = relative_velocity(m, t, y);
     if (m->plant == TF_PLANT_PRESCRIBED) {
         /* a prescribed motion keeps one direction between restarts (corners and reversals), but

@@ -19,9 +19,9 @@ static void heat_jacobian(tf_model_data *md, double t, const double *y, const tf
     const tf_model *m = md->model;
     int n = tf_model_nstate(m), nm = nmech(m), nz = nfric(m);
     int iT = tf_model_temperature_index(m), iW = tf_model_work_index(m);
-    double T = tf_model_temperature(m, t, y);
+    double T = tf_model_temperature(m, t, y), L = model_load(md, t);
     double dz[TF_MAX_FRICTION_STATES], dzp[TF_MAX_FRICTION_STATES], dzm[TF_MAX_FRICTION_STATES];
-    double F = tf_plant_friction_at(md, T, t, y, dz, 0, 0, 0), v = relative_velocity(m, t, y);
+    double F = tf_plant_friction_at(md, T, L, t, y, dz, 0, 0, 0), v = relative_velocity(m, t, y);
     double s = (F * v > 0.0) - (F * v < 0.0);
     double dv_dy[TF_MAX_STATES], dP[TF_MAX_STATES]; /* dP/dy, P = |F v| */
     velocity_partials(m, dv_dy);
@@ -30,8 +30,8 @@ static void heat_jacobian(tf_model_data *md, double t, const double *y, const tf
     double dF_dT = 0.0, ddz_dT[TF_MAX_FRICTION_STATES] = {0};
     if (m->heat.on && m->thermal != TF_THERMAL_NONE) {
         const double h = 1e-3;
-        double Fp = tf_plant_friction_at(md, T + h, t, y, dzp, 0, 0, 0);
-        double Fm = tf_plant_friction_at(md, T - h, t, y, dzm, 0, 0, 0);
+        double Fp = tf_plant_friction_at(md, T + h, L, t, y, dzp, 0, 0, 0);
+        double Fm = tf_plant_friction_at(md, T - h, L, t, y, dzm, 0, 0, 0);
         dF_dT = (Fp - Fm) / (2 * h);
         for (int j = 0; j < nz; j++) ddz_dT[j] = (dzp[j] - dzm[j]) / (2 * h);
     }
@@ -148,8 +148,9 @@ tf_status tf_model_derivatives(tf_model_data *md, double t, const double *y, dou
     tf_friction_partials d; /* the state and the parameter partials from one evaluation */
     double dz[TF_MAX_FRICTION_STATES], Fb, lambda, dF_offset;
     double T = tf_model_temperature(m, t, y);
-    tf_model_params_cached(md, T, &lambda, &dF_offset);
-    double F = tf_plant_friction_at(md, T, t, y, dz, J ? &d : 0, &dp, &Fb);
+    tf_model_params_cached(md, T, model_load(md, t), &lambda, &dF_offset);
+    double L = md->cache.L; /* NaN where the model reads no load */
+    double F = tf_plant_friction_at(md, T, L, t, y, dz, J ? &d : 0, &dp, &Fb);
     if (fast) { /* the same equations as tf_plant_rhs_fast, with the partials' evaluation */
         dy[nm] = dz[0];
         mechanical_rhs(m, t, y, F, dy);
@@ -178,7 +179,7 @@ tf_status tf_model_derivatives(tf_model_data *md, double t, const double *y, dou
         if (tg->kind == TF_TARGET_DF) {
             dF = tf_thermal_df_coef_partial(m->dF_form, &m->dF, tg->coef, T, Fb, Fref, v, md->cache.p[TF_P_VSMOOTH]);
         } else {
-            if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T);
+            if (tg->kind == TF_TARGET_LAW) chain = tf_law_coef_derivative(&m->law[i], tg->coef, T, L);
             dF = tf_thermal_param_partial(m->thermal, m->dF_form, lambda, Fref, i, chain * dp.dF_dp[i], Fb);
         }
         if (m->plant == TF_PLANT_STICK_SLIP) {
@@ -221,8 +222,8 @@ void tf_model_sensitivity_restart(tf_model_data *md, double t, double *Y, const 
     if (!changed || !np) return;
     tf_model_rhs(t, Y, fpl, md);
     double lambda, dF;
-    const double *p = tf_model_params_cached(md, tf_model_temperature(m, t, Y), &lambda, &dF);
-    double v = relative_velocity(m, t, Y), dg_dv, dg_p[TF_NPARAM];
+    const double *p = tf_model_params_cached(md, tf_model_temperature(m, t, Y), model_load(md, t), &lambda, &dF);
+    double L = md->cache.L, v = relative_velocity(m, t, Y), dg_dv, dg_p[TF_NPARAM];
     tf_stribeck(p, v, &dg_dv);
     tf_stribeck_param_partials(p, v, dg_p);
     if (m->fs_follows_fc) dg_p[TF_P_FC] += dg_p[TF_P_FS];
@@ -256,7 +257,7 @@ void tf_model_sensitivity_restart(tf_model_data *md, double t, double *Y, const 
                 double dcap = 0.0; /* d(capacity g)/dtheta, directly */
                 if (tg->kind == TF_TARGET_PARAM) dcap = dgs_p[tg->param];
                 else if (tg->kind == TF_TARGET_LAW) dcap = tf_law_coef_derivative(&m->law[tg->param], tg->coef,
-                                                                                  tf_model_temperature(m, t, Y)) *
+                                                                                  tf_model_temperature(m, t, Y), L) *
                                                            dgs_p[tg->param];
                 num = b * col[row] - w * (dcap + dgs_dv * dv);
             } else {

@@ -40,17 +40,24 @@ static inline double reference_force(const tf_model *m) { return tf_friction_ref
 int tf_plant_fast(const tf_model *m);
 tf_status tf_plant_rhs_fast(double t, const double *y, double *dy, void *ctx);
 
-/* F' at temperature T and, when jac is given, its partials (overwriting the base model's
+/* F' at temperature T and load L and, when jac is given, its partials (overwriting the base model's
  * partials). The base model's parameter partials go to dp, untouched by Model II (the caller
  * applies it: tf_thermal_param_partial); the base model's force (with the ripple) to *F_base. */
-double tf_plant_friction_at(tf_model_data *d, double T, double t, const double *y, double *dz,
+double tf_plant_friction_at(tf_model_data *d, double T, double L, double t, const double *y, double *dz,
                             tf_friction_partials *jac, tf_friction_param_partials *dp, double *F_base);
 
-/* F' at (t, y), at the model's temperature there. */
+/* The load at t for the parameters (tf_model_load), NaN without reading the waveform where the cache
+ * already knows that the model's laws read none. */
+static inline double model_load(const tf_model_data *d, double t)
+{
+    return d->cache.valid && !d->cache.loads ? NAN : tf_model_load(d->model, t);
+}
+
+/* F' at (t, y), at the model's temperature and load there. */
 static inline double tf_plant_friction(tf_model_data *d, double t, const double *y, double *dz,
                                        tf_friction_partials *jac)
 {
-    return tf_plant_friction_at(d, tf_model_temperature(d->model, t, y), t, y, dz, jac, 0, 0);
+    return tf_plant_friction_at(d, tf_model_temperature(d->model, t, y), model_load(d, t), t, y, dz, jac, 0, 0);
 }
 
 /* The plant's mechanical rows under the friction force F (a prescribed motion has none): the one

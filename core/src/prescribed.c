@@ -26,7 +26,7 @@ typedef struct {
 int tf_prescribed_applies(const tf_model *m)
 {
     return m->plant == TF_PLANT_PRESCRIBED && m->input.kind == TF_WAVE_SAMPLED && m->input.n >= 2 &&
-           !m->heat.on && m->T_n <= 1 && m->thermal != TF_THERMAL_MODEL_II &&
+           !m->heat.on && m->T_n <= 1 && m->load.kind == TF_WAVE_ZERO && m->thermal != TF_THERMAL_MODEL_II &&
            tf_friction_nstate(m->friction, m->gms.n) >= 0;
 }
 
@@ -195,7 +195,7 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
     static run_state zero_state;
     if (!m || !tf_prescribed_applies(m))
         return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "model (not a prescribed motion at a constant "
-                            "temperature with a sampled position)", NAN, -1);
+                            "temperature and load with a sampled position)", NAN, -1);
     if (n_out < 1 || !t_out || !F || np < 0 || np > TF_NPARAM || (np > 0 && (!params || !dF)))
         return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "arguments", NAN, -1);
     for (int j = 0; j < np; j++)
@@ -211,7 +211,7 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
     s->params = params;
     s->follows = m->fs_follows_fc;
     s->gms = m->gms;
-    tf_thermal_params(m->thermal, m->p, m->law, m->fs_follows_fc, m->T_const, s->p);
+    tf_thermal_params(m->thermal, m->p, m->law, m->fs_follows_fc, m->T_const, m->load_const, s->p);
     const tf_waveform *w = &m->input;
     int k = 0; /* knots at or before t */
     double t = t_out[0];

@@ -14,9 +14,9 @@ static tf_status rt_done(tf_error *err, tf_status status, const char *what)
 /* tf_model_check's rules on the model as it now is: its structure, and its parameters where they
  * are known (without a thermal extension always; with one at the last temperature stepped at). A
  * refusal names the field (where "model"). */
-static tf_status rt_check(const tf_rt_friction *f, int T_known, double T, tf_error *err)
+static tf_status rt_check(const tf_rt_friction *f, int T_known, double T, double L, tf_error *err)
 {
-    return tf_model_check_friction(&f->model, T_known ? T : NAN, err);
+    return tf_model_check_friction(&f->model, T_known ? T : NAN, T_known ? L : NAN, err);
 }
 
 static int valid_kind(int kind, const tf_gms_elements *gms)
@@ -38,7 +38,7 @@ tf_status tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_
     memcpy(m->p, p, sizeof m->p);
     m->fs_follows_fc = !isfinite(p[TF_P_FS]);
     if (kind == TF_FRICTION_GMS) m->gms = *gms;
-    tf_status bad = rt_check(f, 0, NAN, err);
+    tf_status bad = rt_check(f, 0, NAN, NAN, err);
     if (bad) { /* leave a model that every step refuses, not a half-checked one */
         memset(m, 0, sizeof *m);
         return bad;
@@ -54,22 +54,24 @@ static tf_model_data *rt_data(tf_rt_friction *f)
     return &f->data;
 }
 
-/* The last temperature stepped at, for checking a change there (the cache holds it). */
-static int last_T(const tf_rt_friction *f, double *T)
+/* The last temperature and load stepped at, for checking a change there (the cache holds them; the load
+ * NaN where the model read none). */
+static int last_T(const tf_rt_friction *f, double *T, double *L)
 {
     *T = f->data.cache.T;
+    *L = f->data.cache.L;
     return f->data.cache.valid && f->model.thermal != TF_THERMAL_NONE;
 }
 
 /* After a setter: a refusal restored the model (the cache still holds); an accepted change
  * refills the cache at the last temperature, where it was checked, so the next change is checked
  * there too. */
-static tf_status set_done(tf_rt_friction *f, tf_status bad, int known, double T)
+static tf_status set_done(tf_rt_friction *f, tf_status bad, int known, double T, double L)
 {
     if (!bad) {
         double l, d;
         tf_model_data_changed(rt_data(f));
-        if (known) tf_model_params_cached(rt_data(f), T, &l, &d);
+        if (known) tf_model_params_cached(rt_data(f), T, L, &l, &d);
     }
     return bad;
 }
@@ -81,15 +83,15 @@ tf_status tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law, tf_
     if (param < 0 || param >= TF_NPARAM) return rt_done(err, TF_ERR_BAD_ARGUMENT, "param (index)");
     if (!law) return rt_done(err, TF_ERR_BAD_ARGUMENT, "law (NULL)");
     if (m->thermal == TF_THERMAL_MODEL_II) return rt_done(err, TF_ERR_BAD_ARGUMENT, "thermal (Model II is set)");
-    double T;
-    int known = last_T(f, &T);
+    double T, L;
+    int known = last_T(f, &T, &L);
     int thermal = m->thermal;
     tf_law old = m->law[param];
     m->thermal = TF_THERMAL_MODEL_I;
     m->law[param] = *law;
-    tf_status bad = rt_check(f, known, T, err);
+    tf_status bad = rt_check(f, known, T, L, err);
     if (bad) m->thermal = thermal, m->law[param] = old;
-    return set_done(f, bad, known, T);
+    return set_done(f, bad, known, T, L);
 }
 
 tf_status tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form, tf_error *err)
@@ -98,16 +100,16 @@ tf_status tf_rt_set_model_ii(tf_rt_friction *f, const tf_law *dF, int form, tf_e
     tf_model *m = &f->model;
     if (!dF) return rt_done(err, TF_ERR_BAD_ARGUMENT, "dF (NULL)");
     if (m->thermal == TF_THERMAL_MODEL_I) return rt_done(err, TF_ERR_BAD_ARGUMENT, "thermal (Model I is set)");
-    double T;
-    int known = last_T(f, &T);
+    double T, L;
+    int known = last_T(f, &T, &L);
     int thermal = m->thermal, old_form = m->dF_form;
     tf_law old = m->dF;
     m->thermal = TF_THERMAL_MODEL_II;
     m->dF = *dF;
     m->dF_form = form;
-    tf_status bad = rt_check(f, known, T, err);
+    tf_status bad = rt_check(f, known, T, L, err);
     if (bad) m->thermal = thermal, m->dF = old, m->dF_form = old_form;
-    return set_done(f, bad, known, T);
+    return set_done(f, bad, known, T, L);
 }
 
 tf_status tf_rt_set_param(tf_rt_friction *f, int param, double value, tf_error *err)
@@ -115,17 +117,17 @@ tf_status tf_rt_set_param(tf_rt_friction *f, int param, double value, tf_error *
     if (!f) return rt_done(err, TF_ERR_BAD_ARGUMENT, "f (NULL)");
     tf_model *m = &f->model;
     if (param < 0 || param >= TF_NPARAM) return rt_done(err, TF_ERR_BAD_ARGUMENT, "param (index)");
-    double T;
-    int known = last_T(f, &T);
+    double T, L;
+    int known = last_T(f, &T, &L);
     double old = m->p[param];
     tf_law old_law = m->law[param];
     int old_follows = m->fs_follows_fc;
     m->p[param] = value;
     m->law[param].kind = TF_LAW_NONE;
     if (param == TF_P_FS) m->fs_follows_fc = !isfinite(value);
-    tf_status bad = rt_check(f, known, T, err);
+    tf_status bad = rt_check(f, known, T, L, err);
     if (bad) m->p[param] = old, m->law[param] = old_law, m->fs_follows_fc = old_follows;
-    return set_done(f, bad, known, T);
+    return set_done(f, bad, known, T, L);
 }
 
 tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err)
@@ -137,10 +139,12 @@ tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err)
     return rt_done(err, TF_OK, 0);
 }
 
-/* Parameters at T, checked with tf_model_check's rules whenever T is new (a constant temperature
- * costs one comparison); NULL, with *err filled, when T or the parameters there are refused.
- * A refused temperature leaves the cache invalid, so that it is refused again next time. */
-static const double *rt_params(tf_rt_friction *f, double T, double *lambda, double *dF, tf_error *err)
+static int same(double a, double b) { return a == b || (isnan(a) && isnan(b)); }
+
+/* Parameters at (T, L), checked with tf_model_check's rules whenever T or L is new (a constant temperature
+ * and load cost two comparisons); NULL, with *err filled, when T, L or the parameters there are refused.
+ * A refused temperature or load leaves the cache invalid, so that it is refused again next time. */
+static const double *rt_params(tf_rt_friction *f, double T, double L, double *lambda, double *dF, tf_error *err)
 {
     const tf_model *m = &f->model;
     tf_params_cache *c = &f->data.cache;
@@ -150,12 +154,18 @@ static const double *rt_params(tf_rt_friction *f, double T, double *lambda, doub
         rt_done(err, TF_ERR_BAD_ARGUMENT, "T (not finite)");
         return 0;
     }
-    if (c->valid && (c->T == T || (isnan(T) && isnan(c->T)))) {
+    if (!(c->valid ? c->loads : tf_thermal_load_mask(m->thermal, m->law))) {
+        L = NAN; /* a model without a law of the load ignores it, NaN included */
+    } else if (!isfinite(L)) {
+        rt_done(err, TF_ERR_BAD_ARGUMENT, "load (not finite: the model has a law of the load)");
+        return 0;
+    }
+    if (c->valid && same(c->T, T) && same(c->L, L)) {
         *lambda = c->lambda;
         *dF = c->dF;
         return c->p;
     }
-    const double *p = tf_model_params_cached(rt_data(f), T, lambda, dF);
+    const double *p = tf_model_params_cached(rt_data(f), T, L, lambda, dF);
     if (tf_model_check_params(m, p, *lambda, *dF, err)) {
         c->valid = 0;
         return 0;
@@ -163,11 +173,12 @@ static const double *rt_params(tf_rt_friction *f, double T, double *lambda, doub
     return p;
 }
 
-tf_status tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset, tf_error *err)
+tf_status tf_rt_params_at(tf_rt_friction *f, double T, double load, double *p, double *lambda, double *dF_offset,
+                          tf_error *err)
 {
     if (!f) return rt_done(err, TF_ERR_BAD_ARGUMENT, "f (NULL)");
     double l, d;
-    const double *q = rt_params(f, T, &l, &d, err);
+    const double *q = rt_params(f, T, load, &l, &d, err);
     if (!q) return TF_ERR_BAD_ARGUMENT;
     if (p) memcpy(p, q, sizeof(double) * TF_NPARAM);
     if (lambda) *lambda = l;
@@ -225,7 +236,8 @@ static inline int nstate(const tf_model *m)
 /* One checked step: the states advance in place from a backup, restored unless the force F' (and
  * so every state) is finite. The per-step cost of the checks: three isfinite, the cache test (a
  * model without a thermal extension skips even that) and the backup of the states. */
-static tf_status rt_step(tf_rt_friction *f, double v, double T, double dt, double *F_out, tf_error *err)
+static tf_status rt_step(tf_rt_friction *f, double v, double T, double load, double dt, double *F_out,
+                         tf_error *err)
 {
     if (!isfinite(v)) return rt_done(err, TF_ERR_BAD_ARGUMENT, "v (not finite)");
     if (!isfinite(dt)) return rt_done(err, TF_ERR_BAD_ARGUMENT, "dt (not finite)");
@@ -237,7 +249,7 @@ static tf_status rt_step(tf_rt_friction *f, double v, double T, double dt, doubl
     const double *p;
     if (m->thermal == TF_THERMAL_NONE && c->valid) {
         p = c->p, lambda = c->lambda, dF = c->dF;
-    } else if (!(p = rt_params(f, T, &lambda, &dF, err))) {
+    } else if (!(p = rt_params(f, T, load, &lambda, &dF, err))) {
         return TF_ERR_BAD_ARGUMENT;
     }
     int nz = nstate(m), gms = m->friction == TF_FRICTION_GMS;
@@ -269,18 +281,18 @@ tf_status tf_rt_set_position(tf_rt_friction *f, double x, tf_error *err)
     return rt_done(err, TF_OK, 0);
 }
 
-tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double dt, double *F, tf_error *err)
+tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double load, double dt, double *F, tf_error *err)
 {
     if (F) *F = NAN;
     if (!f || !F) return rt_done(err, TF_ERR_BAD_ARGUMENT, f ? "F (NULL)" : "f (NULL)");
-    return rt_step(f, v, T, dt, F, err);
+    return rt_step(f, v, T, load, dt, F, err);
 }
 
 tf_status tf_rt_from_model(tf_rt_friction *f, const tf_model *m, tf_error *err)
 {
     if (!f) return rt_done(err, TF_ERR_BAD_ARGUMENT, "f (NULL)");
     if (!m) return rt_done(err, TF_ERR_BAD_ARGUMENT, "model (NULL)");
-    if (tf_model_check_friction(m, NAN, err)) return TF_ERR_BAD_ARGUMENT;
+    if (tf_model_check_friction(m, NAN, NAN, err)) return TF_ERR_BAD_ARGUMENT;
     memset(f, 0, sizeof *f); /* every field from a known state: the position (the ripple's argument) at 0 */
     f->model = *m;
     tf_model_data_init(&f->data, &f->model);

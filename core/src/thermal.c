@@ -9,13 +9,13 @@
 #include <string.h>
 
 void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, int fs_follows_fc, double T,
-                       double *p)
+                       double L, double *p)
 {
     memcpy(p, p_base, sizeof(double) * TF_NPARAM);
     if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
     if (thermal != TF_THERMAL_MODEL_I) return;
     for (int i = 0; i < TF_NPARAM; i++)
-        if (laws[i].kind != TF_LAW_NONE) p[i] = tf_law_eval(&laws[i], T, 0);
+        if (laws[i].kind != TF_LAW_NONE) p[i] = tf_law_eval_load(&laws[i], T, L, 0, 0);
     if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
 }
 
@@ -27,20 +27,29 @@ unsigned long tf_thermal_law_mask(const tf_law *laws)
     return mask;
 }
 
+unsigned long tf_thermal_load_mask(int thermal, const tf_law *laws)
+{
+    unsigned long mask = 0;
+    if (thermal != TF_THERMAL_MODEL_I) return 0;
+    for (int i = 0; i < TF_NPARAM; i++)
+        if (laws[i].kind != TF_LAW_NONE && laws[i].load.kind != TF_LOAD_NONE) mask |= 1UL << i;
+    return mask;
+}
+
 void tf_thermal_params_masked(int thermal, const double *p_base, const tf_law *laws, unsigned long mask,
-                              int fs_follows_fc, double T, double *p)
+                              int fs_follows_fc, double T, double L, double *p)
 {
     memcpy(p, p_base, sizeof(double) * TF_NPARAM);
     if (thermal == TF_THERMAL_MODEL_I)
         for (int i = 0; mask; i++, mask >>= 1)
-            if (mask & 1UL) p[i] = tf_law_eval(&laws[i], T, 0);
+            if (mask & 1UL) p[i] = tf_law_eval_load(&laws[i], T, L, 0, 0);
     if (fs_follows_fc) p[TF_P_FS] = p[TF_P_FC];
 }
 
 double tf_thermal_df_coef_partial(int form, const tf_law *dF, int coef, double T, double F_base, double F_ref,
                                   double v, double v_smooth)
 {
-    double dlaw = tf_law_coef_derivative(dF, coef, T);
+    double dlaw = tf_law_coef_derivative(dF, coef, T, 0.0);
     return form == TF_DF_SCALE ? F_base / F_ref * dlaw : dlaw * tanh(v / v_smooth);
 }
 
@@ -78,6 +87,7 @@ const char *tf_thermal_structure_problem(int thermal, const tf_law *laws, const 
             if (!tf_law_ok(&laws[i])) return "law";
     if (thermal == TF_THERMAL_MODEL_II) {
         if (dF->kind == TF_LAW_NONE || !tf_law_ok(dF)) return "dF";
+        if (dF->load.kind != TF_LOAD_NONE) return "dF (a load term: Model I laws only)";
         if (dF_form != TF_DF_SCALE && dF_form != TF_DF_OFFSET) return "dF form";
     }
     return 0;

@@ -34,13 +34,13 @@ static tf_error E;
 static double rt_force(tf_rt_friction *f, double v, double T, double dt)
 {
     double F;
-    tf_rt_step(f, v, T, dt, &F, &E);
+    tf_rt_step(f, v, T, NAN, dt, &F, &E);
     return F;
 }
 static double observer_force(tf_rt_friction *f, double v, double e, double k, double T, double dt)
 {
     double F;
-    tf_observer_step(f, v, e, k, T, dt, &F, &E);
+    tf_observer_step(f, v, e, k, T, NAN, dt, &F, &E);
     return F;
 }
 static double pid_u(tf_pid *c, double e, double dt)
@@ -855,7 +855,7 @@ static void test_rt_init_and_setters_refuse_bad_arguments(void)
           "set_param: sigma0 < 0 refused, the old value kept");
     CHECK(tf_rt_set_param(&f, TF_P_FC, NAN, &E) == B && f.model.p[TF_P_FC] == 1.0, "set_param: NaN fc");
     CHECK(tf_rt_set_param(&f, TF_P_FS, NAN, &E) == TF_OK && f.model.fs_follows_fc, "set_param: NaN fs = no Stribeck");
-    CHECK(tf_rt_reset(NULL, &E) == B && tf_rt_params_at(NULL, 30.0, p, 0, 0, &E) == B, "reset, params_at: NULL");
+    CHECK(tf_rt_reset(NULL, &E) == B && tf_rt_params_at(NULL, 30.0, NAN, p, 0, 0, &E) == B, "reset, params_at: NULL");
     CHECK(tf_rt_from_model(NULL, &f.model, &E) == B && tf_rt_from_model(&f, NULL, &E) == B, "from_model: NULL");
     tf_model bad = f.model;
     bad.p[TF_P_SIGMA0] = -1.0;
@@ -879,21 +879,21 @@ static void test_rt_step_refuses_bad_samples_and_keeps_its_state(void)
     static tf_rt_friction f, twin;
     double F;
     CHECK(isnan(rt_force(NULL, 1e-3, NAN, 1e-4)), "step(NULL) is NaN");
-    CHECK(tf_rt_step(NULL, 1e-3, NAN, 1e-4, &F, &E) == B && isnan(F), "step_status(NULL)");
+    CHECK(tf_rt_step(NULL, 1e-3, NAN, NAN, 1e-4, &F, &E) == B && isnan(F), "step_status(NULL)");
     rt_lugre(&f);
-    CHECK(tf_rt_step(&f, 1e-3, NAN, 1e-4, NULL, &E) == B, "step_status: NULL F");
+    CHECK(tf_rt_step(&f, 1e-3, NAN, NAN, 1e-4, NULL, &E) == B, "step_status: NULL F");
     rt_lugre(&twin);
     for (int i = 0; i < 10; i++) rt_force(&f, 1e-3, NAN, 1e-4), rt_force(&twin, 1e-3, NAN, 1e-4);
     const double bad[] = {NAN, INFINITY, -INFINITY};
     for (int k = 0; k < 3; k++) {
         CHECK(isnan(rt_force(&f, bad[k], NAN, 1e-4)) && E.code == B && !strcmp(E.what, "v (not finite)"),
               "v = %g refused", bad[k]);
-        CHECK(tf_rt_step(&f, 1e-3, NAN, bad[k], &F, &E) == B && isnan(F), "dt = %g refused", bad[k]);
+        CHECK(tf_rt_step(&f, 1e-3, NAN, NAN, bad[k], &F, &E) == B && isnan(F), "dt = %g refused", bad[k]);
     }
     CHECK(rt_force(&f, 1e-3, INFINITY, 1e-4) == rt_force(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
           "without a thermal model T is ignored (NaN, inf), and the refused samples left the state as it was");
     /* an overflow: sigma1 |v| at v = 1e308 is infinite; the step is refused, the state kept */
-    CHECK(tf_rt_step(&f, 1e308, NAN, 1e-4, &F, &E) == TF_ERR_NONFINITE && isnan(F) && f.z[0] == twin.z[0],
+    CHECK(tf_rt_step(&f, 1e308, NAN, NAN, 1e-4, &F, &E) == TF_ERR_NONFINITE && isnan(F) && f.z[0] == twin.z[0],
           "overflowing step: status %d, z %g vs %g", E.code, f.z[0], twin.z[0]);
     CHECK(rt_force(&f, 1e-3, NAN, 1e-4) == rt_force(&twin, 1e-3, NAN, 1e-4) && E.code == TF_OK && !E.what[0],
           "the next good sample continues as if the bad ones had not come");
@@ -908,7 +908,7 @@ static void test_rt_step_refuses_bad_samples_and_keeps_its_state(void)
     CHECK(isnan(rt_force(&f, 1e-3, 60.0, 1e-4)) && E.code == B && !strcmp(E.what, "fc"),
           "Model I: fc < 0 at 60 C refused (%s)", E.what);
     CHECK(isnan(rt_force(&f, 1e-3, 60.0, 1e-4)), "and refused again at the same temperature");
-    CHECK(tf_rt_params_at(&f, 60.0, 0, 0, 0, &E) == B, "params_at 60 C refused");
+    CHECK(tf_rt_params_at(&f, 60.0, NAN, 0, 0, 0, &E) == B, "params_at 60 C refused");
     CHECK(isnan(rt_force(&f, 1e-3, NAN, 1e-4)) && !strcmp(E.what, "T (not finite)"), "NaN T with a thermal model");
     CHECK(isnan(rt_force(&f, 1e-3, INFINITY, 1e-4)) && !strcmp(E.what, "T (not finite)"), "inf T refused");
     CHECK(rt_force(&f, 1e-3, 35.0, 1e-4) == rt_force(&twin, 1e-3, 35.0, 1e-4) && f.z[0] == twin.z[0],
@@ -942,20 +942,20 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
     double p[TF_NPARAM] = {0};
     p[TF_P_FC] = 1.0, p[TF_P_SIGMA2] = 0.4, p[TF_P_VSMOOTH] = 1e-4;
     CHECK(tf_rt_init(&f, TF_FRICTION_COULOMB, p, NULL, &E) == TF_OK &&
-              tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, &F, &E) == B,
+              tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, NAN, 1e-4, &F, &E) == B,
           "observer on Coulomb refused (no state)");
     CHECK(isnan(observer_force(NULL, 1e-3, 0, 100, NAN, 1e-4)), "observer(NULL)");
     rt_lugre(&f);
     rt_lugre(&twin);
-    CHECK(tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, 1e-4, NULL, &E) == B, "observer: NULL F");
+    CHECK(tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, NAN, 1e-4, NULL, &E) == B, "observer: NULL F");
     const double bad[] = {NAN, INFINITY};
     for (int k = 0; k < 2; k++) {
-        CHECK(tf_observer_step(&f, bad[k], 0.0, 100.0, NAN, 1e-4, &F, &E) == B && isnan(F), "observer v");
-        CHECK(tf_observer_step(&f, 1e-3, bad[k], 100.0, NAN, 1e-4, &F, &E) == B, "observer e");
-        CHECK(tf_observer_step(&f, 1e-3, 0.0, bad[k], NAN, 1e-4, &F, &E) == B, "observer k");
-        CHECK(tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, bad[k], &F, &E) == B, "observer dt");
+        CHECK(tf_observer_step(&f, bad[k], 0.0, 100.0, NAN, NAN, 1e-4, &F, &E) == B && isnan(F), "observer v");
+        CHECK(tf_observer_step(&f, 1e-3, bad[k], 100.0, NAN, NAN, 1e-4, &F, &E) == B, "observer e");
+        CHECK(tf_observer_step(&f, 1e-3, 0.0, bad[k], NAN, NAN, 1e-4, &F, &E) == B, "observer k");
+        CHECK(tf_observer_step(&f, 1e-3, 0.0, 100.0, NAN, NAN, bad[k], &F, &E) == B, "observer dt");
     }
-    CHECK(tf_observer_step(&f, 1e-3, 0.0, -1.0, NAN, 1e-4, &F, &E) == B, "observer: negative gain");
+    CHECK(tf_observer_step(&f, 1e-3, 0.0, -1.0, NAN, NAN, 1e-4, &F, &E) == B, "observer: negative gain");
     CHECK(observer_force(&f, 1e-3, 1e-7, 100.0, NAN, 1e-4) == observer_force(&twin, 1e-3, 1e-7, 100.0, NAN, 1e-4) &&
               f.z[0] == twin.z[0],
           "observer state untouched by the refusals");

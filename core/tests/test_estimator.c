@@ -142,7 +142,7 @@ static void test_converges_from_five_kelvin_off(void)
     double dt = 1e-3;
     for (int k = 0; k < 4000; k++) {
         double v = 5e-3 * sin(6.283185307179586 * k * dt), Fm;
-        tf_rt_step(&truth, v, 40.0, dt, &Fm, &E);
+        tf_rt_step(&truth, v, 40.0, NAN, dt, &Fm, &E);
         step(&e, &f, v, Fm, NAN, 40.0, dt);
     }
     CHECK(fabs(e.x[0] - 40.0) < 1e-3, "estimate %g after 4 s", e.x[0]);

@@ -43,6 +43,8 @@ _SMALLEST = 5e-324
 PLANT_CODES = dict(_GROUPS["plant"])
 FRICTION_CODES = dict(_GROUPS["friction"])
 LAW_CODES = dict(_GROUPS["law"])
+LOAD_KIND_CODES = dict(_GROUPS["load_kind"])
+LOAD_COMBINE_CODES = dict(_GROUPS["load_combine"])
 THERMAL_CODES = dict(_GROUPS["thermal"])
 DF_FORM_CODES = dict(_GROUPS["df_form"])
 WAVEFORM_CODES = dict(_GROUPS["waveform"])
@@ -95,10 +97,16 @@ MECHANICAL_STATES = {"stick-slip": ("x_p", "v_p", "x_e", "v_e"), "mass": ("x", "
 # -- descriptions ------------------------------------------------------------------------------
 
 def law_tuple(law):
-    """(kind, a, b, x, y) of a temperature law (thermal.h, tf_law)."""
+    """(kind, a, b, x, y) of a temperature law (law.h, tf_law); a law of temperature and load adds its load term
+    (kind, combine, k, saturation, interaction, c) (law.h, tf_load_term)."""
     fields = law.core_fields()
-    return (LAW_CODES[law.kind], float(fields.get("a", 0.0)), float(fields.get("b", 0.0)), fields.get("x"),
-            fields.get("y"))
+    out = (LAW_CODES[law.kind], float(fields.get("a", 0.0)), float(fields.get("b", 0.0)), fields.get("x"),
+           fields.get("y"))
+    if "load" in fields:
+        kind, combine, k, saturation, interaction, c = fields["load"]
+        out += ((LOAD_KIND_CODES[kind], LOAD_COMBINE_CODES[combine], float(k), float(saturation), int(interaction),
+                 float(c)),)
+    return out
 
 
 def waveform_tuple(waveform):
@@ -113,9 +121,10 @@ def _thermal_kind(model) -> str:
     return {None: "none", "I": "model-i", "II": "model-ii"}[getattr(model.thermal, "model", None)]
 
 
-def model_spec(model, temperature=None, input=None, friction_work: bool = False) -> dict:
+def model_spec(model, temperature=None, input=None, friction_work: bool = False, load=None) -> dict:
     """The dict the binding unpacks into a tf_model (see _core.c). ``temperature``: a number, a
-    ``Sampled`` signal, or None; with a heat model, the ambient temperature (a number)."""
+    ``Sampled`` signal, or None; with a heat model, the ambient temperature (a number). ``load``: a number, a
+    waveform, or None (NaN: none), passed only to a model whose laws read it (a load term)."""
     plant = model.plant
     c = k = T_em = m_e = k_s = v_0 = 0.0
     m = 1.0
@@ -146,6 +155,12 @@ def model_spec(model, temperature=None, input=None, friction_work: bool = False)
     elif temperature is not None:
         T_const = float(temperature)
     waveform = input if input is not None else model.input
+    reads_load = laws is not None and any(law is not None and len(law) > 5 for law in laws)
+    load_wave, load_const = None, math.nan
+    if reads_load and hasattr(load, "core_fields"):  # a waveform (the core's zero kind is its constant's slot)
+        load_wave, load_const = (None, 0.0) if load.kind == "zero" else (waveform_tuple(load), math.nan)
+    elif reads_load and load is not None:
+        load_const = float(load)
     # the arrays (GMS's k and w) by their roles, the binding's keys ("gms_k", "gms_w")
     arrays = {a.role: np.array(getattr(friction, n), float) for n, a in friction.description.arrays.items()}
     return {
@@ -158,7 +173,7 @@ def model_spec(model, temperature=None, input=None, friction_work: bool = False)
         "dF": law_tuple(model.thermal.dF) if thermal == "model-ii" else None,
         "dF_form": DF_FORM_CODES[model.thermal.form] if thermal == "model-ii" else DF_FORM_CODES["scale"],
         "input": waveform_tuple(waveform) if waveform is not None else _ZERO_WAVEFORM,
-        "T_const": T_const, "T_t": T_t, "T_v": T_v,
+        "T_const": T_const, "T_t": T_t, "T_v": T_v, "load": load_wave, "load_const": load_const,
         "heat": heat, "work": int(bool(friction_work)),
     }
 
@@ -173,6 +188,16 @@ def law_eval(law, T: np.ndarray):
     v, d = np.empty_like(T), np.empty_like(T)
     _core.law_eval(law_tuple(law), T, v, d)
     return v, d
+
+
+def law_eval_load(law, T: np.ndarray, L: np.ndarray) -> tuple:
+    """(values, d/dT, d/dL, derivatives in every coefficient (n x ncoef)) of a law at (T[i], L[i]), by the C core
+    (law.h: tf_law_eval_load, tf_law_coef_derivative); contiguous float64 arrays of one length."""
+    v, dT, dL = np.empty_like(T), np.empty_like(T), np.empty_like(T)
+    nc = len(law.coefficient_names())  # the core's count must agree (its output's size is checked)
+    dc = np.empty(T.size * nc)
+    _core.law_eval_load(law_tuple(law), T, L, v, dT, dL, dc)
+    return v, dT, dL, dc.reshape(T.size, nc)
 
 
 def waveform_eval(waveform, t: np.ndarray) -> np.ndarray:
@@ -289,9 +314,9 @@ def loop(plant_spec, T_plant, comp_spec, T_comp, compensation: str, gain, mass, 
     return STATUS_NAMES.get(status, f"status {status}")
 
 
-def rt_steps(spec, T, v, dt, F_out) -> float:
-    """tf_rt_step over the velocities ``v`` (T a number or one per step); seconds, timed in C."""
-    return _core.rt_steps(spec, T, v, float(dt), F_out)
+def rt_steps(spec, T, v, dt, F_out, load=math.nan) -> float:
+    """tf_rt_step over the velocities ``v`` (T and the load each a number or one per step); seconds, timed in C."""
+    return _core.rt_steps(spec, T, v, float(dt), F_out, load)
 
 
 def temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy, T_amb, dt, T_out, var_out, F_out) -> float:
@@ -303,6 +328,6 @@ def temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy, T_amb, 
 
 
 __all__ = ["PARAMETERS", "PLANT_CODES", "FRICTION_CODES", "LAW_CODES", "OUTPUTS", "OUTPUT_COLUMN", "MECHANICAL_STATES",
-           "model_spec", "law_tuple", "waveform_tuple", "run", "run_sensitivities", "prescribed_force", "prescribed_applies", "CoreFailure", "target", "loop",
+           "model_spec", "law_tuple", "law_eval_load", "LOAD_KIND_CODES", "LOAD_COMBINE_CODES", "waveform_tuple", "run", "run_sensitivities", "prescribed_force", "prescribed_applies", "CoreFailure", "target", "loop",
            "rt_steps", "temperature_estimate", "PROXY_CODES", "law_eval", "waveform_eval", "waveform_corners", "state_scale", "rhs_jac", "time_rhs",
            "n_outputs", "state_index"]

@@ -108,13 +108,18 @@ static int get_int(PyObject *dict, const char *key, int *out)
     return PyErr_Occurred() ? -1 : 0;
 }
 
-/* law: None or (kind, a, b, x, y) */
+/* law: None or (kind, a, b, x, y[, load]), load None or (kind, combine, k, saturation, interaction, c)
+ * (law.h: tf_load_term) */
 static int parse_law(arena *a, PyObject *obj, tf_law *law)
 {
     memset(law, 0, sizeof *law);
     if (obj == NULL || obj == Py_None) return 0;
-    PyObject *x = NULL, *y = NULL;
-    if (!PyArg_ParseTuple(obj, "iddOO", &law->kind, &law->a, &law->b, &x, &y)) return -1;
+    PyObject *x = NULL, *y = NULL, *load = Py_None;
+    if (!PyArg_ParseTuple(obj, "iddOO|O", &law->kind, &law->a, &law->b, &x, &y, &load)) return -1;
+    tf_load_term *t = &law->load;
+    if (load != Py_None &&
+        !PyArg_ParseTuple(load, "iiddid", &t->kind, &t->combine, &t->k, &t->saturation, &t->interaction, &t->c))
+        return -1;
     Py_ssize_t nx, ny;
     law->x = get_array(a, x, &nx, "law breakpoints");
     if (PyErr_Occurred()) return -1;
@@ -216,6 +221,11 @@ static int parse_model(arena *a, PyObject *spec, tf_model *m)
     if (PyErr_Occurred()) return -1;
     if (nt != nv) { PyErr_SetString(PyExc_ValueError, "temperature times and values differ in length"); return -1; }
     m->T_n = (int)nt;
+    /* optional: load = a waveform or None, load_const = a number (absent: NaN, no load) */
+    PyObject *load = PyDict_GetItemString(spec, "load"), *load_const = PyDict_GetItemString(spec, "load_const");
+    m->load_const = NAN;
+    if (load && load != Py_None && parse_waveform(a, load, &m->load)) return -1;
+    if (load_const && load_const != Py_None && get_double(spec, "load_const", &m->load_const)) return -1;
     /* optional: heat = (C_th, R_th, eta, T_amb, T_0, P_ext waveform or None); work = 0/1 */
     PyObject *heat = PyDict_GetItemString(spec, "heat");
     if (heat && heat != Py_None) {
@@ -553,6 +563,39 @@ done:
     return result;
 }
 
+/* law_eval_load(law, T, L, value_out, dT_out, dL_out, coef_out): the law at (T[i], L[i]) (tf_law_eval_load),
+ * its partials, and its derivatives in every coefficient (tf_law_coef_derivative) into coef_out (n x ncoef,
+ * row-major); returns ncoef */
+static PyObject *py_law_eval_load(PyObject *self, PyObject *args)
+{
+    PyObject *law_obj, *T_obj, *L_obj, *v_obj, *dT_obj, *dL_obj, *c_obj;
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &law_obj, &T_obj, &L_obj, &v_obj, &dT_obj, &dL_obj, &c_obj)) return NULL;
+    arena a = {0};
+    tf_law law;
+    PyObject *result = NULL;
+    Py_ssize_t nT, nL;
+    if (parse_law(&a, law_obj, &law)) goto done;
+    const double *T = get_array(&a, T_obj, &nT, "T");
+    if (PyErr_Occurred()) goto done;
+    const double *L = get_array(&a, L_obj, &nL, "L");
+    if (PyErr_Occurred()) goto done;
+    if (nL != nT) { PyErr_SetString(PyExc_ValueError, "T and L differ in length"); goto done; }
+    int nc = tf_law_ncoef(&law);
+    double *value = out_array(&a, v_obj, nT, "output sizes differ from T");
+    double *dT = value ? out_array(&a, dT_obj, nT, "output sizes differ from T") : NULL;
+    double *dL = dT ? out_array(&a, dL_obj, nT, "output sizes differ from T") : NULL;
+    double *dc = dL ? out_array(&a, c_obj, nT * nc, "coef_out: n x ncoef values") : NULL;
+    if (!dc) goto done;
+    for (Py_ssize_t i = 0; i < nT; i++) {
+        value[i] = tf_law_eval_load(&law, T[i], L[i], dT + i, dL + i);
+        for (int k = 0; k < nc; k++) dc[i * nc + k] = tf_law_coef_derivative(&law, k, T[i], L[i]);
+    }
+    result = PyLong_FromLong(nc);
+done:
+    arena_free(&a);
+    return result;
+}
+
 /* waveform_eval(wave, t, value_out) -> list of corners in [t[0], t[-1]] */
 static PyObject *py_waveform_eval(PyObject *self, PyObject *args)
 {
@@ -637,19 +680,21 @@ static int loop_estimator(arena *a, PyObject *obj, Py_ssize_t n, tf_loop *L, tf_
 
 /* loop(plant_spec, T_plant, T_plant_series|None, comp_spec|None, T_comp, T_comp_series|None, compensation,
  *      observer_gain, mass, (kp, ki, kd, tau_d), dt, substeps, x_ref, v_ref, estimator|None,
- *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured), inertia_feedforward): the closed loop of
- *      control.h; the outputs are float64 arrays of n values (the last four may be None). */
+ *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured), inertia_feedforward[, load_plant, load_comp]):
+ *      the closed loop of control.h; the outputs are float64 arrays of n values (the last four may be None);
+ *      the loads NaN (none) when not given. */
 static PyObject *py_loop(PyObject *self, PyObject *args)
 {
     PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *Tp_obj, *Tc_obj, *est_obj, *outs[7];
     tf_loop L;
     memset(&L, 0, sizeof L);
+    L.load_plant = L.load_comp = NAN;
     double kp, ki, kd, tau_d;
     long substeps_in;
-    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)p", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
+    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)p|dd", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
                           &L.T_comp, &Tc_obj, &L.compensation, &L.observer_gain, &L.mass, &kp, &ki, &kd, &tau_d, &L.dt,
                           &substeps_in, &xr_obj, &vr_obj, &est_obj, &outs[0], &outs[1], &outs[2], &outs[3], &outs[4],
-                          &outs[5], &outs[6], &L.inertia_feedforward))
+                          &outs[5], &outs[6], &L.inertia_feedforward, &L.load_plant, &L.load_comp))
         return NULL;
     if (substeps_in > TF_LOOP_MAX_SUBSTEPS) { /* beyond an int: the core's own bound, in its words */
         PyErr_SetString(PyExc_ValueError, "loop: n x substeps (at most 1e8 plant substeps in one run)");
@@ -707,13 +752,28 @@ done:
     return result;
 }
 
-/* rt_steps(spec, T, v, dt, F_out) -> seconds: tf_rt_step over the velocities v (one per step) at
- * temperature T (a number, or an array with one per step), the forces into F_out, timed in C */
+/* A per-step input of rt_steps: a float (into *c, NULL returned) or n float64 values. */
+static const double *per_step(arena *a, PyObject *obj, Py_ssize_t n, const char *what, double *c)
+{
+    *c = NAN;
+    if (PyFloat_Check(obj)) {
+        *c = PyFloat_AsDouble(obj);
+        return NULL;
+    }
+    Py_ssize_t len;
+    const double *s = get_array(a, obj, &len, what);
+    if (!PyErr_Occurred() && len != n) PyErr_Format(PyExc_ValueError, "%s: a number or one per velocity", what);
+    return PyErr_Occurred() ? NULL : s;
+}
+
+/* rt_steps(spec, T, v, dt, F_out[, load]) -> seconds: tf_rt_step over the velocities v (one per step) at
+ * temperature T and load (each a number, or an array with one per step; the load NaN when not given), the
+ * forces into F_out, timed in C */
 static PyObject *py_rt_steps(PyObject *self, PyObject *args)
 {
-    PyObject *spec, *v_obj, *F_obj, *T_obj;
+    PyObject *spec, *v_obj, *F_obj, *T_obj, *L_obj = NULL;
     double dt;
-    if (!PyArg_ParseTuple(args, "OOOdO", &spec, &T_obj, &v_obj, &dt, &F_obj)) return NULL;
+    if (!PyArg_ParseTuple(args, "OOOdO|O", &spec, &T_obj, &v_obj, &dt, &F_obj, &L_obj)) return NULL;
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
@@ -725,16 +785,11 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     if (PyErr_Occurred()) goto done;
     double *F = out_array(&a, F_obj, n, "F_out: one float64 per velocity");
     if (!F) goto done;
-    double T_const = NAN;
-    const double *T = NULL;
-    if (PyFloat_Check(T_obj)) {
-        T_const = PyFloat_AsDouble(T_obj);
-    } else {
-        Py_ssize_t nT;
-        T = get_array(&a, T_obj, &nT, "T");
-        if (PyErr_Occurred()) goto done;
-        if (nT != n) { PyErr_SetString(PyExc_ValueError, "T: a number or one per velocity"); goto done; }
-    }
+    double T_const, L_const = NAN;
+    const double *T = per_step(&a, T_obj, n, "T", &T_const), *L = NULL;
+    if (PyErr_Occurred()) goto done;
+    if (L_obj && L_obj != Py_None) L = per_step(&a, L_obj, n, "load", &L_const);
+    if (PyErr_Occurred()) goto done;
     tf_error e;
     if (tf_rt_from_model(f, &m, &e)) { PyErr_Format(PyExc_ValueError, "friction model: %s", e.what); goto done; }
     struct timespec t0, t1;
@@ -742,11 +797,11 @@ static PyObject *py_rt_steps(PyObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (; i < n; i++) /* no record while timing: a refused step changes nothing, so it is repeated for it */
-        if (tf_rt_step(f, v[i], T ? T[i] : T_const, dt, &F[i], NULL)) break;
+        if (tf_rt_step(f, v[i], T ? T[i] : T_const, L ? L[i] : L_const, dt, &F[i], NULL)) break;
     clock_gettime(CLOCK_MONOTONIC, &t1);
     Py_END_ALLOW_THREADS
     /* a refused step: ValueError (an argument or parameter), FloatingPointError (an overflow) */
-    if (i < n && tf_rt_step(f, v[i], T ? T[i] : T_const, dt, &F[i], &e) != TF_OK)
+    if (i < n && tf_rt_step(f, v[i], T ? T[i] : T_const, L ? L[i] : L_const, dt, &F[i], &e) != TF_OK)
         PyErr_Format(e.code == TF_ERR_NONFINITE ? PyExc_FloatingPointError : PyExc_ValueError, "step %zd: %s",
                      i, e.what);
     else
@@ -839,6 +894,9 @@ static const tf_constant constants[] = {
     C("law", "none", TF_LAW_NONE), C("law", "const", TF_LAW_CONST), C("law", "linear", TF_LAW_LINEAR),
     C("law", "exp", TF_LAW_EXP), C("law", "poly", TF_LAW_POLY), C("law", "pwl", TF_LAW_PWL),
     C("law", "table", TF_LAW_TABLE),
+    C("load_kind", "none", TF_LOAD_NONE), C("load_kind", "proportional", TF_LOAD_PROPORTIONAL),
+    C("load_kind", "affine", TF_LOAD_AFFINE),
+    C("load_combine", "product", TF_COMBINE_PRODUCT), C("load_combine", "sum", TF_COMBINE_SUM),
     C("thermal", "none", TF_THERMAL_NONE), C("thermal", "model-i", TF_THERMAL_MODEL_I),
     C("thermal", "model-ii", TF_THERMAL_MODEL_II),
     C("df_form", "scale", TF_DF_SCALE), C("df_form", "offset", TF_DF_OFFSET),
@@ -1050,6 +1108,8 @@ static PyMethodDef methods[] = {
     {"rhs_jac", py_rhs_jac, METH_VARARGS, "Right-hand side and Jacobian at one state; returns the friction force."},
     {"time_rhs", py_time_rhs, METH_VARARGS, "Seconds per right-hand-side evaluation, timed in C (benchmarks)."},
     {"law_eval", py_law_eval, METH_VARARGS, "Evaluate a temperature law and its slope on an array of T."},
+    {"law_eval_load", py_law_eval_load, METH_VARARGS,
+     "Evaluate a law at (T, load) with its partials and coefficient derivatives; returns the coefficients' count."},
     {"waveform_eval", py_waveform_eval, METH_VARARGS, "Evaluate a waveform on an array of t; returns its corners."},
     {"state_scale", py_state_scale, METH_VARARGS, "Characteristic magnitude of each state."},
     {NULL, NULL, 0, NULL}};

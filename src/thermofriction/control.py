@@ -29,6 +29,8 @@ from .errors import InputError, SolverError, shorten
 from .estimation import TemperatureEstimate, TemperatureEstimator
 from .figures.study_plots import loop_figure
 from .models import MassPlant, Model
+from .models.load_laws import load_laws, refuse_load_laws
+from .simulation.loads import as_load, load_findings
 # MAX_REFERENCE_SAMPLES: its name here, as before the split
 from .references import MAX_REFERENCE_SAMPLES, Reference, duty_cycle, point_to_point, sine_reference  # noqa: F401
 from .results import Result, Summary
@@ -261,6 +263,9 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
     """
     where = "simulate_loop"
     _model(where, "stage", stage)
+    refuse_load_laws(stage, "the control loop")
+    if compensation is not None and isinstance(getattr(compensation, "model", None), Model):
+        refuse_load_laws(compensation.model, "the control loop's compensation")
     if not isinstance(stage.plant, MassPlant):
         raise InputError("the closed loop drives a single-mass stage: the model's plant must be 'mass'")
     t, x_ref, v_ref, dt = _checked_reference(where, reference)
@@ -295,9 +300,9 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
     return LoopResult(t, x_ref, outs[0], outs[1], outs[2], outs[3], T_stage, outs[4], outs[5], outs[6])
 
 
-def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None):
+def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None, load=None):
     """The real-time model (realtime.h: tf_rt_step) stepped at ``dt`` through the sliding velocities
-    ``velocity`` (one per step, held over it) at ``temperature``.
+    ``velocity`` (one per step, held over it) at ``temperature`` and ``load``.
 
     Parameters
     ----------
@@ -309,6 +314,9 @@ def friction_steps(model: Model, velocity, dt: float, temperature: float | None 
         The step [s], > 0.
     temperature : float or array_like, optional
         The temperature [C], one value or one per step; required for a thermal model.
+    load : float or array_like, optional
+        The load [N or N m], one value or one per step; required by a model with a law of the load (naming the
+        law), ignored by one without.
 
     Returns
     -------
@@ -330,6 +338,10 @@ def friction_steps(model: Model, velocity, dt: float, temperature: float | None 
     v = _samples(where, "velocity", velocity)
     dt = _number(where, "dt", dt, positive=True)
     F = np.empty_like(v)
+    L = math.nan if load is None else (_number(where, "load", load) if np.ndim(load) == 0 else
+                                       _samples(where, "load", load, v.size))
+    if load_laws(model):
+        return _load_steps(where, model, v, dt, temperature, load, L, F)
     if temperature is None or np.ndim(temperature) == 0:
         T = math.nan if temperature is None else _number(where, "temperature", temperature)
         if model.thermal is not None or temperature is not None:  # (the former: "give a temperature")
@@ -343,6 +355,28 @@ def friction_steps(model: Model, velocity, dt: float, temperature: float | None 
     except FloatingPointError as e:
         raise SolverError(f"{where}: {_step_message(e, T)}") from None
     except ValueError as e:  # the core refused a step: the model at that step's temperature
+        raise InputError(f"{where}: {_step_message(e, T)}") from None
+    return F, seconds
+
+
+def _load_steps(where, model, v, dt, temperature, load, L, F):
+    """friction_steps of a model with a law of the load: checked over the temperatures' and loads' ranges (their
+    extremes, as the simulator checks them), then stepped by the core."""
+    if temperature is None:
+        raise InputError(f"{where}: the model depends on temperature: give a temperature")
+    T = _number(where, "temperature", temperature) if np.ndim(temperature) == 0 else \
+        _samples(where, "temperature", temperature, v.size)
+    Ts = [float(np.min(T)), float(np.max(T))]
+    try:
+        load_findings(model, Ts, None if load is None else as_load(L if np.ndim(L) == 0 else
+                                                                   (np.arange(L.size, dtype=float), L)))
+    except InputError as e:
+        raise InputError(f"{where}: {e}") from None
+    try:
+        seconds = _bridge.rt_steps(model_spec(model, Ts[0], load=float(np.ravel(L)[0])), T, v, dt, F, L)
+    except FloatingPointError as e:
+        raise SolverError(f"{where}: {_step_message(e, T)}") from None
+    except ValueError as e:  # the core refused a step: the model at that step's temperature and load
         raise InputError(f"{where}: {_step_message(e, T)}") from None
     return F, seconds
 

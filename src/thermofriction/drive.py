@@ -1,5 +1,6 @@
-"""How an experiment drives a model: the input waveform, the temperature, and, for a model that
-heats itself, the ambient and start temperatures. Identification, validation, reports and the
+"""How an experiment drives a model: the input waveform, the temperature, the load (a normal force or a load
+torque, per sample where the run's load column varies), and, for a model that heats itself, the ambient and start
+temperatures. Identification, validation, reports and the
 heating methods all ask here, so that a model is driven the same way wherever it is run.
 """
 
@@ -63,12 +64,15 @@ class Drive:
     ``temperature`` is what ``simulate(..., temperature=...)`` takes: the experiment's temperature
     (a number, or its recorded signal where that varies), or, with a heat model, the ambient
     temperature. With a heat model ``initial_temperature`` is where the run starts (None: the
-    model's own rule, T_0 or else ambient) and ``measured_temperature`` the record."""
+    model's own rule, T_0 or else ambient) and ``measured_temperature`` the record. ``load`` is what
+    ``simulate(..., load=...)`` takes: the run's constant load, its recorded ``normal_force[N]`` /
+    ``load_torque[N*m]`` column as a ``Sampled`` signal where that varies (``Experiment.load_input``), or None."""
 
     waveform: Waveform
     temperature: float | Sampled
     initial_temperature: float | None = None
     measured_temperature: np.ndarray | None = None
+    load: float | Sampled | None = None
 
     def model(self, model):
         """``model`` with its heat section set to this drive's ambient and start temperatures."""
@@ -93,9 +97,10 @@ def drive(exp, model, start: str = "model") -> Drive:
     if start not in START_RULES:
         raise ValueError(f"start must be one of {START_RULES}, got {start!r}")
     waveform = experiment_waveform(exp, model)
+    load = exp.load_input() if hasattr(exp, "load_input") else getattr(exp, "load", None)
     if model.heat is None:
         T = exp.temperature_input() if hasattr(exp, "temperature_input") else exp.temperature
-        return Drive(waveform, T)
+        return Drive(waveform, T, load=load)
     T0 = recorded_start_temperature(exp)
     if start == "record":
         if T0 is None:
@@ -105,7 +110,7 @@ def drive(exp, model, start: str = "model") -> Drive:
         T0 = None  # the model's own T_0
     measured = getattr(exp, "temperature_signal", None)
     return Drive(waveform, ambient_temperature(exp, model), T0,
-                 None if measured is None else np.ascontiguousarray(measured, float))
+                 None if measured is None else np.ascontiguousarray(measured, float), load)
 
 
 __all__ = ["Drive", "drive", "input_of", "experiment_waveform", "ambient_temperature", "recorded_start_temperature",

@@ -54,14 +54,14 @@ class FrictionParams:
     ripple_sin: tuple = ()
 
 
-def friction_params(model, T) -> FrictionParams:
-    """The friction parameters of ``model`` at temperature T [degC] (NaN without a thermal model),
-    read from the friction object's attributes and the thermal model's laws."""
+def friction_params(model, T, load=None) -> FrictionParams:
+    """The friction parameters of ``model`` at temperature T [degC] (NaN without a thermal model) and ``load``
+    (read by laws of the load only), read from the friction object's attributes and the thermal model's laws."""
     fr, th = model.friction, model.thermal
     p = {n: getattr(fr, n, None) for n in _ALL_PARAMS}
     laws = th.laws if isinstance(th, ModelI) else {}
     for name, law in laws.items():
-        p[name] = law_value(law, T)
+        p[name] = law_value(law, T, load)
     if p["fs"] is None:
         p["fs"] = p["fc"]  # no Stribeck effect; fs follows fc (and fc's law)
     defaults = {"sigma2": 0.0, "delta": 2.0, "sigma0": math.nan, "sigma1": 0.0, "z_ba": 0.0, "C": math.nan,
@@ -82,13 +82,13 @@ def friction_params(model, T) -> FrictionParams:
     # direction and position (written here from docs/models.md#direction-and-position, by name)
     extra = {}
     for n in ("fc_neg", "fs_neg", "vs_neg", "sigma2_neg", "ripple_period"):
-        value = law_value(laws[n], T) if n in laws else getattr(fr, n, None)
+        value = law_value(laws[n], T, load) if n in laws else getattr(fr, n, None)
         extra[n] = None if value is None else float(value)
     for f_ in ("cos", "sin"):
         amps = []
         for h in (1, 2, 3):
             n = f"ripple_{f_}{h}"
-            value = law_value(laws[n], T) if n in laws else getattr(fr, n, None)
+            value = law_value(laws[n], T, load) if n in laws else getattr(fr, n, None)
             amps.append(0.0 if value is None else float(value))
         extra[f"ripple_{f_}"] = tuple(amps)
     return FrictionParams(**f, k=k, w=w, lam=lam, dF_offset=off, **extra)

@@ -1,13 +1,13 @@
-"""Temperature laws (docs/models.md#model-i, docs/formats.md#model-files) and the temperature
-signal, written again from their definitions (SciPy's PCHIP for tables); the law objects are read
-as plain attributes, never evaluated."""
+"""Temperature laws (docs/models.md#model-i, docs/formats.md#model-files), laws of temperature and load
+(docs/models.md#laws-of-temperature-and-load) and the temperature and load signals, written again from their
+definitions (SciPy's PCHIP for tables); the law objects are read as plain attributes, never evaluated."""
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from thermofriction.models import PWL, Const, Exp, Linear, Poly, Table
+from thermofriction.models import PWL, Const, Exp, Linear, LoadLaw, Poly, Table
 from thermofriction.waveforms import Sampled
 
 
@@ -69,10 +69,34 @@ def _law_value_slope(law, T):
     raise TypeError(f"reference: unknown law {law!r}")
 
 
-def law_value(law, T):
-    """The law at temperature T [degC] (scalar or array)."""
+def law_value(law, T, load=None):
+    """The law at temperature T [degC] (scalar or array), and, for a law of temperature and load, at ``load``."""
+    if isinstance(law, LoadLaw):
+        return load_law_value(law, T, load)
     v = _law_value_slope(law, T)[0]
     return float(v) if np.ndim(T) == 0 else v
+
+
+def load_law_value(law, T, load):
+    """A law of temperature and load, from its definition: with s = |L| (S tanh(|L|/S) with a saturation S),
+    f(T) s (proportional), f(T) (1 + k s) (affine product), f(T) + k s (affine sum), plus c T s with an
+    interaction c."""
+    if load is None or not np.all(np.isfinite(load)):
+        raise ValueError("reference: a law of the load needs a finite load")
+    f = _law_value_slope(law.base, T)[0]
+    term = law.load
+    s = np.abs(np.asarray(load, float))
+    if term.saturation is not None:
+        s = term.saturation * np.tanh(s / term.saturation)
+    if term.kind == "proportional":
+        v = s * f
+    elif term.combine == "sum":
+        v = f + term.k * s
+    else:
+        v = f + f * term.k * s
+    if term.interaction is not None:
+        v = v + term.interaction * s * np.asarray(T, float)
+    return float(v) if np.ndim(v) == 0 else v
 
 
 def law_slope(law, T):
@@ -82,7 +106,7 @@ def law_slope(law, T):
 
 
 def temperature_value(temperature, t):
-    """A constant temperature, or a Sampled signal interpolated (held beyond its ends)."""
+    """A constant temperature (or load), or a Sampled signal interpolated (held beyond its ends)."""
     if isinstance(temperature, Sampled):
         return float(np.interp(t, temperature.time, temperature.value))
     return float(temperature)

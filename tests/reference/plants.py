@@ -39,8 +39,14 @@ class ReferenceSystem:
     ``modes`` holds GMS's element modes (0 stuck, +1/-1 slipping that way), all stuck from rest
     unless ``gms_mode`` says otherwise."""
 
-    def __init__(self, model, temperature=None, input=None, gms_mode=None):
+    def __init__(self, model, temperature=None, input=None, gms_mode=None, load=None):
         self.model = model
+        self.load = load  # a number, a Sampled load (interpolated, held beyond its ends), or None
+        if isinstance(load, Sampled):
+            lt, lv = [float(v) for v in load.time], [float(v) for v in load.value]
+            self.L_of_t = lambda t: interp_scalar(lt, lv, t)
+        else:
+            self.L_of_t = lambda t: load
         self.plant = model.plant.type
         self.kind = model.friction.model
         self.nz = len(model.friction.k) if self.kind == "gms" else _NSTATE[self.kind]
@@ -67,7 +73,7 @@ class ReferenceSystem:
         else:
             T = math.nan if temperature is None else float(temperature)
             self.T_of_t = lambda t: T
-            self._const = friction_params(model, T)
+            self._const = None if isinstance(load, Sampled) else friction_params(model, T, load)
         if gms_mode is not None:
             self.modes = [int(np.sign(mv)) for mv in gms_mode]
         else:
@@ -75,15 +81,15 @@ class ReferenceSystem:
         self._disarmed = set()  # GMS (element, direction) whose capacity was passed unloaded
 
     # -- parameters and inputs -----------------------------------------------------------------
-    def params(self, T) -> FrictionParams:
-        return friction_params(self.model, T)
+    def params(self, T, t=0.0) -> FrictionParams:
+        return friction_params(self.model, T, self.L_of_t(t))
 
     def params_at_time(self, t) -> FrictionParams:
         if self._const is not None:
             return self._const
-        T = self.T_of_t(t)
-        if T != self._last_T:
-            self._last_T, self._last_p = T, friction_params(self.model, T)
+        key = (self.T_of_t(t), self.L_of_t(t))
+        if key != self._last_T:
+            self._last_T, self._last_p = key, friction_params(self.model, *key)
         return self._last_p
 
     def begin_segment(self, a, b):
@@ -272,9 +278,10 @@ class ReferenceSystem:
     # -- tolerances -----------------------------------------------------------------------------
     def corners(self, t0, t1):
         c = waveform_corners(self.input, t0, t1)
-        if isinstance(self.temperature, Sampled):
-            tt = np.asarray(self.temperature.time, float)
-            c = np.union1d(c, tt[(tt > t0) & (tt <= t1)])
+        for signal in (self.temperature, self.load):
+            if isinstance(signal, Sampled):
+                tt = np.asarray(signal.time, float)
+                c = np.union1d(c, tt[(tt > t0) & (tt <= t1)])
         return c
 
     def _input_peak(self):

@@ -117,7 +117,7 @@ class ReferenceSystemResult:
 
 
 def reference_simulate_system(model, t_eval, temperature=None, input=None, method="DOP853", rtol=1e-10,
-                              atol=None, first_step=None, max_step=math.inf):
+                              atol=None, first_step=None, max_step=math.inf, load=None):
     """Integrates any plant with any friction model from rest (solve_ivp, restarted at every corner
     of the input and knot of a sampled temperature; GMS also at every stick/slip switch, located
     by solve_ivp's terminal events, and at crossings that come and go within one step, found by
@@ -125,7 +125,7 @@ def reference_simulate_system(model, t_eval, temperature=None, input=None, metho
     the steps: an adaptive step can jump a short window where the solution moves after being
     exactly still (a slipping GMS element's force, constant while |v| >> vs, rises as v crosses
     the Stribeck band before a reversal) without its error estimate noticing."""
-    sys_ = ReferenceSystem(model, temperature, input)
+    sys_ = ReferenceSystem(model, temperature, input, load=load)
     t_eval = np.asarray(t_eval, float)
     t0, t1 = float(t_eval[0]), float(t_eval[-1])
     n = sys_.n

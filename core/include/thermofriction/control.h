@@ -40,13 +40,14 @@ tf_status tf_pid_step(tf_pid *c, double e, double dt, double *u, tf_error *err);
 
 /* Observer-based compensation: advances z^ (in f->z) by dt and writes F^ [N] to *F.
  * v: measured velocity [m/s]; e = x - x_ref [m]; k: observer gain [1/s], finite and >= 0 (k = 0:
- * no correction); T: temperature [degC]. The observer of Canudas de Wit et al. estimates a bristle
+ * no correction); T: temperature [degC]; load: the load [N or N m] a law of the load reads (ignored
+ * without one, NaN included). The observer of Canudas de Wit et al. estimates a bristle
  * deflection: it is defined for the models with one (LuGre, Dahl, elasto-plastic) and refused
  * (TF_ERR_BAD_ARGUMENT) for the others -- Coulomb and Stribeck have no state to observe (use
  * feed-forward, tf_rt_step), GMS has one per element and no published observer. Refusals as
  * tf_rt_step's (where "observer" for its own arguments). */
-tf_status tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double dt, double *F,
-                           tf_error *err);
+tf_status tf_observer_step(tf_rt_friction *f, double v, double e, double k, double T, double load, double dt,
+                           double *F, tf_error *err);
 
 typedef enum {
     TF_COMP_NONE = 0,
@@ -107,6 +108,10 @@ typedef struct {
        none), the mean acceleration over the period of a held control (needs v_ref); 0: none. Without it a
        large move's error is the PID's lag behind the acceleration, which hides the friction's part. */
     int inertia_feedforward;
+    /* The loads [N or N m] the plant's and the compensation's laws of the load read (constant over the run;
+       ignored by models without such a law; a zeroed struct has 0). The estimator's model takes no load: a
+       law of the load on est_friction is refused. */
+    double load_plant, load_comp;
 } tf_loop;
 
 /* The most plant substeps (n x substeps) one tf_loop_run takes (~10 s of work): more is refused. */

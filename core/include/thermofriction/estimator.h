@@ -95,7 +95,8 @@ tf_status tf_temperature_configure(tf_temperature_estimator *e, const tf_tempera
 /* One step (see above): v [m/s], F_measured [N] (NaN: none), T_proxy [degC] (NaN: none; refused if
  * the configuration has no proxy), T_amb [degC], dt [s] > 0. Writes F^ [N] to *F_hat (NaN on a
  * refusal). TF_ERR_BAD_ARGUMENT: NULL e, f or F_hat, a non-finite v, T_amb or dt, dt <= 0, an
- * infinite F_measured or T_proxy, or f's model refused at the estimate (where "realtime"/"model");
+ * infinite F_measured or T_proxy, or f's model refused at the estimate (where "realtime"/"model"; a
+ * model with a law of the load is refused: the estimator takes no load yet);
  * TF_ERR_NONFINITE: a force, state or covariance that would not be finite. */
 tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double F_measured,
                               double T_proxy, double T_amb, double dt, double *F_hat, tf_error *err);

@@ -1,5 +1,5 @@
 /* Plants (docs/models.md#plants) assembled with a friction model, its thermal extension, an input
- * waveform and a temperature signal into one ODE system: right-hand side, analytic Jacobian,
+ * waveform, a temperature signal and a load signal into one ODE system: right-hand side, analytic Jacobian,
  * outputs. */
 #ifndef THERMOFRICTION_PLANT_H
 #define THERMOFRICTION_PLANT_H
@@ -71,13 +71,21 @@ typedef struct {
        W = integral of |F' v_r| dt [J] (heat.on or work set): per-cycle dissipation to solver
        tolerance, for energy balances and the two-time-scale method. */
     int work;
+
+    /* The load L [N or N m] the laws with a load term read (law.h: a preloaded stage's normal force, the
+       stick-slip actuator's preload): the waveform `load` (periodic or sampled), or, where its kind is
+       TF_WAVE_ZERO, the constant load_const. A model without such a law does not read either. */
+    tf_waveform load;
+    double load_const;
 } tf_model;
 
-/* The parameters at the last temperature a run evaluated them at, so that a constant temperature costs no
- * law evaluations per step. */
+/* The parameters at the last temperature and load a run evaluated them at, so that a constant temperature
+ * and load cost no law evaluations per step. */
 typedef struct {
     int valid;                  /* 0: filled at the next use */
     double T, p[TF_NPARAM], lambda, dF;
+    double L;                   /* the load they were evaluated at (NaN for a model that reads none) */
+    unsigned long loads;        /* tf_thermal_load_mask of the model's laws, taken when the cache is filled */
     int plain;                  /* p symmetric and without a position ripple: the plant's plain evaluation */
     unsigned long laws;         /* tf_thermal_law_mask of the model's laws, taken when the cache is filled */
 } tf_params_cache;
@@ -103,17 +111,19 @@ void tf_model_data_changed(tf_model_data *data);
  * #friction-models, #thermal-extensions: masses, stiffnesses, sigma0, fc, C, v_smooth > 0;
  * damping, sigma1, sigma2, z_ba >= 0; fs >= fc; vs > 0 where fs != fc; elasto-plastic z_ba <
  * fc/sigma0; 1..64 GMS elements with k_i, w_i > 0 summing to one; Model I parameters and Model
- * II's lambda checked at the constant temperature or over the sampled one; periodic inputs with a
- * positive frequency; for prescribed motion a continuous input). Returns TF_OK, or
+ * II's lambda checked at the constant temperature or over the sampled one, and, for a model that reads
+ * the load, at the smallest and largest load magnitude it reaches (the load finite: "load"); periodic
+ * inputs with a positive frequency; for prescribed motion a continuous input). Returns TF_OK, or
  * TF_ERR_BAD_ARGUMENT with the offending field's name in err->what (where "model"; err may be
  * NULL). tf_solve does not call it: callers that build models from user data must (the Python
  * package checks the same rules, with messages). */
 tf_status tf_model_check(const tf_model *model, tf_error *err);
 /* The same rules for the friction model and its thermal extension alone (the plant, input and
- * temperature signal are not looked at: the real-time API, realtime.h, holds no more): the kind,
- * GMS elements, the laws' structure, and the parameters -- always for a model without a thermal
- * extension, at temperature T for one with it (not at all when T is not finite). */
-tf_status tf_model_check_friction(const tf_model *model, double T, tf_error *err);
+ * temperature and load signals are not looked at: the real-time API, realtime.h, holds no more): the
+ * kind, GMS elements, the laws' structure (load terms included), and the parameters -- always for a
+ * model without a thermal extension, at temperature T (and load L, for a model with a law of the load)
+ * for one with it (not at all when T, or L for a model that reads it, is not finite). */
+tf_status tf_model_check_friction(const tf_model *model, double T, double L, tf_error *err);
 /* The same rules for parameters already evaluated at one temperature: p (TF_NPARAM values), Model
  * II's lambda and offset there (as tf_model_params_cached gives them). */
 tf_status tf_model_check_params(const tf_model *model, const double *p, double lambda, double dF_offset,
@@ -127,14 +137,19 @@ double tf_model_temperature(const tf_model *model, double t, const double *y);
 /* Index of the temperature state and of the frictional-work state; -1 where there is none. */
 int tf_model_temperature_index(const tf_model *model);
 int tf_model_work_index(const tf_model *model);
-/* Parameters at temperature T (Model I laws applied). */
-void tf_model_params_at(const tf_model *model, double T, double *p);
+/* The load at time t: the waveform, or the constant (see tf_model.load). */
+double tf_model_load(const tf_model *model, double t);
+/* Whether the model reads the load: a Model I law with a load term. */
+int tf_model_reads_load(const tf_model *model);
+/* Parameters at temperature T and load L (Model I laws applied). */
+void tf_model_params_at(const tf_model *model, double T, double L, double *p);
 /* The thermal factor lambda(T) of Model II's scale form (1 otherwise). */
 double tf_model_lambda(const tf_model *model, double T);
-/* Parameters at T (as tf_model_params_at), Model II's *lambda and offset force *dF_offset, cached
- * in the run's data for the last T: a constant temperature costs no law evaluation. The pointer is into
- * the data's cache, valid until the next call with another T. */
-const double *tf_model_params_cached(tf_model_data *data, double T, double *lambda, double *dF_offset);
+/* Parameters at (T, L) (as tf_model_params_at), Model II's *lambda and offset force *dF_offset, cached
+ * in the run's data for the last (T, L): a constant temperature and load cost no law evaluation (L is no
+ * key for a model that does not read it). The pointer is into the data's cache, valid until the next call
+ * with another T or L. */
+const double *tf_model_params_cached(tf_model_data *data, double T, double L, double *lambda, double *dF_offset);
 /* Friction force F' at (t, state). */
 double tf_model_friction(tf_model_data *data, double t, const double *y);
 void tf_model_initial_state(const tf_model *model, double *y);
@@ -184,7 +199,7 @@ void tf_model_state_scale(const tf_model *model, double *scale);
 tf_status tf_model_rhs(double t, const double *y, double *dy, void *data);
 /* Jacobian d(rhs)/dy, row-major n x n. */
 tf_status tf_model_jac(double t, const double *y, double *J, void *data);
-/* Earliest time after t where the input or the temperature signal has a corner. */
+/* Earliest time after t where the input, the temperature signal or the load (where read) has a corner. */
 double tf_model_next_corner(double t, void *data);
 /* The longest step from (t, y) (tf_ode.max_step): under a prescribed motion with a Stribeck effect, the time
  * in which the input's velocity changes by half of the larger of |v| and the Stribeck velocity; else

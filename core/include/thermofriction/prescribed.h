@@ -23,7 +23,8 @@ extern "C" {
 #endif
 
 /* 1 if tf_prescribed_force applies to the model: a prescribed plant driven by a sampled position, a
- * constant temperature (no signal, no heat balance), no Model II (any friction model). */
+ * constant temperature (no signal, no heat balance) and load (no load waveform), no Model II (any friction
+ * model). */
 int tf_prescribed_applies(const tf_model *model);
 
 /* The friction force at the n_out output times t_out (non-decreasing, from t_out[0], where the

@@ -1,13 +1,13 @@
 /* Real-time friction models: a fixed-step, allocation-free interface for control loops
- * (10-100 kHz on a DSP or microcontroller). Every friction model of friction.h, with Model I or
- * Model II, behind four calls:
+ * (10-100 kHz on a DSP or microcontroller). Every friction model of friction.h, with Model I (its laws
+ * of temperature, or of temperature and load) or Model II, behind four calls:
  *
  *     tf_rt_friction f;
  *     tf_error err;                                        // status.h: why a call was refused
  *     tf_rt_init(&f, TF_FRICTION_LUGRE, p, NULL, &err);    // parameters p[TF_NPARAM]
- *     tf_rt_set_model_i(&f, TF_P_FC, &fc_law, &err);       // optional: a law of temperature
+ *     tf_rt_set_model_i(&f, TF_P_FC, &fc_law, &err);       // optional: a law of temperature (and load)
  *     double F;
- *     if (tf_rt_step(&f, v, T, dt, &F, &err) != TF_OK) ... // every control period
+ *     if (tf_rt_step(&f, v, T, load, dt, &F, &err) != TF_OK) ... // every control period
  *     tf_rt_set_param(&f, TF_P_SIGMA1, 3.0, NULL);         // at run time (err may be NULL)
  *     tf_rt_reset(&f, NULL);                               // internal states to rest
  *
@@ -57,8 +57,9 @@ typedef struct {
  * finite breakpoints, TABLE slopes given); a model with a thermal extension has its parameters
  * (and Model II's lambda > 0) checked at each new temperature it is stepped at, which costs
  * nothing at a constant temperature. TF_ERR_BAD_ARGUMENT: a NULL pointer, an unknown kind or
- * index, a parameter out of its domain (at that temperature), a non-finite v, T (with a thermal
- * extension; without one T is ignored, NaN included) or dt. TF_ERR_NONFINITE: a step whose force
+ * index, a parameter out of its domain (at that temperature and load), a non-finite v, T (with a
+ * thermal extension; without one T is ignored, NaN included), load (with a law of the load; without one
+ * the load is ignored, NaN included) or dt. TF_ERR_NONFINITE: a step whose force
  * or state would not be finite (a velocity or step so large that the equations overflow). */
 
 /* Sets up a model at rest. p: TF_NPARAM values (unused ones ignored); gms: the elements for
@@ -66,7 +67,8 @@ typedef struct {
  * parameters must be valid as given (they are the model's while no law is set): give a
  * parameter that will follow a law its value at some temperature, not 0. */
 tf_status tf_rt_init(tf_rt_friction *f, int kind, const double *p, const tf_gms_elements *gms, tf_error *err);
-/* Model I: parameter `param` follows `law` (copied; its arrays must outlive f). Not with Model II. */
+/* Model I: parameter `param` follows `law` (copied; its arrays must outlive f): a law of temperature, or of
+ * temperature and load (law.h's load term; the steps then need a finite load). Not with Model II. */
 tf_status tf_rt_set_model_i(tf_rt_friction *f, int param, const tf_law *law, tf_error *err);
 /* Model II: dF(T) [N] applied in `form` (TF_DF_SCALE: F (1 + dF / fc); TF_DF_OFFSET: + dF tanh(v / v_smooth)).
  * Not with Model I. */
@@ -79,16 +81,19 @@ tf_status tf_rt_set_param(tf_rt_friction *f, int param, double value, tf_error *
 tf_status tf_rt_set_position(tf_rt_friction *f, double x, tf_error *err);
 /* Internal states to rest (z = 0, GMS elements stuck); the position is kept. */
 tf_status tf_rt_reset(tf_rt_friction *f, tf_error *err);
-/* Parameters at temperature T [degC] into p[TF_NPARAM]; *lambda, *dF_offset (may be NULL).
- * Nothing is written if T or the parameters there are refused. */
-tf_status tf_rt_params_at(tf_rt_friction *f, double T, double *p, double *lambda, double *dF_offset,
+/* Parameters at temperature T [degC] and load `load` [N or N m] (read by a law of the load only) into
+ * p[TF_NPARAM]; *lambda, *dF_offset (may be NULL). Nothing is written if T, the load or the parameters
+ * there are refused. */
+tf_status tf_rt_params_at(tf_rt_friction *f, double T, double load, double *p, double *lambda, double *dF_offset,
                           tf_error *err);
-/* Advances the internal states by dt [s] at sliding velocity v [m/s] and temperature T [degC]
- * (ignored without a thermal model), the position by v dt, and writes the friction force F [N]
+/* Advances the internal states by dt [s] at sliding velocity v [m/s], temperature T [degC]
+ * (ignored without a thermal model) and load `load` (a normal force [N] or a load torque [N m], read by
+ * the laws with a load term; ignored by a model without one), the position by v dt, and writes the
+ * friction force F [N]
  * (with the position ripple at the new position, if the model has one) to *F (the sign convention
  * of docs/models.md#conventions: the force resisting sliding, with v's sign in steady sliding).
  * dt <= 0 gives the force without advancing. On a refusal *F is NaN and the state is unchanged. */
-tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double dt, double *F, tf_error *err);
+tf_status tf_rt_step(tf_rt_friction *f, double v, double T, double load, double dt, double *F, tf_error *err);
 
 /* The friction model and thermal extension of a simulation model (plant.h's tf_model), for
  * callers that already configure one; its laws' arrays must outlive f. */

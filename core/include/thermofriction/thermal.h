@@ -32,16 +32,19 @@ typedef enum {
 
 /* ---- Model I ---- */
 
-/* Parameters at temperature T into p[TF_NPARAM]: p_base, with laws[i] evaluated at T wherever it is
- * set (kind != TF_LAW_NONE) when thermal is TF_THERMAL_MODEL_I; fs = fc when fs_follows_fc. */
+/* Parameters at temperature T and load L into p[TF_NPARAM]: p_base, with laws[i] evaluated at (T, L)
+ * (tf_law_eval_load) wherever it is set (kind != TF_LAW_NONE) when thermal is TF_THERMAL_MODEL_I; fs = fc
+ * when fs_follows_fc. L is read by the laws with a load term only. */
 void tf_thermal_params(int thermal, const double *p_base, const tf_law *laws, int fs_follows_fc, double T,
-                       double *p);
+                       double L, double *p);
 /* The parameters that follow a law: bit i set where laws[i].kind != TF_LAW_NONE (TF_NPARAM <= 32). */
 unsigned long tf_thermal_law_mask(const tf_law *laws);
+/* The parameters whose law has a load term (Model I only; 0 otherwise): a model that reads the load. */
+unsigned long tf_thermal_load_mask(int thermal, const tf_law *laws);
 /* tf_thermal_params with the laws of `mask` only (tf_thermal_law_mask): the plant's per-temperature path,
  * which then visits only the parameters that have a law. */
 void tf_thermal_params_masked(int thermal, const double *p_base, const tf_law *laws, unsigned long mask,
-                              int fs_follows_fc, double T, double *p);
+                              int fs_follows_fc, double T, double L, double *p);
 
 /* ---- Model II: F' = lambda(T) F_base + dF_offset(T) s(v), s(v) = tanh(v / v_smooth) ---- */
 
@@ -91,8 +94,8 @@ static inline double tf_thermal_param_partial(int thermal, int form, double lamb
     return d;
 }
 
-/* dF'/dc for coefficient `coef` of the dF law (Model II): F_base / F_ref dF_c in the scale form,
- * dF_c s(v) in the offset form (dF_c = tf_law_coef_derivative). */
+/* dF'/dc for coefficient `coef` of the dF law (Model II, no load term): F_base / F_ref dF_c in the scale
+ * form, dF_c s(v) in the offset form (dF_c = tf_law_coef_derivative). */
 double tf_thermal_df_coef_partial(int form, const tf_law *dF, int coef, double T, double F_base, double F_ref,
                                   double v, double v_smooth);
 

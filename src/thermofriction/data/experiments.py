@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import InputError
 from ..plausible import TEMPERATURE_RANGE  # noqa: F401  [degC] one range for files, manifests and simulate
 from ..waveforms import Sampled, Waveform
+from .load import load_varies
 
 _LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9}  # micro sign and Greek mu
 _UNITS = {"time": {"s": 1.0, "ms": 1e-3}, "voltage": {"V": 1.0, "mV": 1e-3}, "displacement": _LENGTH,
@@ -87,7 +88,10 @@ class Experiment:
         declared), what a unit warning names; None for an experiment made in memory.
     load : float, optional
         The run's constant load, a normal force [N] or a load torque [N m] (docs/formats.md#loads), carried like
-        its temperature; None: not given.
+        its temperature (a load column's mean); None: not given.
+    load_signal : numpy.ndarray, optional
+        The recorded load column [N or N m], one per sample (what drives a simulation of the run where it
+        varies: ``load_input``).
     """
 
     file: str
@@ -107,6 +111,15 @@ class Experiment:
     headers: dict | None = dataclasses.field(default=None, repr=False)
     #: the run's constant load [N or N m] (a normal force, a load torque), None where not given
     load: float | None = None
+    #: the recorded load column [N or N m], one per sample, None without one
+    load_signal: np.ndarray | None = dataclasses.field(default=None, repr=False)
+
+    def load_input(self):
+        """What ``simulate(..., load=...)`` takes: the recorded load column where it varies (data/load.py:
+        load_varies) as a ``Sampled`` signal through its samples, else the constant ``load`` (None: none)."""
+        if load_varies(self.load_signal):
+            return Sampled(np.asarray(self.time, float), np.asarray(self.load_signal, float))
+        return self.load
 
     @property
     def label(self) -> str:

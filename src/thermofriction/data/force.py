@@ -24,7 +24,7 @@ from ..errors import InputError, shorten
 from .command import COMMAND_SI, COMMAND_UNITS, MEASURED_KEYS, column_key_of, measured_force
 from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
 from .experiments import MIN_SAMPLES, Experiment
-from .load import run_load
+from .load import load_column, run_load
 from .motion import (MOTIONS, POSITION_MISMATCH_ERROR, MotionCheck, MotionWarning, SamplingWarning, check_motion,
                      check_motion_option, choose_motion, motion_waveform, quantum, v_smooth_for, velocity_lag,
                      velocity_of, velocity_resolution, velocity_scale, with_v_smooth)
@@ -385,7 +385,8 @@ def force_experiment(path, name, *, temperature, role, description, from_zero, m
                            input=motion_waveform(t, drive_v, cols["position"][0]), force=F, velocity=v,
                            rotary=cols["rotary"], struct=struct, motion=source, motion_check=check, measured_quantity=quantity,
                            column=column, headers=_headers(path, cols), ambient_temperature=ambient,
-                           proxy_temperature=proxy, continues=continues, load=run_load(path, cols, load))
+                           proxy_temperature=proxy, continues=continues, load=run_load(path, cols, load),
+                           load_signal=load_column(cols))
 
 
 def warm_up_columns(path, cols: dict, temperature, ambient_temperature, continues) -> tuple:

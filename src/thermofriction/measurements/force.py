@@ -309,7 +309,7 @@ class Force(Measurement):
         needs no step size. ``fast``: by the exact stepping wherever it applies (no simulation checks: for
         what only needs the values, the unit check). A ripple is added at the recorded angle (measurements/ripple.py;
         per run: at the angle offset that fits ``measured``). A model with laws of load: at the run's load, by the
-        exact stepping (measurements/force_load.py; the simulator takes no load yet)."""
+        exact stepping (measurements/force_load.py: each run at its constant load)."""
         if load_laws(model):
             return stepped_force(model, exp, warn=True)[0]
         if ripple.additive(model):

@@ -3,8 +3,8 @@
 force along the run's measured motion is the C core's exact stepping of the model holding those values as numbers,
 with its sensitivities to them, and the chain rule to the laws' coefficients is each law's own derivatives
 (``LoadLaw.coefficient_derivatives``; a temperature law's by central differences, as ``Problem.chain_matrix``).
-The simulator does not take a load yet, so a run whose motion the exact stepping does not apply to (or a temperature
-signal) is refused here, naming the file.
+A run whose motion the exact stepping does not apply to (or a temperature signal, or a load that varies over the run)
+is refused here, naming the file: a fit of the laws takes each run at one (temperature, load).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import dataclasses
 import numpy as np
 
 from .. import _bridge
+from ..data.load import LOAD_VARIES, load_varies
 from ..drive import drive
 from ..errors import InputError
 from ..models import Model
@@ -40,8 +41,13 @@ def run_load(exp) -> float:
     Raises
     ------
     InputError
-        The run carries no load.
+        The run carries no load, or its load column varies over the run.
     """
+    signal = getattr(exp, "load_signal", None)
+    if load_varies(signal):
+        raise InputError(f"{exp.file}: the load column varies over the run ({float(np.min(signal)):.4g} to "
+                         f"{float(np.max(signal)):.4g}); a force fit of the laws of the load takes each run's constant "
+                         f"load (within {100 * LOAD_VARIES:g} % of its mean); a simulation is driven by it per sample")
     if getattr(exp, "load", None) is None:
         raise InputError(f"{exp.file}: the model's laws depend on the load but the run has none: give 'load' in the "
                          f"manifest or a normal_force[N] / load_torque[N*m] column")
@@ -127,12 +133,12 @@ def stepped_force(model: Model, exp, names=(), warn: bool = False) -> tuple:
     d = drive(exp, model, start="record")
     if not isinstance(d.temperature, (int, float)):
         raise InputError(f"{exp.file}: the temperature varies over the run; a law of load is fitted on runs at a "
-                         f"constant temperature (the simulator takes no load yet)")
+                         f"constant temperature (each run at one condition, stepped exactly)")
     at = model_at(model, float(d.temperature), load, warn)
     spec = _bridge.model_spec(at, float(d.temperature), d.waveform)
     if not _bridge.prescribed_applies(spec):
         raise InputError(f"{exp.file}: the core's exact stepping does not apply to this model ({model.friction.model});"
-                         f" a law of load needs it (the simulator takes no load yet)")
+                         f" a force fit of a law of load needs it")
     try:
         return _bridge.prescribed_force(spec, np.asarray(exp.time, float), tuple(names))
     except _bridge.CoreFailure as e:

@@ -8,9 +8,11 @@ With ``s = |L|`` (or ``S tanh(|L|/S)`` with a ``saturation`` S, the load-depende
     sum,     affine:        p = f(T) + k s            + c T s     (a gear's load-dependent part beside f(T))
 
 ``c`` (``interaction``, optional) is a fitted interaction between temperature and load. This module is the one place
-that knows a load law: its value, its derivatives in every coefficient (for the chain rule of a joint fit), its range
-of validity in load and the warning outside it, and its file form. The C core does not evaluate load laws yet: a model
-holding one is refused where it would reach it (the simulator, the FMU, the real-time API) with one clear message.
+in Python that knows a load law: its value, its derivatives in every coefficient (for the chain rule of a joint fit),
+its range of validity in load and the warning outside it, its file form, and the fields of the C core's load term
+(law.h: tf_load_term, the same equations in C, evaluated by the simulator and the real-time API at the run's load).
+A model holding one is still refused where the load is not an input yet (the FMU, the control loop, the sweeps and
+``identify``), with one clear message.
 """
 
 from __future__ import annotations
@@ -165,9 +167,13 @@ class LoadLaw(Law):
             raise InputError(f"a load law's load must be a LoadTerm, got {type(self.load).__name__}")
 
     def core_fields(self):
-        raise InputError(f"a law of the load ({self.kind} in temperature, {self.load.kind} in load): the load is not an "
-                         "input of the simulator, the FMU or the real-time API yet; fit and validate it on force "
-                         "data (identification.fit_load_laws), or evaluate it with LoadLaw.value(T, load)")
+        """The temperature law's fields and ``load``: the C core's load term (law.h, tf_load_term) as (kind,
+        combine, k, saturation (0: none), interaction (0/1), c)."""
+        t = self.load
+        return {**self.base.core_fields(),
+                "load": (t.kind, t.combine, 0.0 if t.k is None else float(t.k),
+                         0.0 if t.saturation is None else float(t.saturation), int(t.interaction is not None),
+                         0.0 if t.interaction is None else float(t.interaction))}
 
     # -- coefficients ------------------------------------------------------------------------
     def coefficient_names(self):
@@ -296,8 +302,8 @@ def law_from_dict(d, where: str) -> Law:
 
 
 def refuse_load_laws(model, where: str) -> None:
-    """Refuses a model with a law of load where the load is not an input yet (``where``: the simulator, the FMU,
-    the real-time API), naming the law.
+    """Refuses a model with a law of load where the load is not an input yet (``where``: the FMU, the control
+    loop, the sweeps, ``identify``), naming the law.
 
     Parameters
     ----------

@@ -25,6 +25,7 @@ from ..simulation import AutoSwitch, Dopri5, Rodas4, StepSizeController
 from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
+from ..models.load_laws import refuse_load_laws
 from ..waveforms import Sampled, Waveform
 from ..results import Result, Summary, collecting, heading, lines
 from .cluster import Runner, check_options
@@ -420,6 +421,7 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     import time
 
     model = _args.model(model, Model, loader=load_model)  # the argument types (_args.py): before any work
+    refuse_load_laws(model, "the sweeps")
     _args.number(temperature, "temperature", "degC", none=True)
     check_run_options(duration, sample_rate, solver, controller, scheduler, workers, batch_size, progress)
     if not isinstance(metrics, str):

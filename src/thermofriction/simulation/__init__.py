@@ -1,4 +1,4 @@
-"""Simulation: ``simulate(model, duration, temperature=..., input=...)`` on the C core.
+"""Simulation: ``simulate(model, duration, temperature=..., input=..., load=...)`` on the C core.
 
 Solvers are objects you pass in (``Dopri5()``, ``Rodas4()``, ``AutoSwitch()``), separate from the
 step-size controller (``StepSizeController(rtol=..., atol=...)``). Results come on a uniform
@@ -22,11 +22,12 @@ from ..drive import input_of
 from .. import _args
 from ..errors import InputError, SolverError, shorten
 from ..models import Model, PrescribedMotion, StickSlipPlant
-from ..models.load_laws import refuse_load_laws
+from ..models.load_laws import load_laws
 from ..waveforms import Sampled, Waveform
 from ..results import emit
 from .checks import (as_temperature, check_heated_temperatures, check_passivity, check_prescribed_motion,
                      check_temperatures, coverage_findings, heated_findings, temperature_findings)
+from .loads import as_load, load_findings
 from .result import SimulationResult
 from .solvers import SOLVERS, AutoSwitch, Dopri5, Rodas4, StepSizeController
 
@@ -235,7 +236,7 @@ def _check_types(duration, temperature, sample_rate, t_eval, solver, friction_wo
 def simulate(model: Model, duration: float | None = None, *, temperature=None, input: Waveform | None = None,
              sample_rate: float = 10_000.0, t_eval=None, solver=None,
              controller: StepSizeController | None = None, max_samples: int | None = MAX_SAMPLES,
-             friction_work: bool = False) -> SimulationResult:
+             friction_work: bool = False, load=None) -> SimulationResult:
     """Simulates ``model`` from rest.
 
     Parameters
@@ -264,6 +265,10 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     friction_work : bool, default False
         Also integrate the friction work W = integral of abs(F v_r) dt [J], returned as
         ``SimulationResult.friction_work`` (always done with a heat model).
+    load : float or Waveform or tuple of array_like, optional
+        The load the laws of the load read (a normal force [N] or a load torque [N m]: a preloaded stage's normal
+        force, the stick-slip actuator's preload): a constant, a waveform (``Sampled`` for a recorded one) or
+        (times, values); required by a model with a law of the load, ignored by one without.
 
     Returns
     -------
@@ -275,15 +280,15 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     ------
     InputError
         An argument of the wrong type or out of range, named (``duration must be a number [s], ...``); no
-        temperature for a thermal model; a temperature signal for a model with a heat model; an output grid
-        over ``max_samples``.
+        temperature for a thermal model; no load for a model with a law of the load, naming the law; a
+        temperature signal for a model with a heat model; an output grid over ``max_samples``.
     SolverError
         The integrator stopped (too many steps, a non-finite state): its ``time`` and ``state`` say where.
 
     Warns
     -----
     TemperatureRangeWarning
-        A temperature outside the range a law was calibrated on.
+        A temperature (LoadRangeWarning: a load) outside the range a law was calibrated on.
     PassivityWarning
         Friction parameters that can create energy.
 
@@ -298,7 +303,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     (0.01, 0.0)
     """
     _check_arguments(model, input, controller, max_samples)
-    refuse_load_laws(model, "the simulator")
+    load = as_load(load)
     _check_types(duration, temperature, sample_rate, t_eval, solver, friction_work)
     solver = solver or AutoSwitch()
     if isinstance(solver, str):
@@ -316,10 +321,15 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
                              "temperature as a number (--temperature C), not a temperature signal")
         heat = model.heat.resolved(temperature)
         T_start = sorted({heat.initial_temperature, heat.ambient_temperature})
-        found = temperature_findings(model, T_start[0] if len(T_start) == 1 else Sampled(np.array([0.0, 1.0]),
-                                                                                          np.array(T_start)))
+        T_run = T_start[0] if len(T_start) == 1 else Sampled(np.array([0.0, 1.0]), np.array(T_start))
     else:
-        found = temperature_findings(model, temperature)
+        T_run = temperature
+    if load_laws(model):
+        if T_run is None:
+            raise InputError("the model depends on temperature: give a temperature (e.g. --temperature 35)")
+        found = load_findings(model, T_run.value if isinstance(T_run, Sampled) else [T_run], load)
+    else:
+        found = temperature_findings(model, T_run)
     friction_work = bool(friction_work) or heat is not None
     waveform = input_of(model, input)
     grid = (_Grid(output_grid(duration, sample_rate, t_eval, max_samples), waveform.period, max_samples)
@@ -344,14 +354,14 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     # one block in Fortran order: each output is a contiguous column, which the result holds as a view
     out = np.empty((_bridge.n_outputs(model, friction_work), grid.times.size)).T
     try:
-        stats = _bridge.run(_bridge.model_spec(model, temperature, waveform, friction_work), grid.times, out,
+        stats = _bridge.run(_bridge.model_spec(model, temperature, waveform, friction_work, load), grid.times, out,
                             method=solver.name, rtol=controller.rtol, atol=atol,
                             first_step=controller.first_step or 0.0, max_step=controller.max_step or 0.0,
                             max_steps=controller.max_steps)
     except _bridge.CoreFailure as e:
         raise _explain(e, model, solver, controller, waveform, state_names) from None
     stats["solver"] = stats.pop("method")
-    res = _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period)
+    res = _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period, load)
     emit(res.findings)  # self-heating's, known after the run
     res.findings[:0] = found
     return res
@@ -367,7 +377,7 @@ def _uniform_grid(duration, sample_rate, period, max_samples) -> _Grid:
     return grid
 
 
-def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> SimulationResult:
+def _pack(model, out, grid, stats, temperature, heat, friction_work, period, load=None) -> SimulationResult:
     """The output array as a result: refuses non-finite outputs, reads the step sizes at the period
     starts, removes the joined rows, names the columns."""
     # the C core keeps the states finite; an output computed from finite but extreme values
@@ -394,7 +404,7 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
         cols["stage_displacement"] = cols["stage_velocity"] = None
     if temperature is None and heat is None:
         cols["temperature"][:] = math.nan
-    found = heated_findings(model, cols["time"], cols["temperature"]) if heat is not None and \
+    found = heated_findings(model, cols["time"], cols["temperature"], load) if heat is not None and \
         model.thermal is not None else []
     nfric = model.friction.nstate
     return SimulationResult(
