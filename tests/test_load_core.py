@@ -292,3 +292,39 @@ def test_sensitivities_through_a_law_of_the_load_are_central_differences():
         print(f"{n} coefficient {k}: max |S - FD| / max |S| = {err / scale:.2e}")
         assert np.max(np.abs(fd)) > 1e-3 * scale  # each coefficient moves the run
         assert err <= 1e-3 * scale, (n, k, err / scale)
+
+
+def test_the_command_line_simulates_a_load_file_as_python_does(tmp_path):
+    """`thermofriction simulate --load-file` (time[s], normal_force[mN]: converted to N) gives the run
+    tf.simulate(load=Sampled) gives, to the CSV's 12 digits (the same core; checked against Python here, and Python
+    against the independent reference above); `--load` a constant; a model with a law of the load and no load exits
+    2 naming the law; a load file with another column name or unit exits 2 naming the file and line, writing
+    nothing."""
+    from conftest import run_cli
+    model = preloaded_stage()
+    model.save(tmp_path / "stage.toml")
+    rows = "\n".join(f"{t:g},{1e3 * L:g}" for t, L in zip(RAMP.time, RAMP.value))
+    (tmp_path / "load.csv").write_text("time[s],normal_force[mN]\n" + rows + "\n")
+    r = run_cli("simulate", tmp_path / "stage.toml", "--temperature", 30, "--load-file", tmp_path / "load.csv",
+                "--duration", 12, "--sample-rate", 100, "-o", tmp_path / "out.csv")
+    assert r.returncode == 0, r.stderr
+    out = np.loadtxt(tmp_path / "out.csv", delimiter=",", skiprows=1)
+    assert (tmp_path / "out.csv").read_text().startswith("time[s],input[N],displacement[m],")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tf.PassivityWarning)
+        py = tf.simulate(tf.load_model(tmp_path / "stage.toml"), 12.0, sample_rate=100.0, temperature=30.0,
+                         load=RAMP)
+    assert np.ptp(py.displacement) > 0.5
+    assert np.allclose(out[:, 2], py.displacement, rtol=1e-11, atol=1e-12 * np.ptp(py.displacement))
+    r = run_cli("simulate", tmp_path / "stage.toml", "--temperature", 30, "--load", 60, "--duration", 0.5)
+    assert r.returncode == 0 and "at load 60" in r.stdout, r.stderr
+    r = run_cli("simulate", tmp_path / "stage.toml", "--temperature", 30, "--duration", 0.5)
+    assert r.returncode == 2 and "[thermal] fc: a law of the load" in r.stderr and "Traceback" not in r.stderr
+    (tmp_path / "bad.csv").write_text("time[s],normal_force[kN]\n0,1\n1,2\n")
+    r = run_cli("simulate", tmp_path / "stage.toml", "--temperature", 30, "--load-file", tmp_path / "bad.csv",
+                "-o", tmp_path / "bad-out.csv")
+    assert r.returncode == 2 and "bad.csv: line 1: unknown unit 'kN' of normal_force (use N, mN)" in r.stderr, r.stderr
+    assert not (tmp_path / "bad-out.csv").exists()
+    (tmp_path / "bad.csv").write_text("time[s],force[N]\n0,1\n1,2\n")
+    r = run_cli("simulate", tmp_path / "stage.toml", "--temperature", 30, "--load-file", tmp_path / "bad.csv")
+    assert r.returncode == 2 and "line 1: the value column must be normal_force[N] or load_torque[N*m]" in r.stderr

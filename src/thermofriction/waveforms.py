@@ -345,16 +345,17 @@ class Sampled(Waveform):
         return {"t": self.time, "v": self.value}
 
     @classmethod
-    def from_csv(cls, path, base_dir=None):
-        """Reads ``time[s]`` and one value column (docs/formats.md#inputs)."""
+    def from_csv(cls, path, base_dir=None, columns=None):
+        """Reads ``time[s]`` and one value column (docs/formats.md#inputs); ``columns``: the value column's
+        allowed names and units (read_two_column_csv)."""
         p = Path(path)
         if base_dir is not None and not p.is_absolute():
             p = Path(base_dir) / p
-        time, value = read_two_column_csv(p, "time")
+        time, value = read_two_column_csv(p, "time", columns)
         return cls(time, value, file=str(path))
 
 
-def read_two_column_csv(path: Path, first: str):
+def read_two_column_csv(path: Path, first: str, columns: dict | None = None):
     """A CSV with a header ``first[unit]`` and one value column; time units s or ms.
 
     Parameters
@@ -363,6 +364,9 @@ def read_two_column_csv(path: Path, first: str):
         The file.
     first : str
         The first column's name (``"time"``).
+    columns : dict, optional
+        The value column's allowed names, each with its units and their scales to SI (``{"normal_force": {"N": 1.0,
+        "mN": 1e-3}}``); the values are returned in SI. None: any header, the values as they are.
 
     Returns
     -------
@@ -402,6 +406,7 @@ def read_two_column_csv(path: Path, first: str):
     scale = {"s": 1.0, "ms": 1e-3}.get(unit)
     if scale is None:
         raise InputError(f"{path}: line {lines[0]}: unknown time unit {shorten(unit)} (use s or ms)")
+    value_scale = 1.0 if columns is None else _value_scale(path, lines[0], header[1], columns)
     data = np.empty((len(rows) - 1, 2))
     for k, (i, row) in enumerate(zip(lines[1:], rows[1:]), start=2):
         if len(row) != 2:
@@ -421,7 +426,21 @@ def read_two_column_csv(path: Path, first: str):
     bad = np.nonzero(np.diff(t) <= 0)[0]  # after scaling: ms to s can merge neighbouring values
     if bad.size:
         raise InputError(f"{path}: line {lines[bad[0] + 2]}: time must increase strictly")
-    return t, data[:, 1]
+    return t, data[:, 1] * value_scale
+
+
+def _value_scale(path, line, head: str, columns: dict) -> float:
+    """The value column's scale to SI from its header ``name[unit]``, refused naming the file and line where the
+    name or the unit is not one of ``columns``."""
+    name, _, unit = head.partition("[")
+    name, unit = name.strip(), unit.rstrip("]").strip()
+    allowed = " or ".join(f"{n}[{next(iter(u))}]" for n, u in columns.items())
+    if name not in columns:
+        raise InputError(f"{path}: line {line}: the value column must be {allowed}, got {shorten(head)}")
+    if unit not in columns[name]:
+        raise InputError(f"{path}: line {line}: unknown unit {shorten(unit)} of {name} (use "
+                         f"{', '.join(columns[name])})")
+    return float(columns[name][unit])
 
 
 _KINDS = {"sawtooth": Sawtooth, "sine": Sine, "square": Square, "step": Step}

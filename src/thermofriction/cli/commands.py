@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import _io
 from .._progress import Progress
+from ..data.force import LOAD_FILE_UNITS
 from ..errors import InputError
 from ..measurements.delay import parse_delay
 from ..models import PRESETS, MassPlant, load_model
@@ -24,6 +25,9 @@ def cmd_simulate(args) -> int:
     temperature = args.temperature
     if args.temperature_file:
         temperature = Sampled.from_csv(args.temperature_file)
+    load = args.load
+    if args.load_file:  # docs/cli.md#simulate: time[s] and normal_force[N] or load_torque[N*m]
+        load = Sampled.from_csv(args.load_file, columns=LOAD_FILE_UNITS)
     waveform = parse_waveform(args.input) if args.input else None
     spring_pulled = isinstance(model.plant, MassPlant) and model.plant.spring_stiffness > 0
     if waveform is None and model.input is None and not spring_pulled:
@@ -31,10 +35,12 @@ def cmd_simulate(args) -> int:
     if args.rtol >= 1:
         raise InputError(f"--rtol must be below 1, got {args.rtol!r}")
     controller = StepSizeController(rtol=args.rtol, atol=args.atol, max_steps=args.max_steps)
-    _refuse_inputs(args, _model_inputs(args.model, model), args.temperature_file, _waveform_inputs(waveform))
+    _refuse_inputs(args, _model_inputs(args.model, model), args.temperature_file, args.load_file,
+                   _waveform_inputs(waveform))
     t0 = time.perf_counter()
-    res = simulate(model, args.duration, temperature=temperature, input=waveform, sample_rate=args.sample_rate,
-                   solver=SOLVERS[solver_of(args)](), controller=controller, max_samples=args.max_samples)
+    res = simulate(model, args.duration, temperature=temperature, load=load, input=waveform,
+                   sample_rate=args.sample_rate, solver=SOLVERS[solver_of(args)](), controller=controller,
+                   max_samples=args.max_samples)
     elapsed = time.perf_counter() - t0
     if args.output == "-":
         import io
@@ -60,6 +66,8 @@ def cmd_simulate(args) -> int:
     else:
         T = "at temperature " + (f"{temperature:g} C" if isinstance(temperature, float) else
                                  f"from {args.temperature_file}" if temperature is not None else "not used")
+    if load is not None:
+        T += ", at load " + (f"{load:g}" if isinstance(load, float) else f"from {args.load_file}")
     print(f"{name}: {args.duration:g} s {T}, {len(res.time)} samples", file=out)
     print(f"  final displacement  {res.displacement[-1] * 1e6:.6g} um", file=out)
     print(f"  peak friction force {np.max(np.abs(res.friction_force)):.6g} N", file=out)

@@ -129,6 +129,13 @@ def build_parser() -> argparse.ArgumentParser:
                       help="constant interface temperature [C] (required for thermal models)")
     temp.add_argument("--temperature-file", metavar="F.csv",
                       help="temperature signal: CSV with time[s] and temperature[C], linearly interpolated")
+    load = s.add_mutually_exclusive_group()
+    load.add_argument("--load", type=_finite_float, metavar="L",
+                      help="constant load (normal force [N] or load torque [N m]) the model's laws of load read "
+                           "(required for a model with one; ignored by a model without)")
+    load.add_argument("--load-file", metavar="F.csv",
+                      help="load signal: CSV with time[s] and normal_force[N] or load_torque[N*m], linearly "
+                           "interpolated")
     s.add_argument("--input", metavar="WAVEFORM", help="input waveform, overriding the model's [input]")
     s.add_argument("--duration", type=_positive_float, default=2.0, metavar="S",
                    help="simulated time [s] (default: 2)")

@@ -24,7 +24,7 @@ from ..errors import InputError, shorten
 from .command import COMMAND_SI, COMMAND_UNITS, MEASURED_KEYS, column_key_of, measured_force
 from .csv import TIME_LIMIT, VALUE_LIMIT, _line_of, _scan, header_cell, read_experiment_bytes
 from .experiments import MIN_SAMPLES, Experiment
-from .load import load_column, run_load
+from .load import LOAD_COLUMNS, load_column, run_load
 from .motion import (MOTIONS, POSITION_MISMATCH_ERROR, MotionCheck, MotionWarning, SamplingWarning, check_motion,
                      check_motion_option, choose_motion, motion_waveform, quantum, v_smooth_for, velocity_lag,
                      velocity_of, velocity_resolution, velocity_scale, with_v_smooth)
@@ -59,6 +59,8 @@ _UNITS["displacement"] = _UNITS["position"]
 _SI = {"time": "s", "position": "m", "displacement": "m", "velocity": "m/s", "friction_force": "N",
        "friction_torque": "N*m", "normal_force": "N", "load_torque": "N*m", "temperature": "C", "ambient_temperature": "C",
        "proxy_temperature": "C", **COMMAND_SI}
+#: a load file's value column (``simulate --load-file``): its names and units with their scales to SI
+LOAD_FILE_UNITS = {k: {u: s for u, (s, _) in _UNITS[k].items()} for k in LOAD_COLUMNS}
 #: the columns that hold temperatures [C], each checked for plausibility
 TEMPERATURE_COLUMNS = ("temperature", "ambient_temperature", "proxy_temperature")
 #: Header names that mark a force (torque) experiment, as opposed to an actuator's (voltage, displacement).
@@ -448,5 +450,5 @@ def write_force_csv(path, time, position, force, *, velocity=None, temperature=N
 __all__ = ["ForceExperiment", "SamplingWarning", "MotionWarning", "MotionCheck", "MOTIONS", "read_force_csv",
            "force_experiment", "is_force_file", "is_force_data", "units_of", "motion_waveform", "write_force_csv",
            "GAP_RATIO", "velocity_lag", "velocity_scale", "check_motion", "choose_motion", "quantum",
-           "velocity_resolution", "v_smooth_for", "warm_up_columns", "TEMPERATURE_COLUMNS", "with_v_smooth", "check_sign", "check_motion_option",
+           "velocity_resolution", "v_smooth_for", "warm_up_columns", "TEMPERATURE_COLUMNS", "LOAD_FILE_UNITS", "with_v_smooth", "check_sign", "check_motion_option",
            "POSITION_MISMATCH_ERROR"]
