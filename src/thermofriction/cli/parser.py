@@ -265,7 +265,8 @@ def _add_fmu_command(sub):
                     "when the package was built with the MinGW-w64 cross compiler (or --platforms asks for it), Windows "
                     "x86-64 (the C core inside, the C library its only dependency), with its C sources, from "
                     "which an importer compiles it for any other platform. Inputs: the plant's drive (voltage, force or motion) and, for Model I "
-                    "and II, the temperature [C] (with a [heat] section, the ambient temperature). Outputs: "
+                    "and II, the temperature [C] (with a [heat] section, the ambient temperature), and for a law of the load "
+                    "the load (normal_force [N], or load_torque [N m] for a rotary joint). Outputs: "
                     "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
                     "The model's [input] is not part of the FMU: the importer drives it.",
@@ -275,6 +276,9 @@ def _add_fmu_command(sub):
     f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help=_writes("fmu", "output", "the FMU file"))
     f.add_argument("--temperature", type=_finite_float, metavar="C",
                    help="start value of the temperature input [C] (with [heat]: of the ambient temperature)")
+    f.add_argument("--load", type=_finite_float, metavar="N",
+                   help="a model with a law of the load: start value of its load input [N, or N m for a rotary "
+                        "joint] (default: the middle of the load laws' range of |load|)")
     f.add_argument("--model-identifier", metavar="NAME",
                    help="the FMU's model identifier, letters, digits and _ (default: from the model's name)")
     f.add_argument("--solver", choices=("adaptive", "realtime"), default=None,
