@@ -20,7 +20,8 @@ import pytest
 import reference as R
 import thermofriction as tf
 from thermofriction import control as C
-from thermofriction.models import Exp, Linear, LoadLaw, LoadTerm
+from thermofriction.estimation import TemperatureEstimator
+from thermofriction.models import Exp, Linear, LoadLaw, LoadRangeWarning, LoadTerm
 
 fmpy = pytest.importorskip("fmpy")
 from fmpy import read_model_description  # noqa: E402
@@ -216,3 +217,151 @@ def test_the_windows_binary_under_wine_takes_the_load_as_the_linux_one(tmp_path)
         scale = np.ptp(ref[name])
         assert scale > 0, name
         np.testing.assert_allclose(got[:, k], ref[name][1:], rtol=0, atol=1e-10 * scale, err_msg=name)
+
+
+# ---- the closed loop ----------------------------------------------------------------------------------------------
+
+def loop_stage():
+    """The preloaded stage's contact on a free 1 kg carriage (the loop's single mass)."""
+    return preloaded_stage(tf.MassPlant(mass=1.0))
+
+
+def _loop_case():
+    ref = C.sine_reference(2e-3, 0.5, 2.0)
+    N = np.interp(ref.time, [0.0, 0.4, 1.6, 2.0], [45.0, 45.0, 140.0, 140.0])  # one per control period
+    T = np.interp(ref.time, [0.0, 2.0], [28.0, 36.0])
+    return ref, N, T
+
+
+def test_closed_loop_with_a_load_ramp_matches_the_plain_python_reference():
+    """Oracle: the independent scalar-Python loop (tests/reference/control.py; its laws of the load written again in
+    tests/reference/laws.py). Over 2 s of a 2 mm sine at 0.5 Hz while the stage's normal force ramps 45 -> 140 N
+    and its temperature 28 -> 36 C, the C loop's positions agree with it to 1e-12 of the amplitude, with the
+    observer told the stage's load and temperature (a load sensor) and told a constant 45 N (load-blind); the
+    load-blind observer's friction estimate is the worse, by the laws' change over the ramp."""
+    stage = loop_stage()
+    ref, N, T = _loop_case()
+    amplitude = 2e-3
+    runs = {}
+    for name, told in (("sensor", None), ("blind", 45.0)):
+        res = C.simulate_loop(stage, ref, temperature=T, load=N, compensation=C.Observer(stage, 100.0, load=told))
+        xs = R.reference_closed_loop(stage, ref, T, C.DEFAULT_PID, gain=100.0, L=N, L_comp=told)
+        err = np.max(np.abs(res.position - xs))
+        print(f"loop with a load ramp, observer told {name}: max |x - reference| = {err:.2e} m")
+        assert err <= 1e-12 * amplitude, (name, err)
+        runs[name] = res
+    np.testing.assert_array_equal(runs["sensor"].plant_load, N)
+    np.testing.assert_array_equal(runs["sensor"].compensation_load, N)
+    np.testing.assert_array_equal(runs["blind"].compensation_load, np.full(N.size, 45.0))
+    assert "plant_load" in runs["blind"]._frame()
+    fe = {k: float(np.sqrt(np.mean(r.friction_error[N > 130.0] ** 2))) for k, r in runs.items()}
+    print("RMS friction-estimate error at N > 130 N:", fe)
+    assert fe["blind"] > 3 * fe["sensor"], fe
+
+
+def test_a_load_blind_feed_forward_costs_what_the_load_changes():
+    """Truth: the laws' own values. A feed-forward told a constant 45 N on a stage at 135 N compensates the sliding
+    friction of 45 N: in steady sliding of the sine's middle (|v_ref| > 3 vs) its estimate falls short of the
+    stage's friction by fc(T, 135 N) - fc(T, 45 N) (the LuGre's level, fc plus sigma2 v alike in both), to 2 % of
+    that gap; told the load, it is within 2 % of the gap of the friction. The tracking error says what the blind
+    compensation costs: its RMS error is larger."""
+    stage = loop_stage()
+    ref = C.sine_reference(2e-3, 0.5, 2.0)
+    T = 32.0
+    out = {}
+    for name, told in (("told", None), ("blind", 45.0)):
+        out[name] = C.simulate_loop(stage, ref, temperature=T, load=135.0,
+                                    compensation=C.FeedForward(stage, load=told), inertia_feedforward=True)
+    fc = stage.thermal.laws["fc"]
+    gap = fc.value(T, 135.0) - fc.value(T, 45.0)
+    sliding = np.abs(ref.velocity) > 3 * 1.2e-3
+    mid = sliding & (ref.time > 0.5)
+    blind_short = -out["blind"].friction_error[mid] * np.sign(ref.velocity[mid])
+    assert abs(np.median(blind_short) - gap) <= 0.02 * gap, (np.median(blind_short), gap)
+    assert np.median(np.abs(out["told"].friction_error[mid])) <= 0.02 * gap
+    print(f"feed-forward at 135 N: RMS error told {out['told'].rms_error:.3g} m, blind {out['blind'].rms_error:.3g} m")
+    assert out["blind"].rms_error > 1.5 * out["told"].rms_error
+
+
+def test_the_loop_needs_a_load_for_a_law_of_the_load_and_checks_it():
+    """The loop names the law that needs a load; a load series of the wrong length, a NaN load or a load where the
+    model leaves its domain is refused naming it; a temperature estimator cannot step a law of the load; a
+    load-free stage ignores the load."""
+    stage = loop_stage()
+    ref = C.sine_reference(1e-3, 1.0, 0.05)
+    with pytest.raises(tf.InputError, match=r"the stage: \[thermal\] fc: a law of the load.*give the run's load"):
+        C.simulate_loop(stage, ref, temperature=30.0)
+    with pytest.raises(tf.InputError, match=r"simulate_loop: load must be one-dimensional with 501 values"):
+        C.simulate_loop(stage, ref, temperature=30.0, load=np.full(7, 50.0))
+    bad = np.full(ref.time.size, 50.0)
+    bad[3] = np.nan
+    with pytest.raises(tf.InputError, match=r"load\[3\] is nan"):
+        C.simulate_loop(stage, ref, temperature=30.0, load=bad)
+    with pytest.raises(tf.InputError, match=r"compensation's model: Model I at 30 C and load 0: 'fc' must be positive"), \
+            pytest.warns(LoadRangeWarning):
+        C.simulate_loop(stage, ref, temperature=30.0, load=50.0, compensation=C.FeedForward(stage, load=0.0))
+    with pytest.raises(tf.InputError, match=r"Observer: load must be"):
+        C.Observer(stage, load="heavy")
+    est = TemperatureEstimator(C_th=50.0, R_th=2.0, r_F=0.01)
+    with pytest.raises(tf.InputError, match="steps its friction model at no load"):
+        C.simulate_loop(stage, ref, temperature=30.0, load=50.0, compensation=C.FeedForward(stage, temperature=est))
+    free = tf.load_model("stage-model-i")
+    a = C.simulate_loop(free, ref, temperature=35.0, compensation=C.Observer(free))
+    b = C.simulate_loop(free, ref, temperature=35.0, load=80.0, compensation=C.Observer(free, load=20.0))
+    np.testing.assert_array_equal(a.position, b.position)
+    assert b.plant_load is None and b.compensation_load is None
+
+
+# ---- the sweeps ---------------------------------------------------------------------------------------------------
+
+SWEEP_METRICS = ["final_displacement", "displacement_range", "peak_friction_force"]
+
+
+def swept_stage():
+    import dataclasses
+    return dataclasses.replace(preloaded_stage(), input=tf.Sine(amplitude=0.6, frequency=2.0))
+
+
+def test_sweep_load_axis_equals_simulate_point_by_point():
+    """Truth: tf.simulate run point by point at each (load, temperature) (an independent path through the library);
+    the load axis' unit is N; the points differ with the load (the axis reaches the laws)."""
+    model = swept_stage()
+    grid = {"load": [40.0, 95.0, 140.0], "temperature": [26.0, 37.0]}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tf.PassivityWarning)
+        res = tf.sweep(model, grid, duration=0.5, sample_rate=1000, metrics=SWEEP_METRICS, scheduler="sequential",
+                       batch_size=4)
+        assert len(res) == 6 and res.failed == 0 and res.units["load"] == "N"
+        for i in range(len(res)):
+            r = tf.simulate(model, 0.5, sample_rate=1000, temperature=res["temperature"][i], load=res["load"][i])
+            assert res["final_displacement"][i] == r.displacement[-1]
+            assert res["displacement_range"][i] == np.ptp(r.displacement)
+            assert res["peak_friction_force"][i] == np.max(np.abs(r.friction_force))
+        one = tf.sweep(model, {"temperature": [26.0]}, load=140.0, duration=0.5, sample_rate=1000,
+                       metrics=SWEEP_METRICS, scheduler="sequential")
+    assert one["peak_friction_force"][0] == res["peak_friction_force"][4]
+    assert len(set(res["peak_friction_force"][::2])) == 3
+
+
+def test_cli_sweep_load_axis_on_the_local_cluster_equals_the_sequential_run(tmp_path):
+    """`--grid load=...` on the command line, on the local Dask cluster (two worker processes) and sequentially:
+    the same table, its load column in N; a load axis for a model without a law of the load and a model with one
+    given no load are usage errors (exit 2) naming what to do."""
+    from test_sweep import run
+    (tmp_path / "stage.toml").write_text(swept_stage().to_toml())
+    grid = ["--grid", "load=40:140:50", "--grid", "temperature=26,37", "--metrics", ",".join(SWEEP_METRICS)]
+    common = ["--duration", "0.3", "--sample-rate", "1000"]
+    seq = run("sweep", "stage.toml", *grid, *common, "--scheduler", "sequential", "-o", "seq.csv", cwd=tmp_path)
+    assert seq.returncode == 0, seq.stderr
+    loc = run("sweep", "stage.toml", *grid, *common, "--scheduler", "processes", "--workers", "2", "-o", "local.csv",
+              cwd=tmp_path)
+    assert loc.returncode == 0, loc.stderr
+    assert "a local Dask cluster (2 workers)" in loc.stdout and "6 points (0 failed)" in loc.stdout
+    table = (tmp_path / "local.csv").read_text()
+    assert table == (tmp_path / "seq.csv").read_text() and table.startswith("load[N],temperature[C],")
+    free = run("sweep", "li2009-model-i", "--grid", "load=40,80", "--temperature", "35", *common, "-o", "f.csv",
+               cwd=tmp_path)
+    assert free.returncode == 2 and "grid 'load': the model has no law of the load" in free.stderr
+    none = run("sweep", "stage.toml", "--grid", "temperature=26,37", *common, "-o", "n.csv", cwd=tmp_path)
+    assert none.returncode == 2 and "give a load axis in the grid (load=20:100:20)" in none.stderr, none.stderr
+    assert not (tmp_path / "f.csv").exists() and not (tmp_path / "n.csv").exists()
