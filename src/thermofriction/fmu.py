@@ -43,12 +43,13 @@ from . import _bridge
 from ._io import Target, atomic_write
 from .errors import InputError, shorten
 from . import _args
-from .fmu_description import (MAX_POINTS, default_experiment, description_xml2, description_xml3, load_input,
-                              resource_text, variables_of)
+from .fmu_description import (MAX_POINTS, default_experiment, description_xml2, description_xml3, resource_text,
+                              variables_of)
 from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_description, c_files, source_files
 from .estimation import TemperatureEstimator
 from .models import MassPlant, Model, StickSlipPlant, load_model
 from .models.fit_record import fit_record_lines
+from .models.load_laws import load_laws
 
 #: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
 SOLVERS = ("adaptive", "realtime")
@@ -141,6 +142,26 @@ def _check_exportable(model: Model):
         n = 0 if y is None else len(y)
         if n > MAX_POINTS:
             raise InputError(f"[thermal] {name}: a law of {n} points or coefficients; an FMU takes at most {MAX_POINTS}")
+
+
+def _load_input(model: Model, load: float | None = None):
+    """The load input of a model with a law of the load (docs/fmu.md#the-load-input), (name, unit, what, start),
+    and the load terms' common range of |load| (None: none); (None, None) without such a law. A joint's (a rotary
+    prescribed motion) is ``load_torque`` [N m], any other ``normal_force`` [N]; it starts at ``load``, else at
+    the middle of the range."""
+    terms = [law.load for law in load_laws(model).values()]
+    if not terms:
+        return None, None
+    ranges = [t.range for t in terms if t.range is not None]
+    rng = (max(r[0] for r in ranges), min(r[1] for r in ranges)) if ranges else None
+    rng = rng if rng and rng[0] < rng[1] else None
+    if load is None and rng is None:
+        raise InputError("export_fmu: the model has a law of the load and no load range: give the load input's start "
+                         "(load=..., --load)")
+    start = float(load) if load is not None else 0.5 * (rng[0] + rng[1])
+    if getattr(model.plant, "rotary", False):
+        return ("load_torque", "N m", "load torque on the joint, read by the laws of the load", start), rng
+    return ("normal_force", "N", "normal force on the contact (its preload), read by the laws of the load", start), rng
 
 
 def _check_step(model: Model, step) -> float:
@@ -288,8 +309,9 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     heat_temperature = temperature if model.heat is None else (
         temperature if temperature is not None else (model.heat.ambient_temperature or 20.0))
     spec = _bridge.model_spec(model, temperature=heat_temperature if model.heat is not None else None)
-    variables = variables_of(model, spec, temperature, step, estimator, load)
-    tfm = resource_text(model, spec, variables, solver, estimator, load_input(model, load)[1])
+    load_var, load_range = _load_input(model, load)
+    variables = variables_of(model, spec, temperature, step, estimator, load_var)
+    tfm = resource_text(model, spec, variables, solver, estimator, load_range)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
     tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
     sources = source_files(fmi)

@@ -12,7 +12,6 @@ from . import _bridge
 from ._version import __version__
 from .errors import InputError
 from .models import MassPlant, Model, PrescribedMotion, StickSlipPlant
-from .models.load_laws import load_laws
 
 #: The resource file's format version (core/fmu/fmu_common.c, FMU_FORMAT).
 FORMAT = 2
@@ -86,29 +85,11 @@ def _estimator_io(model: Model, estimator, ambient: float) -> list:
     return out
 
 
-def load_input(model: Model, load: float | None = None):
-    """The load input of a model with a law of the load (None without one): a joint's (a rotary prescribed motion)
-    ``load_torque`` [N m], else ``normal_force`` [N], starting at ``load``, else at the middle of the load terms'
-    common range of |load|; the range itself (None without one)."""
-    terms = [law.load for law in load_laws(model).values()]
-    if not terms:
-        return None, None
-    ranges = [t.range for t in terms if t.range is not None]
-    rng = (max(r[0] for r in ranges), min(r[1] for r in ranges)) if ranges else None
-    rng = rng if rng and rng[0] < rng[1] else None
-    if load is None and rng is None:
-        raise InputError("export_fmu: the model has a law of the load and no load range: give the load input's start "
-                         "(load=..., --load)")
-    start = float(load) if load is not None else 0.5 * (rng[0] + rng[1])
-    name, unit = ("load_torque", "N m") if getattr(model.plant, "rotary", False) else ("normal_force", "N")
-    what = "load torque on the joint" if unit == "N m" else "normal force on the contact (its preload)"
-    return _Variable(name, VR_LOAD, unit, f"{what}, read by the laws of the load", start, "input", "continuous"), rng
-
-
 def variables_of(model: Model, spec: dict, temperature: float | None, step: float | None = None, estimator=None,
-                 load: float | None = None):
+                 load=None):
     """The FMU's variables: inputs, outputs, then every parameter with its role in the binary; with ``estimator``
-    (a TemperatureEstimator) its inputs, outputs and parameters too; ``load``: the load input's start."""
+    (a TemperatureEstimator) its inputs, outputs and parameters too; ``load``: the load input's (name, unit, what,
+    start) for a model with a law of the load (fmu.py: _load_input), else None."""
     plant = model.plant
     drive = {StickSlipPlant: ("voltage", "V", "drive voltage of the actuator"),
              MassPlant: ("force", "N", "force applied to the mass"),
@@ -128,8 +109,8 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
         T0 = temperature if temperature is not None else (rng[0] if rng else 20.0)
         variables.append(_Variable("temperature", VR_TEMPERATURE, "degC",
                                    "temperature of the friction interface", float(T0), "input", "continuous"))
-    load_var = load_input(model, load)[0]
-    variables += [load_var] if load_var else []
+    load_var = _Variable(load[0], VR_LOAD, load[1], load[2], load[3], "input", "continuous") if load else None
+    variables += [load_var] if load else []
     variables += [
         _Variable("displacement", VR_DISPLACEMENT, "m", "displacement of the driven body (end effector, mass, or "
                   "the prescribed motion)", causality="output", variability="continuous"),
@@ -451,5 +432,5 @@ def description_xml3(model: Model, variables, identifier: str, guid: str, source
     return "\n".join(out)
 
 
-__all__ = ["variables_of", "load_input", "VR_LOAD", "resource_text", "description_xml2", "description_xml3", "default_experiment",
+__all__ = ["variables_of", "VR_LOAD", "resource_text", "description_xml2", "description_xml3", "default_experiment",
            "FORMAT", "VR_TIME", "ESTIMATOR_PARAMETERS"]

@@ -324,7 +324,8 @@ def _add_sweep_command(sub):
                     "then the metrics. Runs on threads on this machine's cores, a local Dask cluster or an "
                     "existing one (--scheduler). A point that fails is written with empty metrics and its reason "
                     "in the error column; the others go on (exit status 1 when any failed).",
-        epilog="Grid names: temperature [C]; a field of the input waveform (amplitude, frequency, rise, offset, "
+        epilog="Grid names: temperature [C]; load [N, or N m for a rotary joint] for a model with a law of the load; "
+               "a field of the input waveform (amplitude, frequency, rise, offset, "
                "duty, slew); a model parameter (sigma0, sigma1, fc, fs, vs, sigma2, a law coefficient such as "
                "sigma0.b, dF.values[1], a plant parameter such as m_e). Metrics: "
                + "; ".join(f"{k} [{u}] {what}" for k, (u, what, _) in METRICS.items()) + ".")
