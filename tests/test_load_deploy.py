@@ -91,6 +91,75 @@ def test_fmi2_fmu_with_a_load_ramp_matches_the_simulator(tmp_path):
 
 
 @needs_binary
+def test_realtime_fmu_with_a_load_ramp_converges_to_the_simulator_and_the_cli_sets_the_start(tmp_path):
+    """Truth: tf.simulate as above. The FMU exported with --solver realtime (the core's tf_rt_step at each fixed step,
+    the load read at the step's start) converges to the simulator under the load ramp at first order, as at a
+    constant load: from a 1e-4 s to a 1e-5 s step its largest friction-force error falls 10x (seen: 14 % -> 1.5 %
+    of the force's range, at the slips' onsets; 16 % -> 1.6 % at a constant 90 N) and its displacement is within
+    1e-4 of its range. `thermofriction fmu --load N` sets the load input's start."""
+    import subprocess
+    import sys
+    model = preloaded_stage()
+    (tmp_path / "stage.toml").write_text(model.to_toml())
+    out = subprocess.run([sys.executable, "-m", "thermofriction", "fmu", "stage.toml", "-o", "rt5.fmu", "--solver",
+                          "realtime", "--step", "1e-5", "--load", "45", "--temperature", "25"], cwd=tmp_path,
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    var = {v.name: v for v in read_model_description(str(tmp_path / "rt5.fmu")).modelVariables}
+    assert float(var["normal_force"].start) == 45.0 and var["integrator.step"].variability == "fixed"
+    export_fmu(model, tmp_path / "rt4.fmu", solver="realtime", step=1e-4, temperature=25.0, load=45.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tf.PassivityWarning)
+        ref = tf.simulate(model, t_eval=T_GRID, temperature=tf.Sampled(T_GRID, T_RAMP),
+                          load=tf.Sampled(T_GRID, N_RAMP), controller=tf.StepSizeController(rtol=1e-9))
+    err = {}
+    for name in ("rt4", "rt5"):
+        run = Run(tmp_path / f"{name}.fmu", tmp_path / name, start_values={"temperature": 25.0})
+        got = run.drive(T_GRID, {"force": 0 * T_GRID, "temperature": T_RAMP, "normal_force": N_RAMP},
+                        ["friction_force", "displacement"])
+        run.close()
+        err[name] = [np.max(np.abs(got[k] - getattr(ref, k))) / np.ptp(getattr(ref, k))
+                     for k in ("friction_force", "displacement")]
+    print("realtime FMU, max error / range (friction force, displacement) at 1e-4, 1e-5 s:", err)
+    assert err["rt5"][0] <= err["rt4"][0] / 5 and err["rt5"][1] <= 1e-4, err
+
+
+@needs_binary
+def test_realtime_fmu_is_the_cores_realtime_api_at_the_same_loads(tmp_path):
+    """Independent path: a prescribed sine motion of the preloaded contact through the real-time FMU (ten fixed
+    steps of 0.1 ms per communication step; the normal force ramping 50 -> 130 N, held over each communication
+    step, so that the force the FMU reports at a communication point is at the load its steps used) gives the
+    friction force that the core's real-time API, driven from Python with the same sliding velocities and loads
+    (control.friction_steps, tf_rt_step), gives -- to rounding (1e-12 of range); the same steps at a constant
+    50 N are far from it."""
+    from thermofriction.control import friction_steps
+
+    model = preloaded_stage(tf.PrescribedMotion())
+    step, per = 1e-4, 10
+    t = np.arange(1001) * (step * per)
+    u = 3e-3 * np.sin(2 * np.pi * 1.0 * t) + 8e-4 * np.sin(2 * np.pi * 3.7 * t)
+    N = np.interp(t, [0.0, 0.2, 0.8, 1.0], [50.0, 50.0, 130.0, 130.0])
+    path = tmp_path / "rt.fmu"
+    export_fmu(model, path, solver="realtime", step=step, temperature=30.0, load=50.0)
+    run = Run(path, tmp_path, start_values={"temperature": 30.0, "motion": u[0]})
+    run.fmu.exitInitializationMode()
+    got = np.empty(t.size - 1)
+    for k in range(t.size - 1):
+        run.set("motion", u[k])
+        run.fmu.setRealInputDerivatives([run.vr["motion"]], [1], [(u[k + 1] - u[k]) / (step * per)])
+        run.set("normal_force", N[k])  # held over the step: no derivative
+        run.fmu.doStep(currentCommunicationPoint=t[k], communicationStepSize=step * per)
+        got[k] = run.get("friction_force")[0]
+    run.close()
+    v = np.repeat(np.diff(u) / (step * per), per)
+    F, _ = friction_steps(model, v, step, temperature=30.0, load=np.repeat(N[:-1], per))
+    want = F[per - 1::per]  # the force after each communication step's last fixed step
+    assert np.max(np.abs(got - want)) <= 1e-12 * np.ptp(want)
+    blind, _ = friction_steps(model, v, step, temperature=30.0, load=50.0)
+    assert np.max(np.abs(got - blind[per - 1::per])) > 0.1 * np.ptp(want)
+
+
+@needs_binary
 @pytest.mark.parametrize("solver", ["adaptive", "realtime"])
 def test_fmi3_fmu_takes_the_load_as_the_fmi2_one(solver, tmp_path):
     """Truth: the FMI 2 export of the same model on the same held inputs (fmpy's own master, simulate_fmu):
