@@ -217,7 +217,8 @@ def test_the_fmu_warns_outside_the_load_range_and_refuses_a_bad_load(tmp_path):
     """The load laws' range of |load| (30..150 N) is the FMU's as the temperature's is: a load of 180 N steps with
     fmi2Warning and a logged message naming the range (once per excursion); a NaN load is refused with an error,
     the state unchanged; a load where the model leaves its domain (fc = mu |N| = 0 at N = 0) is refused. A model
-    whose laws have no range needs the load's start at export."""
+    whose laws have no range needs the load's start at export; the temperature estimator (which steps its model at
+    no load) is refused with a law of the load."""
     model = preloaded_stage()
     path = tmp_path / "s.fmu"
     export_fmu(model, path, temperature=30.0)
@@ -241,6 +242,10 @@ def test_the_fmu_warns_outside_the_load_range_and_refuses_a_bad_load(tmp_path):
     with pytest.raises(tf.InputError, match="no load range: give the load input's start"):
         export_fmu(preloaded_stage(rng=None), tmp_path / "n.fmu", temperature=30.0)
     export_fmu(preloaded_stage(rng=None), tmp_path / "n.fmu", temperature=30.0, load=70.0)
+    with pytest.raises(tf.InputError, match="the temperature estimator steps its friction model at no load"):
+        export_fmu(model, tmp_path / "e.fmu", temperature=30.0, estimator=TemperatureEstimator(C_th=5.0, R_th=2.0,
+                                                                                                r_F=0.01))
+    assert not (tmp_path / "e.fmu").exists()
 
 
 DLL = binary_path("win64")

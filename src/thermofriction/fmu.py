@@ -288,7 +288,8 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     InputError
         An argument of the wrong type or value, named; what an FMU cannot carry (a sampled external heat, a
         law with more points than the binary holds), named with what to do; a path that is a folder or cannot
-        be written; an unknown platform; a model with a law of the load, no load range and no ``load``.
+        be written; an unknown platform; a model with a law of the load, no load range and no ``load``, or with
+        ``estimator``.
     ComputationError
         A platform asked for that could not be built, each named with why; nothing is written.
 
@@ -302,6 +303,9 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
                                                            solver, step, fmi, platforms, load)
     _check_exportable(model)
     _args.instance(estimator, TemperatureEstimator, "estimator", "a TemperatureEstimator", none=True)
+    if estimator is not None and load_laws(model):
+        raise InputError(f"export_fmu: the temperature estimator steps its friction model at no load, and the model has "
+                         f"a law of the load ({', '.join(load_laws(model))}): export it without estimator=")
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
         raise InputError(f"model identifier {model_identifier!r}: letters, digits and '_' only, not starting with a "
