@@ -66,7 +66,8 @@ static struct {
 } pool[NLAWS];
 static int used;
 
-/* A law of any kind (known or not) with n = 0..MAXK breakpoints in any order, or NULL arrays. */
+/* A law of any kind (known or not) with n = 0..MAXK breakpoints in any order, or NULL arrays; half of them with a
+ * load term of any kind, combination and numbers (law.h: tf_load_term). */
 static const tf_law *law(reader *r, tf_law *L)
 {
     uint8_t sel = byte(r);
@@ -91,8 +92,19 @@ static const tf_law *law(reader *r, tf_law *L)
     L->x = shape & 8 ? NULL : pool[slot].x;
     L->y = shape & 16 ? NULL : pool[slot].y;
     L->d = shape & 4 ? NULL : pool[slot].d;
+    if (sel >= 128) {
+        L->load.kind = byte(r) % 4; /* 3: unknown */
+        L->load.combine = byte(r) % 3;
+        L->load.k = number(r);
+        L->load.saturation = number(r);
+        L->load.interaction = byte(r) & 1;
+        L->load.c = number(r);
+    }
     return L;
 }
+
+/* A step's load: NaN (none) or any number. */
+static double load_of(reader *r) { return byte(r) & 1 ? NAN : number(r); }
 
 static tf_rt_friction obj[2];
 static tf_gms_elements gms;
@@ -108,8 +120,10 @@ static tf_rt_friction *pick(reader *r)
 
 static int same_law(const tf_law *a, const tf_law *b)
 {
+    const tf_load_term *s = &a->load, *t = &b->load;
     return SAME(a->kind, b->kind) && SAME(a->a, b->a) && SAME(a->b, b->b) && SAME(a->n, b->n) && a->x == b->x &&
-           a->y == b->y && a->d == b->d;
+           a->y == b->y && a->d == b->d && s->kind == t->kind && s->combine == t->combine && SAME(s->k, t->k) &&
+           SAME(s->saturation, t->saturation) && s->interaction == t->interaction && SAME(s->c, t->c);
 }
 
 /* The object as it was: states, model, laws, GMS elements and modes (not its status or cache). */
@@ -288,10 +302,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             check_object(f, status, NULL);
             break;
         case 6: { /* params_at */
-            double T = number(&r), lambda = -1.0, dF = -1.0;
+            double T = number(&r), Lo = load_of(&r), lambda = -1.0, dF = -1.0;
             uint8_t nulls = byte(&r);
             for (int i = 0; i < TF_NPARAM; i++) p[i] = -7.0;
-            status = tf_rt_params_at(f, T, NAN, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &lambda, nulls & 4 ? NULL : &dF,
+            status = tf_rt_params_at(f, T, Lo, nulls & 1 ? NULL : p, nulls & 2 ? NULL : &lambda, nulls & 4 ? NULL : &dF,
                                      &err);
             check_object(f, status, f ? &before : NULL);
             if (status != TF_OK && (p[0] != -7.0 || lambda != -1.0 || dF != -1.0)) FAIL("a refused params_at wrote");
@@ -300,12 +314,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         case 7: { /* a burst of steps at one temperature, one of them perhaps a bad sample */
             int k = 1 + byte(&r) % 32, bad = byte(&r) % 40;
             double v = number(&r), T = number(&r), dt = byte(&r) & 1 ? 1e-4 : number(&r), w = number(&r);
+            double Lo = load_of(&r);
             for (int i = 0; i < k; i++) {
                 double vi = i == bad ? number(&r) : v * sin(w * i);
                 if (f) before = *f;
                 int null_F = (byte(&r) & 1) && byte(&r) < 4; /* (the bytes of the former two variants) */
                 F = 0.0;
-                status = tf_rt_step(f, vi, T, NAN, dt, null_F ? NULL : &F, &err);
+                status = tf_rt_step(f, vi, T, Lo, dt, null_F ? NULL : &F, &err);
                 check_object(f, status, f ? &before : NULL);
                 if (status == TF_OK && !isfinite(F)) FAIL("step: TF_OK with a non-finite force");
                 if (!null_F && (status != TF_OK) != isnan(F)) FAIL("tf_rt_step: *F NaN not exactly on a refusal");
@@ -314,13 +329,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         case 8: { /* observer steps */
             int k = 1 + byte(&r) % 16;
-            double v = number(&r), e = number(&r), gain = number(&r), T = number(&r);
+            double v = number(&r), e = number(&r), gain = number(&r), T = number(&r), Lo = load_of(&r);
             double dt = byte(&r) & 1 ? 1e-4 : number(&r);
             for (int i = 0; i < k; i++) {
                 if (f) before = *f;
                 int null_F = (byte(&r) & 1) && byte(&r) < 4;
                 F = 0.0;
-                status = tf_observer_step(f, v, e * i, gain, T, NAN, dt, null_F ? NULL : &F, &err);
+                status = tf_observer_step(f, v, e * i, gain, T, Lo, dt, null_F ? NULL : &F, &err);
                 check_object(f, status, f ? &before : NULL);
                 if (status == TF_OK && !isfinite(F)) FAIL("observer: TF_OK with a non-finite force");
                 if (!null_F && (status != TF_OK) != isnan(F)) FAIL("tf_observer_step: *F NaN not exactly on a refusal");

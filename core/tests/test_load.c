@@ -55,8 +55,10 @@ static void test_load_term_values_partials_and_coefficients(void)
                 double v = tf_law_eval_load(&law, T, L, &dT, &dL), w = written_out(&law, T, L);
                 CHECK(fabs(v - w) <= 1e-15 * fabs(w), "term %zu at (%g, %g): %.17g vs %.17g", i, T, L, v, w);
                 double hT = 1e-3, hL = 1e-4 * fabs(L);
-                double fT = (tf_law_eval_load(&law, T + hT, L, 0, 0) - tf_law_eval_load(&law, T - hT, L, 0, 0)) / (2 * hT);
-                double fL = (tf_law_eval_load(&law, T, L + hL, 0, 0) - tf_law_eval_load(&law, T, L - hL, 0, 0)) / (2 * hL);
+                double fT = (tf_law_eval_load(&law, T + hT, L, 0, 0) - tf_law_eval_load(&law, T - hT, L, 0, 0)) /
+                            (2 * hT);
+                double fL = (tf_law_eval_load(&law, T, L + hL, 0, 0) - tf_law_eval_load(&law, T, L - hL, 0, 0)) /
+                            (2 * hL);
                 double scale = fabs(v) + 1e-12;
                 CHECK(fabs(dT - fT) <= 1e-8 * scale, "term %zu dT at (%g, %g): %g vs %g", i, T, L, dT, fT);
                 CHECK(fabs(dL - fL) <= 1e-7 * fabs(fL) + 1e-12 * scale, "term %zu dL at (%g, %g): %g vs %g", i, T,
@@ -64,14 +66,15 @@ static void test_load_term_values_partials_and_coefficients(void)
                 /* the coefficients in law.h's order: a, b, then k (affine), then c (interaction) */
                 for (int k = 0; k < nc; k++) {
                     tf_law up = law, dn = law;
-                    double *cu = k == 0 ? &up.a : k == 1 ? &up.b : (k == 2 && terms[i].kind == TF_LOAD_AFFINE) ? &up.load.k : &up.load.c;
-                    double *cd = k == 0 ? &dn.a : k == 1 ? &dn.b : (k == 2 && terms[i].kind == TF_LOAD_AFFINE) ? &dn.load.k : &dn.load.c;
+                    int is_k = k == 2 && terms[i].kind == TF_LOAD_AFFINE;
+                    double *cu = k == 0 ? &up.a : k == 1 ? &up.b : is_k ? &up.load.k : &up.load.c;
+                    double *cd = k == 0 ? &dn.a : k == 1 ? &dn.b : is_k ? &dn.load.k : &dn.load.c;
                     double h = 1e-6 * fmax(fabs(*cu), 1e-3);
                     *cu += h, *cd -= h;
                     double fd = (tf_law_eval_load(&up, T, L, 0, 0) - tf_law_eval_load(&dn, T, L, 0, 0)) / (2 * h);
                     double an = tf_law_coef_derivative(&law, k, T, L);
-                    CHECK(fabs(an - fd) <= 1e-7 * fabs(fd) + 1e-12 * scale, "term %zu coefficient %d at (%g, %g): %g vs %g",
-                          i, k, T, L, an, fd);
+                    CHECK(fabs(an - fd) <= 1e-7 * fabs(fd) + 1e-12 * scale,
+                          "term %zu coefficient %d at (%g, %g): %g vs %g", i, k, T, L, an, fd);
                 }
             }
     }

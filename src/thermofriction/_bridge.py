@@ -156,8 +156,11 @@ def model_spec(model, temperature=None, input=None, friction_work: bool = False,
         T_const = float(temperature)
     waveform = input if input is not None else model.input
     reads_load = laws is not None and any(law is not None and len(law) > 5 for law in laws)
-    load_wave = waveform_tuple(load) if reads_load and hasattr(load, "core_fields") else None
-    load_const = float(load) if reads_load and load is not None and load_wave is None else math.nan
+    load_wave, load_const = None, math.nan
+    if reads_load and hasattr(load, "core_fields"):  # a waveform (the core's zero kind is its constant's slot)
+        load_wave, load_const = (None, 0.0) if load.kind == "zero" else (waveform_tuple(load), math.nan)
+    elif reads_load and load is not None:
+        load_const = float(load)
     # the arrays (GMS's k and w) by their roles, the binding's keys ("gms_k", "gms_w")
     arrays = {a.role: np.array(getattr(friction, n), float) for n, a in friction.description.arrays.items()}
     return {

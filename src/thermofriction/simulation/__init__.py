@@ -280,8 +280,8 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     ------
     InputError
         An argument of the wrong type or out of range, named (``duration must be a number [s], ...``); no
-        temperature for a thermal model; no load for a model with a law of the load, naming the law; a temperature signal for a model with a heat model; an output grid
-        over ``max_samples``.
+        temperature for a thermal model; no load for a model with a law of the load, naming the law; a
+        temperature signal for a model with a heat model; an output grid over ``max_samples``.
     SolverError
         The integrator stopped (too many steps, a non-finite state): its ``time`` and ``state`` say where.
 
@@ -361,7 +361,7 @@ def simulate(model: Model, duration: float | None = None, *, temperature=None, i
     except _bridge.CoreFailure as e:
         raise _explain(e, model, solver, controller, waveform, state_names) from None
     stats["solver"] = stats.pop("method")
-    res = _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period)
+    res = _pack(model, out, grid, stats, temperature, heat, friction_work, waveform.period, load)
     emit(res.findings)  # self-heating's, known after the run
     res.findings[:0] = found
     return res
@@ -377,7 +377,7 @@ def _uniform_grid(duration, sample_rate, period, max_samples) -> _Grid:
     return grid
 
 
-def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> SimulationResult:
+def _pack(model, out, grid, stats, temperature, heat, friction_work, period, load=None) -> SimulationResult:
     """The output array as a result: refuses non-finite outputs, reads the step sizes at the period
     starts, removes the joined rows, names the columns."""
     # the C core keeps the states finite; an output computed from finite but extreme values
@@ -404,7 +404,7 @@ def _pack(model, out, grid, stats, temperature, heat, friction_work, period) -> 
         cols["stage_displacement"] = cols["stage_velocity"] = None
     if temperature is None and heat is None:
         cols["temperature"][:] = math.nan
-    found = heated_findings(model, cols["time"], cols["temperature"]) if heat is not None and \
+    found = heated_findings(model, cols["time"], cols["temperature"], load) if heat is not None and \
         model.thermal is not None else []
     nfric = model.friction.nstate
     return SimulationResult(

@@ -13,7 +13,9 @@ from ..errors import ConditioningWarning, InputError, PassivityWarning, SolverEr
 from ..models import Model, ModelI, ModelII, check_friction_values, dissipativity_violation
 from ..plausible import check_temperature
 from ..results import Finding, emit
+from ..models.load_laws import load_laws
 from ..waveforms import Sampled, Sawtooth, Step, Waveform, Zero
+from .loads import load_findings
 
 
 def as_temperature(temperature):
@@ -292,7 +294,7 @@ def _check_temperatures(model: Model, temperature, found: list):
                                  f"rtol <= 1e-8, or the scale form"))
 
 
-def heated_findings(model: Model, time, temperature) -> list:
+def heated_findings(model: Model, time, temperature, load=None) -> list:
     """With self-heating the temperature range is known only after the run: findings where it left a
     law's calibrated range; refuses a run that crossed a temperature where the model is invalid.
 
@@ -304,11 +306,13 @@ def heated_findings(model: Model, time, temperature) -> list:
         The run's output times [s].
     temperature : numpy.ndarray
         The run's temperature [C] at those times.
+    load : float or Waveform, optional
+        The run's load, for a model with a law of the load (simulation/loads.py: load_findings).
 
     Returns
     -------
     list of Finding
-        As :func:`temperature_findings` over the range the run visited.
+        As :func:`temperature_findings` (``load_findings``) over the range the run visited.
 
     Raises
     ------
@@ -318,6 +322,8 @@ def heated_findings(model: Model, time, temperature) -> list:
     """
     lo, hi = float(np.min(temperature)), float(np.max(temperature))
     try:
+        if load_laws(model):
+            return load_findings(model, [lo, hi], load)
         return temperature_findings(model, Sampled(np.array([0.0, 1.0]), np.array([lo, hi])) if hi > lo else lo)
     except InputError as e:
         raise SolverError(f"self-heating took the temperature to {lo:.4g}..{hi:.4g} C, where the model is "

@@ -90,7 +90,7 @@ def load_findings(model, temperatures, load) -> list:
     model : Model
         A model holding laws of the load.
     temperatures : sequence of float
-        The lowest and highest temperatures [C] of the run (or the one).
+        The temperatures [C] of the run (the one; or its samples, whose range is checked on a grid of 65).
     load : float or Waveform or None
         The load.
 
@@ -112,6 +112,8 @@ def load_findings(model, temperatures, load) -> list:
                          f"(times, values))")
     lo, hi = load_magnitudes(load)
     Ts = np.unique(np.asarray(temperatures, float))
+    if Ts.size > 2:  # a temperature signal: its range on a grid (as the core's check: model_check.c), not each sample
+        Ts = np.unique(np.concatenate([[Ts[0], Ts[-1]], np.linspace(Ts[0], Ts[-1], 65)]))
     found = []
     outside_T = [f"'{n}' ({law.range[0]:g}..{law.range[1]:g} C)" for n, law in model.laws.items()
                  if not law.in_range(Ts)]
