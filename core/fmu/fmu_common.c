@@ -57,6 +57,7 @@ enum {
     VR_MEASURED_FORCE = 9,       /* inputs: the measured friction force [N] (NaN: none) */
     VR_PROXY_TEMPERATURE = 10,   /* the proxy temperature [degC] (NaN: none), with a proxy */
     VR_AMBIENT = 11,             /* the ambient temperature [degC], without a heat model (with one: VR_TEMPERATURE) */
+    VR_LOAD = 12,                /* input: the load [N or N m] a law of the load reads, with a "load_input" line */
     VR_FIRST_PARAMETER = 16
 };
 
@@ -64,12 +65,13 @@ enum {
 typedef enum {
     ROLE_NONE = 0, ROLE_M, ROLE_M_E, ROLE_C, ROLE_K, ROLE_T_EM, ROLE_XI, ROLE_WN, ROLE_GAIN, ROLE_K_S, ROLE_V_0,
     ROLE_PARAM, ROLE_LAW_A, ROLE_LAW_B, ROLE_LAW_X, ROLE_LAW_Y, ROLE_GMS_K, ROLE_GMS_W,
-    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0, ROLE_STEP, ROLE_ESTIMATOR
+    ROLE_C_TH, ROLE_R_TH, ROLE_ETA, ROLE_T_0, ROLE_STEP, ROLE_ESTIMATOR, ROLE_LOAD_K, ROLE_LOAD_S, ROLE_LOAD_C
 } role_kind;
 
 static const char *const ROLE_NAMES[] = {"", "m", "m_e", "c", "k", "T_em", "xi", "wn", "K", "k_s", "v_0",
                                          "p", "law_a", "law_b", "law_x", "law_y", "gms_k", "gms_w",
-                                         "C_th", "R_th", "eta", "T_0", "step", "estimator"};
+                                         "C_th", "R_th", "eta", "T_0", "step", "estimator",
+                                         "load_k", "load_sat", "load_c"};
 
 /* The estimator's parameters (role "estimator", index i): tf_temperature_config's numbers, then its start. */
 enum { EST_C_TH, EST_R_TH, EST_ETA, EST_C_2, EST_R_2, EST_TAU_P, EST_Q_CONTACT, EST_Q_HOUSING, EST_Q_PROXY, EST_R_F,
@@ -83,6 +85,7 @@ typedef struct {
 typedef struct {
     int kind, n;
     double x[MAX_POINTS], y[MAX_POINTS], d[MAX_POINTS];
+    tf_load_term load; /* the law's load term ("load_law" line; k, saturation and c from their parameters) */
 } law_store;
 
 struct fmu_instance {
@@ -97,6 +100,8 @@ struct fmu_instance {
     /* structure (resources) */
     int plant, modal, friction, n_gms, thermal, df_form, fs_follows_fc, heat, temperature_input;
     double range_lo, range_hi; /* the laws' calibrated range; NaN: none */
+    int load_input;          /* the model reads the load: the input VR_LOAD */
+    double load_lo, load_hi; /* the calibrated range of |load| (the load terms' ranges in common); NaN: none */
     tf_waveform p_ext;
     law_store law[NLAW];
     role_t role[MAX_VR];
@@ -105,7 +110,7 @@ struct fmu_instance {
 
     /* values: parameters and inputs by value reference, their start values for fmi2Reset */
     double r[MAX_VR], r_start[MAX_VR];
-    double du, dT;           /* input derivatives for the next step (0: held) */
+    double du, dT, dL;       /* input derivatives for the next step (0: held) */
     int du_set;              /* du given for the next step */
     double u_prev;           /* prescribed motion: where the last step left the motion */
     double last_du;          /* prescribed motion: its slope over the last step (the velocity reported after it) */
@@ -113,11 +118,12 @@ struct fmu_instance {
     /* the model, its run's data (plant.h: the parameter cache and the GMS modes, which are state) and its state */
     tf_model model;
     tf_model_data data;
-    double wave_t[2], wave_v[2], temp_t[2], temp_v[2];
+    double wave_t[2], wave_v[2], temp_t[2], temp_v[2], load_t[2], load_v[2];
     double t, y[TF_MAX_STATES];
     double rtol;
     double fixed_step;       /* > 0: the fixed-step real-time integrator at this step [s]; 0: adaptive */
     int out_of_range;        /* the last temperature was outside the range (warn once per excursion) */
+    int load_out_of_range;   /* the last load was outside its range (the same) */
 
     /* the temperature estimator: on with an "estimator" line (its proxy kind), stepped once per communication
        step after the plant, on its own real-time friction object (the model's friction at the estimate) */
@@ -250,7 +256,7 @@ static int read_resources(instance *c, const char *dir, int is_uri)
     if (!f) return (fmu_fail(c, "cannot open %s (the FMU's model description)", path), -1);
     char line[1024];
     int lineno = 0, ok = 1, have_header = 0;
-    c->range_lo = c->range_hi = NAN;
+    c->range_lo = c->range_hi = c->load_lo = c->load_hi = NAN;
     while (ok && fgets(line, sizeof line, f)) {
         lineno++;
         char key[32];
@@ -284,6 +290,17 @@ static int read_resources(instance *c, const char *dir, int is_uri)
             int i, kind, n;
             ok = sscanf(rest, "%d %d %d", &i, &kind, &n) == 3 && i >= 0 && i < NLAW && n >= 0 && n <= MAX_POINTS;
             if (ok) c->law[i].kind = kind, c->law[i].n = n;
+        } else if (strcmp(key, "load_law") == 0) { /* index kind combine interaction (law.h: tf_load_term) */
+            int i, kind, combine, interaction;
+            ok = sscanf(rest, "%d %d %d %d", &i, &kind, &combine, &interaction) == 4 && i >= 0 && i < TF_NPARAM &&
+                 kind >= TF_LOAD_PROPORTIONAL && kind <= TF_LOAD_AFFINE;
+            if (ok) c->law[i].load.kind = kind, c->law[i].load.combine = combine, c->law[i].load.interaction = interaction;
+        } else if (strcmp(key, "load_input") == 0) { /* the load input's start value [N or N m] */
+            ok = sscanf(rest, "%lf", &c->r_start[VR_LOAD]) == 1 && isfinite(c->r_start[VR_LOAD]);
+            c->load_input = ok;
+            c->r[VR_LOAD] = c->r_start[VR_LOAD];
+        } else if (strcmp(key, "load_range") == 0) {
+            ok = sscanf(rest, "%lf %lf", &c->load_lo, &c->load_hi) == 2;
         } else if (strcmp(key, "var") == 0) { /* vr role i j fixed start */
             unsigned vr;
             char rname[16];
@@ -373,6 +390,9 @@ static int build_model(instance *c, tf_model *m)
             c->fixed_step = v;
             break;
         case ROLE_ESTIMATOR: if (r.i >= 0 && r.i < EST_NPARAM) c->est_p[r.i] = v; break;
+        case ROLE_LOAD_K: if (r.i >= 0 && r.i < TF_NPARAM) c->law[r.i].load.k = v; break;
+        case ROLE_LOAD_S: if (r.i >= 0 && r.i < TF_NPARAM) c->law[r.i].load.saturation = v; break;
+        case ROLE_LOAD_C: if (r.i >= 0 && r.i < TF_NPARAM) c->law[r.i].load.c = v; break;
         default: break;
         }
         if (r.role && !isfinite(v)) return (fmu_fail(c, "parameter (value reference %d) is not finite", vr), -1);
@@ -388,6 +408,7 @@ static int build_model(instance *c, tf_model *m)
         tf_law *law = i < TF_NPARAM ? &m->law[i] : &m->dF;
         if (s->kind == TF_LAW_NONE) continue;
         law->kind = s->kind;
+        if (i < TF_NPARAM) law->load = s->load;
         if (s->kind == TF_LAW_CONST || s->kind == TF_LAW_LINEAR || s->kind == TF_LAW_EXP) {
             law->a = s->x[0];
             law->b = s->y[0];
@@ -412,6 +433,7 @@ static int build_model(instance *c, tf_model *m)
     m->input.n = 2;
     m->input.t = c->wave_t;
     m->input.v = c->wave_v;
+    m->load_const = c->load_input ? c->r[VR_LOAD] : NAN;
     return 0;
 }
 
@@ -442,9 +464,9 @@ static void set_signals(instance *c, tf_model *m, double t, double h)
         du = h > 0 ? (u - c->u_prev) / h : 0.0;
         u = c->u_prev;
     }
-    double dT = c->dT;
+    double dT = c->dT, dL = c->dL;
     if (!(h > 0)) { /* at a communication point: the values at t; a prescribed motion's velocity that of the last step */
-        h = 1.0, dT = 0.0;
+        h = 1.0, dT = dL = 0.0;
         du = c->plant == TF_PLANT_PRESCRIBED ? c->last_du : 0.0;
         u = c->plant == TF_PLANT_PRESCRIBED ? c->u_prev : c->r[VR_DRIVE];
         c->wave_t[0] = t - h, c->wave_t[1] = t + h; /* a segment through (t, u) with slope du */
@@ -469,13 +491,25 @@ temperature:
     } else {
         m->T_const = NAN;
     }
+    if (c->load_input) { /* as the temperature input: a line from its value at t along its derivative */
+        c->load_t[0] = t, c->load_t[1] = t + h;
+        c->load_v[0] = c->r[VR_LOAD], c->load_v[1] = c->r[VR_LOAD] + dL * h;
+        memset(&m->load, 0, sizeof m->load);
+        m->load.kind = TF_WAVE_SAMPLED;
+        m->load.n = 2;
+        m->load.t = c->load_t;
+        m->load.v = c->load_v;
+    }
 }
 
 static int check_model(instance *c, const tf_model *m)
 {
     tf_error e;
     if (tf_model_check(m, &e) == TF_OK) return 0;
-    if (c->temperature_input || c->heat)
+    if (c->load_input)
+        fmu_fail(c, "at time %g s, temperature %g C, load %g: the model is outside its domain ('%s')", c->t,
+                 c->r[VR_TEMPERATURE], c->r[VR_LOAD], e.what);
+    else if (c->temperature_input || c->heat)
         fmu_fail(c, "at time %g s, temperature %g C: the model is outside its domain ('%s')", c->t,
              c->r[VR_TEMPERATURE], e.what);
     else
@@ -495,6 +529,23 @@ static fmu_status check_range(instance *c, double T)
         s = FMU_WARNING;
     }
     c->out_of_range = out;
+    return s;
+}
+
+/* FMU_WARNING (logged) when the load's magnitude leaves the load terms' calibrated range, once per excursion
+ * (the range's tolerance: models/load_laws.py, LOAD_RANGE_TOLERANCE of its span). */
+static fmu_status check_load_range(instance *c, double L)
+{
+    if (!c->load_input || isnan(c->load_lo)) return FMU_OK;
+    double tol = 0.02 * (c->load_hi - c->load_lo), a = fabs(L);
+    int out = !(a >= c->load_lo - tol && a <= c->load_hi + tol);
+    fmu_status s = FMU_OK;
+    if (out && !c->load_out_of_range) {
+        warn(c, "at time %g s the load %g is outside the load laws' calibrated range of |load| [%g, %g]: extrapolated",
+             c->t, L, c->load_lo, c->load_hi);
+        s = FMU_WARNING;
+    }
+    c->load_out_of_range = out;
     return s;
 }
 
@@ -669,6 +720,8 @@ fmu_status fmu_exit_initialization(fmu_instance *c)
     if ((c->temperature_input || c->heat) && !plausible_temperature(c->r[VR_TEMPERATURE]))
         return fmu_fail(c, "the temperature at the start %g C is not a plausible temperature (expected %g to %g C)",
                     c->r[VR_TEMPERATURE], T_MIN, T_MAX);
+    if (c->load_input && !isfinite(c->r[VR_LOAD]))
+        return fmu_fail(c, "the load input at the start is not finite (%g)", c->r[VR_LOAD]);
     if (rebuild(c) != 0) return FMU_ERROR;
     c->u_prev = c->r[VR_DRIVE];
     set_signals(c, &c->model, c->t, 0.0);
@@ -677,8 +730,12 @@ fmu_status fmu_exit_initialization(fmu_instance *c)
     tf_model_on_restart(c->t, c->y, &c->data); /* GMS modes consistent with the start */
     if (est_start(c) != 0) return FMU_ERROR;
     c->mode = S_STEP;
-    if (c->temperature_input || c->heat) return check_range(c, output(c, VR_TEMPERATURE_OUT));
-    return FMU_OK;
+    fmu_status status = check_load_range(c, c->r[VR_LOAD]);
+    if (c->temperature_input || c->heat) {
+        fmu_status r = check_range(c, output(c, VR_TEMPERATURE_OUT));
+        if (r > status) status = r;
+    }
+    return status;
 }
 
 fmu_status fmu_terminate(fmu_instance *c)
@@ -692,10 +749,10 @@ fmu_status fmu_reset(fmu_instance *c)
 {
     if (!c) return FMU_ERROR;
     memcpy(c->r, c->r_start, sizeof c->r);
-    c->du = c->dT = 0;
+    c->du = c->dT = c->dL = 0;
     c->du_set = 0;
     c->t = 0;
-    c->out_of_range = 0;
+    c->out_of_range = c->load_out_of_range = 0;
     c->stop_defined = 0, c->stop = 0.0; /* as instantiated: no experiment yet */
     memset(c->y, 0, sizeof c->y);
     memset(c->data.gms.mode, 0, sizeof c->data.gms.mode);
@@ -721,6 +778,7 @@ static int declared(const instance *c, fmu_vr vr)
     case VR_TEMPERATURE_ESTIMATE: case VR_TEMPERATURE_VARIANCE: case VR_MEASURED_FORCE: return c->estimator;
     case VR_PROXY_TEMPERATURE: return c->estimator && c->est_proxy != TF_PROXY_NONE;
     case VR_AMBIENT: return c->estimator && !c->heat;
+    case VR_LOAD: return c->load_input;
     default: return vr >= VR_FIRST_PARAMETER && vr < MAX_VR && c->role[vr].role != ROLE_NONE;
     }
 }
@@ -757,6 +815,7 @@ fmu_status fmu_set_real(fmu_instance *c, const fmu_vr vr[], size_t n, const doub
             memcpy(c->r, before, sizeof before);
             return fmu_fail(c, "fmi2SetReal: %s (value reference %u) is not finite (%g): refused",
                          v == VR_DRIVE ? "the drive input" : v == VR_TEMPERATURE ? "the temperature input"
+                         : v == VR_LOAD ? "the load input"
                          : measurement ? "a measurement input (NaN: none)" : v == VR_AMBIENT ? "the ambient temperature"
                                        : "a parameter", v, value[k]);
         }
@@ -782,6 +841,7 @@ fmu_status fmu_set_real(fmu_instance *c, const fmu_vr vr[], size_t n, const doub
         }
         if (v == VR_DRIVE) c->du_set = 0, c->du = 0.0; /* a new value without a derivative is held */
         if (v == VR_TEMPERATURE) c->dT = 0.0;
+        if (v == VR_LOAD) c->dL = 0.0;
         c->r[v] = value[k];
     }
     if (changed && c->mode == S_STEP) { /* a tunable parameter: the model must stay valid */
@@ -807,16 +867,17 @@ fmu_status fmu_set_input_derivatives(fmu_instance *c, const fmu_vr vr[], size_t 
     if (n > 0 && (!vr || !order || !value)) return fmu_fail(c, "fmi2SetRealInputDerivatives: NULL argument");
     if (c->mode == S_TERMINATED)
         return fmu_fail(c, "fmi2SetRealInputDerivatives: the instance is terminated");
-    double du = c->du, dT = c->dT; /* a refusal changes nothing */
+    double du = c->du, dT = c->dT, dL = c->dL; /* a refusal changes nothing */
     int du_set = c->du_set;
     for (size_t k = 0; k < n; k++) {
         if (order[k] != 1) return fmu_fail(c, "fmi2SetRealInputDerivatives: only first derivatives (order 1)");
         if (!isfinite(value[k])) return fmu_fail(c, "fmi2SetRealInputDerivatives: derivative is not finite (%g)", value[k]);
         if (vr[k] == VR_DRIVE) du = value[k], du_set = 1;
         else if (vr[k] == VR_TEMPERATURE && c->temperature_input) dT = value[k];
+        else if (vr[k] == VR_LOAD && c->load_input) dL = value[k];
         else return fmu_fail(c, "fmi2SetRealInputDerivatives: value reference %u is no continuous input", vr[k]);
     }
-    c->du = du, c->dT = dT, c->du_set = du_set;
+    c->du = du, c->dT = dT, c->dL = dL, c->du_set = du_set;
     return FMU_OK;
 }
 
@@ -902,6 +963,9 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
     if (!isfinite(c->r[VR_DRIVE]) || !isfinite(c->r[VR_TEMPERATURE]))
         return fmu_fail(c, "at time %g s the inputs are not finite (drive %g, temperature %g)", t, c->r[VR_DRIVE],
                      c->r[VR_TEMPERATURE]);
+    if (c->load_input && !(isfinite(c->r[VR_LOAD]) && isfinite(c->r[VR_LOAD] + c->dL * h)))
+        return fmu_fail(c, "at time %g s the load input is not finite over the step (%g, derivative %g)", t,
+                        c->r[VR_LOAD], c->dL);
     if (!(fabs(t + h) <= TIME_LIMIT))
         return fmu_fail(c, "fmi2DoStep: the step ends at %g s, beyond +-%g s (the integrator's time limit)", t + h,
                     TIME_LIMIT);
@@ -917,6 +981,11 @@ fmu_status fmu_do_step(fmu_instance *c, double t, double h, int no_prior)
         status = check_range(c, c->r[VR_TEMPERATURE]);
         double T1 = c->r[VR_TEMPERATURE] + c->dT * h;
         if (status == FMU_OK && c->dT != 0.0) status = check_range(c, T1);
+    }
+    if (c->load_input) {
+        fmu_status r = check_load_range(c, c->r[VR_LOAD]);
+        if (r == FMU_OK && c->dL != 0.0) r = check_load_range(c, c->r[VR_LOAD] + c->dL * h);
+        if (r > status) status = r;
     }
     set_signals(c, &c->model, c->t, h);
     if (check_model(c, &c->model) != 0) return FMU_ERROR;
@@ -964,22 +1033,23 @@ static fmu_status step_done(instance *c, double h, const double *y, int n, fmu_s
     double y_before[TF_MAX_STATES];
     memcpy(y_before, c->y, sizeof(double) * n);
     double t = c->t, u_prev = c->u_prev, last_du = c->last_du, drive = c->r[VR_DRIVE], T = c->r[VR_TEMPERATURE];
-    double du = c->du, dT = c->dT;
+    double du = c->du, dT = c->dT, L = c->r[VR_LOAD], dL = c->dL;
     int du_set = c->du_set;
     memcpy(c->y, y, sizeof(double) * n);
     c->t += h;
     c->u_prev = c->wave_v[1];
     c->last_du = (c->wave_v[1] - c->wave_v[0]) / h;
     if (c->temperature_input && !c->heat) c->r[VR_TEMPERATURE] += c->dT * h;
+    if (c->load_input) c->r[VR_LOAD] += c->dL * h;
     if (c->du_set || c->plant != TF_PLANT_PRESCRIBED) c->r[VR_DRIVE] = c->wave_v[1];
-    c->du = c->dT = 0.0; /* derivatives hold for one step */
+    c->du = c->dT = c->dL = 0.0; /* derivatives hold for one step */
     c->du_set = 0;
     for (int vr = VR_DISPLACEMENT; vr <= VR_STAGE_DISPLACEMENT; vr++) {
         double v = declared(c, (fmu_vr)vr) ? output(c, vr) : 0.0;
         if (isfinite(v)) continue;
         memcpy(c->y, y_before, sizeof(double) * n);
         c->t = t, c->u_prev = u_prev, c->last_du = last_du, c->r[VR_DRIVE] = drive, c->r[VR_TEMPERATURE] = T;
-        c->du = du, c->dT = dT, c->du_set = du_set;
+        c->du = du, c->dT = dT, c->du_set = du_set, c->r[VR_LOAD] = L, c->dL = dL;
         c->data.gms = *modes;
         return fmu_fail(c, "the step from %g s over %g s gives a non-finite output (value reference %d: %g)", t, h,
                         vr, v);

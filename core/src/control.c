@@ -113,47 +113,49 @@ static tf_status stop_in(tf_error *err, tf_status status, const char *where, lon
     return status;
 }
 
-/* A per-period series: every sample finite and, where it changes, the model valid there (f not NULL). */
-static tf_status series_check(tf_rt_friction *f, const double *T, double load, long n, const char *where,
-                              const char *what, tf_error *err)
+/* Two inputs differ (two NaNs do not: a model without a law of the load reads none). */
+static int differ(double a, double b) { return a != b && !(isnan(a) && isnan(b)); }
+
+/* A part's per-period inputs, the temperature and the load: each a series (every sample finite; NULL: the
+ * constant) and, where the pair changes, the model valid there (f not NULL). */
+static tf_status inputs_check(tf_rt_friction *f, const double *Ts, double T, const double *Ls, double L, long n,
+                              const char *where, const char *T_what, const char *L_what, tf_error *err)
 {
-    for (long i = 0; i < n; i++) {
-        if (!isfinite(T[i])) return stop(err, TF_ERR_BAD_ARGUMENT, where, what, i);
-        if (f && (i == 0 || T[i] != T[i - 1]) && tf_rt_params_at(f, T[i], load, 0, 0, 0, err))
-            return stop_in(err, TF_ERR_BAD_ARGUMENT, where, i);
+    long periods = Ts || Ls ? n : 1;
+    for (long i = 0; i < periods; i++) {
+        double Ti = Ts ? Ts[i] : T, Li = Ls ? Ls[i] : L;
+        if (Ts && !isfinite(Ti)) return stop(err, TF_ERR_BAD_ARGUMENT, where, T_what, i);
+        if (Ls && !isfinite(Li)) return stop(err, TF_ERR_BAD_ARGUMENT, where, L_what, i);
+        if (f && (i == 0 || differ(Ti, Ts ? Ts[i - 1] : T) || differ(Li, Ls ? Ls[i - 1] : L)) &&
+            tf_rt_params_at(f, Ti, Li, 0, 0, 0, err))
+            return stop_in(err, TF_ERR_BAD_ARGUMENT, where, Ts || Ls ? i : -1);
     }
     return TF_OK;
 }
 
-/* The temperatures' inputs: the series, the estimator's (its own checks are per step), the noise. */
+/* The temperatures' and loads' inputs: the series, the estimator's (its own checks are per step), the noise. */
 static tf_status temperature_check(tf_loop *L, long n, tf_error *err)
 {
     const int B = TF_ERR_BAD_ARGUMENT;
     tf_rt_friction *comp = L->compensation != TF_COMP_NONE ? L->comp : 0;
     tf_status status;
-    if (L->T_plant_series) {
-        if ((status = series_check(L->plant, L->T_plant_series, L->load_plant, n, "plant",
-                                   "T_plant_series (not finite)", err)))
-            return status;
-    } else if (tf_rt_params_at(L->plant, L->T_plant, L->load_plant, 0, 0, 0, err))
-        return stop_in(err, B, "plant", -1);
-    if (L->position_noise &&
-        (status = series_check(0, L->position_noise, NAN, n, "loop", "position_noise (not finite)", err)))
+    if ((status = inputs_check(L->plant, L->T_plant_series, L->T_plant, L->load_plant_series, L->load_plant, n,
+                               "plant", "T_plant_series (not finite)", "load_plant_series (not finite)", err)))
         return status;
+    for (long i = 0; L->position_noise && i < n; i++)
+        if (!isfinite(L->position_noise[i])) return stop(err, B, "loop", "position_noise (not finite)", i);
     if (!(isfinite(L->dob_tau) && L->dob_tau >= 0.0)) return stop(err, B, "loop", "dob_tau (finite, >= 0)", -1);
     if (L->estimator) {
         if (!L->est_friction) return stop(err, B, "estimator", "est_friction (NULL)", -1);
         if (!isfinite(L->T_amb)) return stop(err, B, "estimator", "T_amb (not finite)", -1);
         for (long i = 0; L->T_proxy && i < n; i++) /* NaN: not measured in that period */
             if (isinf(L->T_proxy[i])) return stop(err, B, "estimator", "T_proxy (infinite)", i);
+        for (long i = 0; L->load_comp_series && i < n; i++)
+            if (!isfinite(L->load_comp_series[i])) return stop(err, B, "compensation", "load_comp_series (not finite)", i);
         return TF_OK;
     }
-    if (L->T_comp_series)
-        return series_check(comp, L->T_comp_series, L->load_comp, n, "compensation", "T_comp_series (not finite)",
-                            err);
-    if (comp && tf_rt_params_at(comp, L->T_comp, L->load_comp, 0, 0, 0, err))
-        return stop_in(err, B, "compensation", -1);
-    return TF_OK;
+    return inputs_check(comp, L->T_comp_series, L->T_comp, L->load_comp_series, L->load_comp, n, "compensation",
+                        "T_comp_series (not finite)", "load_comp_series (not finite)", err);
 }
 
 /* Everything tf_loop_run can refuse before it starts, so that a refusal writes nothing. */
@@ -243,13 +245,15 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
     for (long i = 0; i < n; i++) {
         double e = x_ref[i] - x, u, Fc = 0.0, Tc, var, Fm;
         double T_plant = L->T_plant_series ? L->T_plant_series[i] : L->T_plant;
+        double L_plant = L->load_plant_series ? L->load_plant_series[i] : L->load_plant;
+        double L_comp = L->load_comp_series ? L->load_comp_series[i] : L->load_comp;
         if ((status = told_temperature(L, i, x, &d, &Tc, &var, &Fm, err))) return status;
         if ((status = tf_pid_step(&L->pid, e, L->dt, &u, 0)))
             return stop(err, status, "pid", "u (not finite: the loop is unstable)", i);
         if (L->compensation == TF_COMP_FEEDFORWARD)
-            status = tf_rt_step(L->comp, v_ref[i], Tc, L->load_comp, L->dt, &Fc, err);
+            status = tf_rt_step(L->comp, v_ref[i], Tc, L_comp, L->dt, &Fc, err);
         else if (L->compensation == TF_COMP_OBSERVER)
-            status = tf_observer_step(L->comp, v, -e, L->observer_gain, Tc, L->load_comp, L->dt, &Fc, err);
+            status = tf_observer_step(L->comp, v, -e, L->observer_gain, Tc, L_comp, L->dt, &Fc, err);
         if (status) return stop_in(err, status, "compensation", i);
         u += Fc;
         if (L->inertia_feedforward && i + 1 < n) u += L->mass * (v_ref[i + 1] - v_ref[i]) / L->dt;
@@ -260,7 +264,7 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
         double F_sum = 0.0;
         for (int s = 0; s < L->substeps; s++) {
             double F;
-            if ((status = tf_rt_step(L->plant, v, T_plant, L->load_plant, h, &F, err)))
+            if ((status = tf_rt_step(L->plant, v, T_plant, L_plant, h, &F, err)))
                 return stop_in(err, status, "plant", i);
             v += (u - F) / L->mass * h;
             x += v * h;

@@ -300,17 +300,20 @@ def target(kind: str, index: int = 0, coefficient: int = 0) -> tuple:
 
 
 def loop(plant_spec, T_plant, comp_spec, T_comp, compensation: str, gain, mass, pid, dt, substeps, x_ref, v_ref,
-         outputs, *, T_plant_series=None, T_comp_series=None, estimator=None, inertia_feedforward=False) -> str:
+         outputs, *, T_plant_series=None, T_comp_series=None, estimator=None, inertia_feedforward=False,
+         load_plant=math.nan, load_comp=math.nan, load_plant_series=None, load_comp_series=None) -> str:
     """The fixed-step closed loop of control.h; returns its status name. ``outputs``: seven arrays of one
     value per period or None (x, u, F_comp, then the trace: F_plant, T_comp, T_variance, F_measured; the
     first three required). ``estimator``: None or (est_spec, config, T0, var0, T_amb, T_proxy, position_noise,
     dob_tau), config the tuple of ``temperature_estimate``. ``inertia_feedforward``: the control adds
     m (v_ref[i+1] - v_ref[i]) / dt. ``substeps`` beyond any C integer is passed as
-    2**31, which the core refuses as it does any n x substeps above TF_LOOP_MAX_SUBSTEPS."""
+    2**31, which the core refuses as it does any n x substeps above TF_LOOP_MAX_SUBSTEPS. The loads: a number
+    each (NaN: none) or, where the series is given, one per period."""
     status = _core.loop(plant_spec, float(T_plant), T_plant_series, comp_spec, float(T_comp), T_comp_series,
                         COMPENSATION_CODES[compensation], float(gain), float(mass), tuple(float(g) for g in pid),
                         float(dt), min(int(substeps), 2**31), x_ref, v_ref, estimator, tuple(outputs),
-                        bool(inertia_feedforward))
+                        bool(inertia_feedforward), float(load_plant), float(load_comp), load_plant_series,
+                        load_comp_series)
     return STATUS_NAMES.get(status, f"status {status}")
 
 

@@ -680,21 +680,23 @@ static int loop_estimator(arena *a, PyObject *obj, Py_ssize_t n, tf_loop *L, tf_
 
 /* loop(plant_spec, T_plant, T_plant_series|None, comp_spec|None, T_comp, T_comp_series|None, compensation,
  *      observer_gain, mass, (kp, ki, kd, tau_d), dt, substeps, x_ref, v_ref, estimator|None,
- *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured), inertia_feedforward[, load_plant, load_comp]):
- *      the closed loop of control.h; the outputs are float64 arrays of n values (the last four may be None);
- *      the loads NaN (none) when not given. */
+ *      (x, u, F_comp, F_plant, T_comp, T_variance, F_measured), inertia_feedforward[, load_plant, load_comp,
+ *      load_plant_series|None, load_comp_series|None]): the closed loop of control.h; the outputs are float64
+ *      arrays of n values (the last four may be None); the loads NaN (none) when not given. */
 static PyObject *py_loop(PyObject *self, PyObject *args)
 {
     PyObject *plant_spec, *comp_spec, *xr_obj, *vr_obj, *Tp_obj, *Tc_obj, *est_obj, *outs[7];
+    PyObject *Lp_obj = Py_None, *Lc_obj = Py_None;
     tf_loop L;
     memset(&L, 0, sizeof L);
     L.load_plant = L.load_comp = NAN;
     double kp, ki, kd, tau_d;
     long substeps_in;
-    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)p|dd", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
+    if (!PyArg_ParseTuple(args, "OdOOdOidd(dddd)dlOOO(OOOOOOO)p|ddOO", &plant_spec, &L.T_plant, &Tp_obj, &comp_spec,
                           &L.T_comp, &Tc_obj, &L.compensation, &L.observer_gain, &L.mass, &kp, &ki, &kd, &tau_d, &L.dt,
                           &substeps_in, &xr_obj, &vr_obj, &est_obj, &outs[0], &outs[1], &outs[2], &outs[3], &outs[4],
-                          &outs[5], &outs[6], &L.inertia_feedforward, &L.load_plant, &L.load_comp))
+                          &outs[5], &outs[6], &L.inertia_feedforward, &L.load_plant, &L.load_comp, &Lp_obj,
+                          &Lc_obj))
         return NULL;
     if (substeps_in > TF_LOOP_MAX_SUBSTEPS) { /* beyond an int: the core's own bound, in its words */
         PyErr_SetString(PyExc_ValueError, "loop: n x substeps (at most 1e8 plant substeps in one run)");
@@ -724,6 +726,8 @@ static PyObject *py_loop(PyObject *self, PyObject *args)
     L.trace = (tf_loop_trace){out[3], out[4], out[5], out[6]};
     if (!(L.T_plant_series = loop_series(&a, Tp_obj, n, "T_plant_series")) && PyErr_Occurred()) goto done;
     if (!(L.T_comp_series = loop_series(&a, Tc_obj, n, "T_comp_series")) && PyErr_Occurred()) goto done;
+    if (!(L.load_plant_series = loop_series(&a, Lp_obj, n, "load_plant_series")) && PyErr_Occurred()) goto done;
+    if (!(L.load_comp_series = loop_series(&a, Lc_obj, n, "load_comp_series")) && PyErr_Occurred()) goto done;
     if (est_obj != Py_None && loop_estimator(&c, est_obj, n, &L, &est, &rt[2])) goto done;
     tf_error e;
     int plant_bad = 0;

@@ -1,5 +1,5 @@
 """The parts of a position control loop with friction compensation (control.h): the PID, the two
-compensations and what each is told about the temperature, and the friction measurement an online
+compensations and what each is told about the temperature and the load, and the friction measurement an online
 temperature estimator reads in the loop. ``thermofriction.control`` runs them (``simulate_loop``)."""
 
 from __future__ import annotations
@@ -98,6 +98,15 @@ def _told(where: str, temperature):
     return _samples(where, "temperature", temperature)
 
 
+def _told_load(where: str, load):
+    """A compensation's load: None (the stage's), a float (held: load-blind) or a 1-D float array (one per period)."""
+    if load is None:
+        return None
+    if np.ndim(load) == 0:
+        return _number(where, "load", load)
+    return _samples(where, "load", load)
+
+
 @dataclass(frozen=True, eq=False)
 class FeedForward:
     """u_ff = F(v_ref, T) from ``model`` told ``temperature`` (None: the stage's, i.e. measured).
@@ -111,20 +120,26 @@ class FeedForward:
         changes); a number [C], held (blind: a calibration temperature never updated); one value per
         control period [C] (a sensor's reading); or a ``TemperatureEstimator``, run in the loop on the
         friction it measures (``simulate_loop``'s ``friction_measurement``).
+    load : float or array_like, optional
+        The load [N or N m] the model's laws of the load are told (a model without one ignores it): None, the
+        stage's (a perfect load sensor); a number, held (load-blind: a calibration load never updated); or one
+        value per control period (a sensor's reading).
 
     Raises
     ------
     InputError
-        Not a Model, or a temperature that is none of these, named.
+        Not a Model, or a temperature or load that is none of these, named.
     """
 
     model: Model
     temperature: float | np.ndarray | TemperatureEstimator | None = None
+    load: float | np.ndarray | None = None
     kind = "feedforward"
 
     def __post_init__(self):
         _model("FeedForward", "model", self.model)
         object.__setattr__(self, "temperature", _told("FeedForward", self.temperature))
+        object.__setattr__(self, "load", _told_load("FeedForward", self.load))
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,17 +159,20 @@ class Observer:
         The observer gain [1/s], >= 0.
     temperature : float, array_like or TemperatureEstimator, optional
         What the model is told, as ``FeedForward``'s ``temperature``.
+    load : float or array_like, optional
+        The load the model is told, as ``FeedForward``'s ``load``.
 
     Raises
     ------
     InputError
-        Not a Model, a friction model without a bristle state, a negative gain, a temperature that is
+        Not a Model, a friction model without a bristle state, a negative gain, a temperature or load that is
         not one of ``FeedForward``'s kinds, named.
     """
 
     model: Model
     gain: float = 100.0
     temperature: float | np.ndarray | TemperatureEstimator | None = None
+    load: float | np.ndarray | None = None
     kind = "observer"
 
     def __post_init__(self):
@@ -165,6 +183,7 @@ class Observer:
                              f"(it needs a LuGre, Dahl or elasto-plastic model; use FeedForward for {kind})")
         _number("Observer", "gain", self.gain, minimum=0.0)
         object.__setattr__(self, "temperature", _told("Observer", self.temperature))
+        object.__setattr__(self, "load", _told_load("Observer", self.load))
 
 
 @dataclass(frozen=True)

@@ -5,11 +5,12 @@
     loop.rms_error, loop.max_error
 
 A single-mass stage ``m x'' = u - F`` (its friction model, with its thermal extension, at the
-stage's ``temperature``: one value, or one per control period as it warms) under a PID at the control
-period ``dt``, plus optional compensation: ``FeedForward`` (the friction model driven by the reference
-velocity) or ``Observer`` (the LuGre observer of Canudas de Wit et al. 1995), each told a temperature:
-the stage's (a perfect sensor), a fixed calibration temperature (blind), a sensor's reading per period,
-or an online ``TemperatureEstimator``'s estimate from the friction a ``DisturbanceObserver`` measures.
+stage's ``temperature``: one value, or one per control period as it warms; and, for laws of the load, at its
+``load``, the same way) under a PID at the control period ``dt``, plus optional compensation: ``FeedForward``
+(the friction model driven by the reference velocity) or ``Observer`` (the LuGre observer of Canudas de Wit et
+al. 1995), each told a temperature: the stage's (a perfect sensor), a fixed calibration temperature (blind), a
+sensor's reading per period, or an online ``TemperatureEstimator``'s estimate from the friction a
+``DisturbanceObserver`` measures; and told a load: the stage's, a sensor's per period, or a constant (load-blind).
 The parts are in ``compensation.py``, the references in ``references.py``.
 """
 
@@ -29,7 +30,7 @@ from .errors import InputError, SolverError, shorten
 from .estimation import TemperatureEstimate, TemperatureEstimator
 from .figures.study_plots import loop_figure
 from .models import MassPlant, Model
-from .models.load_laws import load_laws, refuse_load_laws
+from .models.load_laws import load_laws
 from .simulation.loads import as_load, load_findings
 # MAX_REFERENCE_SAMPLES: its name here, as before the split
 from .references import MAX_REFERENCE_SAMPLES, Reference, duty_cycle, point_to_point, sine_reference  # noqa: F401
@@ -62,6 +63,9 @@ class LoopResult(Result):
         The disturbance observer's friction the estimator read [N] (NaN: none); None without an estimator.
     stats : dict, default {}
         The run's costs.
+    plant_load, compensation_load : numpy.ndarray, optional
+        The stage's load and the load the compensation was told [N or N m], per period; None where the model
+        has no law of the load.
     """
 
     time: np.ndarray
@@ -75,6 +79,8 @@ class LoopResult(Result):
     temperature_variance: np.ndarray | None = None
     measured_friction: np.ndarray | None = None
     stats: dict = field(default_factory=dict)
+    plant_load: np.ndarray | None = None
+    compensation_load: np.ndarray | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -117,7 +123,7 @@ class LoopResult(Result):
         frame = {"time": self.time, "reference": self.reference, "position": self.position, "error": self.error,
                  "control": self.control, "compensation": self.compensation}
         for name in ("plant_friction", "plant_temperature", "compensation_temperature", "temperature_variance",
-                     "measured_friction"):
+                     "measured_friction", "plant_load", "compensation_load"):
             if getattr(self, name) is not None:
                 frame[name] = getattr(self, name)
         return frame
@@ -138,16 +144,36 @@ def _rms(a) -> float:
 
 
 def _plant_temperature(where: str, stage: Model, temperature, n: int):
-    """The stage's temperature: (the first value, the per-period array or None); the model checked at the
-    extremes here (the core checks every period's)."""
+    """The stage's temperature: (the first value, the per-period array or None)."""
     if np.ndim(temperature) == 0:
-        T = _number(where, "temperature", temperature)
-        _check_at(f"{where}: the stage", stage, T)
-        return T, None
+        return _number(where, "temperature", temperature), None
     series = _samples(where, "temperature", temperature, n)
-    for T in sorted({float(series.min()), float(series.max())}):
-        _check_at(f"{where}: the stage", stage, T)
     return float(series[0]), series
+
+
+def _per_period(where: str, name: str, value, n: int):
+    """A number or one value per period: (the first value, the per-period array or None); None: (NaN, None)."""
+    if value is None:
+        return math.nan, None
+    if np.ndim(value) == 0:
+        return _number(where, name, value), None
+    series = _samples(where, name, value, n)
+    return float(series[0]), series
+
+
+def _check_inputs(where: str, model: Model, t, T, T_series, L, L_series):
+    """The model at the extremes of its temperatures and, with a law of the load, of its loads (the core checks
+    every period's), with the simulator's messages."""
+    Ts = sorted({T} if T_series is None else {float(T_series.min()), float(T_series.max())})
+    if not load_laws(model):
+        for Ti in Ts:
+            _check_at(where, model, Ti)
+        return
+    load = None if L_series is None and math.isnan(L) else L if L_series is None else as_load((t, L_series))
+    try:
+        load_findings(model, Ts, load)
+    except InputError as e:
+        raise InputError(f"{where}: {e}") from None
 
 
 def _estimator_inputs(where, comp, n, T_plant, *, ambient, start, start_variance, proxy_temperature,
@@ -170,15 +196,20 @@ def _estimator_inputs(where, comp, n, T_plant, *, ambient, start, start_variance
             T_p = None
         if T_p is None or T_p.shape != (n,) or np.any(np.isinf(T_p)):
             raise InputError(f"{where}: proxy_temperature must have one value per period ({n}), finite or NaN")
+    if load_laws(comp.model):
+        raise InputError(f"{where}: a TemperatureEstimator steps its friction model at no load: the compensation's "
+                         f"model has a law of the load ({', '.join(load_laws(comp.model))}); tell it a measured "
+                         "temperature instead")
     _check_at(f"{where}: the estimator's start", comp.model, T0)
     return (model_spec(comp.model, T0), est.config(), T0, var0, T_amb, T_p, friction_measurement.noise(n),
             friction_measurement.filter_time), T0
 
 
-def _compensation_inputs(where, comp, n, T_plant, T_series, **estimation):
-    """(spec, T_comp, T_comp_series, estimator tuple) of the compensation for the binding."""
+def _compensation_inputs(where, comp, t, T_plant, T_series, L_plant, L_series, **estimation):
+    """(spec, T_comp, T_comp_series, estimator tuple, L_comp, L_comp_series) of the compensation for the binding."""
+    n = t.size
     if comp is None:
-        return None, math.nan, None, None
+        return None, math.nan, None, None, math.nan, None
     told, est, series = comp.temperature, None, None
     name = {"feedforward": "feed-forward"}.get(comp.kind, comp.kind)
     if isinstance(told, TemperatureEstimator):
@@ -192,9 +223,11 @@ def _compensation_inputs(where, comp, n, T_plant, T_series, **estimation):
         T, series = float(told[0]), told
     else:
         T = told
-    for Ti in sorted({T} if series is None else {float(series.min()), float(series.max())}):
-        _check_at(f"{where}: the {name} compensation's model", comp.model, Ti)
-    return model_spec(comp.model, T), T, series, est
+    L, L_series = (L_plant, L_series) if comp.load is None else _per_period(where, f"the {name} compensation's load",
+                                                                           comp.load, n)
+    if est is None:
+        _check_inputs(f"{where}: the {name} compensation's model", comp.model, t, T, series, L, L_series)
+    return model_spec(comp.model, T), T, series, est, L, L_series
 
 
 def _checked_reference(where: str, reference) -> tuple:
@@ -216,7 +249,7 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
                   compensation: FeedForward | Observer | None = None, substeps: int = 10, ambient=None, start=None,
                   start_variance: float = 1.0, proxy_temperature=None,
                   friction_measurement: DisturbanceObserver = DisturbanceObserver(),
-                  inertia_feedforward: bool = False) -> LoopResult:
+                  inertia_feedforward: bool = False, load=None) -> LoopResult:
     """The closed loop of control.h: the C core runs every control period (fixed step, ``reference``'s
     sampling) and ``substeps`` plant steps within it.
 
@@ -248,6 +281,10 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
         Add the reference's inertia force, mass times the reference's mean acceleration over each period
         (computed-torque feed-forward), to the control. Without it a large, fast move's error is the PID's lag
         behind the acceleration, which can hide what the friction compensation does.
+    load : float or array_like, optional
+        The stage's load [N or N m]: one value, or one per control period (held over it), read by its laws of
+        the load (required by a stage with one, ignored otherwise); a compensation told no load of its own
+        (``FeedForward(..., load=None)``) is told this one.
 
     Returns
     -------
@@ -257,19 +294,19 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
     ------
     InputError
         A stage that is not a single mass, a reference or argument of the wrong type or value, named; a
-        model refused at a temperature it is told or the estimate (the period named).
+        model refused at a temperature or load it is told or the estimate (the period named); no load for a
+        stage with a law of the load.
     SolverError
         The closed loop went unstable (a non-finite position), or the estimator overflowed.
     """
     where = "simulate_loop"
     _model(where, "stage", stage)
-    refuse_load_laws(stage, "the control loop")
-    if compensation is not None and isinstance(getattr(compensation, "model", None), Model):
-        refuse_load_laws(compensation.model, "the control loop's compensation")
     if not isinstance(stage.plant, MassPlant):
         raise InputError("the closed loop drives a single-mass stage: the model's plant must be 'mass'")
     t, x_ref, v_ref, dt = _checked_reference(where, reference)
     T_plant, T_series = _plant_temperature(where, stage, temperature, t.size)
+    L_plant, L_series = _per_period(where, "load", load, t.size)
+    _check_inputs(f"{where}: the stage", stage, t, T_plant, T_series, L_plant, L_series)
     if not isinstance(pid, PID):
         raise InputError(f"{where}: pid must be a PID, got {type(pid).__name__}")
     if compensation is not None and not isinstance(compensation, (FeedForward, Observer)):
@@ -278,8 +315,8 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
     _args.whole(substeps, f"{where}: substeps", low=1)
     if not isinstance(inertia_feedforward, (bool, np.bool_)):
         raise InputError(f"{where}: inertia_feedforward must be True or False, got {inertia_feedforward!r}")
-    spec, T_comp, T_comp_series, est = _compensation_inputs(
-        where, compensation, t.size, T_plant, T_series, ambient=ambient, start=start, start_variance=start_variance,
+    spec, T_comp, T_comp_series, est, L_comp, L_comp_series = _compensation_inputs(
+        where, compensation, t, T_plant, T_series, L_plant, L_series, ambient=ambient, start=start, start_variance=start_variance,
         proxy_temperature=proxy_temperature, friction_measurement=friction_measurement)
     outs = [np.empty_like(x_ref) for _ in range(7)]
     if est is None:
@@ -290,14 +327,18 @@ def simulate_loop(stage: Model, reference: Reference, *, temperature, pid: PID =
                               float(getattr(compensation, "gain", 0.0)), stage.plant.mass,
                               (pid.kp, pid.ki, pid.kd, pid.tau_d), dt, int(substeps), x_ref, v_ref, outs,
                               T_plant_series=T_series, T_comp_series=T_comp_series, estimator=est,
-                              inertia_feedforward=bool(inertia_feedforward))
+                              inertia_feedforward=bool(inertia_feedforward), load_plant=L_plant, load_comp=L_comp,
+                              load_plant_series=L_series, load_comp_series=L_comp_series)
     except ValueError as e:  # the core's own checks: the models at a period's temperature, the estimate
         raise InputError(f"{where}: the C core refused the loop: {e}") from None
     if status != "ok":
         raise SolverError("the closed loop went unstable (non-finite position or estimate): lower the gains or the "
                           "control period")
     T_stage = np.full(t.size, T_plant) if T_series is None else T_series
-    return LoopResult(t, x_ref, outs[0], outs[1], outs[2], outs[3], T_stage, outs[4], outs[5], outs[6])
+    loads = [None if not load_laws(m) else np.full(t.size, L) if s is None else s
+             for m, L, s in ((stage, L_plant, L_series), (getattr(compensation, "model", stage), L_comp, L_comp_series))]
+    return LoopResult(t, x_ref, outs[0], outs[1], outs[2], outs[3], T_stage, outs[4], outs[5], outs[6],
+                      plant_load=loads[0], compensation_load=loads[1] if compensation is not None else None)
 
 
 def friction_steps(model: Model, velocity, dt: float, temperature: float | None = None, load=None):

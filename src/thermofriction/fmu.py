@@ -13,7 +13,8 @@ an importer builds it on any platform; ``platforms=`` builds the binaries at exp
 
 The FMU has the plant's drive as input (a voltage for the stick-slip actuator, a force for a mass, the
 displacement for prescribed motion), the temperature [degC] for Model I and II (the ambient temperature
-with a ``[heat]`` section), and every plant, friction, law and heat parameter as a tunable parameter.
+with a ``[heat]`` section), the load (``normal_force`` [N], or ``load_torque`` [N m] for a rotary joint) for a
+model with a law of the load, and every plant, friction, law and heat parameter as a tunable parameter.
 The model file's own ``[input]`` is not part of the FMU: the importer drives it.
 
 Between communication points the FMU integrates with the core's adaptive integrator (the default), or
@@ -48,7 +49,7 @@ from .fmu_sources import FOLDERS, EXTENSIONS, PLATFORMS, build_binaries, build_d
 from .estimation import TemperatureEstimator
 from .models import MassPlant, Model, StickSlipPlant, load_model
 from .models.fit_record import fit_record_lines
-from .models.load_laws import refuse_load_laws
+from .models.load_laws import load_laws
 
 #: The solvers an FMU can carry between communication points (docs/fmu.md#solvers).
 SOLVERS = ("adaptive", "realtime")
@@ -143,6 +144,26 @@ def _check_exportable(model: Model):
             raise InputError(f"[thermal] {name}: a law of {n} points or coefficients; an FMU takes at most {MAX_POINTS}")
 
 
+def _load_input(model: Model, load: float | None = None):
+    """The load input of a model with a law of the load (docs/fmu.md#the-load-input), (name, unit, what, start),
+    and the load terms' common range of |load| (None: none); (None, None) without such a law. A joint's (a rotary
+    prescribed motion) is ``load_torque`` [N m], any other ``normal_force`` [N]; it starts at ``load``, else at
+    the middle of the range."""
+    terms = [law.load for law in load_laws(model).values()]
+    if not terms:
+        return None, None
+    ranges = [t.range for t in terms if t.range is not None]
+    rng = (max(r[0] for r in ranges), min(r[1] for r in ranges)) if ranges else None
+    rng = rng if rng and rng[0] < rng[1] else None
+    if load is None and rng is None:
+        raise InputError("export_fmu: the model has a law of the load and no load range: give the load input's start "
+                         "(load=..., --load)")
+    start = float(load) if load is not None else 0.5 * (rng[0] + rng[1])
+    if getattr(model.plant, "rotary", False):
+        return ("load_torque", "N m", "load torque on the joint, read by the laws of the load", start), rng
+    return ("normal_force", "N", "normal force on the contact (its preload), read by the laws of the load", start), rng
+
+
 def _check_step(model: Model, step) -> float:
     """The realtime solver's step [s]: a positive finite number, below the stability limit 2 / omega
     of semi-implicit Euler on the plant's stiffest spring (the stage's natural frequency, the mass's
@@ -175,11 +196,12 @@ def _solver(solver, integrator):
     return integrator
 
 
-def _checked(model, path, temperature, model_identifier, source, solver, step, fmi, platforms):
+def _checked(model, path, temperature, model_identifier, source, solver, step, fmi, platforms, load=None):
     """export_fmu's arguments, checked before any work: (the model, its source, the temperature, the step)."""
     _args.path(path, "path")
     platforms = _platforms(platforms)
     temperature = _args.number(temperature, "temperature", "degC", none=True)  # finite
+    _args.number(load, "load", "N or N m", none=True)
     _args.text(model_identifier, "model_identifier", none=True)
     _args.text(source, "source", none=True)
     _args.text(solver, "solver")
@@ -190,7 +212,6 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
         model = load_model(model)
     if not isinstance(model, Model):
         raise InputError(f"export_fmu: model must be a Model, a model file or a preset name, got {shorten(model)}")
-    refuse_load_laws(model, "the FMU")
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(f"FMUs are exported on Linux x86-64 only (where the package builds their binaries); "
                          f"this is {platform.system()} {platform.machine()}")
@@ -215,7 +236,7 @@ def _checked(model, path, temperature, model_identifier, source, solver, step, f
 def export_fmu(model, path, *, temperature: float | None = None, model_identifier: str | None = None,
                source: str | None = None, solver: str = "adaptive", step: float | None = None,
                fmi: int = 2, platforms=None, integrator: str | None = None,
-               estimator: TemperatureEstimator | None = None) -> Path | Target:
+               estimator: TemperatureEstimator | None = None, load: float | None = None) -> Path | Target:
     """Writes ``model`` as an FMI 2.0 or FMI 3.0 co-simulation FMU to ``path`` (docs/fmu.md), with its C sources
     (``sources/``: an importer compiles them for its own platform) and binaries.
 
@@ -252,6 +273,10 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         ``measured_friction_force`` (and ``proxy_temperature`` with a proxy; ``ambient_temperature`` without a
         heat model), outputs ``temperature_estimate`` and ``temperature_variance``, its parameters as
         ``estimator.*``; one estimator step per communication step.
+    load : float, optional
+        The start value of the load input [N, or N m for a rotary joint] of a model with a law of the load
+        (docs/fmu.md#the-load-input); default the middle of its load laws' range of |load|, required without one.
+        Ignored by a model without a law of the load (its FMU has no load input).
 
     Returns
     -------
@@ -263,7 +288,8 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     InputError
         An argument of the wrong type or value, named; what an FMU cannot carry (a sampled external heat, a
         law with more points than the binary holds), named with what to do; a path that is a folder or cannot
-        be written; an unknown platform.
+        be written; an unknown platform; a model with a law of the load, no load range and no ``load``, or with
+        ``estimator``.
     ComputationError
         A platform asked for that could not be built, each named with why; nothing is written.
 
@@ -274,9 +300,12 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     """
     solver = _solver(solver, integrator)
     model, source, temperature, step, platforms = _checked(model, path, temperature, model_identifier, source,
-                                                           solver, step, fmi, platforms)
+                                                           solver, step, fmi, platforms, load)
     _check_exportable(model)
     _args.instance(estimator, TemperatureEstimator, "estimator", "a TemperatureEstimator", none=True)
+    if estimator is not None and load_laws(model):
+        raise InputError(f"export_fmu: the temperature estimator steps its friction model at no load, and the model has "
+                         f"a law of the load ({', '.join(load_laws(model))}): export it without estimator=")
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
         raise InputError(f"model identifier {model_identifier!r}: letters, digits and '_' only, not starting with a "
@@ -284,8 +313,9 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     heat_temperature = temperature if model.heat is None else (
         temperature if temperature is not None else (model.heat.ambient_temperature or 20.0))
     spec = _bridge.model_spec(model, temperature=heat_temperature if model.heat is not None else None)
-    variables = variables_of(model, spec, temperature, step, estimator)
-    tfm = resource_text(model, spec, variables, solver, estimator)
+    load_var, load_range = _load_input(model, load)
+    variables = variables_of(model, spec, temperature, step, estimator, load_var)
+    tfm = resource_text(model, spec, variables, solver, estimator, load_range)
     guid = "{" + str(uuid.UUID(hashlib.sha256((tfm + identifier).encode()).hexdigest()[:32])) + "}"
     tfm += f"guid {guid}\n"  # the binary refuses an instantiation with another GUID
     sources = source_files(fmi)

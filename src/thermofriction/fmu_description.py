@@ -43,6 +43,9 @@ ESTIMATOR_PARAMETERS = (
     ("v_min", "m/s", "no friction update below this sliding speed"),
 )
 
+#: The load input [N or N m] of a model with a law of the load (fmu_common.c).
+VR_LOAD = 12
+
 #: Value reference of FMI 3's independent variable time (fmi3_cs.c, VR_TIME).
 VR_TIME = 15
 
@@ -53,7 +56,7 @@ _BASE_UNITS = {
     "kg": {"kg": 1}, "s": {"s": 1}, "N/m": {"kg": 1, "s": -2}, "N s/m": {"kg": 1, "s": -1}, "N/s": {"kg": 1, "m": 1, "s": -3},
     "rad/s": {"rad": 1, "s": -1}, "m/V": {"kg": -1, "m": -1, "s": 3, "A": 1}, "N/V": {"m": -1, "s": 1, "A": 1},
     "J/K": {"kg": 1, "m": 2, "s": -2, "K": -1}, "K/W": {"kg": -1, "m": -2, "s": 3, "K": 1},
-    "K2": {"K": 2}, "K2/s": {"K": 2, "s": -1}, "N2": {"kg": 2, "m": 2, "s": -4},
+    "K2": {"K": 2}, "K2/s": {"K": 2, "s": -1}, "N2": {"kg": 2, "m": 2, "s": -4}, "N m": {"kg": 1, "m": 2, "s": -2},
 }
 
 
@@ -82,9 +85,11 @@ def _estimator_io(model: Model, estimator, ambient: float) -> list:
     return out
 
 
-def variables_of(model: Model, spec: dict, temperature: float | None, step: float | None = None, estimator=None):
+def variables_of(model: Model, spec: dict, temperature: float | None, step: float | None = None, estimator=None,
+                 load=None):
     """The FMU's variables: inputs, outputs, then every parameter with its role in the binary; with ``estimator``
-    (a TemperatureEstimator) its inputs, outputs and parameters too."""
+    (a TemperatureEstimator) its inputs, outputs and parameters too; ``load``: the load input's (name, unit, what,
+    start) for a model with a law of the load (fmu.py: _load_input), else None."""
     plant = model.plant
     drive = {StickSlipPlant: ("voltage", "V", "drive voltage of the actuator"),
              MassPlant: ("force", "N", "force applied to the mass"),
@@ -104,6 +109,8 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
         T0 = temperature if temperature is not None else (rng[0] if rng else 20.0)
         variables.append(_Variable("temperature", VR_TEMPERATURE, "degC",
                                    "temperature of the friction interface", float(T0), "input", "continuous"))
+    load_var = _Variable(load[0], VR_LOAD, load[1], load[2], load[3], "input", "continuous") if load else None
+    variables += [load_var] if load else []
     variables += [
         _Variable("displacement", VR_DISPLACEMENT, "m", "displacement of the driven body (end effector, mass, or "
                   "the prescribed motion)", causality="output", variability="continuous"),
@@ -169,6 +176,7 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
     for name, index, law, unit in laws:
         where = f"thermal.{name}"
         what = f"{law.kind} law of {name}"
+        term, law = getattr(law, "load", None), getattr(law, "base", law)  # a law of the load: its temperature law
         if law.kind == "const":
             add(f"{where}.value", unit, f"value of the {what}", law.value, "law_a", index)
         elif law.kind in ("linear", "exp"):
@@ -184,6 +192,12 @@ def variables_of(model: Model, spec: dict, temperature: float | None, step: floa
                     variability="fixed")
                 add(f"{where}.values[{j + 1}]", unit, f"value at breakpoint {j + 1} of the {what}", v, "law_y",
                     index, j)
+        Lu = load_var.unit if term is not None else ""
+        for key, role, u in (("k", "load_k", f"1/{Lu}" if term and term.combine == "product" else f"{unit}/{Lu}"),
+                             ("saturation", "load_sat", Lu), ("interaction", "load_c", f"{unit}/C/{Lu}")):
+            if term is not None and getattr(term, key) is not None:
+                add(f"{where}.load.{key}", u, f"{key} of the {term.kind} load term of {name}", getattr(term, key),
+                    role, index)
 
     if heat is not None:
         h = heat.resolved(variables[1].start)
@@ -211,9 +225,11 @@ def _elements(friction) -> int:
     return len(getattr(friction, friction.arrays[0])) if friction.arrays else 0
 
 
-def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive", estimator=None) -> str:
+def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive", estimator=None,
+                  load_range=None) -> str:
     """resources/model.tfm: the structure and the parameters' roles (read by fmu_common.c); with ``estimator``
-    its line (the proxy kind, the ambient temperature's start)."""
+    its line (the proxy kind, the ambient temperature's start); with a load input its start, the load terms'
+    structure and ``load_range`` (their common range of |load|, None: none)."""
     lines = [f"thermofriction-fmu {FORMAT}",
              f"# {model.name or 'model'}: written by thermofriction {__version__}",
              f"plant {spec['plant']} {int(isinstance(model.plant, StickSlipPlant) and model.plant.modal)}",
@@ -233,8 +249,15 @@ def resource_text(model: Model, spec: dict, variables, solver: str = "adaptive",
         if law is not None:
             n = 0 if law[4] is None else len(law[4])
             lines.append(f"law {i} {law[0]} {n}")
+        if law is not None and len(law) > 5:  # a load term: kind combine interaction (k, S, c: parameters)
+            lines.append(f"load_law {i} {law[5][0]} {law[5][1]} {law[5][4]}")
     temperature_start = next((v.start for v in variables if v.vr == VR_TEMPERATURE), float("nan"))
     lines.append(f"input 0.0 {temperature_start!r}" if temperature_start == temperature_start else "input 0.0 0.0")
+    load_start = next((v.start for v in variables if v.vr == VR_LOAD), None)
+    if load_start is not None:
+        lines.append(f"load_input {load_start!r}")
+        if load_range is not None:
+            lines.append(f"load_range {float(load_range[0])!r} {float(load_range[1])!r}")
     if estimator is not None:
         starts = {v.vr: v.start for v in variables if v.causality == "input"}
         ambient = starts.get(VR_AMBIENT, starts.get(VR_TEMPERATURE, 20.0))
@@ -409,5 +432,5 @@ def description_xml3(model: Model, variables, identifier: str, guid: str, source
     return "\n".join(out)
 
 
-__all__ = ["variables_of", "resource_text", "description_xml2", "description_xml3", "default_experiment",
+__all__ = ["variables_of", "VR_LOAD", "resource_text", "description_xml2", "description_xml3", "default_experiment",
            "FORMAT", "VR_TIME", "ESTIMATOR_PARAMETERS"]

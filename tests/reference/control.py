@@ -13,29 +13,32 @@ from .friction import friction_params
 
 
 def reference_closed_loop(stage, ref, T, pid, gain=100.0, substeps=10, T_comp=None, friction=False,
-                          inertia_feedforward=False):
+                          inertia_feedforward=False, L=None, L_comp=None):
     """The closed loop of control.h written again as plain scalar Python (LuGre stage, Model I
     parameters at the stage temperature T, PID with a filtered derivative, the Canudas de Wit
     observer told T_comp, semi-implicit Euler plant substeps, the exponential bristle step; with
     inertia_feedforward, the control adds m times the reference velocity's change over the period). T and
     T_comp: one value, or one per control period (a warm-up; what a sensor or an estimator told the
-    observer); T_comp None: T. Returns the position at each period start."""
+    observer); T_comp None: T. L and L_comp, the same for the load a law of the load reads (None: none; L_comp
+    None: L). Returns the position at each period start."""
     n = ref.time.size
     T_plant = np.broadcast_to(np.asarray(T, float), (n,))
     T_told = T_plant if T_comp is None else np.broadcast_to(np.asarray(T_comp, float), (n,))
+    L_plant = np.broadcast_to(np.asarray(math.nan if L is None else L, float), (n,))
+    L_told = L_plant if L_comp is None else np.broadcast_to(np.asarray(L_comp, float), (n,))
     cache = {}
 
-    def params(Ti):
-        if Ti not in cache:
-            p = friction_params(stage, Ti)
-            cache[Ti] = (p.sigma0, p.sigma1, p.sigma2, p.fc, p.fs, p.vs)
-        return cache[Ti]
+    def params(Ti, Li):
+        if (Ti, Li) not in cache:
+            p = friction_params(stage, Ti, None if math.isnan(Li) else Li)
+            cache[Ti, Li] = (p.sigma0, p.sigma1, p.sigma2, p.fc, p.fs, p.vs)
+        return cache[Ti, Li]
 
     m, dt = stage.plant.mass, ref.time[1] - ref.time[0]
     h = dt / substeps
 
-    def step(z, v, dt_, Ti, extra=0.0):
-        s0, s1, s2, fc, fs, vs = params(Ti)
+    def step(z, v, dt_, Ti, Li, extra=0.0):
+        s0, s1, s2, fc, fs, vs = params(Ti, Li)
         g = fc + (fs - fc) * math.exp(-(v / vs) ** 2)
         b = s0 * abs(v) / g
         rate = v - b * z + extra
@@ -54,14 +57,14 @@ def reference_closed_loop(stage, ref, T, pid, gain=100.0, substeps=10, T_comp=No
         dfilt += a * ((e - e_prev) / dt - dfilt)
         integ += e * dt
         e_prev = e
-        zh, Fh = step(zh, v, dt, float(T_told[i]), -gain * -e)
+        zh, Fh = step(zh, v, dt, float(T_told[i]), float(L_told[i]), -gain * -e)
         u = kp * e + ki * integ + kd * dfilt + Fh
         if inertia_feedforward and i + 1 < n:
             u += m * (ref.velocity[i + 1] - ref.velocity[i]) / dt
         xs[i] = x
         F_sum = 0.0
         for _ in range(substeps):
-            z, F = step(z, v, h, float(T_plant[i]))
+            z, F = step(z, v, h, float(T_plant[i]), float(L_plant[i]))
             v += (u - F) / m * h
             x += v * h
             F_sum += F

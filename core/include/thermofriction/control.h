@@ -108,10 +108,13 @@ typedef struct {
        none), the mean acceleration over the period of a held control (needs v_ref); 0: none. Without it a
        large move's error is the PID's lag behind the acceleration, which hides the friction's part. */
     int inertia_feedforward;
-    /* The loads [N or N m] the plant's and the compensation's laws of the load read (constant over the run;
-       ignored by models without such a law; a zeroed struct has 0). The estimator's model takes no load: a
-       law of the load on est_friction is refused. */
+    /* The loads [N or N m] the plant's and the compensation's laws of the load read (ignored by models without
+       such a law; a zeroed struct has 0): load_plant_series / load_comp_series, n values, one per period (held
+       over it, as the temperatures), or, where NULL, load_plant / load_comp throughout. A compensation told a
+       constant load while the plant's varies is load-blind. The estimator's model takes no load: a law of the
+       load on est_friction is refused. */
     double load_plant, load_comp;
+    const double *load_plant_series, *load_comp_series;
 } tf_loop;
 
 /* The most plant substeps (n x substeps) one tf_loop_run takes (~10 s of work): more is refused. */
@@ -124,7 +127,7 @@ typedef struct {
  * writing anything, for a NULL or non-finite argument (mass, dt > 0, substeps >= 1, n x substeps <=
  * TF_LOOP_MAX_SUBSTEPS, gains, a reference or series sample, dob_tau >= 0, T_amb, an estimator
  * without est_friction), an unknown compensation, an observer on a model without a bristle state,
- * or a plant or compensation model refused at one of its given temperatures; or, once running,
+ * or a plant or compensation model refused at one of its given (temperature, load) pairs; or, once running,
  * TF_ERR_NONFINITE if the loop goes unstable, or the estimator's status if it refuses a step or the
  * compensation is refused at the estimated temperature (outputs written up to that period). When it
  * stops short, *err (may be NULL) says which part refused (where: "loop", "reference", "pid",

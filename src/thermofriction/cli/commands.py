@@ -337,7 +337,8 @@ def cmd_fmu(args) -> int:
     model = load_model(args.model)
     _refuse_inputs(args, _model_inputs(args.model, model))
     export_fmu(model, _target(args, "output"), temperature=args.temperature, model_identifier=args.model_identifier,
-               source=args.model, solver=solver, step=args.step, fmi=args.fmi, platforms=args.platforms)
+               source=args.model, solver=solver, step=args.step, fmi=args.fmi, platforms=args.platforms,
+               load=args.load)
     how = f"fixed step {args.step:g} s" if solver == "realtime" else "adaptive integrator"
     where = dict.fromkeys(prebuilt_platforms() if args.platforms is None else args.platforms)
     where = ", ".join([*where, "C sources"])

@@ -272,7 +272,8 @@ def _add_fmu_command(sub):
                     "when the package was built with the MinGW-w64 cross compiler (or --platforms asks for it), Windows "
                     "x86-64 (the C core inside, the C library its only dependency), with its C sources, from "
                     "which an importer compiles it for any other platform. Inputs: the plant's drive (voltage, force or motion) and, for Model I "
-                    "and II, the temperature [C] (with a [heat] section, the ambient temperature). Outputs: "
+                    "and II, the temperature [C] (with a [heat] section, the ambient temperature), and for a law of the load "
+                    "the load (normal_force [N], or load_torque [N m] for a rotary joint). Outputs: "
                     "displacement, velocity, friction force, the stage displacement (stick-slip) and the "
                     "temperature (heat). Every plant, friction, law and heat parameter is a tunable parameter. "
                     "The model's [input] is not part of the FMU: the importer drives it.",
@@ -282,6 +283,9 @@ def _add_fmu_command(sub):
     f.add_argument("-o", "--output", required=True, metavar="OUT.fmu", help=_writes("fmu", "output", "the FMU file"))
     f.add_argument("--temperature", type=_finite_float, metavar="C",
                    help="start value of the temperature input [C] (with [heat]: of the ambient temperature)")
+    f.add_argument("--load", type=_finite_float, metavar="N",
+                   help="a model with a law of the load: start value of its load input [N, or N m for a rotary "
+                        "joint] (default: the middle of the load laws' range of |load|)")
     f.add_argument("--model-identifier", metavar="NAME",
                    help="the FMU's model identifier, letters, digits and _ (default: from the model's name)")
     f.add_argument("--solver", choices=("adaptive", "realtime"), default=None,
@@ -327,7 +331,8 @@ def _add_sweep_command(sub):
                     "then the metrics. Runs on threads on this machine's cores, a local Dask cluster or an "
                     "existing one (--scheduler). A point that fails is written with empty metrics and its reason "
                     "in the error column; the others go on (exit status 1 when any failed).",
-        epilog="Grid names: temperature [C]; a field of the input waveform (amplitude, frequency, rise, offset, "
+        epilog="Grid names: temperature [C]; load [N, or N m for a rotary joint] for a model with a law of the load; "
+               "a field of the input waveform (amplitude, frequency, rise, offset, "
                "duty, slew); a model parameter (sigma0, sigma1, fc, fs, vs, sigma2, a law coefficient such as "
                "sigma0.b, dF.values[1], a plant parameter such as m_e). Metrics: "
                + "; ".join(f"{k} [{u}] {what}" for k, (u, what, _) in METRICS.items()) + ".")

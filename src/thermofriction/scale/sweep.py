@@ -1,4 +1,4 @@
-"""Design sweeps: one simulation per point of a grid (temperature x input x model parameters),
+"""Design sweeps: one simulation per point of a grid (temperature x load x input x model parameters),
 reduced to a few summary metrics per point, batched many points per Dask task.
 
     res = tf.sweep(model, grid={"temperature": np.arange(30, 42.25, 0.25), "amplitude": [10, 20, 30]},
@@ -25,7 +25,7 @@ from ..simulation import AutoSwitch, Dopri5, Rodas4, StepSizeController
 from .._reading import strict_float
 from ..errors import InputError, ThermofrictionError, shorten
 from ..models import Model, load_model
-from ..models.load_laws import refuse_load_laws
+from ..models.load_laws import load_laws
 from ..waveforms import Sampled, Waveform
 from ..results import Result, Summary, collecting, heading, lines
 from .cluster import Runner, check_options
@@ -133,7 +133,7 @@ def _as_axis(name, values):
 
 
 def _kinds(model: Model, waveform, names):
-    """Each grid name's kind ("temperature", "input", "parameter") and unit, checked against the model."""
+    """Each grid name's kind ("temperature", "load", "input", "parameter") and unit, checked against the model."""
     from ..fitting.parameters import target_of, unit_of  # loads SciPy: only when a sweep runs
 
     fields = {f.name for f in dataclasses.fields(waveform)} if dataclasses.is_dataclass(waveform) else set()
@@ -141,6 +141,11 @@ def _kinds(model: Model, waveform, names):
     for name in names:
         if name == "temperature":
             kinds[name], units[name] = "temperature", "C"
+        elif name == "load":
+            if not load_laws(model):
+                raise InputError("grid 'load': the model has no law of the load (docs/models.md#laws-of-temperature-"
+                                 "and-load): every point would be the same")
+            kinds[name], units[name] = "load", "N m" if getattr(model.plant, "rotary", False) else "N"
         elif name in fields and not isinstance(waveform, Sampled):
             kinds[name] = "input"
             units[name] = _WAVEFORM_UNITS.get(name, _INPUT_UNITS.get(model.plant.type, ""))
@@ -160,7 +165,7 @@ def _kinds(model: Model, waveform, names):
 
 # -- one batch of points (runs on a worker) ---------------------------------------------------
 
-def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim):
+def _run_batch(model, waveform, temperature, load, names, kinds, coords, metrics, sim):
     """Simulates each row of ``coords``; returns (values (n, len(metrics)), errors {row: reason},
     warnings). A point that fails is NaN with its reason; the others go on."""
     from ..fitting.parameters import with_values
@@ -173,13 +178,14 @@ def _run_batch(model, waveform, temperature, names, kinds, coords, metrics, sim)
         with collecting() as caught:  # the point's findings, as values
             try:
                 T = point.get("temperature", temperature)
+                L = point.get("load", load)
                 inp = {n: v for n, v in point.items() if kinds[n] == "input"}
                 if "direction" in inp:
                     inp["direction"] = int(inp["direction"])
                 params = {n: v for n, v in point.items() if kinds[n] == "parameter"}
                 m = with_values(model, params) if params else model
                 w = dataclasses.replace(waveform, **inp) if inp else waveform
-                res = simulate(m, temperature=T, input=w, **sim)
+                res = simulate(m, temperature=T, input=w, load=L, **sim)
                 values[i] = [METRICS[k][2](res) for k in metrics]
             except ThermofrictionError as e:
                 errors[i] = str(e)
@@ -367,7 +373,7 @@ def points(axes: dict) -> np.ndarray:
 
 def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, temperature=None,
           metrics=DEFAULT_METRICS, sample_rate: float = 10_000.0, solver=None, controller=None,
-          scheduler=None, workers=None, batch_size=None, progress=None) -> SweepResult:
+          scheduler=None, workers=None, batch_size=None, progress=None, load=None) -> SweepResult:
     """Simulates ``model`` at every point of ``grid`` and returns one row of ``metrics`` per point.
 
     Parameters
@@ -375,7 +381,8 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     model : Model or str or os.PathLike
         The model: a Model, a model file or a preset name.
     grid : dict
-        Name -> values; the points are every combination. Names are ``temperature`` [C], a field of the input
+        Name -> values; the points are every combination. Names are ``temperature`` [C], ``load`` [N, or N m for a
+        rotary joint; a model with a law of the load only], a field of the input
         waveform (``amplitude``, ``frequency``, ``rise``, ...), or any parameter the model can be given by name
         (``sigma0``, ``fc``, a law coefficient ``sigma0.b``, ``dF.values[1]``, a plant's ``m_e``), in the
         model file's units.
@@ -406,6 +413,9 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
         threads and ~100 ms on Dask, at least 4 per worker (docs/scale.md).
     progress : callable, optional
         Called with the number of points done.
+    load : float, optional
+        The load [N or N m] of the points when the grid has no ``load`` axis (a model with a law of the load needs
+        one or the other; a model without one ignores it).
 
     Returns
     -------
@@ -416,13 +426,14 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     Raises
     ------
     InputError
-        An argument of the wrong type or value, named; an unknown grid name or metric; a grid of no points.
+        An argument of the wrong type or value, named; an unknown grid name or metric; a grid of no points; a
+        ``load`` axis for a model without a law of the load, or no load for one with.
     """
     import time
 
     model = _args.model(model, Model, loader=load_model)  # the argument types (_args.py): before any work
-    refuse_load_laws(model, "the sweeps")
     _args.number(temperature, "temperature", "degC", none=True)
+    load = _args.number(load, "load", "N or N m", none=True)
     check_run_options(duration, sample_rate, solver, controller, scheduler, workers, batch_size, progress)
     if not isinstance(metrics, str):
         metrics = _args.names(metrics, "metrics", none=False)
@@ -444,6 +455,9 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
     if model.thermal is not None and "temperature" not in axes and temperature is None and model.heat is None:
         raise InputError("the model depends on temperature: give a temperature axis in the grid "
                          "(temperature=30:42:0.25) or temperature=C for every point")
+    if load_laws(model) and "load" not in axes and load is None:
+        raise InputError(f"the model has a law of the load ({', '.join(load_laws(model))}): give a load axis in the "
+                         "grid (load=20:100:20) or load=N for every point")
     coords = points(axes)
     sim = dict(duration=duration, sample_rate=sample_rate, solver=solver, controller=controller)
     t0 = time.perf_counter()
@@ -452,7 +466,8 @@ def sweep(model, grid, *, input: Waveform | None = None, duration: float = 1.0, 
             a, b = span
             return np.full((b - a, len(metrics)), np.nan), {k: reason for k in range(b - a)}, []
         spans, outs = runner.map_chunks(
-            _run_batch, n, lambda a, b: (model, waveform, temperature, names, kinds, coords[a:b], metrics, sim),
+            _run_batch, n, lambda a, b: (model, waveform, temperature, load, names, kinds, coords[a:b], metrics,
+                                         sim),
             batch_size=batch_size, progress=progress, on_error=lost)
         where = runner.describe()
     values = np.vstack([o[0] for o in outs]) if outs else np.empty((0, len(metrics)))
