@@ -322,3 +322,13 @@ def test_the_command_line_simulates_a_load_file_as_python_does(tmp_path):
     (tmp_path / "bad.csv").write_text("time[s],force[N]\n0,1\n1,2\n")
     r = run_cli("simulate", tmp_path / "stage.toml", "--temperature", 30, "--load-file", tmp_path / "bad.csv")
     assert r.returncode == 2 and "line 1: the value column must be normal_force[N] or load_torque[N*m]" in r.stderr
+
+
+def test_the_temperature_estimator_refuses_a_law_of_the_load_naming_it():
+    """The online estimator steps its model at no load (estimator.c): a model with a law of the load is refused
+    before any step, naming the law, not at its first sample."""
+    est = tf.control.TemperatureEstimator(C_th=1.0, R_th=1.0, r_F=0.01)
+    with pytest.raises(tf.InputError, match=r"\[thermal\] fc: a law of the load .*not an input of the temperature "
+                                            r"estimator"):
+        est.run(preloaded_stage(), np.full(100, 0.01), dt=1e-3, ambient=25.0, start=25.0,
+                measured_force=np.ones(100))

@@ -22,6 +22,7 @@ from ._bridge import model_spec
 from .errors import InputError, SolverError
 from .figures.estimation_plots import estimate_figure
 from .models import Model
+from .models.load_laws import refuse_load_laws
 from .results import Result, Summary
 
 #: Which node the proxy temperature lags (estimator.h: tf_proxy_kind).
@@ -195,6 +196,7 @@ class TemperatureEstimator:
         """
         w = "TemperatureEstimator.run"
         model = _args.instance(model, Model, f"{w}: model", "a thermofriction Model")
+        refuse_load_laws(model, "the temperature estimator (it steps its model at no load)")
         v = _series(w, "velocity", velocity, None)
         n = v.size
         dt = _args.number(dt, f"{w}: dt", "s", positive=True)

@@ -11,7 +11,8 @@ With ``s = |L|`` (or ``S tanh(|L|/S)`` with a ``saturation`` S, the load-depende
 in Python that knows a load law: its value, its derivatives in every coefficient (for the chain rule of a joint fit),
 its range of validity in load and the warning outside it, its file form, and the fields of the C core's load term
 (law.h: tf_load_term, the same equations in C, evaluated by the simulator and the real-time API at the run's load).
-A model holding one is still refused where the load is not an input yet (``identify``), with one clear message.
+A model holding one is refused where the load is not an input yet (the online temperature estimator), with one
+clear message.
 """
 
 from __future__ import annotations
@@ -301,8 +302,8 @@ def law_from_dict(d, where: str) -> Law:
 
 
 def refuse_load_laws(model, where: str) -> None:
-    """Refuses a model with a law of load where the load is not an input yet (``where``: ``identify``), naming the
-    law.
+    """Refuses a model with a law of load where the load is not an input yet (``where``: the temperature
+    estimator), naming the law.
 
     Parameters
     ----------
