@@ -86,6 +86,15 @@ STALL_COST, STALL_EVALUATIONS = 0.1, 3
 LANDED = 1.0
 
 
+#: a start of the multi-start whose coarse stage converged (status 1: the Gauss-Newton step below COARSE_STEP
+#: standard errors, or SciPy's gradient test; not its limit, nor a stalled step) with a cost above the first run's
+#: optimum by more than this many times the misfit's variance is not polished (cost: half the sum of squares in units
+#: of the noise, so one standard error along any direction is half the variance): the step it stopped at would
+#: remove half a variance at most, and the fine stage could not bring it below the optimum already found. Its fine
+#: stage was up to 15 evaluations of a look-alike force fit, at a second optimum the first run's beat
+LOSING = 10.0
+
+
 class _Converged(Exception):
     """Raised inside the least-squares iteration at a point that is already the optimum."""
 
@@ -127,7 +136,7 @@ def compressed(r, J, transform: Transform, theta, scale):
     in the fitted coordinates phi: (f, G), n + 1 rows, with |f| = |r|, G^T f = J^T r and G^T G = J^T J
     (r, J so scaled). Everything the trust-region iteration uses, so that it takes the same steps, but
     at the cost of n + 1 rows instead of one per sample (its SVD and products on 10^5 x 6 matrices cost
-    more than a short simulation). One Householder QR of [J r], R alone: its last column is Q^T r and the part of r
+    more than a short simulation). One QR of [J r], R alone (_r_factor): its last column is Q^T r and the part of r
     outside J's columns (the same numbers as forming Q and projecting r with it, at less than half the cost: on a
     joint's 20,000 samples the QR with Q took longer than the exact stepping of the whole record)."""
     r = r / scale
@@ -137,8 +146,23 @@ def compressed(r, J, transform: Transform, theta, scale):
         Q, R = np.linalg.qr(J)
         qr = Q.T @ r
         return np.append(qr, float(np.linalg.norm(r - Q @ qr))), np.vstack([R, np.zeros((1, p))])
-    Ra = np.linalg.qr(np.column_stack([J, r]), mode="r")
+    Ra = _r_factor(np.column_stack([J, r]))
     return np.append(Ra[:p, p], abs(float(Ra[p, p]))), np.vstack([Ra[:p, :p], np.zeros((1, p))])
+
+
+#: rows of each block of the QR of a tall Jacobian (a block and its R factor stay in the cache)
+QR_BLOCK = 2048
+
+
+def _r_factor(A) -> np.ndarray:
+    """The R factor of A's QR (its rows' signs aside, which change no product R^T R nor R^T of the last column): the
+    blocks' R factors stacked and factored again (the tall-skinny QR). Orthogonal transforms as the one QR is, to
+    rounding, in a third of the time on a joint's 20,000 x 11 (the one Householder QR streams the whole matrix from
+    memory once per column)."""
+    if A.shape[0] <= 2 * QR_BLOCK:
+        return np.linalg.qr(A, mode="r")
+    return np.linalg.qr(np.vstack([np.linalg.qr(A[i:i + QR_BLOCK], mode="r")
+                                   for i in range(0, A.shape[0], QR_BLOCK)]), mode="r")
 
 
 def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfev, tight, scale,
@@ -397,7 +421,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     scale = residual_scale(traces)
     residual_count = sum(t.n_residuals for t in traces)
 
-    def run(phi_start, known=()):
+    def run(phi_start, known=(), beat=None):
         # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
@@ -408,8 +432,10 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
             first = _least_squares(coarse, transform, phi_start, (lo, hi), 40 if max_nfev is None else max_nfev, False, scale,
                                    stall_step=COARSE_STEP, known=known)
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-            if first.landed:
-                first.moved = True
+            losing = beat is not None and first.status == 1 and \
+                first.cost > beat + LOSING * max(2 * beat / max(residual_count, 1), 1)
+            if first.landed or losing:
+                first.moved = True  # (one that cannot win: its coarse optimum is no start for a better one)
                 return first, problem
             phi_start = first.x
         fine = max_nfev if max_nfev is not None else 60 if tight or near else 40 if coarse_only else 15
@@ -432,7 +458,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         # (only an optimum: a first run stopped by its evaluation limit is still walking, and the start that
         # walks on past it was the multi-start's better answer)
         known = [runs[0][0].known] if runs[0][0].known is not None and runs[0][0].status > 0 else []
-        each = functools.partial(run, known=known)
+        each = functools.partial(run, known=known, beat=runs[0][0].cost)
         if one_trace and len(chosen) > 1:  # (their evaluations count in the caller's tallies)
             runs += list(pool().map(in_context(each), chosen))
         else:
