@@ -1,8 +1,7 @@
 """The cheaper paths of issue 42's fourth round, each against an independent reference: the ripple advice's
 periodogram on the bins' grid against SciPy's ``lombscargle`` at the bins' centres; the ripple at a shifted angle
 from the harmonics at the unshifted one against the ripple evaluated at the shifted angle; the tall QR's R factor by
-blocks against numpy's one QR; a held value tried by a Gauss-Newton step against the refit it replaces; and a start
-of the multi-start that cannot win left unpolished against the fit that polishes it."""
+blocks against numpy's one QR; and a held value tried by a Gauss-Newton step against the refit it replaces."""
 
 import math
 import sys
@@ -106,18 +105,3 @@ def test_a_small_held_value_tried_by_a_step_says_what_the_refit_said(force7, mon
     assert all(fit.parameters[n].value == reference.parameters[n].value for n in opts["parameters"])
     assert fit.nfev < reference.nfev - 8
     assert any("Gauss-Newton step" in w for w in fit.warnings)
-
-
-def test_a_start_that_cannot_win_is_not_polished(monkeypatch):
-    """A start of the multi-start whose coarse stage converged above the first run's optimum by more than LOSING
-    variances is not polished: the fit ends where the fit that polishes it (LOSING infinite) ends, at the same cost,
-    with fewer evaluations (the cost study's force truth 2, whose screened start converges in another optimum)."""
-    data, _, start, opts = S.force_case("force-ripple", 0, False)
-    fit = tf.identify(data, init=start, **opts)
-    monkeypatch.setattr(optimiser, "LOSING", math.inf)
-    reference = tf.identify(data, init=start, **opts)
-    for n in opts["parameters"]:
-        p, q = fit.parameters[n], reference.parameters[n]
-        assert abs(p.value - q.value) <= 1e-6 * q.stderr, (n, p.value, q.value, q.stderr)
-    assert fit.cost == reference.cost
-    assert fit.nfev < reference.nfev

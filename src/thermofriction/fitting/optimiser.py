@@ -86,15 +86,6 @@ STALL_COST, STALL_EVALUATIONS = 0.1, 3
 LANDED = 1.0
 
 
-#: a start of the multi-start whose coarse stage converged (status 1: the Gauss-Newton step below COARSE_STEP
-#: standard errors, or SciPy's gradient test; not its limit, nor a stalled step) with a cost above the first run's
-#: optimum by more than this many times the misfit's variance is not polished (cost: half the sum of squares in units
-#: of the noise, so one standard error along any direction is half the variance): the step it stopped at would
-#: remove half a variance at most, and the fine stage could not bring it below the optimum already found. Its fine
-#: stage was up to 15 evaluations of a look-alike force fit, at a second optimum the first run's beat
-LOSING = 10.0
-
-
 class _Converged(Exception):
     """Raised inside the least-squares iteration at a point that is already the optimum."""
 
@@ -421,7 +412,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     scale = residual_scale(traces)
     residual_count = sum(t.n_residuals for t in traces)
 
-    def run(phi_start, known=(), beat=None):
+    def run(phi_start, known=()):
         # far from the optimum the Jacobian need not be precise: converge at rtol 1e-6 (about
         # half the cost per run), then polish at the requested tolerance
         problem = Problem(model, names, traces, rtol=rtol, parallel=not one_trace)
@@ -432,10 +423,8 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
             first = _least_squares(coarse, transform, phi_start, (lo, hi), 40 if max_nfev is None else max_nfev, False, scale,
                                    stall_step=COARSE_STEP, known=known)
             problem.nfev, problem.njev = coarse.nfev, coarse.njev
-            losing = beat is not None and first.status == 1 and \
-                first.cost > beat + LOSING * max(2 * beat / max(residual_count, 1), 1)
-            if first.landed or losing:
-                first.moved = True  # (one that cannot win: its coarse optimum is no start for a better one)
+            if first.landed:
+                first.moved = True
                 return first, problem
             phi_start = first.x
         fine = max_nfev if max_nfev is not None else 60 if tight or near else 40 if coarse_only else 15
@@ -458,7 +447,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         # (only an optimum: a first run stopped by its evaluation limit is still walking, and the start that
         # walks on past it was the multi-start's better answer)
         known = [runs[0][0].known] if runs[0][0].known is not None and runs[0][0].status > 0 else []
-        each = functools.partial(run, known=known, beat=runs[0][0].cost)
+        each = functools.partial(run, known=known)
         if one_trace and len(chosen) > 1:  # (their evaluations count in the caller's tallies)
             runs += list(pool().map(in_context(each), chosen))
         else:
