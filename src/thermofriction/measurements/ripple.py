@@ -99,9 +99,21 @@ def evaluate(model, angle, names=()):
 
 
 def harmonics(angle, period) -> np.ndarray:
-    """The ripple's harmonics at ``angle``: columns cos(k w x), sin(k w x) for k = 1..RIPPLE_ORDER (cos1, sin1,
-    cos2, ...), w = 2 pi / ``period``; every ripple at ``angle`` shifted by any phase is a product of these with
-    the amplitudes rotated (:func:`shifted`)."""
+    """The ripple's harmonics at ``angle``: every ripple at ``angle`` shifted by any phase is a product of these with
+    the amplitudes rotated (:func:`shifted`).
+
+    Parameters
+    ----------
+    angle : array_like
+        The positions [m or rad].
+    period : float
+        The ripple's period, in the positions' unit.
+
+    Returns
+    -------
+    numpy.ndarray
+        n x 2 RIPPLE_ORDER: cos(k w x), sin(k w x) for k = 1..RIPPLE_ORDER (cos1, sin1, cos2, ...), w = 2 pi / period.
+    """
     x = np.asarray(angle, float)
     w = 2.0 * math.pi / period
     H = np.empty((x.size, 2 * RIPPLE_ORDER))
@@ -146,9 +158,25 @@ def _rotated(model, phi):
 
 
 def shifted(model, H, phi, names=()):
-    """:func:`evaluate` at ``angle + phi`` from the harmonics ``H`` at ``angle`` (:func:`harmonics`): products
-    instead of sines and cosines of the whole run (equal to rounding; closer, at large angles, than the shifted
-    angle's own rounding)."""
+    """:func:`evaluate` at ``angle + phi`` from the harmonics ``H`` at ``angle``: products instead of sines and
+    cosines of the whole run (equal to rounding; closer, at large angles, than the shifted angle's own rounding).
+
+    Parameters
+    ----------
+    model : Model
+        The model whose ripple (period and amplitudes) is evaluated.
+    H : numpy.ndarray
+        The harmonics at the unshifted angle (:func:`harmonics`, at the model's period).
+    phi : float
+        The angle offset [m or rad].
+    names : sequence of str, optional
+        The parameters whose columns are returned (the amplitudes' nonzero, the others' zero).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (R, dR/d names, dR/dx) at ``angle + phi``, as :func:`evaluate` returns them.
+    """
     alpha, beta, c, s = _rotated(model, phi)
     J = np.zeros((H.shape[0], len(names)))
     for j, n in enumerate(names):
