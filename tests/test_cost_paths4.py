@@ -68,6 +68,23 @@ def test_the_harmonics_are_kept_per_angle_array_and_period():
     np.testing.assert_array_equal(ripple._harmonics_of(x.copy(), 0.2), a)
 
 
+def test_the_kept_harmonics_stay_within_their_budget(monkeypatch):
+    """The cache keeps at most _HARMONICS_BYTES (harmonics and angles, counted here from the arrays themselves), drops
+    the oldest first, and does not keep a record larger than a quarter of it (computed each time, still right)."""
+    monkeypatch.setattr(ripple, "_HARMONICS", {})
+    monkeypatch.setattr(ripple, "_HARMONICS_BYTES", 4 * 56_000)  # four runs of 1,000: 8 + 48 kB each
+    runs = [np.linspace(0.0, 1.0 + k, 1000) for k in range(6)]
+    for x in runs:
+        ripple._harmonics_of(x, 0.1)
+        assert sum(a.nbytes + H.nbytes for a, _, H in ripple._HARMONICS.values()) <= ripple._HARMONICS_BYTES
+    assert len(ripple._HARMONICS) == 4  # the last four
+    assert runs[-1] is next(reversed(ripple._HARMONICS.values()))[0] and runs[0] is not next(iter(
+        ripple._HARMONICS.values()))[0]
+    long = np.linspace(0.0, 9.0, 5000)
+    np.testing.assert_array_equal(ripple._harmonics_of(long, 0.1), ripple.harmonics(long, 0.1))
+    assert all(a is not long for a, _, _ in ripple._HARMONICS.values())
+
+
 @pytest.mark.parametrize("rows", [20_000, 9_000])
 def test_the_blocked_r_factor_is_the_qr(rows):
     """optimiser._r_factor (R factors of blocks, stacked and factored again) against numpy's QR of the whole: R^T R

@@ -125,8 +125,14 @@ def harmonics(angle, period) -> np.ndarray:
 #: the harmonics of the angles a fit evaluates again and again ({id: (angle, period, harmonics)}: the angle kept,
 #: so that its id is not reused while it is here); their sines and cosines were most of a force fit's ripple
 _HARMONICS = {}
-_HARMONICS_KEPT = 16
+#: at most this many bytes of harmonics (and their angles) kept (a fit's run of 20,000 samples: 1.1 MB)
+_HARMONICS_BYTES = 64 * 2 ** 20
 _HARMONICS_LOCK = threading.Lock()
+
+
+def _kept_bytes() -> int:
+    """The bytes the kept harmonics and their angles hold."""
+    return sum(np.asarray(a).nbytes + H.nbytes for a, _, H in _HARMONICS.values())
 
 
 def _harmonics_of(angle, period) -> np.ndarray:
@@ -136,8 +142,11 @@ def _harmonics_of(angle, period) -> np.ndarray:
     if hit is not None and hit[0] is angle and hit[1] == period:
         return hit[2]
     H = harmonics(angle, period)
+    if H.nbytes > _HARMONICS_BYTES // 4:  # (a record too long to keep: computed each time, as before)
+        return H
     with _HARMONICS_LOCK:
-        while len(_HARMONICS) >= _HARMONICS_KEPT:
+        _HARMONICS.pop(id(angle), None)
+        while _HARMONICS and _kept_bytes() + H.nbytes + np.asarray(angle).nbytes > _HARMONICS_BYTES:
             _HARMONICS.pop(next(iter(_HARMONICS)))
         _HARMONICS[id(angle)] = (angle, period, H)
     return H
