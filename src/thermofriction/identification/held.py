@@ -215,12 +215,18 @@ def _gain_text(trial, res, what) -> str:
     return f"freeing {what} lowers the held-out RMSE {changed} (fit runs {fit_runs}; a refit of {n} evaluations)"
 
 
+def _how(trial) -> str:
+    """How a value was tried: a refit, or one Gauss-Newton step measured by an exact run (advice.STEP_BELOW)."""
+    return ("a Gauss-Newton step with it free (its gain measured by an exact run, as the linearization predicts it)"
+            if trial.get("stepped") else "a refit with it free")
+
+
 def _not_worth(trial, res) -> str:
     """Why a tried refit's gain is not worth a parameter (advice.holds), measured: too small on the fit runs, or
     not held out of sample."""
     fit_runs = f"{_rmses(res.rmse, trial['rmse_after'], res.unit)}, {100 * trial['gain']:.2g} % of the misfit"
     if trial["gain"] < MATERIAL:
-        return f"a refit with it free lowers the RMSE on the fit runs only {fit_runs}, less than {100 * MATERIAL:g} " \
+        return f"{_how(trial)} lowers the RMSE on the fit runs only {fit_runs}, less than {100 * MATERIAL:g} " \
                f"%: not contradicted"
     if "heldout_gain" not in trial:  # (tried because the fit is not adequate; the score test does not single it out)
         return f"a refit with it free lowers the RMSE on the fit runs {fit_runs} ({trial['basis']})"
@@ -325,8 +331,9 @@ def _tried_text(tests, res) -> str:
         if holds(trial):
             out.append(f"{_gain_text(trial, res, what)} ({_advice(t['name'], t['dof'])})")
         elif trial["gain"] < MATERIAL:
+            by = "; a Gauss-Newton step, measured by an exact run" if trial.get("stepped") else ""
             out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit (less than "
-                       f"{100 * MATERIAL:g} %: not worth a parameter)")
+                       f"{100 * MATERIAL:g} %: not worth a parameter{by})")
         else:
             out.append(f"freeing {what} removes {100 * trial['gain']:.2g} % of the misfit on the fit runs but only "
                        f"{100 * trial['heldout_gain']:.2g} % on the held-out runs (RMSE "

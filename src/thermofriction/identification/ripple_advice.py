@@ -68,14 +68,14 @@ def _rms(residuals) -> float:
 
 
 def _binned(x, r, width):
-    """The residuals averaged in bins of the angle ``width`` wide (the bins a run visits): a run that passes the same
-    angles again and again adds its samples to the same bins, so the periodogram's cost is the travel's, not the
-    record's (a bin an eighth of the shortest period searched changes no peak)."""
+    """(bin, mean): the residuals averaged in bins of the angle ``width`` wide (the bins a run visits, numbered from
+    the run's least angle, bin k centred at least + (k + 1/2) ``width``): a run that passes the same angles again and
+    again adds its samples to the same bins, so the periodogram's cost is the travel's, not the record's (a bin an
+    eighth of the shortest period searched changes no peak)."""
     k = np.floor((x - x.min()) / width).astype(np.int64)
     n = np.bincount(k)
     seen = n > 0
-    centres = x.min() + width * (np.nonzero(seen)[0] + 0.5)
-    return centres, (np.bincount(k, weights=r)[seen] / n[seen])
+    return np.nonzero(seen)[0], (np.bincount(k, weights=r)[seen] / n[seen])
 
 
 #: the angular frequencies of one block of the periodogram (its matrices: samples x this, bounded memory)
@@ -122,6 +122,55 @@ def lombscargle(x, y, omega):
     return out
 
 
+def grid_lombscargle(k, y, width, omega):
+    """:func:`lombscargle` of ``y`` at positions ``width * k``, ``k`` whole numbers (the bins' centres, shifted: the
+    periodogram does not change with a shift), by products instead of a sine and a cosine per sample and frequency:
+    with k = B a + b, exp(i omega width k) = exp(i omega width B a) exp(i omega width b), so the sums over the samples
+    are a matrix product over b and a sum over a (the trigonometric matrices have 2 sqrt(max k) rows, not one per
+    sample). The same power to rounding (tests/test_cost_paths.py); 10-20 times faster on a joint's binned runs.
+
+    Parameters
+    ----------
+    k : array_like of int
+        The positions in units of ``width``, nonnegative, each once.
+    y : array_like
+        The values at the positions (about their mean).
+    width : float
+        The positions' unit.
+    omega : array_like
+        The angular frequencies [rad per unit of ``width``'s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The power at each of ``omega``.
+    """
+    k, y = np.asarray(k, np.int64), np.asarray(y, float)
+    B = int(math.isqrt(int(k.max()))) + 1
+    a, b = np.divmod(k, B)
+    rows = int(a.max()) + 1
+    Y, M = np.zeros((rows, B)), np.zeros((rows, B))
+    Y[a, b], M[a, b] = y, 1.0
+    n = float(k.size)
+    tiny = np.finfo(float).epsneg * n
+    out = np.empty(len(omega))
+    for j in range(0, len(omega), BLOCK):
+        theta = np.asarray(omega[j:j + BLOCK], float) * width
+        fine = np.exp(1j * np.multiply.outer(np.arange(B), theta))  # exp(i theta b)
+        coarse = np.exp(1j * np.multiply.outer(B * np.arange(rows), theta))  # exp(i theta B a)
+        z = np.einsum("af,af->f", coarse, Y @ fine)  # sum y exp(i theta k) = yc + i ys
+        z2 = np.einsum("af,af->f", coarse * coarse, M @ (fine * fine))  # sum exp(2 i theta k)
+        cc, cs = 0.5 * (n + z2.real), 0.5 * z2.imag
+        yc, ys = z.real, z.imag
+        tau = 0.5 * np.arctan2(2.0 * cs, 2.0 * cc - n)
+        ct, st = np.cos(tau), np.sin(tau)
+        YC, YS = ct * yc + st * ys, ct * ys - st * yc
+        CC = np.maximum(ct * ct * cc + 2.0 * ct * st * cs + st * st * (n - cc), tiny)
+        SS = np.maximum(n - CC, tiny)
+        out[j:j + BLOCK] = 0.5 * (YC * YC / CC + YS * YS / SS)
+    return out
+
+
 def strongest_period(runs) -> float | None:
     """The period (in the angle's unit) with the most summed Lomb-Scargle power over ``runs`` [(angle,
     residual)], searched between SAMPLES_PER_PERIOD samples' median travel and half the largest run's travel;
@@ -137,10 +186,11 @@ def strongest_period(runs) -> float | None:
     # a peak is 1/(cycles over the travel) wide, relatively: four points across the narrowest one (the shortest's)
     count = int(np.clip(math.ceil(4 * travel / shortest * math.log(longest / shortest)), 200, PERIODS))
     periods = np.geomspace(shortest, longest, count)
-    binned = [_binned(x, r, shortest / BINS_PER_PERIOD) for x, r in runs]
+    width = shortest / BINS_PER_PERIOD
+    binned = [_binned(x, r, width) for x, r in runs]
     best = None
     for _ in range(2):  # the grid, then a finer one between the best point's neighbours
-        power = sum(lombscargle(x, r, 2 * math.pi / periods) for x, r in binned)
+        power = sum(grid_lombscargle(k, r, width, 2 * math.pi / periods) for k, r in binned)
         k = int(np.argmax(power))
         best = float(periods[k])
         periods = np.linspace(periods[max(k - 1, 0)], periods[min(k + 1, periods.size - 1)], 201)
@@ -243,4 +293,4 @@ def _message(out, unit, measurement, rotary) -> str:
             f"({100 * out['gain']:.2g} % of the misfit){held}")
 
 
-__all__ = ["with_ripple_advice", "strongest_period", "lombscargle", "MATERIAL"]
+__all__ = ["with_ripple_advice", "strongest_period", "lombscargle", "grid_lombscargle", "MATERIAL"]

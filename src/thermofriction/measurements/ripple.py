@@ -24,6 +24,7 @@ waveform's position (which starts at the run's first recorded position), without
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
@@ -97,42 +98,136 @@ def evaluate(model, angle, names=()):
     return R, J, dx
 
 
-def _phase_cost(model, x, r0, centred: bool):
-    """cost(phi) = |r0 + R(x + phi)|^2 (about its mean where ``centred``) from the harmonics at ``x`` computed once:
-    shifted by phi, each harmonic's amplitudes rotate by k w phi (the angle-addition formulas), so the cost is a
-    quadratic form in the rotated amplitudes (their Gram matrix and projections of r0). Each point of the phase's
-    grid was the ripple evaluated on the whole run again: two thirds of a fit with a ripple and a phase per run."""
+def harmonics(angle, period) -> np.ndarray:
+    """The ripple's harmonics at ``angle``: every ripple at ``angle`` shifted by any phase is a product of these with
+    the amplitudes rotated (:func:`shifted`).
+
+    Parameters
+    ----------
+    angle : array_like
+        The positions [m or rad].
+    period : float
+        The ripple's period, in the positions' unit.
+
+    Returns
+    -------
+    numpy.ndarray
+        n x 2 RIPPLE_ORDER: cos(k w x), sin(k w x) for k = 1..RIPPLE_ORDER (cos1, sin1, cos2, ...), w = 2 pi / period.
+    """
+    x = np.asarray(angle, float)
+    w = 2.0 * math.pi / period
+    H = np.empty((x.size, 2 * RIPPLE_ORDER))
+    for k in range(1, RIPPLE_ORDER + 1):
+        H[:, 2 * k - 2], H[:, 2 * k - 1] = np.cos(k * w * x), np.sin(k * w * x)
+    return H
+
+
+#: the harmonics of the angles a fit evaluates again and again ({id: (angle, period, harmonics)}: the angle kept,
+#: so that its id is not reused while it is here); their sines and cosines were most of a force fit's ripple
+_HARMONICS = {}
+#: at most this many bytes of harmonics (and their angles) kept (a fit's run of 20,000 samples: 1.1 MB)
+_HARMONICS_BYTES = 64 * 2 ** 20
+_HARMONICS_LOCK = threading.Lock()
+
+
+def _kept_bytes() -> int:
+    """The bytes the kept harmonics and their angles hold."""
+    return sum(np.asarray(a).nbytes + H.nbytes for a, _, H in _HARMONICS.values())
+
+
+def _harmonics_of(angle, period) -> np.ndarray:
+    """:func:`harmonics` of a trace's (unchanging) angle array, computed once per array and period."""
+    with _HARMONICS_LOCK:
+        hit = _HARMONICS.get(id(angle))
+    if hit is not None and hit[0] is angle and hit[1] == period:
+        return hit[2]
+    H = harmonics(angle, period)
+    if H.nbytes > _HARMONICS_BYTES // 4:  # (a record too long to keep: computed each time, as before)
+        return H
+    with _HARMONICS_LOCK:
+        _HARMONICS.pop(id(angle), None)
+        while _HARMONICS and _kept_bytes() + H.nbytes + np.asarray(angle).nbytes > _HARMONICS_BYTES:
+            _HARMONICS.pop(next(iter(_HARMONICS)))
+        _HARMONICS[id(angle)] = (angle, period, H)
+    return H
+
+
+def _rotated(model, phi):
+    """(alpha, beta, cos, sin): R(x + phi) = H alpha and dR/dx(x + phi) = H beta for the harmonics H at x (the
+    angle-addition formulas: harmonic k's amplitudes rotated by k w phi), and that rotation's cos and sin per k."""
     w = 2.0 * math.pi / model.friction.ripple_period
     a = amplitudes(model)
     k = np.arange(1, RIPPLE_ORDER + 1)
-    C = np.column_stack([f(kk * w * x) for kk in k for f in (np.cos, np.sin)])
+    c, s = np.cos(k * w * phi), np.sin(k * w * phi)
+    ak, bk = a[0::2], a[1::2]
+    alpha, beta = np.empty(a.size), np.empty(a.size)
+    alpha[0::2], alpha[1::2] = ak * c + bk * s, bk * c - ak * s
+    beta[0::2], beta[1::2] = k * w * alpha[1::2], -k * w * alpha[0::2]
+    return alpha, beta, c, s
+
+
+def shifted(model, H, phi, names=()):
+    """:func:`evaluate` at ``angle + phi`` from the harmonics ``H`` at ``angle``: products instead of sines and
+    cosines of the whole run (equal to rounding; closer, at large angles, than the shifted angle's own rounding).
+
+    Parameters
+    ----------
+    model : Model
+        The model whose ripple (period and amplitudes) is evaluated.
+    H : numpy.ndarray
+        The harmonics at the unshifted angle (:func:`harmonics`, at the model's period).
+    phi : float
+        The angle offset [m or rad].
+    names : sequence of str, optional
+        The parameters whose columns are returned (the amplitudes' nonzero, the others' zero).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (R, dR/d names, dR/dx) at ``angle + phi``, as :func:`evaluate` returns them.
+    """
+    alpha, beta, c, s = _rotated(model, phi)
+    J = np.zeros((H.shape[0], len(names)))
+    for j, n in enumerate(names):
+        if n in RIPPLE_AMPLITUDES:
+            i = RIPPLE_AMPLITUDES.index(n)
+            hc, hs = H[:, i - i % 2], H[:, i - i % 2 + 1]
+            k = i // 2
+            J[:, j] = hc * c[k] - hs * s[k] if i % 2 == 0 else hs * c[k] + hc * s[k]
+    return H @ alpha, J, H @ beta
+
+
+def _phase_cost(model, x, r0, centred: bool, H=None):
+    """cost(phi) = |r0 + R(x + phi)|^2 (about its mean where ``centred``) from the harmonics at ``x`` computed once
+    (``H``, :func:`harmonics`, or computed here): shifted by phi, each harmonic's amplitudes rotate by k w phi (the
+    angle-addition formulas), so the cost is a quadratic form in the rotated amplitudes (their Gram matrix and
+    projections of r0). Each point of the phase's grid was the ripple evaluated on the whole run again: two thirds
+    of a fit with a ripple and a phase per run."""
+    C = harmonics(x, model.friction.ripple_period) if H is None else H
     e0 = np.asarray(r0, float)
     if centred:
         C, e0 = C - C.mean(axis=0), e0 - e0.mean()
     G, h, c0 = C.T @ C, C.T @ e0, float(e0 @ e0)
 
-    ak, bk = a[0::2], a[1::2]
-
     def cost(phi):
-        c, s = np.cos(k * w * phi), np.sin(k * w * phi)
-        alpha = np.empty(a.size)
-        alpha[0::2], alpha[1::2] = ak * c + bk * s, bk * c - ak * s
+        alpha = _rotated(model, phi)[0]
         return c0 + 2.0 * float(alpha @ h) + float(alpha @ G @ alpha)
     return cost
 
 
-def best_phase(model, angle, r0, centred: bool) -> float:
+def best_phase(model, angle, r0, centred: bool, H=None) -> float:
     """The angle offset ``phi`` in [0, P) that leaves the least ``r0 + R(angle + phi)`` (about its mean where
-    ``centred``: an offset profiled out too); 0 where the model has no amplitude."""
+    ``centred``: an offset profiled out too); 0 where the model has no amplitude. ``H``: the harmonics at ``angle``
+    (:func:`harmonics`) where the caller has them."""
     if not np.any(amplitudes(model)):
         return 0.0
     P = model.friction.ripple_period
-    x = np.asarray(angle, float)
+    H = harmonics(angle, P) if H is None else H
     grid = P * np.arange(PHASE_GRID) / PHASE_GRID
-    cost = _phase_cost(model, x, r0, centred)
+    cost = _phase_cost(model, angle, r0, centred, H)
     phi = float(grid[int(np.argmin([cost(p) for p in grid]))])
     for _ in range(PHASE_STEPS):  # Gauss-Newton on the angle offset
-        R, _, g = evaluate(model, x + phi)
+        R, _, g = shifted(model, H, phi)
         e = r0 + R
         if centred:
             e, g = e - e.mean(), g - g.mean()
@@ -160,8 +255,9 @@ def added(measurement, problem, model, r0, J):
     for i, tr in enumerate(problem.traces):
         sl = slice(start, start + tr.n_residuals)
         phased = per_run and i > 0  # the first trace is the reference: the amplitudes are in its angle
-        phi = best_phase(model, tr.angle, r[sl], centred) if phased else 0.0
-        R, Jr, dx = evaluate(model, tr.angle + phi, names)
+        H = _harmonics_of(tr.angle, model.friction.ripple_period)  # (the same angles at every evaluation)
+        phi = best_phase(model, tr.angle, r[sl], centred, H) if phased else 0.0
+        R, Jr, dx = shifted(model, H, phi, names)
         r[sl] += R
         if J is not None:
             J[sl] += Jr
@@ -264,5 +360,6 @@ def decide(experiments) -> tuple:
                         "angle (ripple_phase = \"recorded\"; \"per-run\" estimates a phase per run)")
 
 
-__all__ = ["started", "RIPPLE_PHASES", "ZERO_START", "added", "additive", "amplitudes", "best_phase", "check_phase_option",
-           "check_per_run", "decide", "phases_said", "evaluate", "for_run", "has_ripple", "projected", "without"]
+__all__ = ["started", "RIPPLE_PHASES", "ZERO_START", "added", "additive", "amplitudes", "best_phase",
+           "check_phase_option", "check_per_run", "decide", "phases_said", "evaluate", "for_run", "harmonics",
+           "has_ripple", "projected", "shifted", "without"]
