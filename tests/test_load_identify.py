@@ -224,3 +224,15 @@ def test_identify_tells_a_load_blind_fit(data):
     said = [w for w in res.warnings if w.startswith("the model is load-blind")]
     assert len(said) == 1 and "held-out runs" in said[0]
     assert float(re.search(r"\(([0-9.]+)x\)", said[0]).group(1)) >= 5
+
+
+def test_model_i_without_laws_of_load_on_runs_spanning_loads_completes_and_is_told(data):
+    """Regression (was a raw InputError, fs below fc, inside the profile of the constant fitted on all runs): Model
+    I from LuGre fc 3, fs 4 N (the truth: fc 2.2-4.8 N, fs 2.9-6.2 N over these runs) on
+    the stage's runs at 20-95 N completes; being load-blind it is not adequate, and its warnings say it is
+    load-blind with the held-out gain of a load law."""
+    m = Model(PrescribedMotion(motion="linear"), LuGre(sigma0=lt.STAGE_SIGMA0, sigma1=lt.STAGE_SIGMA1, sigma2=30.0,
+                                                       vs=lt.STAGE_VS, fc=3.0, fs=4.0))
+    res = tf.identify(data, method="model-i", init=m, parameters=["fc", "fs", "sigma2"], offset="per-experiment")
+    assert res.fit_quality["adequate"] is False
+    assert any(w.startswith("the model is load-blind") for w in res.warnings)

@@ -19,8 +19,8 @@ from .laws import at_shared, fit_law, law_kinds_for, laws_on_information
 from ..fitting.optimiser import AT_NOISE, fit
 from ..fitting.parameters import EXCESS, Parameters, friction_parameters, get_value, unit_of, with_values
 from ..measurements import make_traces
-from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, profile_range,
-                      profiled, settled_constants, widened)
+from .profile import (PROFILE_FIT_EVALUATIONS, PROFILE_POINTS, PROFILE_RANGE, PROFILE_XTOL, Profiled, fs_kept_above_fc,
+                      profile_range, profiled, settled_constants, widened)
 from .procedures import (along_temperatures, counted, fit_friction, fit_result, held_at, levels_held_as_ratios, fitted_names,
                          stribeck_start, temperature_groups, unrefined_result)
 from .result import FitResult
@@ -165,10 +165,12 @@ class _PerTemperature:
             and _fitted(res, n).stderr < abs(_fitted(res, n).value))]
         at_T = base_model(self.init, T).friction.values()
         reset = {n: at_T[n] for n in open_ if n in at_T and n != "fs"}
+        now = res.model.friction.values()
         if "fs" in open_ and "fs" in at_T:  # fs by its excess over fc (fs >= fc)
-            fc = reset.get("fc", res.model.friction.values()["fc"])
+            fc = reset.get("fc", now["fc"])
             reset["fs"] = fc + max(at_T["fs"] - at_T["fc"], 0.0)
-        return res.model.with_friction(**reset) if reset else res.model
+        free = [n for n in self.names if n not in self.held]
+        return res.model.with_friction(**fs_kept_above_fc(now, reset, free)) if reset else res.model
 
     def refit_all(self, groups, temps, starts, values: dict, opts, held=None) -> list:
         """Every temperature's fit with ``values`` held (and ``held``, default the fits' own), each from
@@ -179,7 +181,9 @@ class _PerTemperature:
         held = self.held if held is None else held
 
         def step(i, carried, first):
-            base = self.carried(starts[i], temps[i]).with_friction(**values)
+            carried_model = self.carried(starts[i], temps[i])
+            free = [n for n in self.names if n not in held and n not in values]
+            base = carried_model.with_friction(**fs_kept_above_fc(carried_model.friction.values(), values, free))
             fits[i] = self.fit_one(groups[i], temps[i], base, held, {**self.opts, "starts": 1, **opts})
             self.nfev += fits[i].nfev
             return carried

@@ -340,7 +340,40 @@ def widened(result, factors: dict) -> None:
             f"widened {factor:.3g}x, to [{par.ci95[0]:.4g}, {par.ci95[1]:.4g}]")
 
 
-__all__ = ["profiled", "Profiled", "profile_range", "PROFILE_RANGE", "PROFILE_XTOL", "PROFILE_POINTS",
+def fs_kept_above_fc(now: dict, changes: dict, free) -> dict:
+    """``changes`` to friction values ``now``, kept inside fs >= fc (the model's rule) where a new fc or fs (a
+    start restarted, a profiled constant's trial value) would cross the other.
+
+    Parameters
+    ----------
+    now : dict
+        The friction's values the changes apply to.
+    changes : dict
+        The new values (name -> value).
+    free : collection of str
+        The names the fit moves (not held).
+
+    Returns
+    -------
+    dict
+        ``changes``, with the other of fc and fs added, where it is free, moved to keep the excess fs - fc it had.
+
+    Raises
+    ------
+    ComputationError
+        The crossing one's partner is held: the trial is outside the model's domain (no cost).
+    """
+    fc, fs = changes.get("fc", now.get("fc")), changes.get("fs", now.get("fs"))
+    if fs is None or fc is None or fs >= fc or ("fc" in changes) == ("fs" in changes):
+        return changes
+    excess = max(now["fs"] - now["fc"], 0.0)
+    moved = "fs" if "fc" in changes else "fc"
+    if moved not in free:
+        raise ComputationError(f"fs {fs:.6g} below fc {fc:.6g} with {moved} held: outside the model's domain")
+    return {**changes, moved: fc + excess if moved == "fs" else (fs - excess if fs - excess > 0 else fs)}
+
+
+__all__ = ["fs_kept_above_fc", "profiled", "Profiled", "profile_range", "PROFILE_RANGE", "PROFILE_XTOL", "PROFILE_POINTS",
            "PROFILE_FIT_EVALUATIONS", "CHI2_95", "HeldEnd", "held_refits", "secant_shifts", "standard_errors", "widened",
            "open_constants", "settled_constants", "OPEN_CONSTANT",
            "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING", "HELD_EVALUATIONS"]

@@ -131,8 +131,8 @@ class Force(Measurement):
             raise InputError(f"{exp.file}: force data are fitted with a prescribed-motion model ([plant] type = "
                              f"\"prescribed\"), not a '{model.plant.type}' plant")
         if load_laws(model):
-            raise InputError("[thermal]: laws of the load are fitted by identification.fit_load_laws (a joint fit at "
-                             "each run's load), not by identify yet")
+            raise InputError(f"[thermal] {', '.join(load_laws(model))}: a law of the load is fitted by identify's Model "
+                             "I (method \"model-i\", each run at its load); this fit takes none")
         if model.heat is not None:
             raise InputError("a self-heating model ([heat]) cannot be fitted to force data yet; fit Model I or II on "
                              "the measured temperatures instead")
