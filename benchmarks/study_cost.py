@@ -90,7 +90,8 @@ STAGES = [(optimiser, "_screened_starts", "start screening"),
           (front, "identify_model_i", "joint refinement"), (front, "identify_model_ii", "joint refinement"),
           (front, "with_held_tests", "held tests"), (procedures, "uncertainty", "intervals"),
           (model_i, "widened", "intervals"), (front, "fit_friction", "force fit"),
-          (front, "with_ripple_advice", "ripple advice"), (front, "_with_generalisation", "held-out check")]
+          (front, "with_ripple_advice", "ripple advice"), (front, "_with_generalisation", "held-out check"),
+          (front, "model_free", "model-free map")]
 COUNTS = ("evaluations", "jacobians", "core_calls", "core_time", "wall")
 
 

@@ -32,10 +32,12 @@ BASELINE_FACTOR = 1.5
 
 def _basis(u, lo, hi, knots):
     """A cubic B-spline design matrix of ``u`` (clipped to [lo, hi]) with ``knots`` interior knots at ``u``'s
-    quantiles (given as the array ``knots``)."""
-    from scipy.interpolate import BSpline
+    quantiles (given as the array ``knots``), sparse (CSR: four entries a row)."""
+    from scipy.interpolate import BSpline  # SciPy on first use: not at the package's import
     t = np.concatenate([[lo] * 4, knots, [hi] * 4])
-    return BSpline.design_matrix(np.clip(u, lo, hi), t, 3).toarray()
+    # extrapolate=True only skips SciPy's range check (Python's min and max over the array: most of the time here);
+    # u is clipped to the knots' range, so nothing is extrapolated
+    return BSpline.design_matrix(np.clip(u, lo, hi), t, 3, extrapolate=True)
 
 
 class _Axis:
@@ -49,10 +51,14 @@ class _Axis:
         self.ok = self.hi > self.lo
 
     def columns(self, u, mask=None):
+        """The spline's columns at ``u`` (sparse; rows outside ``mask`` zero)."""
+        from scipy import sparse
         if not self.ok:
-            return np.zeros((np.size(u), 0))
+            return sparse.csr_matrix((np.size(u), 0))
         B = _basis(np.asarray(u, float), self.lo, self.hi, self.knots)
-        return B if mask is None else B * mask[:, None]
+        if mask is not None:  # four entries a row, in row order: the rows outside the mask zeroed in place
+            B.data *= np.repeat(mask.astype(float), np.diff(B.indptr))
+        return B
 
 
 def since_reversal(v, x) -> np.ndarray:
@@ -83,23 +89,65 @@ class _Travel(_Axis):
 
 
 def _columns(axes, v, x, a):
-    """The map's columns (without offsets) at velocity ``v``, position ``x`` and acceleration ``a`` (None: no
+    """The map's columns (without offsets, sparse) at velocity ``v``, position ``x`` and acceleration ``a`` (None: no
     inertia column): per direction a spline in the speed and one in the distance since the last reversal, a
     spline in the position."""
+    from scipy import sparse
     pos, neg = v > 0, v < 0
     d = since_reversal(v, x)
     cols = [axes["v+"].columns(v, pos), axes["v-"].columns(-v, neg), axes["d"].columns(d, pos),
             axes["d"].columns(d, neg), axes["x"].columns(x)]
     if a is not None:
-        cols.append(np.asarray(a, float)[:, None])
-    return np.hstack(cols)
+        cols.append(sparse.csr_matrix(np.asarray(a, float)[:, None]))
+    return sparse.hstack(cols, format="csr")
+
+
+def _design(axes, runs, own, inertia):
+    """The fit runs' design (sparse): the map's columns and the offsets, each run's own (``own``) or one shared."""
+    from scipy import sparse
+    blocks = []
+    for k, (vr, xr, _, ar) in enumerate(runs):
+        X = _columns(axes, np.asarray(vr, float), np.asarray(xr, float), ar if inertia else None)
+        off = sparse.csr_matrix((np.ones(X.shape[0]), (np.arange(X.shape[0]), np.full(X.shape[0], k if own else 0))),
+                                shape=(X.shape[0], len(runs) if own else 1))
+        blocks.append(sparse.hstack([X, off], format="csr"))
+    return sparse.vstack(blocks, format="csr")
+
+
+def _least_squares(X, F):
+    """A least-squares solution of ``X c = F`` for the sparse, tall, rank-deficient design ``X`` (its columns are
+    B-splines: those of one spline sum to one, as do the offsets'), by the normal equations of the column-scaled
+    design: the Gram matrix (a sparse product, a few entries a row) factored by Cholesky with pivoting (LAPACK's
+    ``pstrf``), which stops where the pivots fall below ``len(F)`` rounding units (the design's null space: no change
+    in ``X c``; on the study's designs its pivots are below 1e-13, the others above 1e-3), the other columns'
+    coefficients zero; then one step of iterative refinement on the residuals (what the squared condition number
+    costs in accuracy, given back). The fitted values, and so both RMSEs, equal numpy's SVD ``lstsq`` of the dense
+    design's to 1e-9 of the noise (tests/test_cost_paths5.py)."""
+    from scipy.linalg import cho_solve, lapack
+    XT = X.T.tocsr()
+    G = (XT @ X).toarray()
+    scale = np.sqrt(np.diag(G))
+    scale[scale == 0] = 1.0
+    L, piv, rank, _ = lapack.dpstrf(G / np.outer(scale, scale), lower=1, tol=np.finfo(float).eps * max(X.shape))
+    kept = piv[:rank] - 1  # (LAPACK's pivots count from 1)
+    factor = (np.tril(L[:rank, :rank]), True)
+
+    def solve(rhs):
+        c = np.zeros(X.shape[1])
+        c[kept] = cho_solve(factor, ((XT @ rhs) / scale)[kept])
+        return c / scale
+
+    c = solve(F)
+    return c + solve(F - X @ c)  # the refinement step
 
 
 def baseline_map(fit_runs, held_runs, per_run_offset: bool) -> dict | None:
     """The model-free baseline: ``{"fit_rmse", "heldout_rmse", "columns", "samples"}`` for runs given as
     ``(velocity, position, force, acceleration or None)``; the offset shared by all runs (fitted on the fit runs,
     kept for the held-out ones) or, with ``per_run_offset``, each run's own (a held-out run's estimated on it, as
-    validate scores it). None where the fit runs cannot determine the map (too few samples for its columns)."""
+    validate scores it). None where the fit runs cannot determine the map (too few samples for its columns).
+    The design is sparse (a few B-splines a row) and built once per run; its least squares by the normal
+    equations (:func:`_least_squares`)."""
     if not fit_runs or not held_runs:
         return None
     v = np.concatenate([r[0] for r in fit_runs])
@@ -109,23 +157,11 @@ def baseline_map(fit_runs, held_runs, per_run_offset: bool) -> dict | None:
     step = float(np.quantile(steps[steps > 0], 0.05)) if np.any(steps > 0) else 0.0  # the slow samples' travel
     axes = {"v+": _Axis(v[v > 0]), "v-": _Axis(-v[v < 0]), "d": _Travel(d, step), "x": _Axis(x)}
     inertia = all(r[3] is not None for r in fit_runs + held_runs)
-
-    def design(runs, own):
-        blocks = []
-        for k, (vr, xr, _, ar) in enumerate(runs):
-            X = _columns(axes, np.asarray(vr, float), np.asarray(xr, float), ar if inertia else None)
-            off = np.zeros((X.shape[0], len(runs) if own else 1))
-            off[:, k if own else 0] = 1.0
-            blocks.append(np.hstack([X, off]))
-        return np.vstack(blocks)
-
-    X = design(fit_runs, per_run_offset)
+    X = _design(axes, fit_runs, per_run_offset, inertia)
     F = np.concatenate([np.asarray(r[2], float) for r in fit_runs])
     if X.shape[0] < 5 * X.shape[1]:
         return None
-    scale = np.sqrt(np.sum(X ** 2, axis=0))
-    scale[scale == 0] = 1.0
-    coef = np.linalg.lstsq(X / scale, F, rcond=None)[0] / scale
+    coef = _least_squares(X, F)
     fit_rmse = float(np.sqrt(np.mean((X @ coef - F) ** 2)))
     n_map = X.shape[1] - (len(fit_runs) if per_run_offset else 1)
     errors = []

@@ -350,10 +350,11 @@ class Force(Measurement):
         predicted, measured = self.predicted(model, exp, rtol, fast=True)
         return measured, predicted
 
-    def predict(self, model, exp, rtol=1e-8) -> "ForcePrediction":
-        """Simulates one force experiment on its own samples and compares the force."""
+    def predict(self, model, exp, rtol=1e-8, fast=False) -> "ForcePrediction":
+        """Simulates one force experiment on its own samples and compares the force (``fast``: by the exact stepping
+        wherever it applies, as :meth:`friction_of`)."""
         self.check_model(model, [exp])
-        pred, meas = self.predicted(model, exp, rtol)
+        pred, meas = self.predicted(model, exp, rtol, fast)
         err = pred - meas
         span = float(np.ptp(meas))
         bias = float(np.mean(err))
