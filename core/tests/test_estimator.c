@@ -37,7 +37,7 @@ static tf_temperature_config config(double C_2, int proxy)
 static double step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double Fm, double Tp, double Ta, double dt)
 {
     double F;
-    tf_temperature_step(e, f, v, Fm, Tp, Ta, dt, &F, &E);
+    tf_temperature_step(e, f, v, NAN, Fm, Tp, Ta, dt, &F, &E);
     return F;
 }
 
@@ -179,9 +179,9 @@ static void test_refusals_name_the_argument_and_change_nothing(void)
     memcpy(&e0, &e, sizeof e);
     memcpy(&f0, &f, sizeof f);
     double F = 0.0;
-    CHECK(tf_temperature_step(NULL, &f, 0, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "step NULL e");
-    CHECK(tf_temperature_step(&e, NULL, 0, NAN, NAN, 25, 1e-3, &F, &E) == B, "step NULL f");
-    CHECK(tf_temperature_step(&e, &f, 0, NAN, NAN, 25, 1e-3, NULL, &E) == B, "step NULL F_hat");
+    CHECK(tf_temperature_step(NULL, &f, 0, NAN, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "step NULL e");
+    CHECK(tf_temperature_step(&e, NULL, 0, NAN, NAN, NAN, 25, 1e-3, &F, &E) == B, "step NULL f");
+    CHECK(tf_temperature_step(&e, &f, 0, NAN, NAN, NAN, 25, 1e-3, NULL, &E) == B, "step NULL F_hat");
     struct { double v, Fm, Tp, Ta, dt; const char *what; } bad[] = {
         {NAN, NAN, NAN, 25, 1e-3, "v"}, {0, INFINITY, NAN, 25, 1e-3, "F_measured"},
         {0, NAN, -INFINITY, 25, 1e-3, "T_proxy"}, {0, NAN, 30.0, 25, 1e-3, "T_proxy (given"},
@@ -189,14 +189,14 @@ static void test_refusals_name_the_argument_and_change_nothing(void)
         {0, NAN, NAN, 25, INFINITY, "dt"}};
     for (int k = 0; k < 8; k++) {
         F = 0.0;
-        CHECK(tf_temperature_step(&e, &f, bad[k].v, bad[k].Fm, bad[k].Tp, bad[k].Ta, bad[k].dt, &F, &E) == B &&
+        CHECK(tf_temperature_step(&e, &f, bad[k].v, NAN, bad[k].Fm, bad[k].Tp, bad[k].Ta, bad[k].dt, &F, &E) == B &&
               isnan(F) && strstr(E.what, bad[k].what) == E.what, "step refuses %s: %s", bad[k].what, E.what);
     }
     /* the friction model refused at the estimate (fc(T) <= 0 beyond 125 C), and an overflow */
     e.x[0] = 200.0;
-    CHECK(tf_temperature_step(&e, &f, 1e-2, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "fc <= 0 at 200 C");
+    CHECK(tf_temperature_step(&e, &f, 1e-2, NAN, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "fc <= 0 at 200 C");
     e.x[0] = e0.x[0];
-    CHECK(tf_temperature_step(&e, &f, 1e308, NAN, NAN, 25, 1e-3, &F, &E) == TF_ERR_NONFINITE, "overflow: %d", E.code);
+    CHECK(tf_temperature_step(&e, &f, 1e308, NAN, NAN, NAN, 25, 1e-3, &F, &E) == TF_ERR_NONFINITE, "overflow: %d", E.code);
     /* (field by field: the struct's padding, copied from the caller's config, is not a value) */
     CHECK(!memcmp(e.x, e0.x, sizeof e.x) && !memcmp(e.P, e0.P, sizeof e.P) && !memcmp(e.s, e0.s, sizeof e.s) &&
           e.h == e0.h && e.gated == e0.gated && !memcmp(e.g, e0.g, sizeof e.g) && e.g_dt == e0.g_dt &&
