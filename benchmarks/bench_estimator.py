@@ -40,8 +40,9 @@ def main(runs: int = 15):
                                                     measured_force=F).stats["seconds"],
              "estimator, two nodes + proxy": lambda: two.run(model, v, dt=dt, ambient=30.0, start=30.0,
                                                              measured_force=F, proxy_temperature=T).stats["seconds"],
-             "two nodes + proxy, load law": lambda: two.run(loaded, v, dt=dt, ambient=30.0, start=30.0, measured_force=F,
-                                                            proxy_temperature=T, load=N).stats["seconds"]}
+             "two nodes + proxy, load law": lambda: two.run(loaded, v, dt=dt, ambient=30.0, start=30.0,
+                                                            measured_force=F, proxy_temperature=T,
+                                                            load=N).stats["seconds"]}
     times = {name: [] for name in cases}
     for _ in range(runs):
         for name, run in cases.items():

@@ -328,7 +328,7 @@ def test_the_temperature_estimator_needs_a_load_for_a_law_of_the_load_naming_it(
     """The online estimator steps its model at the load it is given (estimator.c): a model with a law of the load
     and no load is refused before any step, naming the law; a NaN load in the samples is refused naming it."""
     est = tf.control.TemperatureEstimator(C_th=1.0, R_th=1.0, r_F=0.01)
-    with pytest.raises(tf.InputError, match=r"run: the model has a law of the load \(fc\): give load="):
+    with pytest.raises(tf.InputError, match=r"run: the model has a law of the load \(fc, fs\): give load="):
         est.run(preloaded_stage(), np.full(100, 0.01), dt=1e-3, ambient=25.0, start=25.0,
                 measured_force=np.ones(100))
     bad = np.full(100, 60.0)

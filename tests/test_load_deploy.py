@@ -376,8 +376,8 @@ def test_the_loop_needs_a_load_for_a_law_of_the_load_and_checks_it():
     with pytest.raises(tf.InputError, match=r"Observer: load must be"):
         C.Observer(stage, load="heavy")
     est = TemperatureEstimator(C_th=50.0, R_th=2.0, r_F=0.01)
-    with pytest.raises(tf.InputError, match=r"compensation's model has a law of the load \(fc\) and its estimator is "
-                                            r"told no load"):
+    with pytest.raises(tf.InputError, match=r"compensation's model has a law of the load \(fc, fs\) and its "
+                                            r"estimator is told no load"):
         C.simulate_loop(tf.load_model("stage-model-i"), ref, temperature=30.0,
                         compensation=C.FeedForward(stage, temperature=est))
     told = C.simulate_loop(stage, ref, temperature=30.0, load=50.0, compensation=C.FeedForward(stage, temperature=est))
