@@ -10,8 +10,9 @@
  *   Y = thermofriction_mex('simulate', h, t, drive, temperature, rtol)
  *       % N x 5: displacement, velocity, friction force, temperature, stage displacement (NaN: not an
  *       % output of this plant); temperature [] for a model without a temperature input
- *   F = thermofriction_mex('friction', h, v, T, dt)          % tf_rt_step once per element of v
- *   F = thermofriction_mex('observer', h, v, e, k, T, dt)    % tf_observer_step once per element of v
+ *   F = thermofriction_mex('friction', h, v, T, dt[, load])       % tf_rt_step once per element of v
+ *   F = thermofriction_mex('observer', h, v, e, k, T, dt[, load]) % tf_observer_step once per element of v
+ *       % load [N or N m]: read by a law of the load (required by a model with one; without: NaN, ignored)
  *   thermofriction_mex('reset', h)                           % the friction loop's states to rest
  *   thermofriction_mex('close', h)
  *
@@ -207,33 +208,36 @@ static void cmd_simulate(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
     plhs[0] = Y;
 }
 
-/* tf_rt_step (k NULL) or tf_observer_step once per velocity sample. */
+/* tf_rt_step (k NULL) or tf_observer_step once per velocity sample, at the optional trailing load (one value
+ * or one per sample; absent: NaN, which a model without a law of the load ignores and one with refuses). */
 static void cmd_friction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[], int observer)
 {
-    if (nrhs != (observer ? 7 : 5))
-        fail("thermofriction:argument", observer ? "observer takes a handle, v, e, k, T and dt"
-                                                 : "friction takes a handle, v, T and dt");
+    int base = observer ? 7 : 5;
+    if (nrhs != base && nrhs != base + 1)
+        fail("thermofriction:argument", observer ? "observer takes a handle, v, e, k, T, dt and optionally the load"
+                                                 : "friction takes a handle, v, T, dt and optionally the load");
     slot *s = handle(prhs[1]);
     size_t n;
     const double *v = reals(prhs[2], "v", &n);
-    int se = 0, sk = 0, sT, sd;
+    int se = 0, sk = 0, sT, sd, sL = 0;
+    const double none = NAN;
     const double *e = observer ? per_sample(prhs[3], "e", n, &se) : NULL;
     const double *k = observer ? per_sample(prhs[4], "k", n, &sk) : NULL;
     const double *T = per_sample(prhs[observer ? 5 : 3], "T", n, &sT);
     const double *dt = per_sample(prhs[observer ? 6 : 4], "dt", n, &sd);
+    const double *L = nrhs > base ? per_sample(prhs[base], "load", n, &sL) : &none;
     mxArray *out = mxCreateDoubleMatrix(mxGetM(prhs[2]), mxGetN(prhs[2]), mxREAL);
     double *F = mxGetPr(out);
     for (size_t i = 0; i < n; i++) {
         tf_error err;
-        /* no load yet: a model with a law of the load is refused, one without ignores it */
-        tf_status st = observer ? tf_observer_step(&s->rt, v[i], e[i * se], k[i * sk], T[i * sT], NAN, dt[i * sd],
-                                                   &F[i], &err)
-                                : tf_rt_step(&s->rt, v[i], T[i * sT], NAN, dt[i * sd], &F[i], &err);
+        tf_status st = observer ? tf_observer_step(&s->rt, v[i], e[i * se], k[i * sk], T[i * sT], L[i * sL],
+                                                   dt[i * sd], &F[i], &err)
+                                : tf_rt_step(&s->rt, v[i], T[i * sT], L[i * sL], dt[i * sd], &F[i], &err);
         if (st != TF_OK) {
             mxDestroyArray(out);
-            fail("thermofriction:refused", "%s: step %d (v = %g m/s, T = %g C, dt = %g s) refused: %s (%s: '%s'); "
-                 "the steps before it were taken", observer ? "observer" : "friction", (int)i + 1, v[i], T[i * sT],
-                 dt[i * sd], tf_status_message(st), err.where, err.what);
+            fail("thermofriction:refused", "%s: step %d (v = %g m/s, T = %g C, load = %g, dt = %g s) refused: %s "
+                 "(%s: '%s'); the steps before it were taken", observer ? "observer" : "friction", (int)i + 1, v[i],
+                 T[i * sT], L[i * sL], dt[i * sd], tf_status_message(st), err.where, err.what);
         }
     }
     plhs[0] = out;

@@ -166,7 +166,7 @@ int main(int argc, char **argv)
     for (long i = 0; i < n; i++) {
         double s[3], o[3];
         if (fread(s, sizeof s, 1, in) != 1) return 4;
-        if (tf_temperature_step(&est, &f, s[0], s[1], NAN, s[2], %(dt)r, &o[2], &e)) return 5;
+        if (tf_temperature_step(&est, &f, s[0], NAN, s[1], NAN, s[2], %(dt)r, &o[2], &e)) return 5;
         o[0] = tf_temperature_estimate(&est), o[1] = tf_temperature_variance(&est);
         fwrite(o, sizeof o, 1, out);
     }

@@ -324,11 +324,14 @@ def test_the_command_line_simulates_a_load_file_as_python_does(tmp_path):
     assert r.returncode == 2 and "line 1: the value column must be normal_force[N] or load_torque[N*m]" in r.stderr
 
 
-def test_the_temperature_estimator_refuses_a_law_of_the_load_naming_it():
-    """The online estimator steps its model at no load (estimator.c): a model with a law of the load is refused
-    before any step, naming the law, not at its first sample."""
+def test_the_temperature_estimator_needs_a_load_for_a_law_of_the_load_naming_it():
+    """The online estimator steps its model at the load it is given (estimator.c): a model with a law of the load
+    and no load is refused before any step, naming the law; a NaN load in the samples is refused naming it."""
     est = tf.control.TemperatureEstimator(C_th=1.0, R_th=1.0, r_F=0.01)
-    with pytest.raises(tf.InputError, match=r"\[thermal\] fc: a law of the load .*not an input of the temperature "
-                                            r"estimator"):
+    with pytest.raises(tf.InputError, match=r"run: the model has a law of the load \(fc, fs\): give load="):
         est.run(preloaded_stage(), np.full(100, 0.01), dt=1e-3, ambient=25.0, start=25.0,
                 measured_force=np.ones(100))
+    bad = np.full(100, 60.0)
+    bad[7] = np.nan
+    with pytest.raises(tf.InputError, match=r"run: load\[7\] is nan"):
+        est.run(preloaded_stage(), np.full(100, 0.01), dt=1e-3, ambient=25.0, start=25.0, load=bad)

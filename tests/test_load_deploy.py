@@ -217,8 +217,8 @@ def test_the_fmu_warns_outside_the_load_range_and_refuses_a_bad_load(tmp_path):
     """The load laws' range of |load| (30..150 N) is the FMU's as the temperature's is: a load of 180 N steps with
     fmi2Warning and a logged message naming the range (once per excursion); a NaN load is refused with an error,
     the state unchanged; a load where the model leaves its domain (fc = mu |N| = 0 at N = 0) is refused. A model
-    whose laws have no range needs the load's start at export; the temperature estimator (which steps its model at
-    no load) is refused with a law of the load."""
+    whose laws have no range needs the load's start at export; the temperature estimator exports with a law of the
+    load (it steps at the load input)."""
     model = preloaded_stage()
     path = tmp_path / "s.fmu"
     export_fmu(model, path, temperature=30.0)
@@ -242,10 +242,9 @@ def test_the_fmu_warns_outside_the_load_range_and_refuses_a_bad_load(tmp_path):
     with pytest.raises(tf.InputError, match="no load range: give the load input's start"):
         export_fmu(preloaded_stage(rng=None), tmp_path / "n.fmu", temperature=30.0)
     export_fmu(preloaded_stage(rng=None), tmp_path / "n.fmu", temperature=30.0, load=70.0)
-    with pytest.raises(tf.InputError, match="the temperature estimator steps its friction model at no load"):
-        export_fmu(model, tmp_path / "e.fmu", temperature=30.0, estimator=TemperatureEstimator(C_th=5.0, R_th=2.0,
-                                                                                                r_F=0.01))
-    assert not (tmp_path / "e.fmu").exists()
+    export_fmu(model, tmp_path / "e.fmu", temperature=30.0, estimator=TemperatureEstimator(C_th=5.0, R_th=2.0,
+                                                                                            r_F=0.01))
+    assert (tmp_path / "e.fmu").exists()  # the estimator steps at the load input (tests/test_estimator_load.py)
 
 
 DLL = binary_path("win64")
@@ -359,8 +358,8 @@ def test_a_load_blind_feed_forward_costs_what_the_load_changes():
 
 def test_the_loop_needs_a_load_for_a_law_of_the_load_and_checks_it():
     """The loop names the law that needs a load; a load series of the wrong length, a NaN load or a load where the
-    model leaves its domain is refused naming it; a temperature estimator cannot step a law of the load; a
-    load-free stage ignores the load."""
+    model leaves its domain is refused naming it; a temperature estimator steps a law of the load at the
+    compensation's load (and needs one); a load-free stage ignores the load."""
     stage = loop_stage()
     ref = C.sine_reference(1e-3, 1.0, 0.05)
     with pytest.raises(tf.InputError, match=r"the stage: \[thermal\] fc: a law of the load.*give the run's load"):
@@ -377,8 +376,12 @@ def test_the_loop_needs_a_load_for_a_law_of_the_load_and_checks_it():
     with pytest.raises(tf.InputError, match=r"Observer: load must be"):
         C.Observer(stage, load="heavy")
     est = TemperatureEstimator(C_th=50.0, R_th=2.0, r_F=0.01)
-    with pytest.raises(tf.InputError, match="steps its friction model at no load"):
-        C.simulate_loop(stage, ref, temperature=30.0, load=50.0, compensation=C.FeedForward(stage, temperature=est))
+    with pytest.raises(tf.InputError, match=r"compensation's model has a law of the load \(fc, fs\) and its "
+                                            r"estimator is told no load"):
+        C.simulate_loop(tf.load_model("stage-model-i"), ref, temperature=30.0,
+                        compensation=C.FeedForward(stage, temperature=est))
+    told = C.simulate_loop(stage, ref, temperature=30.0, load=50.0, compensation=C.FeedForward(stage, temperature=est))
+    assert np.all(np.isfinite(told.compensation_temperature)) and np.all(told.compensation_load == 50.0)
     free = tf.load_model("stage-model-i")
     a = C.simulate_loop(free, ref, temperature=35.0, compensation=C.Observer(free))
     b = C.simulate_loop(free, ref, temperature=35.0, load=80.0, compensation=C.Observer(free, load=20.0))

@@ -595,7 +595,7 @@ static void est_sync_model(instance *c)
     memcpy(c->est_rt.data.gms.mode, modes, sizeof modes);
 }
 
-/* One estimator step over the communication step h at the sliding velocity v of its start, into the trial
+/* One estimator step over the communication step h at the sliding velocity v and the load of its start, into the trial
  * copies (est_commit takes them once the plant's step succeeded): 0, or logs why not and returns -1. */
 static int est_step(instance *c, double v, double h)
 {
@@ -605,8 +605,9 @@ static int est_step(instance *c, double v, double h)
     double T_amb = c->heat ? c->r[VR_TEMPERATURE] : c->r[VR_AMBIENT], F;
     double T_proxy = c->est_proxy != TF_PROXY_NONE ? c->r[VR_PROXY_TEMPERATURE] : NAN;
     tf_error e;
-    tf_status s = tf_temperature_step(&c->est_trial, &c->est_rt_trial, v, c->r[VR_MEASURED_FORCE], T_proxy, T_amb, h,
-                                      &F, &e);
+    double load = c->load_input ? c->r[VR_LOAD] : NAN; /* the friction's load input, at the step's start as v */
+    tf_status s = tf_temperature_step(&c->est_trial, &c->est_rt_trial, v, load, c->r[VR_MEASURED_FORCE], T_proxy,
+                                      T_amb, h, &F, &e);
     if (s != TF_OK)
         return (fmu_fail(c, "the temperature estimator's step at %g s (estimate %g C) was refused: %s ('%s')", c->t,
                          c->est.x[0], tf_status_message(s), e.what), -1);

@@ -200,9 +200,10 @@ typedef struct {
 } dob_memory;
 
 /* The compensation's temperature in period i (and its variance, the measured friction), from the
- * estimator stepped on the disturbance observer's friction, a sensor's series or the constant. */
-static tf_status told_temperature(tf_loop *L, long i, double x, dob_memory *d, double *T, double *var, double *Fm,
-                                  tf_error *err)
+ * estimator stepped on the disturbance observer's friction at the compensation's load, a sensor's series or the
+ * constant. */
+static tf_status told_temperature(tf_loop *L, long i, double x, double load, dob_memory *d, double *T, double *var,
+                                  double *Fm, tf_error *err)
 {
     double xe = x + (L->position_noise ? L->position_noise[i] : 0.0), dt = L->dt;
     *var = 0.0, *Fm = NAN;
@@ -218,7 +219,7 @@ static tf_status told_temperature(tf_loop *L, long i, double x, dob_memory *d, d
         vc = (xe - d->x2) / (2.0 * dt);
     }
     double Tp = L->T_proxy ? L->T_proxy[i] : NAN;
-    tf_status status = tf_temperature_step(L->estimator, L->est_friction, vc, *Fm, Tp, L->T_amb, dt, &F_hat, err);
+    tf_status status = tf_temperature_step(L->estimator, L->est_friction, vc, load, *Fm, Tp, L->T_amb, dt, &F_hat, err);
     if (status) return stop_in(err, status, "estimator", i);
     d->x2 = d->x1, d->x1 = xe;
     *T = tf_temperature_estimate(L->estimator);
@@ -247,7 +248,7 @@ tf_status tf_loop_run(tf_loop *L, long n, const double *x_ref, const double *v_r
         double T_plant = L->T_plant_series ? L->T_plant_series[i] : L->T_plant;
         double L_plant = L->load_plant_series ? L->load_plant_series[i] : L->load_plant;
         double L_comp = L->load_comp_series ? L->load_comp_series[i] : L->load_comp;
-        if ((status = told_temperature(L, i, x, &d, &Tc, &var, &Fm, err))) return status;
+        if ((status = told_temperature(L, i, x, L_comp, &d, &Tc, &var, &Fm, err))) return status;
         if ((status = tf_pid_step(&L->pid, e, L->dt, &u, 0)))
             return stop(err, status, "pid", "u (not finite: the loop is unstable)", i);
         if (L->compensation == TF_COMP_FEEDFORWARD)

@@ -11,9 +11,6 @@
  * round-off, 1e-16 F / d, both far below what a temperature estimate resolves. One-sided: two friction
  * steps per estimator step, not three (a third of the cost). */
 #define TF_ESTIMATOR_DT 1e-4
-/* The load the estimator steps its friction model at: none yet (a model with a law of the load is refused,
- * "load (not finite...)"; one without ignores it). */
-#define TF_ESTIMATOR_LOAD NAN
 /* The gate on the friction update: skipped where h^2 P_cc < GATE r_F (it would move Tc by less than
  * GATE of the way to the measurement's temperature). */
 #define TF_ESTIMATOR_GATE 1e-9
@@ -113,26 +110,27 @@ static void restore(tf_rt_friction *f, int nz, const rt_backup *b)
 }
 
 /* A trial step from z0 + d s at Tc + d: its force, and its states into z (f restored). */
-static tf_status trial(tf_rt_friction *f, int nz, const rt_backup *b, const double *s, double v, double Tc,
-                       double dt, double *F, double *z)
+static tf_status trial(tf_rt_friction *f, int nz, const rt_backup *b, const double *s, double v, double load,
+                       double Tc, double dt, double *F, double *z)
 {
     for (int j = 0; j < nz; j++) f->z[j] = b->z[j] + TF_ESTIMATOR_DT * s[j];
-    tf_status st = tf_rt_step(f, v, Tc + TF_ESTIMATOR_DT, TF_ESTIMATOR_LOAD, dt, F, 0);
+    tf_status st = tf_rt_step(f, v, Tc + TF_ESTIMATOR_DT, load, dt, F, 0);
     memcpy(z, f->z, sizeof(double) * nz);
     restore(f, nz, b);
     return st;
 }
 
-/* Step 1: f advanced at Tc (tf_rt_step), its force into *F; h = dF/dTc and the new s into s_new (the
+/* Step 1: f advanced at Tc and the load (tf_rt_step), its force into *F; h = dF/dTc and the new s into s_new (the
  * directional forward difference along (s, 1): z follows Tc). A refused trial step (a law's domain
  * edge within TF_ESTIMATOR_DT): h = 0 and s kept. */
 static tf_status friction_step(const tf_temperature_estimator *e, tf_rt_friction *f, int nz, const rt_backup *b,
-                               double v, double dt, double *F, double *h, double *s_new, tf_error *err)
+                               double v, double load, double dt, double *F, double *h, double *s_new,
+                               tf_error *err)
 {
     double Fp, zp[TF_MAX_FRICTION_STATES];
     double Tc = e->x[0];
-    int ok = trial(f, nz, b, e->s, v, Tc, dt, &Fp, zp) == TF_OK;
-    tf_status st = tf_rt_step(f, v, Tc, TF_ESTIMATOR_LOAD, dt, F, err);
+    int ok = trial(f, nz, b, e->s, v, load, Tc, dt, &Fp, zp) == TF_OK;
+    tf_status st = tf_rt_step(f, v, Tc, load, dt, F, err);
     if (st) return st;
     *h = ok ? (Fp - *F) / TF_ESTIMATOR_DT : 0.0;
     for (int j = 0; j < nz; j++) s_new[j] = ok ? (zp[j] - f->z[j]) / TF_ESTIMATOR_DT : e->s[j];
@@ -240,8 +238,8 @@ static int all_finite(const tf_temperature_estimator *e, const double *x, double
     return ok;
 }
 
-tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double F_measured,
-                              double T_proxy, double T_amb, double dt, double *F_hat, tf_error *err)
+tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double load,
+                              double F_measured, double T_proxy, double T_amb, double dt, double *F_hat, tf_error *err)
 {
     if (F_hat) *F_hat = NAN;
     const char *bad = step_problem(e, f, v, F_measured, T_proxy, T_amb, dt, F_hat);
@@ -251,7 +249,7 @@ tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, do
     rt_backup b;
     save(f, nz, &b);
     double F, h, s[TF_MAX_FRICTION_STATES];
-    tf_status st = friction_step(e, f, nz, &b, v, dt, &F, &h, s, err);
+    tf_status st = friction_step(e, f, nz, &b, v, load, dt, &F, &h, s, err);
     if (st) return st;
     /* 2. predict: P = |F v|, dP/dTc = sgn(F v) v h */
     double x[3] = {e->x[0], e->x[1], e->x[2]}, P[3][3], A[3][3] = {{0}};

@@ -37,7 +37,7 @@ static tf_temperature_config config(double C_2, int proxy)
 static double step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double Fm, double Tp, double Ta, double dt)
 {
     double F;
-    tf_temperature_step(e, f, v, Fm, Tp, Ta, dt, &F, &E);
+    tf_temperature_step(e, f, v, NAN, Fm, Tp, Ta, dt, &F, &E);
     return F;
 }
 
@@ -102,6 +102,44 @@ static void test_h_is_the_steady_sliding_slope(void)
     double slope = -0.01 * (1.0 - exp(-pow(v / 1e-3, 2)));
     /* (a linear law: the forward difference is exact up to round-off, 1e-16 F / 1e-4 K) */
     CHECK(fabs(e.h - slope) < 1e-6 * fabs(slope), "h %.10g vs dF/dT %.10g", e.h, slope);
+}
+
+static void test_h_follows_the_load(void)
+{
+    /* Oracle (analytic): fc(T, L) = fc0(T) (1 + k |L|) + c T |L| (law.h's affine product with an interaction),
+     * fc0 = 1.25 - 0.01 T, k = 0.02 / N, c = -1e-4 / (C N): in steady sliding dF/dT = (-0.01 (1 + k |L|) + c |L|)
+     * (1 - exp(-(v/vs)^2)), at each load the estimator is told (the load switched from 5 to 20 N mid-run);
+     * F_hat is the force of a plain tf_rt_step stepped alongside at the same (v, T, L); a NaN load is refused
+     * naming it, the estimator unchanged. */
+    static tf_rt_friction f, g;
+    tf_temperature_estimator e;
+    lugre(&f, 0);
+    tf_law law = fc_law;
+    law.load.kind = TF_LOAD_AFFINE, law.load.combine = TF_COMBINE_PRODUCT, law.load.k = 0.02;
+    law.load.interaction = 1, law.load.c = -1e-4;
+    CHECK(tf_rt_set_model_i(&f, TF_P_FC, &law, &E) == TF_OK, "a law of the load: %s", E.what);
+    g = f;
+    tf_temperature_config c = config(0.0, TF_PROXY_NONE);
+    c.eta = 0.0;
+    CHECK(tf_temperature_init(&e, &c, 30.0, 1.0, &E) == TF_OK, "init: %s", E.what);
+    double v = 1.5e-3, L[2] = {5.0, 20.0};
+    for (int j = 0; j < 2; j++) {
+        double F = NAN, G = NAN;
+        int ok = 1;
+        for (int k = 0; k < 2000; k++) {
+            ok = ok && tf_temperature_step(&e, &f, v, L[j], NAN, NAN, 30.0, 1e-4, &F, &E) == TF_OK;
+            tf_rt_step(&g, v, 30.0, L[j], 1e-4, &G, 0);
+        }
+        CHECK(ok, "steps at load %g: %s", L[j], E.what);
+        double slope = (-0.01 * (1.0 + 0.02 * L[j]) - 1e-4 * L[j]) * (1.0 - exp(-pow(v / 1e-3, 2)));
+        CHECK(fabs(e.h - slope) < 1e-6 * fabs(slope), "h %.10g vs dF/dT %.10g at %g N", e.h, slope, L[j]);
+        CHECK(F == G, "F_hat %.17g vs tf_rt_step %.17g at %g N", F, G, L[j]);
+    }
+    tf_temperature_estimator e0 = e;
+    double F = 0.0;
+    CHECK(tf_temperature_step(&e, &f, v, NAN, NAN, NAN, 30.0, 1e-4, &F, &E) == TF_ERR_BAD_ARGUMENT && isnan(F) &&
+              !strncmp(E.what, "load (not finite", 16) && e.x[0] == e0.x[0] && e.P[0][0] == e0.P[0][0],
+          "a NaN load refused by a law of the load: %s", E.what);
 }
 
 static void test_h_of_a_static_model_ii(void)
@@ -179,9 +217,9 @@ static void test_refusals_name_the_argument_and_change_nothing(void)
     memcpy(&e0, &e, sizeof e);
     memcpy(&f0, &f, sizeof f);
     double F = 0.0;
-    CHECK(tf_temperature_step(NULL, &f, 0, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "step NULL e");
-    CHECK(tf_temperature_step(&e, NULL, 0, NAN, NAN, 25, 1e-3, &F, &E) == B, "step NULL f");
-    CHECK(tf_temperature_step(&e, &f, 0, NAN, NAN, 25, 1e-3, NULL, &E) == B, "step NULL F_hat");
+    CHECK(tf_temperature_step(NULL, &f, 0, NAN, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "step NULL e");
+    CHECK(tf_temperature_step(&e, NULL, 0, NAN, NAN, NAN, 25, 1e-3, &F, &E) == B, "step NULL f");
+    CHECK(tf_temperature_step(&e, &f, 0, NAN, NAN, NAN, 25, 1e-3, NULL, &E) == B, "step NULL F_hat");
     struct { double v, Fm, Tp, Ta, dt; const char *what; } bad[] = {
         {NAN, NAN, NAN, 25, 1e-3, "v"}, {0, INFINITY, NAN, 25, 1e-3, "F_measured"},
         {0, NAN, -INFINITY, 25, 1e-3, "T_proxy"}, {0, NAN, 30.0, 25, 1e-3, "T_proxy (given"},
@@ -189,14 +227,15 @@ static void test_refusals_name_the_argument_and_change_nothing(void)
         {0, NAN, NAN, 25, INFINITY, "dt"}};
     for (int k = 0; k < 8; k++) {
         F = 0.0;
-        CHECK(tf_temperature_step(&e, &f, bad[k].v, bad[k].Fm, bad[k].Tp, bad[k].Ta, bad[k].dt, &F, &E) == B &&
+        CHECK(tf_temperature_step(&e, &f, bad[k].v, NAN, bad[k].Fm, bad[k].Tp, bad[k].Ta, bad[k].dt, &F, &E) == B &&
               isnan(F) && strstr(E.what, bad[k].what) == E.what, "step refuses %s: %s", bad[k].what, E.what);
     }
     /* the friction model refused at the estimate (fc(T) <= 0 beyond 125 C), and an overflow */
     e.x[0] = 200.0;
-    CHECK(tf_temperature_step(&e, &f, 1e-2, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "fc <= 0 at 200 C");
+    CHECK(tf_temperature_step(&e, &f, 1e-2, NAN, NAN, NAN, 25, 1e-3, &F, &E) == B && isnan(F), "fc <= 0 at 200 C");
     e.x[0] = e0.x[0];
-    CHECK(tf_temperature_step(&e, &f, 1e308, NAN, NAN, 25, 1e-3, &F, &E) == TF_ERR_NONFINITE, "overflow: %d", E.code);
+    CHECK(tf_temperature_step(&e, &f, 1e308, NAN, NAN, NAN, 25, 1e-3, &F, &E) == TF_ERR_NONFINITE, "overflow: %d",
+          E.code);
     /* (field by field: the struct's padding, copied from the caller's config, is not a value) */
     CHECK(!memcmp(e.x, e0.x, sizeof e.x) && !memcmp(e.P, e0.P, sizeof e.P) && !memcmp(e.s, e0.s, sizeof e.s) &&
           e.h == e0.h && e.gated == e0.gated && !memcmp(e.g, e0.g, sizeof e.g) && e.g_dt == e0.g_dt &&
@@ -214,6 +253,7 @@ int main(void)
     test_one_node_relaxes_exactly();
     test_two_nodes_reach_the_analytic_steady_state();
     test_h_is_the_steady_sliding_slope();
+    test_h_follows_the_load();
     test_h_of_a_static_model_ii();
     test_converges_from_five_kelvin_off();
     test_refusals_name_the_argument_and_change_nothing();

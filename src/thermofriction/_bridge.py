@@ -322,12 +322,12 @@ def rt_steps(spec, T, v, dt, F_out, load=math.nan) -> float:
     return _core.rt_steps(spec, T, v, float(dt), F_out, load)
 
 
-def temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy, T_amb, dt, T_out, var_out, F_out) -> float:
+def temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy, T_amb, dt, T_out, var_out, F_out,
+                         load=None) -> float:
     """The temperature estimator of estimator.h over whole arrays (config: tf_temperature_config's fields in
-    order; T_proxy None or one per sample); the outputs written in place; seconds, timed in C."""
-    return _core.temperature_estimate(spec, config,
-                                      float(T0), float(var0), v, F_measured, T_proxy, T_amb, float(dt), T_out,
-                                      var_out, F_out)
+    order; T_proxy and the load None or one per sample); the outputs written in place; seconds, timed in C."""
+    return _core.temperature_estimate(spec, config, float(T0), float(var0), v, load, F_measured, T_proxy, T_amb,
+                                      float(dt), T_out, var_out, F_out)
 
 
 __all__ = ["PARAMETERS", "PLANT_CODES", "FRICTION_CODES", "LAW_CODES", "OUTPUTS", "OUTPUT_COLUMN", "MECHANICAL_STATES",

@@ -815,33 +815,34 @@ done:
     return result;
 }
 
-/* temperature_estimate(spec, config, T0, var0, v, F_measured, T_proxy|None, T_amb, dt, T_out, var_out, F_out)
- * -> seconds: the estimator of estimator.h over n samples (v, F_measured, T_amb: n each; NaN in F_measured:
- * none; T_proxy: None or n values, NaN: none) with the friction model of spec from rest; writes the contact
- * temperature estimate, its variance and the friction estimate per sample; the loop timed in C.
+/* temperature_estimate(spec, config, T0, var0, v, load|None, F_measured, T_proxy|None, T_amb, dt, T_out, var_out,
+ * F_out) -> seconds: the estimator of estimator.h over n samples (v, F_measured, T_amb: n each; NaN in
+ * F_measured: none; load: None (NaN: none) or n values; T_proxy: None or n values, NaN: none) with the friction
+ * model of spec from rest; writes the contact temperature estimate, its variance and the friction estimate per
+ * sample; the loop timed in C.
  * config: (C_th, R_th, eta, C_2, R_2, proxy, tau_p, q_contact, q_housing, q_proxy, r_F, r_p, v_min). */
 static PyObject *py_temperature_estimate(PyObject *self, PyObject *args)
 {
-    PyObject *spec, *objs[4], *outs[3];
+    PyObject *spec, *objs[5], *outs[3];
     tf_temperature_config c;
     double T0, var0, dt;
-    if (!PyArg_ParseTuple(args, "O(dddddiddddddd)ddOOOOdOOO", &spec, &c.C_th, &c.R_th, &c.eta, &c.C_2, &c.R_2,
+    if (!PyArg_ParseTuple(args, "O(dddddiddddddd)ddOOOOOdOOO", &spec, &c.C_th, &c.R_th, &c.eta, &c.C_2, &c.R_2,
                           &c.proxy, &c.tau_p, &c.q[0], &c.q[1], &c.q[2], &c.r_F, &c.r_p, &c.v_min, &T0, &var0,
-                          &objs[0], &objs[1], &objs[2], &objs[3], &dt, &outs[0], &outs[1], &outs[2]))
+                          &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &dt, &outs[0], &outs[1], &outs[2]))
         return NULL;
-    static const char *names[4] = {"v", "F_measured", "T_proxy", "T_amb"};
+    static const char *names[5] = {"v", "load", "F_measured", "T_proxy", "T_amb"};
     arena a = {0};
     tf_model m;
     PyObject *result = NULL;
     tf_rt_friction *f = scratch(&a, sizeof *f);
     if (!f || parse_model(&a, spec, &m)) goto done;
-    const double *in[4];
+    const double *in[5];
     Py_ssize_t n = -1, len;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 5; k++) {
         in[k] = get_array(&a, objs[k], &len, names[k]);
         if (PyErr_Occurred()) goto done;
         if (k == 0) n = len;
-        if ((in[k] || k != 2) && len != n) {
+        if ((in[k] || (k != 1 && k != 3)) && len != n) {
             PyErr_Format(PyExc_ValueError, "%s: one value per sample (%zd), got %zd", names[k], n, len);
             goto done;
         }
@@ -859,7 +860,8 @@ static PyObject *py_temperature_estimate(PyObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (; i < n; i++) {
-        status = tf_temperature_step(&est, f, in[0][i], in[1][i], in[2] ? in[2][i] : NAN, in[3][i], dt, &out[2][i], &e);
+        status = tf_temperature_step(&est, f, in[0][i], in[1] ? in[1][i] : NAN, in[2][i], in[3] ? in[3][i] : NAN,
+                                     in[4][i], dt, &out[2][i], &e);
         if (status) break;
         out[0][i] = est.x[0];
         out[1][i] = est.P[0][0];

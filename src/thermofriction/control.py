@@ -196,11 +196,8 @@ def _estimator_inputs(where, comp, n, T_plant, *, ambient, start, start_variance
             T_p = None
         if T_p is None or T_p.shape != (n,) or np.any(np.isinf(T_p)):
             raise InputError(f"{where}: proxy_temperature must have one value per period ({n}), finite or NaN")
-    if load_laws(comp.model):
-        raise InputError(f"{where}: a TemperatureEstimator steps its friction model at no load: the compensation's "
-                         f"model has a law of the load ({', '.join(load_laws(comp.model))}); tell it a measured "
-                         "temperature instead")
-    _check_at(f"{where}: the estimator's start", comp.model, T0)
+    if not load_laws(comp.model):  # with one, checked at the compensation's load (_compensation_inputs)
+        _check_at(f"{where}: the estimator's start", comp.model, T0)
     return (model_spec(comp.model, T0), est.config(), T0, var0, T_amb, T_p, friction_measurement.noise(n),
             friction_measurement.filter_time), T0
 
@@ -225,6 +222,11 @@ def _compensation_inputs(where, comp, t, T_plant, T_series, L_plant, L_series, *
         T = told
     L, L_series = (L_plant, L_series) if comp.load is None else _per_period(where, f"the {name} compensation's load",
                                                                            comp.load, n)
+    if est is not None and load_laws(comp.model):
+        if L_series is None and math.isnan(L):
+            raise InputError(f"{where}: the {name} compensation's model has a law of the load "
+                             f"({', '.join(load_laws(comp.model))}) and its estimator is told no load: give load=")
+        _check_inputs(f"{where}: the estimator's start", comp.model, t, T, None, L, L_series)
     if est is None:
         _check_inputs(f"{where}: the {name} compensation's model", comp.model, t, T, series, L, L_series)
     return model_spec(comp.model, T), T, series, est, L, L_series

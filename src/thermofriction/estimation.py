@@ -22,7 +22,7 @@ from ._bridge import model_spec
 from .errors import InputError, SolverError
 from .figures.estimation_plots import estimate_figure
 from .models import Model
-from .models.load_laws import refuse_load_laws
+from .models.load_laws import load_laws
 from .results import Result, Summary
 
 #: Which node the proxy temperature lags (estimator.h: tf_proxy_kind).
@@ -158,7 +158,7 @@ class TemperatureEstimator:
                 self.q_contact, self.q_housing, self.q_proxy, self.r_F, self.r_p, self.v_min)
 
     def run(self, model: Model, velocity, *, dt: float, ambient, start: float, start_variance: float = 25.0,
-            measured_force=None, proxy_temperature=None) -> TemperatureEstimate:
+            measured_force=None, proxy_temperature=None, load=None) -> TemperatureEstimate:
         """The estimator over n samples: sample i holds ``velocity[i]`` over [i dt, (i+1) dt); its measurements
         are taken at the end, where the estimate applies. ``model``'s friction starts at rest.
 
@@ -181,6 +181,10 @@ class TemperatureEstimator:
             The measured friction force [N], one per sample, NaN where none; None: no friction measurement.
         proxy_temperature : array_like, optional
             The proxy temperature [C], one per sample, NaN where none; only with a ``proxy``.
+        load : float or array_like, optional
+            The load [N or N m] (a normal force, or a joint's load torque), one value or one per sample (held over
+            it, as the velocity), read by the model's laws of the load: required by a model with one, ignored by a
+            model without (docs/models.md#laws-of-temperature-and-load).
 
         Returns
         -------
@@ -190,15 +194,16 @@ class TemperatureEstimator:
         Raises
         ------
         InputError
-            An argument of the wrong type or value, named; the model invalid at the estimate (the step named).
+            An argument of the wrong type or value, named; no ``load`` for a model with a law of the load; the
+            model invalid at the estimate and the load (the step named).
         SolverError
             A step whose estimate or force overflows.
         """
         w = "TemperatureEstimator.run"
         model = _args.instance(model, Model, f"{w}: model", "a thermofriction Model")
-        refuse_load_laws(model, "the temperature estimator (it steps its model at no load)")
         v = _series(w, "velocity", velocity, None)
         n = v.size
+        L = _load(w, model, load, n)
         dt = _args.number(dt, f"{w}: dt", "s", positive=True)
         T_amb = np.full(n, _args.number(ambient, f"{w}: ambient", "C")) if np.ndim(ambient) == 0 else \
             _series(w, "ambient", ambient, n)
@@ -212,13 +217,27 @@ class TemperatureEstimator:
         outs = [np.empty(n) for _ in range(3)]
         try:
             seconds = _bridge.temperature_estimate(model_spec(model, T0), self.config(), T0, var0, v, F_m, T_p, T_amb,
-                                                   dt, *outs)
+                                                   dt, *outs, load=L)
         except FloatingPointError as e:
             raise SolverError(f"{w}: {e}") from None
         except ValueError as e:
             raise InputError(f"{w}: {e}") from None
         return TemperatureEstimate(dt * np.arange(1, n + 1), outs[0], outs[1], outs[2],
                                    {"seconds": seconds, "ns_per_step": 1e9 * seconds / max(n, 1)})
+
+
+def _load(where: str, model: Model, load, n: int) -> np.ndarray | None:
+    """The load per sample for a model with a law of the load (required, finite), or None (the core's NaN: a model
+    without one ignores it, so its results do not depend on ``load``)."""
+    laws = load_laws(model)
+    if not laws:
+        return None
+    if load is None:
+        raise InputError(f"{where}: the model has a law of the load ({', '.join(laws)}): give load= (a number or "
+                         f"one per sample [N or N m])")
+    if np.ndim(load) == 0:
+        return np.full(n, _args.number(load, f"{where}: load", "N or N m"))
+    return _series(where, "load", load, n)
 
 
 def _series(where: str, name: str, values, n, *, nan: bool = False) -> np.ndarray:

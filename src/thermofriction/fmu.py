@@ -272,7 +272,8 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
         Adds the online temperature estimator (docs/fmu.md#temperature-estimator): inputs
         ``measured_friction_force`` (and ``proxy_temperature`` with a proxy; ``ambient_temperature`` without a
         heat model), outputs ``temperature_estimate`` and ``temperature_variance``, its parameters as
-        ``estimator.*``; one estimator step per communication step.
+        ``estimator.*``; one estimator step per communication step (with a law of the load, at the load input the
+        friction reads).
     load : float, optional
         The start value of the load input [N, or N m for a rotary joint] of a model with a law of the load
         (docs/fmu.md#the-load-input); default the middle of its load laws' range of |load|, required without one.
@@ -288,8 +289,7 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
     InputError
         An argument of the wrong type or value, named; what an FMU cannot carry (a sampled external heat, a
         law with more points than the binary holds), named with what to do; a path that is a folder or cannot
-        be written; an unknown platform; a model with a law of the load, no load range and no ``load``, or with
-        ``estimator``.
+        be written; an unknown platform; a model with a law of the load, no load range and no ``load``.
     ComputationError
         A platform asked for that could not be built, each named with why; nothing is written.
 
@@ -303,9 +303,6 @@ def export_fmu(model, path, *, temperature: float | None = None, model_identifie
                                                            solver, step, fmi, platforms, load)
     _check_exportable(model)
     _args.instance(estimator, TemperatureEstimator, "estimator", "a TemperatureEstimator", none=True)
-    if estimator is not None and load_laws(model):
-        raise InputError(f"export_fmu: the temperature estimator steps its friction model at no load, and the model has "
-                         f"a law of the load ({', '.join(load_laws(model))}): export it without estimator=")
     identifier = _identifier(model_identifier or model.name or (Path(source).stem if source else "model"))
     if model_identifier is not None and identifier != model_identifier:
         raise InputError(f"model identifier {model_identifier!r}: letters, digits and '_' only, not starting with a "

@@ -111,8 +111,8 @@ typedef struct {
     /* The loads [N or N m] the plant's and the compensation's laws of the load read (ignored by models without
        such a law; a zeroed struct has 0): load_plant_series / load_comp_series, n values, one per period (held
        over it, as the temperatures), or, where NULL, load_plant / load_comp throughout. A compensation told a
-       constant load while the plant's varies is load-blind. The estimator's model takes no load: a law of the
-       load on est_friction is refused. */
+       constant load while the plant's varies is load-blind. The estimator steps est_friction at the
+       compensation's load. */
     double load_plant, load_comp;
     const double *load_plant_series, *load_comp_series;
 } tf_loop;

@@ -9,7 +9,7 @@
  *     tf_temperature_estimator e;
  *     tf_temperature_init(&e, &c, 25.0, 25.0, &err);          // T0 [degC], its variance [K^2]
  *     double F_hat;                                          // every control period:
- *     tf_temperature_step(&e, &f, v, F_meas, T_proxy, T_amb, dt, &F_hat, &err);   // NaN: not measured
+ *     tf_temperature_step(&e, &f, v, load, F_meas, T_proxy, T_amb, dt, &F_hat, &err);   // NaN: not measured
  *     tf_temperature_estimate(&e), tf_temperature_variance(&e)
  *
  * The heat path (C_2 = 0: one node, R_th straight to ambient; proxy optional):
@@ -21,7 +21,7 @@
  * P (n x n, n <= 3), white process noise of intensity q[i] [K^2/s] on each.
  *
  * One step (dt [s] > 0):
- *   1. the friction: f advances over dt at v and Tc^ (as tf_rt_step), F^ its force; the sensitivity
+ *   1. the friction: f advances over dt at v, Tc^ and the load (tf_rt_step), F^ its force; the sensitivity
  *      s = dz/dTc of its internal states is carried along (the forward difference of the step over
  *      Tc^ + d with z + d s, d = 1e-4 K), and h = dF^/dTc, so that a bristle model's force, which
  *      carries the temperature in its state, is not taken as independent of it;
@@ -92,14 +92,15 @@ tf_status tf_temperature_init(tf_temperature_estimator *e, const tf_temperature_
 /* Replaces the configuration at run time, keeping the state (the same nodes: C_2 > 0 and the proxy kind
  * as at init, else TF_ERR_BAD_ARGUMENT); checked as at init. */
 tf_status tf_temperature_configure(tf_temperature_estimator *e, const tf_temperature_config *c, tf_error *err);
-/* One step (see above): v [m/s], F_measured [N] (NaN: none), T_proxy [degC] (NaN: none; refused if
+/* One step (see above): v [m/s], load [N or N m] (read by f's laws of the load, as tf_rt_step: a model
+ * without one ignores it, NaN included), F_measured [N] (NaN: none), T_proxy [degC] (NaN: none; refused if
  * the configuration has no proxy), T_amb [degC], dt [s] > 0. Writes F^ [N] to *F_hat (NaN on a
  * refusal). TF_ERR_BAD_ARGUMENT: NULL e, f or F_hat, a non-finite v, T_amb or dt, dt <= 0, an
- * infinite F_measured or T_proxy, or f's model refused at the estimate (where "realtime"/"model"; a
- * model with a law of the load is refused: the estimator takes no load yet);
+ * infinite F_measured or T_proxy, or f's model refused at the estimate and the load (where "realtime"/"model": a
+ * non-finite load for a model with a law of the load, "load (not finite: ...)");
  * TF_ERR_NONFINITE: a force, state or covariance that would not be finite. */
-tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double F_measured,
-                              double T_proxy, double T_amb, double dt, double *F_hat, tf_error *err);
+tf_status tf_temperature_step(tf_temperature_estimator *e, tf_rt_friction *f, double v, double load,
+                              double F_measured, double T_proxy, double T_amb, double dt, double *F_hat, tf_error *err);
 /* The contact temperature estimate [degC] and its variance [K^2] (NaN for a NULL e). */
 double tf_temperature_estimate(const tf_temperature_estimator *e);
 double tf_temperature_variance(const tf_temperature_estimator *e);

@@ -301,34 +301,9 @@ def law_from_dict(d, where: str) -> Law:
     return LoadLaw(base, load_term_from_dict(d["load"], where))
 
 
-def refuse_load_laws(model, where: str) -> None:
-    """Refuses a model with a law of load where the load is not an input yet (``where``: the temperature
-    estimator), naming the law.
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-    where : str
-        What refuses it, for the message.
-
-    Raises
-    ------
-    InputError
-        The model holds a law of load.
-    """
-    laws = load_laws(model)
-    if laws:
-        name, law = next(iter(laws.items()))
-        raise InputError(f"[thermal] {name}: a law of the load ({law.load.kind}, {law.load.combine} with the "
-                         f"temperature law): the load is not an input of {where} yet; fit and validate the model on "
-                         f"force data, where each run carries its load")
-
-
 def load_laws(model) -> dict:
     """The model's laws of load: parameter name -> LoadLaw."""
     return {n: law for n, law in getattr(model, "laws", {}).items() if isinstance(law, LoadLaw)}
 
 
-__all__ = ["LoadTerm", "LoadLaw", "LoadRangeWarning", "load_term_from_dict", "law_from_dict", "load_laws",
-           "refuse_load_laws"]
+__all__ = ["LoadTerm", "LoadLaw", "LoadRangeWarning", "load_term_from_dict", "law_from_dict", "load_laws"]
