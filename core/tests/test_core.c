@@ -7,14 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int passed, failed;
-
-#define CHECK(cond, ...)                                                  \
-    do {                                                                  \
-        if (cond) passed++;                                               \
-        else { failed++; printf("FAIL %s:%d: ", __FILE__, __LINE__);      \
-               printf(__VA_ARGS__); printf("\n"); }                       \
-    } while (0)
+#include "check.h"
 
 /* ---- generic ODE harness: records the emitted grid ---- */
 typedef struct { long n; int dim; double *y; } record;
