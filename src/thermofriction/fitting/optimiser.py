@@ -245,6 +245,23 @@ def _least_squares(problem: Problem, transform: Transform, phi0, bounds, max_nfe
     return res
 
 
+def _given_run(first, names, transform, scale) -> list:
+    """[(result, None)]: the optimum ``first`` (names, theta, r, J) of another fit of the same ``names`` as a run of
+    this one would have ended there (``x``, ``cost``, ``known``, its residuals in ``evaluated``); [] where there is
+    none, or it fits other parameters."""
+    if first is None or list(first[0]) != list(names) or first[2] is None or first[3] is None:
+        return []
+    _, theta, r, J = first
+    theta = np.asarray(theta, float)
+    phi = transform.to_phi(theta)
+    f, G = compressed(r, J, transform, theta, scale)
+    res = optimize.OptimizeResult(x=phi, fun=f, cost=0.5 * float(f @ f), success=True, status=1, landed=False,
+                                  message="the Gauss-Newton step is below the fit's threshold (the fit it was given)",
+                                  moved=True, evaluated={phi.tobytes(): (r, J)})
+    res.known = _Known(phi, G[:-1], float(np.linalg.norm(f)) / math.sqrt(max(len(r), 1)))
+    return [(res, None)]
+
+
 def _known(cache, phi):
     """The optimum ``phi`` as a _Known, from its compressed residuals in ``cache`` (None where they are not)."""
     if phi.tobytes() not in cache or cache[phi.tobytes()][2] is None:
@@ -351,7 +368,7 @@ def _screened_starts(screen: Problem, transform: Transform, phi0, bounds, starts
 
 @one_blas_thread
 def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0, max_nfev=None,
-        tight=False, progress=None, near=False, small_step=SMALL_STEP) -> FitOutcome:
+        tight=False, progress=None, near=False, small_step=SMALL_STEP, first=None, found=None) -> FitOutcome:
     """Fits the varying parameters; returns the optimum with its residuals and Jacobian.
 
     Parameters
@@ -383,6 +400,13 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     small_step : float, default SMALL_STEP
         The fit stops where the Gauss-Newton step is below this many standard errors (at the fit's own misfit)
         (COARSE_STEP for a fit that only starts another one).
+    first : tuple, optional
+        (names, theta, r, J): the optimum of another fit of the same parameters on the same traces that started
+        from these initial values (the records' heads' fit, refined on the whole records: model_i.py), which
+        stands for the first run from them: the multi-start goes on from it, as from its own first run, and its
+        runs stop where they land on it (a first run from the initial values walked 41 evaluations to it).
+    found : list, optional
+        Where given, the fit appends its optimum to it as ``first`` takes one.
 
     Returns
     -------
@@ -437,7 +461,7 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
         return math.sqrt(2.0 * res.cost / max(residual_count, 1)) <= AT_NOISE
 
     # The initial guess first. Only if it does not reach the noise, the global phase (_screened_starts).
-    runs = [run(phi0)]
+    runs = _given_run(first, names, transform, scale) or [run(phi0)]
     screen = Problem(model, names, traces, rtol=max(rtol, COARSE_RTOL), parallel=not one_trace)
     n_candidates = 1
     if starts > 1 and not at_noise(runs[0][0]):
@@ -457,10 +481,12 @@ def fit(model: Model, params: Parameters, traces, *, rtol=1e-8, starts=8, seed=0
     # the residuals and Jacobian at the optimum, on the full data at the requested tolerance: the last
     # iteration's, if it evaluated them there
     r, J = best.evaluated.get(best.x.tobytes()) or best_problem.evaluate(theta, jac=True)
+    if found is not None:
+        found.append((list(names), theta, r, J))
     if r is None:
         raise ComputationError("the fit ended where the model cannot be simulated; try another initial guess")
-    nfev = screen.nfev + sum(p.nfev for _, p in runs)
-    njev = sum(p.njev for _, p in runs)
+    nfev = screen.nfev + sum(p.nfev for _, p in runs if p is not None)
+    njev = sum(p.njev for _, p in runs if p is not None)
     success, message = bool(best.success and best.status > 0), best.message
     if best.status == 0:
         message = f"{message} (the evaluation limit; raise it with --max-evaluations, max_evaluations=)"
