@@ -171,12 +171,16 @@ def test_too_few_conditions_fall_back_to_the_joint_fit():
 
 
 def test_options_that_do_not_apply_are_named(data):
+    """Options of other fits given to a fit with laws of the load: each refused by name, before any work."""
     with pytest.raises(tf.InputError, match="laws: a law of load keeps"):
         tf.identify(data, init=stage_start(), laws={"fc": "linear"})
     with pytest.raises(tf.InputError, match="method 'model-i'"):
         tf.identify(data, method="model-ii", init=stage_start())
     with pytest.raises(tf.InputError, match="parameters: 'delta_x' is neither a law"):
         tf.identify(data, init=stage_start(), parameters=["delta_x"])
+    # the multi-start's options are refused by name, not silently ignored (the load fit has no multi-start)
+    with pytest.raises(tf.InputError, match="starts, max_evaluations: not an option of a fit with laws of the load"):
+        tf.identify(data, init=stage_start(), starts=3, max_evaluations=50)
 
 
 def test_the_report_shows_the_laws_over_load(fit, data, tmp_path):

@@ -235,6 +235,7 @@ def identify(data, method="model-i", init=None, *, friction=None, parameters=Non
     if not experiments:
         raise InputError("the dataset has no experiment with role 'fit'")
     if load_laws(init):  # laws of temperature and load (identification/load_identify.py)
+        _no_multi_start_options(starts, seed, max_nfev)
         res = identify_with_load(experiments, init, measurement, method, parameters, laws, refine, progress)
         held = list(getattr(data, "validate", None) or [])
         return _with_generalisation(res, data, held, measurement) if held and res.fit_quality else res
@@ -288,6 +289,16 @@ def _warm_up(data, experiments, init, measurement, friction, parameters, progres
                                  parameters=parameters, **opts).model
     return identify_warm_up(experiments, start, parameters=parameters, progress=progress,
                             held_out=list(getattr(data, "validate", None) or []))
+
+
+def _no_multi_start_options(starts, seed, max_nfev):
+    """A fit with laws of the load (per-condition fits, the laws through them, a joint refinement) takes no
+    multi-start and no evaluation limit: options given for them are refused by name, not ignored."""
+    given = [n for n, v, default in (("starts", starts, 8), ("seed", seed, 0), ("max_evaluations", max_nfev, None))
+             if v != default]
+    if given:
+        raise InputError(f"{', '.join(given)}: not an option of a fit with laws of the load (per-condition fits, the "
+                         "laws through them, a joint refinement; docs/identification.md#laws-of-temperature-and-load)")
 
 
 def _ripple_checks(parameters, init, source, measurement, method):
