@@ -142,7 +142,8 @@ def test_fmu_fuzz_target_runs_10_seconds_without_a_finding(tmp_path):
     derivatives, steps from 1e-9 s to 1e300 s, FMU states, reset, terminate. A crash, sanitiser report,
     hang (10 s) or broken contract (a status other than OK, Warning, Error; fmi2Error without a logged
     message; a step answered OK that did not move the time by h or left a non-finite output; a refused
-    call that changed a variable, the time or an output; fmi2OK for the undeclared references 7-15)
+    call that changed a variable, the time or an output; fmi2OK for an undeclared reference: 13-15, 7-11 without
+    an estimator, 12 without a load input)
     fails the run. 10 s on CI (TF_FUZZ_SECONDS changes it, as for the others)."""
     run_fuzzer(tmp_path, "fuzz_fmu", CORPUS_FMU, default_seconds=10)
 

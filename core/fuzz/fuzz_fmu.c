@@ -21,7 +21,8 @@
  * - a step answered fmi2OK / fmi2Warning moved the FMU's time (fmi2LastSuccessfulTime) by exactly h and
  *   left finite outputs; a refused one moved neither the time nor any output (bit for bit);
  * - a refused fmi2SetReal or fmi2SetRealInputDerivatives changed no variable;
- * - the undeclared value references 7-15 are never read or written with fmi2OK;
+ * - the undeclared value references are never read or written with fmi2OK: 13-15 always, 7-11 without an
+ *   "estimator" line in the resources, 12 without a "load_input" line;
  * - the calls follow the standard's state machine (this target keeps its own model of the modes, moved by
  *   the calls answered OK; fmi2SetFMUstate moves none): fmi2EnterInitializationMode only when instantiated,
  *   fmi2ExitInitializationMode only in initialization mode, fmi2DoStep and fmi2Terminate only in step mode,
@@ -104,10 +105,11 @@ static void write_resources(const char *text, size_t len)
 enum { MAXV = 64 };
 static unsigned vars[MAXV];
 static int nvars, step_vr;
+static int has_estimator, has_load; /* an "estimator" line (value references 7-11), a "load_input" line (12) */
 static char guid[80];
 static void scan_resources(const char *text)
 {
-    nvars = 0, step_vr = -1, guid[0] = 0;
+    nvars = 0, step_vr = -1, guid[0] = 0, has_estimator = 0, has_load = 0;
     for (const char *line = text; line && *line; line = strchr(line, '\n'), line = line ? line + 1 : 0) {
         unsigned vr;
         char role[16];
@@ -116,13 +118,27 @@ static void scan_resources(const char *text)
             if (strcmp(role, "step") == 0) step_vr = (int)vr;
         }
         sscanf(line, "guid %79s", guid);
+        char key[32];
+        if (line[0] != '#' && sscanf(line, "%31s", key) == 1) { /* the key as fmu_common.c reads it */
+            if (strcmp(key, "estimator") == 0) has_estimator = 1;
+            if (strcmp(key, "load_input") == 0) has_load = 1;
+        }
     }
+}
+
+/* Whether a fixed value reference below 16 may be read or written with fmi2OK: 0-6 by the model, 7-11 only with
+ * the estimator, 12 only with the load input, 13-15 never (fmu_common.c's declared()). */
+static int may_be_declared(unsigned vr)
+{
+    if (vr < 7) return 1;
+    if (vr < 12) return has_estimator;
+    return vr == 12 && has_load;
 }
 
 static fmi2ValueReference pick_vr(reader *r)
 {
     uint8_t b = byte(r);
-    if (b < 96) return b % 16;                               /* inputs, outputs, the undeclared 7-15 */
+    if (b < 96) return b % 16;                               /* inputs, outputs, 7-15 (declared or not) */
     if (b < 224 && nvars) return vars[b % nvars];            /* a parameter */
     if (b < 240) return 16 + byte(r) * 9;                    /* another parameter number */
     return b & 1 ? 0xFFFFFFFFu : 2048u + byte(r);            /* beyond every table */
@@ -159,7 +175,8 @@ static void look(fmi2Component c, view *w)
         fmi2Status s = fmi2GetReal(c, &vr, 1, &w->v[k]);
         check_status(s, before);
         w->ok[k] = s == fmi2OK;
-        if (k >= 7 && k < 16 && w->ok[k]) FAIL("an undeclared value reference (7-15) read with fmi2OK");
+        if (k < 16 && w->ok[k] && !may_be_declared((unsigned)k))
+            FAIL("an undeclared value reference (7-15: no estimator, no load input, or 13-15) read with fmi2OK");
         if (!w->ok[k]) w->v[k] = NAN;
     }
 }
@@ -233,7 +250,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (s != fmi2Error && n && mode == M_TERMINATED) FAIL("fmi2SetReal answered OK once terminated");
             if (s != fmi2Error && n)
                 for (size_t k = 0; k < n; k++)
-                    if (vr[k] >= 7 && vr[k] < 16) FAIL("an undeclared value reference (7-15) set with fmi2OK");
+                    if (vr[k] < 16 && !may_be_declared(vr[k]))
+                        FAIL("an undeclared value reference (7-15: no estimator, no load input, or 13-15) set with "
+                             "fmi2OK");
             break;
         }
         case 4: {
