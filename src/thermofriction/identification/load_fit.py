@@ -132,7 +132,24 @@ def _run(model, exp, names):
     return F, np.hstack(cols)
 
 
-def _centred(r, J, sizes, offset):
+def centred(r, J, sizes, offset):
+    """Residuals and Jacobian with the offset policy's means removed.
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        The residuals of the runs, one after the other.
+    J : numpy.ndarray
+        Their Jacobian (a row per residual).
+    sizes : list of int
+        The runs' sample counts.
+    offset : {"per-experiment", "shared", "none"}
+        Each run's mean removed, the whole group's, or none.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+    """
     if offset == "none":
         return r, J
     if offset == "shared":
@@ -199,7 +216,7 @@ def fit_load_laws(model: Model, experiments, free=(), offset: str = "per-experim
                 m = _with(model, names, x)
                 out = [_run(m, e, names) for e in runs]
                 r = np.concatenate([o[0] for o in out]) - measured
-                cache[key] = _centred(r, np.vstack([o[1] for o in out]), sizes, offset)
+                cache[key] = centred(r, np.vstack([o[1] for o in out]), sizes, offset)
             except InputError:  # a step where a rule between parameters breaks (fs below fc): rejected
                 cache[key] = (np.full(measured.size, bad), np.zeros((measured.size, x.size)))
         return cache[key]

@@ -28,7 +28,7 @@ from ..fitting.uncertainty import inflation_of
 from ..measurements.force_load import run_load, stepped_force
 from ..models import Model, ModelI
 from ..models.load_laws import LoadLaw, load_laws
-from .load_fit import LoadFit, fit_load_laws
+from .load_fit import LoadFit, centred, fit_load_laws
 from .load_kinds import CHECKED, effective_aicc, form_of, law_value, ranked
 
 optimize = lazy("scipy.optimize")
@@ -67,18 +67,6 @@ def conditions(runs) -> list:
         else:
             groups.append((T, L, [e]))
     return groups
-
-
-def _centred(r, J, sizes, offset):
-    """Residuals and Jacobian with each run's mean removed ("per-experiment"), the group's ("shared"), or none."""
-    if offset == "none":
-        return r, J
-    edges = np.cumsum([0, *sizes]) if offset == "per-experiment" else np.array([0, r.size])
-    r, J = r.copy(), J.copy()
-    for a, b in zip(edges[:-1], edges[1:]):
-        r[a:b] -= r[a:b].mean()
-        J[a:b] -= J[a:b].mean(axis=0)
-    return r, J
 
 
 def _start_at(model: Model, T: float, load: float) -> Model:
@@ -126,7 +114,7 @@ def fit_condition(model: Model, T: float, load: float, runs, names, offset: str)
             out = [stepped_force(m, e, names) for e in runs]
         except InputError:  # a step where fs falls below fc, say: rejected
             return np.full(measured.size, bad), np.zeros((measured.size, x.size))
-        return _centred(np.concatenate([o[0] for o in out]) - measured, np.vstack([o[1] for o in out]), sizes, offset)
+        return centred(np.concatenate([o[0] for o in out]) - measured, np.vstack([o[1] for o in out]), sizes, offset)
     lower = np.where(x0 > 0, 0.0, -np.inf)
     res = optimize.least_squares(lambda x: evaluate(x)[0], x0, jac=lambda x: evaluate(x)[1], x_scale="jac",
                                  bounds=(lower, np.inf), method="trf", max_nfev=100)

@@ -191,8 +191,7 @@ def effective_aicc(rss: float, n: int, k: int, tau: float) -> float:
     float
     """
     n_eff = n / max(tau, 1.0)
-    aic = n_eff * math.log(max(rss, 1e-300) / n) + 2 * k
-    return aic + 2 * k * (k + 1) / (n_eff - k - 1) if n_eff - k - 1 > 0 else aic
+    return aicc(rss * n_eff / n, n_eff, k)  # n_eff log(rss / n) + the correction on n_eff
 
 
 __all__ = ["FORMS", "CHECKED", "form_of", "equation", "law_value", "candidates", "fit_through", "ranked", "effective_aicc"]
