@@ -30,14 +30,12 @@ from ..models import ModelI
 from ..models.friction import FRICTION_MODELS
 from ..fitting.parameters import get_value
 from .warm_up_fit import Layout, SoakRun, WarmProblem, failed, held_values, law_slope_name, solve
-from .warm_up_path import GRID_NODES, grid_for, spline_basis, warm_record, forces_at
+from .warm_up_path import GRID_NODES, first_bin_width, grid_for, spline_basis, warm_record, forces_at
 from .warm_up_result import warm_up_result
 
 #: the drop in AICc [-] above which a second node is kept (Burnham & Anderson's "essentially no support" for the
 #: model above it)
 SECOND_NODE_AICC = 10.0
-#: the most bins of the heat balance per record, and the widest [s]
-MAX_BINS, MAX_BIN_WIDTH = 1500, 1.0
 #: the evaluations of the short fits that decide which node a proxy follows
 SCREEN_EVALUATIONS = 8
 #: the lowest noise a block is weighted by, relative to its record's range (a noise-free record)
@@ -97,7 +95,7 @@ def setup(experiments, init, parameters=None) -> Setup:
         if e.continues is not None and e.continues not in labels[:labels.index(e.label)]:
             raise InputError(f"{e.label}: continues {e.continues!r}, which is not an earlier warm-up record")
     duration = max(e.duration for e in warm_exps)
-    width = min(MAX_BIN_WIDTH, duration / MAX_BINS)
+    width = first_bin_width(duration)
     warm = [warm_record(e, init, width) for e in warm_exps]
     soak = [SoakRun(e.label, np.asarray(e.time, float), np.asarray(e.force, float),
                     warm_record_waveform(e, init), float(e.temperature)) for e in soak_exps]

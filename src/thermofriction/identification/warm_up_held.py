@@ -15,15 +15,7 @@ import numpy as np
 
 from ..drive import drive
 from ..fitting.quality import fit_quality
-from .warm_up_path import forces_at, track, warm_record
-
-#: the widest bin of a held-out record's heat balance [s] and the most bins (as the fit's, identification/warm_up.py)
-MAX_BIN_WIDTH, MAX_BINS = 1.0, 1500
-
-
-def _bin_width(exp) -> float:
-    t = np.asarray(exp.time, float)
-    return min(MAX_BIN_WIDTH, (t[-1] - t[0]) / MAX_BINS)
+from .warm_up_path import first_bin_width, forces_at, track, warm_record
 
 
 def _start(rec, path, ends):
@@ -70,7 +62,7 @@ def score_held_out(problem, theta, held, unit: str, level: float) -> tuple:
     rows, warnings = [], []
     for exp in held:
         if getattr(exp, "warm_up", False):
-            rec = warm_record(exp, model, _bin_width(exp))
+            rec = warm_record(exp, model, first_bin_width(exp.duration))
             if rec.continues is not None and rec.continues not in ends:
                 warnings.append(f"held-out {rec.label}: continues {rec.continues!r}, which is neither a fitted nor "
                                 "an earlier held-out record; predicted from a soaked start instead")

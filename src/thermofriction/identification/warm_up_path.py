@@ -38,6 +38,24 @@ BIN_FRACTION = 0.05
 MAX_BIN = 1.0
 #: the temperature grid's nodes (the force is computed at each)
 GRID_NODES = 7
+#: the most bins of the heat balance per record, and the widest [s], before the heat path is known
+MAX_BINS, MAX_BIN_WIDTH = 1500, 1.0
+
+
+def first_bin_width(duration: float) -> float:
+    """The bins' width [s] for a record of ``duration`` [s] before the heat path is known: at most MAX_BIN_WIDTH,
+    and at most MAX_BINS bins over the record.
+
+    Parameters
+    ----------
+    duration : float
+        The record's (or the longest record's) duration [s].
+
+    Returns
+    -------
+    float
+    """
+    return min(MAX_BIN_WIDTH, duration / MAX_BINS)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -269,5 +287,6 @@ def interpolation_error(model, rec: WarmRecord, grid, basis, forces) -> float:
     return float(np.max(np.abs(W @ forces - direct)))
 
 
-__all__ = ["HeatPath", "WarmRecord", "Track", "warm_record", "bin_width_for", "forces_at", "spline_basis",
+__all__ = ["HeatPath", "WarmRecord", "Track", "warm_record", "bin_width_for", "first_bin_width", "forces_at",
+           "spline_basis",
            "weights_at", "integrate", "bin_power", "track", "grid_for", "interpolation_error", "GRID_NODES"]
