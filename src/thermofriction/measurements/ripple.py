@@ -154,15 +154,17 @@ def _harmonics_of(angle, period) -> np.ndarray:
 
 def _rotated(model, phi):
     """(alpha, beta, cos, sin): R(x + phi) = H alpha and dR/dx(x + phi) = H beta for the harmonics H at x (the
-    angle-addition formulas: harmonic k's amplitudes rotated by k w phi), and that rotation's cos and sin per k."""
+    angle-addition formulas: harmonic k's amplitudes rotated by k w phi), and that rotation's cos and sin per k;
+    for an array of phases, a row of each per phase."""
     w = 2.0 * math.pi / model.friction.ripple_period
     a = amplitudes(model)
     k = np.arange(1, RIPPLE_ORDER + 1)
-    c, s = np.cos(k * w * phi), np.sin(k * w * phi)
+    kwphi = np.multiply.outer(np.asarray(phi, float), k * w)
+    c, s = np.cos(kwphi), np.sin(kwphi)
     ak, bk = a[0::2], a[1::2]
-    alpha, beta = np.empty(a.size), np.empty(a.size)
-    alpha[0::2], alpha[1::2] = ak * c + bk * s, bk * c - ak * s
-    beta[0::2], beta[1::2] = k * w * alpha[1::2], -k * w * alpha[0::2]
+    alpha, beta = np.empty(c.shape[:-1] + a.shape), np.empty(c.shape[:-1] + a.shape)
+    alpha[..., 0::2], alpha[..., 1::2] = ak * c + bk * s, bk * c - ak * s
+    beta[..., 0::2], beta[..., 1::2] = k * w * alpha[..., 1::2], -k * w * alpha[..., 0::2]
     return alpha, beta, c, s
 
 
@@ -209,9 +211,9 @@ def _phase_cost(model, x, r0, centred: bool, H=None):
         C, e0 = C - C.mean(axis=0), e0 - e0.mean()
     G, h, c0 = C.T @ C, C.T @ e0, float(e0 @ e0)
 
-    def cost(phi):
+    def cost(phi):  # (one phase, or an array of them at once: the grid)
         alpha = _rotated(model, phi)[0]
-        return c0 + 2.0 * float(alpha @ h) + float(alpha @ G @ alpha)
+        return c0 + 2.0 * (alpha @ h) + np.einsum("...i,ij,...j->...", alpha, G, alpha)
     return cost
 
 
@@ -225,7 +227,7 @@ def best_phase(model, angle, r0, centred: bool, H=None) -> float:
     H = harmonics(angle, P) if H is None else H
     grid = P * np.arange(PHASE_GRID) / PHASE_GRID
     cost = _phase_cost(model, angle, r0, centred, H)
-    phi = float(grid[int(np.argmin([cost(p) for p in grid]))])
+    phi = float(grid[int(np.argmin(cost(grid)))])
     for _ in range(PHASE_STEPS):  # Gauss-Newton on the angle offset
         R, _, g = shifted(model, H, phi)
         e = r0 + R
