@@ -45,8 +45,8 @@ HELD_EVALUATIONS = 10
 LOG_CLIP = 1.0
 #: [in its log] where LOG_CLIP binds, the wider clip of another start tried (a factor e^4 = 55): along seed 8's
 #: profile (benchmarks/study_cost.py, free-me) sigma1's poorly determined law moved its coefficient from 12.2 to
-#: 1.2 and 187, the linearization said 0.66 and 225, and the start clipped at a factor e was 12,607 in chi-square
-#: above the optimum
+#: 1.2 and 187, the linearization said 0.66 and 225, and the starts clipped at a factor e were 12,607 and 361 in
+#: chi-square above the optimum (33 and 35 clipped at e^4)
 WIDE_LOG_CLIP = 4.0
 #: the most a flat profile widens a standard error: beyond it the parameter is as good as undetermined, and the
 #: two held fits say no more
@@ -102,7 +102,8 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
             shift = conditional_step(outcome, names, name, side * se, held_params)
             wide = conditional_step(outcome, names, name, side * se, held_params, WIDE_LOG_CLIP)
             if wide != shift:  # the clip binds: the cheapest of three starts (each one run without sensitivities)
-                shift, spent = cheapest_start(held, [shift, wide, {}], experiments, measurement, ropts.get("rtol", 1e-8))
+                shift, spent = cheapest_start(held, [shift, wide, {}], experiments, measurement,
+                                              ropts.get("rtol", 1e-8))
                 out.nfev += spent
             held, held_params, trial = _held_fit(held, shift, lambda m: parameters_of(m, others), experiments,
                                                  measurement, {**once, "max_nfev": HELD_EVALUATIONS})
