@@ -25,8 +25,9 @@ import numpy as np
 from ..errors import ComputationError, InputError
 from ..models import Model
 from .held import PRIOR_FACTOR
-from ..fitting.optimiser import fit
+from ..fitting.optimiser import COARSE_RTOL, fit
 from ..fitting.parameters import with_values
+from ..fitting.problem import Problem
 from ..measurements import make_traces
 from ..fitting.uncertainty import inflation_of, residual_variance, uncertainty
 
@@ -39,6 +40,14 @@ MIN_GAIN = 8.0
 #: the evaluations of each held fit: enough to leave a blocked optimum (its gain of 150-200 came in the first few)
 #: and to see a flat profile's rise, at a fraction of the refinement's cost
 HELD_EVALUATIONS = 10
+#: [in its log] the most the conditional step moves a positive parameter (a factor e): where the profile is
+#: quadratic the held fit starts at its own optimum, and an unlucky linearization cannot throw a start far off
+LOG_CLIP = 1.0
+#: [in its log] where LOG_CLIP binds, the wider clip of another start tried (a factor e^4 = 55): along seed 8's
+#: profile (benchmarks/study_cost.py, free-me) sigma1's poorly determined law moved its coefficient from 12.2 to
+#: 1.2 and 187, the linearization said 0.66 and 225, and the starts clipped at a factor e were 12,607 and 361 in
+#: chi-square above the optimum (33 and 35 clipped at e^4)
+WIDE_LOG_CLIP = 4.0
 #: the most a flat profile widens a standard error: beyond it the parameter is as good as undetermined, and the
 #: two held fits say no more
 MAX_WIDENING = 5.0
@@ -89,7 +98,13 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
         others = [f for f in free if f != name]
         for side in (-PROFILE_STEP, PROFILE_STEP):
             held = with_values(optimum, {name: value + side * se})
-            shift = conditional_step(outcome, names, name, side * se, parameters_of(held, others))
+            held_params = parameters_of(held, others)
+            shift = conditional_step(outcome, names, name, side * se, held_params)
+            wide = conditional_step(outcome, names, name, side * se, held_params, WIDE_LOG_CLIP)
+            if wide != shift:  # the clip binds: the cheapest of three starts (each one run without sensitivities)
+                shift, spent = cheapest_start(held, [shift, wide, {}], experiments, measurement,
+                                              ropts.get("rtol", 1e-8))
+                out.nfev += spent
             held, held_params, trial = _held_fit(held, shift, lambda m: parameters_of(m, others), experiments,
                                                  measurement, {**once, "max_nfev": HELD_EVALUATIONS})
             out.nfev, out.njev = out.nfev + trial.nfev, out.njev + trial.njev
@@ -111,13 +126,14 @@ def profiled(model: Model, params, outcome, traces, experiments, measurement, fr
     return out
 
 
-def conditional_step(outcome, names, name, step, held_params) -> dict:
+def conditional_step(outcome, names, name, step, held_params, clip=LOG_CLIP) -> dict:
     """The other fitted values where the linearization at the optimum (``outcome``: its theta and Jacobian, columns
     in ``names``) puts them with ``name`` moved by ``step``: the least-squares shift -J_o^+ J_m step, a positive
     parameter's by its log (it stays positive; the same to first order). A held fit from there starts at its own
     optimum where the profile is quadratic, and stops after one evaluation (the Gauss-Newton step below SMALL_STEP
     standard errors) instead of walking the conditional valley from the optimum in three; where the profile is not
-    quadratic it goes on from there. Only the parameters ``held_params`` fits are moved.
+    quadratic it goes on from there. Only the parameters ``held_params`` fits are moved, a positive one by at most
+    ``clip`` in its log.
 
     Parameters
     ----------
@@ -131,6 +147,8 @@ def conditional_step(outcome, names, name, step, held_params) -> dict:
         How far ``name`` is moved [its unit].
     held_params : Parameters
         The held fit's parameters (which are fitted, which are positive, their bounds).
+    clip : float, default LOG_CLIP
+        The most a positive parameter's log is moved (a factor e**clip either way).
 
     Returns
     -------
@@ -152,9 +170,54 @@ def conditional_step(outcome, names, name, step, held_params) -> dict:
         if not np.isfinite(d):
             return {}
         p = held_params[names[i]]
-        out[names[i]] = float(v * math.exp(np.clip(d / v, -1.0, 1.0))) if p.positive and v > 0 \
+        out[names[i]] = float(v * math.exp(np.clip(d / v, -clip, clip))) if p.positive and v > 0 \
             else float(np.clip(v + d, p.min, p.max))
     return out
+
+
+def cheapest_start(held, shifts, experiments, measurement, rtol) -> tuple:
+    """The shift of ``shifts`` (each {name: value} for :func:`_held_fit`; {} for ``held`` itself) whose start fits
+    the experiments best, by its residuals alone (one run of each experiment without sensitivities, at the
+    tolerance of a fit's first stage at least: the starts differ by far more than its integration error), and the
+    evaluations spent. A start that cannot be simulated is not taken; of equal ones the first; where none can be
+    simulated, the first (its held fit starts from ``held`` as before).
+
+    Parameters
+    ----------
+    held : Model
+        The optimum's model with the profiled parameter held.
+    shifts : list of dict
+        The candidate starts' values, moved from ``held``.
+    experiments : list of Experiment
+        The experiments the held fit fits.
+    measurement : Measurement or None
+        How its residuals are formed (None: the experiments' own).
+    rtol : float
+        The held fit's relative tolerance.
+
+    Returns
+    -------
+    tuple
+        (the chosen shift, the number of evaluations made).
+    """
+    traces = make_traces(experiments, held, measurement)
+    best, spent = (math.inf, shifts[0]), 0
+    for shift in shifts:
+        try:
+            start = with_values(held, shift)
+        except InputError:
+            continue
+        if start.unphysical_over_range():
+            continue
+        problem = Problem(start, [], traces, rtol=max(rtol, COARSE_RTOL), parallel=len(traces) > 1)
+        try:
+            r, _ = problem.evaluate(np.array([]))
+        except ComputationError:
+            r = None
+        spent += problem.nfev
+        if r is not None and np.all(np.isfinite(r)) and float(r @ r) < best[0]:
+            best = (float(r @ r), shift)
+    return best[1], spent
 
 
 def _held_fit(held, shift, parameters_of, experiments, measurement, opts):
@@ -376,4 +439,5 @@ def fs_kept_above_fc(now: dict, changes: dict, free) -> dict:
 __all__ = ["fs_kept_above_fc", "profiled", "Profiled", "profile_range", "PROFILE_RANGE", "PROFILE_XTOL", "PROFILE_POINTS",
            "PROFILE_FIT_EVALUATIONS", "CHI2_95", "HeldEnd", "held_refits", "secant_shifts", "standard_errors", "widened",
            "open_constants", "settled_constants", "OPEN_CONSTANT",
-           "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING", "HELD_EVALUATIONS"]
+           "PROFILE_STEP", "MIN_GAIN", "MAX_WIDENING", "HELD_EVALUATIONS", "cheapest_start",
+           "LOG_CLIP", "WIDE_LOG_CLIP"]
