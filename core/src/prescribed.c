@@ -13,7 +13,7 @@
 /* The run's state: the friction states z, their sensitivities S (NZ x np), the GMS modes, and the
  * current segment's rates z' = a + b z with their parameter derivatives da, db (NZ x np); the
  * elasto-plastic model's segment instead (prescribed_ep.h). With sensitivities, a one-state model affine in z
- * (LuGre, Dahl: affine) keeps its segment's evaluation aff and the force's partials dF/dp = dF0 + dF1 z (np). */
+ * (LuGre, Dahl: the flag affine) keeps its segment's evaluation aff and the force's partials dF/dp = dF0 + dF1 z (np). */
 typedef struct {
     int kind, nz, np, follows; /* follows: fs = fc at every temperature, so fc moves both */
     int affine, delta; /* delta: the Stribeck exponent is one of the run's parameters */
@@ -218,7 +218,8 @@ static double output(run_state *s, double x, double *dF)
     tf_friction_partials jac;
     tf_friction_param_partials dp;
     double F = tf_friction_eval(s->kind, s->p, &s->gms, s->v, s->z, dz, s->np ? &jac : 0, s->np ? &dp : 0);
-    F += ripple(s, x, s->np ? dp.dF_dp : 0); /* its amplitudes' partials added to dp's (tf_friction_ripple adds) */
+    if (s->p[TF_P_RIPPLE_PERIOD] > 0.0) /* its amplitudes' partials added to dp's (tf_friction_ripple adds) */
+        F += ripple(s, x, s->np ? dp.dF_dp : 0);
     for (int j = 0; j < s->np; j++) {
         double d = pd(s, dp.dF_dp, j);
         for (int i = 0; i < s->nz; i++) d += jac.dF_dz[i] * s->S[i][j];
