@@ -29,47 +29,64 @@ double tf_friction_reference_force(int kind, const double *p)
 /* (|v|/vs)^delta: the Gaussian Stribeck curve (delta = 2, the default) without a pow, the same number */
 static double stribeck_power(double r, double delta) { return delta == 2.0 ? r * r : pow(r, delta); }
 
-double tf_stribeck(const double *p, double v, double *dg)
+/* g(v), with dg/dv into *dg and its parameter partials into dg_p[TF_NPARAM] where not NULL: both from one
+ * exponential (tf_stribeck, tf_stribeck_param_partials, and the bristle models' evaluations that need both);
+ * the exponent delta's partial (a logarithm) only where delta is nonzero (else it stays zero). */
+static inline double stribeck_curve(const double *p, double v, double *dg, double *dg_p, int delta_partial)
 {
     double fc = p[TF_P_FC], fs = p[TF_P_FS], vs = p[TF_P_VS], delta = p[TF_P_DELTA];
-    if (fs == fc || !(vs > 0.0) || v == 0.0) {
-        if (dg) *dg = 0.0;
-        return v == 0.0 ? fs : fc;
+    if (dg) *dg = 0.0;
+    if (dg_p) {
+        memset(dg_p, 0, sizeof(double) * TF_NPARAM);
+        if (v == 0.0 || !(vs > 0.0)) dg_p[v == 0.0 ? TF_P_FS : TF_P_FC] = 1.0; /* g = fs at rest (fc without vs) */
     }
+    if (v == 0.0 || !(vs > 0.0) || (fs == fc && !dg_p)) return v == 0.0 ? fs : fc;
     double r = fabs(v / vs);
     double rd = stribeck_power(r, delta);
     double e = exp(-rd);
+    if (dg_p) {
+        dg_p[TF_P_FC] = 1.0 - e;
+        dg_p[TF_P_FS] = e;
+    }
+    if (fs == fc) return fc; /* no Stribeck effect: vs and delta do not act (their partials stay 0) */
+    if (dg_p) {
+        dg_p[TF_P_VS] = (fs - fc) * e * delta * rd / vs;
+        if (delta_partial) dg_p[TF_P_DELTA] = -(fs - fc) * e * rd * log(r);
+    }
     if (dg) *dg = -(fs - fc) * e * delta * (rd / r) * sgn(v) / vs;
     return fc + (fs - fc) * e;
 }
 
+double tf_stribeck(const double *p, double v, double *dg) { return stribeck_curve(p, v, dg, 0, 0); }
+
+void tf_stribeck_param_partials(const double *p, double v, double *dg) { stribeck_curve(p, v, 0, dg, 1); }
+
 /* LuGre (Canudas de Wit et al. 1995):
  *   z' = v - sigma0 |v| z / g(v),  F = sigma0 z + sigma1(v) z' + sigma2 v  (sigma1(v): tf_sigma1). */
-void tf_stribeck_param_partials(const double *p, double v, double *dg)
+
+/* What a bristle model's evaluation at one velocity needs, whatever the state: g(v) (dg/dv with jac), sigma1(v)
+ * and its derivatives, and with dp g's parameter partials (LuGre: lugre_velocity; the exact stepping evaluates
+ * two states at one velocity from one of these, tf_friction_affine_set). */
+typedef struct {
+    double g, dg, s1, ds1, ds1_dsigma1, ds1_dvd;
+    double dg_p[TF_NPARAM];
+} bristle_velocity;
+
+static inline void lugre_velocity(const double *p, double v, int jac, int dp, int delta, bristle_velocity *w)
 {
-    double fc = p[TF_P_FC], fs = p[TF_P_FS], vs = p[TF_P_VS], delta = p[TF_P_DELTA];
-    memset(dg, 0, sizeof(double) * TF_NPARAM);
-    if (v == 0.0 || !(vs > 0.0)) { /* g = fs at rest (and fc without a Stribeck velocity) */
-        dg[v == 0.0 ? TF_P_FS : TF_P_FC] = 1.0;
-        return;
-    }
-    double r = fabs(v / vs), rd = stribeck_power(r, delta), e = exp(-rd);
-    dg[TF_P_FC] = 1.0 - e;
-    dg[TF_P_FS] = e;
-    if (fs == fc) return; /* no Stribeck effect: vs and delta do not act (their partials stay 0) */
-    dg[TF_P_VS] = (fs - fc) * e * delta * rd / vs;
-    dg[TF_P_DELTA] = -(fs - fc) * e * rd * log(r);
+    w->dg = 0.0;
+    w->g = stribeck_curve(p, v, jac ? &w->dg : 0, dp ? w->dg_p : 0, delta);
+    w->ds1_dsigma1 = 0.0, w->ds1_dvd = 0.0;
+    w->s1 = tf_sigma1(p, v, &w->ds1, dp ? &w->ds1_dsigma1 : 0, dp ? &w->ds1_dvd : 0);
 }
 
-static double lugre(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac,
-                    tf_friction_param_partials *dp)
+/* LuGre at state z, from its velocity's pieces w (lugre_velocity with jac and dp as here). */
+static inline double lugre_state(const double *p, double v, const bristle_velocity *w, const double *z, double *dz,
+                          tf_friction_partials *jac, tf_friction_param_partials *dp)
 {
     double s0 = p[TF_P_SIGMA0], s2 = p[TF_P_SIGMA2];
-    double dg;
-    double g = tf_stribeck(p, v, jac ? &dg : 0);
+    double g = w->g, dg = w->dg, s1 = w->s1;
     double r = s0 * fabs(v) / g; /* relaxation rate of z */
-    double ds1, ds1_dsigma1 = 0.0, ds1_dvd = 0.0;
-    double s1 = tf_sigma1(p, v, &ds1, dp ? &ds1_dsigma1 : 0, dp ? &ds1_dvd : 0);
     double zd, F = tf_lugre_value(p, v, z[0], g, s1, &zd);
     dz[0] = zd;
     if (jac) {
@@ -77,21 +94,27 @@ static double lugre(const double *p, double v, const double *z, double *dz, tf_f
         jac->ddz_dz[0] = -r;
         jac->ddz_dv[0] = 1.0 - z[0] * dr;
         jac->dF_dz[0] = s0 + s1 * jac->ddz_dz[0];
-        jac->dF_dv = ds1 * zd + s1 * jac->ddz_dv[0] + s2;
+        jac->dF_dv = w->ds1 * zd + s1 * jac->ddz_dv[0] + s2;
     }
     if (dp) {
-        double dg[TF_NPARAM];
-        tf_stribeck_param_partials(p, v, dg);
         double dzd_dg = s0 * fabs(v) * z[0] / (g * g); /* z' = v - sigma0 |v| z / g */
-        for (int i = 0; i < TF_NPARAM; i++) dp->ddz_dp[0][i] = dzd_dg * dg[i];
+        for (int i = 0; i < TF_NPARAM; i++) dp->ddz_dp[0][i] = dzd_dg * w->dg_p[i];
         dp->ddz_dp[0][TF_P_SIGMA0] = -fabs(v) * z[0] / g;
         for (int i = 0; i < TF_NPARAM; i++) dp->dF_dp[i] = s1 * dp->ddz_dp[0][i];
         dp->dF_dp[TF_P_SIGMA0] += z[0];
-        dp->dF_dp[TF_P_SIGMA1] = ds1_dsigma1 * zd;
+        dp->dF_dp[TF_P_SIGMA1] = w->ds1_dsigma1 * zd;
         dp->dF_dp[TF_P_SIGMA2] = v;
-        dp->dF_dp[TF_P_VD] = ds1_dvd * zd;
+        dp->dF_dp[TF_P_VD] = w->ds1_dvd * zd;
     }
     return F;
+}
+
+static double lugre(const double *p, double v, const double *z, double *dz, tf_friction_partials *jac,
+                    tf_friction_param_partials *dp)
+{
+    bristle_velocity w;
+    lugre_velocity(p, v, jac != 0, dp != 0, 1, &w);
+    return lugre_state(p, v, &w, z, dz, jac, dp);
 }
 
 /* Static maps: F = G(v) s(v) + sigma2 v with the sign smoothed over v_smooth, s = tanh(v / v_smooth),
@@ -294,6 +317,55 @@ double tf_friction_eval(int kind, const double *p, const tf_gms_elements *el, do
         for (int j = 0; j < nz; j++) to_negative_side(p, dp->ddz_dp[j]);
     }
     return F;
+}
+
+/* ---- the one-state models at one velocity, for the exact stepping of a prescribed motion ---- */
+
+int tf_friction_affine_in_z(int kind) { return kind == TF_FRICTION_LUGRE || kind == TF_FRICTION_DAHL; }
+
+void tf_friction_affine_set(int kind, const double *p, double v, int delta, tf_friction_affine *a)
+{
+    static const double zero = 0.0, one = 1.0;
+    double dz0, dz1;
+    tf_friction_partials jac;
+    tf_friction_param_partials d0, d1;
+    a->kind = kind;
+    a->v = v;
+    a->negative = v < 0.0 && tf_friction_asymmetric(p);
+    const double *q = a->negative ? tf_friction_side(p, v, a->q) : p;
+    if (kind == TF_FRICTION_LUGRE) { /* g, sigma1 and g's partials once for both states */
+        bristle_velocity w;
+        lugre_velocity(q, v, 1, 1, delta, &w);
+        lugre_state(q, v, &w, &zero, &dz0, &jac, &d0);
+        lugre_state(q, v, &w, &one, &dz1, 0, &d1);
+        a->g = w.g, a->s1 = w.s1;
+    } else {
+        tf_friction_eval_side(kind, q, 0, v, &zero, &dz0, &jac, &d0);
+        tf_friction_eval_side(kind, q, 0, v, &one, &dz1, 0, &d1);
+    }
+    a->a = dz0;
+    a->b = jac.ddz_dz[0];
+    a->dF_dz = jac.dF_dz[0];
+    for (int i = 0; i < TF_NPARAM; i++) {
+        a->da[i] = d0.ddz_dp[0][i];
+        a->db[i] = d1.ddz_dp[0][i] - a->da[i];
+        a->dF0[i] = d0.dF_dp[i];
+        a->dF1[i] = d1.dF_dp[i] - a->dF0[i];
+    }
+    if (a->negative) { /* the move is linear: on the slopes as on the values */
+        to_negative_side(p, a->da);
+        to_negative_side(p, a->db);
+        to_negative_side(p, a->dF0);
+        to_negative_side(p, a->dF1);
+    }
+}
+
+double tf_friction_affine_force(const tf_friction_affine *a, const double *p, double z)
+{
+    const double *q = a->negative ? a->q : p;
+    double zd;
+    if (a->kind == TF_FRICTION_LUGRE) return tf_lugre_value(q, a->v, z, a->g, a->s1, &zd);
+    return tf_friction_eval_side(a->kind, q, 0, a->v, &z, &zd, 0, 0);
 }
 
 double tf_friction_ripple(const double *p, double x, double *dR_dx, double *dR_dp)

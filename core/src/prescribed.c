@@ -2,6 +2,7 @@
  * elasto-plastic bristle by prescribed_ep.c. */
 #include "thermofriction/prescribed.h"
 #include "thermofriction/thermal.h"
+#include "friction_private.h"
 #include "prescribed_ep.h"
 
 #include <math.h>
@@ -11,9 +12,13 @@
 
 /* The run's state: the friction states z, their sensitivities S (NZ x np), the GMS modes, and the
  * current segment's rates z' = a + b z with their parameter derivatives da, db (NZ x np); the
- * elasto-plastic model's segment instead (prescribed_ep.h). */
+ * elasto-plastic model's segment instead (prescribed_ep.h). With sensitivities, a one-state model affine in z
+ * (LuGre, Dahl: the flag affine) keeps its segment's evaluation aff and the force's partials dF/dp = dF0 + dF1 z (np). */
 typedef struct {
     int kind, nz, np, follows; /* follows: fs = fc at every temperature, so fc moves both */
+    int affine, delta; /* delta: the Stribeck exponent is one of the run's parameters */
+    tf_friction_affine aff;
+    double dF0[TF_NPARAM], dF1[TF_NPARAM];
     const int *params;
     double p[TF_NPARAM];
     tf_gms_elements gms;
@@ -50,6 +55,22 @@ static void ep_coefficients(run_state *s)
     }
 }
 
+/* A model affine in z: the segment's coefficients and the force's partials in the run's parameters, from one
+ * evaluation at the velocity (tf_friction_affine_set), not one per sample. */
+static void affine_coefficients(run_state *s)
+{
+    const tf_friction_affine *a = &s->aff;
+    tf_friction_affine_set(s->kind, s->p, s->v, s->delta, &s->aff);
+    s->a[0] = a->a;
+    s->b[0] = a->b;
+    for (int j = 0; j < s->np; j++) {
+        s->da[0][j] = pd(s, a->da, j);
+        s->db[0][j] = pd(s, a->db, j);
+        s->dF0[j] = pd(s, a->dF0, j);
+        s->dF1[j] = pd(s, a->dF1, j);
+    }
+}
+
 /* The rates' coefficients at the current velocity and modes, from the friction model's own evaluation
  * at z = 0 (a, da, and b = dz'/dz) and at z = 1 (db = the parameter derivative's slope in z). */
 static void coefficients(run_state *s)
@@ -61,6 +82,10 @@ static void coefficients(run_state *s)
     if (s->nz == 0) return;
     if (s->kind == TF_FRICTION_ELASTOPLASTIC) {
         ep_coefficients(s);
+        return;
+    }
+    if (s->affine) {
+        affine_coefficients(s);
         return;
     }
     tf_friction_eval(s->kind, s->p, &s->gms, s->v, zero, dz, &jac, s->np ? &dp0 : 0);
@@ -163,16 +188,38 @@ static void within_segment(run_state *s, double t, double t1)
     advance(s, t1 - t);
 }
 
+/* The position ripple at the prescribed position x, added to the friction as the plant adds it (plant.c:
+ * friction_at; it has no state); its amplitudes' partials added into dp[TF_NPARAM] when not NULL. */
+static double ripple(const run_state *s, double x, double *dp)
+{
+    return s->p[TF_P_RIPPLE_PERIOD] > 0.0 ? tf_friction_ripple(s->p, x, 0, dp) : 0.0;
+}
+
+/* output() for a model affine in z: the force and its partials at the state from the segment's evaluation
+ * (the force the same number as tf_friction_eval's, so as the run's without sensitivities). */
+static double affine_output(run_state *s, double x, double *dF)
+{
+    double z = s->z[0], F = tf_friction_affine_force(&s->aff, s->p, z);
+    for (int j = 0; j < s->np; j++) dF[j] = s->dF0[j] + z * s->dF1[j] + s->aff.dF_dz * s->S[0][j];
+    if (s->p[TF_P_RIPPLE_PERIOD] > 0.0) {
+        double dR[TF_NPARAM] = {0.0};
+        F += ripple(s, x, dR);
+        for (int j = 0; j < s->np; j++) dF[j] += pd(s, dR, j);
+    }
+    return F;
+}
+
 /* The force and its parameter derivatives at the current state (dF: np values), with the position ripple at
- * the prescribed position x, added to the friction as the plant adds it (plant.c: friction_at; it has no state). */
+ * the prescribed position x. */
 static double output(run_state *s, double x, double *dF)
 {
+    if (s->affine) return affine_output(s, x, dF);
     double dz[NZ];
     tf_friction_partials jac;
     tf_friction_param_partials dp;
     double F = tf_friction_eval(s->kind, s->p, &s->gms, s->v, s->z, dz, s->np ? &jac : 0, s->np ? &dp : 0);
     if (s->p[TF_P_RIPPLE_PERIOD] > 0.0) /* its amplitudes' partials added to dp's (tf_friction_ripple adds) */
-        F += tf_friction_ripple(s->p, x, 0, s->np ? dp.dF_dp : 0);
+        F += ripple(s, x, s->np ? dp.dF_dp : 0);
     for (int j = 0; j < s->np; j++) {
         double d = pd(s, dp.dF_dp, j);
         for (int i = 0; i < s->nz; i++) d += jac.dF_dz[i] * s->S[i][j];
@@ -198,9 +245,12 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
                             "temperature and load with a sampled position)", NAN, -1);
     if (n_out < 1 || !t_out || !F || np < 0 || np > TF_NPARAM || (np > 0 && (!params || !dF)))
         return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "arguments", NAN, -1);
-    for (int j = 0; j < np; j++)
+    int delta = 0;
+    for (int j = 0; j < np; j++) {
         if (params[j] < 0 || params[j] >= TF_NPARAM)
             return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "params (not a tf_param index)", NAN, j);
+        delta |= params[j] == TF_P_DELTA;
+    }
     for (long i = 0; i < n_out; i++)
         if (!isfinite(t_out[i]) || (i > 0 && t_out[i] < t_out[i - 1]))
             return tf_error_set(err, TF_ERR_BAD_ARGUMENT, "prescribed", "t_out (not finite or decreasing)", NAN, i);
@@ -208,6 +258,8 @@ tf_status tf_prescribed_force(const tf_model *m, long n_out, const double *t_out
     s->kind = m->friction;
     s->nz = tf_friction_nstate(m->friction, m->gms.n);
     s->np = np;
+    s->affine = np > 0 && tf_friction_affine_in_z(m->friction);
+    s->delta = delta;
     s->params = params;
     s->follows = m->fs_follows_fc;
     s->gms = m->gms;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "../src/friction_private.h" /* tf_friction_affine_set: the exact stepping's, tested here */
 
 /* ---- generic ODE harness: records the emitted grid ---- */
 typedef struct { long n; int dim; double *y; } record;
@@ -1077,6 +1078,63 @@ static void test_observer_pid_and_loop_refuse_bad_arguments(void)
  * of tf_friction_eval itself, at states and velocities that visit each branch: both signs of v,
  * the elasto-plastic transition band (alpha between 0 and 1) and full sliding, GMS elements stuck
  * and slipping either way, velocities inside and beyond the Stribeck band. */
+static void test_friction_affine_equals_the_evaluation(void)
+{
+    /* tf_friction_affine_set (the exact stepping's one evaluation per velocity of LuGre and Dahl) against
+     * tf_friction_eval at each state: the rate's coefficients and the force the same numbers, the partials
+     * da + db z and dF0 + dF1 z equal to the evaluation's within 1e-13 of each entry's scale, on both sides of
+     * direction-dependent parameters (fs_neg following fc_neg too), with and without a Stribeck effect, at rest;
+     * the Stribeck exponent's partials zero when not wanted, every other entry unchanged. */
+    enum { NSETS = 4 };
+    double sets[NSETS][TF_NPARAM] = {{0}};
+    for (int k = 0; k < NSETS; k++) {
+        double *p = sets[k];
+        p[TF_P_SIGMA0] = 3000.0; p[TF_P_SIGMA1] = 0.3; p[TF_P_SIGMA2] = 0.35; p[TF_P_FC] = 0.9; p[TF_P_FS] = 1.4;
+        p[TF_P_VS] = 0.3; p[TF_P_DELTA] = k == 1 ? 1.6 : 2.0; p[TF_P_VD] = k == 0 ? 0.2 : 0.0;
+    }
+    sets[1][TF_P_FC_NEG] = 0.7, sets[1][TF_P_FS_NEG] = 1.1, sets[1][TF_P_VS_NEG] = 0.2, sets[1][TF_P_SIGMA2_NEG] = 0.3;
+    sets[2][TF_P_FS] = sets[2][TF_P_FC], sets[2][TF_P_FC_NEG] = 0.75; /* no Stribeck effect; fs_neg follows fc_neg */
+    sets[3][TF_P_VS] = 0.0, sets[3][TF_P_FC_NEG] = 0.8;                /* no Stribeck velocity */
+    const int kinds[2] = {TF_FRICTION_LUGRE, TF_FRICTION_DAHL};
+    const double vs[] = {-1.7, -0.25, -1e-3, 0.0, 2e-4, 0.3, 4.0}, zs[] = {-3e-4, 0.0, 1.2e-4, 5e-4};
+    double worst = 0.0;
+    int same = 1, delta_ok = 1, count = 0;
+    for (int m = 0; m < 2; m++)
+        for (int k = 0; k < NSETS; k++)
+            for (size_t a = 0; a < sizeof vs / sizeof vs[0]; a++) {
+                const double *p = sets[k], v = vs[a];
+                tf_friction_affine af, nodelta;
+                tf_friction_affine_set(kinds[m], p, v, 1, &af);
+                tf_friction_affine_set(kinds[m], p, v, 0, &nodelta);
+                for (int i = 0; i < TF_NPARAM; i++) {
+                    int d = i == TF_P_DELTA;
+                    delta_ok &= d ? nodelta.da[i] == 0.0 && nodelta.db[i] == 0.0 && nodelta.dF0[i] == 0.0 &&
+                                        nodelta.dF1[i] == 0.0
+                                  : nodelta.da[i] == af.da[i] && nodelta.db[i] == af.db[i] &&
+                                        nodelta.dF0[i] == af.dF0[i] && nodelta.dF1[i] == af.dF1[i];
+                }
+                for (size_t b = 0; b < sizeof zs / sizeof zs[0]; b++) {
+                    double z = zs[b], dz, dz0;
+                    tf_friction_partials jac;
+                    tf_friction_param_partials dp;
+                    double F = tf_friction_eval(kinds[m], p, 0, v, &z, &dz, &jac, &dp);
+                    tf_friction_eval(kinds[m], p, 0, v, &zs[1], &dz0, 0, 0);
+                    same &= tf_friction_affine_force(&af, p, z) == F && af.a == dz0 && af.b == jac.ddz_dz[0] &&
+                            af.dF_dz == jac.dF_dz[0];
+                    for (int i = 0; i < TF_NPARAM; i++) {
+                        double r = af.da[i] + af.db[i] * z, f = af.dF0[i] + af.dF1[i] * z;
+                        double sr = fabs(af.da[i]) + fabs(af.db[i] * z) + 1e-300;
+                        double sf = fabs(af.dF0[i]) + fabs(af.dF1[i] * z) + 1e-300;
+                        worst = fmax(worst, fmax(fabs(r - dp.ddz_dp[0][i]) / sr, fabs(f - dp.dF_dp[i]) / sf));
+                        count += dp.dF_dp[i] != 0.0;
+                    }
+                }
+            }
+    CHECK(same && delta_ok && worst < 1e-13 && count > 500,
+          "tf_friction_affine_set: coefficients and force the evaluation's (%d), delta's partials only when wanted "
+          "(%d), partials' worst relative difference %g (%d nonzero)", same, delta_ok, worst, count);
+}
+
 static void test_friction_parameter_partials_vs_finite_differences(void)
 {
     const int kinds[6] = {TF_FRICTION_LUGRE, TF_FRICTION_COULOMB, TF_FRICTION_STRIBECK, TF_FRICTION_DAHL,
@@ -1189,6 +1247,7 @@ int main(void)
     test_lu_solves_systems_that_need_pivoting_in_later_columns();
     test_parameter_derivatives_vs_finite_differences();
     test_friction_parameter_partials_vs_finite_differences();
+    test_friction_affine_equals_the_evaluation();
     test_grid_end_one_ulp_past_a_corner();
     test_oscillator_dense_output(TF_METHOD_DOPRI5);
     test_oscillator_dense_output(TF_METHOD_RODAS4);
