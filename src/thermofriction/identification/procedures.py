@@ -261,7 +261,8 @@ def fit_friction(experiments, model: Model, parameters=None, *, method="base", m
 def stribeck_in_range(experiments, model: Model, params: Parameters, traces, outcome, opts) -> tuple:
     """(params, outcome, notes): a fit whose Stribeck velocity ended above every speed of its runs (the
     measurement's ``stribeck_speeds``: force data's) fitted again, by ``opts`` with one start, from its optimum
-    with vs inside the runs' speeds; the better optimum by cost kept, and a note where it is the second. Above
+    with vs inside the runs' speeds; the better optimum by cost kept, and a note where it is the second (its
+    starts then counting the first fit's too). Above
     them g(v) stays above fc + (fs - fc)/e on every sample: the fall towards fc is never seen, fc and vs are not
     determined, and a fit from a rough start stayed there (a joint's vs at 5.7 rad/s on runs of at most 1.5 rad/s,
     its cost 37 % above the one from the truth's values, where the fit from vs = 0.13 rad/s lands in 6
@@ -286,10 +287,10 @@ def stribeck_in_range(experiments, model: Model, params: Parameters, traces, out
     first_cost, cost = float(outcome.r @ outcome.r), float(second.r @ second.r)
     if not cost < first_cost:
         return params, outcome, []
-    return again, second, [
+    return again, dataclasses.replace(second, starts=outcome.starts + second.starts), [
         f"vs ended at {vs:.3g} {unit}, above every speed of the fit runs (at most {largest:.3g} {unit}), where fc "
-        f"and vs are not determined (cost {first_cost:.4g}); the fit again from vs = {start:.3g} {unit}, a tenth of "
-        f"the runs' moving speed, ended lower (cost {cost:.4g}) and is the one kept"]
+        f"and vs are not determined (cost {first_cost:.4g}); the fit again from vs = {start:.3g} {unit}, inside "
+        f"them, ended lower (cost {cost:.4g}) and is the one kept"]
 
 
 def _unsupported_excess(params: Parameters, corr, unit) -> list:
