@@ -41,7 +41,7 @@ from .base import FD_RTOL, FD_STEP, OFFSETS, Measurement, Trace, center, center_
 from .force_finish import force_finish
 from .force_load import stepped_force
 from ..models.load_laws import load_laws
-from .force_start import force_initial, screen_starts, start_section
+from .force_start import force_initial, screen_starts, start_section, stribeck_speeds
 
 #: What to check when a fit to force data is not adequate, where it applies (Force.checks)
 UNITS_CHECK = "check the units in the files' headers"
@@ -113,6 +113,14 @@ class Force(Measurement):
     def unit(self, experiments=()) -> str:
         exps = list(getattr(experiments, "experiments", experiments))
         return "N m" if exps and exps[0].rotary else "N"
+
+    def stribeck_speeds(self, experiments) -> tuple:
+        """(largest, start, unit): the largest speed of the runs' driving motion, above which a fitted Stribeck
+        velocity leaves fc and vs undetermined, a Stribeck velocity inside their speeds to start from
+        (measurements/force_start.py: stribeck_speeds), and the speeds' unit (what identification/procedures.py
+        fit_friction asks where a fit's vs ends above the data's speeds)."""
+        largest, start = stribeck_speeds(experiments)
+        return largest, start, "rad/s" if self.unit(experiments) == "N m" else "m/s"
 
     def initial_model(self, init, method, data, experiments, *, parameters=(), **options):
         """A prescribed-motion model of the data's kind, with starting values read off the data where ``init``
