@@ -9,6 +9,7 @@ Problem.evaluate written here."""
 
 import math
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
@@ -31,14 +32,9 @@ def test_the_clip_bounds_the_log_step_and_the_wide_clip_leaves_the_exact_one():
     minimum's log step (numpy's lstsq of the reduced problem); a free-signed parameter by the exact shift in both."""
     rng = np.random.default_rng(11)
     J = rng.normal(size=(300, 3))
-    J[:, 2] += 0.9 * J[:, 0]
+    J[:, 2] += 0.9 * J[:, 0]  # correlated with the held one
     theta = np.array([1.0, -2.0, 0.5])
-
-    class Outcome:
-        pass
-
-    outcome = Outcome()
-    outcome.theta, outcome.J = theta, J
+    outcome = types.SimpleNamespace(theta=theta, J=J)  # what conditional_step reads of a fit's outcome
     params = Parameters()
     params.add("b", -2.0)
     params.add("c", 0.5, min=0.0)
