@@ -38,12 +38,12 @@ BIN_FRACTION = 0.05
 MAX_BIN = 1.0
 #: the temperature grid's nodes (the force is computed at each)
 GRID_NODES = 7
-#: the most bins of the heat balance per record, and the widest [s], before the heat path is known
-MAX_BINS, MAX_BIN_WIDTH = 1500, 1.0
+#: the most bins of the heat balance per record before the heat path is known (each at most MAX_BIN wide)
+MAX_BINS = 1500
 
 
 def first_bin_width(duration: float) -> float:
-    """The bins' width [s] for a record of ``duration`` [s] before the heat path is known: at most MAX_BIN_WIDTH,
+    """The bins' width [s] for a record of ``duration`` [s] before the heat path is known: at most MAX_BIN,
     and at most MAX_BINS bins over the record.
 
     Parameters
@@ -55,7 +55,7 @@ def first_bin_width(duration: float) -> float:
     -------
     float
     """
-    return min(MAX_BIN_WIDTH, duration / MAX_BINS)
+    return min(MAX_BIN, duration / MAX_BINS)
 
 
 @dataclasses.dataclass(frozen=True)
