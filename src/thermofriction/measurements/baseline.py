@@ -20,6 +20,11 @@ import math
 
 import numpy as np
 
+from .._lazy import lazy
+
+# SciPy on first use: not at the package's import
+interpolate, linalg, sparse = lazy("scipy.interpolate"), lazy("scipy.linalg"), lazy("scipy.sparse")
+
 #: interior knots of each speed spline and of the position spline
 KNOTS = 8
 #: the most a model's held-out RMSE may exceed the baseline's and the fit be called adequate relative to it. The map
@@ -33,11 +38,10 @@ BASELINE_FACTOR = 1.5
 def _basis(u, lo, hi, knots):
     """A cubic B-spline design matrix of ``u`` (clipped to [lo, hi]) with ``knots`` interior knots at ``u``'s
     quantiles (given as the array ``knots``), sparse (CSR: four entries a row)."""
-    from scipy.interpolate import BSpline  # SciPy on first use: not at the package's import
     t = np.concatenate([[lo] * 4, knots, [hi] * 4])
     # extrapolate=True only skips SciPy's range check (Python's min and max over the array: most of the time here);
     # u is clipped to the knots' range, so nothing is extrapolated
-    return BSpline.design_matrix(np.clip(u, lo, hi), t, 3, extrapolate=True)
+    return interpolate.BSpline.design_matrix(np.clip(u, lo, hi), t, 3, extrapolate=True)
 
 
 class _Axis:
@@ -52,7 +56,6 @@ class _Axis:
 
     def columns(self, u, mask=None):
         """The spline's columns at ``u`` (sparse; rows outside ``mask`` zero)."""
-        from scipy import sparse
         if not self.ok:
             return sparse.csr_matrix((np.size(u), 0))
         B = _basis(np.asarray(u, float), self.lo, self.hi, self.knots)
@@ -92,7 +95,6 @@ def _columns(axes, v, x, a):
     """The map's columns (without offsets, sparse) at velocity ``v``, position ``x`` and acceleration ``a`` (None: no
     inertia column): per direction a spline in the speed and one in the distance since the last reversal, a
     spline in the position."""
-    from scipy import sparse
     pos, neg = v > 0, v < 0
     d = since_reversal(v, x)
     cols = [axes["v+"].columns(v, pos), axes["v-"].columns(-v, neg), axes["d"].columns(d, pos),
@@ -104,7 +106,6 @@ def _columns(axes, v, x, a):
 
 def _design(axes, runs, own, inertia):
     """The fit runs' design (sparse): the map's columns and the offsets, each run's own (``own``) or one shared."""
-    from scipy import sparse
     blocks = []
     for k, (vr, xr, _, ar) in enumerate(runs):
         X = _columns(axes, np.asarray(vr, float), np.asarray(xr, float), ar if inertia else None)
@@ -123,18 +124,17 @@ def _least_squares(X, F):
     coefficients zero; then one step of iterative refinement on the residuals (what the squared condition number
     costs in accuracy, given back). The fitted values, and so both RMSEs, equal numpy's SVD ``lstsq`` of the dense
     design's to 1e-9 of the noise (tests/test_cost_paths5.py)."""
-    from scipy.linalg import cho_solve, lapack
     XT = X.T.tocsr()
     G = (XT @ X).toarray()
     scale = np.sqrt(np.diag(G))
     scale[scale == 0] = 1.0
-    L, piv, rank, _ = lapack.dpstrf(G / np.outer(scale, scale), lower=1, tol=np.finfo(float).eps * max(X.shape))
+    L, piv, rank, _ = linalg.lapack.dpstrf(G / np.outer(scale, scale), lower=1, tol=np.finfo(float).eps * max(X.shape))
     kept = piv[:rank] - 1  # (LAPACK's pivots count from 1)
     factor = (np.tril(L[:rank, :rank]), True)
 
     def solve(rhs):
         c = np.zeros(X.shape[1])
-        c[kept] = cho_solve(factor, ((XT @ rhs) / scale)[kept])
+        c[kept] = linalg.cho_solve(factor, ((XT @ rhs) / scale)[kept])
         return c / scale
 
     c = solve(F)
