@@ -364,15 +364,22 @@ def validate(model: Model, data, experiments=None, *, offset=None, motion=None,
     UnitWarning
         A record a power of 1000 off the model's prediction.
     """
+    exps = _checked(model, data, experiments, "experiments", motion)
+    return _scored(model, exps, offset, motion, ripple_phase)
+
+
+def _checked(model, data, experiments, name, motion=None, none=True) -> list:
+    """The experiments scored (``experiments``, named ``name``, where given, and required unless ``none``; else
+    ``data``'s), the arguments checked as :func:`validate` and :func:`heldout_score` take them."""
     _args.model(model, Model)
     _args.dataset(data, Dataset, experiments=True)
-    _args.dataset(experiments, Dataset, "experiments", experiments=True, none=True)
+    _args.dataset(experiments, Dataset, name, experiments=True, none=none)
     if motion is not None:
         check_motion_option(motion, "motion")
     exps = list(experiments if experiments is not None else getattr(data, "experiments", data))
     if not exps:
         raise InputError("the dataset has no experiments")
-    return _scored(model, exps, offset, motion, ripple_phase)
+    return exps
 
 
 def _scored(model, exps, offset, motion, ripple_phase, fast=False) -> ValidationResult:
@@ -432,13 +439,9 @@ def heldout_score(model: Model, data, runs, measurement):
     ThermofrictionError
         As :func:`validate`.
     """
-    _args.model(model, Model)
-    _args.dataset(data, Dataset, experiments=True)
-    _args.dataset(runs, Dataset, "runs", experiments=True)
-    if not runs:
-        raise InputError("the dataset has no experiments")
+    exps = _checked(model, data, runs, "runs", none=False)
     with collecting():  # force data by the exact stepping, as the fit evaluated them (_scored)
-        v = _scored(model, list(runs), measurement.offset if measurement.offset != "shared" else None, None,
+        v = _scored(model, exps, measurement.offset if measurement.offset != "shared" else None, None,
                     getattr(measurement, "ripple_phase", "auto"), fast=True)
     rms = float(np.sqrt(np.mean([p.rmse ** 2 for p in v.predictions]))) if v.predictions else float("nan")
     return rms, v
