@@ -31,7 +31,7 @@ static double stribeck_power(double r, double delta) { return delta == 2.0 ? r *
 
 /* g(v), with dg/dv into *dg and its parameter partials into dg_p[TF_NPARAM] where not NULL: both from one
  * exponential (tf_stribeck, tf_stribeck_param_partials, and the bristle models' evaluations that need both);
- * the exponent delta's partial (a logarithm) only where delta is nonzero (else it stays zero). */
+ * the exponent delta's partial (a logarithm) only with delta_partial (else it stays zero). */
 static inline double stribeck_curve(const double *p, double v, double *dg, double *dg_p, int delta_partial)
 {
     double fc = p[TF_P_FC], fs = p[TF_P_FS], vs = p[TF_P_VS], delta = p[TF_P_DELTA];
